@@ -1,0 +1,1 @@
+//! Offline precompute: environment maps to SRBF lights, and the convolution tables.

@@ -1,0 +1,1 @@
+//! The wgpu runtime: hair input, render passes, and the brute-force reference renderer.
