@@ -18,6 +18,7 @@ pub mod longitudinal;
 pub mod marschner;
 pub mod quadrature;
 pub mod scattering;
+pub mod shared_data;
 pub mod slices;
 pub mod special;
 pub mod srbf;
