@@ -18,7 +18,7 @@
 //! wrong on load is its own [`AssetError`] variant naming the file.
 
 use crate::atomic_write::write_atomically;
-use crate::table::{checked_value_count, Axis, Table, TableError};
+use crate::table::{Axis, Table, TableError, checked_value_count};
 use half::f16;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -44,25 +44,56 @@ pub enum AssetError {
     #[error("{}: not a strandlight table asset (magic bytes \"{found}\", expected \"{}\")", .path.display(), String::from_utf8_lossy(&MAGIC))]
     BadMagic { path: PathBuf, found: String },
     #[error("{}: table format version {found} is not supported (this build reads version {supported}); re-bake the table", .path.display())]
-    UnsupportedVersion { path: PathBuf, found: u32, supported: u32 },
+    UnsupportedVersion {
+        path: PathBuf,
+        found: u32,
+        supported: u32,
+    },
     #[error("{}: file is truncated in the {section}: needs {needed} bytes, has {available}", .path.display())]
-    Truncated { path: PathBuf, section: &'static str, needed: u64, available: u64 },
+    Truncated {
+        path: PathBuf,
+        section: &'static str,
+        needed: u64,
+        available: u64,
+    },
     #[error("{}: metadata length {bytes} exceeds {max} bytes (corrupt header)", .path.display())]
     MetadataTooLarge { path: PathBuf, bytes: u64, max: u32 },
     #[error("{}: metadata is not valid: {source}", .path.display())]
-    BadMetadata { path: PathBuf, source: serde_json::Error },
+    BadMetadata {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
     #[error("{}: table shape in the metadata is invalid: {source}", .path.display())]
     InvalidShape { path: PathBuf, source: TableError },
     #[error("{}: inconsistent file: {problem}", .path.display())]
     Inconsistent { path: PathBuf, problem: String },
     #[error("{}: payload checksum mismatch (stored SHA-256 {stored}, computed {computed}): the file is corrupt", .path.display())]
-    ChecksumMismatch { path: PathBuf, stored: String, computed: String },
+    ChecksumMismatch {
+        path: PathBuf,
+        stored: String,
+        computed: String,
+    },
     #[error("{}: value {value} at node {node:?} channel {channel} is not finite; refusing to store it", .path.display())]
-    NonFiniteValue { path: PathBuf, node: Vec<usize>, channel: usize, value: f32 },
+    NonFiniteValue {
+        path: PathBuf,
+        node: Vec<usize>,
+        channel: usize,
+        value: f32,
+    },
     #[error("{}: value {value} at node {node:?} channel {channel} overflows f16 (|v| ≥ 65520); store as f32 or rescale", .path.display())]
-    F16Overflow { path: PathBuf, node: Vec<usize>, channel: usize, value: f32 },
+    F16Overflow {
+        path: PathBuf,
+        node: Vec<usize>,
+        channel: usize,
+        value: f32,
+    },
     #[error("{}: table was baked for other fiber parameters: `{parameter}` is {baked} in the table but {expected} was asked for; re-bake it", .path.display())]
-    ParameterMismatch { path: PathBuf, parameter: String, baked: String, expected: String },
+    ParameterMismatch {
+        path: PathBuf,
+        parameter: String,
+        baked: String,
+        expected: String,
+    },
 }
 
 /// How payload values are stored. Tables are always f32 in memory.
@@ -109,7 +140,11 @@ impl CreationInfo {
             .map(|d| d.as_secs())
             .unwrap_or(0);
         let command_line = Some(std::env::args().collect::<Vec<_>>().join(" "));
-        Self { unix_time_s, command_line, notes: None }
+        Self {
+            unix_time_s,
+            command_line,
+            notes: None,
+        }
     }
 }
 
@@ -163,7 +198,10 @@ pub fn write_asset(
     storage: Storage,
 ) -> Result<AssetMetadata, AssetError> {
     let (metadata, head, payload) = encode_asset(path, table, description, storage)?;
-    let io_error = |source| AssetError::Io { path: path.to_path_buf(), source };
+    let io_error = |source| AssetError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
     write_atomically(path, |w| {
         w.write_all(&head)?;
         w.write_all(&payload)
@@ -191,8 +229,10 @@ fn encode_asset(
             sha256: sha256_hex(&payload),
         },
     };
-    let json = serde_json::to_vec_pretty(&metadata)
-        .map_err(|source| AssetError::BadMetadata { path: path.to_path_buf(), source })?;
+    let json = serde_json::to_vec_pretty(&metadata).map_err(|source| AssetError::BadMetadata {
+        path: path.to_path_buf(),
+        source,
+    })?;
     if json.len() > MAX_METADATA_BYTES as usize {
         return Err(AssetError::MetadataTooLarge {
             path: path.to_path_buf(),
@@ -220,7 +260,12 @@ fn encode_payload(path: &Path, table: &Table, storage: Storage) -> Result<Vec<u8
     for (offset, &value) in values.iter().enumerate() {
         if !value.is_finite() {
             let (node, channel) = locate(offset);
-            return Err(AssetError::NonFiniteValue { path: path.to_path_buf(), node, channel, value });
+            return Err(AssetError::NonFiniteValue {
+                path: path.to_path_buf(),
+                node,
+                channel,
+                value,
+            });
         }
         match storage {
             Storage::F32 => bytes.extend_from_slice(&value.to_le_bytes()),
@@ -228,7 +273,12 @@ fn encode_payload(path: &Path, table: &Table, storage: Storage) -> Result<Vec<u8
                 let half = f16::from_f32(value);
                 if half.is_infinite() {
                     let (node, channel) = locate(offset);
-                    return Err(AssetError::F16Overflow { path: path.to_path_buf(), node, channel, value });
+                    return Err(AssetError::F16Overflow {
+                        path: path.to_path_buf(),
+                        node,
+                        channel,
+                        value,
+                    });
                 }
                 bytes.extend_from_slice(&half.to_le_bytes());
             }
@@ -248,12 +298,25 @@ pub fn read_asset(path: &Path) -> Result<TableAsset, AssetError> {
     let OpenedAsset { path, metadata, .. } = opened;
     let computed = sha256_hex(&payload);
     if computed != metadata.payload.sha256 {
-        return Err(AssetError::ChecksumMismatch { path, stored: metadata.payload.sha256, computed });
+        return Err(AssetError::ChecksumMismatch {
+            path,
+            stored: metadata.payload.sha256,
+            computed,
+        });
     }
     let values = decode_payload(&payload, metadata.payload.storage);
-    let table = Table::new(metadata.payload.axes.clone(), metadata.payload.channels, values)
-        .map_err(|source| AssetError::InvalidShape { path: path.clone(), source })?;
-    Ok(TableAsset { path, metadata, table })
+    let table =
+        Table::new(metadata.payload.axes.clone(), metadata.payload.channels, values).map_err(|source| {
+            AssetError::InvalidShape {
+                path: path.clone(),
+                source,
+            }
+        })?;
+    Ok(TableAsset {
+        path,
+        metadata,
+        table,
+    })
 }
 
 /// Reads only the header and metadata (checked for consistency with the file size), e.g. to
@@ -274,7 +337,10 @@ struct OpenedAsset {
 impl OpenedAsset {
     fn open(path: &Path) -> Result<Self, AssetError> {
         let path_buf = path.to_path_buf();
-        let io_error = |source| AssetError::Io { path: path_buf.clone(), source };
+        let io_error = |source| AssetError::Io {
+            path: path_buf.clone(),
+            source,
+        };
         let mut file = File::open(path).map_err(io_error)?;
         let file_len = file.metadata().map_err(io_error)?.len();
         let truncated = |section, needed| AssetError::Truncated {
@@ -292,26 +358,40 @@ impl OpenedAsset {
         file.read_exact(&mut header[..header_len]).map_err(io_error)?;
         if header[..8] != MAGIC {
             let found = header[..8].escape_ascii().to_string();
-            return Err(AssetError::BadMagic { path: path_buf, found });
+            return Err(AssetError::BadMagic {
+                path: path_buf,
+                found,
+            });
         }
         if file_len < HEADER_BYTES {
             return Err(truncated("header", HEADER_BYTES));
         }
         let version = u32::from_le_bytes(header[8..12].try_into().unwrap());
         if version != FORMAT_VERSION {
-            return Err(AssetError::UnsupportedVersion { path: path_buf, found: version, supported: FORMAT_VERSION });
+            return Err(AssetError::UnsupportedVersion {
+                path: path_buf,
+                found: version,
+                supported: FORMAT_VERSION,
+            });
         }
         let metadata_len = u32::from_le_bytes(header[12..16].try_into().unwrap());
         if metadata_len > MAX_METADATA_BYTES {
-            return Err(AssetError::MetadataTooLarge { path: path_buf, bytes: metadata_len as u64, max: MAX_METADATA_BYTES });
+            return Err(AssetError::MetadataTooLarge {
+                path: path_buf,
+                bytes: metadata_len as u64,
+                max: MAX_METADATA_BYTES,
+            });
         }
         if file_len < HEADER_BYTES + metadata_len as u64 {
             return Err(truncated("metadata", HEADER_BYTES + metadata_len as u64));
         }
         let mut json = vec![0u8; metadata_len as usize];
         file.read_exact(&mut json).map_err(io_error)?;
-        let metadata: AssetMetadata = serde_json::from_slice(&json)
-            .map_err(|source| AssetError::BadMetadata { path: path_buf.clone(), source })?;
+        let metadata: AssetMetadata =
+            serde_json::from_slice(&json).map_err(|source| AssetError::BadMetadata {
+                path: path_buf.clone(),
+                source,
+            })?;
 
         let payload_bytes = check_payload_shape(&path_buf, &metadata.payload)?;
         let payload_offset = payload_offset(metadata_len as u64);
@@ -322,15 +402,29 @@ impl OpenedAsset {
         if file_len > needed {
             return Err(AssetError::Inconsistent {
                 path: path_buf,
-                problem: format!("{} bytes after the end of the payload (file has {file_len}, axes × channels × storage give {needed})", file_len - needed),
+                problem: format!(
+                    "{} bytes after the end of the payload (file has {file_len}, axes × channels × storage give {needed})",
+                    file_len - needed
+                ),
             });
         }
-        Ok(Self { path: path_buf, file, metadata, payload_offset, payload_bytes })
+        Ok(Self {
+            path: path_buf,
+            file,
+            metadata,
+            payload_offset,
+            payload_bytes,
+        })
     }
 
     fn read_payload(&mut self) -> Result<Vec<u8>, AssetError> {
-        let io_error = |source| AssetError::Io { path: self.path.clone(), source };
-        self.file.seek(SeekFrom::Start(self.payload_offset)).map_err(io_error)?;
+        let io_error = |source| AssetError::Io {
+            path: self.path.clone(),
+            source,
+        };
+        self.file
+            .seek(SeekFrom::Start(self.payload_offset))
+            .map_err(io_error)?;
         // Bounded: the shape check capped the size and the file was seen to hold it.
         let mut payload = vec![0u8; self.payload_bytes as usize];
         self.file.read_exact(&mut payload).map_err(io_error)?;
@@ -340,9 +434,15 @@ impl OpenedAsset {
 
 /// Validates the shape (before any allocation) and returns the payload size it implies.
 fn check_payload_shape(path: &Path, info: &PayloadInfo) -> Result<u64, AssetError> {
-    let count = checked_value_count(&info.axes, info.channels)
-        .map_err(|source| AssetError::InvalidShape { path: path.to_path_buf(), source })?;
-    let inconsistent = |problem| AssetError::Inconsistent { path: path.to_path_buf(), problem };
+    let count =
+        checked_value_count(&info.axes, info.channels).map_err(|source| AssetError::InvalidShape {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    let inconsistent = |problem| AssetError::Inconsistent {
+        path: path.to_path_buf(),
+        problem,
+    };
     if info.layout != PAYLOAD_LAYOUT {
         return Err(inconsistent(format!("unknown payload layout {:?}", info.layout)));
     }
@@ -361,7 +461,10 @@ fn check_payload_shape(path: &Path, info: &PayloadInfo) -> Result<u64, AssetErro
 
 fn decode_payload(bytes: &[u8], storage: Storage) -> Vec<f32> {
     match storage {
-        Storage::F32 => bytes.chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().unwrap())).collect(),
+        Storage::F32 => bytes
+            .chunks_exact(4)
+            .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+            .collect(),
         Storage::F16 => bytes
             .chunks_exact(2)
             .map(|b| f16::from_le_bytes(b.try_into().unwrap()).to_f32())
@@ -378,7 +481,11 @@ pub fn expect_parameters(asset: &TableAsset, expected: &Value) -> Result<(), Ass
         None => Ok(()),
         Some((parameter, baked, expected)) => Err(AssetError::ParameterMismatch {
             path: asset.path.clone(),
-            parameter: if parameter.is_empty() { "/".into() } else { parameter },
+            parameter: if parameter.is_empty() {
+                "/".into()
+            } else {
+                parameter
+            },
             baked,
             expected,
         }),
@@ -403,11 +510,18 @@ fn first_difference(baked: &Value, expected: &Value, pointer: String) -> Option<
         }
         (Value::Array(a), Value::Array(b)) => {
             let common = a.iter().zip(b).enumerate();
-            if let Some(d) = common.into_iter().find_map(|(i, (x, y))| first_difference(x, y, format!("{pointer}/{i}"))) {
+            if let Some(d) = common
+                .into_iter()
+                .find_map(|(i, (x, y))| first_difference(x, y, format!("{pointer}/{i}")))
+            {
                 return Some(d);
             }
             (a.len() != b.len()).then(|| {
-                (pointer, format!("an array of {}", a.len()), format!("an array of {}", b.len()))
+                (
+                    pointer,
+                    format!("an array of {}", a.len()),
+                    format!("an array of {}", b.len()),
+                )
             })
         }
         (Value::Number(a), Value::Number(b)) => {
@@ -447,8 +561,15 @@ mod tests {
                 "eccentricity": {"enabled": false, "a": 0.9},
                 "lobes": 3,
             }),
-            generator: Generator { name: "strandlight-tables tests".into(), version: "0.1.0".into() },
-            created: CreationInfo { unix_time_s: 1_763_770_000, command_line: Some("cargo test".into()), notes: None },
+            generator: Generator {
+                name: "strandlight-tables tests".into(),
+                version: "0.1.0".into(),
+            },
+            created: CreationInfo {
+                unix_time_s: 1_763_770_000,
+                command_line: Some("cargo test".into()),
+                notes: None,
+            },
         }
     }
 
@@ -487,12 +608,20 @@ mod tests {
         let asset = read_asset(&path).unwrap();
         let bits = |t: &Table| t.values().iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_eq!(bits(&asset.table), bits(&table));
-        assert_eq!(asset.table.axes(), table.axes(), "axes (f64 via JSON) round-trip exactly");
+        assert_eq!(
+            asset.table.axes(),
+            table.axes(),
+            "axes (f64 via JSON) round-trip exactly"
+        );
         assert_eq!(asset.metadata.description, description());
         assert_eq!(asset.metadata.payload.storage, Storage::F32);
         assert_eq!(read_asset_metadata(&path).unwrap(), asset.metadata);
         let len = std::fs::metadata(&path).unwrap().len();
-        assert_eq!(len % 16, 0, "the 16-aligned payload of 180 × 4 bytes ends the file");
+        assert_eq!(
+            len % 16,
+            0,
+            "the 16-aligned payload of 180 × 4 bytes ends the file"
+        );
         eprintln!("f32 asset: {} values, {len} bytes", table.values().len());
     }
 
@@ -515,7 +644,11 @@ mod tests {
                 worst_abs_sub = worst_abs_sub.max(err);
             }
         }
-        eprintln!("f16: max relative error {worst_rel:.3e} (bound {:.3e}), max abs error below 2⁻¹⁴ {worst_abs_sub:.3e} (bound {:.3e})", 2f64.powi(-11), 2f64.powi(-25));
+        eprintln!(
+            "f16: max relative error {worst_rel:.3e} (bound {:.3e}), max abs error below 2⁻¹⁴ {worst_abs_sub:.3e} (bound {:.3e})",
+            2f64.powi(-11),
+            2f64.powi(-25)
+        );
         assert!(worst_rel <= 2f64.powi(-11));
         assert!(worst_abs_sub <= 2f64.powi(-25));
         assert_eq!(
@@ -532,14 +665,19 @@ mod tests {
         values[1] = -65519.0; // rounds to −65504: fine
         let table = Table::new(axes(), 1, values.clone()).unwrap();
         let path = write(&dir, "ok.sltab", &table, Storage::F16);
-        assert_eq!(&read_asset(&path).unwrap().table.values()[..2], &[65504.0, -65504.0]);
+        assert_eq!(
+            &read_asset(&path).unwrap().table.values()[..2],
+            &[65504.0, -65504.0]
+        );
 
         values[13] = 65520.0; // node (1, 0, 1): would round to +∞
         let table = Table::new(axes(), 1, values).unwrap();
         let bad = dir.join("bad.sltab");
         let err = write_asset(&bad, &table, &description(), Storage::F16).unwrap_err();
         eprintln!("{err}");
-        assert!(matches!(&err, AssetError::F16Overflow { node, channel: 0, value, .. } if node == &vec![1, 0, 1] && *value == 65520.0));
+        assert!(
+            matches!(&err, AssetError::F16Overflow { node, channel: 0, value, .. } if node == &vec![1, 0, 1] && *value == 65520.0)
+        );
         assert!(err.to_string().contains("bad.sltab"));
         assert!(!bad.exists());
         // The same table is fine in f32.
@@ -554,7 +692,10 @@ mod tests {
         let table = Table::new(axes(), 1, values).unwrap();
         let path = dir.join("nan.sltab");
         let err = write_asset(&path, &table, &description(), Storage::F32).unwrap_err();
-        assert!(matches!(&err, AssetError::NonFiniteValue { node, .. } if node == &vec![4, 3, 2]), "{err}");
+        assert!(
+            matches!(&err, AssetError::NonFiniteValue { node, .. } if node == &vec![4, 3, 2]),
+            "{err}"
+        );
         assert!(!path.exists());
     }
 
@@ -593,18 +734,32 @@ mod tests {
         let (good, json_start, payload_start) = valid_bytes();
         std::fs::write(dir.join("good.sltab"), &good).unwrap();
         read_asset(&dir.join("good.sltab")).unwrap();
-        let json = &good[json_start..json_start + u32::from_le_bytes(good[12..16].try_into().unwrap()) as usize];
+        let json =
+            &good[json_start..json_start + u32::from_le_bytes(good[12..16].try_into().unwrap()) as usize];
         let payload = &good[payload_start..];
         let metadata: Value = serde_json::from_slice(json).unwrap();
 
         let mut b = good.clone();
         b[0] = b'X';
-        assert!(matches!(load(&dir, "magic.sltab", &b), AssetError::BadMagic { .. }));
-        assert!(matches!(load(&dir, "png.sltab", b"\x89PNG\r\n\x1a\n rest"), AssetError::BadMagic { .. }));
+        assert!(matches!(
+            load(&dir, "magic.sltab", &b),
+            AssetError::BadMagic { .. }
+        ));
+        assert!(matches!(
+            load(&dir, "png.sltab", b"\x89PNG\r\n\x1a\n rest"),
+            AssetError::BadMagic { .. }
+        ));
 
         let mut b = good.clone();
         b[8..12].copy_from_slice(&2u32.to_le_bytes());
-        assert!(matches!(load(&dir, "version.sltab", &b), AssetError::UnsupportedVersion { found: 2, supported: 1, .. }));
+        assert!(matches!(
+            load(&dir, "version.sltab", &b),
+            AssetError::UnsupportedVersion {
+                found: 2,
+                supported: 1,
+                ..
+            }
+        ));
 
         for (name, cut, section) in [
             ("cut-magic.sltab", 5, "magic bytes"),
@@ -613,30 +768,48 @@ mod tests {
             ("cut-payload.sltab", good.len() - 1, "payload"),
         ] {
             let err = load(&dir, name, &good[..cut]);
-            assert!(matches!(err, AssetError::Truncated { section: s, .. } if s == section), "{name}");
+            assert!(
+                matches!(err, AssetError::Truncated { section: s, .. } if s == section),
+                "{name}"
+            );
         }
 
         let mut b = good.clone();
         b[json_start] = b'['; // the opening brace of the JSON object
-        assert!(matches!(load(&dir, "json.sltab", &b), AssetError::BadMetadata { .. }));
+        assert!(matches!(
+            load(&dir, "json.sltab", &b),
+            AssetError::BadMetadata { .. }
+        ));
 
         let mut b = good.clone();
         b[12..16].copy_from_slice(&u32::MAX.to_le_bytes());
-        assert!(matches!(load(&dir, "metalen.sltab", &b), AssetError::MetadataTooLarge { .. }));
+        assert!(matches!(
+            load(&dir, "metalen.sltab", &b),
+            AssetError::MetadataTooLarge { .. }
+        ));
 
         let mut b = good.clone();
         b[payload_start + 7] ^= 0x10;
-        assert!(matches!(load(&dir, "checksum.sltab", &b), AssetError::ChecksumMismatch { .. }));
+        assert!(matches!(
+            load(&dir, "checksum.sltab", &b),
+            AssetError::ChecksumMismatch { .. }
+        ));
 
         let mut b = good.clone();
         b.extend_from_slice(&[0; 4]);
-        assert!(matches!(load(&dir, "trailing.sltab", &b), AssetError::Inconsistent { .. }));
+        assert!(matches!(
+            load(&dir, "trailing.sltab", &b),
+            AssetError::Inconsistent { .. }
+        ));
 
         // Metadata that disagrees with the payload size it declares.
         let mut m = metadata.clone();
         m["payload"]["axes"][0]["count"] = json!(6);
         let b = assemble(1, &serde_json::to_vec(&m).unwrap(), payload);
-        assert!(matches!(load(&dir, "shape.sltab", &b), AssetError::Inconsistent { .. }));
+        assert!(matches!(
+            load(&dir, "shape.sltab", &b),
+            AssetError::Inconsistent { .. }
+        ));
 
         // An absurd axis count is refused from the metadata alone, before any allocation.
         let mut m = metadata.clone();
@@ -644,12 +817,24 @@ mod tests {
         m["payload"]["payload_bytes"] = json!(1u64 << 50);
         let b = assemble(1, &serde_json::to_vec(&m).unwrap(), payload);
         let err = load(&dir, "absurd.sltab", &b);
-        assert!(matches!(err, AssetError::InvalidShape { source: TableError::TooLarge { .. }, .. }), "{err}");
+        assert!(
+            matches!(
+                err,
+                AssetError::InvalidShape {
+                    source: TableError::TooLarge { .. },
+                    ..
+                }
+            ),
+            "{err}"
+        );
 
         let mut m = metadata.clone();
         m["payload"]["storage"] = json!("f64");
         let b = assemble(1, &serde_json::to_vec(&m).unwrap(), payload);
-        assert!(matches!(load(&dir, "storage.sltab", &b), AssetError::BadMetadata { .. }));
+        assert!(matches!(
+            load(&dir, "storage.sltab", &b),
+            AssetError::BadMetadata { .. }
+        ));
 
         let err = read_asset(&dir.join("missing.sltab")).unwrap_err();
         assert!(matches!(&err, AssetError::Io { source, .. } if source.kind() == io::ErrorKind::NotFound));
@@ -667,7 +852,12 @@ mod tests {
         expect_parameters(&asset, &wanted).unwrap();
 
         let mismatch = |wanted: &Value| match expect_parameters(&asset, wanted).unwrap_err() {
-            AssetError::ParameterMismatch { parameter, baked, expected, path } => {
+            AssetError::ParameterMismatch {
+                parameter,
+                baked,
+                expected,
+                path,
+            } => {
                 assert_eq!(path, dir.join("p.sltab"));
                 (parameter, baked, expected)
             }
@@ -675,7 +865,10 @@ mod tests {
         };
         let mut w = wanted.clone();
         w["sigma_a"][1] = json!(0.6120000001);
-        assert_eq!(mismatch(&w), ("/sigma_a/1".into(), "0.612".into(), "0.6120000001".into()));
+        assert_eq!(
+            mismatch(&w),
+            ("/sigma_a/1".into(), "0.612".into(), "0.6120000001".into())
+        );
         let mut w = wanted.clone();
         w["eccentricity"]["a"] = json!(0.8);
         w["eta"] = json!(1.6); // later in key order than `eccentricity`
@@ -713,7 +906,10 @@ mod tests {
         let blocked = dir.join("not-a-folder");
         std::fs::write(&blocked, b"file").unwrap();
         let err = write_asset(&blocked.join("t.sltab"), &table, &description(), Storage::F32).unwrap_err();
-        assert!(matches!(err, AssetError::Io { .. }) && err.to_string().contains("not-a-folder"), "{err}");
+        assert!(
+            matches!(err, AssetError::Io { .. }) && err.to_string().contains("not-a-folder"),
+            "{err}"
+        );
         assert_eq!(entries(&dir), vec!["not-a-folder"]);
     }
 }

@@ -47,7 +47,11 @@ pub enum TableError {
     #[error("{channels} channels requested; a table has 1 (scalar) or 3 (RGB) channels")]
     InvalidChannels { channels: usize },
     #[error("table shape {shape:?} × {channels} channels exceeds {max} values")]
-    TooLarge { shape: Vec<usize>, channels: usize, max: usize },
+    TooLarge {
+        shape: Vec<usize>,
+        channels: usize,
+        max: usize,
+    },
     #[error("axes × channels need {expected} values but {actual} were given")]
     ShapeMismatch { expected: usize, actual: usize },
     #[error("the table has {expected} axes but {actual} coordinates were given")]
@@ -100,16 +104,33 @@ pub struct AxisGpu {
 
 impl Axis {
     pub fn uniform(name: impl Into<String>, min: f64, max: f64, count: usize) -> Self {
-        Self { name: name.into(), min, max, count, mapping: AxisMapping::Uniform }
+        Self {
+            name: name.into(),
+            min,
+            max,
+            count,
+            mapping: AxisMapping::Uniform,
+        }
     }
 
     pub fn power(name: impl Into<String>, min: f64, max: f64, count: usize, exponent: f64) -> Self {
-        Self { name: name.into(), min, max, count, mapping: AxisMapping::Power { exponent } }
+        Self {
+            name: name.into(),
+            min,
+            max,
+            count,
+            mapping: AxisMapping::Power { exponent },
+        }
     }
 
     /// Checks finiteness and ordering; a one-node axis may have `min == max`.
     pub fn validate(&self) -> Result<(), TableError> {
-        let fail = |problem: String| Err(TableError::InvalidAxis { axis: self.name.clone(), problem });
+        let fail = |problem: String| {
+            Err(TableError::InvalidAxis {
+                axis: self.name.clone(),
+                problem,
+            })
+        };
         if self.count == 0 {
             return fail("has no nodes (count = 0)".into());
         }
@@ -122,12 +143,12 @@ impl Axis {
         if self.count == 1 && self.min > self.max {
             return fail(format!("range [{}, {}] must have min ≤ max", self.min, self.max));
         }
-        if let AxisMapping::Power { exponent } = self.mapping
-            && !(exponent.is_finite() && exponent > 0.0)
-        {
-            return fail(format!("power mapping exponent {exponent} must be finite and > 0"));
+        match self.mapping {
+            AxisMapping::Power { exponent } if !(exponent.is_finite() && exponent > 0.0) => fail(format!(
+                "power mapping exponent {exponent} must be finite and > 0"
+            )),
+            _ => Ok(()),
         }
-        Ok(())
     }
 
     /// Coordinate of node `i` (`min` at 0 and exactly `max` at `count − 1`).
@@ -149,7 +170,10 @@ impl Axis {
     /// Continuous node position of `x` in `[0, count − 1]`, clamped to the edges.
     pub fn position(&self, x: f64) -> Result<f64, TableError> {
         if x.is_nan() {
-            return Err(TableError::NotFiniteCoordinate { axis: self.name.clone(), value: x });
+            return Err(TableError::NotFiniteCoordinate {
+                axis: self.name.clone(),
+                value: x,
+            });
         }
         if self.count <= 1 {
             return Ok(0.0);
@@ -161,7 +185,11 @@ impl Axis {
         };
         let f = t * (self.count - 1) as f64;
         let nearest = f.round();
-        Ok(if (f - nearest).abs() <= NODE_SNAP { nearest } else { f })
+        Ok(if (f - nearest).abs() <= NODE_SNAP {
+            nearest
+        } else {
+            f
+        })
     }
 
     /// The lower node of the cell holding `x` and the weight of the upper node, in [0, 1].
@@ -200,7 +228,10 @@ pub fn checked_value_count(axes: &[Axis], channels: usize) -> Result<usize, Tabl
         return Err(TableError::NoAxes);
     }
     if axes.len() > MAX_AXES {
-        return Err(TableError::TooManyAxes { count: axes.len(), max: MAX_AXES });
+        return Err(TableError::TooManyAxes {
+            count: axes.len(),
+            max: MAX_AXES,
+        });
     }
     if channels != 1 && channels != 3 {
         return Err(TableError::InvalidChannels { channels });
@@ -252,10 +283,18 @@ impl Table {
     pub fn new(axes: Vec<Axis>, channels: usize, values: Vec<f32>) -> Result<Self, TableError> {
         let expected = checked_value_count(&axes, channels)?;
         if values.len() != expected {
-            return Err(TableError::ShapeMismatch { expected, actual: values.len() });
+            return Err(TableError::ShapeMismatch {
+                expected,
+                actual: values.len(),
+            });
         }
         let strides = strides(&axes, channels);
-        Ok(Self { axes, channels, strides, values })
+        Ok(Self {
+            axes,
+            channels,
+            strides,
+            values,
+        })
     }
 
     /// Fills a table by evaluating `f(coordinates, out)` at every node, in parallel over rows
@@ -265,24 +304,29 @@ impl Table {
         F: Fn(&[f64], &mut [f32]) + Sync,
     {
         let count = checked_value_count(&axes, channels)?;
-        let nodes: Vec<Vec<f64>> =
-            axes.iter().map(|a| (0..a.count).map(|i| a.node(i)).collect()).collect();
+        let nodes: Vec<Vec<f64>> = axes
+            .iter()
+            .map(|a| (0..a.count).map(|i| a.node(i)).collect())
+            .collect();
         let d = axes.len();
         let row_len = axes[d - 1].count * channels;
         let mut values = vec![0.0f32; count];
-        values.par_chunks_mut(row_len).enumerate().for_each(|(row, chunk)| {
-            let mut coords = [0.0f64; MAX_AXES];
-            // Unravel the row number into the indices of all axes but the last.
-            let mut rest = row;
-            for k in (0..d - 1).rev() {
-                coords[k] = nodes[k][rest % axes[k].count];
-                rest /= axes[k].count;
-            }
-            for (j, out) in chunk.chunks_mut(channels).enumerate() {
-                coords[d - 1] = nodes[d - 1][j];
-                f(&coords[..d], out);
-            }
-        });
+        values
+            .par_chunks_mut(row_len)
+            .enumerate()
+            .for_each(|(row, chunk)| {
+                let mut coords = [0.0f64; MAX_AXES];
+                // Unravel the row number into the indices of all axes but the last.
+                let mut rest = row;
+                for k in (0..d - 1).rev() {
+                    coords[k] = nodes[k][rest % axes[k].count];
+                    rest /= axes[k].count;
+                }
+                for (j, out) in chunk.chunks_mut(channels).enumerate() {
+                    coords[d - 1] = nodes[d - 1][j];
+                    f(&coords[..d], out);
+                }
+            });
         Self::new(axes, channels, values)
     }
 
@@ -319,7 +363,10 @@ impl Table {
 
     /// Offset in [`Table::values`] of channel 0 at a node.
     pub fn node_offset(&self, index: &[usize]) -> Result<usize, TableError> {
-        let out_of_range = || TableError::NodeOutOfRange { index: index.to_vec(), shape: self.shape() };
+        let out_of_range = || TableError::NodeOutOfRange {
+            index: index.to_vec(),
+            shape: self.shape(),
+        };
         if index.len() != self.axes.len() {
             return Err(out_of_range());
         }
@@ -354,10 +401,16 @@ impl Table {
     pub fn lookup_into(&self, coords: &[f64], out: &mut [f32]) -> Result<(), TableError> {
         let d = self.axes.len();
         if coords.len() != d {
-            return Err(TableError::WrongCoordinateCount { expected: d, actual: coords.len() });
+            return Err(TableError::WrongCoordinateCount {
+                expected: d,
+                actual: coords.len(),
+            });
         }
         if out.len() != self.channels {
-            return Err(TableError::WrongChannelCount { expected: self.channels, actual: out.len() });
+            return Err(TableError::WrongChannelCount {
+                expected: self.channels,
+                actual: out.len(),
+            });
         }
         let mut base = 0;
         let mut upper_weight = [0.0f64; MAX_AXES];
@@ -366,7 +419,11 @@ impl Table {
             let (lower, w) = self.axes[k].cell(coords[k])?;
             base += lower * self.strides[k];
             upper_weight[k] = w;
-            step[k] = if self.axes[k].count > 1 { self.strides[k] } else { 0 };
+            step[k] = if self.axes[k].count > 1 {
+                self.strides[k]
+            } else {
+                0
+            };
         }
         let mut acc = [0.0f64; 3];
         for corner in 0..(1usize << d) {
@@ -417,9 +474,18 @@ impl Table {
     /// The same for one channel.
     pub fn channel_stats(&self, channel: usize) -> Result<TableStats, TableError> {
         if channel >= self.channels {
-            return Err(TableError::WrongChannelCount { expected: self.channels, actual: channel + 1 });
+            return Err(TableError::WrongChannelCount {
+                expected: self.channels,
+                actual: channel + 1,
+            });
         }
-        let it = self.values.iter().copied().enumerate().skip(channel).step_by(self.channels);
+        let it = self
+            .values
+            .iter()
+            .copied()
+            .enumerate()
+            .skip(channel)
+            .step_by(self.channels);
         Ok(self.stats_of(it))
     }
 
@@ -482,7 +548,9 @@ mod tests {
 
     impl Multilinear {
         fn random(dims: usize, rng: &mut Pcg64) -> Self {
-            Self { coefficients: (0..1 << dims).map(|_| rng.random_range(-2.0..2.0)).collect() }
+            Self {
+                coefficients: (0..1 << dims).map(|_| rng.random_range(-2.0..2.0)).collect(),
+            }
         }
 
         fn eval(&self, s: &[f64]) -> f64 {
@@ -537,10 +605,16 @@ mod tests {
     #[test]
     fn power_mapping_is_multilinear_in_the_warped_coordinate() {
         let mut rng = Pcg64::seed_from_u64(11);
-        let axes = vec![Axis::power("a", 0.01, 1.0, 9, 2.5), Axis::power("b", -1.0, 1.0, 5, 0.5)];
+        let axes = vec![
+            Axis::power("a", 0.01, 1.0, 9, 2.5),
+            Axis::power("b", -1.0, 1.0, 5, 0.5),
+        ];
         // Independent inverse of the documented node placement.
         let warped = |x: &[f64]| -> Vec<f64> {
-            vec![((x[0] - 0.01) / 0.99).powf(1.0 / 2.5), ((x[1] + 1.0) / 2.0).powf(1.0 / 0.5)]
+            vec![
+                ((x[0] - 0.01) / 0.99).powf(1.0 / 2.5),
+                ((x[1] + 1.0) / 2.0).powf(1.0 / 0.5),
+            ]
         };
         let poly = Multilinear::random(2, &mut rng);
         let table = Table::from_fn(axes, 1, |x, out| out[0] = poly.eval(&warped(x)) as f32).unwrap();
@@ -589,7 +663,10 @@ mod tests {
         assert_eq!(at([0.3, f64::NEG_INFINITY]), at([0.3, -2.0]));
         assert_eq!(at([7.0, 9.0]), 12.0); // corner (1, 2): 10·1 + 2
         let err = table.lookup_scalar(&[0.5, f64::NAN]).unwrap_err();
-        assert!(matches!(&err, TableError::NotFiniteCoordinate { axis, .. } if axis == "b"), "{err}");
+        assert!(
+            matches!(&err, TableError::NotFiniteCoordinate { axis, .. } if axis == "b"),
+            "{err}"
+        );
         assert!(err.to_string().contains("`b`"));
     }
 
@@ -598,28 +675,61 @@ mod tests {
         let axes = vec![Axis::uniform("a", 0.0, 1.0, 4), Axis::uniform("b", 0.0, 1.0, 5)];
         assert_eq!(
             Table::new(axes.clone(), 3, vec![0.0; 59]).unwrap_err(),
-            TableError::ShapeMismatch { expected: 60, actual: 59 }
+            TableError::ShapeMismatch {
+                expected: 60,
+                actual: 59
+            }
         );
-        assert!(matches!(Table::new(axes.clone(), 2, vec![0.0; 40]), Err(TableError::InvalidChannels { .. })));
+        assert!(matches!(
+            Table::new(axes.clone(), 2, vec![0.0; 40]),
+            Err(TableError::InvalidChannels { .. })
+        ));
         assert!(matches!(Table::new(vec![], 1, vec![]), Err(TableError::NoAxes)));
         let bad = vec![Axis::uniform("flat", 1.0, 1.0, 4)];
-        assert!(matches!(Table::new(bad, 1, vec![0.0; 4]), Err(TableError::InvalidAxis { .. })));
+        assert!(matches!(
+            Table::new(bad, 1, vec![0.0; 4]),
+            Err(TableError::InvalidAxis { .. })
+        ));
         let bad = vec![Axis::power("p", 0.0, 1.0, 4, -1.0)];
-        assert!(matches!(Table::new(bad, 1, vec![0.0; 4]), Err(TableError::InvalidAxis { .. })));
+        assert!(matches!(
+            Table::new(bad, 1, vec![0.0; 4]),
+            Err(TableError::InvalidAxis { .. })
+        ));
         let table = Table::new(axes, 3, vec![0.0; 60]).unwrap();
-        assert!(matches!(table.lookup_rgb(&[0.5]), Err(TableError::WrongCoordinateCount { .. })));
-        assert!(matches!(table.lookup_scalar(&[0.5, 0.5]), Err(TableError::WrongChannelCount { .. })));
-        assert!(matches!(table.node(&[4, 0]), Err(TableError::NodeOutOfRange { .. })));
+        assert!(matches!(
+            table.lookup_rgb(&[0.5]),
+            Err(TableError::WrongCoordinateCount { .. })
+        ));
+        assert!(matches!(
+            table.lookup_scalar(&[0.5, 0.5]),
+            Err(TableError::WrongChannelCount { .. })
+        ));
+        assert!(matches!(
+            table.node(&[4, 0]),
+            Err(TableError::NodeOutOfRange { .. })
+        ));
     }
 
     #[test]
     fn absurd_shapes_are_refused_without_allocating() {
-        let huge = vec![Axis::uniform("a", 0.0, 1.0, usize::MAX), Axis::uniform("b", 0.0, 1.0, 3)];
-        assert!(matches!(checked_value_count(&huge, 3), Err(TableError::TooLarge { .. })));
+        let huge = vec![
+            Axis::uniform("a", 0.0, 1.0, usize::MAX),
+            Axis::uniform("b", 0.0, 1.0, 3),
+        ];
+        assert!(matches!(
+            checked_value_count(&huge, 3),
+            Err(TableError::TooLarge { .. })
+        ));
         let big = vec![Axis::uniform("a", 0.0, 1.0, 1 << 15); 2];
-        assert!(matches!(Table::from_fn(big, 1, |_, _| {}), Err(TableError::TooLarge { .. })));
+        assert!(matches!(
+            Table::from_fn(big, 1, |_, _| {}),
+            Err(TableError::TooLarge { .. })
+        ));
         let many = vec![Axis::uniform("a", 0.0, 1.0, 2); MAX_AXES + 1];
-        assert!(matches!(checked_value_count(&many, 1), Err(TableError::TooManyAxes { .. })));
+        assert!(matches!(
+            checked_value_count(&many, 1),
+            Err(TableError::TooManyAxes { .. })
+        ));
         // The paper's I_M resolution fits.
         let im = [32, 32, 32, 64].map(|n| Axis::uniform("x", -1.0, 1.0, n));
         assert_eq!(checked_value_count(&im, 3), Ok(32 * 32 * 32 * 64 * 3));
@@ -641,15 +751,29 @@ mod tests {
         ];
         assert_eq!(table.values(), &expected);
         assert_eq!(table.as_bytes().len(), 18 * 4);
-        assert_eq!(table.node_index_of(table.node_offset(&[1, 2]).unwrap()), vec![1, 2]);
+        assert_eq!(
+            table.node_index_of(table.node_offset(&[1, 2]).unwrap()),
+            vec![1, 2]
+        );
     }
 
     #[test]
     fn one_node_axes_are_constant_along_themselves() {
-        let axes = vec![Axis::uniform("fixed", 0.5, 0.5, 1), Axis::uniform("b", 0.0, 1.0, 2)];
+        let axes = vec![
+            Axis::uniform("fixed", 0.5, 0.5, 1),
+            Axis::uniform("b", 0.0, 1.0, 2),
+        ];
         let table = Table::new(axes, 1, vec![3.0, 5.0]).unwrap();
         assert_eq!(table.lookup_scalar(&[-100.0, 0.25]).unwrap(), 3.5);
-        assert_eq!(table.gpu_axes()[0], AxisGpu { min: 0.5, inv_range: 0.0, last_index: 0.0, inv_exponent: 1.0 });
+        assert_eq!(
+            table.gpu_axes()[0],
+            AxisGpu {
+                min: 0.5,
+                inv_range: 0.0,
+                last_index: 0.0,
+                inv_exponent: 1.0
+            }
+        );
     }
 
     #[test]
@@ -657,7 +781,9 @@ mod tests {
         let axis = Axis::power("1/λ", 0.001, 0.1, 64, 2.0);
         let g = axis.gpu();
         for &x in &[0.0, 0.001, 0.0123, 0.05, 0.1, 0.5] {
-            let t = ((x as f32 - g.min) * g.inv_range).clamp(0.0, 1.0).powf(g.inv_exponent);
+            let t = ((x as f32 - g.min) * g.inv_range)
+                .clamp(0.0, 1.0)
+                .powf(g.inv_exponent);
             let f = (t * g.last_index) as f64;
             assert!((f - axis.position(x).unwrap()).abs() < 1e-4, "x={x}");
         }
@@ -666,15 +792,37 @@ mod tests {
     #[test]
     fn stats_count_non_finite_values_and_locate_the_first() {
         let axes = vec![Axis::uniform("a", 0.0, 1.0, 2), Axis::uniform("b", 0.0, 1.0, 2)];
-        let values = vec![1.0, -2.0, 3.0, 4.0, 5.0, 6.0, f32::NAN, 8.0, 9.0, 10.0, f32::INFINITY, 12.0];
+        let values = vec![
+            1.0,
+            -2.0,
+            3.0,
+            4.0,
+            5.0,
+            6.0,
+            f32::NAN,
+            8.0,
+            9.0,
+            10.0,
+            f32::INFINITY,
+            12.0,
+        ];
         let table = Table::new(axes, 3, values).unwrap();
         let s = table.stats();
-        assert_eq!((s.min, s.max, s.finite_count, s.nan_count, s.infinite_count), (-2.0, 12.0, 10, 1, 1));
-        assert_eq!(s.mean, (1.0 - 2.0 + 3.0 + 4.0 + 5.0 + 6.0 + 8.0 + 9.0 + 10.0 + 12.0) / 10.0);
+        assert_eq!(
+            (s.min, s.max, s.finite_count, s.nan_count, s.infinite_count),
+            (-2.0, 12.0, 10, 1, 1)
+        );
+        assert_eq!(
+            s.mean,
+            (1.0 - 2.0 + 3.0 + 4.0 + 5.0 + 6.0 + 8.0 + 9.0 + 10.0 + 12.0) / 10.0
+        );
         // Offset 6 = node (1, 0), channel 0.
         assert_eq!(s.first_non_finite, Some((vec![1, 0], 0)));
         let c1 = table.channel_stats(1).unwrap();
         // Channel 1 holds offsets 1, 4, 7, 10: −2, 5, 8, +∞.
-        assert_eq!((c1.min, c1.max, c1.finite_count, c1.infinite_count), (-2.0, 8.0, 3, 1));
+        assert_eq!(
+            (c1.min, c1.max, c1.finite_count, c1.infinite_count),
+            (-2.0, 8.0, 3, 1)
+        );
     }
 }
