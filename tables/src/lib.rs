@@ -11,6 +11,7 @@ pub mod absorption;
 pub mod angles;
 pub mod artist;
 pub mod asset;
+pub mod atomic_write;
 pub mod dual_scattering;
 pub mod error;
 pub mod kajiya_kay;
