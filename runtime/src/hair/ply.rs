@@ -1,7 +1,8 @@
 //! Hair strands in binary little-endian PLY, as hapPLY-based tools (e.g. hairutil) write them:
 //! an element `vertex` with `x y z` (float or double) and optionally `red green blue`
 //! (uchar 0–255 or float), and an element `strand` with a segment count `nsegs` per strand;
-//! strand `s` owns the next `nsegs + 1` vertices. Other elements (such as `edge`) are read past.
+//! strand `s` owns the next `nsegs + 1` vertices. Other elements (such as `edge`) are read past,
+//! and the elements together must fill the file exactly.
 //! ASCII and big-endian PLY are refused with a clear error.
 
 use std::path::Path;
@@ -171,9 +172,15 @@ pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
         } else {
             offset = skip_with_lists(&bytes, element, offset)?;
         }
-        if index >= vertex_index.max(strand_index) {
-            break; // what follows is not needed
-        }
+    }
+    // Every element was walked, so the file must end exactly here.
+    if offset != bytes.len() {
+        let what = format!("{} elements after the header", elements.len());
+        return Err(if offset > bytes.len() {
+            HairError::Truncated { file: file.into(), what, needed: offset, actual: bytes.len() }
+        } else {
+            HairError::SizeMismatch { file: file.into(), expected: offset, actual: bytes.len() }
+        });
     }
     let counted: u64 = counts.iter().map(|&c| c as u64).sum();
     if counted != points.len() as u64 {

@@ -214,7 +214,9 @@ pub fn encode_hair(model: &HairModel, options: &HairWriteOptions, file: &Path) -
 
     let mut out = Vec::with_capacity(HEADER_BYTES as usize + 2 * counts.len() + 32 * model.point_count());
     out.extend_from_slice(MAGIC);
-    for v in [counts.len() as u32, model.point_count() as u32, flag_bits, counts[0] - 1] {
+    // With a segments array the default count is unused; 0 is what Yuksel's own files hold there.
+    let default_segments = if options.segments_array { 0 } else { counts[0] - 1 };
+    for v in [counts.len() as u32, model.point_count() as u32, flag_bits, default_segments] {
         out.extend_from_slice(&v.to_le_bytes());
     }
     for v in [thickness, transparency, color.x, color.y, color.z] {
