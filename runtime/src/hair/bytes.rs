@@ -22,7 +22,12 @@ impl<'a> FileBytes<'a> {
     }
 
     /// `len` bytes at `offset`, or `Truncated` naming `what`.
-    pub fn slice(&self, offset: u64, len: u64, what: impl FnOnce() -> String) -> Result<&'a [u8], HairError> {
+    pub fn slice(
+        &self,
+        offset: u64,
+        len: u64,
+        what: impl FnOnce() -> String,
+    ) -> Result<&'a [u8], HairError> {
         let end = offset.checked_add(len);
         match end {
             Some(end) if end <= self.len() => Ok(&self.data[offset as usize..end as usize]),
@@ -50,7 +55,12 @@ impl<'a> FileBytes<'a> {
 
     /// Refuses a count whose elements cannot fit in the file even at `bytes_each` apiece: the
     /// check that must come before any allocation sized by that count.
-    pub fn check_count_fits(&self, what: &'static str, count: u64, bytes_each: u64) -> Result<(), HairError> {
+    pub fn check_count_fits(
+        &self,
+        what: &'static str,
+        count: u64,
+        bytes_each: u64,
+    ) -> Result<(), HairError> {
         let need = count.checked_mul(bytes_each);
         if need.is_none_or(|n| n > self.len()) {
             return Err(HairError::AbsurdCount {
@@ -67,7 +77,9 @@ impl<'a> FileBytes<'a> {
 
 /// Little-endian f32s from a byte slice whose length is a multiple of 4.
 pub(crate) fn f32s(bytes: &[u8]) -> impl Iterator<Item = f32> + '_ {
-    bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+    bytes
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
 }
 
 #[cfg(test)]
@@ -80,12 +92,26 @@ mod tests {
         let f = FileBytes::new(&data, Path::new("x.bin"));
         assert_eq!(f.u32_at(0, "a").unwrap(), 1);
         match f.u32_at(2, "the count") {
-            Err(HairError::Truncated { needed: 6, actual: 5, what, .. }) => assert_eq!(what, "the count"),
+            Err(HairError::Truncated {
+                needed: 6,
+                actual: 5,
+                what,
+                ..
+            }) => assert_eq!(what, "the count"),
             other => panic!("expected Truncated, got {other:?}"),
         }
-        assert!(matches!(f.slice(u64::MAX, 2, || "x".into()), Err(HairError::Truncated { .. })));
-        assert!(matches!(f.check_count_fits("points", u64::MAX, 12), Err(HairError::AbsurdCount { .. })));
-        assert!(matches!(f.check_count_fits("points", 2, 3), Err(HairError::AbsurdCount { .. })));
+        assert!(matches!(
+            f.slice(u64::MAX, 2, || "x".into()),
+            Err(HairError::Truncated { .. })
+        ));
+        assert!(matches!(
+            f.check_count_fits("points", u64::MAX, 12),
+            Err(HairError::AbsurdCount { .. })
+        ));
+        assert!(matches!(
+            f.check_count_fits("points", 2, 3),
+            Err(HairError::AbsurdCount { .. })
+        ));
         assert!(f.check_count_fits("points", 1, 5).is_ok());
     }
 }

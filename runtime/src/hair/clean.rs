@@ -61,11 +61,22 @@ pub fn is_degenerate_segment(a: Vec3, b: Vec3) -> bool {
 }
 
 /// Checks every value, merges degenerate segments, drops short strands and builds the model.
-pub(crate) fn finish(raw: RawHair, file: &Path, format: HairFormat, info: String) -> Result<LoadedHair, HairError> {
+pub(crate) fn finish(
+    raw: RawHair,
+    file: &Path,
+    format: HairFormat,
+    info: String,
+) -> Result<LoadedHair, HairError> {
     check_values(&raw, file)?;
     let source_strands = raw.counts.len();
     let source_points = raw.points.len();
-    let RawHair { mut points, counts, mut thickness, mut transparency, mut color } = raw;
+    let RawHair {
+        mut points,
+        counts,
+        mut thickness,
+        mut transparency,
+        mut color,
+    } = raw;
 
     let mut offsets = Vec::with_capacity(counts.len() + 1);
     offsets.push(0u32);
@@ -75,7 +86,8 @@ pub(crate) fn finish(raw: RawHair, file: &Path, format: HairFormat, info: String
     for &count in &counts {
         let strand_start = write;
         for _ in 0..count {
-            let keep = write == strand_start || !is_degenerate_segment(points[write - 1], points[read]);
+            let keep =
+                write == strand_start || !is_degenerate_segment(points[write - 1], points[read]);
             if keep {
                 points[write] = points[read];
                 move_value(&mut thickness, read, write);
@@ -95,7 +107,9 @@ pub(crate) fn finish(raw: RawHair, file: &Path, format: HairFormat, info: String
         }
     }
     if offsets.len() < 2 {
-        return Err(HairError::NoStrands { file: file.to_path_buf() });
+        return Err(HairError::NoStrands {
+            file: file.to_path_buf(),
+        });
     }
     points.truncate(write);
     for a in [&mut thickness, &mut transparency] {
@@ -127,9 +141,27 @@ fn move_value<T: Copy>(attribute: &mut Option<Attribute<T>>, from: usize, to: us
 /// Every point finite; thickness finite and ≥ 0; transparency in [0, 1]; colour finite. The
 /// error names the strand and point so the user can find it in their tool.
 fn check_values(raw: &RawHair, file: &Path) -> Result<(), HairError> {
-    check_uniform(file, "thickness", &raw.thickness, |t| t.is_finite() && *t >= 0.0, "must be finite and ≥ 0")?;
-    check_uniform(file, "transparency", &raw.transparency, |a| (0.0..=1.0).contains(a), "must be in [0, 1]")?;
-    check_uniform(file, "color", &raw.color, |c| c.is_finite(), "must be finite")?;
+    check_uniform(
+        file,
+        "thickness",
+        &raw.thickness,
+        |t| t.is_finite() && *t >= 0.0,
+        "must be finite and ≥ 0",
+    )?;
+    check_uniform(
+        file,
+        "transparency",
+        &raw.transparency,
+        |a| (0.0..=1.0).contains(a),
+        "must be in [0, 1]",
+    )?;
+    check_uniform(
+        file,
+        "color",
+        &raw.color,
+        |c| c.is_finite(),
+        "must be finite",
+    )?;
     let mut index = 0usize;
     for (strand, &count) in raw.counts.iter().enumerate() {
         for point in 0..count as usize {
@@ -140,7 +172,12 @@ fn check_values(raw: &RawHair, file: &Path) -> Result<(), HairError> {
                 point,
                 value,
             };
-            let bad = |what: String, value: String, why| HairError::BadValue { file: file.to_path_buf(), what, value, why };
+            let bad = |what: String, value: String, why| HairError::BadValue {
+                file: file.to_path_buf(),
+                what,
+                value,
+                why,
+            };
             let p = raw.points[index];
             if !p.is_finite() {
                 return Err(non_finite("position", format!("{p}")));
@@ -150,7 +187,11 @@ fn check_values(raw: &RawHair, file: &Path) -> Result<(), HairError> {
                     return Err(non_finite("thickness", t[index].to_string()));
                 }
                 if t[index] < 0.0 {
-                    return Err(bad(format!("thickness of strand {strand}, point {point}"), t[index].to_string(), "negative"));
+                    return Err(bad(
+                        format!("thickness of strand {strand}, point {point}"),
+                        t[index].to_string(),
+                        "negative",
+                    ));
                 }
             }
             if let Some(Attribute::PerPoint(a)) = &raw.transparency {
@@ -158,13 +199,18 @@ fn check_values(raw: &RawHair, file: &Path) -> Result<(), HairError> {
                     return Err(non_finite("transparency", a[index].to_string()));
                 }
                 if !(0.0..=1.0).contains(&a[index]) {
-                    return Err(bad(format!("transparency of strand {strand}, point {point}"), a[index].to_string(), "outside [0, 1]"));
+                    return Err(bad(
+                        format!("transparency of strand {strand}, point {point}"),
+                        a[index].to_string(),
+                        "outside [0, 1]",
+                    ));
                 }
             }
-            if let Some(Attribute::PerPoint(c)) = &raw.color {
-                if !c[index].is_finite() {
+            match &raw.color {
+                Some(Attribute::PerPoint(c)) if !c[index].is_finite() => {
                     return Err(non_finite("color", format!("{}", c[index])));
                 }
+                _ => {}
             }
             index += 1;
         }
@@ -211,47 +257,94 @@ mod tests {
         // Strand 0: a repeated point in the middle and at the tip (2 merges).
         // Strand 1: one point only (dropped). Strand 2: all three points equal (2 merges, dropped).
         // Strand 3: differs by one ulp at 1000 (a merge: below float resolution). Strand 4: empty.
-        let ulp = 1000f32.next_up() - 1000.0;
+        let ulp = f32::from_bits(1000f32.to_bits() + 1) - 1000.0;
         let points = vec![
-            p(0.0, 0.0), p(0.0, 1.0), p(0.0, 1.0), p(0.0, 2.0), p(0.0, 2.0),
+            p(0.0, 0.0),
+            p(0.0, 1.0),
+            p(0.0, 1.0),
+            p(0.0, 2.0),
+            p(0.0, 2.0),
             p(5.0, 5.0),
-            p(7.0, 7.0), p(7.0, 7.0), p(7.0, 7.0),
-            Vec3::new(1.0, 1.0, 1000.0), Vec3::new(1.0, 1.0, 1000.0 + ulp), Vec3::new(1.0, 3.0, 1000.0),
+            p(7.0, 7.0),
+            p(7.0, 7.0),
+            p(7.0, 7.0),
+            Vec3::new(1.0, 1.0, 1000.0),
+            Vec3::new(1.0, 1.0, 1000.0 + ulp),
+            Vec3::new(1.0, 3.0, 1000.0),
         ];
-        let loaded = finish(raw(points, vec![5, 1, 3, 3, 0]), Path::new("t.hair"), HairFormat::Yuksel, String::new()).unwrap();
+        let loaded = finish(
+            raw(points, vec![5, 1, 3, 3, 0]),
+            Path::new("t.hair"),
+            HairFormat::Yuksel,
+            String::new(),
+        )
+        .unwrap();
         let (m, r) = (&loaded.model, &loaded.report);
-        eprintln!("merged {} dropped {} -> {}", r.degenerate_segments_merged, r.short_strands_dropped, m.summary());
+        eprintln!(
+            "merged {} dropped {} -> {}",
+            r.degenerate_segments_merged,
+            r.short_strands_dropped,
+            m.summary()
+        );
         assert_eq!(r.degenerate_segments_merged, 5);
         assert_eq!(r.short_strands_dropped, 3);
         assert_eq!((r.source_strands, r.source_points), (5, 12));
         assert_eq!(m.strand_offsets(), &[0, 3, 5]);
         assert_eq!(m.strand(0), &[p(0.0, 0.0), p(0.0, 1.0), p(0.0, 2.0)]);
         // Attributes follow the kept points: thickness was the original point index.
-        assert_eq!(m.thickness(), Some(&Attribute::PerPoint(vec![0.0, 1.0, 3.0, 9.0, 11.0])));
+        assert_eq!(
+            m.thickness(),
+            Some(&Attribute::PerPoint(vec![0.0, 1.0, 3.0, 9.0, 11.0]))
+        );
         assert_eq!(m.transparency(), Some(&Attribute::Uniform(0.5)));
     }
 
     #[test]
     fn nothing_left_is_an_error() {
         let r = raw(vec![Vec3::ONE, Vec3::ONE], vec![2]);
-        assert!(matches!(finish(r, Path::new("t.hair"), HairFormat::Yuksel, String::new()), Err(HairError::NoStrands { .. })));
+        assert!(matches!(
+            finish(r, Path::new("t.hair"), HairFormat::Yuksel, String::new()),
+            Err(HairError::NoStrands { .. })
+        ));
     }
 
     #[test]
     fn bad_values_name_strand_and_point() {
-        let mut r = raw(vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(0.0, f32::INFINITY, 0.0)], vec![2, 2]);
+        let mut r = raw(
+            vec![
+                Vec3::ZERO,
+                Vec3::X,
+                Vec3::Y,
+                Vec3::new(0.0, f32::INFINITY, 0.0),
+            ],
+            vec![2, 2],
+        );
         match finish(r, Path::new("t.hair"), HairFormat::Yuksel, String::new()) {
-            Err(HairError::NonFinite { strand: 1, point: 1, what: "position", .. }) => {}
+            Err(HairError::NonFinite {
+                strand: 1,
+                point: 1,
+                what: "position",
+                ..
+            }) => {}
             other => panic!("expected NonFinite at strand 1 point 1, got {other:?}"),
         }
         r = raw(vec![Vec3::ZERO, Vec3::X], vec![2]);
         r.thickness = Some(Attribute::PerPoint(vec![0.1, -0.1]));
-        assert!(matches!(finish(r, Path::new("t"), HairFormat::Yuksel, String::new()), Err(HairError::BadValue { .. })));
+        assert!(matches!(
+            finish(r, Path::new("t"), HairFormat::Yuksel, String::new()),
+            Err(HairError::BadValue { .. })
+        ));
         r = raw(vec![Vec3::ZERO, Vec3::X], vec![2]);
         r.transparency = Some(Attribute::Uniform(f32::NAN));
-        assert!(matches!(finish(r, Path::new("t"), HairFormat::Yuksel, String::new()), Err(HairError::BadValue { .. })));
+        assert!(matches!(
+            finish(r, Path::new("t"), HairFormat::Yuksel, String::new()),
+            Err(HairError::BadValue { .. })
+        ));
         r = raw(vec![Vec3::ZERO, Vec3::X], vec![2]);
         r.color = Some(Attribute::PerPoint(vec![Vec3::ONE, Vec3::NAN]));
-        assert!(matches!(finish(r, Path::new("t"), HairFormat::Yuksel, String::new()), Err(HairError::NonFinite { what: "color", .. })));
+        assert!(matches!(
+            finish(r, Path::new("t"), HairFormat::Yuksel, String::new()),
+            Err(HairError::NonFinite { what: "color", .. })
+        ));
     }
 }

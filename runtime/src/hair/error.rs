@@ -15,32 +15,75 @@ pub enum HairError {
     },
 
     #[error("{file}: not a {format} file (starts with {found:02x?})")]
-    BadMagic { file: PathBuf, format: &'static str, found: Vec<u8> },
+    BadMagic {
+        file: PathBuf,
+        format: &'static str,
+        found: Vec<u8>,
+    },
 
     #[error("{file}: truncated: {what} needs {needed} bytes but the file has {actual}")]
-    Truncated { file: PathBuf, what: String, needed: u64, actual: u64 },
+    Truncated {
+        file: PathBuf,
+        what: String,
+        needed: u64,
+        actual: u64,
+    },
 
     /// A count in the header so large that even at the smallest possible size per element the
     /// file could not hold it. Refused before anything is allocated.
-    #[error("{file}: absurd {what} count {count}: at {bytes_each} bytes each it needs more than the file's {file_len} bytes")]
-    AbsurdCount { file: PathBuf, what: &'static str, count: u64, bytes_each: u64, file_len: u64 },
+    #[error(
+        "{file}: absurd {what} count {count}: at {bytes_each} bytes each it needs more than the file's {file_len} bytes"
+    )]
+    AbsurdCount {
+        file: PathBuf,
+        what: &'static str,
+        count: u64,
+        bytes_each: u64,
+        file_len: u64,
+    },
 
     /// The counts are plausible and the data is all there, but the file is longer than they say.
-    #[error("{file}: the header's counts describe {expected} bytes but the file has {actual}; the file is corrupt or not this format")]
-    SizeMismatch { file: PathBuf, expected: u64, actual: u64 },
+    #[error(
+        "{file}: the header's counts describe {expected} bytes but the file has {actual}; the file is corrupt or not this format"
+    )]
+    SizeMismatch {
+        file: PathBuf,
+        expected: u64,
+        actual: u64,
+    },
 
     /// Two counts in the file that must agree do not.
     #[error("{file}: {what}: declared {declared}, but the data gives {actual}")]
-    CountMismatch { file: PathBuf, what: &'static str, declared: u64, actual: u64 },
+    CountMismatch {
+        file: PathBuf,
+        what: &'static str,
+        declared: u64,
+        actual: u64,
+    },
 
     #[error("{file}: invalid {what}: {value} ({why})")]
-    BadValue { file: PathBuf, what: String, value: String, why: &'static str },
+    BadValue {
+        file: PathBuf,
+        what: String,
+        value: String,
+        why: &'static str,
+    },
 
     #[error("{file}: {what} of strand {strand}, point {point} is not finite ({value})")]
-    NonFinite { file: PathBuf, what: &'static str, strand: usize, point: usize, value: String },
+    NonFinite {
+        file: PathBuf,
+        what: &'static str,
+        strand: usize,
+        point: usize,
+        value: String,
+    },
 
     #[error("{file}: unsupported {format} file: {why}")]
-    Unsupported { file: PathBuf, format: &'static str, why: String },
+    Unsupported {
+        file: PathBuf,
+        format: &'static str,
+        why: String,
+    },
 
     #[error("{file}: no strand with at least two distinct points is left after cleaning")]
     NoStrands { file: PathBuf },
@@ -57,5 +100,9 @@ pub enum HairError {
 
     /// A model that the target file format cannot represent.
     #[error("{file}: cannot write as {format}: {why}")]
-    NotRepresentable { file: PathBuf, format: &'static str, why: String },
+    NotRepresentable {
+        file: PathBuf,
+        format: &'static str,
+        why: String,
+    },
 }

@@ -55,7 +55,11 @@ impl Scalp {
     /// The polar-angle limit for a unit-sphere direction `d` (front = +z).
     pub fn polar_limit(&self, d: Vec3) -> f32 {
         let horizontal = (d.x * d.x + d.z * d.z).sqrt();
-        let toward_face = if horizontal > 0.0 { (d.z / horizontal).max(0.0) } else { 0.0 };
+        let toward_face = if horizontal > 0.0 {
+            (d.z / horizontal).max(0.0)
+        } else {
+            0.0
+        };
         self.max_polar_angle + (self.front_polar_angle - self.max_polar_angle) * toward_face
     }
 
@@ -121,26 +125,84 @@ impl GroomParams {
         let f = |v: f32| v as f64;
         let positive = |v: f64| v > 0.0;
         let non_negative = |v: f64| v >= 0.0;
-        for (name, v) in [("scalp.center.x", self.scalp.center.x), ("scalp.center.y", self.scalp.center.y), ("scalp.center.z", self.scalp.center.z)] {
+        for (name, v) in [
+            ("scalp.center.x", self.scalp.center.x),
+            ("scalp.center.y", self.scalp.center.y),
+            ("scalp.center.z", self.scalp.center.z),
+        ] {
             check(name, f(v), |_| true, "")?;
         }
-        for (name, v) in [("scalp.radii.x", self.scalp.radii.x), ("scalp.radii.y", self.scalp.radii.y), ("scalp.radii.z", self.scalp.radii.z)] {
+        for (name, v) in [
+            ("scalp.radii.x", self.scalp.radii.x),
+            ("scalp.radii.y", self.scalp.radii.y),
+            ("scalp.radii.z", self.scalp.radii.z),
+        ] {
             check(name, f(v), positive, "must be > 0")?;
         }
         let angle = |v: f64| v > 0.0 && v <= std::f64::consts::PI;
-        check("scalp.max_polar_angle", f(self.scalp.max_polar_angle), angle, "must be in (0, π]")?;
-        check("scalp.front_polar_angle", f(self.scalp.front_polar_angle), angle, "must be in (0, π]")?;
-        check("strand_count", self.strand_count as f64, |v| (1.0..=1e7).contains(&v), "must be in 1..=10,000,000")?;
-        check("points_per_strand", self.points_per_strand as f64, |v| (2.0..=1024.0).contains(&v), "must be in 2..=1024")?;
+        check(
+            "scalp.max_polar_angle",
+            f(self.scalp.max_polar_angle),
+            angle,
+            "must be in (0, π]",
+        )?;
+        check(
+            "scalp.front_polar_angle",
+            f(self.scalp.front_polar_angle),
+            angle,
+            "must be in (0, π]",
+        )?;
+        check(
+            "strand_count",
+            self.strand_count as f64,
+            |v| (1.0..=1e7).contains(&v),
+            "must be in 1..=10,000,000",
+        )?;
+        check(
+            "points_per_strand",
+            self.points_per_strand as f64,
+            |v| (2.0..=1024.0).contains(&v),
+            "must be in 2..=1024",
+        )?;
         let total = self.strand_count as f64 * self.points_per_strand as f64;
-        check("strand_count × points_per_strand", total, |v| v <= 1e8, "must be ≤ 100,000,000")?;
+        check(
+            "strand_count × points_per_strand",
+            total,
+            |v| v <= 1e8,
+            "must be ≤ 100,000,000",
+        )?;
         check("length_min", f(self.length_min), positive, "must be > 0")?;
-        check("length_max", f(self.length_max), |v| v >= f(self.length_min), "must be ≥ length_min")?;
-        check("curl_radius", f(self.curl_radius), non_negative, "must be ≥ 0")?;
-        check("curl_frequency", f(self.curl_frequency), non_negative, "must be ≥ 0")?;
-        check("clump_count", self.clump_count as f64, |v| v <= self.strand_count as f64, "must be ≤ strand_count")?;
+        check(
+            "length_max",
+            f(self.length_max),
+            |v| v >= f(self.length_min),
+            "must be ≥ length_min",
+        )?;
+        check(
+            "curl_radius",
+            f(self.curl_radius),
+            non_negative,
+            "must be ≥ 0",
+        )?;
+        check(
+            "curl_frequency",
+            f(self.curl_frequency),
+            non_negative,
+            "must be ≥ 0",
+        )?;
+        check(
+            "clump_count",
+            self.clump_count as f64,
+            |v| v <= self.strand_count as f64,
+            "must be ≤ strand_count",
+        )?;
         let unit = |v: f64| (0.0..=1.0).contains(&v);
-        check("clump_strength", f(self.clump_strength), unit, "must be in [0, 1]")?;
+        check(
+            "clump_strength",
+            f(self.clump_strength),
+            unit,
+            "must be in [0, 1]",
+        )?;
         check("gravity", f(self.gravity), unit, "must be in [0, 1]")?;
         check("thickness", f(self.thickness), non_negative, "must be ≥ 0")?;
         Ok(())
@@ -185,11 +247,16 @@ struct StrandSeed {
 pub fn generate_groom(params: &GroomParams) -> Result<HairModel, HairError> {
     params.validate()?;
     let mut rng = SplitMix64(params.seed);
-    let seeds: Vec<StrandSeed> = (0..params.strand_count).map(|_| draw_strand(&mut rng, params)).collect();
+    let seeds: Vec<StrandSeed> = (0..params.strand_count)
+        .map(|_| draw_strand(&mut rng, params))
+        .collect();
     let n = params.points_per_strand;
 
     // The drawn shape of every strand: centre line bent by gravity, plus the curl helix.
-    let shapes: Vec<Vec<Vec3>> = seeds.iter().map(|s| curled_center_line(s, params)).collect();
+    let shapes: Vec<Vec<Vec3>> = seeds
+        .iter()
+        .map(|s| curled_center_line(s, params))
+        .collect();
 
     // Clumps: the first `clump_count` strands are clump centres (their roots are uniformly
     // scattered already); every strand is pulled toward its nearest centre's shape.
@@ -210,14 +277,25 @@ pub fn generate_groom(params: &GroomParams) -> Result<HairModel, HairError> {
                 target[i] += pull;
             }
         }
-        follow_the_leader(&target, seed.length / (n - 1) as f32, &params.scalp, &mut points);
+        follow_the_leader(
+            &target,
+            seed.length / (n - 1) as f32,
+            &params.scalp,
+            &mut points,
+        );
         offsets.push(points.len() as u32);
     }
     let thickness = (0..params.strand_count)
         .flat_map(|_| (0..n).map(|i| params.thickness * (1.0 - 0.7 * i as f32 / (n - 1) as f32)))
         .collect();
     // Only parameters that overflow f32 (e.g. radii near 1e38) can fail here.
-    HairModel::new(points, offsets, Some(Attribute::PerPoint(thickness)), None, None)
+    HairModel::new(
+        points,
+        offsets,
+        Some(Attribute::PerPoint(thickness)),
+        None,
+        None,
+    )
 }
 
 fn draw_strand(rng: &mut SplitMix64, params: &GroomParams) -> StrandSeed {
@@ -234,7 +312,11 @@ fn draw_strand(rng: &mut SplitMix64, params: &GroomParams) -> StrandSeed {
         }
     };
     let root = scalp.center + scalp.radii * d;
-    let lean = Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0));
+    let lean = Vec3::new(
+        rng.range(-1.0, 1.0),
+        rng.range(-1.0, 1.0),
+        rng.range(-1.0, 1.0),
+    );
     StrandSeed {
         root,
         length: rng.range(params.length_min, params.length_max),
@@ -264,7 +346,9 @@ fn curled_center_line(seed: &StrandSeed, params: &GroomParams) -> Vec<Vec3> {
     let in_plane = |v: Vec3| v - v.dot(normal) * normal;
     // Combed hair leaves the scalp at a low angle, flowing away from the crown whorl; a small
     // random lean keeps neighbours from running exactly parallel.
-    let comb = in_plane(seed.root - params.scalp.crown()).try_normalize().unwrap_or_else(|| in_plane(seed.lean).normalize_or(normal.any_orthonormal_vector()));
+    let comb = in_plane(seed.root - params.scalp.crown())
+        .try_normalize()
+        .unwrap_or_else(|| in_plane(seed.lean).normalize_or(normal.any_orthonormal_vector()));
     let start = (comb + ROOT_LIFT * normal + 0.2 * in_plane(seed.lean)).normalize();
     let mut line = Vec::with_capacity(n);
     let mut tangents = Vec::with_capacity(n);
@@ -273,7 +357,9 @@ fn curled_center_line(seed: &StrandSeed, params: &GroomParams) -> Vec<Vec3> {
         let t = i as f32 / (n - 1) as f32;
         // Gravity wins gradually: the bend grows with the distance from the root.
         let bend = params.gravity * (1.0 - (1.0 - t) * (1.0 - t));
-        let dir = (start * (1.0 - bend) + Vec3::NEG_Y * bend).try_normalize().unwrap_or(Vec3::NEG_Y);
+        let dir = (start * (1.0 - bend) + Vec3::NEG_Y * bend)
+            .try_normalize()
+            .unwrap_or(Vec3::NEG_Y);
         line.push(p);
         tangents.push(dir);
         p += step * dir;
@@ -286,7 +372,9 @@ fn curled_center_line(seed: &StrandSeed, params: &GroomParams) -> Vec<Vec3> {
     let mut u = tangents[0].any_orthonormal_vector();
     for i in 0..n {
         let tangent = tangents[i];
-        u = (u - u.dot(tangent) * tangent).try_normalize().unwrap_or_else(|| tangent.any_orthonormal_vector());
+        u = (u - u.dot(tangent) * tangent)
+            .try_normalize()
+            .unwrap_or_else(|| tangent.any_orthonormal_vector());
         let v = tangent.cross(u);
         let s = i as f32 * step;
         let ramp = smoothstep((s / (0.2 * seed.length)).min(1.0));
@@ -312,7 +400,9 @@ fn follow_the_leader(target: &[Vec3], step: f32, scalp: &Scalp, out: &mut Vec<Ve
         let g = scalp.gradient(p);
         if scalp.implicit(p + step * dir) < scalp.implicit(p).max(1.0) && dir.dot(g) < 0.0 {
             let gn = g.normalize();
-            dir = (dir - dir.dot(gn) * gn).try_normalize().unwrap_or_else(|| gn.any_orthonormal_vector());
+            dir = (dir - dir.dot(gn) * gn)
+                .try_normalize()
+                .unwrap_or_else(|| gn.any_orthonormal_vector());
         }
         p += step * dir;
         out.push(p);
@@ -324,7 +414,12 @@ mod tests {
     use super::*;
 
     fn small() -> GroomParams {
-        GroomParams { strand_count: 800, points_per_strand: 16, clump_count: 40, ..GroomParams::default() }
+        GroomParams {
+            strand_count: 800,
+            points_per_strand: 16,
+            clump_count: 40,
+            ..GroomParams::default()
+        }
     }
 
     #[test]
@@ -334,8 +429,16 @@ mod tests {
         let c = generate_groom(&GroomParams { seed: 2, ..small() }).unwrap();
         assert_eq!(a.points_bytes(), b.points_bytes());
         assert_eq!(a, b);
-        let differing = a.points().iter().zip(c.points()).filter(|(p, q)| p != q).count();
-        eprintln!("seed 1 vs 2: {differing} of {} points differ", a.point_count());
+        let differing = a
+            .points()
+            .iter()
+            .zip(c.points())
+            .filter(|(p, q)| p != q)
+            .count();
+        eprintln!(
+            "seed 1 vs 2: {differing} of {} points differ",
+            a.point_count()
+        );
         assert!(differing > a.point_count() * 9 / 10);
     }
 
@@ -344,7 +447,10 @@ mod tests {
         let params = small();
         let m = generate_groom(&params).unwrap();
         assert_eq!(m.strand_count(), params.strand_count);
-        assert_eq!(m.point_count(), params.strand_count * params.points_per_strand);
+        assert_eq!(
+            m.point_count(),
+            params.strand_count * params.points_per_strand
+        );
         let scalp = &params.scalp;
         let (mut worst_root, mut min_inside, mut lengths) = (0f64, f64::INFINITY, Vec::new());
         for strand in m.strands() {
@@ -357,25 +463,60 @@ mod tests {
                 let q = (p - scalp.center).as_dvec3() / scalp.radii.as_dvec3();
                 min_inside = min_inside.min(q.length_squared());
             }
-            lengths.push(strand.windows(2).map(|w| w[0].as_dvec3().distance(w[1].as_dvec3())).sum::<f64>());
+            lengths.push(
+                strand
+                    .windows(2)
+                    .map(|w| w[0].as_dvec3().distance(w[1].as_dvec3()))
+                    .sum::<f64>(),
+            );
         }
-        let (lo, hi) = lengths.iter().fold((f64::INFINITY, 0f64), |(lo, hi), &l| (lo.min(l), hi.max(l)));
-        eprintln!("roots: max |f−1| = {worst_root:.2e}; min f over other points = {min_inside:.6}; lengths {lo:.4}..{hi:.4} (asked {}..{})", params.length_min, params.length_max);
+        let (lo, hi) = lengths
+            .iter()
+            .fold((f64::INFINITY, 0f64), |(lo, hi), &l| (lo.min(l), hi.max(l)));
+        eprintln!(
+            "roots: max |f−1| = {worst_root:.2e}; min f over other points = {min_inside:.6}; lengths {lo:.4}..{hi:.4} (asked {}..{})",
+            params.length_min, params.length_max
+        );
         assert!(worst_root < 1e-5);
         assert!(min_inside > 1.0 - 1e-4);
-        assert!(lo >= params.length_min as f64 * (1.0 - 1e-4) && hi <= params.length_max as f64 * (1.0 + 1e-4));
+        assert!(
+            lo >= params.length_min as f64 * (1.0 - 1e-4)
+                && hi <= params.length_max as f64 * (1.0 + 1e-4)
+        );
         // The lengths actually spread over the range (uniform draws: expect near both ends).
-        assert!(lo < params.length_min as f64 + 0.05 * (params.length_max - params.length_min) as f64);
-        assert!(hi > params.length_max as f64 - 0.05 * (params.length_max - params.length_min) as f64);
+        assert!(
+            lo < params.length_min as f64 + 0.05 * (params.length_max - params.length_min) as f64
+        );
+        assert!(
+            hi > params.length_max as f64 - 0.05 * (params.length_max - params.length_min) as f64
+        );
     }
 
     #[test]
     fn gravity_and_curl_do_what_they_say() {
-        let straight = GroomParams { curl_radius: 0.0, clump_count: 0, ..small() };
-        let up = generate_groom(&GroomParams { gravity: 0.0, ..straight.clone() }).unwrap();
-        let down = generate_groom(&GroomParams { gravity: 1.0, ..straight.clone() }).unwrap();
-        let mean_tip_y = |m: &HairModel| m.strands().map(|s| s[s.len() - 1].y as f64).sum::<f64>() / m.strand_count() as f64;
-        eprintln!("mean tip y: gravity 0 → {:.3}, gravity 1 → {:.3}", mean_tip_y(&up), mean_tip_y(&down));
+        let straight = GroomParams {
+            curl_radius: 0.0,
+            clump_count: 0,
+            ..small()
+        };
+        let up = generate_groom(&GroomParams {
+            gravity: 0.0,
+            ..straight.clone()
+        })
+        .unwrap();
+        let down = generate_groom(&GroomParams {
+            gravity: 1.0,
+            ..straight.clone()
+        })
+        .unwrap();
+        let mean_tip_y = |m: &HairModel| {
+            m.strands().map(|s| s[s.len() - 1].y as f64).sum::<f64>() / m.strand_count() as f64
+        };
+        eprintln!(
+            "mean tip y: gravity 0 → {:.3}, gravity 1 → {:.3}",
+            mean_tip_y(&up),
+            mean_tip_y(&down)
+        );
         assert!(mean_tip_y(&down) < mean_tip_y(&up) - 5.0);
 
         // Without curl a strand is nearly straight when gravity is off: chord ≈ length.
@@ -390,42 +531,112 @@ mod tests {
                 / m.strand_count() as f64
         };
         // 64 points over ~22 units at 0.15 turns/unit: about 19 points per turn.
-        let curly = generate_groom(&GroomParams { gravity: 0.0, curl_radius: 1.0, curl_frequency: 0.15, points_per_strand: 64, ..straight }).unwrap();
-        eprintln!("mean chord/arc: straight {:.4}, curly {:.4}", chord_ratio(&up), chord_ratio(&curly));
+        let curly = generate_groom(&GroomParams {
+            gravity: 0.0,
+            curl_radius: 1.0,
+            curl_frequency: 0.15,
+            points_per_strand: 64,
+            ..straight
+        })
+        .unwrap();
+        eprintln!(
+            "mean chord/arc: straight {:.4}, curly {:.4}",
+            chord_ratio(&up),
+            chord_ratio(&curly)
+        );
         assert!(chord_ratio(&up) > 0.97);
         assert!(chord_ratio(&curly) < chord_ratio(&up) - 0.1);
     }
 
     #[test]
     fn clumping_brings_neighbours_together() {
-        let base = GroomParams { clump_count: 30, ..small() };
+        let base = GroomParams {
+            clump_count: 30,
+            ..small()
+        };
         let spread = |m: &HairModel| {
             // Mean distance from each tip to the tip of the nearest other strand.
             let tips: Vec<Vec3> = m.strands().map(|s| s[s.len() - 1]).collect();
             tips.iter()
                 .enumerate()
-                .map(|(i, a)| tips.iter().enumerate().filter(|(j, _)| *j != i).map(|(_, b)| a.distance(*b)).fold(f32::INFINITY, f32::min) as f64)
+                .map(|(i, a)| {
+                    tips.iter()
+                        .enumerate()
+                        .filter(|(j, _)| *j != i)
+                        .map(|(_, b)| a.distance(*b))
+                        .fold(f32::INFINITY, f32::min) as f64
+                })
                 .sum::<f64>()
                 / tips.len() as f64
         };
-        let loose = generate_groom(&GroomParams { clump_strength: 0.0, ..base.clone() }).unwrap();
-        let tight = generate_groom(&GroomParams { clump_strength: 0.9, ..base }).unwrap();
-        eprintln!("mean nearest-tip distance: no clumping {:.4}, clump 0.9 {:.4}", spread(&loose), spread(&tight));
+        let loose = generate_groom(&GroomParams {
+            clump_strength: 0.0,
+            ..base.clone()
+        })
+        .unwrap();
+        let tight = generate_groom(&GroomParams {
+            clump_strength: 0.9,
+            ..base
+        })
+        .unwrap();
+        eprintln!(
+            "mean nearest-tip distance: no clumping {:.4}, clump 0.9 {:.4}",
+            spread(&loose),
+            spread(&tight)
+        );
         assert!(spread(&tight) < 0.5 * spread(&loose));
     }
 
     #[test]
     fn bad_parameters_are_named() {
         let bad = |p: GroomParams, name: &str| match generate_groom(&p) {
-            Err(HairError::Param(ParamError::OutOfRange { name: n, .. } | ParamError::NotFinite { name: n, .. })) => assert_eq!(n, name),
+            Err(HairError::Param(
+                ParamError::OutOfRange { name: n, .. } | ParamError::NotFinite { name: n, .. },
+            )) => assert_eq!(n, name),
             other => panic!("expected an error naming {name}, got {other:?}"),
         };
-        bad(GroomParams { strand_count: 0, ..small() }, "strand_count");
-        bad(GroomParams { points_per_strand: 1, ..small() }, "points_per_strand");
-        bad(GroomParams { length_max: 1.0, ..small() }, "length_max");
-        bad(GroomParams { gravity: f32::NAN, ..small() }, "gravity");
-        bad(GroomParams { clump_strength: 1.5, ..small() }, "clump_strength");
-        bad(GroomParams { clump_count: 10_000, ..small() }, "clump_count");
+        bad(
+            GroomParams {
+                strand_count: 0,
+                ..small()
+            },
+            "strand_count",
+        );
+        bad(
+            GroomParams {
+                points_per_strand: 1,
+                ..small()
+            },
+            "points_per_strand",
+        );
+        bad(
+            GroomParams {
+                length_max: 1.0,
+                ..small()
+            },
+            "length_max",
+        );
+        bad(
+            GroomParams {
+                gravity: f32::NAN,
+                ..small()
+            },
+            "gravity",
+        );
+        bad(
+            GroomParams {
+                clump_strength: 1.5,
+                ..small()
+            },
+            "clump_strength",
+        );
+        bad(
+            GroomParams {
+                clump_count: 10_000,
+                ..small()
+            },
+            "clump_count",
+        );
         let mut p = small();
         p.scalp.radii.y = 0.0;
         bad(p, "scalp.radii.y");

@@ -29,7 +29,10 @@ pub use yuksel::{HairWriteOptions, load_hair, write_hair};
 
 /// Loads a hair file, choosing the format by extension (`.hair`, `.tfx`, `.data`, `.ply`).
 pub fn load(path: &Path) -> Result<LoadedHair, HairError> {
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
     match ext.as_deref() {
         Some("hair") => load_hair(path),
         Some("tfx") => load_tfx(path),
@@ -40,7 +43,11 @@ pub fn load(path: &Path) -> Result<LoadedHair, HairError> {
 }
 
 fn read_file(path: &Path) -> Result<Vec<u8>, HairError> {
-    std::fs::read(path).map_err(|source| HairError::Io { file: path.into(), action: "read", source })
+    std::fs::read(path).map_err(|source| HairError::Io {
+        file: path.into(),
+        action: "read",
+        source,
+    })
 }
 
 /// Writes through a temporary file beside `path` and renames it, so that a failure never leaves
@@ -49,7 +56,11 @@ fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), HairError> {
     let mut tmp_name = path.file_name().unwrap_or_default().to_os_string();
     tmp_name.push(format!(".{}.tmp", std::process::id()));
     let tmp = path.with_file_name(tmp_name);
-    let io = |action, source| HairError::Io { file: path.into(), action, source };
+    let io = |action, source| HairError::Io {
+        file: path.into(),
+        action,
+        source,
+    };
     std::fs::write(&tmp, bytes).map_err(|e| {
         let _ = std::fs::remove_file(&tmp);
         io("write", e)
@@ -66,7 +77,10 @@ mod tests {
 
     #[test]
     fn unknown_extension_and_missing_file_are_errors() {
-        assert!(matches!(load(Path::new("x.obj")), Err(HairError::UnknownExtension { .. })));
+        assert!(matches!(
+            load(Path::new("x.obj")),
+            Err(HairError::UnknownExtension { .. })
+        ));
         let e = load(Path::new("/nonexistent/dir/x.hair")).unwrap_err();
         assert!(matches!(e, HairError::Io { .. }));
         assert!(e.to_string().contains("/nonexistent/dir/x.hair"), "{e}");

@@ -39,11 +39,17 @@ pub struct Aabb {
 
 impl Aabb {
     pub fn empty() -> Self {
-        Self { min: Vec3::splat(f32::INFINITY), max: Vec3::splat(f32::NEG_INFINITY) }
+        Self {
+            min: Vec3::splat(f32::INFINITY),
+            max: Vec3::splat(f32::NEG_INFINITY),
+        }
     }
 
     pub fn from_points(points: &[Vec3]) -> Self {
-        points.iter().fold(Self::empty(), |b, &p| Self { min: b.min.min(p), max: b.max.max(p) })
+        points.iter().fold(Self::empty(), |b, &p| Self {
+            min: b.min.min(p),
+            max: b.max.max(p),
+        })
     }
 
     pub fn size(&self) -> Vec3 {
@@ -106,17 +112,33 @@ impl HairModel {
                 strand_offsets.last().unwrap()
             ));
         }
-        if let Some(s) = strand_offsets.windows(2).position(|w| w[1] < w[0].saturating_add(2)) {
-            return invalid(format!("strand {s} has fewer than 2 points (or offsets decrease)"));
+        if let Some(s) = strand_offsets
+            .windows(2)
+            .position(|w| w[1] < w[0].saturating_add(2))
+        {
+            return invalid(format!(
+                "strand {s} has fewer than 2 points (or offsets decrease)"
+            ));
         }
         if let Some(i) = points.iter().position(|p| !p.is_finite()) {
             return invalid(format!("point {i} is not finite ({})", points[i]));
         }
-        check_attribute("thickness", &thickness, points.len(), |t| t.is_finite() && *t >= 0.0)?;
-        check_attribute("transparency", &transparency, points.len(), |a| (0.0..=1.0).contains(a))?;
+        check_attribute("thickness", &thickness, points.len(), |t| {
+            t.is_finite() && *t >= 0.0
+        })?;
+        check_attribute("transparency", &transparency, points.len(), |a| {
+            (0.0..=1.0).contains(a)
+        })?;
         check_attribute("color", &color, points.len(), |c| c.is_finite())?;
         let bounds = Aabb::from_points(&points);
-        Ok(Self { points, strand_offsets, thickness, transparency, color, bounds })
+        Ok(Self {
+            points,
+            strand_offsets,
+            thickness,
+            transparency,
+            color,
+            bounds,
+        })
     }
 
     pub fn points(&self) -> &[Vec3] {
@@ -134,7 +156,9 @@ impl HairModel {
     }
 
     pub fn strands(&self) -> impl ExactSizeIterator<Item = &[Vec3]> + '_ {
-        self.strand_offsets.windows(2).map(|w| &self.points[w[0] as usize..w[1] as usize])
+        self.strand_offsets
+            .windows(2)
+            .map(|w| &self.points[w[0] as usize..w[1] as usize])
     }
 
     pub fn strand_count(&self) -> usize {
@@ -207,13 +231,19 @@ fn check_attribute<T: fmt::Debug>(
     let invalid = |problem: String| Err(HairError::InvalidModel { problem });
     match attribute {
         None => Ok(()),
-        Some(Attribute::Uniform(v)) if !valid(v) => invalid(format!("uniform {name} {v:?} is out of range")),
-        Some(Attribute::Uniform(_)) => Ok(()),
-        Some(Attribute::PerPoint(values)) if values.len() != point_count => {
-            invalid(format!("{} {name} values for {point_count} points", values.len()))
+        Some(Attribute::Uniform(v)) if !valid(v) => {
+            invalid(format!("uniform {name} {v:?} is out of range"))
         }
+        Some(Attribute::Uniform(_)) => Ok(()),
+        Some(Attribute::PerPoint(values)) if values.len() != point_count => invalid(format!(
+            "{} {name} values for {point_count} points",
+            values.len()
+        )),
         Some(Attribute::PerPoint(values)) => match values.iter().position(|v| !valid(v)) {
-            Some(i) => invalid(format!("{name} of point {i} ({:?}) is out of range", values[i])),
+            Some(i) => invalid(format!(
+                "{name} of point {i} ({:?}) is out of range",
+                values[i]
+            )),
             None => Ok(()),
         },
     }
@@ -292,7 +322,10 @@ mod tests {
     fn counts_bounds_and_strand_ranges() {
         let (points, offsets) = two_strands();
         let m = HairModel::new(points.clone(), offsets, None, None, None).unwrap();
-        assert_eq!((m.strand_count(), m.point_count(), m.segment_count()), (2, 5, 3));
+        assert_eq!(
+            (m.strand_count(), m.point_count(), m.segment_count()),
+            (2, 5, 3)
+        );
         assert_eq!(m.strand(1), &points[2..5]);
         assert_eq!(m.bounds().min, Vec3::new(0.0, 0.0, -3.0));
         assert_eq!(m.bounds().max, Vec3::new(1.0, 2.0, 0.0));
@@ -306,9 +339,13 @@ mod tests {
     #[test]
     fn invariants_are_enforced() {
         let (points, offsets) = two_strands();
-        let bad = |p: Vec<Vec3>, o: Vec<u32>, t: Option<Attribute<f32>>, a: Option<Attribute<f32>>| {
-            matches!(HairModel::new(p, o, t, a, None), Err(HairError::InvalidModel { .. }))
-        };
+        let bad =
+            |p: Vec<Vec3>, o: Vec<u32>, t: Option<Attribute<f32>>, a: Option<Attribute<f32>>| {
+                matches!(
+                    HairModel::new(p, o, t, a, None),
+                    Err(HairError::InvalidModel { .. })
+                )
+            };
         assert!(bad(points.clone(), vec![0], None, None));
         assert!(bad(points.clone(), vec![0, 1, 5], None, None));
         assert!(bad(points.clone(), vec![0, 2, 4], None, None));
@@ -316,9 +353,29 @@ mod tests {
         let mut nan = points.clone();
         nan[3].y = f32::NAN;
         assert!(bad(nan, offsets.clone(), None, None));
-        assert!(bad(points.clone(), offsets.clone(), Some(Attribute::Uniform(-1.0)), None));
-        assert!(bad(points.clone(), offsets.clone(), Some(Attribute::PerPoint(vec![1.0; 4])), None));
-        assert!(bad(points.clone(), offsets.clone(), None, Some(Attribute::Uniform(1.5))));
-        assert!(!bad(points, offsets, Some(Attribute::PerPoint(vec![1.0; 5])), Some(Attribute::Uniform(1.0))));
+        assert!(bad(
+            points.clone(),
+            offsets.clone(),
+            Some(Attribute::Uniform(-1.0)),
+            None
+        ));
+        assert!(bad(
+            points.clone(),
+            offsets.clone(),
+            Some(Attribute::PerPoint(vec![1.0; 4])),
+            None
+        ));
+        assert!(bad(
+            points.clone(),
+            offsets.clone(),
+            None,
+            Some(Attribute::Uniform(1.5))
+        ));
+        assert!(!bad(
+            points,
+            offsets,
+            Some(Attribute::PerPoint(vec![1.0; 5])),
+            Some(Attribute::Uniform(1.0))
+        ));
     }
 }

@@ -93,7 +93,10 @@ impl Element {
 
     /// The smallest possible size of one instance (lists counted as empty).
     fn min_bytes(&self) -> u64 {
-        self.properties.iter().map(|p| p.list_count.unwrap_or(p.kind).size()).sum()
+        self.properties
+            .iter()
+            .map(|p| p.list_count.unwrap_or(p.kind).size())
+            .sum()
     }
 }
 
@@ -101,29 +104,53 @@ impl Element {
 pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
     let (elements, body_start) = parse_header(data, file)?;
     let bytes = FileBytes::new(data, file);
-    let unsupported = |why: String| HairError::Unsupported { file: file.into(), format: FORMAT, why };
+    let unsupported = |why: String| HairError::Unsupported {
+        file: file.into(),
+        format: FORMAT,
+        why,
+    };
     let find = |name: &str| elements.iter().position(|e| e.name == name);
     let vertex_index = find("vertex").ok_or_else(|| unsupported("no `vertex` element".into()))?;
-    let strand_index = find("strand").ok_or_else(|| unsupported("no `strand` element (segment counts per strand)".into()))?;
+    let strand_index = find("strand")
+        .ok_or_else(|| unsupported("no `strand` element (segment counts per strand)".into()))?;
     let vertex = &elements[vertex_index];
     let strand = &elements[strand_index];
-    let xyz: Vec<usize> = ["x", "y", "z"].iter().filter_map(|n| vertex.property(n)).collect();
+    let xyz: Vec<usize> = ["x", "y", "z"]
+        .iter()
+        .filter_map(|n| vertex.property(n))
+        .collect();
     if xyz.len() != 3 {
         return Err(unsupported("`vertex` lacks one of x, y, z".into()));
     }
-    let rgb: Vec<usize> = ["red", "green", "blue"].iter().filter_map(|n| vertex.property(n)).collect();
+    let rgb: Vec<usize> = ["red", "green", "blue"]
+        .iter()
+        .filter_map(|n| vertex.property(n))
+        .collect();
     let nsegs = ["nsegs", "num_segments", "segments"]
         .iter()
         .find_map(|n| strand.property(n))
         .ok_or_else(|| unsupported("`strand` has no `nsegs` property".into()))?;
-    if [vertex, strand].iter().any(|e| e.properties.iter().any(|p| p.list_count.is_some())) {
-        return Err(unsupported("list properties in `vertex` or `strand`".into()));
+    if [vertex, strand]
+        .iter()
+        .any(|e| e.properties.iter().any(|p| p.list_count.is_some()))
+    {
+        return Err(unsupported(
+            "list properties in `vertex` or `strand`".into(),
+        ));
     }
 
     // Absurd counts: every element's instances must fit in what follows the header.
     let body = FileBytes::new(&data[body_start..], file);
     for e in &elements {
-        body.check_count_fits(if e.name == "vertex" { "vertex" } else { "element" }, e.count, e.min_bytes().max(1))?;
+        body.check_count_fits(
+            if e.name == "vertex" {
+                "vertex"
+            } else {
+                "element"
+            },
+            e.count,
+            e.min_bytes().max(1),
+        )?;
     }
 
     let mut offset = body_start as u64;
@@ -134,7 +161,9 @@ pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
         let stride = element.min_bytes();
         let fixed = element.properties.iter().all(|p| p.list_count.is_none());
         if index == vertex_index || index == strand_index {
-            let all = bytes.slice(offset, stride * element.count, || format!("{} {} elements", element.count, element.name))?;
+            let all = bytes.slice(offset, stride * element.count, || {
+                format!("{} {} elements", element.count, element.name)
+            })?;
             let field_offsets: Vec<usize> = element
                 .properties
                 .iter()
@@ -144,12 +173,23 @@ pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
                     Some(here)
                 })
                 .collect();
-            let value = |row: &[u8], p: usize| element.properties[p].kind.read(&row[field_offsets[p]..]);
+            let value =
+                |row: &[u8], p: usize| element.properties[p].kind.read(&row[field_offsets[p]..]);
             for row in all.chunks_exact(stride as usize) {
                 if index == vertex_index {
-                    points.push(Vec3::new(value(row, xyz[0]) as f32, value(row, xyz[1]) as f32, value(row, xyz[2]) as f32));
+                    points.push(Vec3::new(
+                        value(row, xyz[0]) as f32,
+                        value(row, xyz[1]) as f32,
+                        value(row, xyz[2]) as f32,
+                    ));
                     if rgb.len() == 3 {
-                        let scale = |p: usize| if element.properties[p].kind == Scalar::U8 { 1.0 / 255.0 } else { 1.0 };
+                        let scale = |p: usize| {
+                            if element.properties[p].kind == Scalar::U8 {
+                                1.0 / 255.0
+                            } else {
+                                1.0
+                            }
+                        };
                         let c = |i: usize| (value(row, rgb[i]) * scale(rgb[i])) as f32;
                         colors.push(Vec3::new(c(0), c(1), c(2)));
                     }
@@ -177,9 +217,18 @@ pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
     if offset != bytes.len() {
         let what = format!("{} elements after the header", elements.len());
         return Err(if offset > bytes.len() {
-            HairError::Truncated { file: file.into(), what, needed: offset, actual: bytes.len() }
+            HairError::Truncated {
+                file: file.into(),
+                what,
+                needed: offset,
+                actual: bytes.len(),
+            }
         } else {
-            HairError::SizeMismatch { file: file.into(), expected: offset, actual: bytes.len() }
+            HairError::SizeMismatch {
+                file: file.into(),
+                expected: offset,
+                actual: bytes.len(),
+            }
         });
     }
     let counted: u64 = counts.iter().map(|&c| c as u64).sum();
@@ -192,11 +241,26 @@ pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
         });
     }
     let color = (rgb.len() == 3).then_some(Attribute::PerPoint(colors));
-    finish(RawHair { points, counts, thickness: None, transparency: None, color }, file, HairFormat::Ply, String::new())
+    finish(
+        RawHair {
+            points,
+            counts,
+            thickness: None,
+            transparency: None,
+            color,
+        },
+        file,
+        HairFormat::Ply,
+        String::new(),
+    )
 }
 
 /// Reads past an element that has list properties, one instance at a time.
-fn skip_with_lists(bytes: &FileBytes, element: &Element, mut offset: u64) -> Result<u64, HairError> {
+fn skip_with_lists(
+    bytes: &FileBytes,
+    element: &Element,
+    mut offset: u64,
+) -> Result<u64, HairError> {
     for i in 0..element.count {
         for p in &element.properties {
             let what = || format!("{} {} property {}", element.name, i, p.name);
@@ -214,18 +278,29 @@ fn skip_with_lists(bytes: &FileBytes, element: &Element, mut offset: u64) -> Res
 }
 
 fn parse_header(data: &[u8], file: &Path) -> Result<(Vec<Element>, usize), HairError> {
-    let unsupported = |why: String| HairError::Unsupported { file: file.into(), format: FORMAT, why };
+    let unsupported = |why: String| HairError::Unsupported {
+        file: file.into(),
+        format: FORMAT,
+        why,
+    };
     if !data.starts_with(b"ply\n") && !data.starts_with(b"ply\r\n") {
-        return Err(HairError::BadMagic { file: file.into(), format: FORMAT, found: data[..data.len().min(4)].to_vec() });
+        return Err(HairError::BadMagic {
+            file: file.into(),
+            format: FORMAT,
+            found: data[..data.len().min(4)].to_vec(),
+        });
     }
     const END: &[u8] = b"end_header\n";
     let head = &data[..data.len().min(HEADER_LIMIT)];
-    let end = head.windows(END.len()).position(|w| w == END).ok_or_else(|| HairError::Truncated {
-        file: file.into(),
-        what: format!("a PLY header ending in `end_header` within {HEADER_LIMIT} bytes"),
-        needed: data.len() as u64 + 1,
-        actual: data.len() as u64,
-    })?;
+    let end = head
+        .windows(END.len())
+        .position(|w| w == END)
+        .ok_or_else(|| HairError::Truncated {
+            file: file.into(),
+            what: format!("a PLY header ending in `end_header` within {HEADER_LIMIT} bytes"),
+            needed: data.len() as u64 + 1,
+            actual: data.len() as u64,
+        })?;
     let text = String::from_utf8_lossy(&head[..end]);
     let mut elements: Vec<Element> = Vec::new();
     let mut format_ok = false;
@@ -233,22 +308,45 @@ fn parse_header(data: &[u8], file: &Path) -> Result<(Vec<Element>, usize), HairE
         let words: Vec<&str> = line.split_whitespace().collect();
         match words.as_slice() {
             ["format", "binary_little_endian", _] => format_ok = true,
-            ["format", other, ..] => return Err(unsupported(format!("format {other} (only binary_little_endian)"))),
+            ["format", other, ..] => {
+                return Err(unsupported(format!(
+                    "format {other} (only binary_little_endian)"
+                )));
+            }
             ["element", name, count] => {
-                let count = count.parse().map_err(|_| unsupported(format!("element count `{count}`")))?;
-                elements.push(Element { name: name.to_string(), count, properties: Vec::new() });
+                let count = count
+                    .parse()
+                    .map_err(|_| unsupported(format!("element count `{count}`")))?;
+                elements.push(Element {
+                    name: name.to_string(),
+                    count,
+                    properties: Vec::new(),
+                });
             }
             ["property", "list", count_kind, kind, name] => {
                 let (Some(c), Some(k)) = (Scalar::parse(count_kind), Scalar::parse(kind)) else {
                     return Err(unsupported(format!("property line `{line}`")));
                 };
-                let e = elements.last_mut().ok_or_else(|| unsupported("property before any element".into()))?;
-                e.properties.push(Property { name: name.to_string(), kind: k, list_count: Some(c) });
+                let e = elements
+                    .last_mut()
+                    .ok_or_else(|| unsupported("property before any element".into()))?;
+                e.properties.push(Property {
+                    name: name.to_string(),
+                    kind: k,
+                    list_count: Some(c),
+                });
             }
             ["property", kind, name] => {
-                let k = Scalar::parse(kind).ok_or_else(|| unsupported(format!("property type `{kind}`")))?;
-                let e = elements.last_mut().ok_or_else(|| unsupported("property before any element".into()))?;
-                e.properties.push(Property { name: name.to_string(), kind: k, list_count: None });
+                let k = Scalar::parse(kind)
+                    .ok_or_else(|| unsupported(format!("property type `{kind}`")))?;
+                let e = elements
+                    .last_mut()
+                    .ok_or_else(|| unsupported("property before any element".into()))?;
+                e.properties.push(Property {
+                    name: name.to_string(),
+                    kind: k,
+                    list_count: None,
+                });
             }
             ["comment", ..] | ["obj_info", ..] | [] => {}
             _ => return Err(unsupported(format!("header line `{line}`"))),
@@ -291,7 +389,13 @@ mod tests {
 
     #[test]
     fn reads_strands_and_colors() {
-        let pts = [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [2.0, 0.0, 0.0], [2.0, 1.0, 0.0], [2.0, 2.0, 0.0]];
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 1.0, 0.0],
+            [2.0, 2.0, 0.0],
+        ];
         let m = parse(&file(&pts, &[1, 2], true)).unwrap().model;
         assert_eq!(m.strand_offsets(), &[0, 2, 5]);
         assert_eq!(m.strand(1)[2], Vec3::new(2.0, 2.0, 0.0));
@@ -300,15 +404,36 @@ mod tests {
 
     #[test]
     fn crafted_bad_files_give_their_own_errors() {
-        let pts = [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [2.0, 0.0, 0.0], [2.0, 1.0, 0.0]];
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 1.0, 0.0],
+        ];
         let good = file(&pts, &[1, 1], false);
         assert!(parse(&good).is_ok());
-        assert!(matches!(parse(&file(&pts, &[1, 2], false)), Err(HairError::CountMismatch { .. })));
-        assert!(matches!(parse(&file(&pts, &[1, 0], false)), Err(HairError::CountMismatch { .. })));
-        assert!(matches!(parse(&good[..good.len() - 1]), Err(HairError::Truncated { .. })));
+        assert!(matches!(
+            parse(&file(&pts, &[1, 2], false)),
+            Err(HairError::CountMismatch { .. })
+        ));
+        assert!(matches!(
+            parse(&file(&pts, &[1, 0], false)),
+            Err(HairError::CountMismatch { .. })
+        ));
+        assert!(matches!(
+            parse(&good[..good.len() - 1]),
+            Err(HairError::Truncated { .. })
+        ));
         assert!(matches!(parse(b"plx\n"), Err(HairError::BadMagic { .. })));
-        assert!(matches!(parse(b"ply\nformat ascii 1.0\nend_header\n"), Err(HairError::Unsupported { .. })));
-        let absurd = String::from_utf8_lossy(&good).replace("element vertex 4", "element vertex 400000000");
-        assert!(matches!(parse(absurd.as_bytes()), Err(HairError::AbsurdCount { .. })));
+        assert!(matches!(
+            parse(b"ply\nformat ascii 1.0\nend_header\n"),
+            Err(HairError::Unsupported { .. })
+        ));
+        let absurd =
+            String::from_utf8_lossy(&good).replace("element vertex 4", "element vertex 400000000");
+        assert!(matches!(
+            parse(absurd.as_bytes()),
+            Err(HairError::AbsurdCount { .. })
+        ));
     }
 }

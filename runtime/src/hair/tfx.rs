@@ -41,7 +41,11 @@ pub fn parse_tfx(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
     let version = bytes.f32_at(0, "version")?;
     // Older TressFX versions used other layouts; a non-float here means this is no .tfx at all.
     if !(version.is_finite() && (4.0..5.0).contains(&version)) {
-        return Err(HairError::Unsupported { file: file.into(), format: FORMAT, why: format!("version {version} (only 4.x is known)") });
+        return Err(HairError::Unsupported {
+            file: file.into(),
+            format: FORMAT,
+            why: format!("version {version} (only 4.x is known)"),
+        });
     }
     let strands = bytes.u32_at(4, "strand count")? as u64;
     let per_strand = bytes.u32_at(8, "vertices per strand")? as u64;
@@ -64,7 +68,9 @@ pub fn parse_tfx(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
     bytes.check_count_fits("strand", strands, 16 * per_strand)?;
     let vertices = strands * per_strand;
 
-    let array = |at: u64, bytes_each: u64, count: u64, what: &str| bytes.slice(at, bytes_each * count, || format!("{what} at offset {at}"));
+    let array = |at: u64, bytes_each: u64, count: u64, what: &str| {
+        bytes.slice(at, bytes_each * count, || format!("{what} at offset {at}"))
+    };
     let positions = array(positions_at, 16, vertices, "positions")?;
     if strand_uv_at != 0 {
         array(strand_uv_at, 8, strands, "strand UVs")?;
@@ -75,13 +81,24 @@ pub fn parse_tfx(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
     let thickness = match thickness_at {
         0 => None,
         at => {
-            let per_strand_values: Vec<f32> = f32s(array(at, 4, strands, "strand thickness")?).collect();
-            Some(Attribute::PerPoint(per_strand_values.iter().flat_map(|&t| std::iter::repeat_n(t, per_strand as usize)).collect()))
+            let per_strand_values: Vec<f32> =
+                f32s(array(at, 4, strands, "strand thickness")?).collect();
+            Some(Attribute::PerPoint(
+                per_strand_values
+                    .iter()
+                    .flat_map(|&t| std::iter::repeat_n(t, per_strand as usize))
+                    .collect(),
+            ))
         }
     };
     let color = match color_at {
         0 => None,
-        at => Some(Attribute::PerPoint(rgb_of_float4(array(at, 16, vertices, "vertex colors")?))),
+        at => Some(Attribute::PerPoint(rgb_of_float4(array(
+            at,
+            16,
+            vertices,
+            "vertex colors",
+        )?))),
     };
     let raw = RawHair {
         points: rgb_of_float4(positions),
@@ -98,7 +115,8 @@ fn rgb_of_float4(bytes: &[u8]) -> Vec<Vec3> {
     bytes
         .chunks_exact(16)
         .map(|c| {
-            let f = |i: usize| f32::from_le_bytes([c[4 * i], c[4 * i + 1], c[4 * i + 2], c[4 * i + 3]]);
+            let f =
+                |i: usize| f32::from_le_bytes([c[4 * i], c[4 * i + 1], c[4 * i + 2], c[4 * i + 3]]);
             Vec3::new(f(0), f(1), f(2))
         })
         .collect()
@@ -113,10 +131,32 @@ mod tests {
         let per_strand = strands[0].len() as u32;
         let vertices = strands.len() as u32 * per_strand;
         let positions_at = 160u32;
-        let thickness_at = if thickness.is_some() { positions_at + 16 * vertices } else { 0 };
-        let color_at = if colors { positions_at + 16 * vertices + if thickness.is_some() { 4 * strands.len() as u32 } else { 0 } } else { 0 };
+        let thickness_at = if thickness.is_some() {
+            positions_at + 16 * vertices
+        } else {
+            0
+        };
+        let color_at = if colors {
+            positions_at
+                + 16 * vertices
+                + if thickness.is_some() {
+                    4 * strands.len() as u32
+                } else {
+                    0
+                }
+        } else {
+            0
+        };
         let mut out = 4.0f32.to_le_bytes().to_vec();
-        for v in [strands.len() as u32, per_strand, positions_at, 0, 0, thickness_at, color_at] {
+        for v in [
+            strands.len() as u32,
+            per_strand,
+            positions_at,
+            0,
+            0,
+            thickness_at,
+            color_at,
+        ] {
             out.extend_from_slice(&v.to_le_bytes());
         }
         out.resize(160, 0);
@@ -128,7 +168,11 @@ mod tests {
         }
         if colors {
             for p in strands.iter().flatten() {
-                out.extend([p[0] * 0.5, 0.25, 0.125, 1.0].iter().flat_map(|v| v.to_le_bytes()));
+                out.extend(
+                    [p[0] * 0.5, 0.25, 0.125, 1.0]
+                        .iter()
+                        .flat_map(|v| v.to_le_bytes()),
+                );
             }
         }
         out
@@ -139,7 +183,10 @@ mod tests {
     }
 
     fn two_strands() -> Vec<Vec<[f32; 3]>> {
-        vec![vec![[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 2.0, 0.0]], vec![[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 2.0, 0.0]]]
+        vec![
+            vec![[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 2.0, 0.0]],
+            vec![[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 2.0, 0.0]],
+        ]
     }
 
     #[test]
@@ -148,7 +195,10 @@ mod tests {
         let m = &loaded.model;
         assert_eq!(m.strand_offsets(), &[0, 3, 6]);
         assert_eq!(m.strand(1)[2], Vec3::new(1.0, 2.0, 0.0));
-        assert_eq!(m.thickness(), Some(&Attribute::PerPoint(vec![0.5, 0.5, 0.5, 0.25, 0.25, 0.25])));
+        assert_eq!(
+            m.thickness(),
+            Some(&Attribute::PerPoint(vec![0.5, 0.5, 0.5, 0.25, 0.25, 0.25]))
+        );
         assert_eq!(m.color().unwrap().at(4), Vec3::new(0.5, 0.25, 0.125));
     }
 
@@ -156,8 +206,14 @@ mod tests {
     fn crafted_bad_files_give_their_own_errors() {
         let good = file(&two_strands(), None, false);
         assert!(parse(&good).is_ok());
-        assert!(matches!(parse(&good[..100]), Err(HairError::Truncated { .. })));
-        assert!(matches!(parse(&good[..good.len() - 1]), Err(HairError::Truncated { .. })));
+        assert!(matches!(
+            parse(&good[..100]),
+            Err(HairError::Truncated { .. })
+        ));
+        assert!(matches!(
+            parse(&good[..good.len() - 1]),
+            Err(HairError::Truncated { .. })
+        ));
         let mut v3 = good.clone();
         v3[0..4].copy_from_slice(&3.0f32.to_le_bytes());
         assert!(matches!(parse(&v3), Err(HairError::Unsupported { .. })));
@@ -175,7 +231,17 @@ mod tests {
         assert!(matches!(parse(&uv), Err(HairError::Truncated { .. })));
         let mut nan = two_strands();
         nan[1][1][2] = f32::NAN;
-        assert!(matches!(parse(&file(&nan, None, false)), Err(HairError::NonFinite { strand: 1, point: 1, .. })));
-        assert!(matches!(parse(&file(&two_strands(), Some(&[0.5, f32::NAN]), false)), Err(HairError::NonFinite { .. })));
+        assert!(matches!(
+            parse(&file(&nan, None, false)),
+            Err(HairError::NonFinite {
+                strand: 1,
+                point: 1,
+                ..
+            })
+        ));
+        assert!(matches!(
+            parse(&file(&two_strands(), Some(&[0.5, f32::NAN]), false)),
+            Err(HairError::NonFinite { .. })
+        ));
     }
 }

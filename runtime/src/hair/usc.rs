@@ -35,12 +35,18 @@ pub fn parse_usc(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
             return Err(negative(file, &format!("point count of strand {s}"), count));
         }
         let point_bytes = 12 * count as u64;
-        bytes.slice(offset + 4, point_bytes, || format!("{count} points of strand {s}"))?;
+        bytes.slice(offset + 4, point_bytes, || {
+            format!("{count} points of strand {s}")
+        })?;
         counts.push(count as u32);
         offset += 4 + point_bytes;
     }
     if offset != bytes.len() {
-        return Err(HairError::SizeMismatch { file: file.into(), expected: offset, actual: bytes.len() });
+        return Err(HairError::SizeMismatch {
+            file: file.into(),
+            expected: offset,
+            actual: bytes.len(),
+        });
     }
 
     let total: usize = counts.iter().map(|&c| c as usize).sum();
@@ -51,12 +57,23 @@ pub fn parse_usc(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
         points.extend(vec3s(&data[offset + 4..end]));
         offset = end;
     }
-    let raw = RawHair { points, counts, thickness: None, transparency: None, color: None };
+    let raw = RawHair {
+        points,
+        counts,
+        thickness: None,
+        transparency: None,
+        color: None,
+    };
     finish(raw, file, HairFormat::UscHairSalon, String::new())
 }
 
 fn negative(file: &Path, what: &str, value: i32) -> HairError {
-    HairError::BadValue { file: file.into(), what: what.to_string(), value: value.to_string(), why: "negative" }
+    HairError::BadValue {
+        file: file.into(),
+        what: what.to_string(),
+        value: value.to_string(),
+        why: "negative",
+    }
 }
 
 /// The bytes of a `.data` file for `model` (positions only; the format has nothing else).
@@ -96,14 +113,25 @@ mod tests {
 
     #[test]
     fn reads_strands_and_drops_bald_scalp_points() {
-        let f = file(&[&[[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[9.0, 9.0, 9.0]], &[], &[[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 2.0, 0.5]]]);
+        let f = file(&[
+            &[[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            &[[9.0, 9.0, 9.0]],
+            &[],
+            &[[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 2.0, 0.5]],
+        ]);
         let loaded = parse(&f).unwrap();
         assert_eq!(loaded.report.short_strands_dropped, 2);
-        assert_eq!((loaded.report.source_strands, loaded.report.source_points), (4, 6));
+        assert_eq!(
+            (loaded.report.source_strands, loaded.report.source_points),
+            (4, 6)
+        );
         assert_eq!(loaded.model.strand_offsets(), &[0, 2, 5]);
         assert_eq!(loaded.model.strand(1)[2], Vec3::new(1.0, 2.0, 0.5));
         // And the writer produces exactly the bytes of the kept strands.
-        let kept = file(&[&[[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]], &[[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 2.0, 0.5]]]);
+        let kept = file(&[
+            &[[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            &[[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 2.0, 0.5]],
+        ]);
         assert_eq!(encode_usc(&loaded.model), kept);
     }
 
@@ -111,8 +139,14 @@ mod tests {
     fn crafted_bad_files_give_their_own_errors() {
         let good = file(&[&[[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]]]);
         assert!(parse(&good).is_ok());
-        assert!(matches!(parse(&good[..3]), Err(HairError::Truncated { .. })));
-        assert!(matches!(parse(&good[..good.len() - 2]), Err(HairError::Truncated { .. })));
+        assert!(matches!(
+            parse(&good[..3]),
+            Err(HairError::Truncated { .. })
+        ));
+        assert!(matches!(
+            parse(&good[..good.len() - 2]),
+            Err(HairError::Truncated { .. })
+        ));
         let mut long = good.clone();
         long.push(0);
         assert!(matches!(parse(&long), Err(HairError::SizeMismatch { .. })));
@@ -129,6 +163,13 @@ mod tests {
         huge[4..8].copy_from_slice(&i32::MAX.to_le_bytes());
         assert!(matches!(parse(&huge), Err(HairError::Truncated { .. })));
         let inf = file(&[&[[0.0, 0.0, 0.0], [f32::INFINITY, 1.0, 0.0]]]);
-        assert!(matches!(parse(&inf), Err(HairError::NonFinite { strand: 0, point: 1, .. })));
+        assert!(matches!(
+            parse(&inf),
+            Err(HairError::NonFinite {
+                strand: 0,
+                point: 1,
+                ..
+            })
+        ));
     }
 }
