@@ -122,89 +122,134 @@ impl Default for GroomParams {
 
 impl GroomParams {
     fn validate(&self) -> Result<(), ParamError> {
-        let f = |v: f32| v as f64;
-        let positive = |v: f64| v > 0.0;
-        let non_negative = |v: f64| v >= 0.0;
-        for (name, v) in [
-            ("scalp.center.x", self.scalp.center.x),
-            ("scalp.center.y", self.scalp.center.y),
-            ("scalp.center.z", self.scalp.center.z),
-        ] {
-            check(name, f(v), |_| true, "")?;
+        // Sizes are capped well inside f32 range so that squared radii cannot overflow.
+        const SIZE: f64 = 1e6;
+        const PI: f64 = std::f64::consts::PI;
+        let (scalp, c, r) = (&self.scalp, self.scalp.center, self.scalp.radii);
+        let within = |lo: f64, hi: f64| move |v: f64| (lo..=hi).contains(&v);
+        let above = |lo: f64, hi: f64| move |v: f64| v > lo && v <= hi;
+        let strands = self.strand_count as f64;
+        let points = self.points_per_strand as f64;
+        type Check<'a> = (&'static str, f64, &'a dyn Fn(f64) -> bool, &'static str);
+        let checks: [Check; 19] = [
+            (
+                "scalp.center.x",
+                c.x as f64,
+                &within(-SIZE, SIZE),
+                "must be in [-1e6, 1e6]",
+            ),
+            (
+                "scalp.center.y",
+                c.y as f64,
+                &within(-SIZE, SIZE),
+                "must be in [-1e6, 1e6]",
+            ),
+            (
+                "scalp.center.z",
+                c.z as f64,
+                &within(-SIZE, SIZE),
+                "must be in [-1e6, 1e6]",
+            ),
+            (
+                "scalp.radii.x",
+                r.x as f64,
+                &above(0.0, SIZE),
+                "must be in (0, 1e6]",
+            ),
+            (
+                "scalp.radii.y",
+                r.y as f64,
+                &above(0.0, SIZE),
+                "must be in (0, 1e6]",
+            ),
+            (
+                "scalp.radii.z",
+                r.z as f64,
+                &above(0.0, SIZE),
+                "must be in (0, 1e6]",
+            ),
+            (
+                "scalp.max_polar_angle",
+                scalp.max_polar_angle as f64,
+                &above(0.0, PI),
+                "must be in (0, π]",
+            ),
+            (
+                "scalp.front_polar_angle",
+                scalp.front_polar_angle as f64,
+                &above(0.0, PI),
+                "must be in (0, π]",
+            ),
+            (
+                "strand_count",
+                strands,
+                &within(1.0, 1e7),
+                "must be in 1..=10,000,000",
+            ),
+            (
+                "points_per_strand",
+                points,
+                &within(2.0, 1024.0),
+                "must be in 2..=1024",
+            ),
+            (
+                "strand_count × points_per_strand",
+                strands * points,
+                &within(0.0, 1e8),
+                "must be ≤ 1e8",
+            ),
+            (
+                "length_min",
+                self.length_min as f64,
+                &above(0.0, SIZE),
+                "must be in (0, 1e6]",
+            ),
+            (
+                "length_max",
+                self.length_max as f64,
+                &within(self.length_min as f64, SIZE),
+                "must be in [length_min, 1e6]",
+            ),
+            (
+                "curl_radius",
+                self.curl_radius as f64,
+                &within(0.0, SIZE),
+                "must be in [0, 1e6]",
+            ),
+            (
+                "curl_frequency",
+                self.curl_frequency as f64,
+                &within(0.0, SIZE),
+                "must be in [0, 1e6]",
+            ),
+            (
+                "clump_count",
+                self.clump_count as f64,
+                &within(0.0, strands),
+                "must be ≤ strand_count",
+            ),
+            (
+                "clump_strength",
+                self.clump_strength as f64,
+                &within(0.0, 1.0),
+                "must be in [0, 1]",
+            ),
+            (
+                "gravity",
+                self.gravity as f64,
+                &within(0.0, 1.0),
+                "must be in [0, 1]",
+            ),
+            (
+                "thickness",
+                self.thickness as f64,
+                &within(0.0, SIZE),
+                "must be in [0, 1e6]",
+            ),
+        ];
+        for (name, value, ok, requirement) in checks {
+            check(name, value, ok, requirement)?;
         }
-        for (name, v) in [
-            ("scalp.radii.x", self.scalp.radii.x),
-            ("scalp.radii.y", self.scalp.radii.y),
-            ("scalp.radii.z", self.scalp.radii.z),
-        ] {
-            check(name, f(v), positive, "must be > 0")?;
-        }
-        let angle = |v: f64| v > 0.0 && v <= std::f64::consts::PI;
-        check(
-            "scalp.max_polar_angle",
-            f(self.scalp.max_polar_angle),
-            angle,
-            "must be in (0, π]",
-        )?;
-        check(
-            "scalp.front_polar_angle",
-            f(self.scalp.front_polar_angle),
-            angle,
-            "must be in (0, π]",
-        )?;
-        check(
-            "strand_count",
-            self.strand_count as f64,
-            |v| (1.0..=1e7).contains(&v),
-            "must be in 1..=10,000,000",
-        )?;
-        check(
-            "points_per_strand",
-            self.points_per_strand as f64,
-            |v| (2.0..=1024.0).contains(&v),
-            "must be in 2..=1024",
-        )?;
-        let total = self.strand_count as f64 * self.points_per_strand as f64;
-        check(
-            "strand_count × points_per_strand",
-            total,
-            |v| v <= 1e8,
-            "must be ≤ 100,000,000",
-        )?;
-        check("length_min", f(self.length_min), positive, "must be > 0")?;
-        check(
-            "length_max",
-            f(self.length_max),
-            |v| v >= f(self.length_min),
-            "must be ≥ length_min",
-        )?;
-        check(
-            "curl_radius",
-            f(self.curl_radius),
-            non_negative,
-            "must be ≥ 0",
-        )?;
-        check(
-            "curl_frequency",
-            f(self.curl_frequency),
-            non_negative,
-            "must be ≥ 0",
-        )?;
-        check(
-            "clump_count",
-            self.clump_count as f64,
-            |v| v <= self.strand_count as f64,
-            "must be ≤ strand_count",
-        )?;
-        let unit = |v: f64| (0.0..=1.0).contains(&v);
-        check(
-            "clump_strength",
-            f(self.clump_strength),
-            unit,
-            "must be in [0, 1]",
-        )?;
-        check("gravity", f(self.gravity), unit, "must be in [0, 1]")?;
-        check("thickness", f(self.thickness), non_negative, "must be ≥ 0")?;
         Ok(())
     }
 }
@@ -608,6 +653,24 @@ mod tests {
                 ..small()
             },
             "points_per_strand",
+        );
+        bad(
+            GroomParams {
+                curl_radius: 1e30,
+                ..small()
+            },
+            "curl_radius",
+        );
+        let huge_head = Scalp {
+            radii: Vec3::splat(1e20),
+            ..small().scalp
+        };
+        bad(
+            GroomParams {
+                scalp: huge_head,
+                ..small()
+            },
+            "scalp.radii.x",
         );
         bad(
             GroomParams {

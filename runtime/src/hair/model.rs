@@ -25,6 +25,15 @@ impl<T: Copy> Attribute<T> {
         }
     }
 
+    /// One value per point for `point_count` points, for a GPU buffer: per-point data as it is,
+    /// a uniform value repeated.
+    pub fn per_point_values(&self, point_count: usize) -> std::borrow::Cow<'_, [T]> {
+        match self {
+            Attribute::Uniform(v) => std::borrow::Cow::Owned(vec![*v; point_count]),
+            Attribute::PerPoint(values) => std::borrow::Cow::Borrowed(values),
+        }
+    }
+
     pub fn is_per_point(&self) -> bool {
         matches!(self, Attribute::PerPoint(_))
     }
@@ -377,5 +386,15 @@ mod tests {
             Some(Attribute::PerPoint(vec![1.0; 5])),
             Some(Attribute::Uniform(1.0))
         ));
+        assert_eq!(
+            Attribute::Uniform(0.5f32).per_point_values(3).as_ref(),
+            &[0.5, 0.5, 0.5]
+        );
+        assert_eq!(
+            Attribute::PerPoint(vec![1.0f32, 2.0])
+                .per_point_values(2)
+                .as_ref(),
+            &[1.0, 2.0]
+        );
     }
 }

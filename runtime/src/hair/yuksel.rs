@@ -79,13 +79,8 @@ pub fn parse_hair(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
             why: format!("flags {flag_bits:#07b} have no points array (bit 1)"),
         });
     }
-    if flag_bits & !0b11111 != 0 {
-        return Err(HairError::Unsupported {
-            file: file.into(),
-            format: FORMAT,
-            why: format!("unknown flag bits {flag_bits:#x}"),
-        });
-    }
+    // Bits above 4 mean nothing in the format; cyHairFile ignores them and so does this reader
+    // (the exact-size check below still catches a file whose layout they would change).
     // Refuse absurd counts before anything is sized by them.
     let segment_bytes = if has(flags::SEGMENTS) { 2 } else { 0 };
     bytes.check_count_fits("strand", strands, segment_bytes.max(1))?;
