@@ -308,14 +308,19 @@ fn mangled_real_files_never_panic() {
     ];
     let mut rng = Rng(0x5EED);
     let mut tally = std::collections::BTreeMap::<String, usize>::new();
+    let mut examples = std::collections::BTreeMap::<String, String>::new();
     let mut count = |r: &Result<LoadedHair, HairError>| {
         let key = match r {
             Ok(_) => "Ok".to_string(),
-            Err(e) => format!("{e:?}")
-                .split([' ', '{', '('])
-                .next()
-                .unwrap()
-                .to_string(),
+            Err(e) => {
+                let key = format!("{e:?}")
+                    .split([' ', '{', '('])
+                    .next()
+                    .unwrap()
+                    .to_string();
+                examples.entry(key.clone()).or_insert_with(|| e.to_string());
+                key
+            }
         };
         *tally.entry(key).or_default() += 1;
     };
@@ -380,6 +385,9 @@ fn mangled_real_files_never_panic() {
         }
     }
     eprintln!("outcomes: {tally:?}");
+    for message in examples.values() {
+        eprintln!("  e.g. {message}");
+    }
     assert!(
         tally.len() > 5,
         "the mangling should reach several distinct errors: {tally:?}"

@@ -14,11 +14,12 @@ pub enum HairError {
         source: std::io::Error,
     },
 
-    #[error("{file}: not a {format} file (starts with {found:02x?})")]
+    /// `found` is the file's first bytes, ASCII-escaped.
+    #[error("{file}: not a {format} file (it starts with \"{found}\")")]
     BadMagic {
         file: PathBuf,
         format: &'static str,
-        found: Vec<u8>,
+        found: String,
     },
 
     #[error("{file}: truncated: {what} needs {needed} bytes but the file has {actual}")]
@@ -29,10 +30,10 @@ pub enum HairError {
         actual: u64,
     },
 
-    /// A count in the header so large that even at the smallest possible size per element the
-    /// file could not hold it. Refused before anything is allocated.
+    /// A count so large that even at the smallest possible size per element the file could not
+    /// hold it (a corrupt count, or a badly truncated file). Refused before anything is allocated.
     #[error(
-        "{file}: absurd {what} count {count}: at {bytes_each} bytes each it needs more than the file's {file_len} bytes"
+        "{file}: {what} count {count} needs at least {bytes_each} bytes each, more than the file's {file_len} bytes: the count is corrupt or the file truncated"
     )]
     AbsurdCount {
         file: PathBuf,

@@ -287,7 +287,7 @@ fn parse_header(data: &[u8], file: &Path) -> Result<(Vec<Element>, usize), HairE
         return Err(HairError::BadMagic {
             file: file.into(),
             format: FORMAT,
-            found: data[..data.len().min(4)].to_vec(),
+            found: data[..data.len().min(4)].escape_ascii().to_string(),
         });
     }
     const END: &[u8] = b"end_header\n";

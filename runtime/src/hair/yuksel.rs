@@ -55,7 +55,7 @@ pub fn parse_hair(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
         return Err(HairError::BadMagic {
             file: file.into(),
             format: FORMAT,
-            found: header[0..4].to_vec(),
+            found: header[0..4].escape_ascii().to_string(),
         });
     }
     let strands = bytes.u32_at(4, "strand count")? as u64;
