@@ -85,4 +85,26 @@ mod tests {
         assert!(matches!(e, HairError::Io { .. }));
         assert!(e.to_string().contains("/nonexistent/dir/x.hair"), "{e}");
     }
+
+    #[test]
+    fn a_failed_write_leaves_no_file_behind() {
+        let dir = std::env::temp_dir().join(format!("strandlight-write-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // The final name is taken by a directory, so the rename fails after the temp file exists.
+        let target = dir.join("taken.hair");
+        std::fs::create_dir_all(&target).unwrap();
+        let e = write_atomically(&target, b"HAIR").unwrap_err();
+        assert!(matches!(e, HairError::Io { .. }), "{e}");
+        let left: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(left, vec![std::ffi::OsString::from("taken.hair")]);
+        // A missing folder fails at the first write.
+        assert!(matches!(
+            write_atomically(&dir.join("no/such/x.hair"), b"x"),
+            Err(HairError::Io { .. })
+        ));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 }

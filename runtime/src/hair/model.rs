@@ -82,7 +82,9 @@ impl Aabb {
 ///   `array<vec3<f32>>` has a 16-byte stride);
 /// - `strand_offsets`: `strands + 1` values, strand `s` owns points
 ///   `strand_offsets[s] .. strand_offsets[s + 1]`;
-/// - optional thickness, transparency and colour, uniform or per point.
+/// - optional thickness (in the model's units, as the file gives it), transparency (0 = opaque,
+///   1 = invisible, as in the HAIR format) and linear RGB colour, uniform or per point
+///   ([`Attribute::per_point_values`] expands a uniform value for a buffer).
 ///
 /// Invariants (checked by [`HairModel::new`]): at least one strand, every strand has at least
 /// two points, offsets start at 0 and end at `points.len()`, every value is finite, thickness
