@@ -539,6 +539,39 @@ mod tests {
     }
 
     #[test]
+    fn follow_the_leader_slides_around_the_head_instead_of_through_it() {
+        // A target line from the top of a unit sphere straight down through its centre.
+        let scalp = Scalp {
+            center: Vec3::ZERO,
+            radii: Vec3::ONE,
+            ..small().scalp
+        };
+        let target: Vec<Vec3> = (0..41)
+            .map(|i| Vec3::new(0.01, 1.0 - 0.1 * i as f32, 0.0))
+            .collect();
+        let mut out = Vec::new();
+        follow_the_leader(&target, 0.1, &scalp, &mut out);
+        let min_f = out
+            .iter()
+            .map(|p| p.as_dvec3().length_squared())
+            .fold(f64::INFINITY, f64::min);
+        let worst_step = out
+            .windows(2)
+            .map(|w| (w[0].as_dvec3().distance(w[1].as_dvec3()) - 0.1).abs())
+            .fold(0.0, f64::max);
+        let tip = out[out.len() - 1];
+        eprintln!(
+            "through-the-head target: min |p|² = {min_f:.6}, worst step error {worst_step:.2e}, tip {tip}"
+        );
+        assert!(min_f > 1.0 - 1e-5);
+        assert!(worst_step < 1e-6);
+        assert!(
+            tip.y < 0.0,
+            "the strand should have slid past the equator: {tip}"
+        );
+    }
+
+    #[test]
     fn bad_parameters_are_named() {
         let bad = |p: GroomParams, name: &str| match generate_groom(&p) {
             Err(HairError::Param(
