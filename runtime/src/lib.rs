@@ -1,1 +1,3 @@
 //! The wgpu runtime: hair input, render passes, and the brute-force reference renderer.
+
+pub mod hair;
