@@ -161,6 +161,10 @@ pub struct AssetDescription {
     pub fiber_parameters: Value,
     pub generator: Generator,
     pub created: CreationInfo,
+    /// Content hash of everything that determined the values (parameters, resolution,
+    /// integration settings, generator version): equal keys mean a re-bake can be skipped.
+    #[serde(default)]
+    pub inputs_key: Option<String>,
 }
 
 /// What the writer derives from the table: shape, storage and checksum of the payload.
@@ -570,6 +574,7 @@ mod tests {
                 command_line: Some("cargo test".into()),
                 notes: None,
             },
+            inputs_key: Some("test-key".into()),
         }
     }
 
