@@ -71,6 +71,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             version: env!("CARGO_PKG_VERSION").into(),
         },
         created: CreationInfo::now(),
+        inputs_key: None,
     };
     for storage in [Storage::F32, Storage::F16] {
         let path = out.join(format!("bench-{storage:?}.sltab"));
