@@ -15,8 +15,10 @@ use std::f64::consts::{FRAC_PI_2, PI};
 const PI3: f64 = PI * PI * PI;
 
 /// Floor of |dφ̂/dγ| where a fold (caustic) makes it vanish: the raw N_p has an integrable
-/// singularity there; the floor keeps it finite (1e12 × A) without changing any integral.
-const MIN_SLOPE: f64 = 1e-12;
+/// 1/√|φ − φ_c| singularity there. The floor caps N_p at 5·10⁵·A within ~10⁻¹² rad of a fold
+/// (|dφ̂/dγ| ≈ √(2|φ̂''| |φ − φ_c|)), which changes ∫N_p dφ by ~10⁻⁸ absolute, and keeps the
+/// numerically ambiguous double root at the fold from returning 10¹⁰-sized spikes.
+const MIN_SLOPE: f64 = 1e-6;
 
 /// The per-θ_d quantities of the Bravais projection for a fiber of index η.
 #[derive(Debug, Clone, Copy)]
