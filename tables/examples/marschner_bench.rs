@@ -12,19 +12,32 @@ use strandlight_tables::{FiberAngles, ScatteringFunction};
 
 fn main() {
     let mut args = std::env::args().skip(1);
-    let evals: u64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(1_000_000);
-    let sweep: u64 = args.next().and_then(|s| s.parse().ok()).unwrap_or(1_000_000);
+    let evals: u64 = args
+        .next()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1_000_000);
+    let sweep: u64 = args
+        .next()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1_000_000);
 
     // A fixed low-discrepancy set of angles (golden-ratio sequences), so runs compare.
     let angles: Vec<FiberAngles> = (0..4096u64)
         .map(|k| {
             let f = |a: f64| (k as f64 * a).fract();
-            FiberAngles::new((f(0.618_033_988_7) - 0.5) * PI, (f(0.754_877_666_2) - 0.5) * PI, (2.0 * f(0.569_840_290_9) - 1.0) * PI)
+            FiberAngles::new(
+                (f(0.618_033_988_7) - 0.5) * PI,
+                (f(0.754_877_666_2) - 0.5) * PI,
+                (2.0 * f(0.569_840_290_9) - 1.0) * PI,
+            )
         })
         .collect();
     for model in [LongitudinalModel::Gaussian, LongitudinalModel::DEon] {
-        let m = Marschner::new(MarschnerParams { longitudinal_model: model, ..MarschnerParams::default() })
-            .expect("default parameters are valid");
+        let m = Marschner::new(MarschnerParams {
+            longitudinal_model: model,
+            ..MarschnerParams::default()
+        })
+        .expect("default parameters are valid");
         let mut times = vec![];
         for _ in 0..5 {
             let t = Instant::now();
@@ -44,11 +57,18 @@ fn main() {
         }
         black_box(acc);
         let trt = t.elapsed().as_secs_f64() * 1e9 / evals as f64;
-        println!("{model:?}: eval median {:.1} ns (min {:.1}, max {:.1}) over 5×{evals}; N_TRT alone {trt:.1} ns", times[2], times[0], times[4]);
+        println!(
+            "{model:?}: eval median {:.1} ns (min {:.1}, max {:.1}) over 5×{evals}; N_TRT alone {trt:.1} ns",
+            times[2], times[0], times[4]
+        );
     }
     let t = Instant::now();
     let r = hard_case_sweep(sweep, 0x5eed);
-    println!("hard-case sweep, {} samples in {:.2} s: {r:#?}", sweep, t.elapsed().as_secs_f64());
+    println!(
+        "hard-case sweep, {} samples in {:.2} s: {r:#?}",
+        sweep,
+        t.elapsed().as_secs_f64()
+    );
     if !r.is_clean() {
         std::process::exit(1);
     }

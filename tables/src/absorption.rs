@@ -34,12 +34,36 @@ pub struct MelaninPreset {
 
 /// The known presets, in the order they are listed in errors.
 pub const PRESETS: &[MelaninPreset] = &[
-    MelaninPreset { name: "white", eumelanin: 0.0, pheomelanin: 0.0 },
-    MelaninPreset { name: "blonde", eumelanin: 0.3, pheomelanin: 0.0 },
-    MelaninPreset { name: "red", eumelanin: 0.3, pheomelanin: 2.0 },
-    MelaninPreset { name: "auburn", eumelanin: 1.0, pheomelanin: 1.5 },
-    MelaninPreset { name: "brown", eumelanin: 1.3, pheomelanin: 0.0 },
-    MelaninPreset { name: "dark", eumelanin: 8.0, pheomelanin: 0.0 },
+    MelaninPreset {
+        name: "white",
+        eumelanin: 0.0,
+        pheomelanin: 0.0,
+    },
+    MelaninPreset {
+        name: "blonde",
+        eumelanin: 0.3,
+        pheomelanin: 0.0,
+    },
+    MelaninPreset {
+        name: "red",
+        eumelanin: 0.3,
+        pheomelanin: 2.0,
+    },
+    MelaninPreset {
+        name: "auburn",
+        eumelanin: 1.0,
+        pheomelanin: 1.5,
+    },
+    MelaninPreset {
+        name: "brown",
+        eumelanin: 1.3,
+        pheomelanin: 0.0,
+    },
+    MelaninPreset {
+        name: "dark",
+        eumelanin: 8.0,
+        pheomelanin: 0.0,
+    },
 ];
 
 /// σ_a = C_eu σ_eu + C_ph σ_ph; concentrations must be finite and ≥ 0.
@@ -53,13 +77,21 @@ pub fn sigma_a_from_concentration(eumelanin: f64, pheomelanin: f64) -> Result<Rg
 
 /// Names of the presets, comma-separated (for help texts and errors).
 pub fn preset_names() -> String {
-    PRESETS.iter().map(|p| p.name).collect::<Vec<_>>().join(", ")
+    PRESETS
+        .iter()
+        .map(|p| p.name)
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 /// Looks up a preset by name (case-insensitive; "black" is accepted for "dark").
 pub fn melanin_preset(name: &str) -> Result<MelaninPreset, ParamError> {
     let key = name.trim().to_ascii_lowercase();
-    let key = if key == "black" { "dark".to_string() } else { key };
+    let key = if key == "black" {
+        "dark".to_string()
+    } else {
+        key
+    };
     PRESETS
         .iter()
         .find(|p| p.name == key)
@@ -119,11 +151,17 @@ mod tests {
     fn bad_concentrations_are_typed_errors() {
         assert!(matches!(
             sigma_a_from_concentration(-1.0, 0.0),
-            Err(ParamError::OutOfRange { name: "eumelanin", .. })
+            Err(ParamError::OutOfRange {
+                name: "eumelanin",
+                ..
+            })
         ));
         assert!(matches!(
             sigma_a_from_concentration(0.0, f64::NAN),
-            Err(ParamError::NotFinite { name: "pheomelanin", .. })
+            Err(ParamError::NotFinite {
+                name: "pheomelanin",
+                ..
+            })
         ));
     }
 }

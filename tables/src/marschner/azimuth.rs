@@ -47,12 +47,23 @@ impl Bravais {
         let c = inv_eta_prime.asin();
         let s_t = sin_d / eta;
         let cos_theta_t = (1.0 - s_t * s_t).max(0.0).sqrt();
-        Self { eta2, cos_d, n, inv_eta_prime, c, cos_theta_t }
+        Self {
+            eta2,
+            cos_d,
+            n,
+            inv_eta_prime,
+            c,
+            cos_theta_t,
+        }
     }
 
     /// η′ = n / cos θ_d (+∞ when cos θ_d = 0).
     pub fn eta_prime(&self) -> f64 {
-        if self.cos_d > 0.0 { self.n / self.cos_d } else { f64::INFINITY }
+        if self.cos_d > 0.0 {
+            self.n / self.cos_d
+        } else {
+            f64::INFINITY
+        }
     }
 
     /// Fresnel reflectance entering the fiber at offset h: the mean of the perpendicular
@@ -140,7 +151,11 @@ pub struct CubicExitMap {
 impl CubicExitMap {
     pub fn new(p: usize, c: f64) -> Self {
         let pc = p as f64 * c;
-        Self { p, a1: 6.0 * pc / PI - 2.0, a3: 8.0 * pc / PI3 }
+        Self {
+            p,
+            a1: 6.0 * pc / PI - 2.0,
+            a3: 8.0 * pc / PI3,
+        }
     }
 
     /// φ̂(p, γ) (not wrapped).
@@ -264,7 +279,8 @@ pub fn caustic_placement(b: &Bravais, cp: &CausticParams) -> CausticPlacement {
         // d²φ/dh² at the fold = φ̂''(γ_c) / cos²γ_c (the φ̂' term vanishes there).
         let curvature = (6.0 * map.a3 * gamma_c) / (cos_c * cos_c);
         let delta_h = if curvature > 0.0 {
-            cp.intensity_limit.min(2.0 * (2.0 * cp.width / curvature).sqrt())
+            cp.intensity_limit
+                .min(2.0 * (2.0 * cp.width / curvature).sqrt())
         } else {
             cp.intensity_limit
         };
@@ -322,7 +338,10 @@ mod tests {
         let (lo, hi) = (-4.0, 4.0);
         let mut roots = vec![];
         for i in 0..n {
-            let (mut x0, mut x1) = (lo + (hi - lo) * i as f64 / n as f64, lo + (hi - lo) * (i + 1) as f64 / n as f64);
+            let (mut x0, mut x1) = (
+                lo + (hi - lo) * i as f64 / n as f64,
+                lo + (hi - lo) * (i + 1) as f64 / n as f64,
+            );
             if f(x0) == 0.0 {
                 roots.push(x0);
                 continue;
@@ -330,7 +349,11 @@ mod tests {
             if f(x0) * f(x1) < 0.0 {
                 for _ in 0..200 {
                     let m = 0.5 * (x0 + x1);
-                    if f(m).signum() == f(x0).signum() { x0 = m } else { x1 = m }
+                    if f(m).signum() == f(x0).signum() {
+                        x0 = m
+                    } else {
+                        x1 = m
+                    }
                 }
                 roots.push(0.5 * (x0 + x1));
             }
@@ -356,7 +379,11 @@ mod tests {
             got.retain(|g| g.abs() < 4.0);
             got.sort_by(f64::total_cmp);
             let want = brute_roots(a1, a3, t);
-            assert_eq!(got.len(), want.len(), "a1={a1} a3={a3} t={t}: {got:?} vs {want:?}");
+            assert_eq!(
+                got.len(),
+                want.len(),
+                "a1={a1} a3={a3} t={t}: {got:?} vs {want:?}"
+            );
             for (g, w) in got.iter().zip(&want) {
                 assert!((g - w).abs() < 1e-9, "a1={a1} a3={a3} t={t}: {g} vs {w}");
             }
@@ -384,12 +411,14 @@ mod tests {
         let b = Bravais::new(eta, td);
         let ep = (eta * eta - td.sin().powi(2)).sqrt() / td.cos();
         let epp = eta * eta / ep;
-        for &h in &[0.0, 0.2, 0.5, 0.8, 0.95] {
-            let ci: f64 = (1.0 - h * h as f64).sqrt();
+        for &h in &[0.0f64, 0.2, 0.5, 0.8, 0.95] {
+            let ci: f64 = (1.0 - h * h).sqrt();
             let ct_s = (1.0 - (h / ep).powi(2)).sqrt();
             let rs = ((ci - ep * ct_s) / (ci + ep * ct_s)).powi(2);
             let st_p: f64 = h / epp;
-            let rp = if st_p >= 1.0 { 1.0 } else {
+            let rp = if st_p >= 1.0 {
+                1.0
+            } else {
                 let ct_p = (1.0 - st_p * st_p).sqrt();
                 ((epp * ci - ct_p) / (epp * ci + ct_p)).powi(2)
             };

@@ -86,7 +86,11 @@ impl Marschner {
         Ok(Self {
             alpha: params.alpha_deg.map(f64::to_radians),
             beta: params.beta_deg.map(f64::to_radians),
-            eta_trt_mean: if params.eccentricity == 1.0 { params.eta } else { 0.5 * (e1 + e2) },
+            eta_trt_mean: if params.eccentricity == 1.0 {
+                params.eta
+            } else {
+                0.5 * (e1 + e2)
+            },
             caustic: CausticParams {
                 width: params.caustic_width_deg.to_radians(),
                 glint_scale: params.glint_scale,
@@ -109,12 +113,18 @@ impl Marschner {
     /// M_p(θ_i, θ_o) (units 1/rad).
     pub fn longitudinal(&self, lobe: Lobe, theta_i: f64, theta_o: f64) -> f64 {
         let p = lobe.index();
-        self.params.longitudinal_model.eval(self.beta[p], self.alpha[p], theta_i, theta_o)
+        self.params
+            .longitudinal_model
+            .eval(self.beta[p], self.alpha[p], theta_i, theta_o)
     }
 
     /// N_p(θ_d, φ) per channel (units 1/rad), fibers of random orientation.
     pub fn azimuthal(&self, lobe: Lobe, theta_d: f64, phi: f64) -> Rgb {
-        let eta = if lobe == Lobe::TRT { self.eta_trt_mean } else { self.params.eta };
+        let eta = if lobe == Lobe::TRT {
+            self.eta_trt_mean
+        } else {
+            self.params.eta
+        };
         self.azimuthal_with_index(lobe, &Bravais::new(eta, theta_d), phi)
     }
 
@@ -156,7 +166,11 @@ impl Marschner {
         let theta_d = angles.theta_d();
         let inv_cos2 = 1.0 / cos2_floored(theta_d);
         let b = Bravais::new(self.params.eta, theta_d);
-        let b_trt = if eta_trt == self.params.eta { b } else { Bravais::new(eta_trt, theta_d) };
+        let b_trt = if eta_trt == self.params.eta {
+            b
+        } else {
+            Bravais::new(eta_trt, theta_d)
+        };
         let mut s = [0.0; 3];
         for lobe in Lobe::ALL {
             let m = self.longitudinal(lobe, angles.theta_i, angles.theta_o);

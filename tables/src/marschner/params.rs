@@ -67,15 +67,33 @@ impl MarschnerParams {
 
     /// Checks every parameter; the first problem is returned as a typed error naming it.
     pub fn validate(&self) -> Result<(), ParamError> {
-        check("eta", self.eta, |v| v > 1.0 && v <= 10.0, "must be in (1, 10]")?;
-        for (c, name) in ["sigma_a.r", "sigma_a.g", "sigma_a.b"].into_iter().enumerate() {
+        check(
+            "eta",
+            self.eta,
+            |v| v > 1.0 && v <= 10.0,
+            "must be in (1, 10]",
+        )?;
+        for (c, name) in ["sigma_a.r", "sigma_a.g", "sigma_a.b"]
+            .into_iter()
+            .enumerate()
+        {
             check_non_negative(name, self.sigma_a[c])?;
         }
         let alpha_names = ["alpha_deg.R", "alpha_deg.TT", "alpha_deg.TRT"];
         let beta_names = ["beta_deg.R", "beta_deg.TT", "beta_deg.TRT"];
         for p in 0..3 {
-            check(alpha_names[p], self.alpha_deg[p], |v| v.abs() <= 45.0, "must be in [−45°, 45°]")?;
-            check(beta_names[p], self.beta_deg[p], |v| v > 0.0 && v <= 90.0, "must be in (0°, 90°]")?;
+            check(
+                alpha_names[p],
+                self.alpha_deg[p],
+                |v| v.abs() <= 45.0,
+                "must be in [−45°, 45°]",
+            )?;
+            check(
+                beta_names[p],
+                self.beta_deg[p],
+                |v| v > 0.0 && v <= 90.0,
+                "must be in (0°, 90°]",
+            )?;
         }
         check(
             "caustic_width_deg",
@@ -84,7 +102,12 @@ impl MarschnerParams {
             "must be in (0°, 180°]",
         )?;
         check_non_negative("glint_scale", self.glint_scale)?;
-        check("caustic_fade_range", self.caustic_fade_range, |v| v > 0.0, "must be > 0")?;
+        check(
+            "caustic_fade_range",
+            self.caustic_fade_range,
+            |v| v > 0.0,
+            "must be > 0",
+        )?;
         check(
             "caustic_intensity_limit",
             self.caustic_intensity_limit,
@@ -155,20 +178,118 @@ mod tests {
     fn invalid_parameters_are_typed_errors_naming_the_parameter() {
         let base = MarschnerParams::default();
         let cases: Vec<(MarschnerParams, &str, bool)> = vec![
-            (MarschnerParams { eta: 1.0, ..base.clone() }, "eta", false),
-            (MarschnerParams { eta: 0.5, ..base.clone() }, "eta", false),
-            (MarschnerParams { eta: f64::NAN, ..base.clone() }, "eta", true),
-            (MarschnerParams { sigma_a: [0.1, -0.2, 0.3], ..base.clone() }, "sigma_a.g", false),
-            (MarschnerParams { sigma_a: [0.1, 0.2, f64::INFINITY], ..base.clone() }, "sigma_a.b", true),
-            (MarschnerParams { beta_deg: [7.5, 0.0, 15.0], ..base.clone() }, "beta_deg.TT", false),
-            (MarschnerParams { beta_deg: [-1.0, 3.0, 15.0], ..base.clone() }, "beta_deg.R", false),
-            (MarschnerParams { alpha_deg: [f64::NAN, 0.0, 0.0], ..base.clone() }, "alpha_deg.R", true),
-            (MarschnerParams { caustic_width_deg: -15.0, ..base.clone() }, "caustic_width_deg", false),
-            (MarschnerParams { glint_scale: -0.5, ..base.clone() }, "glint_scale", false),
-            (MarschnerParams { caustic_fade_range: 0.0, ..base.clone() }, "caustic_fade_range", false),
-            (MarschnerParams { caustic_intensity_limit: -0.1, ..base.clone() }, "caustic_intensity_limit", false),
-            (MarschnerParams { eccentricity: 0.6, ..base.clone() }, "eccentricity", false),
-            (MarschnerParams { eccentricity: 1.2, ..base.clone() }, "eccentricity", false),
+            (
+                MarschnerParams {
+                    eta: 1.0,
+                    ..base.clone()
+                },
+                "eta",
+                false,
+            ),
+            (
+                MarschnerParams {
+                    eta: 0.5,
+                    ..base.clone()
+                },
+                "eta",
+                false,
+            ),
+            (
+                MarschnerParams {
+                    eta: f64::NAN,
+                    ..base.clone()
+                },
+                "eta",
+                true,
+            ),
+            (
+                MarschnerParams {
+                    sigma_a: [0.1, -0.2, 0.3],
+                    ..base.clone()
+                },
+                "sigma_a.g",
+                false,
+            ),
+            (
+                MarschnerParams {
+                    sigma_a: [0.1, 0.2, f64::INFINITY],
+                    ..base.clone()
+                },
+                "sigma_a.b",
+                true,
+            ),
+            (
+                MarschnerParams {
+                    beta_deg: [7.5, 0.0, 15.0],
+                    ..base.clone()
+                },
+                "beta_deg.TT",
+                false,
+            ),
+            (
+                MarschnerParams {
+                    beta_deg: [-1.0, 3.0, 15.0],
+                    ..base.clone()
+                },
+                "beta_deg.R",
+                false,
+            ),
+            (
+                MarschnerParams {
+                    alpha_deg: [f64::NAN, 0.0, 0.0],
+                    ..base.clone()
+                },
+                "alpha_deg.R",
+                true,
+            ),
+            (
+                MarschnerParams {
+                    caustic_width_deg: -15.0,
+                    ..base.clone()
+                },
+                "caustic_width_deg",
+                false,
+            ),
+            (
+                MarschnerParams {
+                    glint_scale: -0.5,
+                    ..base.clone()
+                },
+                "glint_scale",
+                false,
+            ),
+            (
+                MarschnerParams {
+                    caustic_fade_range: 0.0,
+                    ..base.clone()
+                },
+                "caustic_fade_range",
+                false,
+            ),
+            (
+                MarschnerParams {
+                    caustic_intensity_limit: -0.1,
+                    ..base.clone()
+                },
+                "caustic_intensity_limit",
+                false,
+            ),
+            (
+                MarschnerParams {
+                    eccentricity: 0.6,
+                    ..base.clone()
+                },
+                "eccentricity",
+                false,
+            ),
+            (
+                MarschnerParams {
+                    eccentricity: 1.2,
+                    ..base.clone()
+                },
+                "eccentricity",
+                false,
+            ),
         ];
         for (p, want, not_finite) in cases {
             let err = p.validate().unwrap_err();

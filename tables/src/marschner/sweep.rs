@@ -125,7 +125,10 @@ pub fn hard_case_sweep(samples: u64, seed: u64) -> SweepReport {
         .map(|p| Marschner::new(p).expect("sweep configurations are valid"))
         .collect();
     let mut rng = SplitMix64(seed);
-    let mut report = SweepReport { configurations: models.len(), ..SweepReport::default() };
+    let mut report = SweepReport {
+        configurations: models.len(),
+        ..SweepReport::default()
+    };
     for _ in 0..samples {
         let model = &models[(rng.next_u64() % models.len() as u64) as usize];
         let (ti, to) = (hard_theta(&mut rng), hard_theta(&mut rng));

@@ -238,7 +238,10 @@ fn hand_computed_values_at_normal_incidence() {
     let c = (1.0 / eta).asin();
     let n_tt = (1.0 - f0).powi(2) / (2.0 * (6.0 * c / PI - 2.0).abs());
     let got = m.azimuthal(Lobe::TT, 0.0, PI)[1];
-    eprintln!("N_R(0,0) = {:.6}, N_TT(0,π) = {got:.6} (hand {n_tt:.6})", f0 / 4.0);
+    eprintln!(
+        "N_R(0,0) = {:.6}, N_TT(0,π) = {got:.6} (hand {n_tt:.6})",
+        f0 / 4.0
+    );
     assert!((got - n_tt).abs() < 1e-12);
     // With absorption the TT chord at h = 0 is the diameter, 2 radii: factor e^{−2σ_a}.
     let absorbing = model(|p| p.sigma_a = [0.3, 0.0, 0.0]);
@@ -257,7 +260,9 @@ fn symmetric_in_phi_and_reciprocal_for_the_gaussian_model() {
     let deon = model(|p| p.longitudinal_model = LongitudinalModel::DEon);
     let mut state = 12345u64;
     let mut next = || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
     let (mut sym, mut rec_g, mut rec_d) = (0.0f64, 0.0f64, 0.0f64);
@@ -276,13 +281,20 @@ fn symmetric_in_phi_and_reciprocal_for_the_gaussian_model() {
                 *rec = rec.max((s[c] - swapped[c]).abs() / scale);
             }
         }
-        let (s, swapped) = (deon.eval(&FiberAngles::new(ti, to, phi)), deon.eval(&FiberAngles::new(to, ti, -phi)));
+        let (s, swapped) = (
+            deon.eval(&FiberAngles::new(ti, to, phi)),
+            deon.eval(&FiberAngles::new(to, ti, -phi)),
+        );
         peak_d = peak_d.max(s[0]);
         diff_d = diff_d.max((s[0] - swapped[0]).abs());
     }
     eprintln!("max relative |S(φ) − S(−φ)| = {sym:.2e}");
-    eprintln!("max relative |S(i,o) − S(o,i)|: Gaussian {rec_g:.2e}, d'Eon (shift on θ_i, not reciprocal) {rec_d:.2e}");
-    eprintln!("d'Eon: max |S(i,o) − S(o,i)| = {diff_d:.3e} against max S = {peak_d:.3e} over the samples");
+    eprintln!(
+        "max relative |S(i,o) − S(o,i)|: Gaussian {rec_g:.2e}, d'Eon (shift on θ_i, not reciprocal) {rec_d:.2e}"
+    );
+    eprintln!(
+        "d'Eon: max |S(i,o) − S(o,i)| = {diff_d:.3e} against max S = {peak_d:.3e} over the samples"
+    );
     assert!(sym < 1e-9);
     assert!(rec_g < 1e-9);
 }
@@ -317,7 +329,10 @@ fn trt_caustic_branches_are_continuous_at_eta_prime_two() {
         let b = m.azimuthal(Lobe::TRT, above, phi)[0];
         eprintln!("φ={phi}: N_TRT at η′=2⁻ {a:.6}, 2⁺ {b:.6}");
         assert!(a.is_finite() && b.is_finite());
-        assert!((a - b).abs() < 2e-3 * a.abs().max(b.abs()).max(1e-3), "φ={phi}: {a} vs {b}");
+        assert!(
+            (a - b).abs() < 2e-3 * a.abs().max(b.abs()).max(1e-3),
+            "φ={phi}: {a} vs {b}"
+        );
     }
     // Far beyond η′ = 2 + Δη′ the glint has faded: smoothed = raw.
     let raw = model(|p| {
@@ -327,7 +342,10 @@ fn trt_caustic_branches_are_continuous_at_eta_prime_two() {
     let td = 1.2;
     assert!(m.trt_bravais_index(td) > 2.3);
     for &phi in &[0.0, 0.7] {
-        assert_eq!(m.azimuthal(Lobe::TRT, td, phi), raw.azimuthal(Lobe::TRT, td, phi));
+        assert_eq!(
+            m.azimuthal(Lobe::TRT, td, phi),
+            raw.azimuthal(Lobe::TRT, td, phi)
+        );
     }
     // Below η′ = 2 the caustic is removed: N_TRT is finite at φ_c, where the raw term spikes.
     let td = 0.1;
@@ -337,7 +355,10 @@ fn trt_caustic_branches_are_continuous_at_eta_prime_two() {
     let phi_c = wrap_angle(a1 * gc - a3 * gc.powi(3));
     let smoothed = m.azimuthal(Lobe::TRT, td, phi_c + 1e-9)[0];
     let spike = raw.azimuthal(Lobe::TRT, td, phi_c - 1e-9)[0];
-    eprintln!("at the caustic φ_c = {phi_c:.4}: raw N_TRT {spike:.3e}, smoothed {smoothed:.4}; η′ = {:.4}", b.eta_prime());
+    eprintln!(
+        "at the caustic φ_c = {phi_c:.4}: raw N_TRT {spike:.3e}, smoothed {smoothed:.4}; η′ = {:.4}",
+        b.eta_prime()
+    );
     assert!(smoothed.is_finite() && smoothed < 10.0 && spike > 20.0);
 }
 
@@ -372,7 +393,10 @@ fn lobe_decomposition_and_directions_agree_with_the_model() {
     assert!((a - (-5f64).to_radians()).abs() < 1e-15 && (b - 7.5f64.to_radians()).abs() < 1e-15);
     let (a, b) = m.lobe_shift_width(2);
     assert!((a - 7.5f64.to_radians()).abs() < 1e-15 && (b - 15f64.to_radians()).abs() < 1e-15);
-    assert_eq!(m.lobe_azimuthal(1, 0.3, 2.0), m.azimuthal(Lobe::TT, 0.3, 2.0));
+    assert_eq!(
+        m.lobe_azimuthal(1, 0.3, 2.0),
+        m.azimuthal(Lobe::TT, 0.3, 2.0)
+    );
     assert_eq!(m.lobe_azimuthal(7, 0.3, 2.0), [0.0; 3]);
     // S from directions equals S from angles; S is the sum of its lobes.
     let (ti, to, phi_i, phi) = (0.4, -0.3, 0.5, 2.2);
@@ -387,7 +411,10 @@ fn lobe_decomposition_and_directions_agree_with_the_model() {
     }
     assert_eq!(m.name(), "marschner");
     assert!(matches!(
-        Marschner::new(MarschnerParams { eta: 0.9, ..MarschnerParams::default() }),
+        Marschner::new(MarschnerParams {
+            eta: 0.9,
+            ..MarschnerParams::default()
+        }),
         Err(ParamError::OutOfRange { name: "eta", .. })
     ));
 }
@@ -397,8 +424,9 @@ fn hard_case_sweep_finds_no_nan_or_inf() {
     let r = hard_case_sweep(1_000_000, 0x5eed);
     eprintln!("{r:#?}");
     assert_eq!(r.samples, 1_000_000);
-    assert!(r.eta_prime_at_least_2 > 100_000 && r.exact_pole > 100_000, "{r:?}");
+    assert!(
+        r.eta_prime_at_least_2 > 100_000 && r.exact_pole > 100_000,
+        "{r:?}"
+    );
     assert!(r.is_clean(), "{r:?}");
 }
-
-
