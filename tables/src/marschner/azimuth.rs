@@ -69,65 +69,82 @@ impl Bravais {
     /// Fresnel reflectance entering the fiber at offset h: the mean of the perpendicular
     /// component with index η′ and the parallel component with η″ (Marschner 2003 App. B).
     pub fn fresnel_entry(&self, h: f64) -> f64 {
-        let cos_i = (1.0 - h * h).max(0.0).sqrt();
-        let cd = self.cos_d;
-        let s_t = h * self.inv_eta_prime;
-        let cos_t = (1.0 - s_t * s_t).max(0.0).sqrt();
-        // r_s = (cos γ_i − η′ cos γ_t)/(cos γ_i + η′ cos γ_t), times cos θ_d.
-        let rs = ratio_squared(cd * cos_i - self.n * cos_t, cd * cos_i + self.n * cos_t);
-        // r_p = (η″ cos γ_i − cos γ″_t)/(η″ cos γ_i + cos γ″_t), times n·η²cos θ_d, with
-        // cos γ″_t = √q/(η² cos θ_d), q = η⁴cos²θ_d − h²n²; q ≤ 0 is total reflection.
-        let e4c2 = self.eta2 * self.eta2 * cd * cd;
-        let q = e4c2 - h * h * self.n * self.n;
-        let rp = if q <= 0.0 {
-            1.0
-        } else {
-            let sq = self.n * q.sqrt();
-            ratio_squared(e4c2 * cos_i - sq, e4c2 * cos_i + sq)
-        };
-        0.5 * (rs + rp)
+        self.interfaces(h).entry
     }
 
     /// Fresnel reflectance from inside at the refracted angle γ_t (sin γ_t = h/η′), for both
     /// internal reflection and exit. The perpendicular part equals the entry one (Snell's law
     /// with the same η′ maps γ_t back to γ_i); the parallel part uses 1/η″ at angle γ_t.
     pub fn fresnel_internal(&self, h: f64) -> f64 {
+        self.interfaces(h).internal
+    }
+
+    /// Both Fresnel factors and cos γ_t at offset h, sharing their square roots.
+    fn interfaces(&self, h: f64) -> Interfaces {
         let cos_i = (1.0 - h * h).max(0.0).sqrt();
         let cd = self.cos_d;
         let s_t = h * self.inv_eta_prime;
         let cos_t = (1.0 - s_t * s_t).max(0.0).sqrt();
+        // r_s = (cos γ_i − η′ cos γ_t)/(cos γ_i + η′ cos γ_t), times cos θ_d; by Snell's law
+        // with η′ the internal r_s at γ_t is the same number.
         let rs = ratio_squared(cd * cos_i - self.n * cos_t, cd * cos_i + self.n * cos_t);
-        // η″ sin γ_t = η² cos²θ_d h / n² ≤ h (η″ ≤ η′), so no total internal reflection.
+        // Entry r_p = (η″ cos γ_i − cos γ″_t)/(η″ cos γ_i + cos γ″_t), times n·η²cos θ_d, with
+        // cos γ″_t = √q/(η² cos θ_d), q = η⁴cos²θ_d − h²n²; q ≤ 0 is total reflection.
+        let e4c2 = self.eta2 * self.eta2 * cd * cd;
+        let q = e4c2 - h * h * self.n * self.n;
+        let rp_entry = if q <= 0.0 {
+            1.0
+        } else {
+            let sq = self.n * q.sqrt();
+            ratio_squared(e4c2 * cos_i - sq, e4c2 * cos_i + sq)
+        };
+        // Internal r_p with 1/η″ at γ_t: η″ sin γ_t = η² cos²θ_d h / n² ≤ h (η″ ≤ η′), so
+        // there is no total internal reflection.
         let eta_pp = self.eta2 * cd / self.n;
         let s_out = (eta_pp * s_t).min(1.0);
         let cos_out = (1.0 - s_out * s_out).max(0.0).sqrt();
-        let rp = ratio_squared(cos_t - eta_pp * cos_out, cos_t + eta_pp * cos_out);
-        0.5 * (rs + rp)
+        let rp_internal = ratio_squared(cos_t - eta_pp * cos_out, cos_t + eta_pp * cos_out);
+        Interfaces {
+            entry: 0.5 * (rs + rp_entry),
+            internal: 0.5 * (rs + rp_internal),
+            cos_gamma_t: cos_t,
+        }
     }
 
-    /// Transmittance of one internal chord at offset h: exp(−σ_a · 2 cos γ_t / cos θ_t), with
-    /// σ_a per unit fiber radius (the chord of the unit circle is 2 cos γ_t; dividing by
-    /// cos θ_t turns the projected length into the 3D path length, which Hunz eq. 52 omits).
-    /// σ_a = +∞ (or overflowing) gives 0: the chord length is > 0 for every h.
+    /// Length of one internal chord at offset h in fiber radii: 2 cos γ_t / cos θ_t (the chord
+    /// of the unit circle is 2 cos γ_t; dividing by cos θ_t turns the projected length into
+    /// the 3D path length, which Hunz eq. 52 omits). cos θ_t ≥ √(1 − 1/η²) > 0.
+    fn chord_length(&self, cos_gamma_t: f64) -> f64 {
+        2.0 * cos_gamma_t / self.cos_theta_t
+    }
+
+    /// Transmittance of one internal chord at offset h: exp(−σ_a · 2 cos γ_t / cos θ_t), σ_a
+    /// per unit fiber radius. σ_a = +∞ (or overflowing) gives 0: the chord is > 0 for |h| < 1.
     pub fn transmittance(&self, h: f64, sigma_a: &Rgb) -> Rgb {
-        let s_t = h * self.inv_eta_prime;
-        let cos_gamma_t = (1.0 - s_t * s_t).max(0.0).sqrt();
-        let length = 2.0 * cos_gamma_t / self.cos_theta_t;
+        let length = self.chord_length(self.interfaces(h).cos_gamma_t);
         sigma_a.map(|s| (-(s * length)).exp())
     }
 
     /// The attenuation A(p, h) of Marschner 2003 eq. 9 / Hunz eq. 54, per channel.
     pub fn attenuation(&self, p: usize, h: f64, sigma_a: &Rgb) -> Rgb {
-        let f_entry = self.fresnel_entry(h);
+        let f = self.interfaces(h);
         if p == 0 {
-            return [f_entry; 3];
+            return [f.entry; 3];
         }
-        let f_in = self.fresnel_internal(h);
-        let t = self.transmittance(h, sigma_a);
-        // Through the fiber: enter, (p − 1) internal reflections, exit.
-        let fresnel = (1.0 - f_entry) * (1.0 - f_in) * f_in.powi(p as i32 - 1);
-        t.map(|tc| fresnel * tc.powi(p as i32))
+        // Through the fiber: enter, (p − 1) internal reflections, exit; p chords.
+        let fresnel = (1.0 - f.entry) * (1.0 - f.internal) * f.internal.powi(p as i32 - 1);
+        if fresnel == 0.0 {
+            return [0.0; 3];
+        }
+        let path = p as f64 * self.chord_length(f.cos_gamma_t);
+        sigma_a.map(|s| fresnel * (-(s * path)).exp())
     }
+}
+
+struct Interfaces {
+    entry: f64,
+    internal: f64,
+    cos_gamma_t: f64,
 }
 
 fn ratio_squared(num: f64, den: f64) -> f64 {
