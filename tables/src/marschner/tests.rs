@@ -430,3 +430,80 @@ fn hard_case_sweep_finds_no_nan_or_inf() {
     );
     assert!(r.is_clean(), "{r:?}");
 }
+
+/// Hunz Algorithm 1 transcribed here line by line, on top of the raw N_TRT, with the fold's
+/// d²φ/dh² taken by finite differences of φ̂(2, asin h) (the implementation uses the closed
+/// form φ̂''(γ_c)/cos²γ_c). Covers both branches (η′ < 2 and the fade above 2).
+#[test]
+fn caustic_smoothing_matches_a_transcription_of_hunz_algorithm_1() {
+    let sigma = [0.3, 0.6, 1.2];
+    let params = |smooth: bool| {
+        model(|p| {
+            p.sigma_a = sigma;
+            p.smooth_caustics = smooth;
+            p.glint_scale = 2.0;
+            // Narrow enough that Δh = 2√(2w_c/|φ''|) < Δh_M and the curvature matters.
+            p.caustic_width_deg = 2.0;
+        })
+    };
+    let (smoothed, raw) = (params(true), params(false));
+    let (w_c, k_g, d_eta, d_h_m): (f64, f64, f64, f64) = (2f64.to_radians(), 2.0, 0.3, 0.5);
+    let g = |x: f64| (-x * x / (2.0 * w_c * w_c)).exp() / (w_c * (2.0 * PI).sqrt());
+    let smoothstep = |a: f64, b: f64, x: f64| {
+        let t = ((x - a) / (b - a)).clamp(0.0, 1.0);
+        t * t * (3.0 - 2.0 * t)
+    };
+    let (mut checked_fade, mut checked_curvature) = (false, false);
+    for &td in &[0.0f64, 0.3, 0.7, 0.82, 0.86, 0.95] {
+        let eta_prime = (1.55f64 * 1.55 - td.sin().powi(2)).sqrt() / td.cos();
+        let (a1, a3) = paper_cubic(1.55, td, 2);
+        let phi_hat = |gamma: f64| a1 * gamma - a3 * gamma.powi(3) + 2.0 * PI;
+        let (delta_h, t, phi_c, h_c) = if eta_prime < 2.0 {
+            let gamma_c = ((12.0 * (1.0 / eta_prime).asin() / PI - 2.0)
+                / (48.0 * (1.0 / eta_prime).asin() / PI.powi(3)))
+            .sqrt();
+            let h_c = gamma_c.sin();
+            let e = 1e-4;
+            let d2 = (phi_hat((h_c + e).asin()) - 2.0 * phi_hat(h_c.asin())
+                + phi_hat((h_c - e).asin()))
+                / (e * e);
+            let dh = d_h_m.min(2.0 * (2.0 * w_c / d2.abs()).sqrt());
+            checked_curvature |= dh < d_h_m;
+            (dh, 1.0, wrap_angle(phi_hat(gamma_c)), h_c)
+        } else {
+            checked_fade |= eta_prime < 2.0 + d_eta;
+            (
+                d_h_m,
+                1.0 - smoothstep(2.0, 2.0 + d_eta, eta_prime),
+                0.0,
+                0.0,
+            )
+        };
+        let a_c = Bravais::new(1.55, td).attenuation(2, h_c, &sigma);
+        for k in 0..24 {
+            let phi = -PI + (k as f64 + 0.37) * 2.0 * PI / 24.0;
+            let raw_n = raw.azimuthal(Lobe::TRT, td, phi);
+            let got = smoothed.azimuthal(Lobe::TRT, td, phi);
+            for c in 0..3 {
+                let mut l = raw_n[c];
+                l *= 1.0 - t * g(wrap_angle(phi - phi_c)) / g(0.0);
+                l *= 1.0 - t * g(wrap_angle(phi + phi_c)) / g(0.0);
+                l += t
+                    * k_g
+                    * a_c[c]
+                    * delta_h
+                    * (g(wrap_angle(phi - phi_c)) + g(wrap_angle(phi + phi_c)));
+                assert!(
+                    (got[c] - l).abs() <= 1e-6 * l.abs().max(1e-6),
+                    "θ_d={td} φ={phi} c={c}: {} vs {l}",
+                    got[c]
+                );
+            }
+        }
+        eprintln!(
+            "θ_d={td}: η′={eta_prime:.4} φ_c={phi_c:.4} h_c={h_c:.4} Δh={delta_h:.4} t={t:.4}"
+        );
+    }
+    assert!(checked_fade, "no θ_d in the fade range η′ ∈ [2, 2.3]");
+    assert!(checked_curvature, "Δh never fell below Δh_M");
+}
