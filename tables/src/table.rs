@@ -66,7 +66,8 @@ pub enum TableError {
 
 /// How an axis spreads its nodes between `min` and `max`.
 ///
-/// Both variants are one multiply-add and at most one `pow` on the GPU (see [`AxisGpu`]).
+/// Every variant is at most one `asin`/`acos`, one multiply-add and one `pow` on the GPU
+/// (see [`AxisGpu`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum AxisMapping {
@@ -77,6 +78,47 @@ pub enum AxisMapping {
     /// toward `min` (e.g. narrow SRBF lobes on a `1/λ` axis), below 1 toward `max`.
     /// A lookup inverts it: `f = (n−1)·((x − min)/(max − min))^(1/exponent)`.
     Power { exponent: f64 },
+    /// For coordinates that are sines of an angle (u·ω = sin θ): nodes uniform in `asin x`, so
+    /// they crowd toward ±1 where functions of θ change fastest per unit of sin θ (grazing).
+    Arcsine,
+    /// For coordinates that are cosines of an angle (cos Δφ): nodes uniform in `acos x`, i.e.
+    /// uniform in the angle — dense near cos = ±1, where the TT lobe (Δφ ≈ π) lives.
+    Arccosine,
+}
+
+impl AxisMapping {
+    /// The space in which nodes are spread uniformly (before any power warp); increasing in x.
+    fn warp(self, x: f64) -> f64 {
+        match self {
+            AxisMapping::Uniform | AxisMapping::Power { .. } => x,
+            AxisMapping::Arcsine => x.clamp(-1.0, 1.0).asin(),
+            AxisMapping::Arccosine => -x.clamp(-1.0, 1.0).acos(),
+        }
+    }
+
+    fn unwarp(self, w: f64) -> f64 {
+        match self {
+            AxisMapping::Uniform | AxisMapping::Power { .. } => w,
+            AxisMapping::Arcsine => w.sin(),
+            AxisMapping::Arccosine => (-w).cos(),
+        }
+    }
+
+    fn exponent(self) -> f64 {
+        match self {
+            AxisMapping::Power { exponent } => exponent,
+            _ => 1.0,
+        }
+    }
+
+    /// The GPU's code for [`AxisMapping::warp`]: 0 none, 1 asin, 2 −acos.
+    fn gpu_code(self) -> u32 {
+        match self {
+            AxisMapping::Uniform | AxisMapping::Power { .. } => 0,
+            AxisMapping::Arcsine => 1,
+            AxisMapping::Arccosine => 2,
+        }
+    }
 }
 
 /// One named table axis with `count` nodes spanning `[min, max]`.
@@ -90,9 +132,10 @@ pub struct Axis {
     pub mapping: AxisMapping,
 }
 
-/// An axis as the GPU evaluates it: `t = clamp((x − min)·inv_range, 0, 1)`, then
-/// `t = pow(t, inv_exponent)` (skip when `inv_exponent == 1`), then `f = t·last_index`.
-/// A one-node axis has `inv_range = last_index = 0`.
+/// An axis as the GPU evaluates it: `w = x` (warp 0), `asin(x)` (1) or `−acos(x)` (2); then
+/// `t = clamp((w − min)·inv_range, 0, 1)`, `t = pow(t, inv_exponent)` (skip when it is 1), and
+/// `f = t·last_index`. `min` and `inv_range` are in the warped space. A one-node axis has
+/// `inv_range = last_index = 0`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct AxisGpu {
@@ -100,6 +143,8 @@ pub struct AxisGpu {
     pub inv_range: f32,
     pub last_index: f32,
     pub inv_exponent: f32,
+    pub warp: u32,
+    pub _pad: [u32; 3],
 }
 
 impl Axis {
@@ -120,6 +165,16 @@ impl Axis {
             max,
             count,
             mapping: AxisMapping::Power { exponent },
+        }
+    }
+
+    pub fn with_mapping(name: impl Into<String>, min: f64, max: f64, count: usize, mapping: AxisMapping) -> Self {
+        Self {
+            name: name.into(),
+            min,
+            max,
+            count,
+            mapping,
         }
     }
 
@@ -147,6 +202,10 @@ impl Axis {
             AxisMapping::Power { exponent } if !(exponent.is_finite() && exponent > 0.0) => fail(format!(
                 "power mapping exponent {exponent} must be finite and > 0"
             )),
+            AxisMapping::Arcsine | AxisMapping::Arccosine if self.min < -1.0 || self.max > 1.0 => fail(format!(
+                "range [{}, {}] must lie in [−1, 1] for an arcsine/arccosine mapping",
+                self.min, self.max
+            )),
             _ => Ok(()),
         }
     }
@@ -159,12 +218,9 @@ impl Axis {
         if i >= self.count - 1 {
             return self.max;
         }
-        let t = i as f64 / (self.count - 1) as f64;
-        let t = match self.mapping {
-            AxisMapping::Uniform => t,
-            AxisMapping::Power { exponent } => t.powf(exponent),
-        };
-        self.min + (self.max - self.min) * t
+        let t = (i as f64 / (self.count - 1) as f64).powf(self.mapping.exponent());
+        let (w0, w1) = (self.mapping.warp(self.min), self.mapping.warp(self.max));
+        self.mapping.unwarp(w0 + (w1 - w0) * t)
     }
 
     /// Continuous node position of `x` in `[0, count − 1]`, clamped to the edges.
@@ -178,11 +234,9 @@ impl Axis {
         if self.count <= 1 {
             return Ok(0.0);
         }
-        let t = ((x - self.min) / (self.max - self.min)).clamp(0.0, 1.0);
-        let t = match self.mapping {
-            AxisMapping::Uniform => t,
-            AxisMapping::Power { exponent } => t.powf(1.0 / exponent),
-        };
+        let m = self.mapping;
+        let (w0, w1) = (m.warp(self.min), m.warp(self.max));
+        let t = ((m.warp(x) - w0) / (w1 - w0)).clamp(0.0, 1.0).powf(1.0 / m.exponent());
         let f = t * (self.count - 1) as f64;
         let nearest = f.round();
         Ok(if (f - nearest).abs() <= NODE_SNAP {
@@ -203,20 +257,20 @@ impl Axis {
     }
 
     pub fn gpu(&self) -> AxisGpu {
+        let m = self.mapping;
+        let (w0, w1) = (m.warp(self.min), m.warp(self.max));
         let (inv_range, last_index) = if self.count > 1 {
-            (1.0 / (self.max - self.min), (self.count - 1) as f64)
+            (1.0 / (w1 - w0), (self.count - 1) as f64)
         } else {
             (0.0, 0.0)
         };
-        let inv_exponent = match self.mapping {
-            AxisMapping::Uniform => 1.0,
-            AxisMapping::Power { exponent } => 1.0 / exponent,
-        };
         AxisGpu {
-            min: self.min as f32,
+            min: w0 as f32,
             inv_range: inv_range as f32,
             last_index: last_index as f32,
-            inv_exponent: inv_exponent as f32,
+            inv_exponent: (1.0 / m.exponent()) as f32,
+            warp: m.gpu_code(),
+            _pad: [0; 3],
         }
     }
 }
@@ -771,7 +825,9 @@ mod tests {
                 min: 0.5,
                 inv_range: 0.0,
                 last_index: 0.0,
-                inv_exponent: 1.0
+                inv_exponent: 1.0,
+                warp: 0,
+                _pad: [0; 3],
             }
         );
     }
@@ -787,6 +843,34 @@ mod tests {
             let f = (t * g.last_index) as f64;
             assert!((f - axis.position(x).unwrap()).abs() < 1e-4, "x={x}");
         }
+    }
+
+    #[test]
+    fn angle_mappings_are_uniform_in_the_angle_and_invert_exactly() {
+        let sine = Axis::with_mapping("u·ω", -1.0, 1.0, 7, AxisMapping::Arcsine);
+        let cosine = Axis::with_mapping("cos Δφ", -1.0, 1.0, 7, AxisMapping::Arccosine);
+        for i in 0..7 {
+            let angle = -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * i as f64 / 6.0;
+            assert!((sine.node(i) - angle.sin()).abs() < 1e-15);
+            let phi = std::f64::consts::PI * (1.0 - i as f64 / 6.0);
+            assert!((cosine.node(i) - phi.cos()).abs() < 1e-15, "node {i}");
+            assert!((sine.position(sine.node(i)).unwrap() - i as f64).abs() < 1e-12);
+            assert!((cosine.position(cosine.node(i)).unwrap() - i as f64).abs() < 1e-12);
+        }
+        // The GPU recipe (warp, scale, clamp) gives the CPU's position.
+        for axis in [&sine, &cosine] {
+            let g = axis.gpu();
+            for &x in &[-1.0, -0.93, -0.2, 0.0, 0.51, 0.999, 1.0] {
+                let w = match g.warp {
+                    1 => (x as f32).asin(),
+                    2 => -(x as f32).acos(),
+                    _ => x as f32,
+                };
+                let f = ((w - g.min) * g.inv_range).clamp(0.0, 1.0) * g.last_index;
+                assert!((f as f64 - axis.position(x).unwrap()).abs() < 1e-5, "{} x={x}", axis.name);
+            }
+        }
+        assert!(Axis::with_mapping("bad", -2.0, 1.0, 3, AxisMapping::Arcsine).validate().is_err());
     }
 
     #[test]
