@@ -133,7 +133,7 @@ pub fn hard_case_sweep(samples: u64, seed: u64) -> SweepReport {
     let mut rng = SweepRng::new(seed);
     let per_model = 1000u64;
     while report.samples < samples {
-        let mut scale = |rng: &mut SweepRng| {
+        let scale = |rng: &mut SweepRng| {
             if rng.uniform() < 0.1 { 0.0 } else { rng.log_range(1e-9, 1e3) }
         };
         let params = KajiyaKayParams {
