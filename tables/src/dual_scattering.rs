@@ -217,7 +217,13 @@ fn fiber_averages_with(
     let mut share = vec![[[0.0; 3]; 2]; lobes];
     for (p, share_p) in share.iter_mut().enumerate() {
         let (alpha, beta) = model.lobe_shift_width(p);
-        let rule = peaked_rule(-FRAC_PI_2, FRAC_PI_2, &[(2.0 * alpha - theta, 2.0 * beta)], &[], 4);
+        // Near grazing incidence (θ → ∓π/2) cos θ_o / cos²θ_d ≈ 4ε/(ε + δ)² at θ_o = ±(π/2 − ε),
+        // δ = π/2 − |θ| (capped at 2·MIN_COS_THETA_D by the guard): a boundary layer with a
+        // 1/ε tail. Grade the rule geometrically toward that pole as well as around the lobe.
+        let layer = (FRAC_PI_2 - theta.abs()).max(2.0 * MIN_COS_THETA_D);
+        let toward = if theta <= 0.0 { 1.0 } else { -1.0 };
+        let splits: Vec<f64> = (0..12).map(|k| toward * (FRAC_PI_2 - layer * 4f64.powi(k))).collect();
+        let rule = peaked_rule(-FRAC_PI_2, FRAC_PI_2, &[(2.0 * alpha - theta, 2.0 * beta)], &splits, 4);
         for (&theta_o, &w) in rule.nodes.iter().zip(&rule.weights) {
             let theta_d = 0.5 * (theta_o - theta);
             let m = model.lobe_longitudinal(p, 0.5 * (theta + theta_o));
@@ -322,6 +328,22 @@ fn grid_position(x: f64, n: usize) -> (usize, f64) {
     (i, u - i as f64)
 }
 
+/// k-th node of the inclination grid θ = (π/2) sin(πs/2), s uniform on [−1, 1]: spacing
+/// (π²/4)(2/(n−1)) at θ = 0, shrinking quadratically toward ±90° where the averages vary on
+/// the scale π/2 − |θ| (grazing boundary layers).
+fn inclination_grid_value(k: usize, n: usize) -> f64 {
+    let s = -1.0 + 2.0 * k as f64 / (n - 1) as f64;
+    FRAC_PI_2 * (FRAC_PI_2 * s).sin()
+}
+
+/// Cell index and fraction of θ on the inclination grid (θ clamped to [−π/2, π/2]).
+fn inclination_grid_position(theta: f64, n: usize) -> (usize, f64) {
+    let s = (theta / FRAC_PI_2).clamp(-1.0, 1.0).asin() / FRAC_PI_2;
+    let u = 0.5 * (s + 1.0) * (n - 1) as f64;
+    let i = (u.floor() as usize).min(n - 2);
+    (i, u - i as f64)
+}
+
 // ---------------------------------------------------------------------------------------------
 // Multiple backscattering.
 
@@ -415,7 +437,8 @@ pub struct DualScatteringConfig {
     pub density_forward: f64,
     /// d_b: scales S_back in S^D = S + d_b S_back (Zinke; Ren §3.2).
     pub density_backward: f64,
-    /// Nodes of the θ grid on [−90°, 90°] the averages are tabulated on (≥ 3).
+    /// Nodes of the θ grid on [−90°, 90°] the averages are tabulated on (≥ 3), spaced as
+    /// θ = 90° sin(90° s) for uniform s (denser toward ±90°).
     pub theta_samples: usize,
     /// Nodes of the θ_d grid the azimuthal hemisphere integrals are tabulated on (≥ 4).
     pub theta_d_samples: usize,
@@ -427,7 +450,7 @@ impl Default for DualScatteringConfig {
         Self {
             density_forward: DEFAULT_DENSITY_FACTOR,
             density_backward: DEFAULT_DENSITY_FACTOR,
-            theta_samples: 361,
+            theta_samples: 513,
             theta_d_samples: 361,
             moments: MomentsForm::PathSeries,
         }
@@ -468,7 +491,7 @@ impl DualScatteringAverages {
         let mut averages = Vec::with_capacity(n);
         let mut moments = Vec::with_capacity(n);
         for k in 0..n {
-            let theta = grid_value(k, n);
+            let theta = inclination_grid_value(k, n);
             let avg = fiber_averages_with(model, theta, |p, theta_d| table.at(p, theta_d));
             for c in 0..3 {
                 let name = "dual_scattering.average_forward_attenuation";
@@ -487,13 +510,13 @@ impl DualScatteringAverages {
 
     /// The tabulated fiber averages at inclination θ (linear interpolation).
     pub fn averages_at(&self, theta: f64) -> FiberAverages {
-        let (i, t) = grid_position(theta, self.averages.len());
+        let (i, t) = inclination_grid_position(theta, self.averages.len());
         self.averages[i].lerp(&self.averages[i + 1], t)
     }
 
     /// Ā_b, Δ̄_b, σ̄_b² at inclination θ (linear interpolation of the tabulated moments).
     pub fn moments_at(&self, theta: f64) -> BackscatterMoments {
-        let (i, t) = grid_position(theta, self.moments.len());
+        let (i, t) = inclination_grid_position(theta, self.moments.len());
         let (a, b) = (&self.moments[i], &self.moments[i + 1]);
         let l = |x: &Rgb, y: &Rgb| -> Rgb { std::array::from_fn(|c| x[c] + t * (y[c] - x[c])) };
         BackscatterMoments {
