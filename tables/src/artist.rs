@@ -109,7 +109,12 @@ impl Default for ArtistParams {
     /// azimuthal widths are this project's choices — the paper gives no numbers for them.
     fn default() -> Self {
         Self {
-            r: HighlightParams { color: [1.0, 1.0, 1.0], intensity: 0.5, shift_deg: -5.0, width_deg: 5.0 },
+            r: HighlightParams {
+                color: [1.0, 1.0, 1.0],
+                intensity: 0.5,
+                shift_deg: -5.0,
+                width_deg: 5.0,
+            },
             tt: TransmissionParams {
                 color: [0.85, 0.62, 0.38],
                 intensity: 1.0,
@@ -117,7 +122,12 @@ impl Default for ArtistParams {
                 width_deg: 2.5,
                 azimuthal_width_deg: 20.0,
             },
-            trt: HighlightParams { color: [0.75, 0.52, 0.30], intensity: 0.35, shift_deg: 7.5, width_deg: 10.0 },
+            trt: HighlightParams {
+                color: [0.75, 0.52, 0.30],
+                intensity: 0.35,
+                shift_deg: 7.5,
+                width_deg: 10.0,
+            },
             glints: GlintParams {
                 color: [1.0, 1.0, 1.0],
                 relative_intensity: 0.5,
@@ -144,39 +154,101 @@ fn check_highlight(
 ) -> Result<(), ParamError> {
     check_color(names.0, color)?;
     check_non_negative(names.1, intensity)?;
-    check(names.2, shift, |s| s.abs() <= MAX_SHIFT_DEG, "must be in [−45°, 45°]")?;
-    check(names.3, width, |w| (MIN_WIDTH_DEG..=MAX_WIDTH_DEG).contains(&w), "must be in [0.1°, 60°]")?;
+    check(
+        names.2,
+        shift,
+        |s| s.abs() <= MAX_SHIFT_DEG,
+        "must be in [−45°, 45°]",
+    )?;
+    check(
+        names.3,
+        width,
+        |w| (MIN_WIDTH_DEG..=MAX_WIDTH_DEG).contains(&w),
+        "must be in [0.1°, 60°]",
+    )?;
     Ok(())
 }
 
 impl ArtistParams {
     pub fn validate(&self) -> Result<(), ParamError> {
         check_highlight(
-            (["artist.r.color[0]", "artist.r.color[1]", "artist.r.color[2]"], "artist.r.intensity", "artist.r.shift_deg", "artist.r.width_deg"),
+            (
+                [
+                    "artist.r.color[0]",
+                    "artist.r.color[1]",
+                    "artist.r.color[2]",
+                ],
+                "artist.r.intensity",
+                "artist.r.shift_deg",
+                "artist.r.width_deg",
+            ),
             self.r.color,
             self.r.intensity,
             self.r.shift_deg,
             self.r.width_deg,
         )?;
         check_highlight(
-            (["artist.tt.color[0]", "artist.tt.color[1]", "artist.tt.color[2]"], "artist.tt.intensity", "artist.tt.shift_deg", "artist.tt.width_deg"),
+            (
+                [
+                    "artist.tt.color[0]",
+                    "artist.tt.color[1]",
+                    "artist.tt.color[2]",
+                ],
+                "artist.tt.intensity",
+                "artist.tt.shift_deg",
+                "artist.tt.width_deg",
+            ),
             self.tt.color,
             self.tt.intensity,
             self.tt.shift_deg,
             self.tt.width_deg,
         )?;
-        check("artist.tt.azimuthal_width_deg", self.tt.azimuthal_width_deg, |w| (0.1..=180.0).contains(&w), "must be in [0.1°, 180°]")?;
+        check(
+            "artist.tt.azimuthal_width_deg",
+            self.tt.azimuthal_width_deg,
+            |w| (0.1..=180.0).contains(&w),
+            "must be in [0.1°, 180°]",
+        )?;
         check_highlight(
-            (["artist.trt.color[0]", "artist.trt.color[1]", "artist.trt.color[2]"], "artist.trt.intensity", "artist.trt.shift_deg", "artist.trt.width_deg"),
+            (
+                [
+                    "artist.trt.color[0]",
+                    "artist.trt.color[1]",
+                    "artist.trt.color[2]",
+                ],
+                "artist.trt.intensity",
+                "artist.trt.shift_deg",
+                "artist.trt.width_deg",
+            ),
             self.trt.color,
             self.trt.intensity,
             self.trt.shift_deg,
             self.trt.width_deg,
         )?;
-        check_color(["artist.glints.color[0]", "artist.glints.color[1]", "artist.glints.color[2]"], self.glints.color)?;
-        check_non_negative("artist.glints.relative_intensity", self.glints.relative_intensity)?;
-        check("artist.glints.azimuthal_width_deg", self.glints.azimuthal_width_deg, |w| (0.1..=180.0).contains(&w), "must be in [0.1°, 180°]")?;
-        check("artist.glints.half_angle_deg", self.glints.half_angle_deg, |g| (0.0..=180.0).contains(&g), "must be in [0°, 180°]")?;
+        check_color(
+            [
+                "artist.glints.color[0]",
+                "artist.glints.color[1]",
+                "artist.glints.color[2]",
+            ],
+            self.glints.color,
+        )?;
+        check_non_negative(
+            "artist.glints.relative_intensity",
+            self.glints.relative_intensity,
+        )?;
+        check(
+            "artist.glints.azimuthal_width_deg",
+            self.glints.azimuthal_width_deg,
+            |w| (0.1..=180.0).contains(&w),
+            "must be in [0.1°, 180°]",
+        )?;
+        check(
+            "artist.glints.half_angle_deg",
+            self.glints.half_angle_deg,
+            |g| (0.0..=180.0).contains(&g),
+            "must be in [0°, 180°]",
+        )?;
         Ok(())
     }
 }
@@ -217,7 +289,8 @@ impl ArtistModel {
     pub fn new(params: ArtistParams) -> Result<Self, ParamError> {
         params.validate()?;
         let scale = |c: [f64; 3], i: f64| c.map(|x| x * i);
-        let glint_color: Rgb = std::array::from_fn(|c| params.trt.color[c] * params.glints.color[c]);
+        let glint_color: Rgb =
+            std::array::from_fn(|c| params.trt.color[c] * params.glints.color[c]);
         let rad = f64::to_radians;
         Ok(Self {
             params,
@@ -225,10 +298,23 @@ impl ArtistModel {
                 scale(params.r.color, params.r.intensity),
                 scale(params.tt.color, params.tt.intensity),
                 scale(params.trt.color, params.trt.intensity),
-                scale(glint_color, params.trt.intensity * params.glints.relative_intensity),
+                scale(
+                    glint_color,
+                    params.trt.intensity * params.glints.relative_intensity,
+                ),
             ],
-            alpha: [rad(params.r.shift_deg), rad(params.tt.shift_deg), rad(params.trt.shift_deg), rad(params.trt.shift_deg)],
-            beta: [rad(params.r.width_deg), rad(params.tt.width_deg), rad(params.trt.width_deg), rad(params.trt.width_deg)],
+            alpha: [
+                rad(params.r.shift_deg),
+                rad(params.tt.shift_deg),
+                rad(params.trt.shift_deg),
+                rad(params.trt.shift_deg),
+            ],
+            beta: [
+                rad(params.r.width_deg),
+                rad(params.tt.width_deg),
+                rad(params.trt.width_deg),
+                rad(params.trt.width_deg),
+            ],
             gamma_tt: rad(params.tt.azimuthal_width_deg),
             gamma_g: rad(params.glints.azimuthal_width_deg),
             glint_half_angle: rad(params.glints.half_angle_deg),
@@ -278,8 +364,8 @@ impl ArtistModel {
             let mn = unit_height_gaussian(self.beta[p], theta_h - self.alpha[p])
                 * self.azimuthal_with_glint_angle(lobe, angles.phi, glint_half_angle)
                 * inv;
-            for c in 0..3 {
-                s[c] += self.weight[p][c] * mn;
+            for (s_c, w_c) in s.iter_mut().zip(&self.weight[p]) {
+                *s_c += w_c * mn;
             }
         }
         s
@@ -294,15 +380,21 @@ impl ArtistModel {
                 continue;
             }
             let phi_integral = self.azimuthal_integral(lobe);
-            let rule = peaked_rule(-FRAC_PI_2, FRAC_PI_2, &[(self.alpha[p], self.beta[p])], &[0.0], 8);
+            let rule = peaked_rule(
+                -FRAC_PI_2,
+                FRAC_PI_2,
+                &[(self.alpha[p], self.beta[p])],
+                &[0.0],
+                8,
+            );
             let longitudinal: f64 = rule
                 .nodes
                 .iter()
                 .zip(&rule.weights)
                 .map(|(&th, &w)| w * self.longitudinal(lobe, th) * inclination_weight(th))
                 .sum();
-            for c in 0..3 {
-                k[c] += self.weight[p][c] * phi_integral * longitudinal;
+            for (k_c, w_c) in k.iter_mut().zip(&self.weight[p]) {
+                *k_c += w_c * phi_integral * longitudinal;
             }
         }
         k
@@ -312,11 +404,18 @@ impl ArtistModel {
     fn azimuthal_integral(&self, lobe: ArtistLobe) -> f64 {
         let peaks = match lobe {
             ArtistLobe::Tt => vec![(PI, self.gamma_tt), (-PI, self.gamma_tt)],
-            ArtistLobe::Glints => vec![(self.glint_half_angle, self.gamma_g), (-self.glint_half_angle, self.gamma_g)],
+            ArtistLobe::Glints => vec![
+                (self.glint_half_angle, self.gamma_g),
+                (-self.glint_half_angle, self.gamma_g),
+            ],
             _ => vec![],
         };
         let rule = peaked_rule(-PI, PI, &peaks, &[0.0], 8);
-        rule.nodes.iter().zip(&rule.weights).map(|(&phi, &w)| w * self.azimuthal(lobe, phi)).sum()
+        rule.nodes
+            .iter()
+            .zip(&rule.weights)
+            .map(|(&phi, &w)| w * self.azimuthal(lobe, phi))
+            .sum()
     }
 
     /// The energy-normalized copy used for multiple scattering (eq. 13).
@@ -329,7 +428,11 @@ impl ArtistModel {
                 [if m > 0.0 { 1.0 / m } else { 0.0 }; 3]
             }
         };
-        NormalizedArtist { model: *self, integral: k, scale }
+        NormalizedArtist {
+            model: *self,
+            integral: k,
+            scale,
+        }
     }
 }
 
@@ -378,7 +481,10 @@ impl LobeDecomposition for ArtistModel {
     fn lobe_azimuthal_peaks(&self, p: usize, _theta_d: f64) -> Vec<(f64, f64)> {
         match ArtistLobe::ALL[p] {
             ArtistLobe::Tt => vec![(PI, self.gamma_tt), (-PI, self.gamma_tt)],
-            ArtistLobe::Glints => vec![(self.glint_half_angle, self.gamma_g), (-self.glint_half_angle, self.gamma_g)],
+            ArtistLobe::Glints => vec![
+                (self.glint_half_angle, self.gamma_g),
+                (-self.glint_half_angle, self.gamma_g),
+            ],
             _ => vec![],
         }
     }
@@ -453,11 +559,22 @@ impl LobeDecomposition for NormalizedArtist {
 /// Random valid parameters for sweeps: widths from 0.5° to 30°, shifts ±15°, intensities from
 /// 1e-6 to 1e3 (or 0), colors often exactly 0 or 1 or very dark.
 pub fn random_params(rng: &mut SweepRng) -> ArtistParams {
-    let intensity = |rng: &mut SweepRng| if rng.uniform() < 0.1 { 0.0 } else { rng.log_range(1e-6, 1e3) };
+    let intensity = |rng: &mut SweepRng| {
+        if rng.uniform() < 0.1 {
+            0.0
+        } else {
+            rng.log_range(1e-6, 1e3)
+        }
+    };
     let width = |rng: &mut SweepRng| rng.log_range(0.5, 30.0);
     let shift = |rng: &mut SweepRng| rng.range(-15.0, 15.0);
     ArtistParams {
-        r: HighlightParams { color: rng.hard_color(), intensity: intensity(rng), shift_deg: shift(rng), width_deg: width(rng) },
+        r: HighlightParams {
+            color: rng.hard_color(),
+            intensity: intensity(rng),
+            shift_deg: shift(rng),
+            width_deg: width(rng),
+        },
         tt: TransmissionParams {
             color: rng.hard_color(),
             intensity: intensity(rng),
@@ -465,7 +582,12 @@ pub fn random_params(rng: &mut SweepRng) -> ArtistParams {
             width_deg: width(rng),
             azimuthal_width_deg: rng.log_range(0.5, 60.0),
         },
-        trt: HighlightParams { color: rng.hard_color(), intensity: intensity(rng), shift_deg: shift(rng), width_deg: width(rng) },
+        trt: HighlightParams {
+            color: rng.hard_color(),
+            intensity: intensity(rng),
+            shift_deg: shift(rng),
+            width_deg: width(rng),
+        },
         glints: GlintParams {
             color: rng.hard_color(),
             relative_intensity: intensity(rng),
@@ -482,12 +604,17 @@ pub fn hard_case_sweep(samples: u64, seed: u64) -> SweepReport {
     let mut rng = SweepRng::new(seed);
     let per_model = 20_000u64;
     while report.samples < samples {
-        let model = ArtistModel::new(random_params(&mut rng)).expect("random_params yields valid parameters");
+        let model = ArtistModel::new(random_params(&mut rng))
+            .expect("random_params yields valid parameters");
         let normalized = model.normalized(Normalization::PerChannel);
         report.record_rgb(normalized.integral());
         report.record_rgb(normalized.scale());
         for _ in 0..per_model / 9 {
-            let a = FiberAngles::new(rng.hard_inclination(), rng.hard_inclination(), rng.hard_azimuth());
+            let a = FiberAngles::new(
+                rng.hard_inclination(),
+                rng.hard_inclination(),
+                rng.hard_azimuth(),
+            );
             report.record_rgb(model.eval(&a));
             report.record_rgb(normalized.eval(&a));
             let g = rng.range(30f64.to_radians(), 45f64.to_radians());

@@ -33,7 +33,8 @@
 //!   averages are defined; Ren writes this θ_d).
 //! * **Forward scattering** along a shadow path (Zinke eqs. 5, 7, 8; Ren §3.2):
 //!   `T_f = d_f ∏_k ā_f(θ_k)` (1 when the point is lit directly), `σ̄_f² = Σ_k β̄_f²(θ_k)`, and
-//!   the spread `ψ_f = s̃_f(φ) g(θ_i − θ_ξ, σ̄_f²)/cos θ_ξ`, s̃_f = 1/π forward.
+//!   the spread `ψ_f = s̃_f(φ) g(θ_i − θ_ξ, 4σ̄_f²)/cos θ_ξ`, s̃_f = 1/π forward (the 4: σ̄_f² is
+//!   in θ_h, the spread is in θ_i; see [`forward_spread`]).
 //!
 //! **Units of M.** The trait's M_p is a unit-area Gaussian in θ_h (Marschner 2003), so
 //! `∫ M_p dθ_o = 2`; a lobe whose N_p integrates to E over φ contributes about 2E to ā_f + ā_b.
@@ -119,7 +120,13 @@ pub trait LobeDecomposition: Send + Sync {
 /// the interval is cut at c, c ± 2w, c ± 6w, c ± 12w (clipped) and at `splits`, and every piece
 /// gets `panels` 8-point panels. Integrands that are Gaussians of any width w ≥ 1e-6·(b−a)
 /// are integrated to ~1e-13; beyond 12w a Gaussian is below e⁻⁷².
-pub fn peaked_rule(a: f64, b: f64, peaks: &[(f64, f64)], splits: &[f64], panels: usize) -> GaussLegendre {
+pub fn peaked_rule(
+    a: f64,
+    b: f64,
+    peaks: &[(f64, f64)],
+    splits: &[f64],
+    panels: usize,
+) -> GaussLegendre {
     let mut cuts = vec![a, b];
     cuts.extend(splits.iter().copied());
     for &(c, w) in peaks {
@@ -129,7 +136,10 @@ pub fn peaked_rule(a: f64, b: f64, peaks: &[(f64, f64)], splits: &[f64], panels:
             cuts.push(c + k * w);
         }
     }
-    let mut cuts: Vec<f64> = cuts.into_iter().filter(|x| x.is_finite() && *x >= a && *x <= b).collect();
+    let mut cuts: Vec<f64> = cuts
+        .into_iter()
+        .filter(|x| x.is_finite() && *x >= a && *x <= b)
+        .collect();
     cuts.sort_by(|x, y| x.total_cmp(y));
     cuts.dedup_by(|x, y| (*x - *y).abs() < 1e-13);
     let mut nodes = Vec::new();
@@ -143,7 +153,11 @@ pub fn peaked_rule(a: f64, b: f64, peaks: &[(f64, f64)], splits: &[f64], panels:
 }
 
 /// Peaks of lobe `p` listed for the whole circle, with their 2π images inside (−π, π].
-fn azimuthal_peaks_on_circle(model: &dyn LobeDecomposition, p: usize, theta_d: f64) -> Vec<(f64, f64)> {
+fn azimuthal_peaks_on_circle(
+    model: &dyn LobeDecomposition,
+    p: usize,
+    theta_d: f64,
+) -> Vec<(f64, f64)> {
     let mut peaks = Vec::new();
     for (c, w) in model.lobe_azimuthal_peaks(p, theta_d) {
         for shift in [-2.0 * PI, 0.0, 2.0 * PI] {
@@ -154,11 +168,18 @@ fn azimuthal_peaks_on_circle(model: &dyn LobeDecomposition, p: usize, theta_d: f
 }
 
 /// `[∫_{|φ|>π/2} N_p dφ, ∫_{|φ|≤π/2} N_p dφ]` per channel at one θ_d: forward and backward.
-pub fn azimuthal_hemisphere_integrals(model: &dyn LobeDecomposition, p: usize, theta_d: f64) -> [Rgb; 2] {
+pub fn azimuthal_hemisphere_integrals(
+    model: &dyn LobeDecomposition,
+    p: usize,
+    theta_d: f64,
+) -> [Rgb; 2] {
     let peaks = azimuthal_peaks_on_circle(model, p, theta_d);
     let splits = [-FRAC_PI_2, 0.0, FRAC_PI_2];
     let mut out = [[0.0; 3]; 2];
-    for (hemi, ranges) in [(0, &[(-PI, -FRAC_PI_2), (FRAC_PI_2, PI)][..]), (1, &[(-FRAC_PI_2, FRAC_PI_2)][..])] {
+    for (hemi, ranges) in [
+        (0, &[(-PI, -FRAC_PI_2), (FRAC_PI_2, PI)][..]),
+        (1, &[(-FRAC_PI_2, FRAC_PI_2)][..]),
+    ] {
         for &(a, b) in ranges {
             let rule = peaked_rule(a, b, &peaks, &splits, 4);
             for (&phi, &w) in rule.nodes.iter().zip(&rule.weights) {
@@ -222,8 +243,16 @@ fn fiber_averages_with(
         // 1/ε tail. Grade the rule geometrically toward that pole as well as around the lobe.
         let layer = (FRAC_PI_2 - theta.abs()).max(2.0 * MIN_COS_THETA_D);
         let toward = if theta <= 0.0 { 1.0 } else { -1.0 };
-        let splits: Vec<f64> = (0..12).map(|k| toward * (FRAC_PI_2 - layer * 4f64.powi(k))).collect();
-        let rule = peaked_rule(-FRAC_PI_2, FRAC_PI_2, &[(2.0 * alpha - theta, 2.0 * beta)], &splits, 4);
+        let splits: Vec<f64> = (0..12)
+            .map(|k| toward * (FRAC_PI_2 - layer * 4f64.powi(k)))
+            .collect();
+        let rule = peaked_rule(
+            -FRAC_PI_2,
+            FRAC_PI_2,
+            &[(2.0 * alpha - theta, 2.0 * beta)],
+            &splits,
+            4,
+        );
         for (&theta_o, &w) in rule.nodes.iter().zip(&rule.weights) {
             let theta_d = 0.5 * (theta_o - theta);
             let m = model.lobe_longitudinal(p, 0.5 * (theta + theta_o));
@@ -260,7 +289,11 @@ fn fiber_averages_with(
                 alpha = shapes.iter().map(|s| s.0).sum::<f64>() / lobes as f64;
                 beta2 = shapes.iter().map(|s| s.1).sum::<f64>() / lobes as f64;
             }
-            let total = if total.is_finite() { total.max(0.0) } else { total };
+            let total = if total.is_finite() {
+                total.max(0.0)
+            } else {
+                total
+            };
             if h == 0 {
                 (out.a_f[c], out.alpha_f[c], out.beta2_f[c]) = (total, alpha, beta2);
             } else {
@@ -273,7 +306,9 @@ fn fiber_averages_with(
 
 /// The fiber averages at θ computed on demand, without any table (slow; a reference).
 pub fn fiber_averages_direct(model: &dyn LobeDecomposition, theta: f64) -> FiberAverages {
-    fiber_averages_with(model, theta, |p, theta_d| azimuthal_hemisphere_integrals(model, p, theta_d))
+    fiber_averages_with(model, theta, |p, theta_d| {
+        azimuthal_hemisphere_integrals(model, p, theta_d)
+    })
 }
 
 /// Hemisphere φ-integrals of every lobe on a uniform θ_d grid over [−π/2, π/2].
@@ -301,14 +336,20 @@ impl AzimuthalTable {
         let v = &self.values[p];
         let (i, t) = grid_position(theta_d, self.samples);
         let at = |k: isize| v[k.clamp(0, self.samples as isize - 1) as usize];
-        let (p0, p1, p2, p3) = (at(i as isize - 1), at(i as isize), at(i as isize + 1), at(i as isize + 2));
+        let (p0, p1, p2, p3) = (
+            at(i as isize - 1),
+            at(i as isize),
+            at(i as isize + 1),
+            at(i as isize + 2),
+        );
         let mut out = [[0.0; 3]; 2];
         for h in 0..2 {
             for c in 0..3 {
                 let (a, b, cc, d) = (p0[h][c], p1[h][c], p2[h][c], p3[h][c]);
                 let y = b + 0.5
                     * t
-                    * (cc - a + t * (2.0 * a - 5.0 * b + 4.0 * cc - d + t * (3.0 * (b - cc) + d - a)));
+                    * (cc - a
+                        + t * (2.0 * a - 5.0 * b + 4.0 * cc - d + t * (3.0 * (b - cc) + d - a)));
                 out[h][c] = y.max(0.0);
             }
         }
@@ -376,7 +417,14 @@ pub struct BackscatterMoments {
 /// Three-backscatter paths: 2N forward events, N − 1 a sum of three independent geometric counts
 /// (Zinke's indices i−j−1, k−j−1, j), so E[N] = (1+2x)/(1−x), Var[N] = 3x/(1−x)²; weight ratio
 /// Ā_3/Ā_1 = ā_b²/(1−x)². The mixture's variance is the law of total variance.
-pub fn backscatter_series(a_f: f64, a_b: f64, alpha_f: f64, alpha_b: f64, beta2_f: f64, beta2_b: f64) -> (f64, f64, f64) {
+pub fn backscatter_series(
+    a_f: f64,
+    a_b: f64,
+    alpha_f: f64,
+    alpha_b: f64,
+    beta2_f: f64,
+    beta2_b: f64,
+) -> (f64, f64, f64) {
     let x = a_f * a_f;
     let q = 1.0 - x;
     let a1 = a_b * x / q;
@@ -399,11 +447,19 @@ pub fn backscatter_series(a_f: f64, a_b: f64, alpha_f: f64, alpha_b: f64, beta2_
 }
 
 /// Zinke 2008 eqs. 16 and 17 as printed: (Δ̄_b, σ̄_b²). Eq. 17 gives σ̄_b; it is squared here.
-pub fn backscatter_zinke_fit(a_f: f64, a_b: f64, alpha_f: f64, alpha_b: f64, beta2_f: f64, beta2_b: f64) -> (f64, f64) {
+pub fn backscatter_zinke_fit(
+    a_f: f64,
+    a_b: f64,
+    alpha_f: f64,
+    alpha_b: f64,
+    beta2_f: f64,
+    beta2_b: f64,
+) -> (f64, f64) {
     let x = a_f * a_f;
     let q = 1.0 - x;
     let y = a_b * a_b;
-    let shift = alpha_b * (1.0 - 2.0 * y / (q * q)) + alpha_f * (2.0 * q * q + 4.0 * x * y) / (q * q * q);
+    let shift =
+        alpha_b * (1.0 - 2.0 * y / (q * q)) + alpha_f * (2.0 * q * q + 4.0 * x * y) / (q * q * q);
     let (bf, bb) = (beta2_f.max(0.0).sqrt(), beta2_b.max(0.0).sqrt());
     // Divide eq. 17's numerator and denominator by ā_b so ā_b → 0 has its finite limit.
     let num = (2.0 * beta2_f + beta2_b).sqrt() + y * (2.0 * beta2_f + 3.0 * beta2_b).sqrt();
@@ -415,12 +471,21 @@ pub fn backscatter_zinke_fit(a_f: f64, a_b: f64, alpha_f: f64, alpha_b: f64, bet
 fn moments_from(avg: &FiberAverages, form: MomentsForm) -> BackscatterMoments {
     let mut m = BackscatterMoments::default();
     for c in 0..3 {
-        let args = (avg.a_f[c], avg.a_b[c], avg.alpha_f[c], avg.alpha_b[c], avg.beta2_f[c], avg.beta2_b[c]);
+        let args = (
+            avg.a_f[c],
+            avg.a_b[c],
+            avg.alpha_f[c],
+            avg.alpha_b[c],
+            avg.beta2_f[c],
+            avg.beta2_b[c],
+        );
         let (att, shift, var) = backscatter_series(args.0, args.1, args.2, args.3, args.4, args.5);
         m.attenuation[c] = att;
         (m.shift[c], m.variance[c]) = match form {
             MomentsForm::PathSeries => (shift, var),
-            MomentsForm::ZinkeFit => backscatter_zinke_fit(args.0, args.1, args.2, args.3, args.4, args.5),
+            MomentsForm::ZinkeFit => {
+                backscatter_zinke_fit(args.0, args.1, args.2, args.3, args.4, args.5)
+            }
         };
     }
     m
@@ -459,10 +524,30 @@ impl Default for DualScatteringConfig {
 
 impl DualScatteringConfig {
     pub fn validate(&self) -> Result<(), ParamError> {
-        check("dual_scattering.density_forward", self.density_forward, |d| (0.0..=1.0).contains(&d), "must be in [0, 1]")?;
-        check("dual_scattering.density_backward", self.density_backward, |d| (0.0..=1.0).contains(&d), "must be in [0, 1]")?;
-        check("dual_scattering.theta_samples", self.theta_samples as f64, |n| (3.0..=1e5).contains(&n), "must be in [3, 100000]")?;
-        check("dual_scattering.theta_d_samples", self.theta_d_samples as f64, |n| (4.0..=1e5).contains(&n), "must be in [4, 100000]")?;
+        check(
+            "dual_scattering.density_forward",
+            self.density_forward,
+            |d| (0.0..=1.0).contains(&d),
+            "must be in [0, 1]",
+        )?;
+        check(
+            "dual_scattering.density_backward",
+            self.density_backward,
+            |d| (0.0..=1.0).contains(&d),
+            "must be in [0, 1]",
+        )?;
+        check(
+            "dual_scattering.theta_samples",
+            self.theta_samples as f64,
+            |n| (3.0..=1e5).contains(&n),
+            "must be in [3, 100000]",
+        )?;
+        check(
+            "dual_scattering.theta_d_samples",
+            self.theta_d_samples as f64,
+            |n| (4.0..=1e5).contains(&n),
+            "must be in [4, 100000]",
+        )?;
         Ok(())
     }
 }
@@ -479,12 +564,25 @@ impl DualScatteringAverages {
     /// Integrates the model's lobes (f64) and tabulates every average. Fails if the
     /// configuration is invalid, a lobe is malformed, or ā_f ≥ 1 anywhere (the backscattering
     /// series would diverge: the model scatters more than it receives forward).
-    pub fn new(model: &dyn LobeDecomposition, config: DualScatteringConfig) -> Result<Self, ParamError> {
+    pub fn new(
+        model: &dyn LobeDecomposition,
+        config: DualScatteringConfig,
+    ) -> Result<Self, ParamError> {
         config.validate()?;
         for p in 0..model.lobe_count() {
             let (alpha, beta) = model.lobe_shift_width(p);
-            check("lobe shift α_p", alpha, |a| a.abs() < FRAC_PI_2, "must be in (−π/2, π/2) radians")?;
-            check("lobe width β_p", beta, |b| b > 0.0 && b < PI, "must be in (0, π) radians")?;
+            check(
+                "lobe shift α_p",
+                alpha,
+                |a| a.abs() < FRAC_PI_2,
+                "must be in (−π/2, π/2) radians",
+            )?;
+            check(
+                "lobe width β_p",
+                beta,
+                |b| b > 0.0 && b < PI,
+                "must be in (0, π) radians",
+            )?;
         }
         let table = AzimuthalTable::new(model, config.theta_d_samples);
         let n = config.theta_samples;
@@ -495,13 +593,27 @@ impl DualScatteringAverages {
             let avg = fiber_averages_with(model, theta, |p, theta_d| table.at(p, theta_d));
             for c in 0..3 {
                 let name = "dual_scattering.average_forward_attenuation";
-                check(name, avg.a_f[c], |a| (0.0..1.0).contains(&a), "must be in [0, 1) at every inclination; ā_f ≥ 1 makes the backscattering series diverge (normalize the fiber model, Sadeghi 2010 eq. 13)")?;
-                check("dual_scattering.average_backward_attenuation", avg.a_b[c], |a| a >= 0.0, "must be ≥ 0")?;
+                check(
+                    name,
+                    avg.a_f[c],
+                    |a| (0.0..1.0).contains(&a),
+                    "must be in [0, 1) at every inclination; ā_f ≥ 1 makes the backscattering series diverge (normalize the fiber model, Sadeghi 2010 eq. 13)",
+                )?;
+                check(
+                    "dual_scattering.average_backward_attenuation",
+                    avg.a_b[c],
+                    |a| a >= 0.0,
+                    "must be ≥ 0",
+                )?;
             }
             moments.push(moments_from(&avg, config.moments));
             averages.push(avg);
         }
-        Ok(Self { config, averages, moments })
+        Ok(Self {
+            config,
+            averages,
+            moments,
+        })
     }
 
     pub fn config(&self) -> &DualScatteringConfig {
@@ -549,7 +661,12 @@ impl DualScatteringAverages {
 
     /// Starts a shadow path for the forward-scattering transmittance and spread.
     pub fn forward_path(&self) -> ForwardScatteringPath {
-        ForwardScatteringPath { product: [1.0; 3], variance: [0.0; 3], events: 0 }
+        ForwardScatteringPath {
+            product: [1.0; 3],
+            variance: [0.0; 3],
+            shift: [0.0; 3],
+            events: 0,
+        }
     }
 }
 
@@ -569,6 +686,7 @@ impl ScatteringFunction for DualScatteringAverages {
 pub struct ForwardScatteringPath {
     product: Rgb,
     variance: Rgb,
+    shift: Rgb,
     events: u32,
 }
 
@@ -579,6 +697,7 @@ impl ForwardScatteringPath {
         for c in 0..3 {
             self.product[c] *= a.a_f[c];
             self.variance[c] += a.beta2_f[c];
+            self.shift[c] += a.alpha_f[c];
         }
         self.events += 1;
     }
@@ -589,25 +708,43 @@ impl ForwardScatteringPath {
 
     /// T_f = d_f ∏ ā_f, or 1 when no fiber was crossed (direct illumination).
     pub fn transmittance(&self, density_forward: f64) -> Rgb {
-        if self.events == 0 { [1.0; 3] } else { self.product.map(|p| density_forward * p) }
+        if self.events == 0 {
+            [1.0; 3]
+        } else {
+            self.product.map(|p| density_forward * p)
+        }
     }
 
     /// σ̄_f² = Σ β̄_f² (rad², in θ_h), 0 for direct illumination.
     pub fn variance(&self) -> Rgb {
         self.variance
     }
+
+    /// Σ ᾱ_f (radians, in θ_h). Each event maps the incident inclination θ to θ − 2α, so the
+    /// light reaches the shading point at θ_ξ − 2Σᾱ_f on average; Zinke and Ren drop this
+    /// drift (their spread is centred on θ_ξ), it is exposed for callers that want it.
+    pub fn shift(&self) -> Rgb {
+        self.shift
+    }
 }
 
 /// Zinke's spread of forward-scattered light (eq. 7; Ren §3.2's ψ_f):
-/// `s̃_f(φ) g(θ_i − θ_ξ, σ̄_f²)/cos θ_ξ`, s̃_f = 1/π for forward azimuths (|φ| > π/2, φ between
-/// the light's azimuth and the incident one), 0 otherwise. `variance` is clamped to
-/// [`MIN_VARIANCE`] (variance 0 is the delta of direct light, handled by the caller), and
-/// cos θ_ξ to [`MIN_COS_THETA_D`].
-pub fn forward_spread(theta_light: f64, theta_i: f64, phi: f64, variance: f64) -> f64 {
+/// `s̃_f(φ) g(θ_i − θ_ξ, 4σ̄_f²)/cos θ_ξ`, s̃_f = 1/π for forward azimuths (|φ| > π/2, φ between
+/// the light's azimuth and the incident one), 0 otherwise.
+///
+/// `forward_variance` is σ̄_f² as [`ForwardScatteringPath::variance`] accumulates it: a sum of
+/// lobe variances in θ_h. Each event maps θ_o = 2θ_h − θ_i, so in the incident inclination the
+/// spread is 4σ̄_f² (Zinke's g is written in θ_i + θ_o = 2θ_h, where the same spread reads
+/// σ̄_f²). It is clamped to [`MIN_VARIANCE`] (variance 0 is the delta of direct light, which
+/// the caller handles), and cos θ_ξ to [`MIN_COS_THETA_D`].
+pub fn forward_spread(theta_light: f64, theta_i: f64, phi: f64, forward_variance: f64) -> f64 {
     if crate::angles::wrap_angle(phi).abs() <= FRAC_PI_2 {
         return 0.0;
     }
-    gaussian(variance.max(MIN_VARIANCE), theta_i - theta_light) / (PI * theta_light.cos().max(MIN_COS_THETA_D))
+    gaussian(
+        (4.0 * forward_variance).max(MIN_VARIANCE),
+        theta_i - theta_light,
+    ) / (PI * theta_light.cos().max(MIN_COS_THETA_D))
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -620,12 +757,20 @@ pub fn hard_case_sweep(samples: u64, seed: u64) -> SweepReport {
     use crate::artist::{ArtistModel, Normalization};
     let mut report = SweepReport::new("dual-scattering");
     let mut rng = SweepRng::new(seed);
-    let config = DualScatteringConfig { theta_samples: 181, theta_d_samples: 181, ..Default::default() };
+    let config = DualScatteringConfig {
+        theta_samples: 181,
+        theta_d_samples: 181,
+        ..Default::default()
+    };
     let per_model = 30_000u64;
     while report.samples < samples {
         let params = crate::artist::random_params(&mut rng);
         let model = ArtistModel::new(params).expect("random_params yields valid parameters");
-        let norm = if rng.uniform() < 0.5 { Normalization::PerChannel } else { Normalization::SharedScale };
+        let norm = if rng.uniform() < 0.5 {
+            Normalization::PerChannel
+        } else {
+            Normalization::SharedScale
+        };
         let normalized = model.normalized(norm);
         let Ok(avg) = DualScatteringAverages::new(&normalized, config) else {
             // ā_f ≥ 1 is reported as a typed error, which is the correct outcome; count it as
@@ -635,7 +780,11 @@ pub fn hard_case_sweep(samples: u64, seed: u64) -> SweepReport {
         };
         let mut path = avg.forward_path();
         for _ in 0..per_model / 12 {
-            let a = FiberAngles::new(rng.hard_inclination(), rng.hard_inclination(), rng.hard_azimuth());
+            let a = FiberAngles::new(
+                rng.hard_inclination(),
+                rng.hard_inclination(),
+                rng.hard_azimuth(),
+            );
             report.record_rgb(avg.backward_scattering(&a));
             let var = [rng.log_range(1e-14, 4.0); 3];
             report.record_rgb(avg.backward_scattering_spread(&a, var));

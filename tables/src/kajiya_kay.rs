@@ -59,9 +59,16 @@ impl Default for KajiyaKayParams {
 
 impl KajiyaKayParams {
     pub fn validate(&self) -> Result<(), ParamError> {
-        const DIFFUSE: [&str; 3] = ["kajiya_kay.diffuse[0]", "kajiya_kay.diffuse[1]", "kajiya_kay.diffuse[2]"];
-        const SPECULAR: [&str; 3] =
-            ["kajiya_kay.specular[0]", "kajiya_kay.specular[1]", "kajiya_kay.specular[2]"];
+        const DIFFUSE: [&str; 3] = [
+            "kajiya_kay.diffuse[0]",
+            "kajiya_kay.diffuse[1]",
+            "kajiya_kay.diffuse[2]",
+        ];
+        const SPECULAR: [&str; 3] = [
+            "kajiya_kay.specular[0]",
+            "kajiya_kay.specular[1]",
+            "kajiya_kay.specular[2]",
+        ];
         for c in 0..3 {
             check_non_negative(DIFFUSE[c], self.diffuse[c])?;
             check_non_negative(SPECULAR[c], self.specular[c])?;
@@ -134,7 +141,11 @@ pub fn hard_case_sweep(samples: u64, seed: u64) -> SweepReport {
     let per_model = 1000u64;
     while report.samples < samples {
         let scale = |rng: &mut SweepRng| {
-            if rng.uniform() < 0.1 { 0.0 } else { rng.log_range(1e-9, 1e3) }
+            if rng.uniform() < 0.1 {
+                0.0
+            } else {
+                rng.log_range(1e-9, 1e3)
+            }
         };
         let params = KajiyaKayParams {
             diffuse: [scale(&mut rng), scale(&mut rng), scale(&mut rng)],
@@ -143,7 +154,11 @@ pub fn hard_case_sweep(samples: u64, seed: u64) -> SweepReport {
         };
         let model = KajiyaKay::new(params).expect("sweep parameters are valid by construction");
         for _ in 0..per_model.min(samples.div_ceil(5)) {
-            let a = FiberAngles::new(rng.hard_inclination(), rng.hard_inclination(), rng.hard_azimuth());
+            let a = FiberAngles::new(
+                rng.hard_inclination(),
+                rng.hard_inclination(),
+                rng.hard_azimuth(),
+            );
             report.record_rgb(model.eval(&a));
             report.record(model.specular_term(&a));
             report.record(model.specular_lobe(&a));
@@ -189,7 +204,9 @@ mod tests {
         let m = KajiyaKay::new(KajiyaKayParams::default()).unwrap();
         let a = FiberAngles::new(0.0, 0.3, 0.0);
         // integrate_sphere supplies the measure's cos θ; the integrand supplies the cos θ_i.
-        let got = integrate_sphere(16, 4, |t, p| m.diffuse_term(&FiberAngles::new(t, a.theta_o, p)) * t.cos());
+        let got = integrate_sphere(16, 4, |t, p| {
+            m.diffuse_term(&FiberAngles::new(t, a.theta_o, p)) * t.cos()
+        });
         let want = PI * PI;
         println!("diffuse ∫ cos θ_i dω_i: quadrature {got:.15}, closed form π² = {want:.15}");
         assert!((got - want).abs() < 1e-12);
@@ -199,14 +216,21 @@ mod tests {
     fn specular_energy_matches_closed_form() {
         let mut worst: f64 = 0.0;
         for p in [1u32, 2, 5, 10, 40, 200] {
-            let params = KajiyaKayParams { exponent: p as f64, ..Default::default() };
+            let params = KajiyaKayParams {
+                exponent: p as f64,
+                ..Default::default()
+            };
             let m = KajiyaKay::new(params).unwrap();
             for theta_o in [0.0, 0.3, -0.7, 1.2, -1.5] {
                 // S does not depend on φ, so the φ integral is 2π; S cos θ_i (through the
                 // guarded specular_term that eval uses) times the measure's cos θ_i.
                 // The clamp puts a kink at θ_i + θ_o = ±π/2; split the rule there so a low p
                 // (a kink in the first derivative) still converges fast.
-                let kink = if theta_o >= 0.0 { FRAC_PI_2 - theta_o } else { -FRAC_PI_2 - theta_o };
+                let kink = if theta_o >= 0.0 {
+                    FRAC_PI_2 - theta_o
+                } else {
+                    -FRAC_PI_2 - theta_o
+                };
                 let quad: f64 = [(-FRAC_PI_2, kink), (kink, FRAC_PI_2)]
                     .iter()
                     .filter(|(a, b)| b > a)
@@ -222,7 +246,9 @@ mod tests {
                 let exact = specular_energy_closed_form(p, theta_o);
                 let rel = (quad - exact).abs() / exact;
                 worst = worst.max(rel);
-                println!("p={p:4} θ_o={theta_o:+.2}: quadrature {quad:.12e}, closed form {exact:.12e}, rel {rel:.2e}");
+                println!(
+                    "p={p:4} θ_o={theta_o:+.2}: quadrature {quad:.12e}, closed form {exact:.12e}, rel {rel:.2e}"
+                );
                 assert!(rel < 1e-12, "p={p} θ_o={theta_o}");
             }
         }
@@ -231,21 +257,32 @@ mod tests {
 
     #[test]
     fn highlight_lies_on_the_specular_cone() {
-        let m = KajiyaKay::new(KajiyaKayParams { exponent: 100.0, ..Default::default() }).unwrap();
+        let m = KajiyaKay::new(KajiyaKayParams {
+            exponent: 100.0,
+            ..Default::default()
+        })
+        .unwrap();
         for theta_i in [-1.2, -0.4, 0.0, 0.5, 1.3] {
             let n = 20_001;
             let (best, _) = (0..n)
                 .map(|k| -FRAC_PI_2 + PI * k as f64 / (n - 1) as f64)
                 .map(|to| (to, m.specular_term(&FiberAngles::new(theta_i, to, 0.3))))
                 .fold((0.0, -1.0), |acc, x| if x.1 > acc.1 { x } else { acc });
-            println!("θ_i={theta_i:+.2}: highlight at θ_o={best:+.5} (cone: {:+.5})", -theta_i);
+            println!(
+                "θ_i={theta_i:+.2}: highlight at θ_o={best:+.5} (cone: {:+.5})",
+                -theta_i
+            );
             assert!((best + theta_i).abs() <= PI / (n - 1) as f64);
         }
     }
 
     #[test]
     fn clamped_lobe_and_grazing_guard_stay_finite() {
-        let m = KajiyaKay::new(KajiyaKayParams { exponent: 2.5, ..Default::default() }).unwrap();
+        let m = KajiyaKay::new(KajiyaKayParams {
+            exponent: 2.5,
+            ..Default::default()
+        })
+        .unwrap();
         // More than 90° off the cone: clamped to zero, not NaN from a negative base.
         assert_eq!(m.specular_lobe(&FiberAngles::new(1.2, 0.9, 0.0)), 0.0);
         // Exactly grazing incidence on the cone: bounded by 1/MIN_COS_THETA_I.
@@ -258,7 +295,11 @@ mod tests {
         let m = KajiyaKay::new(KajiyaKayParams::default()).unwrap();
         let mut rng = SweepRng::new(3);
         for _ in 0..10_000 {
-            let (ti, to, phi) = (rng.hard_inclination(), rng.hard_inclination(), rng.range(-PI, PI));
+            let (ti, to, phi) = (
+                rng.hard_inclination(),
+                rng.hard_inclination(),
+                rng.range(-PI, PI),
+            );
             let a = m.eval(&FiberAngles::new(ti, to, phi));
             let b = m.eval(&FiberAngles::new(ti, to, -phi));
             assert_eq!(a, b);
@@ -267,19 +308,36 @@ mod tests {
 
     #[test]
     fn validation_names_the_parameter() {
-        let bad = KajiyaKayParams { exponent: 0.0, ..Default::default() };
+        let bad = KajiyaKayParams {
+            exponent: 0.0,
+            ..Default::default()
+        };
         let e = KajiyaKay::new(bad).unwrap_err();
         assert!(e.to_string().contains("kajiya_kay.exponent"), "{e}");
         let mut bad = KajiyaKayParams::default();
         bad.specular[1] = f64::NAN;
-        assert!(matches!(KajiyaKay::new(bad), Err(ParamError::NotFinite { name: "kajiya_kay.specular[1]", .. })));
+        assert!(matches!(
+            KajiyaKay::new(bad),
+            Err(ParamError::NotFinite {
+                name: "kajiya_kay.specular[1]",
+                ..
+            })
+        ));
         let mut bad = KajiyaKayParams::default();
         bad.diffuse[2] = -0.1;
-        assert!(matches!(KajiyaKay::new(bad), Err(ParamError::OutOfRange { .. })));
+        assert!(matches!(
+            KajiyaKay::new(bad),
+            Err(ParamError::OutOfRange { .. })
+        ));
         let json = serde_json::to_string(&KajiyaKayParams::default()).unwrap();
         let back: KajiyaKayParams = serde_json::from_str(&json).unwrap();
         assert_eq!(back, KajiyaKayParams::default());
-        assert!(serde_json::from_str::<KajiyaKayParams>(r#"{"diffuse":[0,0,0],"specular":[0,0,0],"exponent":1,"p":2}"#).is_err());
+        assert!(
+            serde_json::from_str::<KajiyaKayParams>(
+                r#"{"diffuse":[0,0,0],"specular":[0,0,0],"exponent":1,"p":2}"#
+            )
+            .is_err()
+        );
     }
 
     #[test]

@@ -144,7 +144,11 @@ impl SweepRng {
     }
 
     pub fn hard_color(&mut self) -> [f64; 3] {
-        [self.hard_channel(), self.hard_channel(), self.hard_channel()]
+        [
+            self.hard_channel(),
+            self.hard_channel(),
+            self.hard_channel(),
+        ]
     }
 }
 

@@ -29,7 +29,10 @@ fn argmax(a: f64, b: f64, n: usize, f: impl Fn(f64) -> f64) -> f64 {
     (0..n)
         .map(|k| a + (b - a) * k as f64 / (n - 1) as f64)
         .map(|x| (x, f(x)))
-        .fold((a, f64::NEG_INFINITY), |acc, v| if v.1 > acc.1 { v } else { acc })
+        .fold(
+            (a, f64::NEG_INFINITY),
+            |acc, v| if v.1 > acc.1 { v } else { acc },
+        )
         .0
 }
 
@@ -38,7 +41,11 @@ fn highlight_position_follows_the_shift() {
     // At fixed θ_d the factor 1/cos²θ_d is constant, so the peak in θ_h is exactly at α_X.
     let step = 1e-3f64.to_radians();
     let n = (80.0f64.to_radians() / step) as usize + 1;
-    for (lobe, phi) in [(ArtistLobe::R, 0.3), (ArtistLobe::Tt, PI), (ArtistLobe::TrtMinusGlints, 0.2)] {
+    for (lobe, phi) in [
+        (ArtistLobe::R, 0.3),
+        (ArtistLobe::Tt, PI),
+        (ArtistLobe::TrtMinusGlints, 0.2),
+    ] {
         for shift in [-12.0, -5.0, 0.0, 3.0, 14.0] {
             let mut p = only(&[lobe]);
             match lobe {
@@ -47,9 +54,17 @@ fn highlight_position_follows_the_shift() {
                 _ => p.trt.shift_deg = shift,
             }
             let m = ArtistModel::new(p).unwrap();
-            let peak = argmax(-40f64.to_radians(), 40f64.to_radians(), n, |th| m.eval(&half_diff(th, 0.25, phi))[0]);
-            println!("{lobe:?} shift {shift:+5.1}°: peak at θ_h = {:+.4}°", peak.to_degrees());
-            assert!((peak - shift.to_radians()).abs() <= step, "{lobe:?} {shift}");
+            let peak = argmax(-40f64.to_radians(), 40f64.to_radians(), n, |th| {
+                m.eval(&half_diff(th, 0.25, phi))[0]
+            });
+            println!(
+                "{lobe:?} shift {shift:+5.1}°: peak at θ_h = {:+.4}°",
+                peak.to_degrees()
+            );
+            assert!(
+                (peak - shift.to_radians()).abs() <= step,
+                "{lobe:?} {shift}"
+            );
         }
     }
 }
@@ -103,7 +118,9 @@ fn glints_sit_at_the_half_angle_and_follow_a_per_fiber_angle() {
     let n = (PI / step) as usize + 1;
     let a0 = |phi: f64| half_diff(m.params().trt.shift_deg.to_radians(), 0.1, phi);
     let g = m.params().glints.half_angle_deg;
-    let peak = argmax(0.0, PI, n, |phi| m.lobe_value(ArtistLobe::Glints, &a0(phi))[0]);
+    let peak = argmax(0.0, PI, n, |phi| {
+        m.lobe_value(ArtistLobe::Glints, &a0(phi))[0]
+    });
     println!("glint peak at φ = {:.4}° (G_angle {g}°)", peak.to_degrees());
     assert!((peak.to_degrees() - g).abs() <= 1e-3);
     // Glint part of eval_with_glint_half_angle = total minus the other three lobes.
@@ -120,7 +137,11 @@ fn glints_sit_at_the_half_angle_and_follow_a_per_fiber_angle() {
         };
         let peak = argmax(0.0, PI, n, glint_only);
         let peak_neg = argmax(-PI, 0.0, n, glint_only);
-        println!("per-fiber G_angle {g_fiber}°: glints at φ = {:+.4}°, {:+.4}°", peak.to_degrees(), peak_neg.to_degrees());
+        println!(
+            "per-fiber G_angle {g_fiber}°: glints at φ = {:+.4}°, {:+.4}°",
+            peak.to_degrees(),
+            peak_neg.to_degrees()
+        );
         assert!((peak.to_degrees() - g_fiber).abs() <= 2e-3);
         assert!((peak_neg.to_degrees() + g_fiber).abs() <= 2e-3);
     }
@@ -132,14 +153,21 @@ fn symmetric_in_azimuth_and_reciprocal() {
     for _ in 0..20 {
         let m = ArtistModel::new(random_params(&mut rng)).unwrap();
         for _ in 0..2000 {
-            let a = FiberAngles::new(rng.hard_inclination(), rng.hard_inclination(), rng.range(-PI, PI));
+            let a = FiberAngles::new(
+                rng.hard_inclination(),
+                rng.hard_inclination(),
+                rng.range(-PI, PI),
+            );
             let mirrored = FiberAngles::new(a.theta_i, a.theta_o, -a.phi);
             assert_eq!(m.eval(&a), m.eval(&mirrored));
             // Swapping ω_i and ω_o keeps θ_h, flips θ_d and φ: f' is reciprocal.
             let s = m.eval(&a.swapped());
             let e = m.eval(&a);
             for c in 0..3 {
-                assert!((s[c] - e[c]).abs() <= 1e-12 * e[c].abs().max(1e-300), "{a:?}");
+                assert!(
+                    (s[c] - e[c]).abs() <= 1e-12 * e[c].abs().max(1e-300),
+                    "{a:?}"
+                );
             }
         }
     }
@@ -153,7 +181,11 @@ fn lobes_reassemble_the_scattering_function() {
     for _ in 0..20 {
         let m = ArtistModel::new(random_params(&mut rng)).unwrap();
         for _ in 0..2000 {
-            let a = FiberAngles::new(rng.range(-1.5, 1.5), rng.range(-1.5, 1.5), rng.range(-PI, PI));
+            let a = FiberAngles::new(
+                rng.range(-1.5, 1.5),
+                rng.range(-1.5, 1.5),
+                rng.range(-PI, PI),
+            );
             let (s, l) = (m.eval(&a), m.eval_lobes(&a));
             for c in 0..3 {
                 let rel = (s[c] - l[c]).abs() / s[c].abs().max(1e-300);
@@ -177,7 +209,10 @@ fn graded_rule(panels: usize) -> GaussLegendre {
         cuts.push(FRAC_PI_2 - e);
     }
     cuts.sort_by(f64::total_cmp);
-    let mut rule = GaussLegendre { nodes: vec![], weights: vec![] };
+    let mut rule = GaussLegendre {
+        nodes: vec![],
+        weights: vec![],
+    };
     for w in cuts.windows(2) {
         let n = if w[1] - w[0] > 1.0 { panels } else { 1 };
         let r = GaussLegendre::composite(8, n, w[0], w[1]);
@@ -188,7 +223,12 @@ fn graded_rule(panels: usize) -> GaussLegendre {
 }
 
 /// (1/4π) ∫∫ f cos θ_i dω_o dω_i by brute force over (θ_i, θ_o, φ) with `eval`.
-fn mean_albedo_brute_force(f: &dyn ScatteringFunction, ti_panels: usize, to_panels: usize, phi_panels: usize) -> Rgb {
+fn mean_albedo_brute_force(
+    f: &dyn ScatteringFunction,
+    ti_panels: usize,
+    to_panels: usize,
+    phi_panels: usize,
+) -> Rgb {
     let ri = graded_rule(ti_panels);
     let ro = graded_rule(to_panels);
     let rp = GaussLegendre::composite(8, phi_panels, -PI, PI);
@@ -214,13 +254,18 @@ fn normalized_copy_has_unit_mean_albedo() {
     wide.tt.width_deg = 6.0;
     wide.r.width_deg = 8.0;
     wide.glints.azimuthal_width_deg = 8.0;
-    for (label, params, panels, tol) in [("wide lobes", wide, (6, 32, 32), 1e-9), ("defaults", ArtistParams::default(), (6, 64, 48), 1e-8)] {
+    for (label, params, panels, tol) in [
+        ("wide lobes", wide, (6, 32, 32), 1e-9),
+        ("defaults", ArtistParams::default(), (6, 64, 48), 1e-8),
+    ] {
         let m = ArtistModel::new(params).unwrap();
         let k = m.normalization_integral();
         let brute = mean_albedo_brute_force(&m, panels.0, panels.1, panels.2);
         let n = m.normalized(Normalization::PerChannel);
         let one = mean_albedo_brute_force(&n, panels.0, panels.1, panels.2);
-        println!("{label}: K = {k:.12?}, brute-force K = {brute:.12?}; normalized mean albedo {one:.12?}");
+        println!(
+            "{label}: K = {k:.12?}, brute-force K = {brute:.12?}; normalized mean albedo {one:.12?}"
+        );
         for c in 0..3 {
             assert!((brute[c] - k[c]).abs() < tol * k[c], "{label} channel {c}");
             assert!((one[c] - 1.0).abs() < tol, "{label} channel {c}");
@@ -241,13 +286,30 @@ fn validation_names_the_parameter() {
     assert!(e.to_string().contains("artist.tt.width_deg"), "{e}");
     let mut p = ArtistParams::default();
     p.r.intensity = f64::NAN;
-    assert!(matches!(ArtistModel::new(p), Err(ParamError::NotFinite { name: "artist.r.intensity", .. })));
+    assert!(matches!(
+        ArtistModel::new(p),
+        Err(ParamError::NotFinite {
+            name: "artist.r.intensity",
+            ..
+        })
+    ));
     let mut p = ArtistParams::default();
     p.trt.color[2] = -1.0;
-    assert!(matches!(ArtistModel::new(p), Err(ParamError::OutOfRange { name: "artist.trt.color[2]", .. })));
+    assert!(matches!(
+        ArtistModel::new(p),
+        Err(ParamError::OutOfRange {
+            name: "artist.trt.color[2]",
+            ..
+        })
+    ));
     let mut p = ArtistParams::default();
     p.glints.half_angle_deg = 200.0;
-    assert!(ArtistModel::new(p).unwrap_err().to_string().contains("artist.glints.half_angle_deg"));
+    assert!(
+        ArtistModel::new(p)
+            .unwrap_err()
+            .to_string()
+            .contains("artist.glints.half_angle_deg")
+    );
     let mut p = ArtistParams::default();
     p.r.shift_deg = 60.0;
     assert!(ArtistModel::new(p).is_err());
@@ -272,7 +334,14 @@ fn inclination_weight_matches_quadrature() {
         let h = FRAC_PI_2 - f64::abs(theta_h);
         // The integrand has boundary layers of width ~|θ_h| at ±h: grade the rule there.
         let t = f64::abs(theta_h);
-        let q = crate::dual_scattering::peaked_rule(-h, h, &[(-h, t), (h, t), (-h, 10.0 * t), (h, 10.0 * t)], &[], 16).integrate(|td: f64| {
+        let q = crate::dual_scattering::peaked_rule(
+            -h,
+            h,
+            &[(-h, t), (h, t), (-h, 10.0 * t), (h, 10.0 * t)],
+            &[],
+            16,
+        )
+        .integrate(|td: f64| {
             (theta_h - td).cos().powi(2) * (theta_h + td).cos() / td.cos().powi(2)
         });
         let w = inclination_weight(theta_h);

@@ -1,5 +1,6 @@
+#![allow(clippy::needless_range_loop)] // per-channel loops read best indexed in these checks
 use super::*;
-use crate::artist::{ArtistModel, ArtistParams, NormalizedArtist, Normalization};
+use crate::artist::{ArtistModel, ArtistParams, Normalization, NormalizedArtist};
 use crate::quadrature::{GaussLegendre, integrate_sphere};
 
 /// A toy fiber whose averages have closed forms: Gaussian M_p and
@@ -21,7 +22,11 @@ impl LobeDecomposition for ToyLobes {
     }
     fn lobe_azimuthal(&self, p: usize, theta_d: f64, phi: f64) -> Rgb {
         let c2 = theta_d.cos().powi(2);
-        let v = if phi.abs() > FRAC_PI_2 { self.lobes[p].2 } else { self.lobes[p].3 };
+        let v = if phi.abs() > FRAC_PI_2 {
+            self.lobes[p].2
+        } else {
+            self.lobes[p].3
+        };
         v.map(|x| x * c2)
     }
 }
@@ -46,8 +51,14 @@ fn toy_closed_form(t: &ToyLobes, theta: f64) -> FiberAverages {
         };
         for front in [true, false] {
             let total: f64 = (0..t.lobes.len()).map(|p| share(p, front)).sum();
-            let alpha: f64 = (0..t.lobes.len()).map(|p| share(p, front) * t.lobes[p].0).sum::<f64>() / total;
-            let beta2: f64 = (0..t.lobes.len()).map(|p| share(p, front) * t.lobes[p].1.powi(2)).sum::<f64>() / total;
+            let alpha: f64 = (0..t.lobes.len())
+                .map(|p| share(p, front) * t.lobes[p].0)
+                .sum::<f64>()
+                / total;
+            let beta2: f64 = (0..t.lobes.len())
+                .map(|p| share(p, front) * t.lobes[p].1.powi(2))
+                .sum::<f64>()
+                / total;
             if front {
                 (out.a_f[c], out.alpha_f[c], out.beta2_f[c]) = (total, alpha, beta2);
             } else {
@@ -63,7 +74,14 @@ fn rel(a: f64, b: f64) -> f64 {
 }
 
 fn fields(a: &FiberAverages) -> [(&'static str, Rgb); 6] {
-    [("a_f", a.a_f), ("a_b", a.a_b), ("alpha_f", a.alpha_f), ("alpha_b", a.alpha_b), ("beta2_f", a.beta2_f), ("beta2_b", a.beta2_b)]
+    [
+        ("a_f", a.a_f),
+        ("a_b", a.a_b),
+        ("alpha_f", a.alpha_f),
+        ("alpha_b", a.alpha_b),
+        ("beta2_f", a.beta2_f),
+        ("beta2_b", a.beta2_b),
+    ]
 }
 
 #[test]
@@ -75,7 +93,10 @@ fn toy_model_averages_match_closed_forms() {
         let want = toy_closed_form(&t, theta);
         let direct = fiber_averages_direct(&t, theta);
         let tab = table.averages_at(theta);
-        for ((name, w), ((_, d), (_, g))) in fields(&want).iter().zip(fields(&direct).iter().zip(fields(&tab).iter())) {
+        for ((name, w), ((_, d), (_, g))) in fields(&want)
+            .iter()
+            .zip(fields(&direct).iter().zip(fields(&tab).iter()))
+        {
             for c in 0..3 {
                 if name.starts_with('a') && w[c] == 0.0 {
                     assert!(d[c].abs() < 1e-15);
@@ -86,16 +107,30 @@ fn toy_model_averages_match_closed_forms() {
                 }
                 worst_direct = worst_direct.max(rel(d[c], w[c]));
                 worst_table = worst_table.max(rel(g[c], w[c]));
-                assert!(rel(d[c], w[c]) < 1e-10, "θ={theta} {name}[{c}]: {} vs {}", d[c], w[c]);
-                assert!(rel(g[c], w[c]) < 1e-4, "θ={theta} {name}[{c}] tabulated: {} vs {}", g[c], w[c]);
+                assert!(
+                    rel(d[c], w[c]) < 1e-10,
+                    "θ={theta} {name}[{c}]: {} vs {}",
+                    d[c],
+                    w[c]
+                );
+                assert!(
+                    rel(g[c], w[c]) < 1e-4,
+                    "θ={theta} {name}[{c}] tabulated: {} vs {}",
+                    g[c],
+                    w[c]
+                );
             }
         }
     }
-    println!("toy closed forms: worst relative error direct {worst_direct:.2e}, tabulated (default grid, linear) {worst_table:.2e}");
+    println!(
+        "toy closed forms: worst relative error direct {worst_direct:.2e}, tabulated (default grid, linear) {worst_table:.2e}"
+    );
 }
 
 fn normalized_default() -> NormalizedArtist {
-    ArtistModel::new(ArtistParams::default()).unwrap().normalized(Normalization::PerChannel)
+    ArtistModel::new(ArtistParams::default())
+        .unwrap()
+        .normalized(Normalization::PerChannel)
 }
 
 /// Composite Gauss–Legendre on [−π/2, π/2] (`panels` 8-point panels) plus decades graded
@@ -107,9 +142,21 @@ fn graded_rule(panels: usize, per_decade: usize) -> GaussLegendre {
         cuts.push(FRAC_PI_2 - 10f64.powi(-k));
     }
     cuts.sort_by(f64::total_cmp);
-    let mut rule = GaussLegendre { nodes: vec![], weights: vec![] };
+    let mut rule = GaussLegendre {
+        nodes: vec![],
+        weights: vec![],
+    };
     for w in cuts.windows(2) {
-        let r = GaussLegendre::composite(8, if w[1] - w[0] > 1.0 { panels } else { per_decade }, w[0], w[1]);
+        let r = GaussLegendre::composite(
+            8,
+            if w[1] - w[0] > 1.0 {
+                panels
+            } else {
+                per_decade
+            },
+            w[0],
+            w[1],
+        );
         rule.nodes.extend(r.nodes);
         rule.weights.extend(r.weights);
     }
@@ -120,7 +167,12 @@ fn graded_rule(panels: usize, per_decade: usize) -> GaussLegendre {
 /// model's own `eval` (no lobes, no tables).
 fn hemispheres_brute_force(f: &dyn ScatteringFunction, theta: f64) -> [Rgb; 2] {
     let rule_o = graded_rule(96, 4);
-    let quarters = [(-PI, -FRAC_PI_2, 0), (FRAC_PI_2, PI, 0), (-FRAC_PI_2, 0.0, 1), (0.0, FRAC_PI_2, 1)];
+    let quarters = [
+        (-PI, -FRAC_PI_2, 0),
+        (FRAC_PI_2, PI, 0),
+        (-FRAC_PI_2, 0.0, 1),
+        (0.0, FRAC_PI_2, 1),
+    ];
     let mut out = [[0.0; 3]; 2];
     for (a, b, h) in quarters {
         let rp = GaussLegendre::composite(8, 24, a, b);
@@ -147,19 +199,28 @@ fn artist_hemisphere_averages_match_brute_force_and_sum_to_the_total() {
         let tab = table.averages_at(theta);
         // The total energy, independently: the whole sphere through integrate_sphere.
         let total: Rgb = std::array::from_fn(|c| {
-            theta.cos() * integrate_sphere(96, 48, |to, phi| m.eval(&FiberAngles::new(theta, to, phi))[c])
+            theta.cos()
+                * integrate_sphere(96, 48, |to, phi| {
+                    m.eval(&FiberAngles::new(theta, to, phi))[c]
+                })
         });
         for c in 0..3 {
-            worst = worst.max(rel(direct.a_f[c], brute[0][c])).max(rel(direct.a_b[c], brute[1][c]));
+            worst = worst
+                .max(rel(direct.a_f[c], brute[0][c]))
+                .max(rel(direct.a_b[c], brute[1][c]));
             worst_sum = worst_sum.max(rel(direct.a_f[c] + direct.a_b[c], total[c]));
-            worst_tab = worst_tab.max(rel(tab.a_f[c], brute[0][c])).max(rel(tab.a_b[c], brute[1][c]));
+            worst_tab = worst_tab
+                .max(rel(tab.a_f[c], brute[0][c]))
+                .max(rel(tab.a_b[c], brute[1][c]));
         }
         println!(
             "θ={theta:+.2}: ā_f {:.9?} (brute {:.9?}), ā_b {:.9?} (brute {:.9?}), total {:.9?}",
             direct.a_f, brute[0], direct.a_b, brute[1], total
         );
     }
-    println!("worst rel: hemispheres vs brute force {worst:.2e}; ā_f+ā_b vs sphere total {worst_sum:.2e}; tabulated vs brute {worst_tab:.2e}");
+    println!(
+        "worst rel: hemispheres vs brute force {worst:.2e}; ā_f+ā_b vs sphere total {worst_sum:.2e}; tabulated vs brute {worst_tab:.2e}"
+    );
     assert!(worst < 1e-8);
     assert!(worst_sum < 1e-7);
     assert!(worst_tab < 2e-3);
@@ -186,7 +247,15 @@ fn normalized_artist_has_unit_mean_total_attenuation() {
 
 /// Brute-force path sums with Zinke's indices: (Ā_b, Δ̄_b, σ̄_b²) of the mixture of paths with
 /// one backscatter (2i forward events) and three (2(i−j−1+k) forward events).
-fn series_brute_force(a_f: f64, a_b: f64, alpha_f: f64, alpha_b: f64, b2f: f64, b2b: f64, n_max: usize) -> (f64, f64, f64) {
+fn series_brute_force(
+    a_f: f64,
+    a_b: f64,
+    alpha_f: f64,
+    alpha_b: f64,
+    b2f: f64,
+    b2b: f64,
+    n_max: usize,
+) -> (f64, f64, f64) {
     let x = a_f * a_f;
     let (mut w_sum, mut ws, mut wm2) = (0.0, 0.0, 0.0);
     let mut add = |w: f64, backs: f64, forward_pairs: f64| {
@@ -225,7 +294,14 @@ fn backscatter_moments_match_brute_force_path_sums() {
     for theta in [-1.2, -0.5, 0.0, 0.3, 1.0] {
         let a = table.averages_at(theta);
         for c in [0, 2] {
-            cases.push((a.a_f[c], a.a_b[c], a.alpha_f[c], a.alpha_b[c], a.beta2_f[c], a.beta2_b[c]));
+            cases.push((
+                a.a_f[c],
+                a.a_b[c],
+                a.alpha_f[c],
+                a.alpha_b[c],
+                a.beta2_f[c],
+                a.beta2_b[c],
+            ));
         }
     }
     let mut worst = [0.0f64; 3];
@@ -240,14 +316,22 @@ fn backscatter_moments_match_brute_force_path_sums() {
             worst[0] = worst[0].max(rel(att, batt));
             worst[1] = worst[1].max((shift - bshift).abs());
             worst[2] = worst[2].max(rel(var, bvar));
-            println!("    rel Ā_b {:.2e}, abs Δ̄_b {:.2e}, rel σ̄_b² {:.2e}", rel(att, batt), (shift - bshift).abs(), rel(var, bvar));
+            println!(
+                "    rel Ā_b {:.2e}, abs Δ̄_b {:.2e}, rel σ̄_b² {:.2e}",
+                rel(att, batt),
+                (shift - bshift).abs(),
+                rel(var, bvar)
+            );
             assert!(rel(att, batt) < 1e-10);
             assert!((shift - bshift).abs() < 1e-10);
             assert!(rel(var, bvar) < 1e-9);
         }
         assert!(att.is_finite() && shift.is_finite() && var > 0.0);
     }
-    println!("closed forms vs brute-force series: Ā_b rel {:.2e}, Δ̄_b abs {:.2e} rad, σ̄_b² rel {:.2e}", worst[0], worst[1], worst[2]);
+    println!(
+        "closed forms vs brute-force series: Ā_b rel {:.2e}, Δ̄_b abs {:.2e} rad, σ̄_b² rel {:.2e}",
+        worst[0], worst[1], worst[2]
+    );
 }
 
 #[test]
@@ -257,12 +341,19 @@ fn zinke_fit_agrees_with_the_series_to_first_order_except_the_alpha_b_sign() {
     let (_, s, _) = backscatter_series(af, ab, 0.05, 0.0, 0.001, 0.001);
     let (fs, _) = backscatter_zinke_fit(af, ab, 0.05, 0.0, 0.001, 0.001);
     let r = ab * ab / (1.0 - af * af).powi(2);
-    println!("α_f term: series {s:.12}, Zinke eq. 16 {fs:.12}, difference {:.2e} (r = Ā_3/Ā_1 = {r:.2e})", (s - fs).abs());
+    println!(
+        "α_f term: series {s:.12}, Zinke eq. 16 {fs:.12}, difference {:.2e} (r = Ā_3/Ā_1 = {r:.2e})",
+        (s - fs).abs()
+    );
     assert!((s - fs).abs() < 10.0 * r * r * s.abs());
     // α_f = 0, α_b = 1: the series gives (1 + 3r)/(1 + r) ≈ 1 + 2r, eq. 16 gives 1 − 2r.
     let (_, s, _) = backscatter_series(af, ab, 0.0, 1.0, 0.001, 0.001);
     let (fs, _) = backscatter_zinke_fit(af, ab, 0.0, 1.0, 0.001, 0.001);
-    println!("α_b coefficient: series {s:.10} (1+2r = {:.10}), Zinke eq. 16 {fs:.10} (1−2r = {:.10})", 1.0 + 2.0 * r, 1.0 - 2.0 * r);
+    println!(
+        "α_b coefficient: series {s:.10} (1+2r = {:.10}), Zinke eq. 16 {fs:.10} (1−2r = {:.10})",
+        1.0 + 2.0 * r,
+        1.0 - 2.0 * r
+    );
     assert!((s - (1.0 + 3.0 * r) / (1.0 + r)).abs() < 1e-14);
     assert!((fs - (1.0 - 2.0 * r)).abs() < 1e-14);
 }
@@ -271,7 +362,15 @@ fn zinke_fit_agrees_with_the_series_to_first_order_except_the_alpha_b_sign() {
 fn backward_scattering_is_finite_non_negative_and_backward_only() {
     let m = normalized_default();
     let avg = DualScatteringAverages::new(&m, DualScatteringConfig::default()).unwrap();
-    let grazing = [-FRAC_PI_2, -FRAC_PI_2 + 1e-12, -1.5, 0.0, 1.5, FRAC_PI_2 - 1e-12, FRAC_PI_2];
+    let grazing = [
+        -FRAC_PI_2,
+        -FRAC_PI_2 + 1e-12,
+        -1.5,
+        0.0,
+        1.5,
+        FRAC_PI_2 - 1e-12,
+        FRAC_PI_2,
+    ];
     let mut count = 0;
     let mut max: f64 = 0.0;
     for &ti in &grazing {
@@ -304,10 +403,17 @@ fn backward_scattering_energy_is_at_most_four_a_b() {
     for theta in [-0.6, 0.0, 0.7] {
         let mom = avg.moments_at(theta);
         let e: Rgb = std::array::from_fn(|c| {
-            theta.cos() * integrate_sphere(256, 16, |to, phi| avg.backward_scattering(&FiberAngles::new(theta, to, phi))[c])
+            theta.cos()
+                * integrate_sphere(256, 16, |to, phi| {
+                    avg.backward_scattering(&FiberAngles::new(theta, to, phi))[c]
+                })
         });
         let ratio: Rgb = std::array::from_fn(|c| e[c] / mom.attenuation[c]);
-        println!("θ={theta:+.1}: Ā_b {:.6?}, σ̄_b {:.3?}°, cos θ ∫S_back dω_o / Ā_b = {ratio:.4?}", mom.attenuation, mom.variance.map(|v| v.sqrt().to_degrees()));
+        println!(
+            "θ={theta:+.1}: Ā_b {:.6?}, σ̄_b {:.3?}°, cos θ ∫S_back dω_o / Ā_b = {ratio:.4?}",
+            mom.attenuation,
+            mom.variance.map(|v| v.sqrt().to_degrees())
+        );
         for c in 0..3 {
             assert!(ratio[c] > 3.0 && ratio[c] < 4.05, "{ratio:?}");
         }
@@ -327,21 +433,30 @@ fn forward_path_accumulates_attenuation_and_variance() {
     }
     let t_f = path.transmittance(0.7);
     for c in 0..3 {
-        let want: f64 = 0.7 * thetas.iter().map(|&t| avg.averages_at(t).a_f[c]).product::<f64>();
+        let want: f64 = 0.7
+            * thetas
+                .iter()
+                .map(|&t| avg.averages_at(t).a_f[c])
+                .product::<f64>();
         let var: f64 = thetas.iter().map(|&t| avg.averages_at(t).beta2_f[c]).sum();
+        let shift: f64 = thetas.iter().map(|&t| avg.averages_at(t).alpha_f[c]).sum();
+        assert!((path.shift()[c] - shift).abs() < 1e-15);
         assert!(rel(t_f[c], want) < 1e-15);
         assert!(rel(path.variance()[c], var) < 1e-15);
     }
-    println!("T_f after 3 events {t_f:.6?}, σ̄_f = {:.3?}°", path.variance().map(|v| v.sqrt().to_degrees()));
+    println!(
+        "T_f after 3 events {t_f:.6?}, σ̄_f = {:.3?}°",
+        path.variance().map(|v| v.sqrt().to_degrees())
+    );
 }
 
 #[test]
 fn forward_spread_integrates_to_its_closed_form() {
-    // ∫ ψ_f dω_i = (1/cos θ_ξ) ∫ g(t, σ²) cos(θ_ξ + t) dt = e^{−σ²/2} when the Gaussian is far
-    // from the poles (the forward half of the azimuths carries 1/π × π).
-    for (theta_light, sigma) in [(0.3, 0.05), (-0.9, 0.02), (0.0, 0.1)] {
+    // With v = 4σ̄_f² the spread in θ_i, ∫ ψ_f dω_i = (1/cos θ_ξ) ∫ g(t, v) cos(θ_ξ + t) dt
+    // = e^{−v/2} when the Gaussian is far from the poles (the forward azimuths carry 1/π × π).
+    for (theta_light, sigma) in [(0.3, 0.025), (-0.9, 0.01), (0.0, 0.05)] {
         let got = integrate_sphere(256, 8, |t, p| forward_spread(theta_light, t, p, sigma * sigma));
-        let want = (-0.5f64 * sigma * sigma).exp();
+        let want = (-2.0f64 * sigma * sigma).exp();
         println!("ψ_f(θ_ξ={theta_light}, σ={sigma}): ∫ = {got:.14}, closed form {want:.14}");
         assert!((got - want).abs() < 1e-10);
     }
@@ -354,11 +469,20 @@ fn divergent_forward_attenuation_is_a_typed_error() {
     let raw = ArtistModel::new(p).unwrap();
     let e = DualScatteringAverages::new(&raw, DualScatteringConfig::default()).unwrap_err();
     println!("{e}");
-    assert!(e.to_string().contains("dual_scattering.average_forward_attenuation"));
-    let bad = DualScatteringConfig { density_forward: 1.5, ..Default::default() };
+    assert!(
+        e.to_string()
+            .contains("dual_scattering.average_forward_attenuation")
+    );
+    let bad = DualScatteringConfig {
+        density_forward: 1.5,
+        ..Default::default()
+    };
     assert!(DualScatteringAverages::new(&toy(), bad).is_err());
     let json = serde_json::to_string(&DualScatteringConfig::default()).unwrap();
-    assert_eq!(serde_json::from_str::<DualScatteringConfig>(&json).unwrap(), DualScatteringConfig::default());
+    assert_eq!(
+        serde_json::from_str::<DualScatteringConfig>(&json).unwrap(),
+        DualScatteringConfig::default()
+    );
 }
 
 #[test]
@@ -367,8 +491,15 @@ fn tabulation_error_against_on_demand_computation() {
     // relative error where the value exceeds 1% of that maximum.
     let m = normalized_default();
     let mut rng = SweepRng::new(99);
-    let thetas: Vec<f64> =
-        (0..40).map(|_| if rng.uniform() < 0.3 { rng.hard_inclination() } else { rng.range(-1.5, 1.5) }).collect();
+    let thetas: Vec<f64> = (0..40)
+        .map(|_| {
+            if rng.uniform() < 0.3 {
+                rng.hard_inclination()
+            } else {
+                rng.range(-1.5, 1.5)
+            }
+        })
+        .collect();
     let direct: Vec<(FiberAverages, BackscatterMoments)> = thetas
         .iter()
         .map(|&t| {
@@ -376,14 +507,23 @@ fn tabulation_error_against_on_demand_computation() {
             (d, moments_from(&d, MomentsForm::PathSeries))
         })
         .collect();
-    let pick = |a: &FiberAverages, b: &BackscatterMoments| -> [Rgb; 4] { [a.a_f, a.a_b, b.attenuation, b.variance] };
+    let pick = |a: &FiberAverages, b: &BackscatterMoments| -> [Rgb; 4] {
+        [a.a_f, a.a_b, b.attenuation, b.variance]
+    };
     for (theta_samples, theta_d_samples) in [(257, 181), (513, 361), (1025, 721)] {
-        let config = DualScatteringConfig { theta_samples, theta_d_samples, ..Default::default() };
+        let config = DualScatteringConfig {
+            theta_samples,
+            theta_d_samples,
+            ..Default::default()
+        };
         let avg = DualScatteringAverages::new(&m, config).unwrap();
         let mut max_abs = [0.0f64; 4];
         let mut max_rel = [0.0f64; 4];
         for q in 0..4 {
-            let peak = direct.iter().flat_map(|(d, dm)| pick(d, dm)[q]).fold(0.0, f64::max);
+            let peak = direct
+                .iter()
+                .flat_map(|(d, dm)| pick(d, dm)[q])
+                .fold(0.0, f64::max);
             for (&t, (d, dm)) in thetas.iter().zip(&direct) {
                 let want = pick(d, dm)[q];
                 let got = pick(&avg.averages_at(t), &avg.moments_at(t))[q];
@@ -396,7 +536,10 @@ fn tabulation_error_against_on_demand_computation() {
                 }
             }
         }
-        let (ma, mr) = (max_abs.map(|e| format!("{e:.2e}")), max_rel.map(|e| format!("{e:.2e}")));
+        let (ma, mr) = (
+            max_abs.map(|e| format!("{e:.2e}")),
+            max_rel.map(|e| format!("{e:.2e}")),
+        );
         println!(
             "θ grid {theta_samples}, θ_d grid {theta_d_samples} (40 random θ, 30% near ±90°): max abs/peak [ā_f, ā_b, Ā_b, σ̄_b²] = {ma:?}, max rel (>1% of peak) = {mr:?}"
         );
