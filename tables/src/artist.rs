@@ -33,7 +33,10 @@
 //! cos θ_i cos θ_o = cos²θ_d − sin²θ_h). The tests check it against brute-force 3-D quadrature of
 //! the normalized model. Eq. 13 divides per channel ([`Normalization::PerChannel`]), which makes
 //! every channel's mean albedo 1; [`Normalization::SharedScale`] divides all channels by the
-//! largest K instead, keeping the artist's color ratios.
+//! largest K instead, keeping the artist's color ratios. Because K is a mean over incident
+//! inclinations, ā_f + ā_b exceeds 1 at some inclinations (by ~5% for the defaults) and a
+//! transmission-dominated fiber can reach ā_f ≥ 1 there, where the backscattering series
+//! diverges; [`Normalization::PeakPerChannel`] divides by the peak over inclinations instead.
 
 use crate::angles::FiberAngles;
 use crate::dual_scattering::{LobeDecomposition, inverse_cos2_guarded, peaked_rule};
@@ -421,18 +424,36 @@ impl ArtistModel {
     /// The energy-normalized copy used for multiple scattering (eq. 13).
     pub fn normalized(&self, mode: Normalization) -> NormalizedArtist {
         let k = self.normalization_integral();
+        let inverse = |x: f64| if x > 0.0 { 1.0 / x } else { 0.0 };
         let scale = match mode {
-            Normalization::PerChannel => k.map(|x| if x > 0.0 { 1.0 / x } else { 0.0 }),
-            Normalization::SharedScale => {
-                let m = k.iter().copied().fold(0.0, f64::max);
-                [if m > 0.0 { 1.0 / m } else { 0.0 }; 3]
-            }
+            Normalization::PerChannel => k.map(inverse),
+            Normalization::SharedScale => [inverse(k.iter().copied().fold(0.0, f64::max)); 3],
+            Normalization::PeakPerChannel => self.peak_total_attenuation().map(inverse),
         };
         NormalizedArtist {
             model: *self,
             integral: k,
             scale,
         }
+    }
+
+    /// Per channel, the largest `ā_f(θ) + ā_b(θ) = cos θ ∫ f'_s dω_o` over incident inclinations
+    /// (θ on a ¼° grid; the maximum is smooth, so the grid underestimates it by ~1e-5).
+    pub fn peak_total_attenuation(&self) -> Rgb {
+        // N'_X does not depend on θ_d: its hemisphere integrals are constants per lobe.
+        let halves: Vec<[Rgb; 2]> = (0..4)
+            .map(|p| crate::dual_scattering::azimuthal_hemisphere_integrals(self, p, 0.0))
+            .collect();
+        let mut peak = [0.0f64; 3];
+        let n = 721;
+        for k in 0..n {
+            let theta = -FRAC_PI_2 + PI * k as f64 / (n - 1) as f64;
+            let a = crate::dual_scattering::fiber_averages_with(self, theta, |p, _| halves[p]);
+            for (c, peak_c) in peak.iter_mut().enumerate() {
+                *peak_c = peak_c.max(a.a_f[c] + a.a_b[c]);
+            }
+        }
+        peak
     }
 }
 
@@ -501,9 +522,14 @@ pub enum Normalization {
     /// All channels divided by the largest K: the brightest channel's mean albedo becomes 1
     /// and the others keep their ratio to it (multiple scattering keeps the hair's color).
     SharedScale,
+    /// Each channel divided by its largest ā_f(θ) + ā_b(θ) over inclinations instead of the
+    /// mean: no inclination returns more than it receives, so ā_f < 1 wherever anything is
+    /// scattered backward and the backscattering series always converges. The mean albedo is
+    /// then below 1 (by the variation of ā_f + ā_b with θ, ~5% for the defaults).
+    PeakPerChannel,
 }
 
-/// `f_s^norm = f'_s · scale`, scale = 1/K per channel (or shared).
+/// `f_s^norm = f'_s · scale`, scale = 1/K per channel (or shared, or 1/peak).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NormalizedArtist {
     model: ArtistModel,

@@ -20,6 +20,8 @@ pub struct SweepReport {
     pub negative: u64,
     /// Largest finite value seen (useful to spot values that are finite but absurd).
     pub max_finite: f64,
+    /// Random parameter sets the model refused with a typed error (not a failure).
+    pub rejected: u64,
 }
 
 impl SweepReport {
@@ -31,6 +33,7 @@ impl SweepReport {
             infinite: 0,
             negative: 0,
             max_finite: 0.0,
+            rejected: 0,
         }
     }
 
@@ -69,6 +72,7 @@ impl SweepReport {
         self.infinite += other.infinite;
         self.negative += other.negative;
         self.max_finite = self.max_finite.max(other.max_finite);
+        self.rejected += other.rejected;
     }
 }
 
@@ -76,8 +80,14 @@ impl fmt::Display for SweepReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "{}: {} values, {} NaN, {} Inf, {} negative, max finite {:.3e}",
-            self.name, self.samples, self.nan, self.infinite, self.negative, self.max_finite
+            "{}: {} values, {} NaN, {} Inf, {} negative, max finite {:.3e}, {} parameter sets rejected",
+            self.name,
+            self.samples,
+            self.nan,
+            self.infinite,
+            self.negative,
+            self.max_finite,
+            self.rejected
         )
     }
 }
