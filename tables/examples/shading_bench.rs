@@ -68,6 +68,10 @@ fn main() {
         black_box(art.normalization_integral());
     });
     println!("artist eq. 13 normalization integral: {:.3} ms", t * 1e3);
+    let t = median_seconds(5, || {
+        black_box(art.peak_total_attenuation());
+    });
+    println!("artist peak ā_f+ā_b over inclinations (PeakPerChannel): {:.3} ms", t * 1e3);
     let norm = art.normalized(Normalization::PerChannel);
 
     for (theta_samples, theta_d_samples) in [(257, 181), (513, 361), (1025, 721)] {

@@ -647,7 +647,7 @@ impl DualScatteringAverages {
     /// f_back for light that was already spread by forward scattering: the variance
     /// `forward_variance` (σ̄_f², rad² in θ_h) is added to σ̄_b² (Sadeghi 2010's f_back^scatter).
     pub fn backward_scattering_spread(&self, angles: &FiberAngles, forward_variance: Rgb) -> Rgb {
-        if angles.phi.abs() > FRAC_PI_2 {
+        if crate::angles::wrap_angle(angles.phi).abs() > FRAC_PI_2 {
             return [0.0; 3];
         }
         let theta = 0.5 * (angles.theta_i - angles.theta_o);
