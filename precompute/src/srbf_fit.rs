@@ -29,6 +29,11 @@ use std::sync::Mutex;
 use strandlight_tables::error::{check, ParamError};
 use strandlight_tables::srbf::{self, SrbfLobe};
 
+/// A round must lower the best relative MSE by this fraction to count as progress ...
+const STAGNATION_TOLERANCE: f64 = 1e-4;
+/// ... and this many rounds in a row without progress end the fit.
+const STAGNATION_ROUNDS: usize = 4;
+
 /// What the fit may do. The defaults are the paper's.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FitOptions {
@@ -71,6 +76,14 @@ impl FitOptions {
         check("lambda_min", self.lambda_min, |v| v > 0.0, "must be > 0")?;
         check("lambda_max", self.lambda_max, |v| v >= self.lambda_min && v <= 1e5, "must be in [lambda_min, 1e5]")?;
         check("grid_width", self.grid_width as f64, |v| v >= 8.0, "must be ≥ 8")?;
+        // The Gram matrix is exact (closed form) while ⟨G, L⟩ is a sum over grid pixels; that
+        // sum is accurate only while G² spans about a pixel or more: λ ≤ W²/64.
+        check(
+            "lambda_max",
+            self.lambda_max,
+            |v| v <= (self.grid_width * self.grid_width) as f64 / 64.0,
+            "must be ≤ grid_width²/64 (a narrower lobe falls between the fit grid's pixels; raise the grid width)",
+        )?;
         check("rotate", self.rotate_degrees, |_| true, "")?;
         Ok(())
     }
@@ -125,6 +138,7 @@ pub fn fit(map: &EnvMap, options: &FitOptions, progress: &mut dyn FnMut(&RoundRe
     let mut history = Vec::new();
     let mut evaluations = 0;
     let mut best: Option<(f64, Vec<(DVec3, f64)>)> = None;
+    let mut stalled_rounds = 0;
     for _round in 0..3 * options.max_lobes + 3 {
         let round = optimize_round(&grid, &lobes, bounds, options, &mut evaluations);
         lobes = round.lobes;
@@ -139,6 +153,16 @@ pub fn fit(map: &EnvMap, options: &FitOptions, progress: &mut dyn FnMut(&RoundRe
             best = Some((ev.relative_mse, alive.clone()));
         }
         if ev.relative_mse <= options.target_relative_mse || alive.len() >= options.max_lobes {
+            break;
+        }
+        // Stagnation: insertions keep dying or no longer reduce the error (e.g. a sun narrower
+        // than λ_max allows dominates the residual). More rounds would only burn time.
+        let improved = history.len() < 2 || {
+            let previous_best = history[..history.len() - 1].iter().map(|r| r.relative_mse).fold(f64::INFINITY, f64::min);
+            ev.relative_mse < previous_best * (1.0 - STAGNATION_TOLERANCE)
+        };
+        stalled_rounds = if improved { 0 } else { stalled_rounds + 1 };
+        if stalled_rounds >= STAGNATION_ROUNDS {
             break;
         }
         lobes = alive;
@@ -375,13 +399,19 @@ fn optimize_round(
     let (start_cost, _) = problem.cost_and_gradient(&init);
     if options.iterations_per_round > 0 && start_cost.is_finite() {
         let solver = LBFGS::new(MoreThuenteLineSearch::new(), 8)
-            .with_tolerance_cost(1e-6 * start_cost.max(1e-12))
+            .with_tolerance_cost(1e-12 * start_cost.max(1e-12))
             .and_then(|s| s.with_tolerance_grad(1e-9));
         if let Ok(solver) = solver {
             // A line-search failure ends the round early; the best point seen is kept below.
-            let _ = Executor::new(problem, solver)
+            let r = Executor::new(problem, solver)
                 .configure(|state| state.param(init.clone()).max_iters(options.iterations_per_round))
                 .run();
+            if std::env::var_os("STRANDLIGHT_FIT_DEBUG").is_some() {
+                match r {
+                    Ok(r) => eprintln!("round: iters {} cost {} status {:?}", r.state.iter, r.state.best_cost, r.state.termination_status),
+                    Err(e) => eprintln!("round error: {e}"),
+                }
+            }
         }
     }
     let (_, best_params, count) = best.into_inner().unwrap();
