@@ -97,3 +97,87 @@ impl SrbfSet {
 pub fn power(lobe: &SrbfLobe) -> [f64; 3] {
     lobe.amplitude.map(|a| a * srbf::integral(lobe.lambda))
 }
+
+/// What a light set was made from.
+pub struct Source<'a> {
+    pub map: &'a crate::envmap::EnvMap,
+    /// File name (no directories) or `procedural:NAME`.
+    pub name: String,
+    pub sha256: String,
+    pub sanitized: BadPixelCounts,
+}
+
+/// Lobes back in the map's own frame (undoing `rotate_degrees`), for error checks and previews.
+pub fn unrotated(lobes: &[SrbfLobe], rotate_degrees: f64) -> Vec<SrbfLobe> {
+    lobes
+        .iter()
+        .map(|l| SrbfLobe {
+            center: crate::envmap::rotate_about_up(l.center(), -rotate_degrees).to_array(),
+            ..*l
+        })
+        .collect()
+}
+
+impl SrbfSet {
+    /// Runs the adaptive fit and measures its error independently (direct pixel sums, on the
+    /// fit grid and on the full-resolution map).
+    pub fn fit(
+        source: &Source,
+        options: &FitOptions,
+        progress: &mut dyn FnMut(&RoundRecord),
+    ) -> Result<SrbfSet, crate::srbf_fit::FitError> {
+        let start = std::time::Instant::now();
+        let fit = crate::srbf_fit::fit(source.map, options, progress)?;
+        let seconds = start.elapsed().as_secs_f64();
+        Ok(Self::measured(source, options, LightKind::Srbf, fit.lobes, &fit.grid_map, fit.history, seconds))
+    }
+
+    /// The median-cut baseline with `count` directional lights, in the same format.
+    pub fn directional(source: &Source, count: usize, options: &FitOptions) -> SrbfSet {
+        let start = std::time::Instant::now();
+        let lights = crate::median_cut::median_cut(source.map, count.max(1));
+        let norm = srbf::integral(DIRECTIONAL_LAMBDA);
+        let lobes = lights
+            .iter()
+            .map(|l| SrbfLobe {
+                center: crate::envmap::rotate_about_up(l.direction, options.rotate_degrees).to_array(),
+                lambda: DIRECTIONAL_LAMBDA,
+                amplitude: l.power.map(|p| p / norm),
+            })
+            .collect();
+        let seconds = start.elapsed().as_secs_f64();
+        let grid = source.map.downsampled(options.grid_width, options.grid_width / 2);
+        Self::measured(source, options, LightKind::Directional, lobes, &grid, Vec::new(), seconds)
+    }
+
+    fn measured(
+        source: &Source,
+        options: &FitOptions,
+        kind: LightKind,
+        lobes: Vec<SrbfLobe>,
+        grid_map: &crate::envmap::EnvMap,
+        history: Vec<RoundRecord>,
+        seconds: f64,
+    ) -> SrbfSet {
+        use crate::srbf_objective::relative_mse_by_pixels;
+        let own_frame = unrotated(&lobes, options.rotate_degrees);
+        let relative_mse = relative_mse_by_pixels(grid_map, &own_frame);
+        let full_resolution_relative_mse = relative_mse_by_pixels(source.map, &own_frame);
+        SrbfSet {
+            format: FORMAT.into(),
+            version: FORMAT_VERSION,
+            kind,
+            lobes,
+            source: source.name.clone(),
+            source_sha256: source.sha256.clone(),
+            options: options.clone(),
+            sanitized: source.sanitized,
+            fit_grid: [grid_map.width(), grid_map.height()],
+            relative_l2_error: relative_mse.sqrt(),
+            relative_mse,
+            full_resolution_relative_mse,
+            history,
+            seconds,
+        }
+    }
+}
