@@ -16,9 +16,10 @@ fn disk(w: DVec3, center: DVec3, radius: f64) -> f64 {
 }
 
 /// Sun and sky: a clear-sky gradient (blue zenith, pale horizon), a warm sun of angular radius
-/// 2° at 35° elevation toward azimuth u = 0.6 (front right), and a grey-brown ground.
-/// The sun is wider than the real one (0.27°) so that an SRBF fit with λ ≤ 64 stays honest
-/// about its error at a glance; the sun carries about half of the light.
+/// 6° at 35° elevation toward azimuth u = 0.6 (front right), and a grey-brown ground.
+/// The sun is much wider than the real one (0.27°): a lobe with λ ≤ 64 is ~7° wide, and a
+/// real sun would dominate the squared error beyond what any such lobe can fit (see
+/// docs/BENCHMARKS.md on quarry_01). It carries about a third of the light.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SunSky {
     pub sun_direction: DVec3,
@@ -33,8 +34,8 @@ impl Default for SunSky {
     fn default() -> Self {
         Self {
             sun_direction: uv_to_direction(0.6, 0.5 - 35.0 / 180.0),
-            sun_angular_radius: 2f64.to_radians(),
-            sun_radiance: [900.0, 800.0, 640.0],
+            sun_angular_radius: 6f64.to_radians(),
+            sun_radiance: [60.0, 54.0, 44.0],
             zenith: [0.25, 0.45, 0.9],
             horizon: [0.9, 0.95, 1.0],
             ground: [0.18, 0.15, 0.12],

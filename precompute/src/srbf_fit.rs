@@ -139,6 +139,9 @@ pub fn fit(map: &EnvMap, options: &FitOptions, progress: &mut dyn FnMut(&RoundRe
     let mut evaluations = 0;
     let mut best: Option<(f64, Vec<(DVec3, f64)>)> = None;
     let mut stalled_rounds = 0;
+    // Where inserted lobes died (NNLS gave them zero): not tried again.
+    let mut tabu: Vec<DVec3> = Vec::new();
+    let mut inserted: Option<DVec3> = None;
     for _round in 0..3 * options.max_lobes + 3 {
         let round = optimize_round(&grid, &lobes, bounds, options, &mut evaluations);
         lobes = round.lobes;
@@ -146,6 +149,11 @@ pub fn fit(map: &EnvMap, options: &FitOptions, progress: &mut dyn FnMut(&RoundRe
         // Dead lobes (zero amplitude in every channel) are free slots for insertion.
         let alive: Vec<(DVec3, f64)> =
             lobes.iter().zip(&ev.amplitudes).filter(|(_, a)| a.iter().any(|&v| v > 0.0)).map(|(l, _)| *l).collect();
+        if let Some(xi) = inserted.take() {
+            if !alive.iter().any(|(c, _)| c.dot(xi) > 0.999) {
+                tabu.push(xi);
+            }
+        }
         let record = RoundRecord { lobes: alive.len(), relative_mse: ev.relative_mse, evaluations };
         history.push(record);
         progress(&record);
@@ -169,7 +177,8 @@ pub fn fit(map: &EnvMap, options: &FitOptions, progress: &mut dyn FnMut(&RoundRe
         // Amplitudes re-solved for the surviving lobes.
         let amplitudes = evaluate(&grid, &centers(&lobes), &lambdas(&lobes)).amplitudes;
         let residual = coarse.residual(&grid, &lobes, &amplitudes);
-        coarse.place_greedily_from(&grid, residual, &mut lobes, 1, bounds);
+        coarse.place_greedily_from(residual, &mut lobes, 1, bounds, &tabu);
+        inserted = lobes.last().map(|l| l.0);
     }
     let (_, best_lobes) = best.expect("at least one round ran");
     let ev = evaluate(&grid, &centers(&best_lobes), &lambdas(&best_lobes));
@@ -235,7 +244,7 @@ impl CoarseResidual {
     fn place_greedily(&self, grid: &FitGrid, lobes: &mut Vec<(DVec3, f64)>, count: usize, bounds: (f64, f64)) {
         let pixels = grid.radiance.iter().map(|p| p.map(|v| v as f32)).collect();
         let residual = EnvMap::from_pixels(grid.width, grid.height, pixels).downsampled(self.width, self.height);
-        self.place_greedily_from(grid, residual, lobes, count, bounds);
+        self.place_greedily_from(residual, lobes, count, bounds, &[]);
     }
 
     /// Matching pursuit: the lobe (center among the candidates, λ among a few values in the
@@ -243,12 +252,14 @@ impl CoarseResidual {
     /// its share is subtracted from the residual and the next lobe is chosen.
     fn place_greedily_from(
         &self,
-        _grid: &FitGrid,
         mut residual: EnvMap,
         lobes: &mut Vec<(DVec3, f64)>,
         count: usize,
         (lo, hi): (f64, f64),
+        tabu: &[DVec3],
     ) {
+        // Candidates closer than about two candidate spacings to a tabu center are skipped.
+        let tabu_cos = (2.0 * std::f64::consts::TAU / 64.0).cos();
         let trial_lambdas = [lo, (lo * hi).sqrt(), hi];
         let (w, h) = (residual.width(), residual.height());
         let weights: Vec<f64> = (0..h).map(|y| residual.row_solid_angle(y)).collect();
@@ -261,6 +272,9 @@ impl CoarseResidual {
                 .enumerate()
                 .map(|(ci, &xi)| {
                     let mut best = (f64::NEG_INFINITY, ci, lo, [0.0; 3]);
+                    if tabu.iter().any(|t| t.dot(xi) > tabu_cos) {
+                        return best;
+                    }
                     for &lambda in &trial_lambdas {
                         let mut proj = [0.0; 3];
                         for (i, d) in dirs.iter().enumerate() {
@@ -414,8 +428,14 @@ fn optimize_round(
             }
         }
     }
-    let (_, best_params, count) = best.into_inner().unwrap();
-    *evaluations += count;
+    let (best_cost, best_params, count) = best.into_inner().unwrap();
+    *evaluations += count + 1;
+    // The sigmoid start point moves a λ that sat exactly on a bound a little; never let that
+    // make a round worse than the state it started from.
+    let incoming = evaluate(grid, &centers(lobes), &lambdas(lobes)).relative_mse;
+    if incoming <= best_cost {
+        return RoundResult { lobes: lobes.to_vec() };
+    }
     RoundResult { lobes: problem_lobes(&origin, (lo, hi), &best_params) }
 }
 
