@@ -29,8 +29,10 @@ use std::sync::Mutex;
 use strandlight_tables::error::{check, ParamError};
 use strandlight_tables::srbf::{self, SrbfLobe};
 
-/// A round must lower the best relative MSE by this fraction to count as progress ...
-const STAGNATION_TOLERANCE: f64 = 1e-4;
+/// A round must lower the best relative MSE by this much (absolute: a part in 10⁶ of the map's
+/// squared norm) to count as progress. Absolute, because on a map whose error is dominated by
+/// a sun no lobe can resolve, the rest of the sky still improves by small absolute amounts ...
+const STAGNATION_TOLERANCE: f64 = 1e-6;
 /// ... and this many rounds in a row without progress end the fit.
 const STAGNATION_ROUNDS: usize = 4;
 
@@ -167,7 +169,7 @@ pub fn fit(map: &EnvMap, options: &FitOptions, progress: &mut dyn FnMut(&RoundRe
         // than λ_max allows dominates the residual). More rounds would only burn time.
         let improved = history.len() < 2 || {
             let previous_best = history[..history.len() - 1].iter().map(|r| r.relative_mse).fold(f64::INFINITY, f64::min);
-            ev.relative_mse < previous_best * (1.0 - STAGNATION_TOLERANCE)
+            ev.relative_mse < previous_best - STAGNATION_TOLERANCE
         };
         stalled_rounds = if improved { 0 } else { stalled_rounds + 1 };
         if stalled_rounds >= STAGNATION_ROUNDS {
@@ -176,9 +178,9 @@ pub fn fit(map: &EnvMap, options: &FitOptions, progress: &mut dyn FnMut(&RoundRe
         lobes = alive;
         // Amplitudes re-solved for the surviving lobes.
         let amplitudes = evaluate(&grid, &centers(&lobes), &lambdas(&lobes)).amplitudes;
-        let residual = coarse.residual(&grid, &lobes, &amplitudes);
-        coarse.place_greedily_from(residual, &mut lobes, 1, bounds, &tabu);
-        inserted = lobes.last().map(|l| l.0);
+        let new_lobe = coarse.best_insertion(&grid, &lobes, &amplitudes, bounds, &tabu);
+        lobes.push(new_lobe);
+        inserted = Some(new_lobe.0);
     }
     let (_, best_lobes) = best.expect("at least one round ran");
     let ev = evaluate(&grid, &centers(&best_lobes), &lambdas(&best_lobes));
@@ -224,9 +226,20 @@ impl CoarseResidual {
         Self { width, height, candidates }
     }
 
-    /// (radiance − fit) on the coarse grid, as an EnvMap (box-filtered from the fit grid).
-    fn residual(&self, grid: &FitGrid, lobes: &[(DVec3, f64)], amplitudes: &[[f64; 3]]) -> EnvMap {
-        let pixels: Vec<[f32; 3]> = (0..grid.dirs.len())
+    /// The lobe to insert after a round: like matching pursuit, but scored against the residual
+    /// on the full fit grid, where it is (nearly) orthogonal to the current lobes, so a spot
+    /// the current lobes already fit as well as they can (a sun narrower than λ_max allows)
+    /// scores low instead of attracting lobes that NNLS would zero. Candidates: a 32 × 16 grid
+    /// of centers plus the pixel of largest residual; λ among a few values in the bounds.
+    fn best_insertion(
+        &self,
+        grid: &FitGrid,
+        lobes: &[(DVec3, f64)],
+        amplitudes: &[[f64; 3]],
+        (lo, hi): (f64, f64),
+        tabu: &[DVec3],
+    ) -> (DVec3, f64) {
+        let residual: Vec<[f64; 3]> = (0..grid.dirs.len())
             .into_par_iter()
             .map(|i| {
                 let d = grid.dirs[i];
@@ -235,16 +248,45 @@ impl CoarseResidual {
                     let g = srbf::kernel(d.dot(*xi), *lambda);
                     (0..3).for_each(|c| r[c] -= a[c] * g);
                 }
-                r.map(|v| v as f32)
+                r
             })
             .collect();
-        EnvMap::from_pixels(grid.width, grid.height, pixels).downsampled(self.width, self.height)
+        let largest = (0..residual.len())
+            .max_by(|&a, &b| {
+                let s = |i: usize| residual[i].iter().sum::<f64>() * grid.row_weight[i / grid.width];
+                s(a).total_cmp(&s(b)).then(b.cmp(&a))
+            })
+            .unwrap_or(0);
+        let (cw, ch) = (grid.width.min(32), (grid.width.min(32) / 2).max(1));
+        let mut candidates: Vec<DVec3> = (0..cw * ch).map(|i| crate::envmap::pixel_direction(i % cw, i / cw, cw, ch)).collect();
+        candidates.push(grid.dirs[largest]);
+        let tabu_cos = (std::f64::consts::TAU / 64.0).cos();
+        let trial_lambdas = [lo, (lo * hi).sqrt(), hi];
+        let scored: Vec<(f64, DVec3, f64)> = candidates
+            .par_iter()
+            .map(|&xi| {
+                let mut best = (f64::NEG_INFINITY, xi, lo);
+                if tabu.iter().any(|t| t.dot(xi) > tabu_cos) {
+                    return best;
+                }
+                for &lambda in &trial_lambdas {
+                    let proj = grid.correlate(xi, lambda, &residual);
+                    let score = proj.iter().map(|p| p.max(0.0).powi(2)).sum::<f64>() / srbf::squared_norm(lambda);
+                    if score > best.0 {
+                        best = (score, xi, lambda);
+                    }
+                }
+                best
+            })
+            .collect();
+        let best = scored.into_iter().fold((f64::NEG_INFINITY, candidates[0], lo), |b, s| if s.0 > b.0 { s } else { b });
+        (best.1, best.2)
     }
 
     fn place_greedily(&self, grid: &FitGrid, lobes: &mut Vec<(DVec3, f64)>, count: usize, bounds: (f64, f64)) {
         let pixels = grid.radiance.iter().map(|p| p.map(|v| v as f32)).collect();
         let residual = EnvMap::from_pixels(grid.width, grid.height, pixels).downsampled(self.width, self.height);
-        self.place_greedily_from(residual, lobes, count, bounds, &[]);
+        self.place_greedily_from(residual, lobes, count, bounds);
     }
 
     /// Matching pursuit: the lobe (center among the candidates, λ among a few values in the
@@ -256,10 +298,8 @@ impl CoarseResidual {
         lobes: &mut Vec<(DVec3, f64)>,
         count: usize,
         (lo, hi): (f64, f64),
-        tabu: &[DVec3],
     ) {
-        // Candidates closer than about two candidate spacings to a tabu center are skipped.
-        let tabu_cos = (2.0 * std::f64::consts::TAU / 64.0).cos();
+
         let trial_lambdas = [lo, (lo * hi).sqrt(), hi];
         let (w, h) = (residual.width(), residual.height());
         let weights: Vec<f64> = (0..h).map(|y| residual.row_solid_angle(y)).collect();
@@ -272,9 +312,6 @@ impl CoarseResidual {
                 .enumerate()
                 .map(|(ci, &xi)| {
                     let mut best = (f64::NEG_INFINITY, ci, lo, [0.0; 3]);
-                    if tabu.iter().any(|t| t.dot(xi) > tabu_cos) {
-                        return best;
-                    }
                     for &lambda in &trial_lambdas {
                         let mut proj = [0.0; 3];
                         for (i, d) in dirs.iter().enumerate() {

@@ -64,6 +64,24 @@ impl FitGrid {
         y0.min(self.height)..y1
     }
 
+    /// ⟨G, R_c⟩ for a lobe and any per-pixel field R on this grid (e.g. a residual).
+    pub fn correlate(&self, xi: DVec3, lambda: f64, field: &[[f64; 3]]) -> [f64; 3] {
+        let mut b = [0.0; 3];
+        for y in self.rows_within(xi, lambda) {
+            let w = self.row_weight[y];
+            let row = y * self.width..(y + 1) * self.width;
+            for (d, r) in self.dirs[row.clone()].iter().zip(&field[row]) {
+                let t = lambda * (d.dot(xi) - 1.0);
+                if t < -CULL_EXPONENT {
+                    continue;
+                }
+                let g = w * t.exp();
+                (0..3).for_each(|c| b[c] += g * r[c]);
+            }
+        }
+        b
+    }
+
     /// `(b_c, ∂b_c/∂ξ (ambient, 3 per channel), ∂b_c/∂λ)` for one lobe.
     fn project(&self, xi: DVec3, lambda: f64) -> ([f64; 3], [DVec3; 3], [f64; 3]) {
         let mut b = [0.0; 3];
