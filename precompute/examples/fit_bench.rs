@@ -16,6 +16,15 @@ use strandlight_precompute::srbf_fit::{fit, FitOptions};
 use strandlight_precompute::srbf_objective::relative_mse_by_pixels;
 use strandlight_precompute::procedural_env;
 
+/// CPU seconds this process has used (all threads), from /proc/self/stat (Linux; 0 elsewhere).
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    // Fields after the ")" that closes the command name: utime and stime are the 12th and 13th.
+    let rest = stat.rsplit(')').next().unwrap_or("");
+    let f: Vec<f64> = rest.split_whitespace().filter_map(|v| v.parse().ok()).collect();
+    if f.len() > 13 { (f[11] + f[12]) / 100.0 } else { 0.0 }
+}
+
 fn main() {
     let mut args = std::env::args().skip(1);
     let (mut dir, mut out) = (None, None);
@@ -44,18 +53,21 @@ fn main() {
 
     let mut md = String::new();
     let threads = rayon::current_num_threads();
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    md += &format!("Load average at start (machine shared with other builds): {}\n\n", load.trim());
     md += &format!(
         "Machine: {} logical CPUs available, rayon threads: {threads}. Fit grid 256 × 128, λ ∈ [16, 64].\n\n",
         std::thread::available_parallelism().map(|n| n.get()).unwrap_or(0)
     );
-    md += "| map | size | lobes for rel. MSE ≤ 0.15 | rel. MSE reached | full-res rel. MSE | s (default fit) | L2 @16 | L2 @32 | L2 @49 | L2 @64 | s (16→64 sweep) |\n";
-    md += "|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md += "| map | size | lobes for rel. MSE ≤ 0.15 | rel. MSE reached | full-res rel. MSE | s (default fit) | CPU s | L2 @16 | L2 @32 | L2 @49 | L2 @64 | s (16→64 sweep) |\n";
+    md += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     let mut extra = Vec::new();
     for (name, map) in &maps {
         let defaults = FitOptions::default();
-        let t = Instant::now();
+        let (t, cpu) = (Instant::now(), cpu_seconds());
         let result = fit(map, &defaults, &mut |_| {}).expect("fit");
         let s_default = t.elapsed().as_secs_f64();
+        let cpu_default = cpu_seconds() - cpu;
         let reached = relative_mse_by_pixels(&result.grid_map, &result.lobes);
         let full = relative_mse_by_pixels(map, &result.lobes);
         let lobes_cell = if reached <= defaults.target_relative_mse {
@@ -82,7 +94,7 @@ fn main() {
                 .unwrap_or_else(|| "–".into())
         };
         let row = format!(
-            "| {name} | {}×{} | {lobes_cell} | {reached:.3} | {full:.3} | {s_default:.2} | {} | {} | {} | {} | {s_sweep:.2} |\n",
+            "| {name} | {}×{} | {lobes_cell} | {reached:.3} | {full:.3} | {s_default:.2} | {cpu_default:.2} | {} | {} | {} | {} | {s_sweep:.2} |\n",
             map.width(),
             map.height(),
             at(16),

@@ -49,8 +49,10 @@ pub struct FitOptions {
     pub lambda_max: f64,
     /// Width of the prefiltered fit grid (its height is half of it).
     pub grid_width: usize,
-    /// L-BFGS iterations after each insertion.
+    /// L-BFGS iterations after each insertion (few: the next rounds keep refining every lobe).
     pub iterations_per_round: u64,
+    /// L-BFGS iterations of the final polish of the best state.
+    pub final_iterations: u64,
     /// Environment rotation about +Y in degrees, applied to the fitted lobe centers.
     pub rotate_degrees: f64,
 }
@@ -64,7 +66,8 @@ impl Default for FitOptions {
             lambda_min: 16.0,
             lambda_max: 64.0,
             grid_width: 256,
-            iterations_per_round: 30,
+            iterations_per_round: 10,
+            final_iterations: 100,
             rotate_degrees: 0.0,
         }
     }
@@ -182,7 +185,19 @@ pub fn fit(map: &EnvMap, options: &FitOptions, progress: &mut dyn FnMut(&RoundRe
         lobes.push(new_lobe);
         inserted = Some(new_lobe.0);
     }
-    let (_, best_lobes) = best.expect("at least one round ran");
+    let (best_mse, mut best_lobes) = best.expect("at least one round ran");
+    if options.final_iterations > 0 {
+        let polish = FitOptions { iterations_per_round: options.final_iterations, ..options.clone() };
+        let polished = optimize_round(&grid, &best_lobes, bounds, &polish, &mut evaluations).lobes;
+        let ev = evaluate(&grid, &centers(&polished), &lambdas(&polished));
+        if ev.relative_mse < best_mse {
+            let alive = ev.amplitudes.iter().filter(|a| a.iter().any(|&v| v > 0.0)).count();
+            let record = RoundRecord { lobes: alive, relative_mse: ev.relative_mse, evaluations };
+            history.push(record);
+            progress(&record);
+            best_lobes = polished;
+        }
+    }
     let ev = evaluate(&grid, &centers(&best_lobes), &lambdas(&best_lobes));
     let lobes = best_lobes
         .iter()
