@@ -19,10 +19,11 @@ use strandlight_precompute::procedural_env;
 /// CPU seconds this process has used (all threads), from /proc/self/stat (Linux; 0 elsewhere).
 fn cpu_seconds() -> f64 {
     let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    // Fields after the ")" that closes the command name: utime and stime are the 12th and 13th.
+    // Fields after the ")" that closes the command name (utime, stime: fields 14, 15 of proc(5)).
     let rest = stat.rsplit(')').next().unwrap_or("");
     let f: Vec<f64> = rest.split_whitespace().filter_map(|v| v.parse().ok()).collect();
-    if f.len() > 13 { (f[11] + f[12]) / 100.0 } else { 0.0 }
+    // The state letter is not a number and is skipped, so utime and stime land at 10 and 11.
+    if f.len() > 12 { (f[10] + f[11]) / 100.0 } else { 0.0 }
 }
 
 fn main() {
