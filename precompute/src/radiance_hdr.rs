@@ -48,6 +48,12 @@ pub fn decode(path: &Path, bytes: &[u8]) -> Result<EnvMap, EnvMapError> {
     let layout = Layout::parse(&resolution)
         .ok_or_else(|| header_err(format!("unreadable resolution line {resolution:?}")))?;
 
+    // Even the densest run-length code (127 pixels in 2 bytes per plane) needs about one byte
+    // per 16 pixels: refuse a header that promises more than the file can hold before
+    // allocating for it.
+    if (layout.width * layout.height) as u128 > 16 * (bytes.len() - pos) as u128 + 1024 {
+        return Err(EnvMapError::Truncated { path: path.into(), scanline: 0, scanlines: layout.scanlines });
+    }
     let mut reader = ScanlineReader { bytes, pos, path };
     let mut pixels = vec![[0.0f32; 3]; layout.width * layout.height];
     let mut line = vec![[0u8; 4]; layout.scanline_len];

@@ -135,6 +135,9 @@ fn each_bad_file_gives_its_own_error() {
     assert!(matches!(&e, EnvMapError::RadianceHeader { problem, .. } if problem.contains("resolution")), "{e}");
     let e = err(&good[..good.len() - 20]);
     assert!(matches!(e, EnvMapError::Truncated { scanline: 7, scanlines: 8, .. }), "{e}");
+    // A header that promises a million-pixel-square image in a few bytes.
+    let e = err(b"#?RADIANCE\n\n-Y 1000000 +X 1000000\n\x02\x02");
+    assert!(matches!(e, EnvMapError::Truncated { scanline: 0, .. }), "{e}");
     // A run longer than the scanline.
     let mut corrupt = b"#?RADIANCE\n\n-Y 1 +X 8\n".to_vec();
     corrupt.extend_from_slice(&[2, 2, 0, 8, 128 + 9, 7]);
