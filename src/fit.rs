@@ -50,20 +50,32 @@ pub struct FitArgs {
 }
 
 pub fn run(args: FitArgs) -> anyhow::Result<()> {
-    let (map, name, sha256, sanitized) = if let Some(proc_name) = args.envmap.strip_prefix("procedural:") {
-        let Some(map) = procedural_env::by_name(proc_name, 1024) else {
-            bail!("unknown procedural environment {proc_name:?} (known: {})", procedural_env::NAMES.join(", "));
+    let (map, name, sha256, sanitized) =
+        if let Some(proc_name) = args.envmap.strip_prefix("procedural:") {
+            let Some(map) = procedural_env::by_name(proc_name, 1024) else {
+                bail!(
+                    "unknown procedural environment {proc_name:?} (known: {})",
+                    procedural_env::NAMES.join(", ")
+                );
+            };
+            (map, args.envmap.clone(), String::new(), Default::default())
+        } else {
+            let path = Path::new(&args.envmap);
+            let loaded = envmap_io::load(
+                path,
+                LoadOptions {
+                    sanitize: args.sanitize,
+                },
+            )?;
+            if loaded.sanitized.total() > 0 {
+                eprintln!("{}: sanitized {}", path.display(), loaded.sanitized);
+            }
+            let name = path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            (loaded.map, name, loaded.sha256, loaded.sanitized)
         };
-        (map, args.envmap.clone(), String::new(), Default::default())
-    } else {
-        let path = Path::new(&args.envmap);
-        let loaded = envmap_io::load(path, LoadOptions { sanitize: args.sanitize })?;
-        if loaded.sanitized.total() > 0 {
-            eprintln!("{}: sanitized {}", path.display(), loaded.sanitized);
-        }
-        let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        (loaded.map, name, loaded.sha256, loaded.sanitized)
-    };
     let options = FitOptions {
         initial_lobes: args.initial_lobes,
         max_lobes: args.max_lobes,
@@ -74,14 +86,21 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
         rotate_degrees: args.rotate,
         ..FitOptions::default()
     };
-    let source = Source { map: &map, name: name.clone(), sha256, sanitized };
+    let source = Source {
+        map: &map,
+        name: name.clone(),
+        sha256,
+        sanitized,
+    };
     let set = match args.directional {
         Some(n) => SrbfSet::directional(&source, n, &options),
         None => {
             let bar = indicatif::ProgressBar::new(args.max_lobes as u64);
             bar.set_style(
-                indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} lobes  {msg}")
-                    .expect("valid template"),
+                indicatif::ProgressStyle::with_template(
+                    "{elapsed_precise} [{bar:40}] {pos}/{len} lobes  {msg}",
+                )
+                .expect("valid template"),
             );
             let set = SrbfSet::fit(&source, &options, &mut |r| {
                 bar.set_position(r.lobes as u64);
@@ -91,7 +110,9 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
             set
         }
     };
-    let stem = Path::new(name.trim_start_matches("procedural:")).file_stem().map(|s| s.to_string_lossy().into_owned());
+    let stem = Path::new(name.trim_start_matches("procedural:"))
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned());
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = stem.unwrap_or_else(|| "envmap".into());
         match args.directional {
@@ -109,7 +130,11 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
         "{}: {} {} lights, relative L2 error {:.4}, relative MSE {:.4} (full resolution {:.4}), {:.2} s → {}",
         name,
         set.lobes.len(),
-        if args.directional.is_some() { "directional" } else { "SRBF" },
+        if args.directional.is_some() {
+            "directional"
+        } else {
+            "SRBF"
+        },
         set.relative_l2_error,
         set.relative_mse,
         set.full_resolution_relative_mse,

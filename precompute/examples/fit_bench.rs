@@ -11,19 +11,26 @@
 use std::path::PathBuf;
 use std::time::Instant;
 use strandlight_precompute::envmap::EnvMap;
-use strandlight_precompute::envmap_io::{load, LoadOptions};
-use strandlight_precompute::srbf_fit::{fit, FitOptions};
-use strandlight_precompute::srbf_objective::relative_mse_by_pixels;
+use strandlight_precompute::envmap_io::{LoadOptions, load};
 use strandlight_precompute::procedural_env;
+use strandlight_precompute::srbf_fit::{FitOptions, fit};
+use strandlight_precompute::srbf_objective::relative_mse_by_pixels;
 
 /// CPU seconds this process has used (all threads), from /proc/self/stat (Linux; 0 elsewhere).
 fn cpu_seconds() -> f64 {
     let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
     // Fields after the ")" that closes the command name (utime, stime: fields 14, 15 of proc(5)).
     let rest = stat.rsplit(')').next().unwrap_or("");
-    let f: Vec<f64> = rest.split_whitespace().filter_map(|v| v.parse().ok()).collect();
+    let f: Vec<f64> = rest
+        .split_whitespace()
+        .filter_map(|v| v.parse().ok())
+        .collect();
     // The state letter is not a number and is skipped, so utime and stime land at 10 and 11.
-    if f.len() > 12 { (f[10] + f[11]) / 100.0 } else { 0.0 }
+    if f.len() > 12 {
+        (f[10] + f[11]) / 100.0
+    } else {
+        0.0
+    }
 }
 
 fn main() {
@@ -36,10 +43,15 @@ fn main() {
             dir = Some(PathBuf::from(a));
         }
     }
-    let dir = dir.or_else(|| strandlight_tables::shared_data::shared_data_dir().map(|d| d.join("envmaps")));
+    let dir = dir
+        .or_else(|| strandlight_tables::shared_data::shared_data_dir().map(|d| d.join("envmaps")));
     let mut maps: Vec<(String, EnvMap)> = Vec::new();
     if let Some(dir) = &dir {
-        let mut files: Vec<_> = std::fs::read_dir(dir).expect("readable folder").flatten().map(|e| e.path()).collect();
+        let mut files: Vec<_> = std::fs::read_dir(dir)
+            .expect("readable folder")
+            .flatten()
+            .map(|e| e.path())
+            .collect();
         files.sort();
         for f in files {
             match load(&f, LoadOptions::default()) {
@@ -49,16 +61,24 @@ fn main() {
         }
     }
     for name in procedural_env::NAMES {
-        maps.push((format!("procedural:{name}"), procedural_env::by_name(name, 1024).unwrap()));
+        maps.push((
+            format!("procedural:{name}"),
+            procedural_env::by_name(name, 1024).unwrap(),
+        ));
     }
 
     let mut md = String::new();
     let threads = rayon::current_num_threads();
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
-    md += &format!("Load average at start (machine shared with other builds): {}\n\n", load.trim());
+    md += &format!(
+        "Load average at start (machine shared with other builds): {}\n\n",
+        load.trim()
+    );
     md += &format!(
         "Machine: {} logical CPUs available, rayon threads: {threads}. Fit grid 256 × 128, λ ∈ [16, 64].\n\n",
-        std::thread::available_parallelism().map(|n| n.get()).unwrap_or(0)
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(0)
     );
     md += "| map | size | lobes for rel. MSE ≤ 0.15 | rel. MSE reached | full-res rel. MSE | s (default fit) | CPU s | L2 @16 | L2 @32 | L2 @49 | L2 @64 | s (16→64 sweep) |\n";
     md += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -77,7 +97,11 @@ fn main() {
             format!("not reached ({} lobes)", result.lobes.len())
         };
 
-        let sweep = FitOptions { initial_lobes: 16, target_relative_mse: 0.0, ..FitOptions::default() };
+        let sweep = FitOptions {
+            initial_lobes: 16,
+            target_relative_mse: 0.0,
+            ..FitOptions::default()
+        };
         let t = Instant::now();
         let swept = fit(map, &sweep, &mut |_| {}).expect("fit");
         let s_sweep = t.elapsed().as_secs_f64();
@@ -89,7 +113,11 @@ fn main() {
                 .filter(|r| r.lobes <= k)
                 .last()
                 .map(|r| {
-                    let note = if r.lobes < k { format!(" ({})", r.lobes) } else { String::new() };
+                    let note = if r.lobes < k {
+                        format!(" ({})", r.lobes)
+                    } else {
+                        String::new()
+                    };
                     format!("{:.3}{note}", r.relative_mse.sqrt())
                 })
                 .unwrap_or_else(|| "–".into())
@@ -108,13 +136,19 @@ fn main() {
         if reached > defaults.target_relative_mse {
             // What a wider λ bound buys where the default misses the target (λ ≤ 1024 is what
             // the 256-wide grid resolves).
-            let wide = FitOptions { lambda_max: 1024.0, ..FitOptions::default() };
+            let wide = FitOptions {
+                lambda_max: 1024.0,
+                ..FitOptions::default()
+            };
             let t = Instant::now();
             let r = fit(map, &wide, &mut |_| {}).expect("fit");
             let s = t.elapsed().as_secs_f64();
             let e = relative_mse_by_pixels(&r.grid_map, &r.lobes);
             let f = relative_mse_by_pixels(map, &r.lobes);
-            extra.push(format!("| {name} | [16, 1024] | {} | {e:.3} | {f:.3} | {s:.2} |\n", r.lobes.len()));
+            extra.push(format!(
+                "| {name} | [16, 1024] | {} | {e:.3} | {f:.3} | {s:.2} |\n",
+                r.lobes.len()
+            ));
         }
     }
     md += "\nThe maps that miss the target, with a wider bandwidth bound (`--lambda-max 1024`, default fit otherwise):\n\n";

@@ -64,8 +64,16 @@ impl EnvMap {
     /// A map from row-major pixels (top row first). The caller guarantees the size matches;
     /// the 2:1 aspect is checked by the loaders, which know the file name to report.
     pub fn from_pixels(width: usize, height: usize, pixels: Vec<Rgb32>) -> Self {
-        assert_eq!(pixels.len(), width * height, "pixel count must equal width × height");
-        Self { width, height, pixels }
+        assert_eq!(
+            pixels.len(),
+            width * height,
+            "pixel count must equal width × height"
+        );
+        Self {
+            width,
+            height,
+            pixels,
+        }
     }
 
     /// A map whose radiance is `f(ω)` at every pixel center.
@@ -78,7 +86,11 @@ impl EnvMap {
                 c.map(|v| v as f32)
             })
             .collect();
-        Self { width, height, pixels }
+        Self {
+            width,
+            height,
+            pixels,
+        }
     }
 
     pub fn width(&self) -> usize {
@@ -198,7 +210,11 @@ impl EnvMap {
                 sum.map(|s| (s / wsum) as f32)
             })
             .collect();
-        EnvMap { width, height, pixels }
+        EnvMap {
+            width,
+            height,
+            pixels,
+        }
     }
 }
 
@@ -228,7 +244,10 @@ fn overlap_weights(
 
 /// Direction of the center of pixel (x, y) in a `width × height` map.
 pub fn pixel_direction(x: usize, y: usize, width: usize, height: usize) -> DVec3 {
-    uv_to_direction((x as f64 + 0.5) / width as f64, (y as f64 + 0.5) / height as f64)
+    uv_to_direction(
+        (x as f64 + 0.5) / width as f64,
+        (y as f64 + 0.5) / height as f64,
+    )
 }
 
 /// `(u, v) ∈ [0,1]²` to the unit direction (see the module documentation).
@@ -281,7 +300,10 @@ mod tests {
     fn uv_round_trips() {
         for &(u, v) in &[(0.1, 0.2), (0.6, 0.9), (0.999, 0.5), (0.25, 0.01)] {
             let (u2, v2) = direction_to_uv(uv_to_direction(u, v));
-            assert!((u - u2).abs() < 1e-12 && (v - v2).abs() < 1e-12, "{u},{v} → {u2},{v2}");
+            assert!(
+                (u - u2).abs() < 1e-12 && (v - v2).abs() < 1e-12,
+                "{u},{v} → {u2},{v2}"
+            );
         }
     }
 

@@ -27,11 +27,18 @@ pub struct LoadedEnvMap {
 
 /// Reads, checks and (if asked) sanitizes an environment map.
 pub fn load(path: &Path, options: LoadOptions) -> Result<LoadedEnvMap, EnvMapError> {
-    let bytes = std::fs::read(path).map_err(|source| EnvMapError::Io { path: path.into(), source })?;
+    let bytes = std::fs::read(path).map_err(|source| EnvMapError::Io {
+        path: path.into(),
+        source,
+    })?;
     let sha256 = hex(&Sha256::digest(&bytes));
     let mut map = decode(path, &bytes)?;
     if map.width() != 2 * map.height() {
-        return Err(EnvMapError::NotTwoToOne { path: path.into(), width: map.width(), height: map.height() });
+        return Err(EnvMapError::NotTwoToOne {
+            path: path.into(),
+            width: map.width(),
+            height: map.height(),
+        });
     }
     let bad = map.bad_pixels();
     let sanitized = if bad.total() == 0 {
@@ -39,9 +46,17 @@ pub fn load(path: &Path, options: LoadOptions) -> Result<LoadedEnvMap, EnvMapErr
     } else if options.sanitize {
         map.sanitize()
     } else {
-        return Err(EnvMapError::BadPixels { path: path.into(), counts: bad });
+        return Err(EnvMapError::BadPixels {
+            path: path.into(),
+            counts: bad,
+        });
     };
-    Ok(LoadedEnvMap { map, path: path.into(), sha256, sanitized })
+    Ok(LoadedEnvMap {
+        map,
+        path: path.into(),
+        sha256,
+        sanitized,
+    })
 }
 
 /// Decodes by content (signature), not by extension.
@@ -65,7 +80,10 @@ fn decode_exr(path: &Path, bytes: &[u8]) -> Result<EnvMap, EnvMapError> {
         .no_deep_data()
         .largest_resolution_level()
         .rgba_channels(
-            |size, _| Pixels { width: size.width(), data: vec![[0.0; 3]; size.area()] },
+            |size, _| Pixels {
+                width: size.width(),
+                data: vec![[0.0; 3]; size.area()],
+            },
             // The reader matches channels by name (R, G, B; alpha optional), so files that
             // store B, G, R come out right; samples of any type are converted to f32.
             |p: &mut Pixels, pos: Vec2<usize>, (r, g, b, _a): (f32, f32, f32, f32)| {
@@ -75,7 +93,10 @@ fn decode_exr(path: &Path, bytes: &[u8]) -> Result<EnvMap, EnvMapError> {
         .first_valid_layer()
         .all_attributes()
         .from_buffered(std::io::Cursor::new(bytes))
-        .map_err(|e| EnvMapError::Exr { path: path.into(), message: e.to_string() })?;
+        .map_err(|e| EnvMapError::Exr {
+            path: path.into(),
+            message: e.to_string(),
+        })?;
     let pixels = image.layer_data.channel_data.pixels;
     let height = pixels.data.len() / pixels.width.max(1);
     Ok(EnvMap::from_pixels(pixels.width, height, pixels.data))
@@ -94,6 +115,12 @@ pub fn write_exr(map: &EnvMap, path: &Path) -> Result<(), EnvMapError> {
         let p = map.pixel(x, y);
         (p[0], p[1], p[2])
     })
-    .map_err(|e| EnvMapError::Exr { path: path.into(), message: e.to_string() })?;
-    std::fs::rename(&tmp, path).map_err(|source| EnvMapError::Io { path: path.into(), source })
+    .map_err(|e| EnvMapError::Exr {
+        path: path.into(),
+        message: e.to_string(),
+    })?;
+    std::fs::rename(&tmp, path).map_err(|source| EnvMapError::Io {
+        path: path.into(),
+        source,
+    })
 }

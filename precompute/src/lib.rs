@@ -20,5 +20,5 @@ pub mod srbf_set;
 
 pub use envmap::EnvMap;
 pub use envmap_error::EnvMapError;
-pub use srbf_fit::{fit, FitOptions};
+pub use srbf_fit::{FitOptions, fit};
 pub use srbf_set::SrbfSet;

@@ -56,7 +56,12 @@ fn luminance(p: [f32; 3]) -> f64 {
 /// `count` lights (fewer only if the map has fewer pixels).
 pub fn median_cut(map: &EnvMap, count: usize) -> Vec<DirectionalLight> {
     let table = EnergyTable::new(map);
-    let mut regions = vec![Region { x0: 0, y0: 0, x1: map.width(), y1: map.height() }];
+    let mut regions = vec![Region {
+        x0: 0,
+        y0: 0,
+        x1: map.width(),
+        y1: map.height(),
+    }];
     while regions.len() < count {
         // The most energetic region that can still be split (ties: first one; deterministic).
         let Some(i) = (0..regions.len())
@@ -64,7 +69,12 @@ pub fn median_cut(map: &EnvMap, count: usize) -> Vec<DirectionalLight> {
                 let r = regions[i];
                 r.x1 - r.x0 > 1 || r.y1 - r.y0 > 1
             })
-            .max_by(|&a, &b| table.sum(regions[a]).total_cmp(&table.sum(regions[b])).then(b.cmp(&a)))
+            .max_by(|&a, &b| {
+                table
+                    .sum(regions[a])
+                    .total_cmp(&table.sum(regions[b]))
+                    .then(b.cmp(&a))
+            })
         else {
             break;
         };
@@ -82,8 +92,18 @@ fn split(map: &EnvMap, table: &EnergyTable, r: Region) -> (Region, Region) {
     let total = table.sum(r);
     let split_x = r.x1 - r.x0 > 1 && (width >= height || r.y1 - r.y0 == 1);
     // The cut that makes the first part's energy closest to half.
-    let (lo, hi) = if split_x { (r.x0 + 1, r.x1) } else { (r.y0 + 1, r.y1) };
-    let part = |c: usize| if split_x { Region { x1: c, ..r } } else { Region { y1: c, ..r } };
+    let (lo, hi) = if split_x {
+        (r.x0 + 1, r.x1)
+    } else {
+        (r.y0 + 1, r.y1)
+    };
+    let part = |c: usize| {
+        if split_x {
+            Region { x1: c, ..r }
+        } else {
+            Region { y1: c, ..r }
+        }
+    };
     let cut = (lo..hi)
         .min_by(|&a, &b| {
             let da = (table.sum(part(a)) - 0.5 * total).abs();
@@ -91,7 +111,11 @@ fn split(map: &EnvMap, table: &EnergyTable, r: Region) -> (Region, Region) {
             da.total_cmp(&db)
         })
         .unwrap_or(lo);
-    let rest = if split_x { Region { x0: cut, ..r } } else { Region { y0: cut, ..r } };
+    let rest = if split_x {
+        Region { x0: cut, ..r }
+    } else {
+        Region { y0: cut, ..r }
+    };
     (part(cut), rest)
 }
 
@@ -111,7 +135,10 @@ fn light_of(map: &EnvMap, r: Region) -> DirectionalLight {
         let (x, y) = ((r.x0 + r.x1) / 2, (r.y0 + r.y1) / 2);
         centroid = map.direction(x.min(map.width() - 1), y.min(map.height() - 1));
     }
-    DirectionalLight { direction: centroid.normalize(), power }
+    DirectionalLight {
+        direction: centroid.normalize(),
+        power,
+    }
 }
 
 #[cfg(test)]
@@ -135,8 +162,16 @@ mod tests {
         }
         // With enough lights the brightest one sits on the bright pixel.
         let lights = median_cut(&map, 64);
-        let brightest = lights.iter().max_by(|a, b| a.power[0].total_cmp(&b.power[0])).unwrap();
-        let angle = brightest.direction.dot(map.direction(90, 20)).clamp(-1.0, 1.0).acos().to_degrees();
+        let brightest = lights
+            .iter()
+            .max_by(|a, b| a.power[0].total_cmp(&b.power[0]))
+            .unwrap();
+        let angle = brightest
+            .direction
+            .dot(map.direction(90, 20))
+            .clamp(-1.0, 1.0)
+            .acos()
+            .to_degrees();
         eprintln!("brightest light is {angle:.2}° from the bright pixel");
         assert!(angle < 3.0);
     }

@@ -14,11 +14,17 @@ pub fn solve(a_mat: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
     let mut passive = vec![false; n];
     let scale = b.amax().max(1e-300);
     let tol = 1e-12 * scale;
-    let ridge = 1e-12 * (0..n).map(|i| a_mat[(i, i)]).fold(0.0, f64::max).max(1e-300);
+    let ridge = 1e-12
+        * (0..n)
+            .map(|i| a_mat[(i, i)])
+            .fold(0.0, f64::max)
+            .max(1e-300);
     let mut w = b - a_mat * &x;
     for _outer in 0..3 * n + 3 {
         // The most violated dual constraint among the active (zero) variables.
-        let candidate = (0..n).filter(|&j| !passive[j] && w[j] > tol).max_by(|&i, &j| w[i].total_cmp(&w[j]));
+        let candidate = (0..n)
+            .filter(|&j| !passive[j] && w[j] > tol)
+            .max_by(|&i, &j| w[i].total_cmp(&w[j]));
         let Some(j) = candidate else { break };
         passive[j] = true;
         for _inner in 0..3 * n + 3 {
@@ -47,15 +53,25 @@ pub fn solve(a_mat: &DMatrix<f64>, b: &DVector<f64>) -> DVector<f64> {
 }
 
 /// Solves `A_PP s_P = b_P` with zeros outside the passive set P.
-fn solve_passive(a_mat: &DMatrix<f64>, b: &DVector<f64>, passive: &[bool], ridge: f64) -> DVector<f64> {
+fn solve_passive(
+    a_mat: &DMatrix<f64>,
+    b: &DVector<f64>,
+    passive: &[bool],
+    ridge: f64,
+) -> DVector<f64> {
     let idx: Vec<usize> = (0..b.len()).filter(|&i| passive[i]).collect();
     let m = idx.len();
-    let sub = DMatrix::from_fn(m, m, |r, c| a_mat[(idx[r], idx[c])] + if r == c { ridge } else { 0.0 });
+    let sub = DMatrix::from_fn(m, m, |r, c| {
+        a_mat[(idx[r], idx[c])] + if r == c { ridge } else { 0.0 }
+    });
     let rhs = DVector::from_fn(m, |r, _| b[idx[r]]);
     let sol = match sub.clone().cholesky() {
         Some(ch) => ch.solve(&rhs),
         // Not numerically positive definite: fall back to a pseudo-inverse solve.
-        None => sub.svd(true, true).solve(&rhs, 1e-14).unwrap_or_else(|_| DVector::zeros(m)),
+        None => sub
+            .svd(true, true)
+            .solve(&rhs, 1e-14)
+            .unwrap_or_else(|_| DVector::zeros(m)),
     };
     let mut s = DVector::zeros(b.len());
     for (r, &i) in idx.iter().enumerate() {
@@ -87,7 +103,9 @@ mod tests {
     #[test]
     fn matches_brute_force_on_small_problems() {
         // A Gram matrix of random-ish vectors, several right-hand sides of mixed sign.
-        let g = DMatrix::from_fn(9, 5, |r, c| (((r * 131 + c * 71 + 7) as f64).sin() * 1000.0).fract());
+        let g = DMatrix::from_fn(9, 5, |r, c| {
+            (((r * 131 + c * 71 + 7) as f64).sin() * 1000.0).fract()
+        });
         let a = g.transpose() * &g;
         for seed in 0..6 {
             let b = DVector::from_fn(5, |r, _| ((r + seed * 5) as f64 * 1.3).cos());
@@ -96,7 +114,10 @@ mod tests {
             let want = brute_force(&a, &b);
             eprintln!("nnls seed {seed}: {got:.12} vs brute force {want:.12}");
             assert!(x.iter().all(|&v| v >= 0.0));
-            assert!((got - want).abs() < 1e-9 * (1.0 + want.abs()), "{got} vs {want}");
+            assert!(
+                (got - want).abs() < 1e-9 * (1.0 + want.abs()),
+                "{got} vs {want}"
+            );
         }
     }
 }

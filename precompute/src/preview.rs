@@ -14,18 +14,28 @@ pub const TONEMAP: &str = "exposure to mean luminance 0.18, Reinhard x/(1+x), sR
 #[derive(Debug, thiserror::Error)]
 pub enum PreviewError {
     #[error("{path}: cannot write the preview: {message}")]
-    Write { path: std::path::PathBuf, message: String },
+    Write {
+        path: std::path::PathBuf,
+        message: String,
+    },
 }
 
 /// Writes the three panels at `panel_width × panel_width/2` each, `map` being the original.
 /// `lobes` are in the map's own frame (undo any rotation before calling).
-pub fn write_preview(map: &EnvMap, lobes: &[SrbfLobe], panel_width: usize, path: &Path) -> Result<(), PreviewError> {
+pub fn write_preview(
+    map: &EnvMap,
+    lobes: &[SrbfLobe],
+    panel_width: usize,
+    path: &Path,
+) -> Result<(), PreviewError> {
     let original = map.downsampled(panel_width, panel_width / 2);
     let (w, h) = (original.width(), original.height());
     let fit = crate::procedural_env::from_srbf_lobes(w, lobes);
     let lum = |p: [f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
     let mean: f64 = (0..h)
-        .map(|y| original.row_solid_angle(y) * (0..w).map(|x| lum(original.pixel(x, y))).sum::<f64>())
+        .map(|y| {
+            original.row_solid_angle(y) * (0..w).map(|x| lum(original.pixel(x, y))).sum::<f64>()
+        })
         .sum::<f64>()
         / (4.0 * std::f64::consts::PI);
     let exposure = if mean > 0.0 { 0.18 / mean } else { 1.0 };
@@ -43,13 +53,28 @@ pub fn write_preview(map: &EnvMap, lobes: &[SrbfLobe], panel_width: usize, path:
         }
     }
     let mut bytes = Vec::new();
-    let write_err = |message: String| PreviewError::Write { path: path.into(), message };
-    img.write_to(&mut std::io::Cursor::new(&mut bytes), image::ImageFormat::Png).map_err(|e| write_err(e.to_string()))?;
+    let write_err = |message: String| PreviewError::Write {
+        path: path.into(),
+        message,
+    };
+    img.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )
+    .map_err(|e| write_err(e.to_string()))?;
     crate::atomic::write(path, &bytes).map_err(|e| write_err(e.to_string()))
 }
 
 fn encode(x: f64) -> u8 {
-    let t = if x.is_finite() && x > 0.0 { x / (1.0 + x) } else { 0.0 };
-    let s = if t <= 0.0031308 { 12.92 * t } else { 1.055 * t.powf(1.0 / 2.4) - 0.055 };
+    let t = if x.is_finite() && x > 0.0 {
+        x / (1.0 + x)
+    } else {
+        0.0
+    };
+    let s = if t <= 0.0031308 {
+        12.92 * t
+    } else {
+        1.055 * t.powf(1.0 / 2.4) - 0.055
+    };
     (s * 255.0 + 0.5).clamp(0.0, 255.0) as u8
 }

@@ -3,7 +3,7 @@
 //! known SRBF lobes (for tests that must recover them). All return the same [`EnvMap`] as the
 //! loaders, in [`crate::envmap`]'s convention (+Y up, image center toward −Z).
 
-use crate::envmap::{uv_to_direction, EnvMap};
+use crate::envmap::{EnvMap, uv_to_direction};
 use glam::DVec3;
 use strandlight_tables::srbf::SrbfLobe;
 
@@ -65,9 +65,21 @@ impl SunSky {
 /// A photo studio: a large soft key light (front left, above), a dimmer fill (front right,
 /// low) and a small bright rim light behind, over a dim grey cyclorama that darkens downward.
 pub fn three_light_studio(width: usize) -> EnvMap {
-    let key = (uv_to_direction(0.4, 0.3), 12f64.to_radians(), [40.0, 38.0, 35.0]);
-    let fill = (uv_to_direction(0.62, 0.45), 18f64.to_radians(), [8.0, 8.5, 9.0]);
-    let rim = (uv_to_direction(0.05, 0.35), 6f64.to_radians(), [60.0, 60.0, 60.0]);
+    let key = (
+        uv_to_direction(0.4, 0.3),
+        12f64.to_radians(),
+        [40.0, 38.0, 35.0],
+    );
+    let fill = (
+        uv_to_direction(0.62, 0.45),
+        18f64.to_radians(),
+        [8.0, 8.5, 9.0],
+    );
+    let rim = (
+        uv_to_direction(0.05, 0.35),
+        6f64.to_radians(),
+        [60.0, 60.0, 60.0],
+    );
     EnvMap::from_fn(width, width / 2, |w| {
         let base = 0.05 + 0.1 * (0.5 + 0.5 * w.y);
         let mut c = [base; 3];
@@ -112,7 +124,10 @@ mod tests {
     fn sun_power_matches_its_disk() {
         // The sun's contribution integrates to radiance × solid angle of its (soft) disk.
         let sky = SunSky::default();
-        let no_sun = SunSky { sun_radiance: [0.0; 3], ..sky };
+        let no_sun = SunSky {
+            sun_radiance: [0.0; 3],
+            ..sky
+        };
         let (a, b) = (sky.to_map(2048).integral(), no_sun.to_map(2048).integral());
         let solid_angle = 2.0 * PI * (1.0 - sky.sun_angular_radius.cos());
         let expected = sky.sun_radiance[0] * solid_angle;

@@ -15,20 +15,29 @@ use std::path::Path;
 
 /// Decodes a Radiance file already read into memory; `path` is only for messages.
 pub fn decode(path: &Path, bytes: &[u8]) -> Result<EnvMap, EnvMapError> {
-    let header_err = |problem: String| EnvMapError::RadianceHeader { path: path.into(), problem };
+    let header_err = |problem: String| EnvMapError::RadianceHeader {
+        path: path.into(),
+        problem,
+    };
     let mut pos = 0;
     let next_line = |pos: &mut usize| -> Option<String> {
         if *pos >= bytes.len() {
             return None;
         }
-        let end = bytes[*pos..].iter().position(|&b| b == b'\n').map_or(bytes.len(), |i| *pos + i);
-        let line = String::from_utf8_lossy(&bytes[*pos..end]).trim_end_matches('\r').to_string();
+        let end = bytes[*pos..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .map_or(bytes.len(), |i| *pos + i);
+        let line = String::from_utf8_lossy(&bytes[*pos..end])
+            .trim_end_matches('\r')
+            .to_string();
         *pos = (end + 1).min(bytes.len());
         Some(line)
     };
 
     let magic = next_line(&mut pos).unwrap_or_default();
-    if !(magic.starts_with("#?RADIANCE") || magic.starts_with("#?RGBE") || magic.starts_with("#?")) {
+    if !(magic.starts_with("#?RADIANCE") || magic.starts_with("#?RGBE") || magic.starts_with("#?"))
+    {
         return Err(header_err("missing the '#?RADIANCE' signature".into()));
     }
     // Header lines up to the first empty line: VAR=value pairs and '#' comments.
@@ -52,7 +61,11 @@ pub fn decode(path: &Path, bytes: &[u8]) -> Result<EnvMap, EnvMapError> {
     // per 16 pixels: refuse a header that promises more than the file can hold before
     // allocating for it.
     if (layout.width * layout.height) as u128 > 16 * (bytes.len() - pos) as u128 + 1024 {
-        return Err(EnvMapError::Truncated { path: path.into(), scanline: 0, scanlines: layout.scanlines });
+        return Err(EnvMapError::Truncated {
+            path: path.into(),
+            scanline: 0,
+            scanlines: layout.scanlines,
+        });
     }
     let mut reader = ScanlineReader { bytes, pos, path };
     let mut pixels = vec![[0.0f32; 3]; layout.width * layout.height];
@@ -104,7 +117,15 @@ impl Layout {
         // left to right.
         let layout = |rows, major_from_start, minor_from_start| {
             let (width, height) = if rows { (n2, n1) } else { (n1, n2) };
-            Some(Layout { width, height, scanlines: n1, scanline_len: n2, rows, major_from_start, minor_from_start })
+            Some(Layout {
+                width,
+                height,
+                scanlines: n1,
+                scanline_len: n2,
+                rows,
+                major_from_start,
+                minor_from_start,
+            })
         };
         match (a1, a2) {
             ("-Y", "+X") => layout(true, true, true),
@@ -121,9 +142,21 @@ impl Layout {
 
     /// Image (x, y), y = 0 at the top, of pixel t of scanline s.
     fn image_position(&self, s: usize, t: usize) -> (usize, usize) {
-        let major = if self.major_from_start { s } else { self.scanlines - 1 - s };
-        let minor = if self.minor_from_start { t } else { self.scanline_len - 1 - t };
-        if self.rows { (minor, major) } else { (major, minor) }
+        let major = if self.major_from_start {
+            s
+        } else {
+            self.scanlines - 1 - s
+        };
+        let minor = if self.minor_from_start {
+            t
+        } else {
+            self.scanline_len - 1 - t
+        };
+        if self.rows {
+            (minor, major)
+        } else {
+            (major, minor)
+        }
     }
 }
 
@@ -135,26 +168,45 @@ struct ScanlineReader<'a> {
 
 impl ScanlineReader<'_> {
     fn truncated(&self, s: usize, n: usize) -> EnvMapError {
-        EnvMapError::Truncated { path: self.path.into(), scanline: s, scanlines: n }
+        EnvMapError::Truncated {
+            path: self.path.into(),
+            scanline: s,
+            scanlines: n,
+        }
     }
 
     fn corrupt(&self, s: usize, problem: impl Into<String>) -> EnvMapError {
-        EnvMapError::CorruptScanline { path: self.path.into(), scanline: s, problem: problem.into() }
+        EnvMapError::CorruptScanline {
+            path: self.path.into(),
+            scanline: s,
+            problem: problem.into(),
+        }
     }
 
     fn byte(&mut self, s: usize, n: usize) -> Result<u8, EnvMapError> {
-        let b = *self.bytes.get(self.pos).ok_or_else(|| self.truncated(s, n))?;
+        let b = *self
+            .bytes
+            .get(self.pos)
+            .ok_or_else(|| self.truncated(s, n))?;
         self.pos += 1;
         Ok(b)
     }
 
     fn quad(&mut self, s: usize, n: usize) -> Result<[u8; 4], EnvMapError> {
-        let q = self.bytes.get(self.pos..self.pos + 4).ok_or_else(|| self.truncated(s, n))?;
+        let q = self
+            .bytes
+            .get(self.pos..self.pos + 4)
+            .ok_or_else(|| self.truncated(s, n))?;
         self.pos += 4;
         Ok([q[0], q[1], q[2], q[3]])
     }
 
-    fn read_scanline(&mut self, out: &mut [[u8; 4]], s: usize, n: usize) -> Result<(), EnvMapError> {
+    fn read_scanline(
+        &mut self,
+        out: &mut [[u8; 4]],
+        s: usize,
+        n: usize,
+    ) -> Result<(), EnvMapError> {
         let len = out.len();
         if !(8..=0x7fff).contains(&len) {
             return self.read_old_style(out, s, n);
@@ -198,7 +250,12 @@ impl ScanlineReader<'_> {
 
     /// Flat RGBE quads, with old-style runs: (1, 1, 1, k) repeats the previous pixel
     /// k · 256^m times, m counting consecutive run quads.
-    fn read_old_style(&mut self, out: &mut [[u8; 4]], s: usize, n: usize) -> Result<(), EnvMapError> {
+    fn read_old_style(
+        &mut self,
+        out: &mut [[u8; 4]],
+        s: usize,
+        n: usize,
+    ) -> Result<(), EnvMapError> {
         let mut i = 0;
         let mut shift = 0u32;
         while i < out.len() {
@@ -231,7 +288,8 @@ impl ScanlineReader<'_> {
 pub fn encode_for_tests(map: &EnvMap, resolution: &str, rle: bool) -> Vec<u8> {
     let layout = Layout::parse(resolution).expect("valid resolution line");
     assert_eq!((layout.width, layout.height), (map.width(), map.height()));
-    let mut out = b"#?RADIANCE\n# written by strandlight tests\nFORMAT=32-bit_rle_rgbe\n\n".to_vec();
+    let mut out =
+        b"#?RADIANCE\n# written by strandlight tests\nFORMAT=32-bit_rle_rgbe\n\n".to_vec();
     out.extend_from_slice(resolution.as_bytes());
     out.push(b'\n');
     for s in 0..layout.scanlines {

@@ -21,8 +21,8 @@
 //! round and the previous best is kept). Results do not depend on the thread count: all
 //! parallel sums are reduced in a fixed order.
 
-use crate::envmap::{rotate_about_up, EnvMap};
-use crate::srbf_objective::{evaluate, FitGrid};
+use crate::envmap::{EnvMap, rotate_about_up};
+use crate::srbf_objective::{FitGrid, evaluate};
 use argmin::core::{CostFunction, Error as ArgminError, Executor, Gradient};
 use argmin::solver::linesearch::MoreThuenteLineSearch;
 use argmin::solver::quasinewton::LBFGS;
@@ -30,7 +30,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::sync::Mutex;
-use strandlight_tables::error::{check, ParamError};
+use strandlight_tables::error::{ParamError, check};
 use strandlight_tables::srbf::{self, SrbfLobe};
 
 /// A round must lower the best relative MSE by this much (absolute: a part in 10⁶ of the map's
@@ -79,12 +79,37 @@ impl Default for FitOptions {
 
 impl FitOptions {
     pub fn validate(&self) -> Result<(), ParamError> {
-        check("initial_lobes", self.initial_lobes as f64, |v| v >= 1.0, "must be ≥ 1")?;
-        check("max_lobes", self.max_lobes as f64, |v| (1.0..=4096.0).contains(&v), "must be in [1, 4096]")?;
-        check("target_error", self.target_relative_mse, |v| v >= 0.0, "must be ≥ 0")?;
+        check(
+            "initial_lobes",
+            self.initial_lobes as f64,
+            |v| v >= 1.0,
+            "must be ≥ 1",
+        )?;
+        check(
+            "max_lobes",
+            self.max_lobes as f64,
+            |v| (1.0..=4096.0).contains(&v),
+            "must be in [1, 4096]",
+        )?;
+        check(
+            "target_error",
+            self.target_relative_mse,
+            |v| v >= 0.0,
+            "must be ≥ 0",
+        )?;
         check("lambda_min", self.lambda_min, |v| v > 0.0, "must be > 0")?;
-        check("lambda_max", self.lambda_max, |v| v >= self.lambda_min && v <= 1e5, "must be in [lambda_min, 1e5]")?;
-        check("grid_width", self.grid_width as f64, |v| v >= 8.0, "must be ≥ 8")?;
+        check(
+            "lambda_max",
+            self.lambda_max,
+            |v| v >= self.lambda_min && v <= 1e5,
+            "must be in [lambda_min, 1e5]",
+        )?;
+        check(
+            "grid_width",
+            self.grid_width as f64,
+            |v| v >= 8.0,
+            "must be ≥ 8",
+        )?;
         // The Gram matrix is exact (closed form) while ⟨G, L⟩ is a sum over grid pixels; that
         // sum is accurate only while G² spans about a pixel or more: λ ≤ W²/64.
         check(
@@ -123,14 +148,19 @@ pub struct SrbfFit {
 
 #[derive(Debug, thiserror::Error)]
 pub enum FitError {
-    #[error("invalid fit option: {0}")]
+    /// Names the option (e.g. `lambda_max` for `--lambda-max`) and what it must satisfy.
+    #[error(transparent)]
     Option(#[from] ParamError),
     #[error("the environment map is black (zero everywhere): there is nothing to fit")]
     BlackMap,
 }
 
 /// Fits SRBF lights to `map`. `progress` is called after every round.
-pub fn fit(map: &EnvMap, options: &FitOptions, progress: &mut dyn FnMut(&RoundRecord)) -> Result<SrbfFit, FitError> {
+pub fn fit(
+    map: &EnvMap,
+    options: &FitOptions,
+    progress: &mut dyn FnMut(&RoundRecord),
+) -> Result<SrbfFit, FitError> {
     options.validate()?;
     let grid_map = map.downsampled(options.grid_width, options.grid_width / 2);
     let grid = FitGrid::new(&grid_map);
@@ -156,14 +186,22 @@ pub fn fit(map: &EnvMap, options: &FitOptions, progress: &mut dyn FnMut(&RoundRe
         lobes = round.lobes;
         let ev = evaluate(&grid, &centers(&lobes), &lambdas(&lobes));
         // Dead lobes (zero amplitude in every channel) are free slots for insertion.
-        let alive: Vec<(DVec3, f64)> =
-            lobes.iter().zip(&ev.amplitudes).filter(|(_, a)| a.iter().any(|&v| v > 0.0)).map(|(l, _)| *l).collect();
+        let alive: Vec<(DVec3, f64)> = lobes
+            .iter()
+            .zip(&ev.amplitudes)
+            .filter(|(_, a)| a.iter().any(|&v| v > 0.0))
+            .map(|(l, _)| *l)
+            .collect();
         if let Some(xi) = inserted.take() {
             if !alive.iter().any(|(c, _)| c.dot(xi) > 0.999) {
                 tabu.push(xi);
             }
         }
-        let record = RoundRecord { lobes: alive.len(), relative_mse: ev.relative_mse, evaluations };
+        let record = RoundRecord {
+            lobes: alive.len(),
+            relative_mse: ev.relative_mse,
+            evaluations,
+        };
         history.push(record);
         progress(&record);
         if best.as_ref().is_none_or(|(e, _)| ev.relative_mse < *e) {
@@ -175,7 +213,10 @@ pub fn fit(map: &EnvMap, options: &FitOptions, progress: &mut dyn FnMut(&RoundRe
         // Stagnation: insertions keep dying or no longer reduce the error (e.g. a sun narrower
         // than λ_max allows dominates the residual). More rounds would only burn time.
         let improved = history.len() < 2 || {
-            let previous_best = history[..history.len() - 1].iter().map(|r| r.relative_mse).fold(f64::INFINITY, f64::min);
+            let previous_best = history[..history.len() - 1]
+                .iter()
+                .map(|r| r.relative_mse)
+                .fold(f64::INFINITY, f64::min);
             ev.relative_mse < previous_best - STAGNATION_TOLERANCE
         };
         stalled_rounds = if improved { 0 } else { stalled_rounds + 1 };
@@ -191,12 +232,23 @@ pub fn fit(map: &EnvMap, options: &FitOptions, progress: &mut dyn FnMut(&RoundRe
     }
     let (best_mse, mut best_lobes) = best.expect("at least one round ran");
     if options.final_iterations > 0 {
-        let polish = FitOptions { iterations_per_round: options.final_iterations, ..options.clone() };
+        let polish = FitOptions {
+            iterations_per_round: options.final_iterations,
+            ..options.clone()
+        };
         let polished = optimize_round(&grid, &best_lobes, bounds, &polish, &mut evaluations).lobes;
         let ev = evaluate(&grid, &centers(&polished), &lambdas(&polished));
         if ev.relative_mse < best_mse {
-            let alive = ev.amplitudes.iter().filter(|a| a.iter().any(|&v| v > 0.0)).count();
-            let record = RoundRecord { lobes: alive, relative_mse: ev.relative_mse, evaluations };
+            let alive = ev
+                .amplitudes
+                .iter()
+                .filter(|a| a.iter().any(|&v| v > 0.0))
+                .count();
+            let record = RoundRecord {
+                lobes: alive,
+                relative_mse: ev.relative_mse,
+                evaluations,
+            };
             history.push(record);
             progress(&record);
             best_lobes = polished;
@@ -213,7 +265,12 @@ pub fn fit(map: &EnvMap, options: &FitOptions, progress: &mut dyn FnMut(&RoundRe
             amplitude: a.map(|v| v * grid.scale),
         })
         .collect();
-    Ok(SrbfFit { lobes, objective_relative_mse: ev.relative_mse, history, grid_map })
+    Ok(SrbfFit {
+        lobes,
+        objective_relative_mse: ev.relative_mse,
+        history,
+        grid_map,
+    })
 }
 
 fn centers(lobes: &[(DVec3, f64)]) -> Vec<DVec3> {
@@ -222,7 +279,6 @@ fn centers(lobes: &[(DVec3, f64)]) -> Vec<DVec3> {
 fn lambdas(lobes: &[(DVec3, f64)]) -> Vec<f64> {
     lobes.iter().map(|l| l.1).collect()
 }
-
 
 // ---------------------------------------------------------------------------------------------
 // Placement by importance.
@@ -241,8 +297,14 @@ impl CoarseResidual {
         let height = (width / 2).max(1);
         let cw = grid_map.width().min(64);
         let ch = (cw / 2).max(1);
-        let candidates = (0..cw * ch).map(|i| crate::envmap::pixel_direction(i % cw, i / cw, cw, ch)).collect();
-        Self { width, height, candidates }
+        let candidates = (0..cw * ch)
+            .map(|i| crate::envmap::pixel_direction(i % cw, i / cw, cw, ch))
+            .collect();
+        Self {
+            width,
+            height,
+            candidates,
+        }
     }
 
     /// The lobe to insert after a round: like matching pursuit, but scored against the residual
@@ -272,12 +334,15 @@ impl CoarseResidual {
             .collect();
         let largest = (0..residual.len())
             .max_by(|&a, &b| {
-                let s = |i: usize| residual[i].iter().sum::<f64>() * grid.row_weight[i / grid.width];
+                let s =
+                    |i: usize| residual[i].iter().sum::<f64>() * grid.row_weight[i / grid.width];
                 s(a).total_cmp(&s(b)).then(b.cmp(&a))
             })
             .unwrap_or(0);
         let (cw, ch) = (grid.width.min(32), (grid.width.min(32) / 2).max(1));
-        let mut candidates: Vec<DVec3> = (0..cw * ch).map(|i| crate::envmap::pixel_direction(i % cw, i / cw, cw, ch)).collect();
+        let mut candidates: Vec<DVec3> = (0..cw * ch)
+            .map(|i| crate::envmap::pixel_direction(i % cw, i / cw, cw, ch))
+            .collect();
         candidates.push(grid.dirs[largest]);
         let tabu_cos = (std::f64::consts::TAU / 64.0).cos();
         let trial_lambdas = [lo, (lo * hi).sqrt(), hi];
@@ -290,7 +355,8 @@ impl CoarseResidual {
                 }
                 for &lambda in &trial_lambdas {
                     let proj = grid.correlate(xi, lambda, &residual);
-                    let score = proj.iter().map(|p| p.max(0.0).powi(2)).sum::<f64>() / srbf::squared_norm(lambda);
+                    let score = proj.iter().map(|p| p.max(0.0).powi(2)).sum::<f64>()
+                        / srbf::squared_norm(lambda);
                     if score > best.0 {
                         best = (score, xi, lambda);
                     }
@@ -298,13 +364,24 @@ impl CoarseResidual {
                 best
             })
             .collect();
-        let best = scored.into_iter().fold((f64::NEG_INFINITY, candidates[0], lo), |b, s| if s.0 > b.0 { s } else { b });
+        let best = scored
+            .into_iter()
+            .fold((f64::NEG_INFINITY, candidates[0], lo), |b, s| {
+                if s.0 > b.0 { s } else { b }
+            });
         (best.1, best.2)
     }
 
-    fn place_greedily(&self, grid: &FitGrid, lobes: &mut Vec<(DVec3, f64)>, count: usize, bounds: (f64, f64)) {
+    fn place_greedily(
+        &self,
+        grid: &FitGrid,
+        lobes: &mut Vec<(DVec3, f64)>,
+        count: usize,
+        bounds: (f64, f64),
+    ) {
         let pixels = grid.radiance.iter().map(|p| p.map(|v| v as f32)).collect();
-        let residual = EnvMap::from_pixels(grid.width, grid.height, pixels).downsampled(self.width, self.height);
+        let residual = EnvMap::from_pixels(grid.width, grid.height, pixels)
+            .downsampled(self.width, self.height);
         self.place_greedily_from(residual, lobes, count, bounds);
     }
 
@@ -318,11 +395,12 @@ impl CoarseResidual {
         count: usize,
         (lo, hi): (f64, f64),
     ) {
-
         let trial_lambdas = [lo, (lo * hi).sqrt(), hi];
         let (w, h) = (residual.width(), residual.height());
         let weights: Vec<f64> = (0..h).map(|y| residual.row_solid_angle(y)).collect();
-        let dirs: Vec<DVec3> = (0..w * h).map(|i| residual.direction(i % w, i / w)).collect();
+        let dirs: Vec<DVec3> = (0..w * h)
+            .map(|i| residual.direction(i % w, i / w))
+            .collect();
         for _ in 0..count {
             let res = residual.pixels();
             let scored: Vec<(f64, usize, f64, [f64; 3])> = self
@@ -338,7 +416,8 @@ impl CoarseResidual {
                             (0..3).for_each(|c| proj[c] += g * res[i][c] as f64);
                         }
                         let norm2 = srbf::squared_norm(lambda);
-                        let score: f64 = proj.iter().map(|p| p.max(0.0).powi(2)).sum::<f64>() / norm2;
+                        let score: f64 =
+                            proj.iter().map(|p| p.max(0.0).powi(2)).sum::<f64>() / norm2;
                         if score > best.0 {
                             best = (score, ci, lambda, proj.map(|p| p.max(0.0) / norm2));
                         }
@@ -348,7 +427,11 @@ impl CoarseResidual {
                 .collect();
             // First maximum in candidate order: deterministic.
             let (score, ci, lambda, amp) =
-                scored.into_iter().fold((f64::NEG_INFINITY, 0, lo, [0.0; 3]), |b, s| if s.0 > b.0 { s } else { b });
+                scored
+                    .into_iter()
+                    .fold((f64::NEG_INFINITY, 0, lo, [0.0; 3]), |b, s| {
+                        if s.0 > b.0 { s } else { b }
+                    });
             let xi = self.candidates[ci];
             let _ = score;
             lobes.push((xi, lambda));
@@ -408,7 +491,11 @@ impl RoundProblem<'_> {
         }
         let cost = ev.relative_mse;
         let finite = cost.is_finite() && grad.iter().all(|g| g.is_finite());
-        let (cost, grad) = if finite { (cost, grad) } else { (f64::INFINITY, vec![0.0; p.len()]) };
+        let (cost, grad) = if finite {
+            (cost, grad)
+        } else {
+            (f64::INFINITY, vec![0.0; p.len()])
+        };
         {
             let mut best = self.best.lock().unwrap();
             best.2 += 1;
@@ -460,12 +547,22 @@ fn optimize_round(
         .collect();
     let mut init = Vec::with_capacity(3 * lobes.len());
     for (_, lambda) in lobes {
-        let s = if hi > lo { ((lambda - lo) / (hi - lo)).clamp(0.02, 0.98) } else { 0.5 };
+        let s = if hi > lo {
+            ((lambda - lo) / (hi - lo)).clamp(0.02, 0.98)
+        } else {
+            0.5
+        };
         init.extend_from_slice(&[0.0, 0.0, (s / (1.0 - s)).ln()]);
     }
     let best = Mutex::new((f64::INFINITY, init.clone(), 0));
     let cache = Mutex::new(None);
-    let problem = RoundProblem { grid, origin: origin.clone(), bounds: (lo, hi), best: &best, cache: &cache };
+    let problem = RoundProblem {
+        grid,
+        origin: origin.clone(),
+        bounds: (lo, hi),
+        best: &best,
+        cache: &cache,
+    };
     let (start_cost, _) = problem.cost_and_gradient(&init);
     if options.iterations_per_round > 0 && start_cost.is_finite() {
         let solver = LBFGS::new(MoreThuenteLineSearch::new(), 8)
@@ -474,11 +571,18 @@ fn optimize_round(
         if let Ok(solver) = solver {
             // A line-search failure ends the round early; the best point seen is kept below.
             let r = Executor::new(problem, solver)
-                .configure(|state| state.param(init.clone()).max_iters(options.iterations_per_round))
+                .configure(|state| {
+                    state
+                        .param(init.clone())
+                        .max_iters(options.iterations_per_round)
+                })
                 .run();
             if std::env::var_os("STRANDLIGHT_FIT_DEBUG").is_some() {
                 match r {
-                    Ok(r) => eprintln!("round: iters {} cost {} status {:?}", r.state.iter, r.state.best_cost, r.state.termination_status),
+                    Ok(r) => eprintln!(
+                        "round: iters {} cost {} status {:?}",
+                        r.state.iter, r.state.best_cost, r.state.termination_status
+                    ),
                     Err(e) => eprintln!("round error: {e}"),
                 }
             }
@@ -490,12 +594,20 @@ fn optimize_round(
     // make a round worse than the state it started from.
     let incoming = evaluate(grid, &centers(lobes), &lambdas(lobes)).relative_mse;
     if incoming <= best_cost {
-        return RoundResult { lobes: lobes.to_vec() };
+        return RoundResult {
+            lobes: lobes.to_vec(),
+        };
     }
-    RoundResult { lobes: problem_lobes(&origin, (lo, hi), &best_params) }
+    RoundResult {
+        lobes: problem_lobes(&origin, (lo, hi), &best_params),
+    }
 }
 
-fn problem_lobes(origin: &[(DVec3, DVec3, DVec3)], (lo, hi): (f64, f64), p: &[f64]) -> Vec<(DVec3, f64)> {
+fn problem_lobes(
+    origin: &[(DVec3, DVec3, DVec3)],
+    (lo, hi): (f64, f64),
+    p: &[f64],
+) -> Vec<(DVec3, f64)> {
     origin
         .iter()
         .enumerate()

@@ -37,7 +37,9 @@ impl FitGrid {
     pub fn new(map: &EnvMap) -> FitGrid {
         let (width, height) = (map.width(), map.height());
         let row_weight: Vec<f64> = (0..height).map(|y| map.row_solid_angle(y)).collect();
-        let dirs = (0..width * height).map(|i| map.direction(i % width, i / width)).collect();
+        let dirs = (0..width * height)
+            .map(|i| map.direction(i % width, i / width))
+            .collect();
         let mut norm2 = 0.0;
         for y in 0..height {
             for x in 0..width {
@@ -46,8 +48,19 @@ impl FitGrid {
             }
         }
         let scale = if norm2 > 0.0 { norm2.sqrt() } else { 1.0 };
-        let radiance = map.pixels().iter().map(|p| p.map(|v| v as f64 / scale)).collect();
-        FitGrid { width, height, dirs, row_weight, radiance, scale }
+        let radiance = map
+            .pixels()
+            .iter()
+            .map(|p| p.map(|v| v as f64 / scale))
+            .collect();
+        FitGrid {
+            width,
+            height,
+            dirs,
+            row_weight,
+            radiance,
+            scale,
+        }
     }
 
     /// The rows that a lobe of bandwidth λ at ξ can reach above the culling threshold.
@@ -130,23 +143,40 @@ fn gram_entry(xi_k: DVec3, l_k: f64, xi_j: DVec3, l_j: f64) -> GramEntry {
     let m = mv.length();
     if m < 1e-9 {
         let value = 4.0 * PI * (-(l_k + l_j)).exp();
-        return GramEntry { d_lambda_k: -value, d_xi_k: DVec3::ZERO };
+        return GramEntry {
+            d_lambda_k: -value,
+            d_xi_k: DVec3::ZERO,
+        };
     }
     let e = (m - l_k - l_j).exp();
     let f = srbf::integral(m);
     // f(m) = 2π(1 − e^{−2m})/m, f′(m) = 2π(2m e^{−2m} + expm1(−2m))/m².
-    let df = if m < 1e-4 { -4.0 * PI } else { 2.0 * PI * (2.0 * m * (-2.0 * m).exp() + (-2.0 * m).exp_m1()) / (m * m) };
+    let df = if m < 1e-4 {
+        -4.0 * PI
+    } else {
+        2.0 * PI * (2.0 * m * (-2.0 * m).exp() + (-2.0 * m).exp_m1()) / (m * m)
+    };
     let value = e * f;
     let d_dm = e * (f + df);
-    GramEntry { d_lambda_k: -value + d_dm * xi_k.dot(mv) / m, d_xi_k: mv * (d_dm * l_k / m) }
+    GramEntry {
+        d_lambda_k: -value + d_dm * xi_k.dot(mv) / m,
+        d_xi_k: mv * (d_dm * l_k / m),
+    }
 }
 
 /// E, amplitudes and gradient for the given lobes.
 pub fn evaluate(grid: &FitGrid, centers: &[DVec3], lambdas: &[f64]) -> Evaluation {
     let k = centers.len();
-    let projections: Vec<_> = (0..k).into_par_iter().map(|i| grid.project(centers[i], lambdas[i])).collect();
+    let projections: Vec<_> = (0..k)
+        .into_par_iter()
+        .map(|i| grid.project(centers[i], lambdas[i]))
+        .collect();
     let gram = DMatrix::from_fn(k, k, |r, c| {
-        if r == c { srbf::squared_norm(lambdas[r]) } else { srbf::inner_product(centers[r], lambdas[r], centers[c], lambdas[c]) }
+        if r == c {
+            srbf::squared_norm(lambdas[r])
+        } else {
+            srbf::inner_product(centers[r], lambdas[r], centers[c], lambdas[c])
+        }
     });
     let mut amplitudes = vec![[0.0; 3]; k];
     let mut relative_mse = 1.0;
@@ -183,7 +213,12 @@ pub fn evaluate(grid: &FitGrid, centers: &[DVec3], lambdas: &[f64]) -> Evaluatio
         }
     }
     // Guard against round-off making a perfect fit slightly negative.
-    Evaluation { relative_mse: relative_mse.max(0.0), amplitudes, grad_center, grad_lambda }
+    Evaluation {
+        relative_mse: relative_mse.max(0.0),
+        amplitudes,
+        grad_center,
+        grad_lambda,
+    }
 }
 
 /// d/dx of 2π(1 − e^{−2x})/x.
@@ -236,7 +271,11 @@ mod tests {
 
     fn lobes() -> (Vec<DVec3>, Vec<f64>) {
         (
-            vec![uv_to_direction(0.58, 0.33), uv_to_direction(0.2, 0.6), uv_to_direction(0.9, 0.5)],
+            vec![
+                uv_to_direction(0.58, 0.33),
+                uv_to_direction(0.2, 0.6),
+                uv_to_direction(0.9, 0.5),
+            ],
             vec![30.0, 5.0, 8.0],
         )
     }
@@ -247,15 +286,23 @@ mod tests {
         let (centers, lambdas) = lobes();
         let ev = evaluate(&grid, &centers, &lambdas);
         eprintln!("E = {}, amplitudes {:?}", ev.relative_mse, ev.amplitudes);
-        assert!(ev.amplitudes.iter().all(|a| a.iter().all(|&v| v > 0.0)), "all lobes active");
+        assert!(
+            ev.amplitudes.iter().all(|a| a.iter().all(|&v| v > 0.0)),
+            "all lobes active"
+        );
         let h = 1e-6;
         for k in 0..centers.len() {
             let mut lp = lambdas.clone();
             lp[k] += h;
             let mut lm = lambdas.clone();
             lm[k] -= h;
-            let fd = (evaluate(&grid, &centers, &lp).relative_mse - evaluate(&grid, &centers, &lm).relative_mse) / (2.0 * h);
-            eprintln!("∂E/∂λ_{k}: analytic {:.6e}, finite difference {:.6e}", ev.grad_lambda[k], fd);
+            let fd = (evaluate(&grid, &centers, &lp).relative_mse
+                - evaluate(&grid, &centers, &lm).relative_mse)
+                / (2.0 * h);
+            eprintln!(
+                "∂E/∂λ_{k}: analytic {:.6e}, finite difference {:.6e}",
+                ev.grad_lambda[k], fd
+            );
             assert!((fd - ev.grad_lambda[k]).abs() < 1e-4 * fd.abs().max(1e-6));
             for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
                 // Move along a tangent direction (ambient gradient dotted with it).
@@ -267,7 +314,10 @@ mod tests {
                 };
                 let fd = (shifted(h) - shifted(-h)) / (2.0 * h);
                 let an = ev.grad_center[k].dot(t);
-                assert!((fd - an).abs() < 1e-4 * fd.abs().max(1e-5), "lobe {k} axis {axis}: {an} vs {fd}");
+                assert!(
+                    (fd - an).abs() < 1e-4 * fd.abs().max(1e-5),
+                    "lobe {k} axis {axis}: {an} vs {fd}"
+                );
             }
         }
     }
@@ -290,7 +340,10 @@ mod tests {
             })
             .collect();
         let direct = relative_mse_by_pixels(&map, &lobes);
-        eprintln!("objective E = {:.6}, direct pixel sum = {direct:.6}", ev.relative_mse);
+        eprintln!(
+            "objective E = {:.6}, direct pixel sum = {direct:.6}",
+            ev.relative_mse
+        );
         // They differ only by the quadrature of ⟨G_k, G_j⟩ on a 96×48 grid.
         assert!((direct - ev.relative_mse).abs() < 0.01 * direct + 1e-4);
     }

@@ -54,39 +54,80 @@ pub struct SrbfSet {
 #[derive(Debug, thiserror::Error)]
 pub enum SrbfSetError {
     #[error("{path}: {source}")]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     #[error("{path}: not a valid SRBF set: {source}")]
-    Json { path: PathBuf, source: serde_json::Error },
-    #[error("{path}: format {format:?} version {version} is not {FORMAT:?} version {FORMAT_VERSION}")]
-    Version { path: PathBuf, format: String, version: u32 },
+    Json {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
+    #[error(
+        "{path}: format {format:?} version {version} is not {FORMAT:?} version {FORMAT_VERSION}"
+    )]
+    Version {
+        path: PathBuf,
+        format: String,
+        version: u32,
+    },
     #[error("{path}: lobe {index} is invalid: {problem}")]
-    BadLobe { path: PathBuf, index: usize, problem: String },
+    BadLobe {
+        path: PathBuf,
+        index: usize,
+        problem: String,
+    },
 }
 
 impl SrbfSet {
     pub fn save(&self, path: &Path) -> Result<(), SrbfSetError> {
         let json = serde_json::to_vec_pretty(self).expect("an SrbfSet always serializes");
-        crate::atomic::write(path, &json).map_err(|source| SrbfSetError::Io { path: path.into(), source })
+        crate::atomic::write(path, &json).map_err(|source| SrbfSetError::Io {
+            path: path.into(),
+            source,
+        })
     }
 
     pub fn load(path: &Path) -> Result<SrbfSet, SrbfSetError> {
-        let bytes = std::fs::read(path).map_err(|source| SrbfSetError::Io { path: path.into(), source })?;
-        let set: SrbfSet =
-            serde_json::from_slice(&bytes).map_err(|source| SrbfSetError::Json { path: path.into(), source })?;
+        let bytes = std::fs::read(path).map_err(|source| SrbfSetError::Io {
+            path: path.into(),
+            source,
+        })?;
+        let set: SrbfSet = serde_json::from_slice(&bytes).map_err(|source| SrbfSetError::Json {
+            path: path.into(),
+            source,
+        })?;
         if set.format != FORMAT || set.version != FORMAT_VERSION {
-            return Err(SrbfSetError::Version { path: path.into(), format: set.format, version: set.version });
+            return Err(SrbfSetError::Version {
+                path: path.into(),
+                format: set.format,
+                version: set.version,
+            });
         }
         for (index, lobe) in set.lobes.iter().enumerate() {
-            let bad = |problem: String| SrbfSetError::BadLobe { path: path.into(), index, problem };
+            let bad = |problem: String| SrbfSetError::BadLobe {
+                path: path.into(),
+                index,
+                problem,
+            };
             let len = lobe.center().length();
             if !len.is_finite() || (len - 1.0).abs() > 1e-6 {
-                return Err(bad(format!("center {:?} is not a unit vector", lobe.center)));
+                return Err(bad(format!(
+                    "center {:?} is not a unit vector",
+                    lobe.center
+                )));
             }
             if !(lobe.lambda.is_finite() && lobe.lambda > 0.0) {
-                return Err(bad(format!("lambda {} must be finite and > 0", lobe.lambda)));
+                return Err(bad(format!(
+                    "lambda {} must be finite and > 0",
+                    lobe.lambda
+                )));
             }
             if lobe.amplitude.iter().any(|a| !a.is_finite() || *a < 0.0) {
-                return Err(bad(format!("amplitude {:?} must be finite and ≥ 0", lobe.amplitude)));
+                return Err(bad(format!(
+                    "amplitude {:?} must be finite and ≥ 0",
+                    lobe.amplitude
+                )));
             }
         }
         Ok(set)
@@ -129,7 +170,15 @@ impl SrbfSet {
         let start = std::time::Instant::now();
         let fit = crate::srbf_fit::fit(source.map, options, progress)?;
         let seconds = start.elapsed().as_secs_f64();
-        Ok(Self::measured(source, options, LightKind::Srbf, fit.lobes, &fit.grid_map, fit.history, seconds))
+        Ok(Self::measured(
+            source,
+            options,
+            LightKind::Srbf,
+            fit.lobes,
+            &fit.grid_map,
+            fit.history,
+            seconds,
+        ))
     }
 
     /// The median-cut baseline with `count` directional lights, in the same format.
@@ -140,14 +189,25 @@ impl SrbfSet {
         let lobes = lights
             .iter()
             .map(|l| SrbfLobe {
-                center: crate::envmap::rotate_about_up(l.direction, options.rotate_degrees).to_array(),
+                center: crate::envmap::rotate_about_up(l.direction, options.rotate_degrees)
+                    .to_array(),
                 lambda: DIRECTIONAL_LAMBDA,
                 amplitude: l.power.map(|p| p / norm),
             })
             .collect();
         let seconds = start.elapsed().as_secs_f64();
-        let grid = source.map.downsampled(options.grid_width, options.grid_width / 2);
-        Self::measured(source, options, LightKind::Directional, lobes, &grid, Vec::new(), seconds)
+        let grid = source
+            .map
+            .downsampled(options.grid_width, options.grid_width / 2);
+        Self::measured(
+            source,
+            options,
+            LightKind::Directional,
+            lobes,
+            &grid,
+            Vec::new(),
+            seconds,
+        )
     }
 
     fn measured(

@@ -3,14 +3,18 @@
 
 use glam::DVec3;
 use std::f64::consts::PI;
-use strandlight_precompute::envmap::{rotate_about_up, uv_to_direction, EnvMap};
-use strandlight_precompute::procedural_env::{from_srbf_lobes, SunSky};
-use strandlight_precompute::srbf_fit::{fit, FitError, FitOptions};
+use strandlight_precompute::envmap::{EnvMap, rotate_about_up, uv_to_direction};
+use strandlight_precompute::procedural_env::{SunSky, from_srbf_lobes};
+use strandlight_precompute::srbf_fit::{FitError, FitOptions, fit};
 use strandlight_precompute::srbf_set::{Source, SrbfSet, SrbfSetError};
 use strandlight_tables::srbf::{self, SrbfLobe};
 
 fn known_lobes() -> Vec<SrbfLobe> {
-    let lobe = |u, v, lambda, amplitude| SrbfLobe { center: uv_to_direction(u, v).to_array(), lambda, amplitude };
+    let lobe = |u, v, lambda, amplitude| SrbfLobe {
+        center: uv_to_direction(u, v).to_array(),
+        lambda,
+        amplitude,
+    };
     vec![
         lobe(0.15, 0.3, 20.0, [3.0, 2.0, 1.0]),
         lobe(0.45, 0.6, 40.0, [1.0, 1.5, 2.5]),
@@ -20,7 +24,12 @@ fn known_lobes() -> Vec<SrbfLobe> {
 }
 
 fn source(map: &EnvMap) -> Source<'_> {
-    Source { map, name: "test".into(), sha256: String::new(), sanitized: Default::default() }
+    Source {
+        map,
+        name: "test".into(),
+        sha256: String::new(),
+        sanitized: Default::default(),
+    }
 }
 
 #[test]
@@ -38,18 +47,38 @@ fn a_map_made_of_known_srbfs_is_recovered() {
         ..FitOptions::default()
     };
     let result = fit(&map, &options, &mut |_| {}).unwrap();
-    eprintln!("recovery: objective relative MSE {:.3e}", result.objective_relative_mse);
+    eprintln!(
+        "recovery: objective relative MSE {:.3e}",
+        result.objective_relative_mse
+    );
     assert_eq!(result.lobes.len(), 4);
     for t in &truth {
         let nearest = result
             .lobes
             .iter()
-            .min_by(|a, b| b.center().dot(t.center()).total_cmp(&a.center().dot(t.center())))
+            .min_by(|a, b| {
+                b.center()
+                    .dot(t.center())
+                    .total_cmp(&a.center().dot(t.center()))
+            })
             .unwrap();
-        let angle = nearest.center().dot(t.center()).clamp(-1.0, 1.0).acos().to_degrees();
-        let amp_err = (0..3).map(|c| (nearest.amplitude[c] / t.amplitude[c] - 1.0).abs()).fold(0.0, f64::max);
+        let angle = nearest
+            .center()
+            .dot(t.center())
+            .clamp(-1.0, 1.0)
+            .acos()
+            .to_degrees();
+        let amp_err = (0..3)
+            .map(|c| (nearest.amplitude[c] / t.amplitude[c] - 1.0).abs())
+            .fold(0.0, f64::max);
         let lambda_err = (nearest.lambda / t.lambda - 1.0).abs();
-        eprintln!("  true λ {:>4.1}: center off by {angle:.3}°, λ {:.2} ({:.2}%), amplitude worst {:.2}%", t.lambda, nearest.lambda, 100.0 * lambda_err, 100.0 * amp_err);
+        eprintln!(
+            "  true λ {:>4.1}: center off by {angle:.3}°, λ {:.2} ({:.2}%), amplitude worst {:.2}%",
+            t.lambda,
+            nearest.lambda,
+            100.0 * lambda_err,
+            100.0 * amp_err
+        );
         assert!(angle < 0.5, "center {angle}°");
         assert!(amp_err < 0.03, "amplitude {amp_err}");
         assert!(lambda_err < 0.03, "lambda {lambda_err}");
@@ -61,11 +90,26 @@ fn error_decreases_as_lobes_are_added() {
     // Four known lobes plus the studio's soft lights: several rounds of real progress.
     let lobes = from_srbf_lobes(64, &known_lobes());
     let studio = strandlight_precompute::procedural_env::three_light_studio(64);
-    let px = lobes.pixels().iter().zip(studio.pixels()).map(|(a, b)| std::array::from_fn(|c| a[c] + 0.1 * b[c])).collect();
+    let px = lobes
+        .pixels()
+        .iter()
+        .zip(studio.pixels())
+        .map(|(a, b)| std::array::from_fn(|c| a[c] + 0.1 * b[c]))
+        .collect();
     let map = EnvMap::from_pixels(64, 32, px);
-    let options = FitOptions { initial_lobes: 1, max_lobes: 10, target_relative_mse: 0.0, grid_width: 64, ..FitOptions::default() };
+    let options = FitOptions {
+        initial_lobes: 1,
+        max_lobes: 10,
+        target_relative_mse: 0.0,
+        grid_width: 64,
+        ..FitOptions::default()
+    };
     let result = fit(&map, &options, &mut |_| {}).unwrap();
-    let errors: Vec<(usize, f64)> = result.history.iter().map(|r| (r.lobes, r.relative_mse)).collect();
+    let errors: Vec<(usize, f64)> = result
+        .history
+        .iter()
+        .map(|r| (r.lobes, r.relative_mse))
+        .collect();
     eprintln!("history (lobes, relative MSE): {errors:.4?}");
     assert!(errors.len() >= 5);
     for pair in errors.windows(2) {
@@ -86,10 +130,17 @@ fn independent_relative_mse(map: &EnvMap, lobes: &[SrbfLobe]) -> f64 {
         let d_omega = theta.sin() * (PI / h as f64) * (2.0 * PI / w as f64);
         for x in 0..w {
             let phi = 2.0 * PI * ((x as f64 + 0.5) / w as f64 - 0.5);
-            let dir = DVec3::new(theta.sin() * phi.sin(), theta.cos(), -theta.sin() * phi.cos());
+            let dir = DVec3::new(
+                theta.sin() * phi.sin(),
+                theta.cos(),
+                -theta.sin() * phi.cos(),
+            );
             let p = map.pixel(x, y);
             for c in 0..3 {
-                let f: f64 = lobes.iter().map(|l| l.amplitude[c] * srbf::kernel(dir.dot(l.center()), l.lambda)).sum();
+                let f: f64 = lobes
+                    .iter()
+                    .map(|l| l.amplitude[c] * srbf::kernel(dir.dot(l.center()), l.lambda))
+                    .sum();
                 err += d_omega * (f - p[c] as f64).powi(2);
                 norm += d_omega * (p[c] as f64).powi(2);
             }
@@ -101,7 +152,12 @@ fn independent_relative_mse(map: &EnvMap, lobes: &[SrbfLobe]) -> f64 {
 #[test]
 fn reported_errors_equal_an_independent_recomputation_and_rotation_is_consistent() {
     let map = SunSky::default().to_map(128).downsampled(64, 32);
-    let options = FitOptions { initial_lobes: 8, max_lobes: 10, grid_width: 64, ..FitOptions::default() };
+    let options = FitOptions {
+        initial_lobes: 8,
+        max_lobes: 10,
+        grid_width: 64,
+        ..FitOptions::default()
+    };
     let set = SrbfSet::fit(&source(&map), &options, &mut |_| {}).unwrap();
     let check = independent_relative_mse(&map, &set.lobes);
     eprintln!(
@@ -113,7 +169,15 @@ fn reported_errors_equal_an_independent_recomputation_and_rotation_is_consistent
 
     // Rotated by 90°: the same fit with every center turned, and the error against the map
     // looked up through the inverse rotation is unchanged.
-    let rotated = SrbfSet::fit(&source(&map), &FitOptions { rotate_degrees: 90.0, ..options.clone() }, &mut |_| {}).unwrap();
+    let rotated = SrbfSet::fit(
+        &source(&map),
+        &FitOptions {
+            rotate_degrees: 90.0,
+            ..options.clone()
+        },
+        &mut |_| {},
+    )
+    .unwrap();
     assert_eq!(rotated.lobes.len(), set.lobes.len());
     for (a, b) in set.lobes.iter().zip(&rotated.lobes) {
         assert!((rotate_about_up(a.center(), 90.0) - b.center()).length() < 1e-12);
@@ -125,9 +189,19 @@ fn reported_errors_equal_an_independent_recomputation_and_rotation_is_consistent
 #[test]
 fn the_result_does_not_depend_on_the_thread_count() {
     let map = SunSky::default().to_map(128).downsampled(64, 32);
-    let options = FitOptions { initial_lobes: 6, max_lobes: 9, target_relative_mse: 0.0, grid_width: 64, ..FitOptions::default() };
+    let options = FitOptions {
+        initial_lobes: 6,
+        max_lobes: 9,
+        target_relative_mse: 0.0,
+        grid_width: 64,
+        ..FitOptions::default()
+    };
     let run = |threads| {
-        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| fit(&map, &options, &mut |_| {}).unwrap().lobes)
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| fit(&map, &options, &mut |_| {}).unwrap().lobes)
     };
     let (one, three) = (run(1), run(3));
     eprintln!("1 thread and 3 threads: {} lobes each", one.len());
@@ -137,21 +211,53 @@ fn the_result_does_not_depend_on_the_thread_count() {
 #[test]
 fn bad_options_and_black_maps_are_refused_by_name() {
     let map = SunSky::default().to_map(64);
-    let e = fit(&map, &FitOptions { lambda_min: 70.0, ..FitOptions::default() }, &mut |_| {}).unwrap_err();
+    let e = fit(
+        &map,
+        &FitOptions {
+            lambda_min: 70.0,
+            ..FitOptions::default()
+        },
+        &mut |_| {},
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("lambda_max"), "{e}");
-    let e = fit(&map, &FitOptions { lambda_min: f64::NAN, ..FitOptions::default() }, &mut |_| {}).unwrap_err();
+    let e = fit(
+        &map,
+        &FitOptions {
+            lambda_min: f64::NAN,
+            ..FitOptions::default()
+        },
+        &mut |_| {},
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("lambda_min"), "{e}");
-    let e = fit(&map, &FitOptions { lambda_max: 2000.0, ..FitOptions::default() }, &mut |_| {}).unwrap_err();
+    let e = fit(
+        &map,
+        &FitOptions {
+            lambda_max: 2000.0,
+            ..FitOptions::default()
+        },
+        &mut |_| {},
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("grid_width"), "{e}");
     eprintln!("example: {e}");
     let black = EnvMap::from_pixels(64, 32, vec![[0.0; 3]; 64 * 32]);
-    assert!(matches!(fit(&black, &FitOptions::default(), &mut |_| {}), Err(FitError::BlackMap)));
+    assert!(matches!(
+        fit(&black, &FitOptions::default(), &mut |_| {}),
+        Err(FitError::BlackMap)
+    ));
 }
 
 #[test]
 fn sets_round_trip_through_json_and_bad_files_are_refused() {
     let map = SunSky::default().to_map(64);
-    let options = FitOptions { initial_lobes: 3, max_lobes: 3, grid_width: 64, ..FitOptions::default() };
+    let options = FitOptions {
+        initial_lobes: 3,
+        max_lobes: 3,
+        grid_width: 64,
+        ..FitOptions::default()
+    };
     let set = SrbfSet::fit(&source(&map), &options, &mut |_| {}).unwrap();
     let dir = std::env::temp_dir().join(format!("strandlight-set-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -160,13 +266,26 @@ fn sets_round_trip_through_json_and_bad_files_are_refused() {
     assert_eq!(SrbfSet::load(&path).unwrap(), set);
     let text = std::fs::read_to_string(&path).unwrap();
     std::fs::write(&path, text.replacen("\"lambda\": ", "\"lambda\": -", 1)).unwrap();
-    assert!(matches!(SrbfSet::load(&path), Err(SrbfSetError::BadLobe { index: 0, .. })));
+    assert!(matches!(
+        SrbfSet::load(&path),
+        Err(SrbfSetError::BadLobe { index: 0, .. })
+    ));
     std::fs::write(&path, &text[..text.len() / 2]).unwrap();
-    assert!(matches!(SrbfSet::load(&path), Err(SrbfSetError::Json { .. })));
+    assert!(matches!(
+        SrbfSet::load(&path),
+        Err(SrbfSetError::Json { .. })
+    ));
 
     // The directional baseline in the same format carries the whole map's power.
     let d = SrbfSet::directional(&source(&map), 16, &options);
-    let total: f64 = d.lobes.iter().map(|l| strandlight_precompute::srbf_set::power(l)[0]).sum();
-    eprintln!("16 directional lights carry {total:.4} of ∫L dω = {:.4}", map.integral()[0]);
+    let total: f64 = d
+        .lobes
+        .iter()
+        .map(|l| strandlight_precompute::srbf_set::power(l)[0])
+        .sum();
+    eprintln!(
+        "16 directional lights carry {total:.4} of ∫L dω = {:.4}",
+        map.integral()[0]
+    );
     assert!((total - map.integral()[0]).abs() < 1e-9 * total);
 }
