@@ -7,11 +7,7 @@ mod summary;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(
-    name = "strandlight",
-    version,
-    about = "Strand hair under environment lighting (Ren et al. 2010)"
-)]
+#[command(name = "strandlight", version, about = "Strand hair under environment lighting (Ren et al. 2010)")]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
