@@ -111,7 +111,7 @@ fn main() {
                 .history
                 .iter()
                 .filter(|r| r.lobes <= k)
-                .last()
+                .next_back()
                 .map(|r| {
                     let note = if r.lobes < k {
                         format!(" ({})", r.lobes)

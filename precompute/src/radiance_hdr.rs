@@ -46,10 +46,10 @@ pub fn decode(path: &Path, bytes: &[u8]) -> Result<EnvMap, EnvMapError> {
         if line.is_empty() {
             break;
         }
-        if let Some(format) = line.strip_prefix("FORMAT=") {
-            if format.trim() != "32-bit_rle_rgbe" {
-                return Err(header_err(format!("unsupported pixel format {format:?}")));
-            }
+        if let Some(format) = line.strip_prefix("FORMAT=")
+            && format.trim() != "32-bit_rle_rgbe"
+        {
+            return Err(header_err(format!("unsupported pixel format {format:?}")));
         }
     }
     let resolution =

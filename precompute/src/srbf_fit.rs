@@ -192,10 +192,10 @@ pub fn fit(
             .filter(|(_, a)| a.iter().any(|&v| v > 0.0))
             .map(|(l, _)| *l)
             .collect();
-        if let Some(xi) = inserted.take() {
-            if !alive.iter().any(|(c, _)| c.dot(xi) > 0.999) {
-                tabu.push(xi);
-            }
+        if let Some(xi) = inserted.take()
+            && !alive.iter().any(|(c, _)| c.dot(xi) > 0.999)
+        {
+            tabu.push(xi);
         }
         let record = RoundRecord {
             lobes: alive.len(),
@@ -461,8 +461,11 @@ struct RoundProblem<'a> {
     /// The best (cost, params) seen, and the evaluation count.
     best: &'a Mutex<(f64, Vec<f64>, usize)>,
     /// Cost and gradient of the last parameter vector (argmin asks for them separately).
-    cache: &'a Mutex<Option<(Vec<f64>, f64, Vec<f64>)>>,
+    cache: &'a Mutex<Option<CachedEvaluation>>,
 }
+
+/// Parameters, cost and gradient of the last evaluation.
+type CachedEvaluation = (Vec<f64>, f64, Vec<f64>);
 
 fn sigmoid(t: f64) -> f64 {
     1.0 / (1.0 + (-t).exp())
@@ -470,10 +473,10 @@ fn sigmoid(t: f64) -> f64 {
 
 impl RoundProblem<'_> {
     fn cost_and_gradient(&self, p: &[f64]) -> (f64, Vec<f64>) {
-        if let Some((q, c, g)) = self.cache.lock().unwrap().as_ref() {
-            if q.as_slice() == p {
-                return (*c, g.clone());
-            }
+        if let Some((q, c, g)) = self.cache.lock().unwrap().as_ref()
+            && q.as_slice() == p
+        {
+            return (*c, g.clone());
         }
         let lobes = problem_lobes(&self.origin, self.bounds, p);
         let ev = evaluate(self.grid, &centers(&lobes), &lambdas(&lobes));
