@@ -149,6 +149,7 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
             "relative_l2_error": set.relative_l2_error,
             "relative_mse": set.relative_mse,
             "full_resolution_relative_mse": set.full_resolution_relative_mse,
+            "power_ratio": set.power_ratio,
             "seconds": set.seconds,
             "out": out,
         });

@@ -80,8 +80,8 @@ fn main() {
             .map(|n| n.get())
             .unwrap_or(0)
     );
-    md += "| map | size | lobes for rel. MSE ≤ 0.15 | rel. MSE reached | full-res rel. MSE | s (default fit) | CPU s | L2 @16 | L2 @32 | L2 @49 | L2 @64 | s (16→64 sweep) |\n";
-    md += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    md += "| map | size | lobes for rel. MSE ≤ 0.15 | rel. MSE reached | full-res rel. MSE | s (default fit) | CPU s | power fit/map (R/G/B) | L2 @16 | L2 @32 | L2 @49 | L2 @64 | s (16→64 sweep) |\n";
+    md += "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     let mut extra = Vec::new();
     for (name, map) in &maps {
         let defaults = FitOptions::default();
@@ -90,6 +90,18 @@ fn main() {
         let s_default = t.elapsed().as_secs_f64();
         let cpu_default = cpu_seconds() - cpu;
         let reached = relative_mse_by_pixels(&result.grid_map, &result.lobes);
+        let map_power = map.integral();
+        let power_ratio: Vec<String> = (0..3)
+            .map(|c| {
+                let p: f64 = result
+                    .lobes
+                    .iter()
+                    .map(|l| strandlight_precompute::srbf_set::power(l)[c])
+                    .sum();
+                format!("{:.2}", p / map_power[c])
+            })
+            .collect();
+        let power_ratio = power_ratio.join("/");
         let full = relative_mse_by_pixels(map, &result.lobes);
         let lobes_cell = if reached <= defaults.target_relative_mse {
             format!("{}", result.lobes.len())
@@ -123,7 +135,7 @@ fn main() {
                 .unwrap_or_else(|| "–".into())
         };
         let row = format!(
-            "| {name} | {}×{} | {lobes_cell} | {reached:.3} | {full:.3} | {s_default:.2} | {cpu_default:.2} | {} | {} | {} | {} | {s_sweep:.2} |\n",
+            "| {name} | {}×{} | {lobes_cell} | {reached:.3} | {full:.3} | {s_default:.2} | {cpu_default:.2} | {power_ratio} | {} | {} | {} | {} | {s_sweep:.2} |\n",
             map.width(),
             map.height(),
             at(16),

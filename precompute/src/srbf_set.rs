@@ -46,6 +46,10 @@ pub struct SrbfSet {
     /// The same relative MSE against the full-resolution map (a sun narrower than the fit
     /// grid's pixels counts fully here).
     pub full_resolution_relative_mse: f64,
+    /// ∫ fit dω / ∫ map dω per channel. An L2 fit does not preserve power: a source narrower
+    /// than any allowed lobe is fitted with about twice its power (for a point source the
+    /// optimal lobe carries ∫G/‖G‖² = 2× its power), so sun maps come out too bright overall.
+    pub power_ratio: [f64; 3],
     /// Relative MSE after each optimization round.
     pub history: Vec<RoundRecord>,
     pub seconds: f64,
@@ -223,6 +227,15 @@ impl SrbfSet {
         let own_frame = unrotated(&lobes, options.rotate_degrees);
         let relative_mse = relative_mse_by_pixels(grid_map, &own_frame);
         let full_resolution_relative_mse = relative_mse_by_pixels(source.map, &own_frame);
+        let map_power = source.map.integral();
+        let power_ratio = std::array::from_fn(|c| {
+            let fit: f64 = lobes.iter().map(|l| power(l)[c]).sum();
+            if map_power[c] > 0.0 {
+                fit / map_power[c]
+            } else {
+                0.0
+            }
+        });
         SrbfSet {
             format: FORMAT.into(),
             version: FORMAT_VERSION,
@@ -236,6 +249,7 @@ impl SrbfSet {
             relative_l2_error: relative_mse.sqrt(),
             relative_mse,
             full_resolution_relative_mse,
+            power_ratio,
             history,
             seconds,
         }

@@ -289,3 +289,36 @@ fn sets_round_trip_through_json_and_bad_files_are_refused() {
     );
     assert!((total - map.integral()[0]).abs() < 1e-9 * total);
 }
+
+#[test]
+fn a_sun_narrower_than_any_lobe_is_fitted_with_about_twice_its_power() {
+    // L2 theory: for a point source of power E, the best single lobe has amplitude
+    // E·G(0)/‖G‖², so it carries E·∫G/‖G‖² = E·(2π/λ)/(π/λ) = 2E. Nothing can be found
+    // elsewhere on a black map, so the fit's total power is close to twice the sun's.
+    let mut px = vec![[0.0f32; 3]; 256 * 128];
+    for (x, y) in [(150, 40), (151, 40), (150, 41), (151, 41)] {
+        px[y * 256 + x] = [1.0e4; 3];
+    }
+    let map = EnvMap::from_pixels(256, 128, px);
+    let options = FitOptions {
+        initial_lobes: 1,
+        max_lobes: 4,
+        target_relative_mse: 0.0,
+        grid_width: 64,
+        ..FitOptions::default()
+    };
+    let set = SrbfSet::fit(&source(&map), &options, &mut |_| {}).unwrap();
+    eprintln!(
+        "point-like sun: {} lobes, λ {:?}, relative MSE {:.3}, power fit/map {:.3}",
+        set.lobes.len(),
+        set.lobes.iter().map(|l| l.lambda).collect::<Vec<_>>(),
+        set.relative_mse,
+        set.power_ratio[0]
+    );
+    assert!(
+        set.power_ratio[0] > 1.9 && set.power_ratio[0] < 2.05,
+        "{:?}",
+        set.power_ratio
+    );
+    assert!(set.power_ratio.iter().all(|r| r.is_finite()));
+}
