@@ -3,6 +3,7 @@
 
 mod fit;
 mod summary;
+mod sweep;
 
 use clap::{Parser, Subcommand};
 
@@ -16,15 +17,19 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Print the fiber models, their default parameters and sample values (the default).
-    Summary,
+    Summary(summary::SummaryArgs),
     /// Fit SRBF lights to an environment map (Ren 2010 §3.1), or the median-cut baseline.
     Fit(fit::FitArgs),
+    /// Hard-case sweep of every fiber model (NaN/Inf/negative counts), in parallel.
+    Sweep(sweep::SweepArgs),
 }
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
-    match cli.command.unwrap_or(Command::Summary) {
-        Command::Summary => summary::run(),
+    let default = Command::Summary(summary::SummaryArgs::default());
+    match cli.command.unwrap_or(default) {
+        Command::Summary(args) => summary::run(args),
         Command::Fit(args) => fit::run(args),
+        Command::Sweep(args) => sweep::run(args),
     }
 }

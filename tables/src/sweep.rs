@@ -162,6 +162,41 @@ impl SweepRng {
     }
 }
 
+/// Seed of chunk `index` of a sweep seeded `seed`: one SplitMix64 step from a mix of both, so
+/// neighbouring chunks (and neighbouring seeds) draw unrelated streams.
+pub fn chunk_seed(seed: u64, index: u64) -> u64 {
+    SweepRng::new(seed ^ index.wrapping_mul(0xD1B5_4A32_D192_ED03)).next_u64()
+}
+
+/// Runs `sweep(samples, seed)` as chunks of at most `chunk` requested samples, in parallel on
+/// the rayon pool, and merges the chunk reports in chunk order. Chunk `k` is seeded
+/// [`chunk_seed`]`(seed, k)`, so the result depends on `samples`, `seed` and `chunk` only, never
+/// on the number of threads. `on_chunk(n)` is called (from any thread) after each chunk of `n`
+/// requested samples, for progress display.
+pub fn chunked_sweep(
+    name: &str,
+    samples: u64,
+    seed: u64,
+    chunk: u64,
+    sweep: impl Fn(u64, u64) -> SweepReport + Sync,
+    on_chunk: impl Fn(u64) + Sync,
+) -> SweepReport {
+    use rayon::prelude::*;
+    let chunk = chunk.max(1);
+    let reports: Vec<SweepReport> = (0..samples.div_ceil(chunk))
+        .into_par_iter()
+        .map(|k| {
+            let n = chunk.min(samples - k * chunk);
+            let report = sweep(n, chunk_seed(seed, k));
+            on_chunk(n);
+            report
+        })
+        .collect();
+    let mut total = SweepReport::new(name);
+    reports.iter().for_each(|r| total.merge(r));
+    total
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -191,5 +226,40 @@ mod tests {
         assert_eq!((r.samples, r.nan, r.infinite, r.negative), (5, 1, 1, 1));
         assert_eq!(r.max_finite, 3.0);
         assert!(!r.is_clean());
+    }
+
+    /// A stand-in sweep whose report is a pure function of (samples, seed): the chunked
+    /// result must equal the in-order merge of the chunks run one by one, on any pool.
+    fn toy_sweep(samples: u64, seed: u64) -> SweepReport {
+        let mut r = SweepReport::new("toy");
+        let mut rng = SweepRng::new(seed);
+        for _ in 0..samples {
+            r.record(rng.log_range(1e-3, 1e3));
+        }
+        r
+    }
+
+    #[test]
+    fn chunked_sweep_is_independent_of_the_thread_count() {
+        let (samples, seed, chunk) = (10_007u64, 42u64, 1_000u64);
+        let mut serial = SweepReport::new("toy");
+        for k in 0..samples.div_ceil(chunk) {
+            serial.merge(&toy_sweep(chunk.min(samples - k * chunk), chunk_seed(seed, k)));
+        }
+        for threads in [1, 2, 5] {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let counted = std::sync::atomic::AtomicU64::new(0);
+            let r = pool.install(|| {
+                chunked_sweep("toy", samples, seed, chunk, toy_sweep, |n| {
+                    counted.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+                })
+            });
+            println!("{threads} threads: {r}");
+            assert_eq!(r, serial);
+            assert_eq!(r.samples, samples);
+            assert_eq!(counted.into_inner(), samples);
+        }
+        // Different chunks must draw different streams (a repeated seed would repeat maxima).
+        assert_ne!(chunk_seed(seed, 0), chunk_seed(seed, 1));
     }
 }
