@@ -100,7 +100,9 @@ pub fn run(args: SummaryArgs) -> anyhow::Result<()> {
         version: env!("CARGO_PKG_VERSION"),
         models: models()?,
         presets: presets()?,
-        furnace_rule: format!("integrate_sphere({FURNACE_PANELS:?}) (8-point Gauss–Legendre panels)"),
+        furnace_rule: format!(
+            "integrate_sphere({FURNACE_PANELS:?}) (8-point Gauss–Legendre panels)"
+        ),
         white_furnace_marschner: white_furnace()?,
         single_event_albedo_marschner: single_event_albedo()?,
         srbf_rule: format!("integrate_sphere({SRBF_PANELS:?}) (8-point Gauss–Legendre panels)"),
@@ -125,9 +127,21 @@ fn models() -> anyhow::Result<Vec<ModelSummary>> {
     };
     let artist = ArtistModel::new(ArtistParams::default())?;
     Ok(vec![
-        summarize("marschner (defaults: brown, Gaussian M_p)", &gaussian, &Marschner::new(gaussian.clone())?)?,
-        summarize("marschner (d'Eon M_p)", &deon, &Marschner::new(deon.clone())?)?,
-        summarize("kajiya-kay", &KajiyaKayParams::default(), &KajiyaKay::new(KajiyaKayParams::default())?)?,
+        summarize(
+            "marschner (defaults: brown, Gaussian M_p)",
+            &gaussian,
+            &Marschner::new(gaussian.clone())?,
+        )?,
+        summarize(
+            "marschner (d'Eon M_p)",
+            &deon,
+            &Marschner::new(deon.clone())?,
+        )?,
+        summarize(
+            "kajiya-kay",
+            &KajiyaKayParams::default(),
+            &KajiyaKay::new(KajiyaKayParams::default())?,
+        )?,
         summarize("artist (raw f'_s)", artist.params(), &artist)?,
         summarize(
             "artist (normalized per channel, Sadeghi eq. 13)",
@@ -149,7 +163,11 @@ fn summarize(
             theta_i_deg: ti,
             theta_o_deg: to,
             phi_deg: phi,
-            s: model.eval(&FiberAngles::new(ti.to_radians(), to.to_radians(), phi.to_radians())),
+            s: model.eval(&FiberAngles::new(
+                ti.to_radians(),
+                to.to_radians(),
+                phi.to_radians(),
+            )),
         })
         .collect();
     Ok(ModelSummary {
@@ -268,8 +286,13 @@ fn srbf_rows() -> Vec<SrbfRow> {
 // Text output.
 
 fn print_text(s: &Summary) {
-    println!("strandlight {} — fiber models on built-in defaults", s.version);
-    println!("S convention: L_o = D ∫ S(ω_i, ω_o) L_i cos θ_i dω_i; angles in degrees, S per RGB channel.\n");
+    println!(
+        "strandlight {} — fiber models on built-in defaults",
+        s.version
+    );
+    println!(
+        "S convention: L_o = D ∫ S(ω_i, ω_o) L_i cos θ_i dω_i; angles in degrees, S per RGB channel.\n"
+    );
     s.models.iter().for_each(print_model);
     print_presets(&s.presets);
     print_furnace(s);
@@ -309,7 +332,10 @@ fn print_presets(presets: &[PresetSummary]) {
 }
 
 fn print_furnace(s: &Summary) {
-    println!("== white furnace, Marschner with σ_a = 0: ∫ S_p cos θ_o dω_o by {}", s.furnace_rule);
+    println!(
+        "== white furnace, Marschner with σ_a = 0: ∫ S_p cos θ_o dω_o by {}",
+        s.furnace_rule
+    );
     for r in &s.white_furnace_marschner {
         println!(
             "   θ_i = {:>4.1}°: R {:.5}  TT {:.5}  TRT {:.5}  total {:.5} (twice the panels: {:.5})",
@@ -317,8 +343,12 @@ fn print_furnace(s: &Summary) {
         );
     }
     println!("   (≈ 1 − what leaves after ≥ 2 internal reflections, which the model omits; M_p's");
-    println!("    spread in θ_d moves the total by a few percent either way: Marschner is not exactly");
-    println!("    energy-conserving, see tables/src/marschner/tests.rs white_furnace_energy_per_lobe)\n");
+    println!(
+        "    spread in θ_d moves the total by a few percent either way: Marschner is not exactly"
+    );
+    println!(
+        "    energy-conserving, see tables/src/marschner/tests.rs white_furnace_energy_per_lobe)\n"
+    );
 }
 
 fn print_albedo(rows: &[AlbedoRow]) {
@@ -336,7 +366,10 @@ fn print_albedo(rows: &[AlbedoRow]) {
 }
 
 fn print_srbf(s: &Summary) {
-    println!("== SRBF ∫ exp(λ(cos γ − 1)) dω: closed form 2π(1 − e^(−2λ))/λ vs {}", s.srbf_rule);
+    println!(
+        "== SRBF ∫ exp(λ(cos γ − 1)) dω: closed form 2π(1 − e^(−2λ))/λ vs {}",
+        s.srbf_rule
+    );
     for r in &s.srbf_integral {
         println!(
             "   λ = {:>4}: closed form {:.12}  quadrature {:.12}  rel. diff {:+.2e}",

@@ -145,7 +145,12 @@ pub fn run(args: SweepArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn run_one(sweep: &ModelSweep, samples: u64, seed: u64, bar: &indicatif::ProgressBar) -> ModelResult {
+fn run_one(
+    sweep: &ModelSweep,
+    samples: u64,
+    seed: u64,
+    bar: &indicatif::ProgressBar,
+) -> ModelResult {
     bar.set_message(sweep.name);
     let start = Instant::now();
     let report = chunked_sweep(sweep.name, samples, seed, sweep.chunk, sweep.run, |n| {
@@ -175,7 +180,16 @@ fn print_table(s: &SweepSummary) {
     );
     println!(
         "{:<16} {:>12} {:>14} {:>5} {:>5} {:>5} {:>11} {:>9} {:>9} {:>12}",
-        "model", "samples", "values", "NaN", "Inf", "neg", "max finite", "rejected", "seconds", "samples/s"
+        "model",
+        "samples",
+        "values",
+        "NaN",
+        "Inf",
+        "neg",
+        "max finite",
+        "rejected",
+        "seconds",
+        "samples/s"
     );
     for m in &s.models {
         println!(
@@ -193,7 +207,14 @@ fn print_table(s: &SweepSummary) {
         );
     }
     println!("a sample is: {}", sample_units());
-    println!("{}", if s.clean { "clean: no NaN, Inf or negative value" } else { "NOT CLEAN" });
+    println!(
+        "{}",
+        if s.clean {
+            "clean: no NaN, Inf or negative value"
+        } else {
+            "NOT CLEAN"
+        }
+    );
 }
 
 fn sample_units() -> String {

@@ -244,10 +244,16 @@ mod tests {
         let (samples, seed, chunk) = (10_007u64, 42u64, 1_000u64);
         let mut serial = SweepReport::new("toy");
         for k in 0..samples.div_ceil(chunk) {
-            serial.merge(&toy_sweep(chunk.min(samples - k * chunk), chunk_seed(seed, k)));
+            serial.merge(&toy_sweep(
+                chunk.min(samples - k * chunk),
+                chunk_seed(seed, k),
+            ));
         }
         for threads in [1, 2, 5] {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
             let counted = std::sync::atomic::AtomicU64::new(0);
             let r = pool.install(|| {
                 chunked_sweep("toy", samples, seed, chunk, toy_sweep, |n| {
