@@ -102,18 +102,39 @@ pub fn scaled_bessel_sequence(kappa: f64, n_max: usize) -> Vec<f64> {
 /// φ_k = −π + 2π k/N, such that f(φ) = a₀/2 + Σ aₙ cos nφ (trapezoid rule: exact for
 /// band-limited f, spectrally accurate for smooth f).
 pub fn cosine_coefficients(samples: &[f64], n_max: usize) -> Vec<f64> {
-    let n = samples.len();
-    let scale = 2.0 / n as f64;
-    (0..=n_max)
-        .map(|h| {
-            let mut acc = 0.0;
-            for (k, &s) in samples.iter().enumerate() {
-                let phi = -PI + 2.0 * PI * k as f64 / n as f64;
-                acc += s * (h as f64 * phi).cos();
+    CosineBasis::new(samples.len(), n_max).coefficients(samples)
+}
+
+/// cos(nφ_k) for the sample points φ_k = −π + 2πk/N, computed once per grid.
+struct CosineBasis {
+    samples: usize,
+    /// `table[n * samples + k]` = cos(n φ_k).
+    table: Vec<f64>,
+}
+
+impl CosineBasis {
+    fn new(samples: usize, n_max: usize) -> Self {
+        let mut table = Vec::with_capacity((n_max + 1) * samples);
+        for n in 0..=n_max {
+            for k in 0..samples {
+                let phi = -PI + 2.0 * PI * k as f64 / samples as f64;
+                table.push((n as f64 * phi).cos());
             }
-            acc * scale
-        })
-        .collect()
+        }
+        Self { samples, table }
+    }
+
+    fn phi(&self, k: usize) -> f64 {
+        -PI + 2.0 * PI * k as f64 / self.samples as f64
+    }
+
+    fn coefficients(&self, samples: &[f64]) -> Vec<f64> {
+        let scale = 2.0 / self.samples as f64;
+        self.table
+            .chunks_exact(self.samples)
+            .map(|row| row.iter().zip(samples).map(|(c, s)| c * s).sum::<f64>() * scale)
+            .collect()
+    }
 }
 
 /// Harmonics needed so that the von Mises factor Ĩₙ(κ)/Ĩ₀(κ) ≈ e^{−n²/2κ} of the widest
@@ -137,6 +158,14 @@ where
     let spectra = azimuthal_spectra(s, &theta_rule.nodes, &grid.sin_theta_o, settings.phi_samples, n_max);
 
     let n_o = grid.sin_theta_o.len();
+    let delta_cosines: Vec<Vec<f64>> = grid
+        .cos_delta_phi
+        .iter()
+        .map(|&cd| {
+            let delta = cd.clamp(-1.0, 1.0).acos();
+            (0..=n_max).map(|n| (n as f64 * delta).cos()).collect()
+        })
+        .collect();
     let mut out = vec![[0.0; 3]; grid.len()];
     let block = n_o * grid.cos_delta_phi.len() * grid.lambda.len();
     out.par_chunks_mut(block).enumerate().for_each(|(xi_index, chunk)| {
@@ -145,9 +174,8 @@ where
             let kernel = ThetaKernel::new(&theta_rule, theta_xi, lambda, n_max);
             for o in 0..n_o {
                 let harmonics = kernel.harmonic_sums(&spectra[o], n_max);
-                for (d, &cd) in grid.cos_delta_phi.iter().enumerate() {
-                    let delta = cd.clamp(-1.0, 1.0).acos();
-                    let value = cosine_series(&harmonics, delta).map(|v| 2.0 * PI * v);
+                for (d, cosines) in delta_cosines.iter().enumerate() {
+                    let value = cosine_series(&harmonics, cosines).map(|v| 2.0 * PI * v);
                     chunk[(o * grid.cos_delta_phi.len() + d) * grid.lambda.len() + l] = value;
                 }
             }
@@ -161,6 +189,7 @@ fn azimuthal_spectra<F>(s: &F, theta_i: &[f64], sin_theta_o: &[f64], phi_samples
 where
     F: Fn(&FiberAngles) -> Rgb + Sync,
 {
+    let basis = CosineBasis::new(phi_samples, n_max);
     sin_theta_o
         .par_iter()
         .map(|&so| {
@@ -168,15 +197,14 @@ where
             theta_i
                 .iter()
                 .map(|&ti| {
-                    let samples: Vec<Rgb> = (0..phi_samples)
-                        .map(|k| {
-                            let phi = -PI + 2.0 * PI * k as f64 / phi_samples as f64;
-                            s(&FiberAngles { theta_i: ti, theta_o, phi })
-                        })
-                        .collect();
-                    let per_channel: Vec<Vec<f64>> = (0..3)
-                        .map(|c| cosine_coefficients(&samples.iter().map(|v| v[c]).collect::<Vec<_>>(), n_max))
-                        .collect();
+                    let mut channels = vec![vec![0.0; phi_samples]; 3];
+                    for k in 0..phi_samples {
+                        let v = s(&FiberAngles { theta_i: ti, theta_o, phi: basis.phi(k) });
+                        for c in 0..3 {
+                            channels[c][k] = v[c];
+                        }
+                    }
+                    let per_channel: Vec<Vec<f64>> = channels.iter().map(|ch| basis.coefficients(ch)).collect();
                     (0..=n_max).map(|n| [per_channel[0][n], per_channel[1][n], per_channel[2][n]]).collect()
                 })
                 .collect()
@@ -229,10 +257,10 @@ impl ThetaKernel {
     }
 }
 
-fn cosine_series(harmonics: &[Rgb], delta: f64) -> Rgb {
+/// Σₙ hₙ cos(nΔ), given cos(nΔ) for every n.
+fn cosine_series(harmonics: &[Rgb], cosines: &[f64]) -> Rgb {
     let mut v = [0.0; 3];
-    for (n, h) in harmonics.iter().enumerate() {
-        let c = (n as f64 * delta).cos();
+    for (h, &c) in harmonics.iter().zip(cosines) {
         for k in 0..3 {
             v[k] += h[k] * c;
         }
