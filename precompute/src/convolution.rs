@@ -24,15 +24,15 @@ use strandlight_tables::scattering::Rgb;
 pub struct ConvolutionSettings {
     /// 8-point Gauss–Legendre panels over θ_i ∈ [−π/2, π/2].
     pub theta_panels: usize,
-    /// Samples of S over φ ∈ [−π, π) from which its cosine series is taken.
-    pub phi_samples: usize,
+    /// 8-point Gauss–Legendre panels over φ ∈ [0, π] for the cosine series of S.
+    pub phi_panels: usize,
     /// Harmonics kept; `None` picks enough for the largest λ of the grid.
     pub max_harmonic: Option<usize>,
 }
 
 impl Default for ConvolutionSettings {
     fn default() -> Self {
-        Self { theta_panels: 96, phi_samples: 512, max_harmonic: None }
+        Self { theta_panels: 96, phi_panels: 32, max_harmonic: None }
     }
 }
 
@@ -98,41 +98,39 @@ pub fn scaled_bessel_sequence(kappa: f64, n_max: usize) -> Vec<f64> {
     out
 }
 
-/// Cosine-series coefficients aₙ (n ≤ n_max) of a periodic function sampled at
-/// φ_k = −π + 2π k/N, such that f(φ) = a₀/2 + Σ aₙ cos nφ (trapezoid rule: exact for
-/// band-limited f, spectrally accurate for smooth f).
-pub fn cosine_coefficients(samples: &[f64], n_max: usize) -> Vec<f64> {
-    CosineBasis::new(samples.len(), n_max).coefficients(samples)
+/// Cosine-series coefficients aₙ (n ≤ n_max) of an even 2π-periodic function, such that
+/// f(φ) = a₀/2 + Σ aₙ cos nφ, from aₙ = (2/π) ∫₀^π f(φ) cos nφ dφ by composite Gauss–Legendre
+/// on [0, π]. Kinks of even functions sit at 0 and π (e.g. |cos φ/2|, Marschner's N_R), which
+/// are panel ends here, so they cost no accuracy; the trapezoid rule would alias them as 1/N².
+pub fn cosine_coefficients(f: impl Fn(f64) -> f64, phi_panels: usize, n_max: usize) -> Vec<f64> {
+    let basis = CosineBasis::new(phi_panels, n_max);
+    let samples: Vec<f64> = basis.nodes.iter().map(|&p| f(p)).collect();
+    basis.coefficients(&samples)
 }
 
-/// cos(nφ_k) for the sample points φ_k = −π + 2πk/N, computed once per grid.
+/// Quadrature nodes φ_k on [0, π] and the weights (2/π) w_k cos(nφ_k), computed once per grid.
 struct CosineBasis {
-    samples: usize,
-    /// `table[n * samples + k]` = cos(n φ_k).
+    nodes: Vec<f64>,
+    /// `table[n * nodes.len() + k]`.
     table: Vec<f64>,
 }
 
 impl CosineBasis {
-    fn new(samples: usize, n_max: usize) -> Self {
-        let mut table = Vec::with_capacity((n_max + 1) * samples);
+    fn new(phi_panels: usize, n_max: usize) -> Self {
+        let rule = GaussLegendre::composite(8, phi_panels, 0.0, PI);
+        let mut table = Vec::with_capacity((n_max + 1) * rule.nodes.len());
         for n in 0..=n_max {
-            for k in 0..samples {
-                let phi = -PI + 2.0 * PI * k as f64 / samples as f64;
-                table.push((n as f64 * phi).cos());
+            for (&p, &w) in rule.nodes.iter().zip(&rule.weights) {
+                table.push(2.0 / PI * w * (n as f64 * p).cos());
             }
         }
-        Self { samples, table }
-    }
-
-    fn phi(&self, k: usize) -> f64 {
-        -PI + 2.0 * PI * k as f64 / self.samples as f64
+        Self { nodes: rule.nodes, table }
     }
 
     fn coefficients(&self, samples: &[f64]) -> Vec<f64> {
-        let scale = 2.0 / self.samples as f64;
         self.table
-            .chunks_exact(self.samples)
-            .map(|row| row.iter().zip(samples).map(|(c, s)| c * s).sum::<f64>() * scale)
+            .chunks_exact(self.nodes.len())
+            .map(|row| row.iter().zip(samples).map(|(c, s)| c * s).sum::<f64>())
             .collect()
     }
 }
@@ -153,9 +151,9 @@ where
     let n_max = settings
         .max_harmonic
         .unwrap_or_else(|| harmonics_for(lambda_max))
-        .min(settings.phi_samples / 2 - 1);
+        .min(8 * settings.phi_panels / 2);
     let theta_rule = GaussLegendre::composite(8, settings.theta_panels, -FRAC_PI_2, FRAC_PI_2);
-    let spectra = azimuthal_spectra(s, &theta_rule.nodes, &grid.sin_theta_o, settings.phi_samples, n_max);
+    let spectra = azimuthal_spectra(s, &theta_rule.nodes, &grid.sin_theta_o, settings.phi_panels, n_max);
 
     let n_o = grid.sin_theta_o.len();
     let delta_cosines: Vec<Vec<f64>> = grid
@@ -184,12 +182,14 @@ where
     out
 }
 
-/// aₙ(θ_i, θ_o) per channel: `spectra[o][i][n]`.
-fn azimuthal_spectra<F>(s: &F, theta_i: &[f64], sin_theta_o: &[f64], phi_samples: usize, n_max: usize) -> Vec<Vec<Vec<Rgb>>>
+/// aₙ(θ_i, θ_o) per channel: `spectra[o][i][n]`. S is symmetrized in φ (exact for round
+/// fibers; for eccentric ones the table holds the orientation average of ±φ, which is what a
+/// table indexed by cos Δφ can hold).
+fn azimuthal_spectra<F>(s: &F, theta_i: &[f64], sin_theta_o: &[f64], phi_panels: usize, n_max: usize) -> Vec<Vec<Vec<Rgb>>>
 where
     F: Fn(&FiberAngles) -> Rgb + Sync,
 {
-    let basis = CosineBasis::new(phi_samples, n_max);
+    let basis = CosineBasis::new(phi_panels, n_max);
     sin_theta_o
         .par_iter()
         .map(|&so| {
@@ -197,11 +197,12 @@ where
             theta_i
                 .iter()
                 .map(|&ti| {
-                    let mut channels = vec![vec![0.0; phi_samples]; 3];
-                    for k in 0..phi_samples {
-                        let v = s(&FiberAngles { theta_i: ti, theta_o, phi: basis.phi(k) });
+                    let mut channels = vec![vec![0.0; basis.nodes.len()]; 3];
+                    for (k, &phi) in basis.nodes.iter().enumerate() {
+                        let plus = s(&FiberAngles { theta_i: ti, theta_o, phi });
+                        let minus = s(&FiberAngles { theta_i: ti, theta_o, phi: -phi });
                         for c in 0..3 {
-                            channels[c][k] = v[c];
+                            channels[c][k] = 0.5 * (plus[c] + minus[c]);
                         }
                     }
                     let per_channel: Vec<Vec<f64>> = channels.iter().map(|ch| basis.coefficients(ch)).collect();
@@ -343,18 +344,19 @@ mod tests {
     }
 
     #[test]
-    fn cosine_coefficients_are_exact_for_trigonometric_polynomials() {
-        let n = 64;
-        let samples: Vec<f64> = (0..n)
-            .map(|k| {
-                let p = -PI + 2.0 * PI * k as f64 / n as f64;
-                3.0 + 2.0 * p.cos() - 0.5 * (5.0 * p).cos()
-            })
-            .collect();
-        let a = cosine_coefficients(&samples, 8);
+    fn cosine_coefficients_match_closed_forms() {
+        // A trigonometric polynomial, and |cos φ/2| whose kink at π the trapezoid rule would
+        // alias: its coefficients are aₙ = (4/π)(−1)^{n+1}/(4n² − 1).
+        let a = cosine_coefficients(|p| 3.0 + 2.0 * p.cos() - 0.5 * (5.0 * p).cos(), 8, 8);
         let want = [6.0, 2.0, 0.0, 0.0, 0.0, -0.5, 0.0, 0.0, 0.0];
         for (g, w) in a.iter().zip(want) {
             assert!((g - w).abs() < 1e-13, "{a:?}");
+        }
+        let k = cosine_coefficients(|p| (p / 2.0).cos().abs(), 16, 40);
+        for (n, g) in k.iter().enumerate() {
+            let n = n as f64;
+            let w = 4.0 / PI * (-1f64).powf(n + 1.0) / (4.0 * n * n - 1.0);
+            assert!((g - w).abs() < 1e-12, "n={n}: {g} vs {w}");
         }
     }
 
@@ -366,7 +368,7 @@ mod tests {
             cos_delta_phi: vec![-1.0, -0.2, 0.5, 1.0],
             lambda: vec![16.0, 40.0, 64.0],
         };
-        let settings = ConvolutionSettings { theta_panels: 48, phi_samples: 256, max_harmonic: None };
+        let settings = ConvolutionSettings { theta_panels: 48, phi_panels: 16, max_harmonic: None };
         let fast = convolve_grid(&smooth_s, &grid, &settings);
         let mut worst: f64 = 0.0;
         let mut peak: f64 = 0.0;
