@@ -352,7 +352,7 @@ mod tests {
         for (g, w) in a.iter().zip(want) {
             assert!((g - w).abs() < 1e-13, "{a:?}");
         }
-        let k = cosine_coefficients(|p| (p / 2.0).cos().abs(), 16, 40);
+        let k = cosine_coefficients(|p| (p / 2.0).cos().abs(), 32, 40);
         for (n, g) in k.iter().enumerate() {
             let n = n as f64;
             let w = 4.0 / PI * (-1f64).powf(n + 1.0) / (4.0 * n * n - 1.0);
