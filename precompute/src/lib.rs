@@ -2,3 +2,5 @@
 pub mod convolution;
 pub mod convolution_table;
 pub mod table_check;
+pub mod attenuation_ratio;
+pub mod srbf_spread;
