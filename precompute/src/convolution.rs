@@ -108,6 +108,15 @@ pub fn cosine_coefficients(f: impl Fn(f64) -> f64, phi_panels: usize, n_max: usi
     basis.coefficients(&samples)
 }
 
+/// Cosine series of S(θ_i, θ_o, ·) per channel (symmetrized in φ, as [`convolve_grid`] does).
+pub fn cosine_coefficients_many<F>(s: &F, theta_i: f64, theta_o: f64, phi_panels: usize, n_max: usize) -> Vec<Rgb>
+where
+    F: Fn(&FiberAngles) -> Rgb,
+{
+    let basis = CosineBasis::new(phi_panels, n_max);
+    basis.spectrum(s, theta_i, theta_o)
+}
+
 /// Quadrature nodes φ_k on [0, π] and the weights (2/π) w_k cos(nφ_k), computed once per grid.
 struct CosineBasis {
     nodes: Vec<f64>,
@@ -125,6 +134,20 @@ impl CosineBasis {
             }
         }
         Self { nodes: rule.nodes, table }
+    }
+
+    /// The cosine series of `s` at (θ_i, θ_o), per channel: `[n][c]`.
+    fn spectrum<F: Fn(&FiberAngles) -> Rgb>(&self, s: &F, theta_i: f64, theta_o: f64) -> Vec<Rgb> {
+        let mut channels = vec![vec![0.0; self.nodes.len()]; 3];
+        for (k, &phi) in self.nodes.iter().enumerate() {
+            let plus = s(&FiberAngles { theta_i, theta_o, phi });
+            let minus = s(&FiberAngles { theta_i, theta_o, phi: -phi });
+            for c in 0..3 {
+                channels[c][k] = 0.5 * (plus[c] + minus[c]);
+            }
+        }
+        let per_channel: Vec<Vec<f64>> = channels.iter().map(|ch| self.coefficients(ch)).collect();
+        (0..per_channel[0].len()).map(|n| [per_channel[0][n], per_channel[1][n], per_channel[2][n]]).collect()
     }
 
     fn coefficients(&self, samples: &[f64]) -> Vec<f64> {
@@ -194,21 +217,7 @@ where
         .par_iter()
         .map(|&so| {
             let theta_o = so.clamp(-1.0, 1.0).asin();
-            theta_i
-                .iter()
-                .map(|&ti| {
-                    let mut channels = vec![vec![0.0; basis.nodes.len()]; 3];
-                    for (k, &phi) in basis.nodes.iter().enumerate() {
-                        let plus = s(&FiberAngles { theta_i: ti, theta_o, phi });
-                        let minus = s(&FiberAngles { theta_i: ti, theta_o, phi: -phi });
-                        for c in 0..3 {
-                            channels[c][k] = 0.5 * (plus[c] + minus[c]);
-                        }
-                    }
-                    let per_channel: Vec<Vec<f64>> = channels.iter().map(|ch| basis.coefficients(ch)).collect();
-                    (0..=n_max).map(|n| [per_channel[0][n], per_channel[1][n], per_channel[2][n]]).collect()
-                })
-                .collect()
+            theta_i.iter().map(|&ti| basis.spectrum(s, ti, theta_o)).collect()
         })
         .collect()
 }

@@ -4,3 +4,4 @@ pub mod convolution_table;
 pub mod table_check;
 pub mod attenuation_ratio;
 pub mod srbf_spread;
+pub mod multiple_scattering_table;
