@@ -5,3 +5,4 @@ pub mod table_check;
 pub mod attenuation_ratio;
 pub mod srbf_spread;
 pub mod multiple_scattering_table;
+pub mod bake;
