@@ -192,9 +192,11 @@ where
     out.par_chunks_mut(block).enumerate().for_each(|(xi_index, chunk)| {
         let theta_xi = grid.sin_theta_xi[xi_index].clamp(-1.0, 1.0).asin();
         for (l, &lambda) in grid.lambda.iter().enumerate() {
-            let kernel = ThetaKernel::new(&theta_rule, theta_xi, lambda, n_max);
+            // κ ≤ λ cos θ_ξ: lobes near the fiber's poles need few harmonics.
+            let n_used = n_max.min(harmonics_for(lambda * theta_xi.cos()));
+            let kernel = ThetaKernel::new(&theta_rule, theta_xi, lambda, n_used);
             for o in 0..n_o {
-                let harmonics = kernel.harmonic_sums(&spectra[o], n_max);
+                let harmonics = kernel.harmonic_sums(&spectra[o], n_used);
                 for (d, cosines) in delta_cosines.iter().enumerate() {
                     let value = cosine_series(&harmonics, cosines).map(|v| 2.0 * PI * v);
                     chunk[(o * grid.cos_delta_phi.len() + d) * grid.lambda.len() + l] = value;
@@ -225,7 +227,8 @@ where
 /// The θ_i-dependent part of the integrand for one (θ_ξ, λ): quadrature weight × cos²θ_i ×
 /// longitudinal SRBF factor, and the von Mises harmonics, restricted to nodes that matter.
 struct ThetaKernel {
-    nodes: Vec<(usize, f64, Vec<f64>)>,
+    /// (θ_i node index, W_i εₙ Ĩₙ(κ_i) for n = 0..=n_max).
+    nodes: Vec<(usize, Vec<f64>)>,
 }
 
 impl ThetaKernel {
@@ -245,7 +248,8 @@ impl ThetaKernel {
                 let kappa = lambda * rule.nodes[i].cos() * theta_xi.cos();
                 let mut bessel = scaled_bessel_sequence(kappa.max(0.0), n_max);
                 bessel[0] *= 0.5; // ε₀
-                (i, w, bessel)
+                bessel.iter_mut().for_each(|b| *b *= w);
+                (i, bessel)
             })
             .collect();
         Self { nodes }
@@ -254,12 +258,11 @@ impl ThetaKernel {
     /// Aₙ = Σ_i W_i εₙ Ĩₙ(κ_i) aₙ(θ_i, θ_o) per channel.
     fn harmonic_sums(&self, spectra_o: &[Vec<Rgb>], n_max: usize) -> Vec<Rgb> {
         let mut acc = vec![[0.0; 3]; n_max + 1];
-        for (i, w, bessel) in &self.nodes {
+        for (i, weighted_bessel) in &self.nodes {
             let a = &spectra_o[*i];
-            for n in 0..=n_max {
-                let f = w * bessel[n];
+            for ((acc_n, a_n), f) in acc.iter_mut().zip(a).zip(weighted_bessel) {
                 for c in 0..3 {
-                    acc[n][c] += f * a[n][c];
+                    acc_n[c] += f * a_n[c];
                 }
             }
         }

@@ -5,7 +5,7 @@ use crate::convolution::{convolve_grid, ConvolutionGrid, ConvolutionSettings};
 use serde::{Deserialize, Serialize};
 use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::scattering::Rgb;
-use strandlight_tables::table::{Axis, Table, TableError};
+use strandlight_tables::table::{Axis, AxisMapping, Table, TableError};
 
 pub const AXIS_U_DOT_XI: &str = "u_dot_xi";
 pub const AXIS_U_DOT_WO: &str = "u_dot_wo";
@@ -19,9 +19,9 @@ pub struct ConvolutionResolution {
     pub u_dot_wo: usize,
     pub cos_dphi: usize,
     pub inv_lambda: usize,
-    /// Exponent of the power mapping of the cos Δφ axis, which packs nodes toward cos Δφ = −1
-    /// where the TT lobe lives (1 = the paper's uniform axis; 2 is uniform in angle there).
-    pub cos_dphi_exponent: f64,
+    /// How the direction axes spread their nodes: the paper's uniform steps in u·ξ, u·ω_o and
+    /// cos Δφ, or steps uniform in the angles (denser at grazing angles and near the TT lobe).
+    pub axes: DirectionAxes,
     /// The SRBF bandwidths the table spans.
     pub lambda_min: f64,
     pub lambda_max: f64,
@@ -35,23 +35,45 @@ impl Default for ConvolutionResolution {
             u_dot_wo: 32,
             cos_dphi: 32,
             inv_lambda: 64,
-            cos_dphi_exponent: 1.0,
+            axes: DirectionAxes::Uniform,
             lambda_min: 16.0,
             lambda_max: 64.0,
         }
     }
 }
 
+/// Node placement of the three direction axes of a 4D table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum DirectionAxes {
+    /// Ren 2010: uniform in u·ξ, u·ω_o and cos Δφ.
+    #[default]
+    Uniform,
+    /// Uniform in θ_ξ, θ_o and Δφ (arcsine/arccosine mappings; one asin/acos per lookup).
+    Angular,
+}
+
+impl DirectionAxes {
+    /// The three direction axes (u·ξ, u·ω_o, cos Δφ) with these counts.
+    pub fn build(self, n_xi: usize, n_o: usize, n_phi: usize) -> [Axis; 3] {
+        let (sine, cosine) = match self {
+            DirectionAxes::Uniform => (AxisMapping::Uniform, AxisMapping::Uniform),
+            DirectionAxes::Angular => (AxisMapping::Arcsine, AxisMapping::Arccosine),
+        };
+        [
+            Axis::with_mapping(AXIS_U_DOT_XI, -1.0, 1.0, n_xi, sine),
+            Axis::with_mapping(AXIS_U_DOT_WO, -1.0, 1.0, n_o, sine),
+            Axis::with_mapping(AXIS_COS_DPHI, -1.0, 1.0, n_phi, cosine),
+        ]
+    }
+}
+
 impl ConvolutionResolution {
     pub fn axes(&self) -> Vec<Axis> {
-        let cos_dphi = if self.cos_dphi_exponent == 1.0 {
-            Axis::uniform(AXIS_COS_DPHI, -1.0, 1.0, self.cos_dphi)
-        } else {
-            Axis::power(AXIS_COS_DPHI, -1.0, 1.0, self.cos_dphi, self.cos_dphi_exponent)
-        };
+        let [xi, wo, cos_dphi] = self.axes.build(self.u_dot_xi, self.u_dot_wo, self.cos_dphi);
         vec![
-            Axis::uniform(AXIS_U_DOT_XI, -1.0, 1.0, self.u_dot_xi),
-            Axis::uniform(AXIS_U_DOT_WO, -1.0, 1.0, self.u_dot_wo),
+            xi,
+            wo,
             cos_dphi,
             Axis::uniform(AXIS_INV_LAMBDA, 1.0 / self.lambda_max, 1.0 / self.lambda_min, self.inv_lambda),
         ]

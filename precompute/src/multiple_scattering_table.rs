@@ -32,7 +32,7 @@ pub struct MultipleScatteringResolution {
     pub sigma_f: usize,
     /// Largest forward-scattering spread tabulated (radians); lookups beyond clamp to it.
     pub sigma_f_max: f64,
-    pub cos_dphi_exponent: f64,
+    pub axes: crate::convolution_table::DirectionAxes,
     /// Nodes of the uniform θ_i grid on which H is sampled.
     pub theta_nodes: usize,
     /// Gauss–Legendre panels over φ ∈ [0, π] for the cosine series, and harmonics kept.
@@ -48,7 +48,7 @@ impl Default for MultipleScatteringResolution {
             cos_dphi: 32,
             sigma_f: 64,
             sigma_f_max: 1.0,
-            cos_dphi_exponent: 1.0,
+            axes: Default::default(),
             theta_nodes: 1025,
             phi_panels: 32,
             harmonics: 127,
@@ -58,15 +58,11 @@ impl Default for MultipleScatteringResolution {
 
 impl MultipleScatteringResolution {
     pub fn axes(&self) -> Vec<Axis> {
-        use crate::convolution_table::{AXIS_COS_DPHI, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
+        let [xi, wo, cos_dphi] = self.axes.build(self.u_dot_xi, self.u_dot_wo, self.cos_dphi);
         vec![
-            Axis::uniform(AXIS_U_DOT_XI, -1.0, 1.0, self.u_dot_xi),
-            Axis::uniform(AXIS_U_DOT_WO, -1.0, 1.0, self.u_dot_wo),
-            if self.cos_dphi_exponent == 1.0 {
-                Axis::uniform(AXIS_COS_DPHI, -1.0, 1.0, self.cos_dphi)
-            } else {
-                Axis::power(AXIS_COS_DPHI, -1.0, 1.0, self.cos_dphi, self.cos_dphi_exponent)
-            },
+            xi,
+            wo,
+            cos_dphi,
             Axis::uniform(AXIS_SIGMA_F, 0.0, self.sigma_f_max, self.sigma_f),
         ]
     }
