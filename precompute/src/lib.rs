@@ -1,8 +1,9 @@
 //! Offline precompute: environment maps to SRBF lights, and the convolution tables.
+pub mod attenuation_ratio;
+pub mod bake;
 pub mod convolution;
 pub mod convolution_table;
-pub mod table_check;
-pub mod attenuation_ratio;
-pub mod srbf_spread;
 pub mod multiple_scattering_table;
-pub mod bake;
+pub mod point_light_luts;
+pub mod srbf_spread;
+pub mod table_check;
