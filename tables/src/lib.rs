@@ -23,6 +23,7 @@ pub mod shared_data;
 pub mod slices;
 pub mod special;
 pub mod srbf;
+pub mod sweep;
 pub mod table;
 
 pub use angles::FiberAngles;

@@ -110,12 +110,20 @@ impl Marschner {
         (self.alpha[lobe.index()], self.beta[lobe.index()])
     }
 
-    /// M_p(θ_i, θ_o) (units 1/rad).
+    /// M_p(θ_i, θ_o) as it enters S (units 1/rad), including the energy normalization
+    /// (see [`MarschnerParams::energy_conserving`]).
     pub fn longitudinal(&self, lobe: Lobe, theta_i: f64, theta_o: f64) -> f64 {
         let p = lobe.index();
-        self.params
-            .longitudinal_model
-            .eval(self.beta[p], self.alpha[p], theta_i, theta_o)
+        self.energy_scale()
+            * self
+                .params
+                .longitudinal_model
+                .eval(self.beta[p], self.alpha[p], theta_i, theta_o)
+    }
+
+    /// ½ for the energy-conserving normalization of M_p, 1 for Marschner's published one.
+    pub fn energy_scale(&self) -> f64 {
+        if self.params.energy_conserving { 0.5 } else { 1.0 }
     }
 
     /// N_p(θ_d, φ) per channel (units 1/rad), fibers of random orientation.
@@ -212,9 +220,11 @@ impl LobeDecomposition for Marschner {
         Lobe::from_index(p).map_or((0.0, 0.0), |l| self.shift_width(l))
     }
 
-    /// N_p; a lobe index ≥ 3 scatters nothing.
+    /// N_p, times the energy normalization because the trait's M_p is the unit-area Gaussian
+    /// in θ_h; a lobe index ≥ 3 scatters nothing.
     fn lobe_azimuthal(&self, p: usize, theta_d: f64, phi: f64) -> Rgb {
-        Lobe::from_index(p).map_or([0.0; 3], |l| self.azimuthal(l, theta_d, phi))
+        let k = self.energy_scale();
+        Lobe::from_index(p).map_or([0.0; 3], |l| self.azimuthal(l, theta_d, phi).map(|v| k * v))
     }
 }
 

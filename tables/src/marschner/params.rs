@@ -27,6 +27,11 @@ pub struct MarschnerParams {
     pub beta_deg: [f64; 3],
     /// Gaussian in θ_h (Marschner) or d'Eon 2011's term.
     pub longitudinal_model: LongitudinalModel,
+    /// Marschner 2003 normalizes M_p to unit area over θ_h, so over θ_o (= 2θ_h − θ_i) it has
+    /// area 2 and a white fiber scatters about twice the light it receives. `true` (default)
+    /// halves M_p so a white fiber conserves energy (what dual scattering and the multiple-
+    /// scattering tables need); `false` gives the published scale.
+    pub energy_conserving: bool,
     /// Replace the TRT caustics by glints (Marschner 2003 §4.3, Hunz Algorithm 1).
     pub smooth_caustics: bool,
     /// Azimuthal width w_c of the caustic glints, degrees.
@@ -133,6 +138,7 @@ impl Default for MarschnerParams {
             alpha_deg,
             beta_deg,
             longitudinal_model: LongitudinalModel::Gaussian,
+            energy_conserving: true,
             smooth_caustics: true,
             caustic_width_deg: 15.0,
             glint_scale: 0.5,
