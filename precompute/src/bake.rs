@@ -10,7 +10,7 @@ use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandlight_tables::asset::{read_asset_metadata, write_asset, AssetDescription, AssetError, CreationInfo, Generator, Storage};
-use strandlight_tables::table::{Table, TableError};
+use strandlight_tables::table::Table;
 use thiserror::Error;
 
 /// File extension of baked tables.
@@ -19,7 +19,7 @@ pub const TABLE_EXTENSION: &str = "sltab";
 #[derive(Debug, Error)]
 pub enum BakeError {
     #[error("{table}: {source}")]
-    Table { table: String, source: TableError },
+    Build { table: String, source: Box<dyn std::error::Error + Send + Sync> },
     #[error(transparent)]
     Asset(#[from] AssetError),
     #[error("{table}: the computed table holds {nan} NaN and {inf} infinite values (first at node {first:?}); refusing to write it")]
@@ -27,6 +27,9 @@ pub enum BakeError {
     #[error("cannot create the output folder {}: {source}", .path.display())]
     OutputDir { path: PathBuf, source: std::io::Error },
 }
+
+/// Whatever a table's builder can fail with.
+pub type BuildError = Box<dyn std::error::Error + Send + Sync>;
 
 /// One table to bake.
 pub struct TableJob {
@@ -38,7 +41,7 @@ pub struct TableJob {
     pub fiber_parameters: Value,
     /// Resolution and integration settings: part of the cache key, not of the parameter check.
     pub settings: Value,
-    pub build: Box<dyn FnOnce() -> Result<Table, TableError> + Send>,
+    pub build: Box<dyn FnOnce() -> Result<Table, BuildError> + Send>,
 }
 
 /// What happened to one job.
@@ -92,7 +95,7 @@ pub fn bake_job(job: TableJob, dir: &Path, storage: Storage) -> Result<BakedTabl
         created: CreationInfo::now(),
         inputs_key: Some(key),
     };
-    let table = (job.build)().map_err(|source| BakeError::Table { table: name.into(), source })?;
+    let table = (job.build)().map_err(|source| BakeError::Build { table: name.into(), source })?;
     let stats = table.stats();
     if stats.nan_count + stats.infinite_count > 0 {
         return Err(BakeError::NonFinite {
@@ -119,7 +122,7 @@ mod tests {
             scattering_function: "none".into(),
             fiber_parameters: json!({ "scale": scale }),
             settings: json!({ "n": 5 }),
-            build: Box::new(move || Table::from_fn(vec![Axis::uniform("x", 0.0, 1.0, 5)], 1, move |x, out| out[0] = x[0] as f32 * scale)),
+            build: Box::new(move || Ok(Table::from_fn(vec![Axis::uniform("x", 0.0, 1.0, 5)], 1, move |x, out| out[0] = x[0] as f32 * scale)?)),
         }
     }
 
@@ -145,7 +148,7 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("strandlight-bake-nan-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         let bad = TableJob {
-            build: Box::new(|| Table::from_fn(vec![Axis::uniform("x", 0.0, 1.0, 3)], 1, |x, out| out[0] = if x[0] > 0.7 { f32::NAN } else { 1.0 })),
+            build: Box::new(|| Ok(Table::from_fn(vec![Axis::uniform("x", 0.0, 1.0, 3)], 1, |x, out| out[0] = if x[0] > 0.7 { f32::NAN } else { 1.0 })?)),
             ..job(1.0)
         };
         let err = bake_job(bad, &dir, Storage::F32).unwrap_err();

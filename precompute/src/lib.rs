@@ -7,3 +7,4 @@ pub mod multiple_scattering_table;
 pub mod point_light_luts;
 pub mod srbf_spread;
 pub mod table_check;
+pub mod bake_plan;
