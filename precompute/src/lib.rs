@@ -8,3 +8,4 @@ pub mod point_light_luts;
 pub mod srbf_spread;
 pub mod table_check;
 pub mod bake_plan;
+pub mod check_tables;
