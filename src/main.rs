@@ -1,6 +1,7 @@
 //! `strandlight`: the command-line front end. Parsing, progress and dispatch only; the work
 //! lives in the library crates.
 
+mod fit;
 mod summary;
 
 use clap::{Parser, Subcommand};
@@ -16,11 +17,14 @@ struct Cli {
 enum Command {
     /// Print the fiber models, their default parameters and sample values (the default).
     Summary,
+    /// Fit SRBF lights to an environment map (Ren 2010 §3.1), or the median-cut baseline.
+    Fit(fit::FitArgs),
 }
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command.unwrap_or(Command::Summary) {
         Command::Summary => summary::run(),
+        Command::Fit(args) => fit::run(args),
     }
 }

@@ -1,0 +1,257 @@
+//! The fitted light set as a file: what the runtime loads. JSON (serde), written atomically.
+//!
+//! Directions follow [`crate::envmap`]'s convention (+Y up, image center toward −Z), already
+//! rotated by `options.rotate_degrees`. A lobe's radiance is `amplitude · exp(λ(ω·ξ − 1))`.
+//! For `kind = "directional"` (the median-cut baseline) each light is stored as a very narrow
+//! lobe (λ = [`DIRECTIONAL_LAMBDA`]) whose integral `amplitude · srbf::integral(λ)` is the
+//! light's power (∫ L dω of its region), so one format serves both; a renderer that wants delta
+//! lights uses `power()` and the center.
+
+use crate::envmap::BadPixelCounts;
+use crate::srbf_fit::{FitOptions, RoundRecord};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use strandlight_tables::srbf::{self, SrbfLobe};
+
+pub const FORMAT: &str = "strandlight-srbf-set";
+pub const FORMAT_VERSION: u32 = 1;
+/// Bandwidth that stands for a directional light (support ≈ 2.1°).
+pub const DIRECTIONAL_LAMBDA: f64 = 1.0e4;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LightKind {
+    Srbf,
+    Directional,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SrbfSet {
+    pub format: String,
+    pub version: u32,
+    pub kind: LightKind,
+    pub lobes: Vec<SrbfLobe>,
+    /// The environment map's file name (no directories) and the SHA-256 of its bytes.
+    pub source: String,
+    pub source_sha256: String,
+    pub options: FitOptions,
+    /// Bad pixel values that `--sanitize` replaced (all zero when none were found).
+    pub sanitized: BadPixelCounts,
+    /// Size of the prefiltered grid the errors below are measured on.
+    pub fit_grid: [usize; 2],
+    /// √(Σ w‖fit − map‖² / Σ w‖map‖²) over RGB, w the pixel solid angle, on the fit grid.
+    pub relative_l2_error: f64,
+    /// The paper's criterion: Σ w‖fit − map‖² / Σ w‖map‖² (= relative_l2_error²).
+    pub relative_mse: f64,
+    /// The same relative MSE against the full-resolution map (a sun narrower than the fit
+    /// grid's pixels counts fully here).
+    pub full_resolution_relative_mse: f64,
+    /// ∫ fit dω / ∫ map dω per channel. An L2 fit does not preserve power: a source narrower
+    /// than any allowed lobe is fitted with about twice its power (for a point source the
+    /// optimal lobe carries ∫G/‖G‖² = 2× its power), so sun maps come out too bright overall.
+    pub power_ratio: [f64; 3],
+    /// Relative MSE after each optimization round.
+    pub history: Vec<RoundRecord>,
+    pub seconds: f64,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum SrbfSetError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: not a valid SRBF set: {source}")]
+    Json {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
+    #[error(
+        "{path}: format {format:?} version {version} is not {FORMAT:?} version {FORMAT_VERSION}"
+    )]
+    Version {
+        path: PathBuf,
+        format: String,
+        version: u32,
+    },
+    #[error("{path}: lobe {index} is invalid: {problem}")]
+    BadLobe {
+        path: PathBuf,
+        index: usize,
+        problem: String,
+    },
+}
+
+impl SrbfSet {
+    pub fn save(&self, path: &Path) -> Result<(), SrbfSetError> {
+        let json = serde_json::to_vec_pretty(self).expect("an SrbfSet always serializes");
+        crate::atomic::write(path, &json).map_err(|source| SrbfSetError::Io {
+            path: path.into(),
+            source,
+        })
+    }
+
+    pub fn load(path: &Path) -> Result<SrbfSet, SrbfSetError> {
+        let bytes = std::fs::read(path).map_err(|source| SrbfSetError::Io {
+            path: path.into(),
+            source,
+        })?;
+        let set: SrbfSet = serde_json::from_slice(&bytes).map_err(|source| SrbfSetError::Json {
+            path: path.into(),
+            source,
+        })?;
+        if set.format != FORMAT || set.version != FORMAT_VERSION {
+            return Err(SrbfSetError::Version {
+                path: path.into(),
+                format: set.format,
+                version: set.version,
+            });
+        }
+        for (index, lobe) in set.lobes.iter().enumerate() {
+            let bad = |problem: String| SrbfSetError::BadLobe {
+                path: path.into(),
+                index,
+                problem,
+            };
+            let len = lobe.center().length();
+            if !len.is_finite() || (len - 1.0).abs() > 1e-6 {
+                return Err(bad(format!(
+                    "center {:?} is not a unit vector",
+                    lobe.center
+                )));
+            }
+            if !(lobe.lambda.is_finite() && lobe.lambda > 0.0) {
+                return Err(bad(format!(
+                    "lambda {} must be finite and > 0",
+                    lobe.lambda
+                )));
+            }
+            if lobe.amplitude.iter().any(|a| !a.is_finite() || *a < 0.0) {
+                return Err(bad(format!(
+                    "amplitude {:?} must be finite and ≥ 0",
+                    lobe.amplitude
+                )));
+            }
+        }
+        Ok(set)
+    }
+}
+
+/// ∫ L dω of one lobe, per channel: its power as a light.
+pub fn power(lobe: &SrbfLobe) -> [f64; 3] {
+    lobe.amplitude.map(|a| a * srbf::integral(lobe.lambda))
+}
+
+/// What a light set was made from.
+pub struct Source<'a> {
+    pub map: &'a crate::envmap::EnvMap,
+    /// File name (no directories) or `procedural:NAME`.
+    pub name: String,
+    pub sha256: String,
+    pub sanitized: BadPixelCounts,
+}
+
+/// Lobes back in the map's own frame (undoing `rotate_degrees`), for error checks and previews.
+pub fn unrotated(lobes: &[SrbfLobe], rotate_degrees: f64) -> Vec<SrbfLobe> {
+    lobes
+        .iter()
+        .map(|l| SrbfLobe {
+            center: crate::envmap::rotate_about_up(l.center(), -rotate_degrees).to_array(),
+            ..*l
+        })
+        .collect()
+}
+
+impl SrbfSet {
+    /// Runs the adaptive fit and measures its error independently (direct pixel sums, on the
+    /// fit grid and on the full-resolution map).
+    pub fn fit(
+        source: &Source,
+        options: &FitOptions,
+        progress: &mut dyn FnMut(&RoundRecord),
+    ) -> Result<SrbfSet, crate::srbf_fit::FitError> {
+        let start = std::time::Instant::now();
+        let fit = crate::srbf_fit::fit(source.map, options, progress)?;
+        let seconds = start.elapsed().as_secs_f64();
+        Ok(Self::measured(
+            source,
+            options,
+            LightKind::Srbf,
+            fit.lobes,
+            &fit.grid_map,
+            fit.history,
+            seconds,
+        ))
+    }
+
+    /// The median-cut baseline with `count` directional lights, in the same format.
+    pub fn directional(source: &Source, count: usize, options: &FitOptions) -> SrbfSet {
+        let start = std::time::Instant::now();
+        let lights = crate::median_cut::median_cut(source.map, count.max(1));
+        let norm = srbf::integral(DIRECTIONAL_LAMBDA);
+        let lobes = lights
+            .iter()
+            .map(|l| SrbfLobe {
+                center: crate::envmap::rotate_about_up(l.direction, options.rotate_degrees)
+                    .to_array(),
+                lambda: DIRECTIONAL_LAMBDA,
+                amplitude: l.power.map(|p| p / norm),
+            })
+            .collect();
+        let seconds = start.elapsed().as_secs_f64();
+        let grid = source
+            .map
+            .downsampled(options.grid_width, options.grid_width / 2);
+        Self::measured(
+            source,
+            options,
+            LightKind::Directional,
+            lobes,
+            &grid,
+            Vec::new(),
+            seconds,
+        )
+    }
+
+    fn measured(
+        source: &Source,
+        options: &FitOptions,
+        kind: LightKind,
+        lobes: Vec<SrbfLobe>,
+        grid_map: &crate::envmap::EnvMap,
+        history: Vec<RoundRecord>,
+        seconds: f64,
+    ) -> SrbfSet {
+        use crate::srbf_objective::relative_mse_by_pixels;
+        let own_frame = unrotated(&lobes, options.rotate_degrees);
+        let relative_mse = relative_mse_by_pixels(grid_map, &own_frame);
+        let full_resolution_relative_mse = relative_mse_by_pixels(source.map, &own_frame);
+        let map_power = source.map.integral();
+        let power_ratio = std::array::from_fn(|c| {
+            let fit: f64 = lobes.iter().map(|l| power(l)[c]).sum();
+            if map_power[c] > 0.0 {
+                fit / map_power[c]
+            } else {
+                0.0
+            }
+        });
+        SrbfSet {
+            format: FORMAT.into(),
+            version: FORMAT_VERSION,
+            kind,
+            lobes,
+            source: source.name.clone(),
+            source_sha256: source.sha256.clone(),
+            options: options.clone(),
+            sanitized: source.sanitized,
+            fit_grid: [grid_map.width(), grid_map.height()],
+            relative_l2_error: relative_mse.sqrt(),
+            relative_mse,
+            full_resolution_relative_mse,
+            power_ratio,
+            history,
+            seconds,
+        }
+    }
+}

@@ -1,0 +1,159 @@
+//! `strandlight fit ENVMAP`: environment map in, SRBF lights out (or the median-cut baseline
+//! with `--directional N`). Parsing, progress and printing only; the work is in
+//! `strandlight_precompute`.
+
+use anyhow::{Context, bail};
+use std::path::{Path, PathBuf};
+use strandlight_precompute::envmap_io::{self, LoadOptions};
+use strandlight_precompute::srbf_set::{Source, SrbfSet, unrotated};
+use strandlight_precompute::{FitOptions, preview, procedural_env};
+
+#[derive(clap::Args)]
+pub struct FitArgs {
+    /// A Radiance .hdr or OpenEXR equirectangular map (2:1), or procedural:sun_and_sky /
+    /// procedural:studio.
+    pub envmap: String,
+    /// Stop adding lobes at this count.
+    #[arg(long, default_value_t = 64)]
+    pub max_lobes: usize,
+    /// Lobes placed (by importance) before the first optimization.
+    #[arg(long, default_value_t = 30)]
+    pub initial_lobes: usize,
+    /// Target relative MSE Σw‖fit−map‖²/Σw‖map‖² (the paper's "15%" criterion).
+    #[arg(long, default_value_t = 0.15)]
+    pub target_error: f64,
+    #[arg(long, default_value_t = 16.0)]
+    pub lambda_min: f64,
+    #[arg(long, default_value_t = 64.0)]
+    pub lambda_max: f64,
+    /// Width of the prefiltered grid the fit runs on (height = width/2); λ_max ≤ width²/64.
+    #[arg(long, default_value_t = 256)]
+    pub grid_width: usize,
+    /// Rotate the environment about +Y (up) by this many degrees.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub rotate: f64,
+    /// Replace NaN/negative values by 0 and +Inf by the largest finite value instead of refusing.
+    #[arg(long)]
+    pub sanitize: bool,
+    /// Instead of SRBFs, write N median-cut directional lights (Debevec 2005) for comparison.
+    #[arg(long, value_name = "N")]
+    pub directional: Option<usize>,
+    /// Output file (default: ENVMAP's stem + .srbf.json or .directional-N.json, here).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Write original | reconstruction | |error| side by side as a PNG.
+    #[arg(long, value_name = "FILE.png")]
+    pub preview: Option<PathBuf>,
+    /// Print one JSON object with the result on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+pub fn run(args: FitArgs) -> anyhow::Result<()> {
+    let (map, name, sha256, sanitized) =
+        if let Some(proc_name) = args.envmap.strip_prefix("procedural:") {
+            let Some(map) = procedural_env::by_name(proc_name, 1024) else {
+                bail!(
+                    "unknown procedural environment {proc_name:?} (known: {})",
+                    procedural_env::NAMES.join(", ")
+                );
+            };
+            (map, args.envmap.clone(), String::new(), Default::default())
+        } else {
+            let path = Path::new(&args.envmap);
+            let loaded = envmap_io::load(
+                path,
+                LoadOptions {
+                    sanitize: args.sanitize,
+                },
+            )?;
+            if loaded.sanitized.total() > 0 {
+                eprintln!("{}: sanitized {}", path.display(), loaded.sanitized);
+            }
+            let name = path
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            (loaded.map, name, loaded.sha256, loaded.sanitized)
+        };
+    let options = FitOptions {
+        initial_lobes: args.initial_lobes,
+        max_lobes: args.max_lobes,
+        target_relative_mse: args.target_error,
+        lambda_min: args.lambda_min,
+        lambda_max: args.lambda_max,
+        grid_width: args.grid_width,
+        rotate_degrees: args.rotate,
+        ..FitOptions::default()
+    };
+    let source = Source {
+        map: &map,
+        name: name.clone(),
+        sha256,
+        sanitized,
+    };
+    let set = match args.directional {
+        Some(n) => SrbfSet::directional(&source, n, &options),
+        None => {
+            let bar = indicatif::ProgressBar::new(args.max_lobes as u64);
+            bar.set_style(
+                indicatif::ProgressStyle::with_template(
+                    "{elapsed_precise} [{bar:40}] {pos}/{len} lobes  {msg}",
+                )
+                .expect("valid template"),
+            );
+            let set = SrbfSet::fit(&source, &options, &mut |r| {
+                bar.set_position(r.lobes as u64);
+                bar.set_message(format!("relative MSE {:.4}", r.relative_mse));
+            })?;
+            bar.finish_and_clear();
+            set
+        }
+    };
+    let stem = Path::new(name.trim_start_matches("procedural:"))
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned());
+    let out = args.out.clone().unwrap_or_else(|| {
+        let stem = stem.unwrap_or_else(|| "envmap".into());
+        match args.directional {
+            Some(n) => PathBuf::from(format!("{stem}.directional-{n}.json")),
+            None => PathBuf::from(format!("{stem}.srbf.json")),
+        }
+    });
+    set.save(&out)?;
+    if let Some(png) = &args.preview {
+        preview::write_preview(&map, &unrotated(&set.lobes, args.rotate), 512, png)
+            .with_context(|| format!("writing {}", png.display()))?;
+        eprintln!("preview: {} (tonemap: {})", png.display(), preview::TONEMAP);
+    }
+    eprintln!(
+        "{}: {} {} lights, relative L2 error {:.4}, relative MSE {:.4} (full resolution {:.4}), {:.2} s → {}",
+        name,
+        set.lobes.len(),
+        if args.directional.is_some() {
+            "directional"
+        } else {
+            "SRBF"
+        },
+        set.relative_l2_error,
+        set.relative_mse,
+        set.full_resolution_relative_mse,
+        set.seconds,
+        out.display()
+    );
+    if args.json {
+        let summary = serde_json::json!({
+            "source": set.source,
+            "kind": set.kind,
+            "lobes": set.lobes.len(),
+            "relative_l2_error": set.relative_l2_error,
+            "relative_mse": set.relative_mse,
+            "full_resolution_relative_mse": set.full_resolution_relative_mse,
+            "power_ratio": set.power_ratio,
+            "seconds": set.seconds,
+            "out": out,
+        });
+        println!("{summary}");
+    }
+    Ok(())
+}
