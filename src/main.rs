@@ -3,6 +3,7 @@
 
 mod fit;
 mod summary;
+mod tables_cmd;
 
 use clap::{Parser, Subcommand};
 
@@ -19,6 +20,12 @@ enum Command {
     Summary,
     /// Fit SRBF lights to an environment map (Ren 2010 §3.1), or the median-cut baseline.
     Fit(fit::FitArgs),
+    /// Bake the convolution tables and point-light lookup textures for a fiber.
+    Bake(tables_cmd::BakeArgs),
+    /// Check baked tables against direct f64 integration at random off-grid points.
+    CheckTables(tables_cmd::CheckArgs),
+    /// Describe a baked table; optionally write its tiled slices as PNG and EXR.
+    Inspect(tables_cmd::InspectArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -26,5 +33,8 @@ fn main() -> anyhow::Result<()> {
     match cli.command.unwrap_or(Command::Summary) {
         Command::Summary => summary::run(),
         Command::Fit(args) => fit::run(args),
+        Command::Bake(args) => tables_cmd::bake(args),
+        Command::CheckTables(args) => tables_cmd::check(args),
+        Command::Inspect(args) => tables_cmd::inspect(args),
     }
 }

@@ -10,7 +10,7 @@
 
 use std::f64::consts::PI;
 use strandlight_tables::quadrature::GaussLegendre;
-use strandlight_tables::table::{Axis, Table, TableError};
+use strandlight_tables::table::{Axis, AxisMapping, Table, TableError};
 
 pub const AXIS_NU: &str = "nu";
 pub const AXIS_ABS_SIN_THETA: &str = "abs_sin_theta";
@@ -42,7 +42,8 @@ pub fn attenuation_ratio(nu: f64, sin_theta: f64) -> f64 {
 
 /// The 2D table over (ν ∈ [0, ν_max], |sin θ| ∈ [0, 1]); α is even in θ.
 pub fn attenuation_ratio_table(nu_count: usize, sin_count: usize, nu_max: f64) -> Result<Table, TableError> {
-    let axes = vec![Axis::uniform(AXIS_NU, 0.0, nu_max, nu_count), Axis::uniform(AXIS_ABS_SIN_THETA, 0.0, 1.0, sin_count)];
+    // Uniform in θ: α = cos θ for aligned fibers has an infinite slope in sin θ at the pole.
+    let axes = vec![Axis::uniform(AXIS_NU, 0.0, nu_max, nu_count), Axis::with_mapping(AXIS_ABS_SIN_THETA, 0.0, 1.0, sin_count, AxisMapping::Arcsine)];
     Table::from_fn(axes, 1, |x, out| out[0] = attenuation_ratio(x[0], x[1]) as f32)
 }
 

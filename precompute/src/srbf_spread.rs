@@ -11,7 +11,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use strandlight_tables::angles::{direction, inclination};
 use strandlight_tables::quadrature::GaussLegendre;
 use strandlight_tables::srbf::kernel;
-use strandlight_tables::table::{Axis, Table, TableError};
+use strandlight_tables::table::{Axis, AxisMapping, Table, TableError};
 
 pub const AXIS_ABS_U_DOT_XI: &str = "abs_u_dot_xi";
 pub const AXIS_LAMBDA: &str = "lambda";
@@ -43,7 +43,8 @@ pub fn srbf_longitudinal_variance(sin_theta_xi: f64, lambda: f64) -> f64 {
 /// The 2D table over (|u·ξ| ∈ [0, 1], λ ∈ [λ_min, λ_max]); the variance is even in u·ξ.
 pub fn srbf_spread_table(xi_count: usize, lambda_count: usize, lambda_min: f64, lambda_max: f64) -> Result<Table, TableError> {
     let axes = vec![
-        Axis::uniform(AXIS_ABS_U_DOT_XI, 0.0, 1.0, xi_count),
+        // Uniform in θ_ξ: the variance changes fastest near the pole (|u·ξ| → 1).
+        Axis::with_mapping(AXIS_ABS_U_DOT_XI, 0.0, 1.0, xi_count, AxisMapping::Arcsine),
         Axis::uniform(AXIS_LAMBDA, lambda_min, lambda_max, lambda_count),
     ];
     Table::from_fn(axes, 1, |x, out| out[0] = srbf_longitudinal_variance(x[0], x[1]) as f32)
