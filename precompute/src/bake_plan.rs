@@ -379,6 +379,8 @@ fn push_fiber_averages(jobs: &mut Vec<TableJob>, averages: DualScatteringAverage
 }
 
 fn push_kajiya_kay(jobs: &mut Vec<TableJob>, fiber: &FiberDescription, res: &BakeResolution, settings: ConvolutionSettings) -> Result<(), FiberError> {
+    // Neither integrand depends on φ: only the zeroth harmonic is non-zero, exactly.
+    let settings = ConvolutionSettings { max_harmonic: Some(0), ..settings };
     let kk = Arc::new(KajiyaKay::new(fiber.kajiya_kay).map_err(param_error("[kajiya_kay]"))?);
     let conv = res.convolution;
     let grid_2d = {

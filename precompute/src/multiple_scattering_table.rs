@@ -169,28 +169,33 @@ where
         .collect();
 
     let (n_o, n_d, n_s) = (wos.len(), cds.len(), sigmas.len());
+    // H as a matrix: rows θ_j, columns (o, d, c). For each ξ, all σ̄_f at once are one matrix
+    // product W·H (W: σ̄_f × θ_j weights), which streams H through the cache once per ξ
+    // instead of once per (ξ, σ̄_f).
+    let n_j = theta.len();
+    let h_matrix = nalgebra::DMatrix::from_fn(n_j, n_o * n_d * 3, |j, col| {
+        let (od, c) = (col / 3, col % 3);
+        h[od / n_d][od % n_d][j][c]
+    });
     let mut values = vec![0f32; xis.len() * n_o * n_d * n_s * 3];
     values.par_chunks_mut(n_o * n_d * n_s * 3).zip(&xis).for_each(|(chunk, &sx)| {
         let theta_xi = sx.clamp(-1.0, 1.0).asin();
+        let mut w = nalgebra::DMatrix::<f64>::zeros(n_s, n_j);
+        let mut inv_norm = vec![0.0; n_s];
         for (k, &sigma) in sigmas.iter().enumerate() {
-            let w = gaussian_weights(&theta, theta_xi, sigma);
-            let norm: f64 = w.iter().zip(&theta).map(|(w, t)| w * t.cos()).sum();
+            let weights = gaussian_weights(&theta, theta_xi, sigma);
+            let norm: f64 = weights.iter().zip(&theta).map(|(w, t)| w * t.cos()).sum();
             // Exactly along the fiber with σ̄_f = 0 no light reaches the fiber's cross-section.
-            let inv_norm = if norm > 1e-12 { 1.0 / norm } else { 0.0 };
-            for o in 0..n_o {
-                for d in 0..n_d {
-                    let mut v = [0.0; 3];
-                    for (wj, hj) in w.iter().zip(&h[o][d]) {
-                        if *wj != 0.0 {
-                            for c in 0..3 {
-                                v[c] += wj * hj[c];
-                            }
-                        }
-                    }
-                    let base = ((o * n_d + d) * n_s + k) * 3;
-                    for c in 0..3 {
-                        chunk[base + c] = (v[c] * inv_norm) as f32;
-                    }
+            inv_norm[k] = if norm > 1e-12 { 1.0 / norm } else { 0.0 };
+            for (j, wj) in weights.into_iter().enumerate() {
+                w[(k, j)] = wj;
+            }
+        }
+        let product = w * &h_matrix; // n_s × (o, d, c)
+        for k in 0..n_s {
+            for od in 0..n_o * n_d {
+                for c in 0..3 {
+                    chunk[(od * n_s + k) * 3 + c] = (product[(k, od * 3 + c)] * inv_norm[k]) as f32;
                 }
             }
         }
