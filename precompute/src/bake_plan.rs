@@ -89,6 +89,9 @@ pub struct BakeResolution {
     pub attenuation_nu_max: f64,
     pub srbf_spread: [usize; 2],
     pub fiber_average_thetas: usize,
+    /// Nodes per direction axis of the Kajiya-Kay tables: cheap (at most 3D, monochrome), so
+    /// they get enough nodes to follow the specular lobe (p = 40 is ~9° wide).
+    pub kajiya_kay_direction_nodes: usize,
 }
 
 /// [`ConvolutionSettings`] as it is written into cache keys.
@@ -118,6 +121,7 @@ impl Default for BakeResolution {
             attenuation_nu_max: 1.0,
             srbf_spread: [32, 64],
             fiber_average_thetas: 128,
+            kajiya_kay_direction_nodes: 96,
         }
     }
 }
@@ -132,6 +136,7 @@ impl BakeResolution {
         r.attenuation_ratio = [n, n];
         r.srbf_spread = [n, 2 * n];
         r.fiber_average_thetas = 4 * n;
+        r.kajiya_kay_direction_nodes = 3 * n;
         r.settings = ConvolutionSettingsSerde { theta_panels: 48, phi_panels: 16 };
         r
     }
@@ -382,7 +387,8 @@ fn push_kajiya_kay(jobs: &mut Vec<TableJob>, fiber: &FiberDescription, res: &Bak
     // Neither integrand depends on φ: only the zeroth harmonic is non-zero, exactly.
     let settings = ConvolutionSettings { max_harmonic: Some(0), ..settings };
     let kk = Arc::new(KajiyaKay::new(fiber.kajiya_kay).map_err(param_error("[kajiya_kay]"))?);
-    let conv = res.convolution;
+    let n = res.kajiya_kay_direction_nodes;
+    let conv = ConvolutionResolution { u_dot_xi: n, u_dot_wo: n, ..res.convolution };
     let grid_2d = {
         let axes = conv.axes();
         ConvolutionGrid {
