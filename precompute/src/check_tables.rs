@@ -187,7 +187,12 @@ fn compare(asset: &TableAsset, name: &str, reference: &Reference, points: &[Vec<
         max_rel_error: max_rel,
         samples: points.len(),
         worst_point: worst,
-    })
+        table_max: scale,
+        table_p999: 0.0,
+        max_abs_error_p999: 0.0,
+        rms_abs_error_p999: 0.0,
+    }
+    .with_percentile(table))
 }
 
 fn section<T: serde::de::DeserializeOwned + Default>(params: &Value, key: &str) -> Result<T, String> {

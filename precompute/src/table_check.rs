@@ -24,9 +24,40 @@ pub struct TableAccuracy {
     pub samples: usize,
     /// The worst point, as (u·ξ, u·ω_o, cos Δφ, 1/λ).
     pub worst_point: [f64; 4],
+    /// max |value| of the table, the scale of the errors above.
+    pub table_max: f64,
+    /// The 99.9th percentile of |value|; where a corner singularity of the model makes the
+    /// maximum unrepresentative (I_G at u·ξ = −u·ω_o = ±1), errors relative to it say more.
+    pub table_p999: f64,
+    /// `max_abs_error` and `rms_abs_error` rescaled to the 99.9th percentile.
+    pub max_abs_error_p999: f64,
+    pub rms_abs_error_p999: f64,
 }
 
-/// A deterministic stratified point set over the table's domain: u·ξ and u·ω_o stratified in
+/// The 99.9th percentile of |v| over a table's values.
+pub fn percentile_999(values: &[f32]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let mut a: Vec<f32> = values.iter().map(|v| v.abs()).collect();
+    let k = ((a.len() - 1) as f64 * 0.999).round() as usize;
+    let (_, v, _) = a.select_nth_unstable_by(k, f32::total_cmp);
+    *v as f64
+}
+
+impl TableAccuracy {
+    /// Fills the percentile-relative fields from the max-relative ones.
+    pub fn with_percentile(mut self, table: &Table) -> Self {
+        self.table_p999 = percentile_999(table.values());
+        let ratio = if self.table_p999 > 0.0 { self.table_max / self.table_p999 } else { 1.0 };
+        self.max_abs_error_p999 = self.max_abs_error * ratio;
+        self.rms_abs_error_p999 = self.rms_abs_error * ratio;
+        self
+    }
+}
+
+/// A deterministic stratified point set over the table's domain, 10% of it on the domain's
+/// hard edges (u·ξ or u·ω_o = ±1, λ at a bound): u·ξ and u·ω_o stratified in
 /// the sine (so grazing ±1 ends get their share), Δφ stratified in angle (so the TT region near
 /// π is sampled as densely as the rest), 1/λ uniform. `lambda` spans [λ_min, λ_max].
 pub fn stratified_points(count: usize, lambda_min: f64, lambda_max: f64, seed: u64) -> Vec<[f64; 4]> {
@@ -34,11 +65,21 @@ pub fn stratified_points(count: usize, lambda_min: f64, lambda_max: f64, seed: u
     (0..count)
         .map(|k| {
             let stratum = (k as f64 + rng.unit()) / count as f64;
-            let sx = -1.0 + 2.0 * rng.unit();
-            let so = -1.0 + 2.0 * rng.unit();
+            let mut sx = -1.0 + 2.0 * rng.unit();
+            let mut so = -1.0 + 2.0 * rng.unit();
             // Cycle strata over the Δφ axis, the one whose lobes are narrowest.
             let delta = PI * stratum;
-            let inv = 1.0 / lambda_max + (1.0 / lambda_min - 1.0 / lambda_max) * rng.unit();
+            let mut inv = 1.0 / lambda_max + (1.0 / lambda_min - 1.0 / lambda_max) * rng.unit();
+            // One point in ten sits on a hard edge of the domain: ξ or ω_o along the fiber
+            // (u·ξ, u·ω_o = ±1) or λ at either bound.
+            let sign = if k % 20 < 10 { 1.0 } else { -1.0 };
+            match k % 10 {
+                0 => sx = sign,
+                1 => so = sign,
+                2 => inv = 1.0 / lambda_max,
+                3 => inv = 1.0 / lambda_min,
+                _ => {}
+            }
             [sx, so, delta.cos(), inv]
         })
         .collect()
@@ -91,7 +132,12 @@ where
         max_rel_error: max_rel,
         samples: points.len(),
         worst_point: worst,
-    })
+        table_max: scale,
+        table_p999: 0.0,
+        max_abs_error_p999: 0.0,
+        rms_abs_error_p999: 0.0,
+    }
+    .with_percentile(table))
 }
 
 /// Re-export for callers that build points themselves.
