@@ -4,6 +4,7 @@
 mod fit;
 mod summary;
 mod sweep;
+mod tables_cmd;
 
 use clap::{Parser, Subcommand};
 
@@ -22,6 +23,12 @@ enum Command {
     Fit(fit::FitArgs),
     /// Hard-case sweep of every fiber model (NaN/Inf/negative counts), in parallel.
     Sweep(sweep::SweepArgs),
+    /// Bake the convolution tables and point-light lookup textures for a fiber.
+    Bake(tables_cmd::BakeArgs),
+    /// Check baked tables against direct f64 integration at random off-grid points.
+    CheckTables(tables_cmd::CheckArgs),
+    /// Describe a baked table; optionally write its tiled slices as PNG and EXR.
+    Inspect(tables_cmd::InspectArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -31,5 +38,8 @@ fn main() -> anyhow::Result<()> {
         Command::Summary(args) => summary::run(args),
         Command::Fit(args) => fit::run(args),
         Command::Sweep(args) => sweep::run(args),
+        Command::Bake(args) => tables_cmd::bake(args),
+        Command::CheckTables(args) => tables_cmd::check(args),
+        Command::Inspect(args) => tables_cmd::inspect(args),
     }
 }

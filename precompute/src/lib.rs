@@ -3,14 +3,26 @@
 //! Environment input: [`envmap`] (the in-memory map and THE direction convention),
 //! [`envmap_io`] (files), [`radiance_hdr`], [`procedural_env`]. Lights: [`srbf_fit`] (the
 //! adaptive SRBF fit), [`median_cut`] (the directional baseline), [`srbf_set`] (the file the
-//! runtime reads), [`preview`] (a picture of what the fit lost). Tables:
-//! [`point_light_luts`] (Hunz Algorithm 2).
+//! runtime reads), [`preview`] (a picture of what the fit lost).
+//!
+//! Tables: [`convolution`] (the SRBF–fiber convolution engine and its brute-force reference),
+//! [`convolution_table`] (I_M, I_A, I_d, I_s as tables), [`multiple_scattering_table`] (I_G),
+//! [`attenuation_ratio`], [`srbf_spread`], [`point_light_luts`] (Hunz Algorithm 2),
+//! [`bake_plan`] (which tables a fiber needs), [`bake`] (assets and the cache),
+//! [`table_check`] and [`check_tables`] (accuracy against f64 references).
 
 pub mod atomic;
+pub mod attenuation_ratio;
+pub mod bake;
+pub mod bake_plan;
+pub mod check_tables;
+pub mod convolution;
+pub mod convolution_table;
 pub mod envmap;
 pub mod envmap_error;
 pub mod envmap_io;
 pub mod median_cut;
+pub mod multiple_scattering_table;
 pub mod nnls;
 pub mod point_light_luts;
 pub mod preview;
@@ -19,6 +31,8 @@ pub mod radiance_hdr;
 pub mod srbf_fit;
 pub mod srbf_objective;
 pub mod srbf_set;
+pub mod srbf_spread;
+pub mod table_check;
 
 pub use envmap::EnvMap;
 pub use envmap_error::EnvMapError;

@@ -1,0 +1,159 @@
+//! Baking: turns table jobs into asset files, skipping those whose inputs are unchanged.
+//!
+//! Each job names its table, the fiber parameters and the settings that determine its values;
+//! their SHA-256 is the job's `inputs_key`, stored in the asset. A re-bake whose key matches the
+//! file on disk is skipped (a content-addressed cache), and any change rebakes.
+
+use serde::Serialize;
+use serde_json::{json, Value};
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use strandlight_tables::asset::{read_asset_metadata, write_asset, AssetDescription, AssetError, CreationInfo, Generator, Storage};
+use strandlight_tables::table::Table;
+use thiserror::Error;
+
+/// File extension of baked tables.
+pub const TABLE_EXTENSION: &str = "sltab";
+
+#[derive(Debug, Error)]
+pub enum BakeError {
+    #[error("{table}: {source}")]
+    Build { table: String, source: Box<dyn std::error::Error + Send + Sync> },
+    #[error(transparent)]
+    Asset(#[from] AssetError),
+    #[error("{table}: the computed table holds {nan} NaN and {inf} infinite values (first at node {first:?}); refusing to write it")]
+    NonFinite { table: String, nan: usize, inf: usize, first: Option<Vec<usize>> },
+    #[error("cannot create the output folder {}: {source}", .path.display())]
+    OutputDir { path: PathBuf, source: std::io::Error },
+}
+
+/// Whatever a table's builder can fail with.
+pub type BuildError = Box<dyn std::error::Error + Send + Sync>;
+
+/// One table to bake.
+pub struct TableJob {
+    /// File and report name (`marschner`, `kk_diffuse`, …).
+    pub name: &'static str,
+    pub quantity: String,
+    pub scattering_function: String,
+    /// The model parameters the table depends on; the runtime checks them.
+    pub fiber_parameters: Value,
+    /// Resolution and integration settings: part of the cache key, not of the parameter check.
+    pub settings: Value,
+    pub build: Box<dyn FnOnce() -> Result<Table, BuildError> + Send>,
+}
+
+/// What happened to one job.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct BakedTable {
+    pub name: String,
+    pub path: PathBuf,
+    pub bytes: u64,
+    pub seconds: f64,
+    /// True when an existing file with the same inputs was kept.
+    pub cached: bool,
+    pub max_value: f32,
+}
+
+impl TableJob {
+    pub fn inputs_key(&self) -> String {
+        let inputs = json!({
+            "name": self.name,
+            "scattering_function": self.scattering_function,
+            "fiber_parameters": self.fiber_parameters,
+            "settings": self.settings,
+            "generator": env!("CARGO_PKG_VERSION"),
+        });
+        Sha256::digest(inputs.to_string().as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
+    }
+}
+
+pub fn table_path(dir: &Path, name: &str) -> PathBuf {
+    dir.join(format!("{name}.{TABLE_EXTENSION}"))
+}
+
+/// Bakes `job` into `dir` unless a file with the same inputs is already there.
+pub fn bake_job(job: TableJob, dir: &Path, storage: Storage) -> Result<BakedTable, BakeError> {
+    std::fs::create_dir_all(dir).map_err(|source| BakeError::OutputDir { path: dir.to_path_buf(), source })?;
+    let path = table_path(dir, job.name);
+    let key = job.inputs_key();
+    let start = Instant::now();
+    if let Ok(existing) = read_asset_metadata(&path) {
+        if existing.description.inputs_key.as_deref() == Some(key.as_str()) && existing.payload.storage == storage {
+            let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+            return Ok(BakedTable { name: job.name.into(), path, bytes, seconds: start.elapsed().as_secs_f64(), cached: true, max_value: f32::NAN });
+        }
+    }
+    let name = job.name;
+    let description = AssetDescription {
+        name: name.into(),
+        quantity: job.quantity.clone(),
+        scattering_function: job.scattering_function.clone(),
+        fiber_parameters: job.fiber_parameters.clone(),
+        generator: Generator { name: "strandlight bake".into(), version: env!("CARGO_PKG_VERSION").into() },
+        created: CreationInfo::now(),
+        inputs_key: Some(key),
+    };
+    let table = (job.build)().map_err(|source| BakeError::Build { table: name.into(), source })?;
+    let stats = table.stats();
+    if stats.nan_count + stats.infinite_count > 0 {
+        return Err(BakeError::NonFinite {
+            table: name.into(),
+            nan: stats.nan_count,
+            inf: stats.infinite_count,
+            first: stats.first_non_finite.map(|(node, _channel)| node),
+        });
+    }
+    write_asset(&path, &table, &description, storage)?;
+    let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
+    Ok(BakedTable { name: name.into(), path, bytes, seconds: start.elapsed().as_secs_f64(), cached: false, max_value: stats.max })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use strandlight_tables::table::Axis;
+
+    fn job(scale: f32) -> TableJob {
+        TableJob {
+            name: "test_table",
+            quantity: "x·scale".into(),
+            scattering_function: "none".into(),
+            fiber_parameters: json!({ "scale": scale }),
+            settings: json!({ "n": 5 }),
+            build: Box::new(move || Ok(Table::from_fn(vec![Axis::uniform("x", 0.0, 1.0, 5)], 1, move |x, out| out[0] = x[0] as f32 * scale)?)),
+        }
+    }
+
+    #[test]
+    fn unchanged_inputs_are_cached_and_changed_ones_rebake() {
+        let dir = std::env::temp_dir().join(format!("strandlight-bake-test-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let first = bake_job(job(2.0), &dir, Storage::F32).unwrap();
+        assert!(!first.cached);
+        let again = bake_job(job(2.0), &dir, Storage::F32).unwrap();
+        assert!(again.cached, "same inputs must be served from the file");
+        let changed = bake_job(job(3.0), &dir, Storage::F32).unwrap();
+        assert!(!changed.cached, "new parameters must rebake");
+        let asset = strandlight_tables::asset::read_asset(&first.path).unwrap();
+        assert_eq!(asset.table.lookup_scalar(&[1.0]).unwrap(), 3.0);
+        let other_storage = bake_job(job(3.0), &dir, Storage::F16).unwrap();
+        assert!(!other_storage.cached);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn non_finite_tables_are_refused_and_leave_no_file() {
+        let dir = std::env::temp_dir().join(format!("strandlight-bake-nan-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let bad = TableJob {
+            build: Box::new(|| Ok(Table::from_fn(vec![Axis::uniform("x", 0.0, 1.0, 3)], 1, |x, out| out[0] = if x[0] > 0.7 { f32::NAN } else { 1.0 })?)),
+            ..job(1.0)
+        };
+        let err = bake_job(bad, &dir, Storage::F32).unwrap_err();
+        assert!(matches!(err, BakeError::NonFinite { nan: 1, .. }), "{err}");
+        assert!(!table_path(&dir, "test_table").exists());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,488 @@
+//! What to bake for a fiber: the table jobs of each model (Ren 2010 §4, §6; Hunz §3.3.4), and
+//! the decision to skip multiple scattering for hair too dark to need it.
+
+use crate::attenuation_ratio::attenuation_ratio_table;
+use crate::bake::{BuildError, TableJob};
+use crate::convolution::{convolve_grid, ConvolutionGrid, ConvolutionSettings};
+use crate::convolution_table::{bake_convolution_table, ConvolutionResolution};
+use crate::multiple_scattering_table::{bake_multiple_scattering_table, MultipleScatteringResolution};
+use crate::point_light_luts::{bake_lut_m, bake_lut_n, LutResolution};
+use crate::srbf_spread::srbf_spread_table;
+use serde::{Deserialize, Serialize};
+use serde_json::json;
+use std::path::Path;
+use std::sync::Arc;
+use strandlight_tables::artist::{ArtistModel, ArtistParams, Normalization};
+use strandlight_tables::dual_scattering::{DualScatteringAverages, DualScatteringBcsdf, DualScatteringConfig, LobeDecomposition};
+use strandlight_tables::error::ParamError;
+use strandlight_tables::kajiya_kay::{KajiyaKay, KajiyaKayParams};
+use strandlight_tables::marschner::{Marschner, MarschnerParams};
+use strandlight_tables::scattering::{Rgb, ScatteringFunction};
+use strandlight_tables::table::{Axis, AxisMapping, Table};
+use strandlight_tables::FiberAngles;
+use thiserror::Error;
+
+/// Everything about a fiber that any table depends on. A TOML file with any subset of these
+/// sections (`[marschner]`, `[kajiya_kay]`, `[artist]`, `[dual_scattering]`); the rest default.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct FiberDescription {
+    pub marschner: MarschnerParams,
+    pub kajiya_kay: KajiyaKayParams,
+    pub artist: ArtistParams,
+    pub dual_scattering: DualScatteringConfig,
+}
+
+#[derive(Debug, Error)]
+pub enum FiberError {
+    #[error("{}: {source}", .path.display())]
+    Read { path: std::path::PathBuf, source: std::io::Error },
+    #[error("{}: not a valid fiber description: {message}", .path.display())]
+    Parse { path: std::path::PathBuf, message: String },
+    #[error("{context}: {source}")]
+    Param { context: String, source: ParamError },
+}
+
+impl FiberDescription {
+    /// The defaults with the Marschner absorption of a named melanin preset.
+    pub fn preset(name: &str) -> Result<Self, FiberError> {
+        let marschner = MarschnerParams::with_preset(name).map_err(|source| FiberError::Param { context: "--preset".into(), source })?;
+        Ok(Self { marschner, ..Self::default() })
+    }
+
+    pub fn from_toml_file(path: &Path) -> Result<Self, FiberError> {
+        let text = std::fs::read_to_string(path).map_err(|source| FiberError::Read { path: path.into(), source })?;
+        let fiber: Self = toml::from_str(&text).map_err(|e| FiberError::Parse { path: path.into(), message: e.to_string() })?;
+        fiber.validate().map_err(|e| match e {
+            FiberError::Param { context, source } => FiberError::Param { context: format!("{}: {context}", path.display()), source },
+            other => other,
+        })?;
+        Ok(fiber)
+    }
+
+    pub fn validate(&self) -> Result<(), FiberError> {
+        self.marschner.validate().map_err(param_error("[marschner]"))?;
+        self.kajiya_kay.validate().map_err(param_error("[kajiya_kay]"))?;
+        self.artist.validate().map_err(param_error("[artist]"))?;
+        self.dual_scattering.validate().map_err(param_error("[dual_scattering]"))?;
+        Ok(())
+    }
+}
+
+/// The scattering models a bake can cover.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Model {
+    Marschner,
+    KajiyaKay,
+    Artist,
+}
+
+/// Node counts of every table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BakeResolution {
+    pub convolution: ConvolutionResolution,
+    pub settings: ConvolutionSettingsSerde,
+    pub multiple: MultipleScatteringResolution,
+    pub luts: LutResolution,
+    pub attenuation_ratio: [usize; 2],
+    pub attenuation_nu_max: f64,
+    pub srbf_spread: [usize; 2],
+    pub fiber_average_thetas: usize,
+    /// Nodes per direction axis of the Kajiya-Kay tables: cheap (at most 3D, monochrome), so
+    /// they get enough nodes to follow the specular lobe (p = 40 is ~9° wide).
+    pub kajiya_kay_direction_nodes: usize,
+}
+
+/// [`ConvolutionSettings`] as it is written into cache keys.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ConvolutionSettingsSerde {
+    pub theta_panels: usize,
+    pub phi_panels: usize,
+}
+
+impl From<ConvolutionSettingsSerde> for ConvolutionSettings {
+    fn from(s: ConvolutionSettingsSerde) -> Self {
+        Self { theta_panels: s.theta_panels, phi_panels: s.phi_panels, max_harmonic: None }
+    }
+}
+
+impl Default for BakeResolution {
+    /// The paper's sample counts (32 per direction axis, 64 for λ and σ̄_f) on angular axes.
+    fn default() -> Self {
+        let convolution = ConvolutionResolution { axes: crate::convolution_table::DirectionAxes::Angular, ..Default::default() };
+        let d = ConvolutionSettings::default();
+        Self {
+            convolution,
+            settings: ConvolutionSettingsSerde { theta_panels: d.theta_panels, phi_panels: d.phi_panels },
+            multiple: MultipleScatteringResolution { axes: crate::convolution_table::DirectionAxes::Angular, ..Default::default() },
+            luts: LutResolution::default(),
+            attenuation_ratio: [32, 32],
+            attenuation_nu_max: 1.0,
+            srbf_spread: [32, 64],
+            fiber_average_thetas: 128,
+            kajiya_kay_direction_nodes: 96,
+        }
+    }
+}
+
+impl BakeResolution {
+    /// Every direction axis with `n` nodes, λ and σ̄_f with `2n`: for quick runs and CI.
+    pub fn reduced(n: usize) -> Self {
+        let mut r = Self::default();
+        r.convolution = ConvolutionResolution { u_dot_xi: n, u_dot_wo: n, cos_dphi: n, inv_lambda: 2 * n, ..r.convolution };
+        r.multiple = MultipleScatteringResolution { u_dot_xi: n, u_dot_wo: n, cos_dphi: n, sigma_f: 2 * n, theta_nodes: 513, ..r.multiple };
+        r.luts = LutResolution::square(4 * n);
+        r.attenuation_ratio = [n, n];
+        r.srbf_spread = [n, 2 * n];
+        r.fiber_average_thetas = 4 * n;
+        r.kajiya_kay_direction_nodes = 3 * n;
+        r.settings = ConvolutionSettingsSerde { theta_panels: 48, phi_panels: 16 };
+        r
+    }
+
+    /// Spans only the SRBF bandwidths actually used (with a margin), not the global bounds.
+    pub fn with_lambda_range(mut self, lambda_min: f64, lambda_max: f64) -> Self {
+        self.convolution.lambda_min = lambda_min;
+        self.convolution.lambda_max = lambda_max;
+        self
+    }
+}
+
+/// What the plan decided not to bake, and why.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct SkippedTable {
+    pub name: String,
+    pub reason: String,
+}
+
+/// The jobs for `models`, plus the tables skipped.
+pub struct BakePlan {
+    pub jobs: Vec<TableJob>,
+    pub skipped: Vec<SkippedTable>,
+    /// The direction-averaged single-event albedo ā_f + ā_b of the brightest channel: the
+    /// share of the scattered energy that goes on to scatter again (the multiple-scattering
+    /// share in a dense volume).
+    pub multiple_scattering_share: Option<f64>,
+}
+
+/// Below this multiple-scattering share the `multiple` table is skipped unless forced.
+pub const DEFAULT_MULTIPLE_THRESHOLD: f64 = 0.15;
+
+#[derive(Debug, Clone)]
+pub struct PlanOptions {
+    pub models: Vec<Model>,
+    pub resolution: BakeResolution,
+    pub force_multiple: bool,
+    pub multiple_threshold: f64,
+}
+
+impl Default for PlanOptions {
+    fn default() -> Self {
+        Self { models: vec![Model::Marschner, Model::KajiyaKay, Model::Artist], resolution: BakeResolution::default(), force_multiple: false, multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD }
+    }
+}
+
+fn boxed<E: std::error::Error + Send + Sync + 'static>(e: E) -> BuildError {
+    Box::new(e)
+}
+
+fn param_error(context: &'static str) -> impl Fn(ParamError) -> FiberError {
+    move |source| FiberError::Param { context: context.into(), source }
+}
+
+/// Builds the list of jobs. Cheap: every table is computed only when its job runs.
+pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan, FiberError> {
+    fiber.validate()?;
+    let res = options.resolution.clone();
+    let settings: ConvolutionSettings = res.settings.into();
+    let conv_settings = json!({ "resolution": res.convolution, "settings": res.settings });
+    let mut jobs = Vec::new();
+    let mut skipped = Vec::new();
+    let mut share = None;
+
+    // The physical model whose BCSDF multiple scattering uses: Marschner if baked, else the
+    // artist model's normalized copy (Sadeghi eq. 13).
+    let mut multiple_source: Option<(Arc<dyn ScatteringFunction>, DualScatteringAverages, serde_json::Value, &'static str)> = None;
+
+    if options.models.contains(&Model::Marschner) {
+        let m = Arc::new(Marschner::new(fiber.marschner.clone()).map_err(param_error("[marschner]"))?);
+        let params = json!({ "marschner": fiber.marschner });
+        let s = m.clone();
+        jobs.push(TableJob {
+            name: "marschner",
+            quantity: "I_M: ∫ G(ω_i; ξ, λ) S(ω_i, ω_o) cos θ_i dω_i, Marschner single scattering (Ren eq. 8), RGB".into(),
+            scattering_function: "marschner".into(),
+            fiber_parameters: params.clone(),
+            settings: conv_settings.clone(),
+            build: Box::new(move || Ok(bake_convolution_table(&|a: &FiberAngles| s.eval(a), &res.convolution, &settings)?)),
+        });
+        let averages = DualScatteringAverages::new(m.as_ref() as &dyn LobeDecomposition, fiber.dual_scattering).map_err(param_error("[marschner] dual-scattering averages"))?;
+        let full_params = json!({ "marschner": fiber.marschner, "dual_scattering": fiber.dual_scattering });
+        let bcsdf = Arc::new(DualScatteringBcsdf { single: (*m).clone(), averages: averages.clone() });
+        let b = bcsdf.clone();
+        let r2 = options.resolution.clone();
+        jobs.push(TableJob {
+            name: "marschner_full",
+            quantity: "I_M with d_b·S_back: ∫ G (S + d_b S_back) cos θ_i dω_i (Ren §7), RGB".into(),
+            scattering_function: "marschner+dual-scattering-back".into(),
+            fiber_parameters: full_params.clone(),
+            settings: conv_settings.clone(),
+            build: Box::new(move || Ok(bake_convolution_table(&|a: &FiberAngles| b.eval(a), &r2.convolution, &settings)?)),
+        });
+        push_fiber_averages(&mut jobs, averages.clone(), full_params.clone(), options.resolution.fiber_average_thetas);
+        let (mm, mn) = (m.clone(), m.clone());
+        let (luts_m, luts_n) = (options.resolution.luts, options.resolution.luts);
+        jobs.push(TableJob {
+            name: "lut_m",
+            quantity: "Hunz Alg. 2 M texture: M_R, M_TT, M_TRT, cos θ_d over (sin θ_i, sin θ_o)".into(),
+            scattering_function: "marschner".into(),
+            fiber_parameters: params.clone(),
+            settings: json!({ "luts": luts_m }),
+            build: Box::new(move || bake_lut_m(&mm, &luts_m).map_err(boxed)),
+        });
+        jobs.push(TableJob {
+            name: "lut_n",
+            quantity: "Hunz Alg. 2 N texture: N_R, N_TT, N_TRT over (cos φ, cos θ_d), RGB".into(),
+            scattering_function: "marschner".into(),
+            fiber_parameters: params,
+            settings: json!({ "luts": luts_n }),
+            build: Box::new(move || bake_lut_n(&mn, &luts_n).map_err(boxed)),
+        });
+        multiple_source = Some((m as Arc<dyn ScatteringFunction>, averages, full_params, "marschner"));
+    }
+
+    if options.models.contains(&Model::KajiyaKay) {
+        push_kajiya_kay(&mut jobs, fiber, &options.resolution, settings)?;
+    }
+
+    if options.models.contains(&Model::Artist) {
+        let a = Arc::new(ArtistModel::new(fiber.artist).map_err(param_error("[artist]"))?);
+        let s = a.clone();
+        let r = options.resolution.clone();
+        jobs.push(TableJob {
+            name: "artist",
+            quantity: "I_A: ∫ G(ω_i; ξ, λ) f'_s(ω_i, ω_o) cos θ_i dω_i, artist-friendly model (Sadeghi eq. 12), RGB".into(),
+            scattering_function: "artist".into(),
+            fiber_parameters: json!({ "artist": fiber.artist }),
+            settings: conv_settings.clone(),
+            build: Box::new(move || Ok(bake_convolution_table(&|x: &FiberAngles| s.eval(x), &r.convolution, &settings)?)),
+        });
+        if multiple_source.is_none() {
+            let normalized = a.normalized(Normalization::PeakPerChannel);
+            let averages = DualScatteringAverages::new(&normalized as &dyn LobeDecomposition, fiber.dual_scattering).map_err(param_error("[artist] dual-scattering averages"))?;
+            let params = json!({ "artist": fiber.artist, "dual_scattering": fiber.dual_scattering, "normalization": "peak-per-channel" });
+            push_fiber_averages(&mut jobs, averages.clone(), params.clone(), options.resolution.fiber_average_thetas);
+            multiple_source = Some((Arc::new(normalized) as Arc<dyn ScatteringFunction>, averages, params, "artist-normalized"));
+        }
+    }
+
+    if let Some((single, averages, params, name)) = multiple_source {
+        let albedo = single_event_albedo(&averages);
+        share = Some(albedo);
+        if albedo < options.multiple_threshold && !options.force_multiple {
+            skipped.push(SkippedTable {
+                name: "multiple".into(),
+                reason: format!(
+                    "multiple scattering carries about {:.1}% of the scattered energy (largest single-event albedo ā_f + ā_b), below the {:.1}% threshold: rendering single scattering only (use --force-multiple to bake it anyway)",
+                    100.0 * albedo,
+                    100.0 * options.multiple_threshold
+                ),
+            });
+        } else {
+            let r = options.resolution.clone();
+            let d_b = averages.config().density_backward;
+            jobs.push(TableJob {
+                name: "multiple",
+                quantity: "I_G: ∫ ψ_f(ξ, ω_i, σ̄_f) (S + d_b S_back) cos θ_i dω_i (Ren eq. 11), σ̄_f = std of θ_i, RGB".into(),
+                scattering_function: format!("{name}+dual-scattering-back"),
+                fiber_parameters: params,
+                settings: json!({ "multiple": r.multiple }),
+                build: Box::new(move || {
+                    let s_d = |a: &FiberAngles| -> Rgb {
+                        let s = single.eval(a);
+                        let b = averages.backward_scattering(a);
+                        std::array::from_fn(|c| s[c] + d_b * b[c])
+                    };
+                    Ok(bake_multiple_scattering_table(&s_d, &r.multiple)?)
+                }),
+            });
+        }
+        let r = options.resolution.clone();
+        jobs.push(TableJob {
+            name: "attenuation_ratio",
+            quantity: "α(ν, θ) = σ_t(ω)/σ_t⊥ for fiber-direction deviation ν (Ren §6)".into(),
+            scattering_function: String::new(),
+            fiber_parameters: json!({}),
+            settings: json!({ "attenuation_ratio": r.attenuation_ratio, "nu_max": r.attenuation_nu_max }),
+            build: Box::new(move || Ok(attenuation_ratio_table(r.attenuation_ratio[0], r.attenuation_ratio[1], r.attenuation_nu_max)?)),
+        });
+        let r = options.resolution.clone();
+        jobs.push(TableJob {
+            name: "srbf_spread",
+            quantity: "first-event longitudinal variance of an SRBF light over (|u·ξ|, λ), rad² (Ren §6)".into(),
+            scattering_function: String::new(),
+            fiber_parameters: json!({}),
+            settings: json!({ "srbf_spread": r.srbf_spread, "lambda": [r.convolution.lambda_min, r.convolution.lambda_max] }),
+            build: Box::new(move || Ok(srbf_spread_table(r.srbf_spread[0], r.srbf_spread[1], r.convolution.lambda_min, r.convolution.lambda_max)?)),
+        });
+    }
+    Ok(BakePlan { jobs, skipped, multiple_scattering_share: share })
+}
+
+/// The single-event albedo ā_f + ā_b averaged over incident directions (cos θ-weighted over
+/// inclinations, as light arrives isotropically in a dense volume), for the brightest channel.
+/// In a dense medium of albedo a the multiply scattered share of the scattered light is a.
+pub fn single_event_albedo(averages: &DualScatteringAverages) -> f64 {
+    let rule = strandlight_tables::quadrature::GaussLegendre::composite(8, 16, -std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2);
+    (0..3)
+        .map(|c| {
+            0.5 * rule.integrate(|theta| {
+                let a = averages.averages_at(theta);
+                (a.a_f[c] + a.a_b[c]) * theta.cos()
+            })
+        })
+        .fold(0.0, f64::max)
+}
+
+/// Names of the quantities on the `quantity` axis of `fiber_averages`, in node order.
+pub const FIBER_AVERAGE_QUANTITIES: [&str; 9] = ["a_f", "a_b", "alpha_f", "alpha_b", "beta2_f", "beta2_b", "A_b", "Delta_b", "sigma2_b"];
+
+fn push_fiber_averages(jobs: &mut Vec<TableJob>, averages: DualScatteringAverages, params: serde_json::Value, thetas: usize) {
+    jobs.push(TableJob {
+        name: "fiber_averages",
+        quantity: format!("dual-scattering fiber averages per inclination (Zinke 2008), quantity axis = {FIBER_AVERAGE_QUANTITIES:?}, angles in radians of θ_h, RGB"),
+        scattering_function: "dual-scattering".into(),
+        fiber_parameters: params,
+        settings: json!({ "thetas": thetas }),
+        build: Box::new(move || {
+            let axes = vec![
+                Axis::with_mapping("sin_theta", -1.0, 1.0, thetas, AxisMapping::Arcsine),
+                Axis::uniform("quantity", 0.0, (FIBER_AVERAGE_QUANTITIES.len() - 1) as f64, FIBER_AVERAGE_QUANTITIES.len()),
+            ];
+            Ok(Table::from_fn(axes, 3, |x, out| {
+                let theta = x[0].clamp(-1.0, 1.0).asin();
+                let a = averages.averages_at(theta);
+                let m = averages.moments_at(theta);
+                let q: Rgb = match x[1].round() as usize {
+                    0 => a.a_f,
+                    1 => a.a_b,
+                    2 => a.alpha_f,
+                    3 => a.alpha_b,
+                    4 => a.beta2_f,
+                    5 => a.beta2_b,
+                    6 => m.attenuation,
+                    7 => m.shift,
+                    _ => m.variance,
+                };
+                for c in 0..3 {
+                    out[c] = q[c] as f32;
+                }
+            })?)
+        }),
+    });
+}
+
+fn push_kajiya_kay(jobs: &mut Vec<TableJob>, fiber: &FiberDescription, res: &BakeResolution, settings: ConvolutionSettings) -> Result<(), FiberError> {
+    // Neither integrand depends on φ: only the zeroth harmonic is non-zero, exactly.
+    let settings = ConvolutionSettings { max_harmonic: Some(0), ..settings };
+    let kk = Arc::new(KajiyaKay::new(fiber.kajiya_kay).map_err(param_error("[kajiya_kay]"))?);
+    let n = res.kajiya_kay_direction_nodes;
+    let conv = ConvolutionResolution { u_dot_xi: n, u_dot_wo: n, ..res.convolution };
+    let grid_2d = {
+        let axes = conv.axes();
+        ConvolutionGrid {
+            sin_theta_xi: (0..axes[0].count).map(|i| axes[0].node(i)).collect(),
+            sin_theta_o: vec![0.0],
+            cos_delta_phi: vec![1.0],
+            lambda: (0..axes[3].count).map(|i| 1.0 / axes[3].node(i)).collect(),
+        }
+    };
+    let diffuse_axes = {
+        let a = conv.axes();
+        vec![a[0].clone(), a[3].clone()]
+    };
+    jobs.push(TableJob {
+        name: "kk_diffuse",
+        quantity: "I_d: ∫ G(ω_i; ξ, λ) cos θ_i dω_i (Ren §4; times K_d at run time), monochrome".into(),
+        scattering_function: "kajiya-kay".into(),
+        fiber_parameters: json!({}),
+        settings: json!({ "resolution": conv, "settings": res.settings }),
+        build: Box::new(move || {
+            let v = convolve_grid(&|_: &FiberAngles| [1.0, 1.0, 1.0], &grid_2d, &settings);
+            Ok(Table::new(diffuse_axes, 1, v.iter().map(|x| x[0] as f32).collect())?)
+        }),
+    });
+    let exponent = fiber.kajiya_kay.exponent;
+    let spec_axes = {
+        let a = conv.axes();
+        vec![a[0].clone(), a[1].clone(), a[3].clone()]
+    };
+    let grid_3d = {
+        let a = conv.axes();
+        ConvolutionGrid {
+            sin_theta_xi: (0..a[0].count).map(|i| a[0].node(i)).collect(),
+            sin_theta_o: (0..a[1].count).map(|i| a[1].node(i)).collect(),
+            cos_delta_phi: vec![1.0],
+            lambda: (0..a[3].count).map(|i| 1.0 / a[3].node(i)).collect(),
+        }
+    };
+    jobs.push(TableJob {
+        name: "kk_specular",
+        quantity: "I_s: ∫ G(ω_i; ξ, λ) cos^p(θ_i + θ_o) dω_i (Ren §4; times K_s at run time), monochrome".into(),
+        scattering_function: "kajiya-kay".into(),
+        fiber_parameters: json!({ "exponent": exponent }),
+        settings: json!({ "resolution": conv, "settings": res.settings }),
+        build: Box::new(move || {
+            // The engine integrates S·cos θ_i; I_s has no cos θ_i, so hand it lobe / cos θ_i
+            // (Gauss–Legendre nodes never sit on the poles).
+            let s = |a: &FiberAngles| {
+                let v = kk.specular_lobe(a) / a.theta_i.cos();
+                [v, v, v]
+            };
+            let v = convolve_grid(&s, &grid_3d, &settings);
+            Ok(Table::new(spec_axes, 1, v.iter().map(|x| x[0] as f32).collect())?)
+        }),
+    });
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dark_hair_skips_multiple_scattering_and_blonde_keeps_it() {
+        let options = PlanOptions { models: vec![Model::Marschner], resolution: BakeResolution::reduced(4), ..Default::default() };
+        let dark = plan(&FiberDescription::preset("dark").unwrap(), &options).unwrap();
+        let blonde = plan(&FiberDescription::preset("blonde").unwrap(), &options).unwrap();
+        for preset in ["dark", "brown", "red", "blonde", "white"] {
+            let p = plan(&FiberDescription::preset(preset).unwrap(), &options).unwrap();
+            println!("multiple-scattering share {preset}: {:.4}", p.multiple_scattering_share.unwrap());
+        }
+        assert!(dark.skipped.iter().any(|s| s.name == "multiple"));
+        assert!(blonde.jobs.iter().any(|j| j.name == "multiple"));
+        // The share is an albedo: above the ~4.6% Fresnel reflectance of R alone, below 1.
+        let d = dark.multiple_scattering_share.unwrap();
+        assert!(d > 0.046 && d < DEFAULT_MULTIPLE_THRESHOLD, "{d}");
+        let forced = plan(&FiberDescription::preset("dark").unwrap(), &PlanOptions { force_multiple: true, ..options }).unwrap();
+        assert!(forced.jobs.iter().any(|j| j.name == "multiple"));
+    }
+
+    #[test]
+    fn fiber_files_report_the_file_and_the_parameter() {
+        let dir = std::env::temp_dir().join(format!("strandlight-fiber-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("bad.toml");
+        std::fs::write(&path, "[marschner]\neta = 0.9\n").unwrap();
+        let err = FiberDescription::from_toml_file(&path).unwrap_err().to_string();
+        assert!(err.contains("bad.toml") && err.contains("eta"), "{err}");
+        std::fs::write(&path, "[marschner]\netta = 1.5\n").unwrap();
+        let err = FiberDescription::from_toml_file(&path).unwrap_err().to_string();
+        assert!(err.contains("bad.toml") && err.contains("etta"), "{err}");
+        std::fs::write(&path, "[marschner]\neta = 1.6\n[dual_scattering]\ndensity_backward = 0.6\n").unwrap();
+        let ok = FiberDescription::from_toml_file(&path).unwrap();
+        assert_eq!(ok.marschner.eta, 1.6);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,263 @@
+//! `check-tables`: every baked table against an independent f64 computation of what it
+//! tabulates, at random off-grid points. The models are rebuilt from the parameters stored in
+//! each asset, so the check needs nothing but the files.
+
+use crate::attenuation_ratio::attenuation_ratio;
+
+use crate::convolution::convolve_reference;
+use crate::multiple_scattering_table::multiple_scattering_reference;
+use crate::srbf_spread::srbf_longitudinal_variance;
+use crate::table_check::{stratified_points, TableAccuracy};
+use rayon::prelude::*;
+use serde_json::Value;
+use std::sync::Arc;
+use strandlight_tables::artist::{ArtistModel, ArtistParams, Normalization};
+use strandlight_tables::asset::TableAsset;
+use strandlight_tables::dual_scattering::{backscatter_series, fiber_averages_direct, DualScatteringAverages, DualScatteringConfig, LobeDecomposition};
+use strandlight_tables::kajiya_kay::{KajiyaKay, KajiyaKayParams};
+use strandlight_tables::marschner::{Lobe, Marschner, MarschnerParams};
+use strandlight_tables::scattering::{Rgb, ScatteringFunction};
+use strandlight_tables::FiberAngles;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum CheckError {
+    #[error("{}: table `{name}` is not one strandlight knows how to check", .path.display())]
+    UnknownTable { path: std::path::PathBuf, name: String },
+    #[error("{}: its fiber parameters cannot be read back: {message}", .path.display())]
+    Parameters { path: std::path::PathBuf, message: String },
+    #[error("{}: lookup failed: {source}", .path.display())]
+    Lookup { path: std::path::PathBuf, source: strandlight_tables::table::TableError },
+}
+
+/// Panels of the reference quadratures: converged well below the tables' errors (the harmonic
+/// method and this reference agree to 1e-13 on smooth integrands; see `convolution`).
+const REFERENCE_PANELS: usize = 32;
+
+type Reference = Arc<dyn Fn(&[f64]) -> Vec<f64> + Send + Sync>;
+
+/// Checks one table at `samples` points.
+pub fn check_asset(asset: &TableAsset, samples: usize, seed: u64) -> Result<TableAccuracy, CheckError> {
+    let name = asset.metadata.description.name.clone();
+    let params = &asset.metadata.description.fiber_parameters;
+    let path = asset.path.clone();
+    let bad = |message: String| CheckError::Parameters { path: path.clone(), message };
+    let table = &asset.table;
+    let axes = table.axes();
+    let (reference, points): (Reference, Vec<Vec<f64>>) = match name.as_str() {
+        "marschner" | "marschner_full" | "artist" => {
+            let s = scattering_from(&name, params).map_err(bad)?;
+            let (lmin, lmax) = (1.0 / axes[3].max, 1.0 / axes[3].min);
+            let pts = stratified_points(samples, lmin, lmax, seed).into_iter().map(|p| p.to_vec()).collect();
+            let r: Reference = Arc::new(move |x: &[f64]| {
+                let v = convolve_reference(&|a: &FiberAngles| s.eval(a), x[0].asin(), x[1].asin(), x[2].clamp(-1.0, 1.0).acos(), 1.0 / x[3], REFERENCE_PANELS);
+                v.to_vec()
+            });
+            (r, pts)
+        }
+        "kk_diffuse" | "kk_specular" => {
+            let exponent = params.get("exponent").and_then(Value::as_f64).unwrap_or(KajiyaKayParams::default().exponent);
+            let kk = KajiyaKay::new(KajiyaKayParams { exponent, ..Default::default() }).map_err(|e| bad(e.to_string()))?;
+            let diffuse = name == "kk_diffuse";
+            let r: Reference = Arc::new(move |x: &[f64]| {
+                let (theta_xi, theta_o, inv) = if diffuse { (x[0].asin(), 0.0, x[1]) } else { (x[0].asin(), x[1].asin(), x[2]) };
+                let s = |a: &FiberAngles| {
+                    let v = if diffuse { 1.0 } else { kk.specular_lobe(a) / a.theta_i.cos() };
+                    [v, v, v]
+                };
+                vec![convolve_reference(&s, theta_xi, theta_o, 0.0, 1.0 / inv, REFERENCE_PANELS)[0]]
+            });
+            (r, random_points(table, samples, seed))
+        }
+        "multiple" => {
+            let s_d = bcsdf_from(params).map_err(bad)?;
+            let r: Reference = Arc::new(move |x: &[f64]| {
+                multiple_scattering_reference(&|a: &FiberAngles| s_d.eval(a), x[0].asin(), x[1].asin(), x[2].clamp(-1.0, 1.0).acos(), x[3].max(1e-4), 24).to_vec()
+            });
+            (r, random_points(table, samples, seed))
+        }
+        "attenuation_ratio" => (Arc::new(|x: &[f64]| vec![attenuation_ratio(x[0], x[1])]), random_points(table, samples, seed)),
+        "srbf_spread" => (Arc::new(|x: &[f64]| vec![srbf_longitudinal_variance(x[0], x[1])]), random_points(table, samples, seed)),
+        "fiber_averages" => {
+            let model = lobes_from(params).map_err(bad)?;
+            let r: Reference = Arc::new(move |x: &[f64]| {
+                let theta = x[0].clamp(-1.0, 1.0).asin();
+                let a = fiber_averages_direct(model.as_lobes(), theta);
+                let q = x[1].round() as usize;
+                (0..3)
+                    .map(|c| {
+                        let (ab, db, sb) = backscatter_series(a.a_f[c], a.a_b[c], a.alpha_f[c], a.alpha_b[c], a.beta2_f[c], a.beta2_b[c]);
+                        [a.a_f[c], a.a_b[c], a.alpha_f[c], a.alpha_b[c], a.beta2_f[c], a.beta2_b[c], ab, db, sb][q]
+                    })
+                    .collect()
+            });
+            (r, random_points(table, samples, seed))
+        }
+        "lut_m" | "lut_n" => {
+            let m = Arc::new(marschner_from(params).map_err(bad)?);
+            let is_m = name == "lut_m";
+            let r: Reference = Arc::new(move |x: &[f64]| {
+                let lobe = |q: f64| [Lobe::R, Lobe::TT, Lobe::TRT][(q.round() as usize).min(2)];
+                if is_m {
+                    let (ti, to) = (x[0].asin(), x[1].asin());
+                    if x[2].round() as usize == 3 {
+                        vec![((to - ti) / 2.0).cos()]
+                    } else {
+                        vec![m.longitudinal(lobe(x[2]), ti, to)]
+                    }
+                } else {
+                    m.azimuthal(lobe(x[2]), x[1].clamp(0.0, 1.0).acos(), x[0].clamp(-1.0, 1.0).acos()).to_vec()
+                }
+            });
+            (r, random_points(table, samples, seed))
+        }
+        _ => return Err(CheckError::UnknownTable { path: asset.path.clone(), name }),
+    };
+    compare(asset, &name, &reference, &points)
+}
+
+/// Points uniform over every continuous axis; integer-labelled axes (`quantity`, `lobe`) get a
+/// random node.
+fn random_points(table: &strandlight_tables::table::Table, count: usize, seed: u64) -> Vec<Vec<f64>> {
+    let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    let mut unit = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    (0..count)
+        .map(|_| {
+            table
+                .axes()
+                .iter()
+                .map(|a| {
+                    if a.name == "quantity" || a.name == "lobe" {
+                        (unit() * a.count as f64).floor().min((a.count - 1) as f64)
+                    } else {
+                        a.min + (a.max - a.min) * unit()
+                    }
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn compare(asset: &TableAsset, name: &str, reference: &Reference, points: &[Vec<f64>]) -> Result<TableAccuracy, CheckError> {
+    let table = &asset.table;
+    let channels = table.channels();
+    let table_max = table.stats().max.abs().max(table.stats().min.abs()) as f64;
+    let rows: Vec<Result<(Vec<f64>, f64, Option<f64>), CheckError>> = points
+        .par_iter()
+        .map(|p| {
+            let mut looked = vec![0f32; channels];
+            table.lookup_into(p, &mut looked).map_err(|source| CheckError::Lookup { path: asset.path.clone(), source })?;
+            let want = reference(p);
+            let mut abs: f64 = 0.0;
+            let mut rel: Option<f64> = None;
+            for c in 0..channels {
+                let e = (looked[c] as f64 - want[c]).abs();
+                abs = abs.max(e);
+                if want[c].abs() > 0.01 * table_max {
+                    rel = Some(rel.unwrap_or(0.0).max(e / want[c].abs()));
+                }
+            }
+            Ok((p.clone(), abs, rel))
+        })
+        .collect();
+    let (mut max_abs, mut sum_sq, mut max_rel) = (0.0f64, 0.0, 0.0f64);
+    let mut worst = [0.0; 4];
+    for row in rows {
+        let (p, abs, rel) = row?;
+        if abs > max_abs {
+            max_abs = abs;
+            worst = [0.0; 4];
+            for (w, v) in worst.iter_mut().zip(&p) {
+                *w = *v;
+            }
+        }
+        sum_sq += abs * abs;
+        max_rel = max_rel.max(rel.unwrap_or(0.0));
+    }
+    let scale = if table_max > 0.0 { table_max } else { 1.0 };
+    Ok(TableAccuracy {
+        name: name.to_string(),
+        max_abs_error: max_abs / scale,
+        rms_abs_error: (sum_sq / points.len().max(1) as f64).sqrt() / scale,
+        max_rel_error: max_rel,
+        samples: points.len(),
+        worst_point: worst,
+        table_max: scale,
+        table_p999: 0.0,
+        max_abs_error_p999: 0.0,
+        rms_abs_error_p999: 0.0,
+    }
+    .with_percentile(table))
+}
+
+fn section<T: serde::de::DeserializeOwned + Default>(params: &Value, key: &str) -> Result<T, String> {
+    match params.get(key) {
+        Some(v) => serde_json::from_value(v.clone()).map_err(|e| format!("[{key}]: {e}")),
+        None => Ok(T::default()),
+    }
+}
+
+fn marschner_from(params: &Value) -> Result<Marschner, String> {
+    Marschner::new(section::<MarschnerParams>(params, "marschner")?).map_err(|e| e.to_string())
+}
+
+fn artist_from(params: &Value) -> Result<ArtistModel, String> {
+    ArtistModel::new(section::<ArtistParams>(params, "artist")?).map_err(|e| e.to_string())
+}
+
+/// The function a convolution table integrates.
+fn scattering_from(name: &str, params: &Value) -> Result<Arc<dyn ScatteringFunction>, String> {
+    Ok(match name {
+        "marschner" => Arc::new(marschner_from(params)?),
+        "artist" => Arc::new(artist_from(params)?),
+        _ => bcsdf_from(params)?,
+    })
+}
+
+/// The single-scattering model with its lobe view, as the bake chose it from the parameters.
+fn lobes_from(params: &Value) -> Result<Arc<dyn LobesAndScattering>, String> {
+    if params.get("marschner").is_some() {
+        Ok(Arc::new(marschner_from(params)?))
+    } else {
+        Ok(Arc::new(artist_from(params)?.normalized(Normalization::PeakPerChannel)))
+    }
+}
+
+trait LobesAndScattering: LobeDecomposition + ScatteringFunction {
+    fn as_lobes(&self) -> &dyn LobeDecomposition;
+}
+impl<T: LobeDecomposition + ScatteringFunction> LobesAndScattering for T {
+    fn as_lobes(&self) -> &dyn LobeDecomposition {
+        self
+    }
+}
+
+struct Bcsdf {
+    single: Arc<dyn LobesAndScattering>,
+    averages: DualScatteringAverages,
+}
+
+impl ScatteringFunction for Bcsdf {
+    fn name(&self) -> &'static str {
+        "bcsdf"
+    }
+    fn eval(&self, a: &FiberAngles) -> Rgb {
+        let s = self.single.eval(a);
+        let b = self.averages.backward_scattering(a);
+        let d_b = self.averages.config().density_backward;
+        std::array::from_fn(|c| s[c] + d_b * b[c])
+    }
+}
+
+/// S + d_b·S_back, rebuilt from the stored parameters.
+fn bcsdf_from(params: &Value) -> Result<Arc<dyn ScatteringFunction>, String> {
+    let single = lobes_from(params)?;
+    let config = section::<DualScatteringConfig>(params, "dual_scattering")?;
+    let averages = DualScatteringAverages::new(single.as_lobes(), config).map_err(|e| e.to_string())?;
+    Ok(Arc::new(Bcsdf { single, averages }))
+}
