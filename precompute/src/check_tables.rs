@@ -7,7 +7,7 @@ use crate::attenuation_ratio::attenuation_ratio;
 use crate::convolution::convolve_reference;
 use crate::multiple_scattering_table::multiple_scattering_reference;
 use crate::srbf_spread::srbf_longitudinal_variance;
-use crate::table_check::{stratified_points, TableAccuracy};
+use crate::table_check::{stratified_points, summarize, TableAccuracy};
 use rayon::prelude::*;
 use serde_json::Value;
 use std::sync::Arc;
@@ -165,34 +165,9 @@ fn compare(asset: &TableAsset, name: &str, reference: &Reference, points: &[Vec<
             Ok((p.clone(), abs, rel))
         })
         .collect();
-    let (mut max_abs, mut sum_sq, mut max_rel) = (0.0f64, 0.0, 0.0f64);
-    let mut worst = [0.0; 4];
-    for row in rows {
-        let (p, abs, rel) = row?;
-        if abs > max_abs {
-            max_abs = abs;
-            worst = [0.0; 4];
-            for (w, v) in worst.iter_mut().zip(&p) {
-                *w = *v;
-            }
-        }
-        sum_sq += abs * abs;
-        max_rel = max_rel.max(rel.unwrap_or(0.0));
-    }
-    let scale = if table_max > 0.0 { table_max } else { 1.0 };
-    Ok(TableAccuracy {
-        name: name.to_string(),
-        max_abs_error: max_abs / scale,
-        rms_abs_error: (sum_sq / points.len().max(1) as f64).sqrt() / scale,
-        max_rel_error: max_rel,
-        samples: points.len(),
-        worst_point: worst,
-        table_max: scale,
-        table_p999: 0.0,
-        max_abs_error_p999: 0.0,
-        rms_abs_error_p999: 0.0,
-    }
-    .with_percentile(table))
+    let rows = rows.into_iter().collect::<Result<Vec<_>, _>>()?;
+    let directional = matches!(name, "marschner" | "marschner_full" | "artist" | "multiple" | "kk_specular");
+    Ok(summarize(name, table, table_max, &rows, directional))
 }
 
 fn section<T: serde::de::DeserializeOwned + Default>(params: &Value, key: &str) -> Result<T, String> {
