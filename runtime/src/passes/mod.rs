@@ -1,0 +1,3 @@
+//! Render passes: small units with explicit inputs and outputs, each shader beside its pass.
+
+pub mod strands;
