@@ -1,3 +1,4 @@
 //! Render passes: small units with explicit inputs and outputs, each shader beside its pass.
 
+pub mod deep_opacity;
 pub mod strands;

@@ -261,37 +261,15 @@ impl StrandPass {
         let device = &gpu.device;
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("strands.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("strands.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(
+                concat!(
+                    include_str!("strand_quads.wgsl"),
+                    include_str!("strands.wgsl")
+                )
+                .into(),
+            ),
         });
-        let storage = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only: true },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("strands"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                storage(1),
-                storage(2),
-                storage(3),
-                storage(4),
-            ],
-        });
+        let layout = strand_bind_group_layout(device);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("strands"),
             bind_group_layouts: &[Some(&layout)],
@@ -352,47 +330,7 @@ impl StrandPass {
         target: &RenderTarget,
     ) {
         let device = &gpu.device;
-        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("strand frame"),
-            contents: bytemuck::bytes_of(&frame.uniform()),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        // A storage binding may not be empty: pad with one unused light.
-        let mut lights: Vec<GpuLight> = frame.lights.iter().map(Light::to_gpu).collect();
-        if lights.is_empty() {
-            lights.push(bytemuck::Zeroable::zeroed());
-        }
-        let lights = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("lights"),
-            contents: bytemuck::cast_slice(&lights),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("strands"),
-            layout: &self.layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: uniform.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: geometry.points.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: geometry.segments.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: geometry.attributes.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: lights.as_entire_binding(),
-                },
-            ],
-        });
+        let bind_group = strand_bind_group(gpu, &self.layout, geometry, frame);
         let color_view = target.color.create_view(&Default::default());
         let depth_view = target.depth.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -426,6 +364,93 @@ impl StrandPass {
         }
         gpu.queue.submit([encoder.finish()]);
     }
+}
+
+/// Group 0 of every pass that draws strand quads (`strand_quads.wgsl`): frame uniform, points,
+/// segments, point attributes, lights.
+pub fn strand_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let storage = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("strands"),
+        entries: &[
+            wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+            storage(1),
+            storage(2),
+            storage(3),
+            storage(4),
+        ],
+    });
+    layout
+}
+
+/// Group 0's resources for `geometry` seen through `frame`.
+pub fn strand_bind_group(
+    gpu: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    geometry: &StrandGeometry,
+    frame: &FrameParams,
+) -> wgpu::BindGroup {
+    let device = &gpu.device;
+    let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("strand frame"),
+        contents: bytemuck::bytes_of(&frame.uniform()),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    // A storage binding may not be empty: pad with one unused light.
+    let mut lights: Vec<GpuLight> = frame.lights.iter().map(Light::to_gpu).collect();
+    if lights.is_empty() {
+        lights.push(bytemuck::Zeroable::zeroed());
+    }
+    let lights = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("lights"),
+        contents: bytemuck::cast_slice(&lights),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("strands"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniform.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: geometry.points.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: geometry.segments.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: geometry.attributes.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 4,
+                resource: lights.as_entire_binding(),
+            },
+        ],
+    });
+    bind_group
 }
 
 #[cfg(test)]
