@@ -10,6 +10,7 @@ use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::{self, GroomParams, HairModel};
 use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
 use strandlight_runtime::lights::Light;
+use strandlight_runtime::passes::deep_opacity::DomSettings;
 use strandlight_runtime::passes::strands::{FrameParams, KajiyaKay};
 use strandlight_runtime::render::render_frame;
 
@@ -57,6 +58,15 @@ pub struct RenderArgs {
     shadows: Shadows,
     #[arg(long, value_enum, default_value = "none")]
     transparency: Transparency,
+    /// Deep opacity map layers (1..=8), with --shadows dom.
+    #[arg(long, default_value_t = 4)]
+    dom_layers: u32,
+    /// Layer spacing in world units (default: 1% of the hair's bounding-box diagonal).
+    #[arg(long)]
+    dom_spacing: Option<f32>,
+    /// Deep opacity map resolution (square).
+    #[arg(long, default_value_t = 512)]
+    dom_size: u32,
     /// Image size WxH in pixels.
     #[arg(long, default_value = "512x512")]
     size: String,
@@ -117,9 +127,6 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         Shading::KajiyaKay => {}
         other => bail!("--shading {other:?} is not implemented yet; only kajiya-kay renders"),
     }
-    if let Shadows::Dom = args.shadows {
-        bail!("--shadows dom is not implemented yet");
-    }
     match args.transparency {
         Transparency::None => {}
         other => bail!(
@@ -152,12 +159,20 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         shading: KajiyaKay::default(),
         width_override_px: args.fiber_width_px,
     };
-    let rendered = render_frame(&gpu, &model, &frame)?;
+    let shadows = match args.shadows {
+        Shadows::None => None,
+        Shadows::Dom => Some(DomSettings {
+            resolution: args.dom_size,
+            layers: args.dom_layers,
+            spacing: args.dom_spacing.unwrap_or(model.bounds().diagonal() * 0.01),
+        }),
+    };
+    let rendered = render_frame(&gpu, &model, &frame, shadows)?;
     let stem = output_stem(&args.out);
     let exr_path = stem.with_extension("exr");
     let png_path = stem.with_extension("png");
     let description = format!(
-        "{source}; {width}x{height}; Kajiya-Kay {:?}; lights {}; camera {:?}",
+        "{source}; {width}x{height}; Kajiya-Kay {:?}; shadows {shadows:?}; lights {}; camera {:?}",
         frame.shading,
         args.lights.join(" "),
         args.camera

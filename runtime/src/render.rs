@@ -6,8 +6,12 @@ use std::time::Instant;
 use crate::gpu::readback::ReadbackError;
 use crate::gpu::{AdapterReport, GpuContext, read_texture_rgba};
 use crate::hair::HairModel;
+use crate::lights::Light;
+use crate::passes::deep_opacity::{
+    DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError, light_camera,
+};
 use crate::passes::strands::{
-    FrameParams, RenderTarget, StrandGeometry, StrandPass, TooManyPoints,
+    FrameParams, RenderTarget, ShadowInput, StrandGeometry, StrandPass, TooManyPoints,
 };
 
 #[derive(Debug, thiserror::Error)]
@@ -18,6 +22,10 @@ pub enum RenderError {
     BadSize { width: u32, height: u32, max: u32 },
     #[error(transparent)]
     TooManyPoints(#[from] TooManyPoints),
+    #[error(transparent)]
+    DomSettings(#[from] DomSettingsError),
+    #[error("deep opacity maps need a directional light; the frame has none")]
+    NoDirectionalLight,
     #[error(transparent)]
     Readback(#[from] ReadbackError),
     #[error("the GPU reported an error: {0}")]
@@ -65,12 +73,30 @@ fn timed<T>(
     out
 }
 
-/// Renders `model` with `frame` and reads the picture back.
+/// Renders `model` with `frame` and reads the picture back. With `shadows`, the first
+/// directional light is shadowed through a deep opacity map (other lights are unshadowed).
 pub fn render_frame(
     gpu: &GpuContext,
     model: &HairModel,
     frame: &FrameParams,
+    shadows: Option<DomSettings>,
 ) -> Result<Frame, RenderError> {
+    let shadowed_light = match shadows {
+        None => None,
+        Some(settings) => {
+            settings.check()?;
+            let (index, direction) = frame
+                .lights
+                .iter()
+                .enumerate()
+                .find_map(|(i, l)| match l {
+                    Light::Directional { direction, .. } => Some((i, *direction)),
+                    _ => None,
+                })
+                .ok_or(RenderError::NoDirectionalLight)?;
+            Some((settings, index as u32, direction))
+        }
+    };
     let max = gpu.device.limits().max_texture_dimension_2d;
     if frame.width == 0 || frame.height == 0 || frame.width > max || frame.height > max {
         return Err(RenderError::BadSize {
@@ -86,8 +112,27 @@ pub fn render_frame(
     })?;
     let pass = timed(&mut timings, gpu, "pipeline", || StrandPass::new(gpu));
     let target = RenderTarget::new(gpu, frame.width, frame.height);
+    let mut memory_bytes = geometry.memory();
+    let shadow_map = match shadowed_light {
+        None => None,
+        Some((settings, index, direction)) => {
+            let dom_pass = timed(&mut timings, gpu, "dom pipeline", || {
+                DeepOpacityPass::new(gpu)
+            });
+            let map = DeepOpacityMap::new(gpu, light_camera(direction, model.bounds()), settings);
+            timed(&mut timings, gpu, "deep opacity", || {
+                dom_pass.draw(gpu, &geometry, &map)
+            });
+            memory_bytes.extend(map.memory());
+            Some((map, index))
+        }
+    };
+    let shadow = shadow_map.as_ref().map(|(map, light_index)| ShadowInput {
+        map,
+        light_index: *light_index,
+    });
     timed(&mut timings, gpu, "strands", || {
-        pass.draw(gpu, &geometry, frame, &target)
+        pass.draw(gpu, &geometry, frame, &target, shadow)
     });
     let pixels = timed(&mut timings, gpu, "readback", || {
         read_texture_rgba(gpu, &target.color)
@@ -95,7 +140,6 @@ pub fn render_frame(
     if let Some(error) = pollster::block_on(scope.pop()) {
         return Err(RenderError::Gpu(error.to_string()));
     }
-    let mut memory_bytes = geometry.memory();
     memory_bytes.extend(target.memory());
     Ok(Frame {
         width: frame.width,

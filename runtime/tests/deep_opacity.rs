@@ -5,11 +5,15 @@
 use glam::Vec3;
 use strandlight_runtime::camera::{Camera, Projection};
 use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::gpu::read_texture_rgba;
 use strandlight_runtime::hair::{Attribute, HairModel};
+use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::{
     DeepOpacityMap, DeepOpacityPass, DomSettings, transmittance_before_layer,
 };
-use strandlight_runtime::passes::strands::StrandGeometry;
+use strandlight_runtime::passes::strands::{
+    FrameParams, KajiyaKay, RenderTarget, ShadowInput, StrandGeometry, StrandPass,
+};
 
 const RES: u32 = 64;
 /// Light-map texels per world unit (2 units across 64 texels).
@@ -142,4 +146,88 @@ fn bad_settings_are_refused() {
         .check()
         .is_err()
     );
+}
+
+/// The strand pass reads the map: a horizontal probe fiber behind the slab (all four rows
+/// between it and the light) is lit by (1 − d/s)^4 of the light; one in front of it by all of
+/// it. The map is built from the slab alone so the probe does not shadow itself.
+#[test]
+fn shading_behind_the_slab_is_dimmed_by_the_closed_form_transmittance() {
+    let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+    let thickness = 0.01f32;
+    let coverage = thickness as f64 * PER_UNIT;
+    let slab_geometry = StrandGeometry::upload(&gpu, &slab(4, thickness)).unwrap();
+    let map = DeepOpacityMap::new(
+        &gpu,
+        light_camera(),
+        DomSettings {
+            resolution: RES,
+            layers: 4,
+            spacing: 0.08,
+        },
+    );
+    DeepOpacityPass::new(&gpu).draw(&gpu, &slab_geometry, &map);
+
+    let color = Vec3::new(0.5, 0.3, 0.2);
+    let shading = KajiyaKay {
+        kd: 0.6,
+        ks: 0.25,
+        shininess: 40.0,
+    };
+    let strand_pass = StrandPass::new(&gpu);
+    for (z, expected_t) in [(-0.5f32, (1.0 - coverage).powi(4)), (0.5, 1.0)] {
+        // Along x at y = 0.5 (image row 16 ± 2 px): probe covers pixel rows 14..=17, columns 7..=56.
+        let probe = HairModel::new(
+            vec![Vec3::new(-0.8, 0.5, z), Vec3::new(0.8, 0.5, z)],
+            vec![0, 2],
+            None,
+            None,
+            Some(Attribute::Uniform(color)),
+        )
+        .unwrap();
+        let geometry = StrandGeometry::upload(&gpu, &probe).unwrap();
+        let frame = FrameParams {
+            camera: light_camera(),
+            width: RES,
+            height: RES,
+            lights: vec![Light::Directional {
+                direction: Vec3::Z,
+                intensity: 1.0,
+            }],
+            shading,
+            width_override_px: Some(4.0),
+        };
+        let target = RenderTarget::new(&gpu, RES, RES);
+        strand_pass.draw(
+            &gpu,
+            &geometry,
+            &frame,
+            &target,
+            Some(ShadowInput {
+                map: &map,
+                light_index: 0,
+            }),
+        );
+        let pixels = read_texture_rgba(&gpu, &target.color).unwrap();
+        // t = x, l = e = z: sin = 1, cone = 1, so L = T·(kd·c + ks).
+        let mut worst = 0.0f64;
+        for x in 8..56usize {
+            for y in [14usize, 15, 16] {
+                let got = pixels[y * RES as usize + x];
+                for (k, c) in [0.5f64, 0.3, 0.2].into_iter().enumerate() {
+                    let expected = expected_t * (0.6 * c + 0.25);
+                    let err = (got[k] as f64 - expected).abs() / expected;
+                    worst = worst.max(err);
+                    assert!(
+                        err < 1e-3,
+                        "probe z {z} pixel ({x},{y}) channel {k}: {} vs {expected}",
+                        got[k]
+                    );
+                }
+            }
+        }
+        eprintln!(
+            "probe at z = {z}: transmittance {expected_t:.5} expected; worst relative error of the shaded pixels {worst:.2e}"
+        );
+    }
 }

@@ -10,6 +10,7 @@ use crate::camera::Camera;
 use crate::gpu::GpuContext;
 use crate::hair::HairModel;
 use crate::lights::{GpuLight, Light};
+use crate::passes::deep_opacity::{DeepOpacityMap, DomSettings};
 
 /// Hair colour where the file has none (linear RGB, a mid brown).
 pub const DEFAULT_HAIR_COLOR: [f32; 3] = [0.35, 0.22, 0.12];
@@ -254,6 +255,57 @@ impl RenderTarget {
 pub struct StrandPass {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
+    shadow_layout: wgpu::BindGroupLayout,
+}
+
+/// A deep opacity map that shadows light `light_index` of the frame.
+pub struct ShadowInput<'a> {
+    pub map: &'a DeepOpacityMap,
+    pub light_index: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct ShadowUniform {
+    view_proj: [[f32; 4]; 4],
+    near: f32,
+    far: f32,
+    spacing: f32,
+    layers: u32,
+    light_index: u32,
+    resolution: f32,
+    _pad: [f32; 2],
+}
+
+fn shadow_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("strand shadows"),
+        entries: &[
+            texture(0, wgpu::TextureSampleType::Depth),
+            texture(1, wgpu::TextureSampleType::Float { filterable: false }),
+            texture(2, wgpu::TextureSampleType::Float { filterable: false }),
+            wgpu::BindGroupLayoutEntry {
+                binding: 3,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            },
+        ],
+    })
 }
 
 impl StrandPass {
@@ -270,9 +322,10 @@ impl StrandPass {
             ),
         });
         let layout = strand_bind_group_layout(device);
+        let shadow_layout = shadow_bind_group_layout(device);
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("strands"),
-            bind_group_layouts: &[Some(&layout)],
+            bind_group_layouts: &[Some(&layout), Some(&shadow_layout)],
             immediate_size: 0,
         });
         let premultiplied_over = wgpu::BlendComponent {
@@ -318,7 +371,11 @@ impl StrandPass {
             multiview_mask: None,
             cache: None,
         });
-        Self { pipeline, layout }
+        Self {
+            pipeline,
+            layout,
+            shadow_layout,
+        }
     }
 
     /// Clears the target to transparent black and draws every segment.
@@ -328,9 +385,69 @@ impl StrandPass {
         geometry: &StrandGeometry,
         frame: &FrameParams,
         target: &RenderTarget,
+        shadow: Option<ShadowInput<'_>>,
     ) {
         let device = &gpu.device;
         let bind_group = strand_bind_group(gpu, &self.layout, geometry, frame);
+        // Without shadows a 1×1 map is bound and no light refers to it.
+        let placeholder;
+        let (map, light_index) = match shadow {
+            Some(s) => (s.map, s.light_index),
+            None => {
+                placeholder = DeepOpacityMap::new(
+                    gpu,
+                    frame.camera,
+                    DomSettings {
+                        resolution: 1,
+                        layers: 1,
+                        spacing: 1.0,
+                    },
+                );
+                (&placeholder, u32::MAX)
+            }
+        };
+        let shadow_uniform = ShadowUniform {
+            view_proj: (map.camera.projection_matrix(1.0) * map.camera.view()).to_cols_array_2d(),
+            near: map.camera.near,
+            far: map.camera.far,
+            spacing: map.settings.spacing,
+            layers: map.settings.layers,
+            light_index,
+            resolution: map.settings.resolution as f32,
+            _pad: [0.0; 2],
+        };
+        let shadow_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("strand shadow params"),
+            contents: bytemuck::bytes_of(&shadow_uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let views = [
+            map.nearest_depth.create_view(&Default::default()),
+            map.layers[0].create_view(&Default::default()),
+            map.layers[1].create_view(&Default::default()),
+        ];
+        let shadow_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("strand shadows"),
+            layout: &self.shadow_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&views[0]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&views[1]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&views[2]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: shadow_buffer.as_entire_binding(),
+                },
+            ],
+        });
         let color_view = target.color.create_view(&Default::default());
         let depth_view = target.depth.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -360,6 +477,7 @@ impl StrandPass {
             });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
+            pass.set_bind_group(1, &shadow_group, &[]);
             pass.draw(0..6, 0..geometry.segment_count);
         }
         gpu.queue.submit([encoder.finish()]);
