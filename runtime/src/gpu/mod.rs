@@ -4,4 +4,4 @@ pub mod device;
 pub mod readback;
 
 pub use device::{AdapterReport, DeviceError, GpuContext};
-pub use readback::read_texture_rgba;
+pub use readback::{read_buffer, read_texture_rgba};

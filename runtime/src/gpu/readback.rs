@@ -79,3 +79,26 @@ pub fn read_texture_rgba(
     buffer.unmap();
     Ok(pixels)
 }
+
+/// A storage buffer's bytes (the buffer needs `COPY_SRC`).
+pub fn read_buffer(gpu: &GpuContext, source: &wgpu::Buffer) -> Result<Vec<u8>, ReadbackError> {
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: source.size(),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    encoder.copy_buffer_to_buffer(source, 0, &buffer, 0, source.size());
+    gpu.queue.submit([encoder.finish()]);
+    let slice = buffer.slice(..);
+    let (sender, receiver) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = sender.send(r);
+    });
+    gpu.wait_idle();
+    receiver.recv().unwrap_or(Err(wgpu::BufferAsyncError))?;
+    let bytes = slice.get_mapped_range()?.to_vec();
+    buffer.unmap();
+    Ok(bytes)
+}

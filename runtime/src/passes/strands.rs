@@ -277,7 +277,7 @@ struct ShadowUniform {
     _pad: [f32; 2],
 }
 
-fn shadow_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+pub fn shadow_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT,
@@ -389,65 +389,7 @@ impl StrandPass {
     ) {
         let device = &gpu.device;
         let bind_group = strand_bind_group(gpu, &self.layout, geometry, frame);
-        // Without shadows a 1×1 map is bound and no light refers to it.
-        let placeholder;
-        let (map, light_index) = match shadow {
-            Some(s) => (s.map, s.light_index),
-            None => {
-                placeholder = DeepOpacityMap::new(
-                    gpu,
-                    frame.camera,
-                    DomSettings {
-                        resolution: 1,
-                        layers: 1,
-                        spacing: 1.0,
-                    },
-                );
-                (&placeholder, u32::MAX)
-            }
-        };
-        let shadow_uniform = ShadowUniform {
-            view_proj: (map.camera.projection_matrix(1.0) * map.camera.view()).to_cols_array_2d(),
-            near: map.camera.near,
-            far: map.camera.far,
-            spacing: map.settings.spacing,
-            layers: map.settings.layers,
-            light_index,
-            resolution: map.settings.resolution as f32,
-            _pad: [0.0; 2],
-        };
-        let shadow_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("strand shadow params"),
-            contents: bytemuck::bytes_of(&shadow_uniform),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let views = [
-            map.nearest_depth.create_view(&Default::default()),
-            map.layers[0].create_view(&Default::default()),
-            map.layers[1].create_view(&Default::default()),
-        ];
-        let shadow_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("strand shadows"),
-            layout: &self.shadow_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&views[0]),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(&views[1]),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::TextureView(&views[2]),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: shadow_buffer.as_entire_binding(),
-                },
-            ],
-        });
+        let shadow_group = shadow_bind_group(gpu, &self.shadow_layout, frame, shadow);
         let color_view = target.color.create_view(&Default::default());
         let depth_view = target.depth.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -569,6 +511,76 @@ pub fn strand_bind_group(
         ],
     });
     bind_group
+}
+
+/// Group 1 of the shading passes: the deep opacity map of one light, or a 1×1 placeholder.
+pub fn shadow_bind_group(
+    gpu: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    frame: &FrameParams,
+    shadow: Option<ShadowInput<'_>>,
+) -> wgpu::BindGroup {
+    let device = &gpu.device;
+    // Without shadows a 1×1 map is bound and no light refers to it.
+    let placeholder;
+    let (map, light_index) = match shadow {
+        Some(s) => (s.map, s.light_index),
+        None => {
+            placeholder = DeepOpacityMap::new(
+                gpu,
+                frame.camera,
+                DomSettings {
+                    resolution: 1,
+                    layers: 1,
+                    spacing: 1.0,
+                },
+            );
+            (&placeholder, u32::MAX)
+        }
+    };
+    let shadow_uniform = ShadowUniform {
+        view_proj: (map.camera.projection_matrix(1.0) * map.camera.view()).to_cols_array_2d(),
+        near: map.camera.near,
+        far: map.camera.far,
+        spacing: map.settings.spacing,
+        layers: map.settings.layers,
+        light_index,
+        resolution: map.settings.resolution as f32,
+        _pad: [0.0; 2],
+    };
+    let shadow_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("strand shadow params"),
+        contents: bytemuck::bytes_of(&shadow_uniform),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let views = [
+        map.nearest_depth.create_view(&Default::default()),
+        map.layers[0].create_view(&Default::default()),
+        map.layers[1].create_view(&Default::default()),
+    ];
+    let shadow_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("strand shadows"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&views[0]),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(&views[1]),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::TextureView(&views[2]),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: shadow_buffer.as_entire_binding(),
+            },
+        ],
+    });
+    shadow_group
 }
 
 #[cfg(test)]

@@ -72,8 +72,8 @@ fn light_at(light: Light, world: vec3<f32>) -> vec4<f32> {
     return vec4<f32>(l, e);
 }
 
-@fragment
-fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+// The fragment's pre-multiplied shaded colour (Svoboda §2.5).
+fn shade(in: VertexOut) -> vec4<f32> {
     let t = normalize(in.tangent);
     var e = frame.toward_eye.xyz;
     if (frame.eye.w > 0.5) { e = normalize(frame.eye.xyz - in.world); }
@@ -84,6 +84,11 @@ fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
         if (i == shadow.light_index) { visible = shadow_transmittance(in.world); }
         radiance += visible * li.w * kajiya_kay(t, li.xyz, e, in.color);
     }
-    // Pre-multiplied alpha (Svoboda §2.5): blending is "one, one − source alpha".
     return vec4<f32>(radiance * in.alpha, in.alpha);
+}
+
+// Blended in draw order with "one, one − source alpha".
+@fragment
+fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    return shade(in);
 }
