@@ -12,7 +12,7 @@ use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::DomSettings;
 use strandlight_runtime::passes::strands::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::render_frame;
+use strandlight_runtime::render::{self, RenderOptions, render_frame};
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum Shading {
@@ -67,6 +67,9 @@ pub struct RenderArgs {
     /// Deep opacity map resolution (square).
     #[arg(long, default_value_t = 512)]
     dom_size: u32,
+    /// A-buffer node buffer size, in nodes per pixel (clamped to the adapter's limit).
+    #[arg(long, default_value_t = 16)]
+    abuffer_nodes_per_pixel: u32,
     /// Image size WxH in pixels.
     #[arg(long, default_value = "512x512")]
     size: String,
@@ -127,12 +130,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         Shading::KajiyaKay => {}
         other => bail!("--shading {other:?} is not implemented yet; only kajiya-kay renders"),
     }
-    match args.transparency {
-        Transparency::None => {}
-        other => bail!(
-            "--transparency {other:?} is not implemented yet; only none (depth-tested, coverage blended in draw order)"
-        ),
-    }
+    let transparency = match args.transparency {
+        Transparency::None => render::Transparency::Opaque,
+        Transparency::Abuffer => render::Transparency::ABuffer {
+            nodes_per_pixel: args.abuffer_nodes_per_pixel,
+        },
+        Transparency::Dbk => {
+            bail!("--transparency dbk is not implemented yet (none and abuffer are)")
+        }
+    };
     let (width, height) = parse_size(&args.size)?;
     if let Some(w) = args.fiber_width_px {
         if !(w.is_finite() && w > 0.0) {
@@ -167,7 +173,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             spacing: args.dom_spacing.unwrap_or(model.bounds().diagonal() * 0.01),
         }),
     };
-    let rendered = render_frame(&gpu, &model, &frame, shadows)?;
+    let rendered = render_frame(
+        &gpu,
+        &model,
+        &frame,
+        &RenderOptions {
+            shadows,
+            transparency,
+        },
+    )?;
     let stem = output_stem(&args.out);
     let exr_path = stem.with_extension("exr");
     let png_path = stem.with_extension("png");
@@ -197,8 +211,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             "pass_ms": stats.timings.iter().map(|t| (t.pass.clone(), serde_json::json!(t.milliseconds))).collect::<serde_json::Map<_, _>>(),
             "gpu_memory_bytes": stats.memory_bytes.iter().map(|(n, b)| (n.clone(), serde_json::json!(b))).collect::<serde_json::Map<_, _>>(),
             "covered_pixels": covered,
-            "fragments_stored": null,
-            "fragments_dropped": null,
+            "fragments_stored": stats.fragments.map(|f| f.stored),
+            "fragments_dropped": stats.fragments.map(|f| f.dropped),
+            "fragments_truncated_at_resolve": stats.fragments.map(|f| f.truncated),
+            "abuffer_node_capacity": stats.fragments.map(|f| f.capacity),
             "outputs": { "exr": exr_path, "png": png_path, "png_tonemap": PNG_TONEMAP },
         });
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -211,6 +227,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         );
         for t in &stats.timings {
             println!("  {:<10} {:>9.2} ms", t.pass, t.milliseconds);
+        }
+        if let Some(f) = stats.fragments {
+            println!(
+                "A-buffer: {} fragments stored, {} dropped (node buffer holds {}), {} truncated at resolve (over 64 in a pixel)",
+                f.stored, f.dropped, f.capacity, f.truncated
+            );
         }
         println!(
             "wrote {} and {} ({covered} pixels covered)",

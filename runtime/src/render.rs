@@ -7,6 +7,7 @@ use crate::gpu::readback::ReadbackError;
 use crate::gpu::{AdapterReport, GpuContext, read_texture_rgba};
 use crate::hair::HairModel;
 use crate::lights::Light;
+use crate::passes::abuffer::ABufferPass;
 use crate::passes::deep_opacity::{
     DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError, light_camera,
 };
@@ -47,6 +48,35 @@ pub struct RenderStats {
     pub memory_bytes: Vec<(String, u64)>,
     pub segments: u32,
     pub timing_method: &'static str,
+    /// A-buffer only: fragments stored, dropped for a full node buffer, truncated at resolve.
+    pub fragments: Option<FragmentCounts>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FragmentCounts {
+    pub stored: u64,
+    pub dropped: u64,
+    pub truncated: u64,
+    pub capacity: u64,
+}
+
+/// How overlapping fibers combine.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Transparency {
+    /// Depth-tested, coverage blended in draw order (plain opaque rendering).
+    #[default]
+    Opaque,
+    /// Per-pixel linked lists sorted at resolve; `nodes_per_pixel` × pixels nodes (clamped to
+    /// the adapter's storage-binding limit).
+    ABuffer { nodes_per_pixel: u32 },
+}
+
+/// Everything besides the frame that changes how it is rendered.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderOptions {
+    /// Deep opacity maps for the first directional light.
+    pub shadows: Option<DomSettings>,
+    pub transparency: Transparency,
 }
 
 pub struct Frame {
@@ -79,9 +109,9 @@ pub fn render_frame(
     gpu: &GpuContext,
     model: &HairModel,
     frame: &FrameParams,
-    shadows: Option<DomSettings>,
+    options: &RenderOptions,
 ) -> Result<Frame, RenderError> {
-    let shadowed_light = match shadows {
+    let shadowed_light = match options.shadows {
         None => None,
         Some(settings) => {
             settings.check()?;
@@ -111,7 +141,6 @@ pub fn render_frame(
         StrandGeometry::upload(gpu, model)
     })?;
     let pass = timed(&mut timings, gpu, "pipeline", || StrandPass::new(gpu));
-    let target = RenderTarget::new(gpu, frame.width, frame.height);
     let mut memory_bytes = geometry.memory();
     let shadow_map = match shadowed_light {
         None => None,
@@ -131,16 +160,43 @@ pub fn render_frame(
         map,
         light_index: *light_index,
     });
-    timed(&mut timings, gpu, "strands", || {
-        pass.draw(gpu, &geometry, frame, &target, shadow)
-    });
-    let pixels = timed(&mut timings, gpu, "readback", || {
-        read_texture_rgba(gpu, &target.color)
-    })?;
+    let mut fragments = None;
+    let pixels = match options.transparency {
+        Transparency::Opaque => {
+            let target = RenderTarget::new(gpu, frame.width, frame.height);
+            timed(&mut timings, gpu, "strands", || {
+                pass.draw(gpu, &geometry, frame, &target, shadow)
+            });
+            memory_bytes.extend(target.memory());
+            timed(&mut timings, gpu, "readback", || {
+                read_texture_rgba(gpu, &target.color)
+            })?
+        }
+        Transparency::ABuffer { nodes_per_pixel } => {
+            let abuffer = timed(&mut timings, gpu, "abuffer pipeline", || {
+                ABufferPass::new(gpu)
+            });
+            let wanted = frame.width as u64 * frame.height as u64 * nodes_per_pixel as u64;
+            let capacity = ABufferPass::max_capacity(gpu, wanted);
+            let out = timed(
+                &mut timings,
+                gpu,
+                "abuffer build + resolve + readback",
+                || abuffer.draw(gpu, &geometry, frame, shadow, capacity),
+            )?;
+            memory_bytes.extend(out.memory_bytes);
+            fragments = Some(FragmentCounts {
+                stored: out.fragments_stored,
+                dropped: out.fragments_dropped,
+                truncated: out.fragments_truncated,
+                capacity: capacity as u64,
+            });
+            out.pixels
+        }
+    };
     if let Some(error) = pollster::block_on(scope.pop()) {
         return Err(RenderError::Gpu(error.to_string()));
     }
-    memory_bytes.extend(target.memory());
     Ok(Frame {
         width: frame.width,
         height: frame.height,
@@ -151,6 +207,7 @@ pub fn render_frame(
             memory_bytes,
             segments: geometry.segment_count,
             timing_method: "CPU wall clock around submit + wait for idle",
+            fragments,
         },
     })
 }

@@ -8,7 +8,7 @@ use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::strands::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::render_frame;
+use strandlight_runtime::render::{RenderOptions, render_frame};
 
 const SIZE: u32 = 64;
 
@@ -125,7 +125,7 @@ fn a_single_strand_matches_cpu_kajiya_kay_under_three_lights() {
         shading,
         width_override_px: Some(4.0),
     };
-    let out = render_frame(&gpu, &model, &frame, None).unwrap();
+    let out = render_frame(&gpu, &model, &frame, &RenderOptions::default()).unwrap();
     let e = [0.0, 0.0, 1.0];
     let (kd, ks, p) = (0.6, 0.4, 20.0);
     let mut worst = 0.0f64;
@@ -242,13 +242,25 @@ fn coverage_alpha_of_sub_pixel_strands_integrates_to_their_width() {
     );
 
     // The user's width.
-    let out = render_frame(&gpu, &vertical, &params(ortho_camera(), Some(0.37)), None).unwrap();
+    let out = render_frame(
+        &gpu,
+        &vertical,
+        &params(ortho_camera(), Some(0.37)),
+        &RenderOptions::default(),
+    )
+    .unwrap();
     let (mean, spread) = mean_row_alpha(&out, 12..52);
     eprintln!("user width 0.37 px: row alpha sum mean {mean:.6}, max deviation {spread:.2e}");
     assert!((mean - 0.37).abs() < 1e-4 && spread < 1e-4);
 
     // The file's thickness 0.02 at 32 px per unit: 0.64 px.
-    let out = render_frame(&gpu, &vertical, &params(ortho_camera(), None), None).unwrap();
+    let out = render_frame(
+        &gpu,
+        &vertical,
+        &params(ortho_camera(), None),
+        &RenderOptions::default(),
+    )
+    .unwrap();
     let (mean, spread) = mean_row_alpha(&out, 12..52);
     eprintln!(
         "thickness 0.02 orthographic (0.64 px): row alpha sum mean {mean:.6}, max deviation {spread:.2e}"
@@ -264,7 +276,13 @@ fn coverage_alpha_of_sub_pixel_strands_integrates_to_their_width() {
     let expected = 0.02 * (SIZE as f64 / 2.0) / (5.0 * (fov / 2.0).tan());
     let xp = Vec3::new((0.3 / 32.0 * 5.0 * (fov / 2.0).tan()) as f32, 0.0, 0.0);
     let strand = straight_strand(xp - Vec3::Y, xp + Vec3::Y, 5, Some(0.02), white);
-    let out = render_frame(&gpu, &strand, &params(perspective, None), None).unwrap();
+    let out = render_frame(
+        &gpu,
+        &strand,
+        &params(perspective, None),
+        &RenderOptions::default(),
+    )
+    .unwrap();
     let (mean, spread) = mean_row_alpha(&out, 12..52);
     eprintln!(
         "thickness 0.02 perspective ({expected:.4} px): row alpha sum mean {mean:.6}, max deviation {spread:.2e}"
@@ -275,7 +293,13 @@ fn coverage_alpha_of_sub_pixel_strands_integrates_to_their_width() {
     let angle = 30f64.to_radians();
     let half = Vec3::new(angle.sin() as f32, angle.cos() as f32, 0.0) * 0.9;
     let slanted = straight_strand(-half, half, 7, None, white);
-    let out = render_frame(&gpu, &slanted, &params(ortho_camera(), Some(0.5)), None).unwrap();
+    let out = render_frame(
+        &gpu,
+        &slanted,
+        &params(ortho_camera(), Some(0.5)),
+        &RenderOptions::default(),
+    )
+    .unwrap();
     let (mean, spread) = mean_row_alpha(&out, 12..52);
     let expected = 0.5 / angle.cos();
     eprintln!(
