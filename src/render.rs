@@ -70,6 +70,9 @@ pub struct RenderArgs {
     /// A-buffer node buffer size, in nodes per pixel (clamped to the adapter's limit).
     #[arg(long, default_value_t = 16)]
     abuffer_nodes_per_pixel: u32,
+    /// DBK layer depth Δ in world units (default: 5% of the hair's bounding-box diagonal).
+    #[arg(long)]
+    dbk_delta: Option<f32>,
     /// Image size WxH in pixels.
     #[arg(long, default_value = "512x512")]
     size: String,
@@ -135,9 +138,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         Transparency::Abuffer => render::Transparency::ABuffer {
             nodes_per_pixel: args.abuffer_nodes_per_pixel,
         },
-        Transparency::Dbk => {
-            bail!("--transparency dbk is not implemented yet (none and abuffer are)")
-        }
+        Transparency::Dbk => render::Transparency::Dbk {
+            nodes_per_pixel: args.abuffer_nodes_per_pixel,
+            delta: args.dbk_delta.unwrap_or(0.0),
+        },
     };
     let (width, height) = parse_size(&args.size)?;
     if let Some(w) = args.fiber_width_px {
@@ -150,7 +154,21 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         .iter()
         .map(|s| Light::parse(s))
         .collect::<Result<Vec<_>, _>>()?;
+    if let Some(d) = args.dbk_delta {
+        if !(d.is_finite() && d >= 0.0) {
+            bail!("--dbk-delta {d}: must be a non-negative number of world units");
+        }
+    }
     let (model, source) = load_hair(args.hair.as_deref())?;
+    let transparency = match transparency {
+        render::Transparency::Dbk {
+            nodes_per_pixel, ..
+        } => render::Transparency::Dbk {
+            nodes_per_pixel,
+            delta: args.dbk_delta.unwrap_or(model.bounds().diagonal() * 0.05),
+        },
+        other => other,
+    };
     let gpu = GpuContext::new_headless()?;
     let camera = Camera::framing(
         model.bounds(),

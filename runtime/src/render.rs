@@ -7,7 +7,7 @@ use crate::gpu::readback::ReadbackError;
 use crate::gpu::{AdapterReport, GpuContext, read_texture_rgba};
 use crate::hair::HairModel;
 use crate::lights::Light;
-use crate::passes::abuffer::ABufferPass;
+use crate::passes::abuffer::{ABufferPass, ListMode};
 use crate::passes::deep_opacity::{
     DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError, light_camera,
 };
@@ -69,6 +69,9 @@ pub enum Transparency {
     /// Per-pixel linked lists sorted at resolve; `nodes_per_pixel` × pixels nodes (clamped to
     /// the adapter's storage-binding limit).
     ABuffer { nodes_per_pixel: u32 },
+    /// DBK-buffer: lists for fragments within `delta` (world units of view depth) behind each
+    /// pixel's nearest fiber, an opaque fallback for the rest.
+    Dbk { nodes_per_pixel: u32, delta: f32 },
 }
 
 /// Everything besides the frame that changes how it is rendered.
@@ -172,7 +175,14 @@ pub fn render_frame(
                 read_texture_rgba(gpu, &target.color)
             })?
         }
-        Transparency::ABuffer { nodes_per_pixel } => {
+        Transparency::ABuffer { nodes_per_pixel }
+        | Transparency::Dbk {
+            nodes_per_pixel, ..
+        } => {
+            let list_mode = match options.transparency {
+                Transparency::Dbk { delta, .. } => ListMode::Dbk { delta },
+                _ => ListMode::All,
+            };
             let abuffer = timed(&mut timings, gpu, "abuffer pipeline", || {
                 ABufferPass::new(gpu)
             });
@@ -182,7 +192,7 @@ pub fn render_frame(
                 &mut timings,
                 gpu,
                 "abuffer build + resolve + readback",
-                || abuffer.draw(gpu, &geometry, frame, shadow, capacity),
+                || abuffer.draw(gpu, &geometry, frame, shadow, capacity, list_mode),
             )?;
             memory_bytes.extend(out.memory_bytes);
             fragments = Some(FragmentCounts {

@@ -8,7 +8,7 @@ use strandlight_runtime::camera::{Camera, Projection};
 use strandlight_runtime::gpu::{GpuContext, read_texture_rgba};
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::lights::Light;
-use strandlight_runtime::passes::abuffer::ABufferPass;
+use strandlight_runtime::passes::abuffer::{ABufferPass, ListMode};
 use strandlight_runtime::passes::strands::{
     FrameParams, KajiyaKay, RenderTarget, StrandGeometry, StrandPass,
 };
@@ -81,7 +81,8 @@ fn abuffer_composites_in_depth_order_and_counts_fragments() {
     let back = (-0.2f32, Vec3::new(0.1, 0.3, 0.9));
     let run = |list: &[(f32, Vec3)], capacity| {
         let geometry = StrandGeometry::upload(&gpu, &strands(list)).unwrap();
-        pass.draw(&gpu, &geometry, &frame, None, capacity).unwrap()
+        pass.draw(&gpu, &geometry, &frame, None, capacity, ListMode::All)
+            .unwrap()
     };
 
     // One strand: the resolve equals hardware "over" onto black.
@@ -149,4 +150,88 @@ fn abuffer_composites_in_depth_order_and_counts_fragments() {
     );
     assert_eq!(small.fragments_stored, 10);
     assert_eq!(small.fragments_dropped, 2 * COVERED_ROWS - 10);
+}
+
+/// DBK with Δ covering the whole volume equals the A-buffer pixel for pixel; with Δ smaller
+/// than the gap between two strands, the front one is listed, the back one falls back to the
+/// opaque target, and the composite is still front + (1 − α_front)·back.
+#[test]
+fn dbk_agrees_with_the_abuffer() {
+    let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+    let pass = ABufferPass::new(&gpu);
+    let capacity = ABufferPass::max_capacity(&gpu, 1 << 16);
+    let front = (0.2f32, Vec3::new(0.8, 0.2, 0.1));
+    let back = (-0.2f32, Vec3::new(0.1, 0.3, 0.9));
+    let middle = (0.0f32, Vec3::new(0.2, 0.9, 0.2));
+    for (name, frame) in [
+        ("orthographic", frame()),
+        (
+            "perspective",
+            FrameParams {
+                camera: Camera {
+                    projection: Projection::Perspective { fov_y: 0.5 },
+                    ..camera()
+                },
+                ..frame()
+            },
+        ),
+    ] {
+        let geometry = StrandGeometry::upload(&gpu, &strands(&[back, front, middle])).unwrap();
+        let reference = pass
+            .draw(&gpu, &geometry, &frame, None, capacity, ListMode::All)
+            .unwrap();
+        let whole = pass
+            .draw(
+                &gpu,
+                &geometry,
+                &frame,
+                None,
+                capacity,
+                ListMode::Dbk { delta: 100.0 },
+            )
+            .unwrap();
+        let max_diff = |a: &[[f32; 4]], b: &[[f32; 4]]| {
+            a.iter()
+                .zip(b)
+                .flat_map(|(p, q)| (0..4).map(move |k| (p[k] - q[k]).abs()))
+                .fold(0.0f32, f32::max)
+        };
+        let whole_diff = max_diff(&whole.pixels, &reference.pixels);
+        assert_eq!(whole.fragments_stored, reference.fragments_stored, "{name}");
+        assert!(
+            whole_diff < 1e-6,
+            "{name}: DBK(Δ = all) vs A-buffer differ by {whole_diff}"
+        );
+
+        // Two strands 0.4 apart, Δ = 0.1: one listed fragment per row, the other in the fallback.
+        let pair = StrandGeometry::upload(&gpu, &strands(&[back, front])).unwrap();
+        let reference = pass
+            .draw(&gpu, &pair, &frame, None, capacity, ListMode::All)
+            .unwrap();
+        let thin = pass
+            .draw(
+                &gpu,
+                &pair,
+                &frame,
+                None,
+                capacity,
+                ListMode::Dbk { delta: 0.1 },
+            )
+            .unwrap();
+        let thin_diff = max_diff(&thin.pixels, &reference.pixels);
+        eprintln!(
+            "{name}: DBK(Δ = all) vs A-buffer max |Δ| {whole_diff:.2e} ({} fragments); DBK(Δ = 0.1) vs A-buffer on two strands max |Δ| {thin_diff:.2e}, {} listed of {}",
+            whole.fragments_stored, thin.fragments_stored, reference.fragments_stored
+        );
+        let front_alone = StrandGeometry::upload(&gpu, &strands(&[front])).unwrap();
+        let front_fragments = pass
+            .draw(&gpu, &front_alone, &frame, None, capacity, ListMode::All)
+            .unwrap()
+            .fragments_stored;
+        assert_eq!(
+            thin.fragments_stored, front_fragments,
+            "{name}: only the front strand is listed"
+        );
+        assert!(thin_diff < 1e-6, "{name}");
+    }
 }

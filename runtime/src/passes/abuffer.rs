@@ -39,8 +39,21 @@ struct Params {
     _pad: [u32; 2],
 }
 
+/// Which fragments go into the lists.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ListMode {
+    /// Every fragment (A-buffer).
+    All,
+    /// DBK-buffer: fragments within `delta` (view depth, world units) of the pixel's nearest
+    /// fiber; the rest fall back to an opaque depth-tested target composited underneath.
+    Dbk { delta: f32 },
+}
+
 pub struct ABufferPass {
     build: wgpu::RenderPipeline,
+    dbk_build: wgpu::RenderPipeline,
+    depth_prepass: wgpu::RenderPipeline,
+    dbk_layout: wgpu::BindGroupLayout,
     resolve: wgpu::ComputePipeline,
     strand_layout: wgpu::BindGroupLayout,
     shadow_layout: wgpu::BindGroupLayout,
@@ -157,6 +170,16 @@ impl ABufferPass {
                 storage_entry(2, compute, false),
                 storage_entry(3, compute, false),
                 uniform_entry(4, compute),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: compute,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
             ],
         });
         let resolve_pipeline_layout =
@@ -173,13 +196,190 @@ impl ABufferPass {
             compilation_options: Default::default(),
             cache: None,
         });
+        let dbk_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dbk"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: frag,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                uniform_entry(1, frag),
+            ],
+        });
+        let depth_tested = wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        };
+        let primitive = wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            cull_mode: None,
+            ..Default::default()
+        };
+        let vertex = wgpu::VertexState {
+            module: &build_shader,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        };
+        let prepass_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("dbk depth prepass"),
+            bind_group_layouts: &[Some(&strand_layout)],
+            immediate_size: 0,
+        });
+        let depth_prepass = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("dbk depth prepass"),
+            layout: Some(&prepass_layout),
+            vertex: vertex.clone(),
+            fragment: None,
+            primitive,
+            depth_stencil: Some(depth_tested.clone()),
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        let dbk_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("dbk build"),
+            bind_group_layouts: &[
+                Some(&strand_layout),
+                Some(&shadow_layout),
+                Some(&lists_layout),
+                Some(&dbk_layout),
+            ],
+            immediate_size: 0,
+        });
+        let dbk_build = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("dbk build"),
+            layout: Some(&dbk_pipeline_layout),
+            vertex,
+            fragment: Some(wgpu::FragmentState {
+                module: &build_shader,
+                entry_point: Some("fs_dbk"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: gpu.hdr_format(),
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            primitive,
+            depth_stencil: Some(depth_tested),
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
         Self {
             build,
+            dbk_build,
+            depth_prepass,
+            dbk_layout,
             resolve,
             strand_layout,
             shadow_layout,
             lists_layout,
         }
+    }
+
+    /// DBK: the nearest-depth prepass, then the build that sorts fragments into the lists or
+    /// the depth-tested fallback.
+    #[allow(clippy::too_many_arguments)]
+    fn encode_dbk(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        delta: f32,
+        nearest_depth: &wgpu::Texture,
+        target: &RenderTarget,
+        [strands, shadows, lists]: [&wgpu::BindGroup; 3],
+    ) {
+        let device = &gpu.device;
+        let nearest_view = nearest_depth.create_view(&Default::default());
+        let camera = &frame.camera;
+        let dbk_params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("dbk params"),
+            contents: bytemuck::cast_slice(&[
+                camera.near,
+                camera.far,
+                delta,
+                f32::from_bits(camera.is_perspective() as u32),
+            ]),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let dbk_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("dbk"),
+            layout: &self.dbk_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&nearest_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: dbk_params.as_entire_binding(),
+                },
+            ],
+        });
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("dbk depth prepass"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &nearest_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.depth_prepass);
+            pass.set_bind_group(0, strands, &[]);
+            pass.draw(0..6, 0..geometry.segment_count);
+        }
+        let color_view = target.color.create_view(&Default::default());
+        let depth_view = target.depth.create_view(&Default::default());
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("dbk build"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &color_view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.dbk_build);
+        pass.set_bind_group(0, strands, &[]);
+        pass.set_bind_group(1, shadows, &[]);
+        pass.set_bind_group(2, lists, &[]);
+        pass.set_bind_group(3, &dbk_group, &[]);
+        pass.draw(0..6, 0..geometry.segment_count);
     }
 
     /// The node capacity the adapter's storage-binding limit allows, at most `wanted`.
@@ -196,6 +396,7 @@ impl ABufferPass {
         frame: &FrameParams,
         shadow: Option<ShadowInput<'_>>,
         capacity: u32,
+        mode: ListMode,
     ) -> Result<ABufferFrame, ReadbackError> {
         let device = &gpu.device;
         let (width, height) = (frame.width, frame.height);
@@ -243,14 +444,34 @@ impl ABufferPass {
                 _pad: [0; 2],
             },
         );
+        let is_dbk = matches!(mode, ListMode::Dbk { .. });
         let resolve_params = uniform(
             "abuffer resolve params",
             Params {
                 a: width,
                 b: height,
-                _pad: [0; 2],
+                _pad: [is_dbk as u32, 0],
             },
         );
+        let target = RenderTarget::new(gpu, width, height);
+        let nearest = RenderTarget::new(gpu, 1, 1);
+        let nearest_depth = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("dbk nearest depth"),
+            size: target.depth.size(),
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        // The A-buffer binds a 1×1 fallback it never reads.
+        let fallback = if is_dbk {
+            &target.color
+        } else {
+            &nearest.color
+        };
+        let fallback_view = fallback.create_view(&Default::default());
         let strands = strand_bind_group(gpu, &self.strand_layout, geometry, frame);
         let shadows = shadow_bind_group(gpu, &self.shadow_layout, frame, shadow);
         let lists = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -299,12 +520,26 @@ impl ABufferPass {
                     binding: 4,
                     resource: resolve_params.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&fallback_view),
+                },
             ],
         });
-        let target = RenderTarget::new(gpu, width, height);
         let depth_view = target.depth.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
-        {
+        if let ListMode::Dbk { delta } = mode {
+            self.encode_dbk(
+                gpu,
+                &mut encoder,
+                geometry,
+                frame,
+                delta,
+                &nearest_depth,
+                &target,
+                [&strands, &shadows, &lists],
+            );
+        } else {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("abuffer build"),
                 color_attachments: &[],
@@ -353,7 +588,25 @@ impl ABufferPass {
                 ("abuffer nodes".into(), nodes.size()),
                 ("abuffer resolved".into(), resolved.size()),
                 ("depth".into(), pixels * 4),
-            ],
+            ]
+            .into_iter()
+            .chain(
+                is_dbk
+                    .then(|| {
+                        vec![
+                            ("dbk nearest depth".to_string(), pixels * 4),
+                            (
+                                "dbk fallback colour".to_string(),
+                                pixels
+                                    * target.color.format().block_copy_size(None).unwrap_or(16)
+                                        as u64,
+                            ),
+                        ]
+                    })
+                    .into_iter()
+                    .flatten(),
+            )
+            .collect(),
         })
     }
 }

@@ -25,6 +25,8 @@ const MAX_SORTED: u32 = 64u;
 // Fragments beyond MAX_SORTED in one pixel, left out of the composite.
 @group(0) @binding(3) var<storage, read_write> truncated: atomic<u32>;
 @group(0) @binding(4) var<uniform> params: ResolveParams;
+// DBK: the opaque fallback drawn beyond the layer (params._pad0 = 1); unused for the A-buffer.
+@group(0) @binding(5) var fallback: texture_2d<f32>;
 
 @compute @workgroup_size(8, 8)
 fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -55,6 +57,9 @@ fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
     var sum = vec4<f32>(0.0);
     for (var k = 0u; k < count; k++) {
         sum += (1.0 - sum.a) * colors[k];
+    }
+    if (params._pad0 != 0u) {
+        sum += (1.0 - sum.a) * textureLoad(fallback, vec2<i32>(id.xy), 0);
     }
     resolved[pixel] = sum;
 }

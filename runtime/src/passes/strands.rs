@@ -228,7 +228,9 @@ impl RenderTarget {
             color: texture(
                 "hdr colour",
                 gpu.hdr_format(),
-                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::COPY_SRC
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
             ),
             depth: texture(
                 "depth",
