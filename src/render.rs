@@ -144,20 +144,20 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         },
     };
     let (width, height) = parse_size(&args.size)?;
-    if let Some(w) = args.fiber_width_px {
-        if !(w.is_finite() && w > 0.0) {
-            bail!("--fiber-width-px {w}: must be a positive number of pixels");
-        }
+    if let Some(w) = args.fiber_width_px
+        && !(w.is_finite() && w > 0.0)
+    {
+        bail!("--fiber-width-px {w}: must be a positive number of pixels");
     }
     let lights = args
         .lights
         .iter()
         .map(|s| Light::parse(s))
         .collect::<Result<Vec<_>, _>>()?;
-    if let Some(d) = args.dbk_delta {
-        if !(d.is_finite() && d >= 0.0) {
-            bail!("--dbk-delta {d}: must be a non-negative number of world units");
-        }
+    if let Some(d) = args.dbk_delta
+        && !(d.is_finite() && d >= 0.0)
+    {
+        bail!("--dbk-delta {d}: must be a non-negative number of world units");
     }
     let (model, source) = load_hair(args.hair.as_deref())?;
     let transparency = match transparency {

@@ -140,6 +140,22 @@ pub fn write_png(
     })
 }
 
+/// EXR text is Latin-1: other characters (×, λ) are written as `<U+00D7>`.
+fn latin1_text(s: &str) -> exr::meta::attribute::Text {
+    let latin1: String = s
+        .chars()
+        .map(|c| {
+            if (c as u32) < 256 {
+                c.to_string()
+            } else {
+                format!("<U+{:04X}>", c as u32)
+            }
+        })
+        .collect();
+    exr::meta::attribute::Text::new_or_none(latin1)
+        .unwrap_or_else(|| exr::meta::attribute::Text::new_or_panic("(text)"))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -189,20 +205,4 @@ mod tests {
         ));
         std::fs::remove_dir_all(&dir).ok();
     }
-}
-
-/// EXR text is Latin-1: other characters (×, λ) are written as `<U+00D7>`.
-fn latin1_text(s: &str) -> exr::meta::attribute::Text {
-    let latin1: String = s
-        .chars()
-        .map(|c| {
-            if (c as u32) < 256 {
-                c.to_string()
-            } else {
-                format!("<U+{:04X}>", c as u32)
-            }
-        })
-        .collect();
-    exr::meta::attribute::Text::new_or_none(latin1)
-        .unwrap_or_else(|| exr::meta::attribute::Text::new_or_panic("(text)"))
 }

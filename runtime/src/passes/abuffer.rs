@@ -384,7 +384,7 @@ impl ABufferPass {
 
     /// The node capacity the adapter's storage-binding limit allows, at most `wanted`.
     pub fn max_capacity(gpu: &GpuContext, wanted: u64) -> u32 {
-        let limit = gpu.device.limits().max_storage_buffer_binding_size as u64 / NODE_BYTES;
+        let limit = gpu.device.limits().max_storage_buffer_binding_size / NODE_BYTES;
         wanted.min(limit).min(u32::MAX as u64 - 1) as u32
     }
 

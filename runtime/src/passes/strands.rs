@@ -441,7 +441,8 @@ pub fn strand_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout 
         },
         count: None,
     };
-    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("strands"),
         entries: &[
             wgpu::BindGroupLayoutEntry {
@@ -459,8 +460,7 @@ pub fn strand_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout 
             storage(3),
             storage(4),
         ],
-    });
-    layout
+    })
 }
 
 /// Group 0's resources for `geometry` seen through `frame`.
@@ -486,7 +486,8 @@ pub fn strand_bind_group(
         contents: bytemuck::cast_slice(&lights),
         usage: wgpu::BufferUsages::STORAGE,
     });
-    let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("strands"),
         layout,
         entries: &[
@@ -511,8 +512,7 @@ pub fn strand_bind_group(
                 resource: lights.as_entire_binding(),
             },
         ],
-    });
-    bind_group
+    })
 }
 
 /// Group 1 of the shading passes: the deep opacity map of one light, or a 1×1 placeholder.
@@ -560,7 +560,8 @@ pub fn shadow_bind_group(
         map.layers[0].create_view(&Default::default()),
         map.layers[1].create_view(&Default::default()),
     ];
-    let shadow_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("strand shadows"),
         layout,
         entries: &[
@@ -581,8 +582,7 @@ pub fn shadow_bind_group(
                 resource: shadow_buffer.as_entire_binding(),
             },
         ],
-    });
-    shadow_group
+    })
 }
 
 #[cfg(test)]
@@ -597,7 +597,7 @@ mod tests {
         assert_eq!(
             t,
             vec![
-                0 | FIRST_SEGMENT_BIT,
+                FIRST_SEGMENT_BIT,
                 1 | LAST_SEGMENT_BIT,
                 3 | FIRST_SEGMENT_BIT | LAST_SEGMENT_BIT
             ]
