@@ -143,7 +143,6 @@ pub fn render_frame(
     let geometry = timed(&mut timings, gpu, "upload", || {
         StrandGeometry::upload(gpu, model)
     })?;
-    let pass = timed(&mut timings, gpu, "pipeline", || StrandPass::new(gpu));
     let mut memory_bytes = geometry.memory();
     let shadow_map = match shadowed_light {
         None => None,
@@ -166,6 +165,9 @@ pub fn render_frame(
     let mut fragments = None;
     let pixels = match options.transparency {
         Transparency::Opaque => {
+            let pass = timed(&mut timings, gpu, "strand pipeline", || {
+                StrandPass::new(gpu)
+            });
             let target = RenderTarget::new(gpu, frame.width, frame.height);
             timed(&mut timings, gpu, "strands", || {
                 pass.draw(gpu, &geometry, frame, &target, shadow)
