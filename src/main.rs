@@ -2,6 +2,7 @@
 //! lives in the library crates.
 
 mod fit;
+mod render;
 mod summary;
 mod sweep;
 mod tables_cmd;
@@ -9,7 +10,11 @@ mod tables_cmd;
 use clap::{Parser, Subcommand};
 
 #[derive(Parser)]
-#[command(name = "strandlight", version, about = "Strand hair under environment lighting (Ren et al. 2010)")]
+#[command(
+    name = "strandlight",
+    version,
+    about = "Strand hair under environment lighting (Ren et al. 2010)"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Option<Command>,
@@ -29,6 +34,8 @@ enum Command {
     CheckTables(tables_cmd::CheckArgs),
     /// Describe a baked table; optionally write its tiled slices as PNG and EXR.
     Inspect(tables_cmd::InspectArgs),
+    /// Render a hair model headless under point lights to EXR (linear) and PNG (tonemapped).
+    Render(render::RenderArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -41,5 +48,6 @@ fn main() -> anyhow::Result<()> {
         Command::Bake(args) => tables_cmd::bake(args),
         Command::CheckTables(args) => tables_cmd::check(args),
         Command::Inspect(args) => tables_cmd::inspect(args),
+        Command::Render(args) => render::run(args),
     }
 }

@@ -1,3 +1,9 @@
 //! The wgpu runtime: hair input, render passes, and the brute-force reference renderer.
 
+pub mod camera;
+pub mod gpu;
 pub mod hair;
+pub mod image_out;
+pub mod lights;
+pub mod passes;
+pub mod render;

@@ -48,7 +48,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let n = 2_000_000;
     let points: Vec<[f64; 4]> = (0..n)
-        .map(|_| [2.0 * next() - 1.0, 2.0 * next() - 1.0, 2.0 * next() - 1.0, next()])
+        .map(|_| {
+            [
+                2.0 * next() - 1.0,
+                2.0 * next() - 1.0,
+                2.0 * next() - 1.0,
+                next(),
+            ]
+        })
         .collect();
     let t = Instant::now();
     let mut sum = 0.0f64;

@@ -54,7 +54,10 @@ impl FiberAngles {
 
 /// Inclination of `w` from the plane normal to unit `u`; clamped so rounding never gives NaN.
 pub fn inclination(u: DVec3, w: DVec3) -> f64 {
-    u.dot(w).clamp(-1.0, 1.0).asin().clamp(-FRAC_PI_2, FRAC_PI_2)
+    u.dot(w)
+        .clamp(-1.0, 1.0)
+        .asin()
+        .clamp(-FRAC_PI_2, FRAC_PI_2)
 }
 
 /// Wraps an angle to (−π, π].
@@ -68,7 +71,11 @@ pub fn wrap_angle(a: f64) -> f64 {
 
 /// A unit direction from fiber-frame angles, with the tangent along +z and φ = 0 along +x.
 pub fn direction(theta: f64, phi: f64) -> DVec3 {
-    DVec3::new(theta.cos() * phi.cos(), theta.cos() * phi.sin(), theta.sin())
+    DVec3::new(
+        theta.cos() * phi.cos(),
+        theta.cos() * phi.sin(),
+        theta.sin(),
+    )
 }
 
 #[cfg(test)]
@@ -80,7 +87,8 @@ mod tests {
         let u = DVec3::Z;
         for &(ti, to, phi) in &[(0.3, -0.2, 1.0), (-1.2, 1.4, -2.9), (0.0, 0.0, PI)] {
             let phi_i = 0.7;
-            let a = FiberAngles::from_directions(u, direction(ti, phi_i), direction(to, phi_i + phi));
+            let a =
+                FiberAngles::from_directions(u, direction(ti, phi_i), direction(to, phi_i + phi));
             assert!((a.theta_i - ti).abs() < 1e-12);
             assert!((a.theta_o - to).abs() < 1e-12);
             assert!((a.phi - wrap_angle(phi)).abs() < 1e-12, "{a:?}");
@@ -93,7 +101,10 @@ mod tests {
             let a = k as f64 * 0.77;
             let w = wrap_angle(a);
             assert!(w > -PI && w <= PI);
-            assert!(((a - w) / (2.0 * PI)).fract().abs() < 1e-9 || ((a - w) / (2.0 * PI)).fract().abs() > 1.0 - 1e-9);
+            assert!(
+                ((a - w) / (2.0 * PI)).fract().abs() < 1e-9
+                    || ((a - w) / (2.0 * PI)).fract().abs() > 1.0 - 1e-9
+            );
         }
     }
 }

@@ -292,7 +292,10 @@ fn encode_payload(path: &Path, table: &Table, storage: Storage) -> Result<Vec<u8
 }
 
 fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
+    Sha256::digest(bytes)
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
 }
 
 /// Reads and checks an asset: header, metadata, shape, payload size and checksum.
@@ -309,13 +312,15 @@ pub fn read_asset(path: &Path) -> Result<TableAsset, AssetError> {
         });
     }
     let values = decode_payload(&payload, metadata.payload.storage);
-    let table =
-        Table::new(metadata.payload.axes.clone(), metadata.payload.channels, values).map_err(|source| {
-            AssetError::InvalidShape {
-                path: path.clone(),
-                source,
-            }
-        })?;
+    let table = Table::new(
+        metadata.payload.axes.clone(),
+        metadata.payload.channels,
+        values,
+    )
+    .map_err(|source| AssetError::InvalidShape {
+        path: path.clone(),
+        source,
+    })?;
     Ok(TableAsset {
         path,
         metadata,
@@ -359,7 +364,8 @@ impl OpenedAsset {
         }
         let mut header = [0u8; HEADER_BYTES as usize];
         let header_len = file_len.min(HEADER_BYTES) as usize;
-        file.read_exact(&mut header[..header_len]).map_err(io_error)?;
+        file.read_exact(&mut header[..header_len])
+            .map_err(io_error)?;
         if header[..8] != MAGIC {
             let found = header[..8].escape_ascii().to_string();
             return Err(AssetError::BadMagic {
@@ -438,17 +444,21 @@ impl OpenedAsset {
 
 /// Validates the shape (before any allocation) and returns the payload size it implies.
 fn check_payload_shape(path: &Path, info: &PayloadInfo) -> Result<u64, AssetError> {
-    let count =
-        checked_value_count(&info.axes, info.channels).map_err(|source| AssetError::InvalidShape {
+    let count = checked_value_count(&info.axes, info.channels).map_err(|source| {
+        AssetError::InvalidShape {
             path: path.to_path_buf(),
             source,
-        })?;
+        }
+    })?;
     let inconsistent = |problem| AssetError::Inconsistent {
         path: path.to_path_buf(),
         problem,
     };
     if info.layout != PAYLOAD_LAYOUT {
-        return Err(inconsistent(format!("unknown payload layout {:?}", info.layout)));
+        return Err(inconsistent(format!(
+            "unknown payload layout {:?}",
+            info.layout
+        )));
     }
     let expected = (count * info.storage.bytes_per_value()) as u64;
     if info.payload_bytes != expected {
@@ -497,7 +507,11 @@ pub fn expect_parameters(asset: &TableAsset, expected: &Value) -> Result<(), Ass
 }
 
 /// The first place two JSON values differ: (pointer, baked as text, expected as text).
-fn first_difference(baked: &Value, expected: &Value, pointer: String) -> Option<(String, String, String)> {
+fn first_difference(
+    baked: &Value,
+    expected: &Value,
+    pointer: String,
+) -> Option<(String, String, String)> {
     let differ = |p: String| Some((p, baked.to_string(), expected.to_string()));
     match (baked, expected) {
         (Value::Object(a), Value::Object(b)) => {
@@ -658,7 +672,8 @@ mod tests {
         assert!(worst_abs_sub <= 2f64.powi(-25));
         assert_eq!(
             std::fs::metadata(&path).unwrap().len(),
-            payload_offset(serde_json::to_vec_pretty(&asset.metadata).unwrap().len() as u64) + 60 * 3 * 2
+            payload_offset(serde_json::to_vec_pretty(&asset.metadata).unwrap().len() as u64)
+                + 60 * 3 * 2
         );
     }
 
@@ -708,7 +723,8 @@ mod tests {
     fn valid_bytes() -> (Vec<u8>, usize, usize) {
         let mut rng = Pcg64::seed_from_u64(5);
         let table = random_table(&mut rng, 1, 10.0);
-        let (_, head, payload) = encode_asset(Path::new("x"), &table, &description(), Storage::F32).unwrap();
+        let (_, head, payload) =
+            encode_asset(Path::new("x"), &table, &description(), Storage::F32).unwrap();
         let payload_start = head.len();
         ([head, payload].concat(), 16, payload_start)
     }
@@ -729,7 +745,10 @@ mod tests {
         std::fs::write(&path, bytes).unwrap();
         let err = read_asset(&path).unwrap_err();
         eprintln!("{name}: {err}");
-        assert!(err.to_string().contains(name), "error names the file: {err}");
+        assert!(
+            err.to_string().contains(name),
+            "error names the file: {err}"
+        );
         err
     }
 
@@ -739,8 +758,8 @@ mod tests {
         let (good, json_start, payload_start) = valid_bytes();
         std::fs::write(dir.join("good.sltab"), &good).unwrap();
         read_asset(&dir.join("good.sltab")).unwrap();
-        let json =
-            &good[json_start..json_start + u32::from_le_bytes(good[12..16].try_into().unwrap()) as usize];
+        let json = &good[json_start
+            ..json_start + u32::from_le_bytes(good[12..16].try_into().unwrap()) as usize];
         let payload = &good[payload_start..];
         let metadata: Value = serde_json::from_slice(json).unwrap();
 
@@ -842,7 +861,9 @@ mod tests {
         ));
 
         let err = read_asset(&dir.join("missing.sltab")).unwrap_err();
-        assert!(matches!(&err, AssetError::Io { source, .. } if source.kind() == io::ErrorKind::NotFound));
+        assert!(
+            matches!(&err, AssetError::Io { source, .. } if source.kind() == io::ErrorKind::NotFound)
+        );
         assert!(err.to_string().contains("missing.sltab"));
     }
 
@@ -880,7 +901,10 @@ mod tests {
         assert_eq!(mismatch(&w).0, "/eccentricity/a");
         let mut w = wanted.clone();
         w.as_object_mut().unwrap().remove("eta");
-        assert_eq!(mismatch(&w), ("/eta".into(), "1.55".into(), "absent".into()));
+        assert_eq!(
+            mismatch(&w),
+            ("/eta".into(), "1.55".into(), "absent".into())
+        );
         let mut w = wanted.clone();
         w["sigma_a"] = json!([0.432, 0.612, 0.98, 1.0]);
         assert_eq!(mismatch(&w).0, "/sigma_a");
@@ -910,7 +934,13 @@ mod tests {
         // An impossible destination is an Io error naming it, leaving nothing behind.
         let blocked = dir.join("not-a-folder");
         std::fs::write(&blocked, b"file").unwrap();
-        let err = write_asset(&blocked.join("t.sltab"), &table, &description(), Storage::F32).unwrap_err();
+        let err = write_asset(
+            &blocked.join("t.sltab"),
+            &table,
+            &description(),
+            Storage::F32,
+        )
+        .unwrap_err();
         assert!(
             matches!(err, AssetError::Io { .. }) && err.to_string().contains("not-a-folder"),
             "{err}"

@@ -41,9 +41,12 @@ fn parent_dir(path: &Path) -> &Path {
 }
 
 fn create_temp_beside(path: &Path) -> io::Result<(PathBuf, File)> {
-    let name = path
-        .file_name()
-        .ok_or_else(|| io::Error::new(io::ErrorKind::InvalidInput, "the destination has no file name"))?;
+    let name = path.file_name().ok_or_else(|| {
+        io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "the destination has no file name",
+        )
+    })?;
     let dir = parent_dir(path);
     loop {
         let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
@@ -110,7 +113,10 @@ pub(crate) mod tests {
 
     pub(crate) fn scratch_dir(label: &str) -> ScratchDir {
         let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
-        let dir = std::env::temp_dir().join(format!("strandlight-test-{label}-{}-{n}", std::process::id()));
+        let dir = std::env::temp_dir().join(format!(
+            "strandlight-test-{label}-{}-{n}",
+            std::process::id()
+        ));
         let _ = fs::remove_dir_all(&dir);
         fs::create_dir_all(&dir).unwrap();
         ScratchDir(dir)

@@ -41,7 +41,11 @@ impl GaussLegendre {
     }
 
     pub fn integrate(&self, mut f: impl FnMut(f64) -> f64) -> f64 {
-        self.nodes.iter().zip(&self.weights).map(|(&x, &w)| w * f(x)).sum()
+        self.nodes
+            .iter()
+            .zip(&self.weights)
+            .map(|(&x, &w)| w * f(x))
+            .sum()
     }
 
     /// The same rule repeated on `panels` equal sub-intervals: robust for peaked integrands.

@@ -86,7 +86,13 @@ impl SliceLayout {
                 let columns = (counts[2] as f64).sqrt().ceil() as usize;
                 (Some(1), TileGrid::Wrapped { axis: 2, columns })
             }
-            _ => (Some(1), TileGrid::Axes { columns: 2, rows: 3 }),
+            _ => (
+                Some(1),
+                TileGrid::Axes {
+                    columns: 2,
+                    rows: 3,
+                },
+            ),
         };
         let fixed = (4..d).map(|k| (k, counts[k] / 2)).collect();
         let largest = counts[0].max(y_axis.map_or(1, |y| counts[y]));
@@ -187,8 +193,8 @@ impl SlicePicture {
         }
         for (column, row, grid_held) in shape.tile_cells(layout) {
             let left = layout.gap as usize + column * (shape.tile_width + layout.gap as usize);
-            let top =
-                layout.gap as usize + (shape.rows - 1 - row) * (shape.tile_height + layout.gap as usize);
+            let top = layout.gap as usize
+                + (shape.rows - 1 - row) * (shape.tile_height + layout.gap as usize);
             for &(axis, node) in &grid_held {
                 index[axis] = node;
             }
@@ -198,7 +204,11 @@ impl SlicePicture {
                 }
                 for ix in 0..shape.nx {
                     index[layout.x_axis] = ix;
-                    let rgb = rgb_of(table.node(&index).expect("layout checked against the shape"));
+                    let rgb = rgb_of(
+                        table
+                            .node(&index)
+                            .expect("layout checked against the shape"),
+                    );
                     let (px, py) = (left + ix * s, top + (shape.ny - 1 - iy) * s);
                     for y in py..py + s {
                         for x in px..px + s {
@@ -253,11 +263,12 @@ impl SlicePicture {
             }),
         );
         let image = Image::from_layer(layer);
-        write_atomically(path, |w| image.write().to_buffered(w).map_err(io::Error::other)).map_err(|source| {
-            SliceError::Write {
-                path: path.to_path_buf(),
-                source,
-            }
+        write_atomically(path, |w| {
+            image.write().to_buffered(w).map_err(io::Error::other)
+        })
+        .map_err(|source| SliceError::Write {
+            path: path.to_path_buf(),
+            source,
         })
     }
 
@@ -395,7 +406,10 @@ impl Shape {
         if layout.pixels_per_node == 0 {
             return invalid("pixels_per_node must be at least 1".into());
         }
-        let (nx, ny) = (counts[layout.x_axis], layout.y_axis.map_or(1, |y| counts[y]));
+        let (nx, ny) = (
+            counts[layout.x_axis],
+            layout.y_axis.map_or(1, |y| counts[y]),
+        );
         let (columns, rows) = match layout.grid {
             TileGrid::Single => (1, 1),
             TileGrid::Axes { columns, rows } => (counts[columns], counts[rows]),
@@ -497,7 +511,8 @@ mod tests {
 
     /// Distinct value per node and channel, from the node index alone.
     fn value(index: &[usize], channel: usize) -> f32 {
-        1.0 + (index[0] + 3 * index[1] + 12 * index[2] + 24 * index.get(3).copied().unwrap_or(0)) as f32
+        1.0 + (index[0] + 3 * index[1] + 12 * index[2] + 24 * index.get(3).copied().unwrap_or(0))
+            as f32
             + 0.25 * channel as f32
     }
 
@@ -527,7 +542,9 @@ mod tests {
                     vec![[0.0f32; 3]; size.width() * size.height()],
                 )
             },
-            |(w, _, px): &mut (usize, usize, Vec<[f32; 3]>), p, (r, g, b, _a): (f32, f32, f32, f32)| {
+            |(w, _, px): &mut (usize, usize, Vec<[f32; 3]>),
+             p,
+             (r, g, b, _a): (f32, f32, f32, f32)| {
                 px[p.y() * *w + p.x()] = [r, g, b]
             },
         )
@@ -554,7 +571,10 @@ mod tests {
         let layout = SliceLayout {
             x_axis: 0,
             y_axis: Some(1),
-            grid: TileGrid::Axes { columns: 2, rows: 3 },
+            grid: TileGrid::Axes {
+                columns: 2,
+                rows: 3,
+            },
             fixed: vec![],
             pixels_per_node: 2,
             gap: 1,
@@ -566,7 +586,10 @@ mod tests {
         let (s, gap) = (2usize, 1usize);
         let (tile_w, tile_h) = (3 * s, 4 * s);
         let (width, height) = (gap + 2 * (tile_w + gap), gap + 3 * (tile_h + gap));
-        assert_eq!((picture.width as usize, picture.height as usize), (width, height));
+        assert_eq!(
+            (picture.width as usize, picture.height as usize),
+            (width, height)
+        );
 
         let (w, h, exr) = read_exr(&exr_path);
         assert_eq!((w, h), (width, height));
@@ -614,7 +637,9 @@ mod tests {
         );
 
         // The PNG names its tonemap and layout in text chunks.
-        let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png_path).unwrap()));
+        let decoder = png::Decoder::new(std::io::BufReader::new(
+            std::fs::File::open(&png_path).unwrap(),
+        ));
         let reader = decoder.read_info().unwrap();
         let text: Vec<(String, String)> = reader
             .info()
@@ -628,7 +653,10 @@ mod tests {
                 .map(|(_, v)| v.clone())
                 .unwrap()
         };
-        assert!(find("Tonemap").contains("sRGB") && find("Tonemap").contains(&format!("{:e}", max as f32)));
+        assert!(
+            find("Tonemap").contains("sRGB")
+                && find("Tonemap").contains(&format!("{:e}", max as f32))
+        );
         assert!(find("Description").contains("`a0·ξ`"));
     }
 
@@ -640,7 +668,10 @@ mod tests {
         let layout = SliceLayout {
             x_axis: 0,
             y_axis: Some(1),
-            grid: TileGrid::Wrapped { axis: 3, columns: 2 },
+            grid: TileGrid::Wrapped {
+                axis: 3,
+                columns: 2,
+            },
             fixed: vec![(2, 1)],
             pixels_per_node: 1,
             gap: 2,
@@ -696,7 +727,10 @@ mod tests {
         let t = table(&[2, 2, 3, 5], 1);
         let mut layout = SliceLayout::default_for(&t);
         assert!(SlicePicture::render(&t, &layout).is_ok());
-        layout.grid = TileGrid::Axes { columns: 2, rows: 2 };
+        layout.grid = TileGrid::Axes {
+            columns: 2,
+            rows: 2,
+        };
         assert!(matches!(
             SlicePicture::render(&t, &layout),
             Err(SliceError::InvalidLayout(_))
@@ -719,8 +753,9 @@ mod tests {
         let axes = [32, 32, 32, 64]
             .map(|n| Axis::uniform("x", -1.0, 1.0, n))
             .to_vec();
-        let layout =
-            SliceLayout::default_for(&Table::new(axes.clone(), 1, vec![0.0; 32 * 32 * 32 * 64]).unwrap());
+        let layout = SliceLayout::default_for(
+            &Table::new(axes.clone(), 1, vec![0.0; 32 * 32 * 32 * 64]).unwrap(),
+        );
         let shape = Shape::check(&axes, &layout).unwrap();
         eprintln!("I_M default picture: {} × {} px", shape.width, shape.height);
         assert_eq!((shape.width, shape.height), (1 + 32 * 33, 1 + 64 * 33));

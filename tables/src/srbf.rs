@@ -98,7 +98,9 @@ mod tests {
     fn lobe_integral_by_quadrature(lambda: f64, xi: DVec3) -> f64 {
         // Panels scale with the lobe width so narrow lobes are resolved.
         let panels = ((lambda.sqrt() * 4.0) as usize).clamp(8, 800);
-        integrate_sphere(panels, panels, |t, p| kernel(direction(t, p).dot(xi), lambda))
+        integrate_sphere(panels, panels, |t, p| {
+            kernel(direction(t, p).dot(xi), lambda)
+        })
     }
 
     #[test]

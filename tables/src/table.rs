@@ -56,12 +56,17 @@ pub enum TableError {
     ShapeMismatch { expected: usize, actual: usize },
     #[error("the table has {expected} axes but {actual} coordinates were given")]
     WrongCoordinateCount { expected: usize, actual: usize },
-    #[error("coordinate for axis `{axis}` is {value}; lookups need a number (±∞ clamps, NaN does not)")]
+    #[error(
+        "coordinate for axis `{axis}` is {value}; lookups need a number (±∞ clamps, NaN does not)"
+    )]
     NotFiniteCoordinate { axis: String, value: f64 },
     #[error("the table has {expected} channels but {actual} were asked for")]
     WrongChannelCount { expected: usize, actual: usize },
     #[error("node index {index:?} is outside the shape {shape:?}")]
-    NodeOutOfRange { index: Vec<usize>, shape: Vec<usize> },
+    NodeOutOfRange {
+        index: Vec<usize>,
+        shape: Vec<usize>,
+    },
 }
 
 /// How an axis spreads its nodes between `min` and `max`.
@@ -193,10 +198,16 @@ impl Axis {
             return fail(format!("range [{}, {}] is not finite", self.min, self.max));
         }
         if self.count > 1 && self.min >= self.max {
-            return fail(format!("range [{}, {}] must have min < max", self.min, self.max));
+            return fail(format!(
+                "range [{}, {}] must have min < max",
+                self.min, self.max
+            ));
         }
         if self.count == 1 && self.min > self.max {
-            return fail(format!("range [{}, {}] must have min ≤ max", self.min, self.max));
+            return fail(format!(
+                "range [{}, {}] must have min ≤ max",
+                self.min, self.max
+            ));
         }
         match self.mapping {
             AxisMapping::Power { exponent } if !(exponent.is_finite() && exponent > 0.0) => fail(format!(
@@ -603,7 +614,9 @@ mod tests {
     impl Multilinear {
         fn random(dims: usize, rng: &mut Pcg64) -> Self {
             Self {
-                coefficients: (0..1 << dims).map(|_| rng.random_range(-2.0..2.0)).collect(),
+                coefficients: (0..1 << dims)
+                    .map(|_| rng.random_range(-2.0..2.0))
+                    .collect(),
             }
         }
 
@@ -642,11 +655,15 @@ mod tests {
         for dims in 1..=4 {
             let axes = random_axes(dims, &mut rng);
             let poly = Multilinear::random(dims, &mut rng);
-            let table = Table::from_fn(axes.clone(), 1, |x, out| out[0] = poly.eval(x) as f32).unwrap();
+            let table =
+                Table::from_fn(axes.clone(), 1, |x, out| out[0] = poly.eval(x) as f32).unwrap();
             let mut worst = 0.0f64;
             for _ in 0..2000 {
                 // Points strictly inside the range: the closed form is the reference.
-                let x: Vec<f64> = axes.iter().map(|a| rng.random_range(a.min..a.max)).collect();
+                let x: Vec<f64> = axes
+                    .iter()
+                    .map(|a| rng.random_range(a.min..a.max))
+                    .collect();
                 let got = table.lookup_scalar(&x).unwrap() as f64;
                 worst = worst.max((got - poly.eval(&x)).abs() / poly.bound());
             }
@@ -671,7 +688,8 @@ mod tests {
             ]
         };
         let poly = Multilinear::random(2, &mut rng);
-        let table = Table::from_fn(axes, 1, |x, out| out[0] = poly.eval(&warped(x)) as f32).unwrap();
+        let table =
+            Table::from_fn(axes, 1, |x, out| out[0] = poly.eval(&warped(x)) as f32).unwrap();
         let mut worst = 0.0f64;
         for _ in 0..2000 {
             let x = [rng.random_range(0.01..1.0), rng.random_range(-1.0..1.0)];
@@ -693,7 +711,9 @@ mod tests {
             Axis::power("1/λ", 1.0 / 64.0, 1.0 / 16.0, 7, 1.7),
             Axis::uniform("cosφ", -1.0, 1.0, 5),
         ];
-        let mut values: Vec<f32> = (0..32 * 7 * 5 * 3).map(|_| rng.random_range(-1e3..1e3)).collect();
+        let mut values: Vec<f32> = (0..32 * 7 * 5 * 3)
+            .map(|_| rng.random_range(-1e3..1e3))
+            .collect();
         values[3] = f32::INFINITY; // channel 0 of node (0, 0, 1)
         let table = Table::new(axes.clone(), 3, values).unwrap();
         for i in 0..32 {
@@ -701,7 +721,11 @@ mod tests {
                 for k in 0..5 {
                     let x = [axes[0].node(i), axes[1].node(j), axes[2].node(k)];
                     let got = table.lookup_rgb(&x).unwrap();
-                    assert_eq!(&got[..], table.node(&[i, j, k]).unwrap(), "node {i},{j},{k}");
+                    assert_eq!(
+                        &got[..],
+                        table.node(&[i, j, k]).unwrap(),
+                        "node {i},{j},{k}"
+                    );
                 }
             }
         }
@@ -709,7 +733,10 @@ mod tests {
 
     #[test]
     fn out_of_range_clamps_to_the_edge_and_nan_is_an_error() {
-        let axes = vec![Axis::uniform("a", 0.0, 1.0, 3), Axis::uniform("b", -2.0, 2.0, 4)];
+        let axes = vec![
+            Axis::uniform("a", 0.0, 1.0, 3),
+            Axis::uniform("b", -2.0, 2.0, 4),
+        ];
         let table = Table::from_fn(axes, 1, |x, out| out[0] = (10.0 * x[0] + x[1]) as f32).unwrap();
         let at = |x: [f64; 2]| table.lookup_scalar(&x).unwrap();
         assert_eq!(at([-5.0, 0.5]), at([0.0, 0.5]));
@@ -726,7 +753,10 @@ mod tests {
 
     #[test]
     fn shape_and_argument_mismatches_are_typed_errors() {
-        let axes = vec![Axis::uniform("a", 0.0, 1.0, 4), Axis::uniform("b", 0.0, 1.0, 5)];
+        let axes = vec![
+            Axis::uniform("a", 0.0, 1.0, 4),
+            Axis::uniform("b", 0.0, 1.0, 5),
+        ];
         assert_eq!(
             Table::new(axes.clone(), 3, vec![0.0; 59]).unwrap_err(),
             TableError::ShapeMismatch {
@@ -738,7 +768,10 @@ mod tests {
             Table::new(axes.clone(), 2, vec![0.0; 40]),
             Err(TableError::InvalidChannels { .. })
         ));
-        assert!(matches!(Table::new(vec![], 1, vec![]), Err(TableError::NoAxes)));
+        assert!(matches!(
+            Table::new(vec![], 1, vec![]),
+            Err(TableError::NoAxes)
+        ));
         let bad = vec![Axis::uniform("flat", 1.0, 1.0, 4)];
         assert!(matches!(
             Table::new(bad, 1, vec![0.0; 4]),
@@ -791,7 +824,10 @@ mod tests {
 
     #[test]
     fn layout_is_row_major_last_axis_fastest_channels_innermost() {
-        let axes = vec![Axis::uniform("a", 0.0, 1.0, 2), Axis::uniform("b", 0.0, 2.0, 3)];
+        let axes = vec![
+            Axis::uniform("a", 0.0, 1.0, 2),
+            Axis::uniform("b", 0.0, 2.0, 3),
+        ];
         let table = Table::from_fn(axes, 3, |x, out| {
             for (c, o) in out.iter_mut().enumerate() {
                 *o = (100.0 * x[0] + 10.0 * x[1]) as f32 + c as f32;
@@ -875,7 +911,10 @@ mod tests {
 
     #[test]
     fn stats_count_non_finite_values_and_locate_the_first() {
-        let axes = vec![Axis::uniform("a", 0.0, 1.0, 2), Axis::uniform("b", 0.0, 1.0, 2)];
+        let axes = vec![
+            Axis::uniform("a", 0.0, 1.0, 2),
+            Axis::uniform("b", 0.0, 1.0, 2),
+        ];
         let values = vec![
             1.0,
             -2.0,

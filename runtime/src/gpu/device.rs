@@ -1,0 +1,188 @@
+//! Headless device selection: a hardware adapter when one exists, else the software Vulkan
+//! driver (Mesa's lavapipe), else a typed error that says how to install one.
+
+use std::fmt;
+
+/// Where the frames are computed: the adapter wgpu chose and why.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AdapterReport {
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+    /// True when the adapter is a CPU (software) rasterizer such as lavapipe.
+    pub is_software: bool,
+}
+
+impl fmt::Display for AdapterReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} ({}, {}, driver {})",
+            self.name, self.backend, self.device_type, self.driver
+        )
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum DeviceError {
+    #[error(
+        "no GPU adapter found (looked at: {looked_at}); install a Vulkan driver — on a machine \
+         without a GPU, Mesa's software driver lavapipe: `apt-get install mesa-vulkan-drivers \
+         libvulkan1` (Debian/Ubuntu) or `dnf install mesa-vulkan-drivers` (Fedora)"
+    )]
+    NoAdapter { looked_at: String },
+    #[error("adapter {adapter} refused a device: {source}")]
+    RequestDevice {
+        adapter: String,
+        #[source]
+        source: wgpu::RequestDeviceError,
+    },
+}
+
+/// A device and queue with the features the passes use.
+pub struct GpuContext {
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub report: AdapterReport,
+    /// `Rgba32Float` can be a blended render target (else the passes use `Rgba16Float`).
+    pub float32_blendable: bool,
+}
+
+impl GpuContext {
+    /// A headless device: hardware first (discrete, integrated, virtual), the software
+    /// rasterizer last.
+    pub fn new_headless() -> Result<Self, DeviceError> {
+        pollster::block_on(Self::new_headless_async())
+    }
+
+    async fn new_headless_async() -> Result<Self, DeviceError> {
+        let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+        desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN);
+        let instance = wgpu::Instance::new(desc);
+        let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
+        let looked_at = if adapters.is_empty() {
+            "no Vulkan adapters".to_string()
+        } else {
+            adapters
+                .iter()
+                .map(|a| a.get_info().name)
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let adapter = match adapters
+            .into_iter()
+            .min_by_key(|a| preference_rank(a.get_info().device_type))
+        {
+            Some(a) => a,
+            None => instance
+                .request_adapter(&wgpu::RequestAdapterOptions {
+                    force_fallback_adapter: true,
+                    ..Default::default()
+                })
+                .await
+                .map_err(|_| DeviceError::NoAdapter { looked_at })?,
+        };
+        let info = adapter.get_info();
+        let report = AdapterReport {
+            name: info.name.clone(),
+            backend: format!("{:?}", info.backend),
+            device_type: format!("{:?}", info.device_type),
+            driver: format!("{} {}", info.driver, info.driver_info)
+                .trim()
+                .to_string(),
+            is_software: info.device_type == wgpu::DeviceType::Cpu,
+        };
+        let float32_blendable = adapter
+            .features()
+            .contains(wgpu::Features::FLOAT32_BLENDABLE);
+        let mut required_features = wgpu::Features::empty();
+        if float32_blendable {
+            required_features |= wgpu::Features::FLOAT32_BLENDABLE;
+        }
+        let (device, queue) = adapter
+            .request_device(&wgpu::DeviceDescriptor {
+                label: Some("strandlight"),
+                required_features,
+                required_limits: adapter.limits(),
+                ..Default::default()
+            })
+            .await
+            .map_err(|source| DeviceError::RequestDevice {
+                adapter: report.to_string(),
+                source,
+            })?;
+        Ok(Self {
+            instance,
+            adapter,
+            device,
+            queue,
+            report,
+            float32_blendable,
+        })
+    }
+
+    /// The HDR colour format of render targets.
+    pub fn hdr_format(&self) -> wgpu::TextureFormat {
+        if self.float32_blendable {
+            wgpu::TextureFormat::Rgba32Float
+        } else {
+            wgpu::TextureFormat::Rgba16Float
+        }
+    }
+
+    /// Blocks until all submitted work has finished.
+    pub fn wait_idle(&self) {
+        // A lost device surfaces as an error in the following map/readback; nothing to do here.
+        let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
+    }
+}
+
+/// Lower is preferred: hardware first, the CPU rasterizer last.
+fn preference_rank(t: wgpu::DeviceType) -> u8 {
+    match t {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// CI installs lavapipe, so a missing adapter is a broken install: fail, with the hint.
+    #[test]
+    fn a_headless_device_exists() {
+        let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+        eprintln!(
+            "adapter: {} (software: {}, Rgba32Float blendable: {})",
+            gpu.report, gpu.report.is_software, gpu.float32_blendable
+        );
+        assert!(!gpu.report.name.is_empty());
+    }
+
+    #[test]
+    fn hardware_is_preferred_over_the_software_rasterizer() {
+        assert!(
+            preference_rank(wgpu::DeviceType::DiscreteGpu) < preference_rank(wgpu::DeviceType::Cpu)
+        );
+        assert!(
+            preference_rank(wgpu::DeviceType::IntegratedGpu)
+                < preference_rank(wgpu::DeviceType::Cpu)
+        );
+    }
+
+    #[test]
+    fn the_no_adapter_error_says_how_to_install_lavapipe() {
+        let text = DeviceError::NoAdapter {
+            looked_at: "no Vulkan adapters".into(),
+        }
+        .to_string();
+        assert!(text.contains("mesa-vulkan-drivers"), "{text}");
+    }
+}

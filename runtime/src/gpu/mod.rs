@@ -1,0 +1,7 @@
+//! GPU plumbing shared by the passes: the device, and reading textures back to the CPU.
+
+pub mod device;
+pub mod readback;
+
+pub use device::{AdapterReport, DeviceError, GpuContext};
+pub use readback::{read_buffer, read_texture_rgba};

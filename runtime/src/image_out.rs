@@ -1,0 +1,208 @@
+//! Writing rendered frames: a linear EXR (RGBA, alpha pre-multiplied as OpenEXR expects) and a
+//! tonemapped 8-bit PNG for looking at. Both are written atomically.
+
+use std::io;
+use std::path::{Path, PathBuf};
+
+use strandlight_tables::atomic_write::write_atomically;
+
+#[derive(Debug, thiserror::Error)]
+pub enum ImageWriteError {
+    #[error("{path}: {width}×{height} image needs {expected} pixels, got {got}")]
+    WrongSize {
+        path: PathBuf,
+        width: u32,
+        height: u32,
+        expected: usize,
+        got: usize,
+    },
+    #[error("writing {path}: {source}")]
+    Write {
+        path: PathBuf,
+        #[source]
+        source: io::Error,
+    },
+}
+
+/// The PNG's operator, also written into its `Tonemap` text chunk.
+pub const PNG_TONEMAP: &str = "composited over black (pre-multiplied colour as is), exposure 1, \
+    Reinhard c/(1+c) per channel, sRGB transfer curve, 8 bit RGB";
+
+fn check_size(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 4]],
+) -> Result<(), ImageWriteError> {
+    let expected = width as usize * height as usize;
+    if pixels.len() != expected {
+        return Err(ImageWriteError::WrongSize {
+            path: path.into(),
+            width,
+            height,
+            expected,
+            got: pixels.len(),
+        });
+    }
+    Ok(())
+}
+
+/// Linear float RGBA EXR, ZIP-compressed.
+pub fn write_exr(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 4]],
+    comment: &str,
+) -> Result<(), ImageWriteError> {
+    use exr::prelude::*;
+    check_size(path, width, height, pixels)?;
+    let mut attributes = LayerAttributes::named(latin1_text("strandlight render"));
+    attributes.comments = Some(latin1_text(comment));
+    attributes.software_name = Some(latin1_text(concat!(
+        "strandlight-runtime ",
+        env!("CARGO_PKG_VERSION")
+    )));
+    let w = width as usize;
+    let layer = Layer::new(
+        (w, height as usize),
+        attributes,
+        Encoding::SMALL_LOSSLESS,
+        SpecificChannels::rgba(|p: Vec2<usize>| {
+            let [r, g, b, a] = pixels[p.y() * w + p.x()];
+            (r, g, b, a)
+        }),
+    );
+    let image = Image::from_layer(layer);
+    write_atomically(path, |out| {
+        image.write().to_buffered(out).map_err(io::Error::other)
+    })
+    .map_err(|source| ImageWriteError::Write {
+        path: path.into(),
+        source,
+    })
+}
+
+/// One channel of [`PNG_TONEMAP`]; non-finite values become 0 (and are counted by callers that care).
+pub fn tonemap_channel(c: f32) -> u8 {
+    let c = if c.is_finite() {
+        c.max(0.0) as f64
+    } else {
+        0.0
+    };
+    let p = c / (1.0 + c);
+    let encoded = if p <= 0.0031308 {
+        12.92 * p
+    } else {
+        1.055 * p.powf(1.0 / 2.4) - 0.055
+    };
+    (encoded * 255.0).round().clamp(0.0, 255.0) as u8
+}
+
+/// 8-bit RGB PNG tonemapped with [`PNG_TONEMAP`] (named in its `Tonemap` text chunk).
+pub fn write_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 4]],
+    description: &str,
+) -> Result<(), ImageWriteError> {
+    check_size(path, width, height, pixels)?;
+    let bytes: Vec<u8> = pixels
+        .iter()
+        .flat_map(|p| {
+            [
+                tonemap_channel(p[0]),
+                tonemap_channel(p[1]),
+                tonemap_channel(p[2]),
+            ]
+        })
+        .collect();
+    let encode = |w: &mut std::io::BufWriter<std::fs::File>| -> Result<(), png::EncodingError> {
+        let mut encoder = png::Encoder::new(w, width, height);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.add_itxt_chunk(
+            "Software".into(),
+            concat!("strandlight-runtime ", env!("CARGO_PKG_VERSION")).into(),
+        )?;
+        encoder.add_itxt_chunk("Description".into(), description.into())?;
+        encoder.add_itxt_chunk("Tonemap".into(), PNG_TONEMAP.into())?;
+        let mut writer = encoder.write_header()?;
+        writer.write_image_data(&bytes)?;
+        writer.finish()
+    };
+    write_atomically(path, |w| encode(w).map_err(io::Error::other)).map_err(|source| {
+        ImageWriteError::Write {
+            path: path.into(),
+            source,
+        }
+    })
+}
+
+/// EXR text is Latin-1: other characters (×, λ) are written as `<U+00D7>`.
+fn latin1_text(s: &str) -> exr::meta::attribute::Text {
+    let latin1: String = s
+        .chars()
+        .map(|c| {
+            if (c as u32) < 256 {
+                c.to_string()
+            } else {
+                format!("<U+{:04X}>", c as u32)
+            }
+        })
+        .collect();
+    exr::meta::attribute::Text::new_or_none(latin1)
+        .unwrap_or_else(|| exr::meta::attribute::Text::new_or_panic("(text)"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exr_round_trips_and_png_decodes_with_the_tonemap_named() {
+        let dir =
+            std::env::temp_dir().join(format!("strandlight-image-out-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (w, h) = (5u32, 3u32);
+        let pixels: Vec<[f32; 4]> = (0..w * h)
+            .map(|i| [i as f32 * 0.25, 1.0, 1e3, 0.5])
+            .collect();
+        let exr_path = dir.join("a.exr");
+        write_exr(&exr_path, w, h, &pixels, "test").unwrap();
+        let back = exr::prelude::read_first_rgba_layer_from_file(
+            &exr_path,
+            |res, _| vec![[0f32; 4]; res.width() * res.height()],
+            move |v: &mut Vec<[f32; 4]>, p, (r, g, b, a): (f32, f32, f32, f32)| {
+                v[p.y() * w as usize + p.x()] = [r, g, b, a]
+            },
+        )
+        .unwrap();
+        assert_eq!(back.layer_data.channel_data.pixels, pixels);
+
+        let png_path = dir.join("a.png");
+        write_png(&png_path, w, h, &pixels, "test").unwrap();
+        let decoder = png::Decoder::new(std::io::BufReader::new(
+            std::fs::File::open(&png_path).unwrap(),
+        ));
+        let mut reader = decoder.read_info().unwrap();
+        let text = reader
+            .info()
+            .utf8_text
+            .iter()
+            .map(|t| t.get_text().unwrap())
+            .collect::<Vec<_>>()
+            .join("|");
+        assert!(text.contains("Reinhard"), "{text}");
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        reader.next_frame(&mut buf).unwrap();
+        // 1.0 → Reinhard 0.5 → sRGB 0.7354 → 188; 1e3 → 0.999 → 255.
+        assert_eq!(&buf[0..3], &[0, 188, 255]);
+        assert!(matches!(
+            write_png(&png_path, 4, 4, &pixels, "x"),
+            Err(ImageWriteError::WrongSize { .. })
+        ));
+        std::fs::remove_dir_all(&dir).ok();
+    }
+}

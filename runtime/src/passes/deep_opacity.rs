@@ -1,0 +1,377 @@
+//! Deep opacity maps for a directional light: a light-space depth prepass (nearest fiber per
+//! texel), then one additive pass that sorts every fragment's optical depth into K layers of
+//! configurable spacing, the last layer taking what lies beyond (`deep_opacity.wgsl`).
+//! Inputs: [`StrandGeometry`], the light's direction, the hair's bounds, [`DomSettings`].
+//! Output: [`DeepOpacityMap`] (layer textures + nearest-depth texture + the light's camera).
+//! The pipelines are built once and the per-light targets can be reused, so the pass repeats
+//! cheaply for many lights.
+
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+use crate::camera::{Camera, Projection};
+use crate::gpu::GpuContext;
+use crate::gpu::readback::{ReadbackError, read_texture_rgba};
+use crate::hair::Aabb;
+use crate::passes::strands::{
+    DEPTH_FORMAT, FrameParams, KajiyaKay, StrandGeometry, strand_bind_group,
+    strand_bind_group_layout,
+};
+
+/// At most this many layers (two RGBA targets).
+pub const MAX_LAYERS: u32 = 8;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DomSettings {
+    pub resolution: u32,
+    pub layers: u32,
+    /// Layer thickness along the light direction, world units.
+    pub spacing: f32,
+}
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum DomSettingsError {
+    #[error("deep opacity map layers {0}: must be 1..={MAX_LAYERS}")]
+    Layers(u32),
+    #[error("deep opacity map layer spacing {0}: must be positive and finite")]
+    Spacing(f32),
+    #[error("deep opacity map resolution {0}: must be 1..=8192")]
+    Resolution(u32),
+}
+
+impl DomSettings {
+    pub fn check(&self) -> Result<(), DomSettingsError> {
+        if !(1..=MAX_LAYERS).contains(&self.layers) {
+            return Err(DomSettingsError::Layers(self.layers));
+        }
+        if !(self.spacing.is_finite() && self.spacing > 0.0) {
+            return Err(DomSettingsError::Spacing(self.spacing));
+        }
+        if !(1..=8192).contains(&self.resolution) {
+            return Err(DomSettingsError::Resolution(self.resolution));
+        }
+        Ok(())
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct DomUniform {
+    near: f32,
+    far: f32,
+    spacing: f32,
+    layers: u32,
+}
+
+/// The orthographic camera of a directional light (`toward_light` points at the light) that
+/// just covers `bounds`.
+pub fn light_camera(toward_light: Vec3, bounds: Aabb) -> Camera {
+    let center = bounds.center();
+    let radius = (bounds.diagonal() * 0.5).max(1e-6);
+    let dir = toward_light.normalize();
+    let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    Camera {
+        eye: center + dir * (2.0 * radius),
+        target: center,
+        up,
+        projection: Projection::Orthographic {
+            half_height: radius,
+        },
+        near: radius * 0.5,
+        far: radius * 3.5,
+    }
+}
+
+/// One light's maps.
+pub struct DeepOpacityMap {
+    pub camera: Camera,
+    pub settings: DomSettings,
+    pub nearest_depth: wgpu::Texture,
+    /// Layers 0–3 and 4–7 in the channels of two textures.
+    pub layers: [wgpu::Texture; 2],
+}
+
+impl DeepOpacityMap {
+    pub fn new(gpu: &GpuContext, camera: Camera, settings: DomSettings) -> Self {
+        let size = wgpu::Extent3d {
+            width: settings.resolution,
+            height: settings.resolution,
+            depth_or_array_layers: 1,
+        };
+        let texture = |label, format, usage| {
+            gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let layer_usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        Self {
+            camera,
+            settings,
+            nearest_depth: texture(
+                "dom nearest depth",
+                DEPTH_FORMAT,
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            ),
+            layers: [
+                texture("dom layers 0-3", gpu.hdr_format(), layer_usage),
+                texture("dom layers 4-7", gpu.hdr_format(), layer_usage),
+            ],
+        }
+    }
+
+    /// Per texel, the K layers' optical depths (row-major from the top).
+    pub fn read_layers(&self, gpu: &GpuContext) -> Result<Vec<Vec<f32>>, ReadbackError> {
+        let a = read_texture_rgba(gpu, &self.layers[0])?;
+        let b = read_texture_rgba(gpu, &self.layers[1])?;
+        let k = self.settings.layers as usize;
+        Ok(a.iter()
+            .zip(&b)
+            .map(|(x, y)| x.iter().chain(y.iter()).take(k).copied().collect())
+            .collect())
+    }
+
+    pub fn memory(&self) -> Vec<(String, u64)> {
+        let texels = self.settings.resolution as u64 * self.settings.resolution as u64;
+        let layer_texel = self.layers[0].format().block_copy_size(None).unwrap_or(16) as u64;
+        vec![
+            ("dom nearest depth".into(), texels * 4),
+            ("dom layers".into(), 2 * texels * layer_texel),
+        ]
+    }
+}
+
+/// Transmittance in front of layer `k` from one texel's layers: exp(−Σ_{j<k} layer_j).
+pub fn transmittance_before_layer(layers: &[f32], k: usize) -> f64 {
+    (-layers[..k.min(layers.len())]
+        .iter()
+        .map(|&t| t as f64)
+        .sum::<f64>())
+    .exp()
+}
+
+/// The two pipelines, built once.
+pub struct DeepOpacityPass {
+    depth_pipeline: wgpu::RenderPipeline,
+    layer_pipeline: wgpu::RenderPipeline,
+    strand_layout: wgpu::BindGroupLayout,
+    dom_layout: wgpu::BindGroupLayout,
+}
+
+impl DeepOpacityPass {
+    pub fn new(gpu: &GpuContext) -> Self {
+        let device = &gpu.device;
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("deep_opacity.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(
+                concat!(
+                    include_str!("strand_quads.wgsl"),
+                    include_str!("deep_opacity.wgsl")
+                )
+                .into(),
+            ),
+        });
+        let strand_layout = strand_bind_group_layout(device);
+        let dom_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dom"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let depth_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("dom depth"),
+            bind_group_layouts: &[Some(&strand_layout)],
+            immediate_size: 0,
+        });
+        let layer_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("dom layers"),
+            bind_group_layouts: &[Some(&strand_layout), Some(&dom_layout)],
+            immediate_size: 0,
+        });
+        let vertex = wgpu::VertexState {
+            module: &shader,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        };
+        let primitive = wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            cull_mode: None,
+            ..Default::default()
+        };
+        let depth_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("dom depth"),
+            layout: Some(&depth_layout),
+            vertex: vertex.clone(),
+            fragment: None,
+            primitive,
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        let additive = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let target = Some(wgpu::ColorTargetState {
+            format: gpu.hdr_format(),
+            blend: Some(wgpu::BlendState {
+                color: additive,
+                alpha: additive,
+            }),
+            write_mask: wgpu::ColorWrites::ALL,
+        });
+        let layer_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("dom layers"),
+            layout: Some(&layer_layout),
+            vertex,
+            fragment: Some(wgpu::FragmentState {
+                module: &shader,
+                entry_point: Some("fs_layers"),
+                compilation_options: Default::default(),
+                targets: &[target.clone(), target],
+            }),
+            primitive,
+            depth_stencil: None,
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        Self {
+            depth_pipeline,
+            layer_pipeline,
+            strand_layout,
+            dom_layout,
+        }
+    }
+
+    /// Fills `map` from `geometry` as seen from its light camera.
+    pub fn draw(&self, gpu: &GpuContext, geometry: &StrandGeometry, map: &DeepOpacityMap) {
+        let device = &gpu.device;
+        let res = map.settings.resolution;
+        let frame = FrameParams {
+            camera: map.camera,
+            width: res,
+            height: res,
+            lights: Vec::new(),
+            shading: KajiyaKay::default(),
+            width_override_px: None,
+        };
+        let strands = strand_bind_group(gpu, &self.strand_layout, geometry, &frame);
+        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("dom params"),
+            contents: bytemuck::bytes_of(&DomUniform {
+                near: map.camera.near,
+                far: map.camera.far,
+                spacing: map.settings.spacing,
+                layers: map.settings.layers,
+            }),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let depth_view = map.nearest_depth.create_view(&Default::default());
+        let dom_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("dom"),
+            layout: &self.dom_layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&depth_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: uniform.as_entire_binding(),
+                },
+            ],
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("dom depth"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.depth_pipeline);
+            pass.set_bind_group(0, &strands, &[]);
+            pass.draw(0..6, 0..geometry.segment_count);
+        }
+        let views: Vec<_> = map
+            .layers
+            .iter()
+            .map(|t| t.create_view(&Default::default()))
+            .collect();
+        let attachments: Vec<_> = views
+            .iter()
+            .map(|view| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
+            })
+            .collect();
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("dom layers"),
+                color_attachments: &attachments,
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.layer_pipeline);
+            pass.set_bind_group(0, &strands, &[]);
+            pass.set_bind_group(1, &dom_group, &[]);
+            pass.draw(0..6, 0..geometry.segment_count);
+        }
+        gpu.queue.submit([encoder.finish()]);
+    }
+}

@@ -1,0 +1,43 @@
+// Deep opacity map layers (Yuksel & Keyser; Svoboda §4, Hunz §4), appended to strand_quads.wgsl
+// and drawn from the light's orthographic camera after a depth prepass that left the nearest
+// fiber depth z0 per texel. Each fragment adds its optical depth τ = −ln(1 − α) (α: coverage ×
+// opacity) to layer k = floor((d − d0) / spacing), the last layer taking everything beyond, so
+// the transmittance in front of layer k is exp(−Σ_{j<k} layer_j) = Π(1 − α) of the fibers there.
+// Up to 8 layers: two RGBA targets, additive blending.
+
+struct DomParams {
+    near: f32,
+    far: f32,
+    spacing: f32,
+    layers: u32,
+};
+
+@group(1) @binding(0) var nearest_depth: texture_depth_2d;
+@group(1) @binding(1) var<uniform> dom: DomParams;
+
+struct Layers {
+    @location(0) first: vec4<f32>,
+    @location(1) second: vec4<f32>,
+};
+
+// The largest α a fragment may carry: an opaque fiber still lets exp(−6.9) ≈ 0.1% through,
+// which keeps τ finite.
+const MAX_ALPHA: f32 = 0.999;
+
+@fragment
+fn fs_layers(in: VertexOut) -> Layers {
+    let z0 = textureLoad(nearest_depth, vec2<i32>(in.clip.xy), 0);
+    let d0 = dom.near + z0 * (dom.far - dom.near);
+    let d = dom.near + in.clip.z * (dom.far - dom.near);
+    let k = min(u32(max(d - d0, 0.0) / dom.spacing), dom.layers - 1u);
+    let tau = -log(1.0 - min(in.alpha, MAX_ALPHA));
+    var out: Layers;
+    out.first = vec4<f32>(0.0);
+    out.second = vec4<f32>(0.0);
+    if (k < 4u) {
+        out.first[k] = tau;
+    } else {
+        out.second[k - 4u] = tau;
+    }
+    return out;
+}

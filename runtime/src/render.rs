@@ -1,0 +1,225 @@
+//! One headless frame end to end: upload, strand pass, readback, with per-pass timings and the
+//! GPU memory each buffer and texture holds.
+
+use std::time::Instant;
+
+use crate::gpu::readback::ReadbackError;
+use crate::gpu::{AdapterReport, GpuContext, read_texture_rgba};
+use crate::hair::HairModel;
+use crate::lights::Light;
+use crate::passes::abuffer::{ABufferPass, ListMode};
+use crate::passes::deep_opacity::{
+    DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError, light_camera,
+};
+use crate::passes::strands::{
+    FrameParams, RenderTarget, ShadowInput, StrandGeometry, StrandPass, TooManyPoints,
+};
+
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    #[error(
+        "image size {width}×{height} must be between 1 and {max} on each side (the adapter's limit)"
+    )]
+    BadSize { width: u32, height: u32, max: u32 },
+    #[error(transparent)]
+    TooManyPoints(#[from] TooManyPoints),
+    #[error(transparent)]
+    DomSettings(#[from] DomSettingsError),
+    #[error("deep opacity maps need a directional light; the frame has none")]
+    NoDirectionalLight,
+    #[error(transparent)]
+    Readback(#[from] ReadbackError),
+    #[error("the GPU reported an error: {0}")]
+    Gpu(String),
+}
+
+/// Wall-clock milliseconds of one pass: CPU time around submit and wait-for-idle (timestamp
+/// queries are not used yet).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassTiming {
+    pub pass: String,
+    pub milliseconds: f64,
+}
+
+#[derive(Clone, Debug)]
+pub struct RenderStats {
+    pub adapter: AdapterReport,
+    pub timings: Vec<PassTiming>,
+    pub memory_bytes: Vec<(String, u64)>,
+    pub segments: u32,
+    pub timing_method: &'static str,
+    /// A-buffer only: fragments stored, dropped for a full node buffer, truncated at resolve.
+    pub fragments: Option<FragmentCounts>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FragmentCounts {
+    pub stored: u64,
+    pub dropped: u64,
+    pub truncated: u64,
+    pub capacity: u64,
+}
+
+/// How overlapping fibers combine.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum Transparency {
+    /// Depth-tested, coverage blended in draw order (plain opaque rendering).
+    #[default]
+    Opaque,
+    /// Per-pixel linked lists sorted at resolve; `nodes_per_pixel` × pixels nodes (clamped to
+    /// the adapter's storage-binding limit).
+    ABuffer { nodes_per_pixel: u32 },
+    /// DBK-buffer: lists for fragments within `delta` (world units of view depth) behind each
+    /// pixel's nearest fiber, an opaque fallback for the rest.
+    Dbk { nodes_per_pixel: u32, delta: f32 },
+}
+
+/// Everything besides the frame that changes how it is rendered.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderOptions {
+    /// Deep opacity maps for the first directional light.
+    pub shadows: Option<DomSettings>,
+    pub transparency: Transparency,
+}
+
+pub struct Frame {
+    pub width: u32,
+    pub height: u32,
+    /// Linear, pre-multiplied RGBA, row-major from the top.
+    pub pixels: Vec<[f32; 4]>,
+    pub stats: RenderStats,
+}
+
+fn timed<T>(
+    timings: &mut Vec<PassTiming>,
+    gpu: &GpuContext,
+    pass: &str,
+    work: impl FnOnce() -> T,
+) -> T {
+    let start = Instant::now();
+    let out = work();
+    gpu.wait_idle();
+    timings.push(PassTiming {
+        pass: pass.to_string(),
+        milliseconds: start.elapsed().as_secs_f64() * 1e3,
+    });
+    out
+}
+
+/// Renders `model` with `frame` and reads the picture back. With `shadows`, the first
+/// directional light is shadowed through a deep opacity map (other lights are unshadowed).
+pub fn render_frame(
+    gpu: &GpuContext,
+    model: &HairModel,
+    frame: &FrameParams,
+    options: &RenderOptions,
+) -> Result<Frame, RenderError> {
+    let shadowed_light = match options.shadows {
+        None => None,
+        Some(settings) => {
+            settings.check()?;
+            let (index, direction) = frame
+                .lights
+                .iter()
+                .enumerate()
+                .find_map(|(i, l)| match l {
+                    Light::Directional { direction, .. } => Some((i, *direction)),
+                    _ => None,
+                })
+                .ok_or(RenderError::NoDirectionalLight)?;
+            Some((settings, index as u32, direction))
+        }
+    };
+    let max = gpu.device.limits().max_texture_dimension_2d;
+    if frame.width == 0 || frame.height == 0 || frame.width > max || frame.height > max {
+        return Err(RenderError::BadSize {
+            width: frame.width,
+            height: frame.height,
+            max,
+        });
+    }
+    let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let mut timings = Vec::new();
+    let geometry = timed(&mut timings, gpu, "upload", || {
+        StrandGeometry::upload(gpu, model)
+    })?;
+    let mut memory_bytes = geometry.memory();
+    let shadow_map = match shadowed_light {
+        None => None,
+        Some((settings, index, direction)) => {
+            let dom_pass = timed(&mut timings, gpu, "dom pipeline", || {
+                DeepOpacityPass::new(gpu)
+            });
+            let map = DeepOpacityMap::new(gpu, light_camera(direction, model.bounds()), settings);
+            timed(&mut timings, gpu, "deep opacity", || {
+                dom_pass.draw(gpu, &geometry, &map)
+            });
+            memory_bytes.extend(map.memory());
+            Some((map, index))
+        }
+    };
+    let shadow = shadow_map.as_ref().map(|(map, light_index)| ShadowInput {
+        map,
+        light_index: *light_index,
+    });
+    let mut fragments = None;
+    let pixels = match options.transparency {
+        Transparency::Opaque => {
+            let pass = timed(&mut timings, gpu, "strand pipeline", || {
+                StrandPass::new(gpu)
+            });
+            let target = RenderTarget::new(gpu, frame.width, frame.height);
+            timed(&mut timings, gpu, "strands", || {
+                pass.draw(gpu, &geometry, frame, &target, shadow)
+            });
+            memory_bytes.extend(target.memory());
+            timed(&mut timings, gpu, "readback", || {
+                read_texture_rgba(gpu, &target.color)
+            })?
+        }
+        Transparency::ABuffer { nodes_per_pixel }
+        | Transparency::Dbk {
+            nodes_per_pixel, ..
+        } => {
+            let list_mode = match options.transparency {
+                Transparency::Dbk { delta, .. } => ListMode::Dbk { delta },
+                _ => ListMode::All,
+            };
+            let abuffer = timed(&mut timings, gpu, "abuffer pipeline", || {
+                ABufferPass::new(gpu)
+            });
+            let wanted = frame.width as u64 * frame.height as u64 * nodes_per_pixel as u64;
+            let capacity = ABufferPass::max_capacity(gpu, wanted);
+            let out = timed(
+                &mut timings,
+                gpu,
+                "abuffer build + resolve + readback",
+                || abuffer.draw(gpu, &geometry, frame, shadow, capacity, list_mode),
+            )?;
+            memory_bytes.extend(out.memory_bytes);
+            fragments = Some(FragmentCounts {
+                stored: out.fragments_stored,
+                dropped: out.fragments_dropped,
+                truncated: out.fragments_truncated,
+                capacity: capacity as u64,
+            });
+            out.pixels
+        }
+    };
+    if let Some(error) = pollster::block_on(scope.pop()) {
+        return Err(RenderError::Gpu(error.to_string()));
+    }
+    Ok(Frame {
+        width: frame.width,
+        height: frame.height,
+        pixels,
+        stats: RenderStats {
+            adapter: gpu.report.clone(),
+            timings,
+            memory_bytes,
+            segments: geometry.segment_count,
+            timing_method: "CPU wall clock around submit + wait for idle",
+            fragments,
+        },
+    })
+}

@@ -1,0 +1,233 @@
+//! Deep opacity maps against the closed form for a slab of parallel strands: rows of fibers of
+//! diameter d spaced s apart, each row at an independent lateral offset, transmit (1 − d/s)
+//! per row, so the light reaching depth m rows in is (1 − d/s)^m.
+
+use glam::Vec3;
+use strandlight_runtime::camera::{Camera, Projection};
+use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::gpu::read_texture_rgba;
+use strandlight_runtime::hair::{Attribute, HairModel};
+use strandlight_runtime::lights::Light;
+use strandlight_runtime::passes::deep_opacity::{
+    DeepOpacityMap, DeepOpacityPass, DomSettings, transmittance_before_layer,
+};
+use strandlight_runtime::passes::strands::{
+    FrameParams, KajiyaKay, RenderTarget, ShadowInput, StrandGeometry, StrandPass,
+};
+
+const RES: u32 = 64;
+/// Light-map texels per world unit (2 units across 64 texels).
+const PER_UNIT: f64 = 32.0;
+
+/// Rows at z = 0.3 − 0.1·r (the light is at +z), one vertical fiber per texel column, each row
+/// shifted by its own sub-texel offset.
+fn slab(rows: usize, thickness: f32) -> HairModel {
+    let offsets = [0.17, -0.23, 0.05, 0.29, -0.11, -0.02];
+    let mut points = Vec::new();
+    let mut strand_offsets = vec![0u32];
+    for r in 0..rows {
+        let z = 0.3 - 0.1 * r as f32;
+        for c in 0..RES {
+            let x = ((c as f64 + 0.5 + offsets[r % offsets.len()]) / PER_UNIT - 1.0) as f32;
+            points.push(Vec3::new(x, -0.9, z));
+            points.push(Vec3::new(x, 0.9, z));
+            strand_offsets.push(points.len() as u32);
+        }
+    }
+    HairModel::new(
+        points,
+        strand_offsets,
+        Some(Attribute::Uniform(thickness)),
+        None,
+        None,
+    )
+    .unwrap()
+}
+
+fn light_camera() -> Camera {
+    Camera {
+        eye: Vec3::new(0.0, 0.0, 5.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        projection: Projection::Orthographic { half_height: 1.0 },
+        near: 1.0,
+        far: 10.0,
+    }
+}
+
+#[test]
+fn slab_of_parallel_strands_matches_the_closed_form() {
+    let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+    let thickness = 0.01f32;
+    let coverage = thickness as f64 * PER_UNIT; // d/s = 0.32
+    let rows = 4;
+    let model = slab(rows, thickness);
+    let geometry = StrandGeometry::upload(&gpu, &model).unwrap();
+    let pass = DeepOpacityPass::new(&gpu);
+    // Rows lie 0.1 apart; with spacing 0.08 they fall at 0, 1.25, 2.5, 3.75 layers behind the
+    // nearest fiber. K = 3: the last layer takes rows 2 and 3. K = 8: one row per layer 0..3.
+    for (layers, expected_rows_per_layer) in [
+        (3u32, vec![1.0, 1.0, 2.0]),
+        (8, vec![1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0]),
+    ] {
+        let settings = DomSettings {
+            resolution: RES,
+            layers,
+            spacing: 0.08,
+        };
+        settings.check().unwrap();
+        let map = DeepOpacityMap::new(&gpu, light_camera(), settings);
+        pass.draw(&gpu, &geometry, &map);
+        let texels = map.read_layers(&gpu).unwrap();
+        let tau_row = -(1.0 - coverage).ln();
+        let mut worst_t = 0.0f64;
+        let mut checked = 0;
+        for ty in 8..56usize {
+            for tx in 2..62usize {
+                let t = &texels[ty * RES as usize + tx];
+                for (k, &rows_in_layer) in expected_rows_per_layer.iter().enumerate() {
+                    let expected = rows_in_layer * tau_row;
+                    assert!(
+                        (t[k] as f64 - expected).abs() < 1e-4,
+                        "K={layers} texel ({tx},{ty}) layer {k}: {} vs {expected}",
+                        t[k]
+                    );
+                }
+                // Transmittance in front of each layer and behind the whole slab.
+                let mut rows_before = 0.0;
+                for k in 0..=expected_rows_per_layer.len() {
+                    let closed = (1.0 - coverage).powf(rows_before);
+                    let dom = transmittance_before_layer(t, k);
+                    worst_t = worst_t.max((dom - closed).abs() / closed);
+                    if k < expected_rows_per_layer.len() {
+                        rows_before += expected_rows_per_layer[k];
+                    }
+                }
+                checked += 1;
+            }
+        }
+        let sample = &texels[32 * RES as usize + 32];
+        eprintln!(
+            "K={layers}: {checked} texels; layers at the centre {sample:?} (τ per row {tau_row:.5}); \
+             behind the slab exp(−Στ) = {:.5} vs (1 − d/s)^{rows} = {:.5}; worst relative transmittance error {worst_t:.2e}",
+            transmittance_before_layer(sample, sample.len()),
+            (1.0 - coverage).powi(rows as i32)
+        );
+        assert!(worst_t < 1e-3);
+    }
+}
+
+#[test]
+fn bad_settings_are_refused() {
+    assert!(
+        DomSettings {
+            resolution: 64,
+            layers: 9,
+            spacing: 0.1
+        }
+        .check()
+        .is_err()
+    );
+    assert!(
+        DomSettings {
+            resolution: 64,
+            layers: 4,
+            spacing: 0.0
+        }
+        .check()
+        .is_err()
+    );
+    assert!(
+        DomSettings {
+            resolution: 0,
+            layers: 4,
+            spacing: 0.1
+        }
+        .check()
+        .is_err()
+    );
+}
+
+/// The strand pass reads the map: a horizontal probe fiber behind the slab (all four rows
+/// between it and the light) is lit by (1 − d/s)^4 of the light; one in front of it by all of
+/// it. The map is built from the slab alone so the probe does not shadow itself.
+#[test]
+fn shading_behind_the_slab_is_dimmed_by_the_closed_form_transmittance() {
+    let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+    let thickness = 0.01f32;
+    let coverage = thickness as f64 * PER_UNIT;
+    let slab_geometry = StrandGeometry::upload(&gpu, &slab(4, thickness)).unwrap();
+    let map = DeepOpacityMap::new(
+        &gpu,
+        light_camera(),
+        DomSettings {
+            resolution: RES,
+            layers: 4,
+            spacing: 0.08,
+        },
+    );
+    DeepOpacityPass::new(&gpu).draw(&gpu, &slab_geometry, &map);
+
+    let color = Vec3::new(0.5, 0.3, 0.2);
+    let shading = KajiyaKay {
+        kd: 0.6,
+        ks: 0.25,
+        shininess: 40.0,
+    };
+    let strand_pass = StrandPass::new(&gpu);
+    for (z, expected_t) in [(-0.5f32, (1.0 - coverage).powi(4)), (0.5, 1.0)] {
+        // Along x at y = 0.5 (image row 16 ± 2 px): probe covers pixel rows 14..=17, columns 7..=56.
+        let probe = HairModel::new(
+            vec![Vec3::new(-0.8, 0.5, z), Vec3::new(0.8, 0.5, z)],
+            vec![0, 2],
+            None,
+            None,
+            Some(Attribute::Uniform(color)),
+        )
+        .unwrap();
+        let geometry = StrandGeometry::upload(&gpu, &probe).unwrap();
+        let frame = FrameParams {
+            camera: light_camera(),
+            width: RES,
+            height: RES,
+            lights: vec![Light::Directional {
+                direction: Vec3::Z,
+                intensity: 1.0,
+            }],
+            shading,
+            width_override_px: Some(4.0),
+        };
+        let target = RenderTarget::new(&gpu, RES, RES);
+        strand_pass.draw(
+            &gpu,
+            &geometry,
+            &frame,
+            &target,
+            Some(ShadowInput {
+                map: &map,
+                light_index: 0,
+            }),
+        );
+        let pixels = read_texture_rgba(&gpu, &target.color).unwrap();
+        // t = x, l = e = z: sin = 1, cone = 1, so L = T·(kd·c + ks).
+        let mut worst = 0.0f64;
+        for x in 8..56usize {
+            for y in [14usize, 15, 16] {
+                let got = pixels[y * RES as usize + x];
+                for (k, c) in [0.5f64, 0.3, 0.2].into_iter().enumerate() {
+                    let expected = expected_t * (0.6 * c + 0.25);
+                    let err = (got[k] as f64 - expected).abs() / expected;
+                    worst = worst.max(err);
+                    assert!(
+                        err < 1e-3,
+                        "probe z {z} pixel ({x},{y}) channel {k}: {} vs {expected}",
+                        got[k]
+                    );
+                }
+            }
+        }
+        eprintln!(
+            "probe at z = {z}: transmittance {expected_t:.5} expected; worst relative error of the shaded pixels {worst:.2e}"
+        );
+    }
+}

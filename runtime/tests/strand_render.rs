@@ -1,0 +1,309 @@
+//! The strand pass against independent CPU computations: Kajiya-Kay shading of a single straight
+//! strand at sampled pixels (f64, several lights of every kind), and the coverage alpha of
+//! sub-pixel strands summed across the strand against their width in pixels.
+
+use glam::Vec3;
+use strandlight_runtime::camera::{Camera, Projection};
+use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::hair::{Attribute, HairModel};
+use strandlight_runtime::lights::Light;
+use strandlight_runtime::passes::strands::{FrameParams, KajiyaKay};
+use strandlight_runtime::render::{RenderOptions, render_frame};
+
+const SIZE: u32 = 64;
+
+fn gpu() -> GpuContext {
+    GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Orthographic, looking down −z, 2 world units tall: 32 pixels per unit, world x = 0 on the
+/// boundary between pixel columns 31 and 32.
+fn ortho_camera() -> Camera {
+    Camera {
+        eye: Vec3::new(0.0, 0.0, 5.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        projection: Projection::Orthographic { half_height: 1.0 },
+        near: 1.0,
+        far: 10.0,
+    }
+}
+
+fn straight_strand(
+    from: Vec3,
+    to: Vec3,
+    points: usize,
+    thickness: Option<f32>,
+    color: Vec3,
+) -> HairModel {
+    let pts = (0..points)
+        .map(|i| from.lerp(to, i as f32 / (points - 1) as f32))
+        .collect();
+    HairModel::new(
+        pts,
+        vec![0, points as u32],
+        thickness.map(Attribute::Uniform),
+        None,
+        Some(Attribute::Uniform(color)),
+    )
+    .unwrap()
+}
+
+fn pixel(frame: &strandlight_runtime::render::Frame, x: u32, y: u32) -> [f32; 4] {
+    frame.pixels[(y * frame.width + x) as usize]
+}
+
+/// Kajiya-Kay in f64, written from the textbook form: diffuse kd·c·sin(t,l); specular
+/// ks·cos(angle between e and the cone of mirror directions around t)^p.
+fn kajiya_kay_f64(
+    t: [f64; 3],
+    l: [f64; 3],
+    e: [f64; 3],
+    c: [f64; 3],
+    kd: f64,
+    ks: f64,
+    p: f64,
+) -> [f64; 3] {
+    let dot = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let theta_l = dot(t, l).clamp(-1.0, 1.0).acos();
+    let theta_e = dot(t, e).clamp(-1.0, 1.0).acos();
+    // The mirror cone makes angle π − θ_l with t; e makes θ_e.
+    let cone = (theta_e - (std::f64::consts::PI - theta_l)).cos().max(0.0);
+    let spec = ks * cone.powf(p);
+    [0, 1, 2].map(|k| kd * c[k] * theta_l.sin() + spec)
+}
+
+fn normalize(v: [f64; 3]) -> [f64; 3] {
+    let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    v.map(|x| x / n)
+}
+
+#[test]
+fn a_single_strand_matches_cpu_kajiya_kay_under_three_lights() {
+    let gpu = gpu();
+    // Tilted 30° toward the camera in the y–z plane so that (t·l)(t·e) ≠ 0; it still projects
+    // onto the image column x = 0.
+    let tilt = 30f64.to_radians();
+    let dir = [0.0, tilt.cos(), tilt.sin()];
+    let half_len = 0.8;
+    let a = Vec3::new(
+        0.0,
+        -(half_len * dir[1]) as f32,
+        -(half_len * dir[2]) as f32,
+    );
+    let b = -a;
+    let color = [0.5, 0.3, 0.2];
+    let model = straight_strand(a, b, 9, None, Vec3::new(0.5, 0.3, 0.2));
+    let spot_position = [-1.0, 0.0, 2.0];
+    let spot_half_angle = 12f64.to_radians();
+    let lights = vec![
+        Light::Directional {
+            direction: Vec3::new(1.0, 0.5, 1.0).normalize(),
+            intensity: 1.0,
+        },
+        Light::Point {
+            position: Vec3::new(1.5, 1.0, 2.0),
+            intensity: 6.0,
+        },
+        Light::Spot {
+            position: Vec3::new(-1.0, 0.0, 2.0),
+            direction: Vec3::new(1.0, 0.0, -2.0).normalize(),
+            half_angle: spot_half_angle as f32,
+            intensity: 4.0,
+        },
+    ];
+    let shading = KajiyaKay {
+        kd: 0.6,
+        ks: 0.4,
+        shininess: 20.0,
+    };
+    let frame = FrameParams {
+        camera: ortho_camera(),
+        width: SIZE,
+        height: SIZE,
+        lights,
+        shading,
+        width_override_px: Some(4.0),
+    };
+    let out = render_frame(&gpu, &model, &frame, &RenderOptions::default()).unwrap();
+    let e = [0.0, 0.0, 1.0];
+    let (kd, ks, p) = (0.6, 0.4, 20.0);
+    let mut worst = 0.0f64;
+    let mut compared = 0;
+    let mut spot_lit_rows = 0;
+    for row in 12..52u32 {
+        // Pixel centre's world y, and the strand point there.
+        let y = 1.0 - (row as f64 + 0.5) / 32.0;
+        let s = y / dir[1];
+        let world = [0.0, y, s * dir[2]];
+        let mut expected = kajiya_kay_f64(dir, normalize([1.0, 0.5, 1.0]), e, color, kd, ks, p);
+        let point_to = [1.5 - world[0], 1.0 - world[1], 2.0 - world[2]];
+        let d2 = point_to.iter().map(|x| x * x).sum::<f64>();
+        let kk = kajiya_kay_f64(dir, normalize(point_to), e, color, kd, ks, p);
+        for k in 0..3 {
+            expected[k] += 6.0 / d2 * kk[k];
+        }
+        let spot_to = [
+            spot_position[0] - world[0],
+            spot_position[1] - world[1],
+            spot_position[2] - world[2],
+        ];
+        let s2 = spot_to.iter().map(|x| x * x).sum::<f64>();
+        let l = normalize(spot_to);
+        let axis = normalize([1.0, 0.0, -2.0]);
+        let cos_off_axis = -(l[0] * axis[0] + l[1] * axis[1] + l[2] * axis[2]);
+        if (cos_off_axis - spot_half_angle.cos()).abs() < 2e-3 {
+            continue; // on the hard edge of the cone: either answer is right
+        }
+        if cos_off_axis >= spot_half_angle.cos() {
+            spot_lit_rows += 1;
+            let kk = kajiya_kay_f64(dir, l, e, color, kd, ks, p);
+            for k in 0..3 {
+                expected[k] += 4.0 / s2 * kk[k];
+            }
+        }
+        for column in [31u32, 32] {
+            let got = pixel(&out, column, row);
+            assert!(
+                (got[3] - 1.0).abs() < 1e-6,
+                "row {row} col {column}: alpha {}",
+                got[3]
+            );
+            for k in 0..3 {
+                let err = (got[k] as f64 - expected[k]).abs() / expected[k].abs().max(1e-3);
+                worst = worst.max(err);
+                compared += 1;
+                assert!(
+                    err < 3e-3,
+                    "row {row} col {column} channel {k}: GPU {} CPU {}",
+                    got[k],
+                    expected[k]
+                );
+            }
+        }
+    }
+    eprintln!(
+        "Kajiya-Kay: {compared} channel samples, worst relative error {worst:.2e}; spot lit {spot_lit_rows} of the rows; adapter {}",
+        out.stats.adapter
+    );
+    assert!(
+        spot_lit_rows > 5 && spot_lit_rows < 35,
+        "the spot cone should light only part of the strand"
+    );
+    // Nothing outside the 4-pixel quad.
+    for row in 0..SIZE {
+        for column in (0..28).chain(36..SIZE) {
+            assert_eq!(
+                pixel(&out, column, row),
+                [0.0; 4],
+                "pixel ({column}, {row})"
+            );
+        }
+    }
+}
+
+/// Mean over interior rows of the alpha summed along each row.
+fn mean_row_alpha(
+    out: &strandlight_runtime::render::Frame,
+    rows: std::ops::Range<u32>,
+) -> (f64, f64) {
+    let sums: Vec<f64> = rows
+        .map(|row| (0..out.width).map(|x| pixel(out, x, row)[3] as f64).sum())
+        .collect();
+    let mean = sums.iter().sum::<f64>() / sums.len() as f64;
+    let spread = sums.iter().map(|s| (s - mean).abs()).fold(0.0, f64::max);
+    (mean, spread)
+}
+
+#[test]
+fn coverage_alpha_of_sub_pixel_strands_integrates_to_their_width() {
+    let gpu = gpu();
+    let white = Vec3::ONE;
+    let lights = vec![Light::Directional {
+        direction: Vec3::Z,
+        intensity: 1.0,
+    }];
+    let params = |camera, width_override_px| FrameParams {
+        camera,
+        width: SIZE,
+        height: SIZE,
+        lights: lights.clone(),
+        shading: KajiyaKay::default(),
+        width_override_px,
+    };
+    // 0.3 px right of a column boundary, so the one-pixel quad covers exactly one pixel centre.
+    let x = 0.3 / 32.0;
+    let vertical = straight_strand(
+        Vec3::new(x, -0.8, 0.0),
+        Vec3::new(x, 0.8, 0.0),
+        5,
+        Some(0.02),
+        white,
+    );
+
+    // The user's width.
+    let out = render_frame(
+        &gpu,
+        &vertical,
+        &params(ortho_camera(), Some(0.37)),
+        &RenderOptions::default(),
+    )
+    .unwrap();
+    let (mean, spread) = mean_row_alpha(&out, 12..52);
+    eprintln!("user width 0.37 px: row alpha sum mean {mean:.6}, max deviation {spread:.2e}");
+    assert!((mean - 0.37).abs() < 1e-4 && spread < 1e-4);
+
+    // The file's thickness 0.02 at 32 px per unit: 0.64 px.
+    let out = render_frame(
+        &gpu,
+        &vertical,
+        &params(ortho_camera(), None),
+        &RenderOptions::default(),
+    )
+    .unwrap();
+    let (mean, spread) = mean_row_alpha(&out, 12..52);
+    eprintln!(
+        "thickness 0.02 orthographic (0.64 px): row alpha sum mean {mean:.6}, max deviation {spread:.2e}"
+    );
+    assert!((mean - 0.64).abs() < 1e-4 && spread < 1e-4);
+
+    // Perspective: 0.02 at depth 5 with a 30° field of view over 64 rows.
+    let fov: f64 = 30f64.to_radians();
+    let perspective = Camera {
+        projection: Projection::Perspective { fov_y: fov as f32 },
+        ..ortho_camera()
+    };
+    let expected = 0.02 * (SIZE as f64 / 2.0) / (5.0 * (fov / 2.0).tan());
+    let xp = Vec3::new((0.3 / 32.0 * 5.0 * (fov / 2.0).tan()) as f32, 0.0, 0.0);
+    let strand = straight_strand(xp - Vec3::Y, xp + Vec3::Y, 5, Some(0.02), white);
+    let out = render_frame(
+        &gpu,
+        &strand,
+        &params(perspective, None),
+        &RenderOptions::default(),
+    )
+    .unwrap();
+    let (mean, spread) = mean_row_alpha(&out, 12..52);
+    eprintln!(
+        "thickness 0.02 perspective ({expected:.4} px): row alpha sum mean {mean:.6}, max deviation {spread:.2e}"
+    );
+    assert!((mean - expected).abs() < 1e-3 * expected && spread < 1e-3);
+
+    // A strand 30° from vertical in the image plane: each row crosses 1/cos 30° of its width.
+    let angle = 30f64.to_radians();
+    let half = Vec3::new(angle.sin() as f32, angle.cos() as f32, 0.0) * 0.9;
+    let slanted = straight_strand(-half, half, 7, None, white);
+    let out = render_frame(
+        &gpu,
+        &slanted,
+        &params(ortho_camera(), Some(0.5)),
+        &RenderOptions::default(),
+    )
+    .unwrap();
+    let (mean, spread) = mean_row_alpha(&out, 12..52);
+    let expected = 0.5 / angle.cos();
+    eprintln!(
+        "slanted 30°, 0.5 px: row alpha sum mean {mean:.5} (expected {expected:.5}), max row deviation {spread:.3}"
+    );
+    assert!((mean - expected).abs() < 0.02 * expected);
+}

@@ -1,0 +1,262 @@
+//! `strandlight render`: one headless frame of a hair model under point lights, written as a
+//! linear EXR and a tonemapped PNG, with timings and GPU memory on request.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, bail};
+use clap::{Args, ValueEnum};
+use strandlight_runtime::camera::Camera;
+use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::hair::{self, GroomParams, HairModel};
+use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
+use strandlight_runtime::lights::Light;
+use strandlight_runtime::passes::deep_opacity::DomSettings;
+use strandlight_runtime::passes::strands::{FrameParams, KajiyaKay};
+use strandlight_runtime::render::{self, RenderOptions, render_frame};
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum Shading {
+    KajiyaKay,
+    Marschner,
+    Artist,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum Shadows {
+    None,
+    Dom,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum Transparency {
+    None,
+    Abuffer,
+    Dbk,
+}
+
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum CameraKind {
+    Perspective,
+    Orthographic,
+}
+
+/// The default light when none is given: from the upper right front.
+const DEFAULT_LIGHT: &str = "directional:0.5,0.7,1:2";
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Hair file (.hair, .tfx, .data, .ply); the procedural groom when omitted.
+    #[arg(long)]
+    hair: Option<PathBuf>,
+    /// Repeatable: directional:X,Y,Z[:I] (toward the light), point:X,Y,Z[:I],
+    /// spot:X,Y,Z:DX,DY,DZ:HALF_ANGLE_DEGREES[:I].
+    #[arg(long = "light", default_value = DEFAULT_LIGHT)]
+    lights: Vec<String>,
+    #[arg(long, value_enum, default_value = "kajiya-kay")]
+    shading: Shading,
+    #[arg(long, value_enum, default_value = "none")]
+    shadows: Shadows,
+    #[arg(long, value_enum, default_value = "none")]
+    transparency: Transparency,
+    /// Deep opacity map layers (1..=8), with --shadows dom.
+    #[arg(long, default_value_t = 4)]
+    dom_layers: u32,
+    /// Layer spacing in world units (default: 1% of the hair's bounding-box diagonal).
+    #[arg(long)]
+    dom_spacing: Option<f32>,
+    /// Deep opacity map resolution (square).
+    #[arg(long, default_value_t = 512)]
+    dom_size: u32,
+    /// A-buffer node buffer size, in nodes per pixel (clamped to the adapter's limit).
+    #[arg(long, default_value_t = 16)]
+    abuffer_nodes_per_pixel: u32,
+    /// DBK layer depth Δ in world units (default: 5% of the hair's bounding-box diagonal).
+    #[arg(long)]
+    dbk_delta: Option<f32>,
+    /// Image size WxH in pixels.
+    #[arg(long, default_value = "512x512")]
+    size: String,
+    /// The default camera looks along −z at the hair's bounds and frames them.
+    #[arg(long, value_enum, default_value = "perspective")]
+    camera: CameraKind,
+    /// Every fiber this many pixels wide (default: the file's thickness, projected).
+    #[arg(long)]
+    fiber_width_px: Option<f32>,
+    /// Output stem: writes STEM.exr (linear) and STEM.png (tonemapped).
+    #[arg(long, default_value = "render")]
+    out: PathBuf,
+    /// Print adapter, per-pass milliseconds and GPU memory as JSON.
+    #[arg(long)]
+    json: bool,
+}
+
+fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .with_context(|| format!("--size {text:?}: expected WxH, e.g. 656x861"))?;
+    let parse = |s: &str| -> anyhow::Result<u32> {
+        let v: u32 = s
+            .trim()
+            .parse()
+            .with_context(|| format!("--size {text:?}: {s:?} is not a whole number"))?;
+        if v == 0 {
+            bail!("--size {text:?}: sides must be at least 1 pixel");
+        }
+        Ok(v)
+    };
+    Ok((parse(w)?, parse(h)?))
+}
+
+/// `render.exr` → `render`: the stem may be given with either extension.
+fn output_stem(out: &Path) -> PathBuf {
+    match out.extension().and_then(|e| e.to_str()) {
+        Some("exr" | "png") => out.with_extension(""),
+        _ => out.to_path_buf(),
+    }
+}
+
+fn load_hair(path: Option<&Path>) -> anyhow::Result<(HairModel, String)> {
+    match path {
+        Some(path) => {
+            let loaded = hair::load(path)?;
+            Ok((loaded.model, path.display().to_string()))
+        }
+        None => Ok((
+            hair::generate_groom(&GroomParams::default())?,
+            "procedural groom (default parameters)".to_string(),
+        )),
+    }
+}
+
+pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+    match args.shading {
+        Shading::KajiyaKay => {}
+        other => bail!("--shading {other:?} is not implemented yet; only kajiya-kay renders"),
+    }
+    let transparency = match args.transparency {
+        Transparency::None => render::Transparency::Opaque,
+        Transparency::Abuffer => render::Transparency::ABuffer {
+            nodes_per_pixel: args.abuffer_nodes_per_pixel,
+        },
+        Transparency::Dbk => render::Transparency::Dbk {
+            nodes_per_pixel: args.abuffer_nodes_per_pixel,
+            delta: args.dbk_delta.unwrap_or(0.0),
+        },
+    };
+    let (width, height) = parse_size(&args.size)?;
+    if let Some(w) = args.fiber_width_px
+        && !(w.is_finite() && w > 0.0)
+    {
+        bail!("--fiber-width-px {w}: must be a positive number of pixels");
+    }
+    let lights = args
+        .lights
+        .iter()
+        .map(|s| Light::parse(s))
+        .collect::<Result<Vec<_>, _>>()?;
+    if let Some(d) = args.dbk_delta
+        && !(d.is_finite() && d >= 0.0)
+    {
+        bail!("--dbk-delta {d}: must be a non-negative number of world units");
+    }
+    let (model, source) = load_hair(args.hair.as_deref())?;
+    let transparency = match transparency {
+        render::Transparency::Dbk {
+            nodes_per_pixel, ..
+        } => render::Transparency::Dbk {
+            nodes_per_pixel,
+            delta: args.dbk_delta.unwrap_or(model.bounds().diagonal() * 0.05),
+        },
+        other => other,
+    };
+    let gpu = GpuContext::new_headless()?;
+    let camera = Camera::framing(
+        model.bounds(),
+        width as f32 / height as f32,
+        matches!(args.camera, CameraKind::Orthographic),
+    );
+    let frame = FrameParams {
+        camera,
+        width,
+        height,
+        lights,
+        shading: KajiyaKay::default(),
+        width_override_px: args.fiber_width_px,
+    };
+    let shadows = match args.shadows {
+        Shadows::None => None,
+        Shadows::Dom => Some(DomSettings {
+            resolution: args.dom_size,
+            layers: args.dom_layers,
+            spacing: args.dom_spacing.unwrap_or(model.bounds().diagonal() * 0.01),
+        }),
+    };
+    let rendered = render_frame(
+        &gpu,
+        &model,
+        &frame,
+        &RenderOptions {
+            shadows,
+            transparency,
+        },
+    )?;
+    let stem = output_stem(&args.out);
+    let exr_path = stem.with_extension("exr");
+    let png_path = stem.with_extension("png");
+    let description = format!(
+        "{source}; {width}x{height}; Kajiya-Kay {:?}; shadows {shadows:?}; lights {}; camera {:?}",
+        frame.shading,
+        args.lights.join(" "),
+        args.camera
+    );
+    write_exr(&exr_path, width, height, &rendered.pixels, &description)?;
+    write_png(&png_path, width, height, &rendered.pixels, &description)?;
+    let covered = rendered.pixels.iter().filter(|p| p[3] > 0.0).count();
+    let stats = &rendered.stats;
+    if args.json {
+        let report = serde_json::json!({
+            "hair": source,
+            "strands": model.strand_count(),
+            "segments": stats.segments,
+            "size": [width, height],
+            "adapter": {
+                "name": stats.adapter.name,
+                "backend": stats.adapter.backend,
+                "device_type": stats.adapter.device_type,
+                "driver": stats.adapter.driver,
+            },
+            "timing_method": stats.timing_method,
+            "pass_ms": stats.timings.iter().map(|t| (t.pass.clone(), serde_json::json!(t.milliseconds))).collect::<serde_json::Map<_, _>>(),
+            "gpu_memory_bytes": stats.memory_bytes.iter().map(|(n, b)| (n.clone(), serde_json::json!(b))).collect::<serde_json::Map<_, _>>(),
+            "covered_pixels": covered,
+            "fragments_stored": stats.fragments.map(|f| f.stored),
+            "fragments_dropped": stats.fragments.map(|f| f.dropped),
+            "fragments_truncated_at_resolve": stats.fragments.map(|f| f.truncated),
+            "abuffer_node_capacity": stats.fragments.map(|f| f.capacity),
+            "outputs": { "exr": exr_path, "png": png_path, "png_tonemap": PNG_TONEMAP },
+        });
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!("adapter: {}", stats.adapter);
+        println!(
+            "hair: {source}, {} strands, {} segments",
+            model.strand_count(),
+            stats.segments
+        );
+        for t in &stats.timings {
+            println!("  {:<10} {:>9.2} ms", t.pass, t.milliseconds);
+        }
+        if let Some(f) = stats.fragments {
+            println!(
+                "A-buffer: {} fragments stored, {} dropped (node buffer holds {}), {} truncated at resolve (over 64 in a pixel)",
+                f.stored, f.dropped, f.capacity, f.truncated
+            );
+        }
+        println!(
+            "wrote {} and {} ({covered} pixels covered)",
+            exr_path.display(),
+            png_path.display()
+        );
+    }
+    Ok(())
+}
