@@ -119,13 +119,8 @@ pub fn check_asset(asset: &TableAsset, samples: usize, seed: u64) -> Result<Tabl
 /// Points uniform over every continuous axis; integer-labelled axes (`quantity`, `lobe`) get a
 /// random node.
 fn random_points(table: &strandlight_tables::table::Table, count: usize, seed: u64) -> Vec<Vec<f64>> {
-    let mut state = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
-    let mut unit = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rng = strandlight_tables::sweep::SweepRng::new(seed);
+    let mut unit = move || rng.uniform();
     (0..count)
         .map(|_| {
             table

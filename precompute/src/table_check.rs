@@ -9,6 +9,7 @@ use serde::Serialize;
 use std::f64::consts::PI;
 use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::scattering::Rgb;
+use strandlight_tables::sweep::SweepRng;
 use strandlight_tables::table::{Table, TableError};
 
 /// What `check-tables --json` reports per table.
@@ -66,15 +67,16 @@ impl TableAccuracy {
 /// the sine (so grazing ±1 ends get their share), Δφ stratified in angle (so the TT region near
 /// π is sampled as densely as the rest), 1/λ uniform. `lambda` spans [λ_min, λ_max].
 pub fn stratified_points(count: usize, lambda_min: f64, lambda_max: f64, seed: u64) -> Vec<[f64; 4]> {
-    let mut rng = SplitMix64(seed);
+    // A fixed generator: the points must not change with thread count or a crate's version.
+    let mut rng = SweepRng::new(seed);
     (0..count)
         .map(|k| {
-            let stratum = (k as f64 + rng.unit()) / count as f64;
-            let mut sx = -1.0 + 2.0 * rng.unit();
-            let mut so = -1.0 + 2.0 * rng.unit();
+            let stratum = (k as f64 + rng.uniform()) / count as f64;
+            let mut sx = -1.0 + 2.0 * rng.uniform();
+            let mut so = -1.0 + 2.0 * rng.uniform();
             // Cycle strata over the Δφ axis, the one whose lobes are narrowest.
             let delta = PI * stratum;
-            let mut inv = 1.0 / lambda_max + (1.0 / lambda_min - 1.0 / lambda_max) * rng.unit();
+            let mut inv = 1.0 / lambda_max + (1.0 / lambda_min - 1.0 / lambda_max) * rng.uniform();
             // One point in ten sits on a hard edge of the domain: ξ or ω_o along the fiber
             // (u·ξ, u·ω_o = ±1) or λ at either bound.
             let sign = if k % 20 < 10 { 1.0 } else { -1.0 };
@@ -170,24 +172,6 @@ pub fn summarize(name: &str, table: &Table, table_max: f64, rows: &[(Vec<f64>, f
 /// Re-export for callers that build points themselves.
 pub fn coordinates(theta_xi: f64, theta_o: f64, delta_phi: f64, lambda: f64) -> [f64; 4] {
     table_coordinates(theta_xi, theta_o, delta_phi, lambda)
-}
-
-/// A tiny deterministic generator: the check's points must not depend on thread count or on
-/// a crate's version-to-version stream changes.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    fn unit(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
 }
 
 #[cfg(test)]
