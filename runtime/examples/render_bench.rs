@@ -148,7 +148,10 @@ fn probe_fragments(
             transparency,
         },
     )?;
-    let f = out.stats.fragments.ok_or("list probe returned no fragment counts")?;
+    let f = out
+        .stats
+        .fragments
+        .ok_or("list probe returned no fragment counts")?;
     Ok(f.stored + f.dropped)
 }
 
@@ -224,7 +227,14 @@ fn main() -> Result<(), BoxError> {
     let max_npp = (gpu.device.limits().max_storage_buffer_binding_size / NODE_BYTES)
         / (WIDTH as u64 * HEIGHT as u64);
     let max_npp = max_npp.max(1) as u32;
-    let all = probe_fragments(&gpu, &model, &frame, Transparency::ABuffer { nodes_per_pixel: max_npp })?;
+    let all = probe_fragments(
+        &gpu,
+        &model,
+        &frame,
+        Transparency::ABuffer {
+            nodes_per_pixel: max_npp,
+        },
+    )?;
     let dbk = probe_fragments(
         &gpu,
         &model,
@@ -366,7 +376,9 @@ fn print_ratios(results: &[Measured]) {
     println!();
     println!("Ratios (same run):");
     println!();
-    println!("| shadows | A-buffer / opaque frame time | DBK / A-buffer frame time | DBK / A-buffer GPU memory (total) | DBK / A-buffer lists used | DBK / A-buffer fragments stored |");
+    println!(
+        "| shadows | A-buffer / opaque frame time | DBK / A-buffer frame time | DBK / A-buffer GPU memory (total) | DBK / A-buffer lists used | DBK / A-buffer fragments stored |"
+    );
     println!("|---|---:|---:|---:|---:|---:|");
     for tag in ["", " + DOM"] {
         let (Some(o), Some(a), Some(d)) = (

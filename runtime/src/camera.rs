@@ -179,8 +179,8 @@ impl Camera {
         }
         let toward_eye = (eye - center) / distance;
         let half_min = (radius / distance).asin();
-        let fov_y = fov_y_for_narrow_half_angle(half_min, aspect)
-            .min(MAX_FOV_Y_DEGREES.to_radians());
+        let fov_y =
+            fov_y_for_narrow_half_angle(half_min, aspect).min(MAX_FOV_Y_DEGREES.to_radians());
         let projection = if orthographic {
             Projection::Orthographic {
                 half_height: radius / aspect.min(1.0),
@@ -303,7 +303,13 @@ mod tests {
         let mut widest = 0.0f32;
         for corner in corners(bounds) {
             let c = camera_space(cam, corner);
-            assert!(c.z > cam.near && c.z < cam.far, "{what}: {corner} depth {} outside {}..{}", c.z, cam.near, cam.far);
+            assert!(
+                c.z > cam.near && c.z < cam.far,
+                "{what}: {corner} depth {} outside {}..{}",
+                c.z,
+                cam.near,
+                cam.far
+            );
             let (sx, sy) = match cam.projection {
                 Projection::Perspective { fov_y } => {
                     let t = (fov_y * 0.5).tan();
@@ -313,7 +319,10 @@ mod tests {
                     (c.x / (half_height * aspect), c.y / half_height)
                 }
             };
-            assert!(sx.abs() <= 1.0 && sy.abs() <= 1.0, "{what}: {corner} at screen ({sx}, {sy})");
+            assert!(
+                sx.abs() <= 1.0 && sy.abs() <= 1.0,
+                "{what}: {corner} at screen ({sx}, {sy})"
+            );
             widest = widest.max(sx.abs()).max(sy.abs());
         }
         widest
@@ -337,10 +346,16 @@ mod tests {
                     if let Projection::Perspective { fov_y } = cam.projection {
                         let sphere_half = (radius / cam.eye.distance(bounds.center())).asin();
                         let narrow_half = ((fov_y * 0.5).tan() * aspect.min(1.0)).atan();
-                        assert!((sphere_half - narrow_half).abs() < 1e-5, "{what}: sphere {sphere_half} vs field {narrow_half}");
+                        assert!(
+                            (sphere_half - narrow_half).abs() < 1e-5,
+                            "{what}: sphere {sphere_half} vs field {narrow_half}"
+                        );
                     }
                     eprintln!("{what}: widest corner at {widest:.3} of the half-screen");
-                    assert!(widest > 0.3, "{what}: the box is framed too loosely ({widest})");
+                    assert!(
+                        widest > 0.3,
+                        "{what}: the box is framed too loosely ({widest})"
+                    );
                 }
             }
         }
@@ -359,15 +374,24 @@ mod tests {
         let vp = cam.projection_matrix(1.0) * cam.view();
         let top = vp.project_point3(Vec3::new(0.0, 0.0, 0.9));
         let right = vp.project_point3(Vec3::new(0.9, 0.0, 0.0));
-        assert!(top.y > 0.1 && top.x.abs() < 1e-5, "top of a Z-up box at NDC {top}");
-        assert!(right.x > 0.1 && right.y.abs() < 1e-5, "+x of a Z-up box at NDC {right}");
+        assert!(
+            top.y > 0.1 && top.x.abs() < 1e-5,
+            "top of a Z-up box at NDC {top}"
+        );
+        assert!(
+            right.x > 0.1 && right.y.abs() < 1e-5,
+            "+x of a Z-up box at NDC {right}"
+        );
         let by_hand = camera_space(&cam, Vec3::new(0.9, 0.0, 0.9));
         assert!(by_hand.x > 0.0 && by_hand.y > 0.0);
         // Y-up: the same for +y.
         let cam = Camera::framing_front(bounds, 1.0, false, UpAxis::Y);
         let vp = cam.projection_matrix(1.0) * cam.view();
         let top = vp.project_point3(Vec3::new(0.0, 0.9, 0.0));
-        assert!(top.y > 0.1 && cam.eye.z > 1.0, "top of a Y-up box at NDC {top}");
+        assert!(
+            top.y > 0.1 && cam.eye.z > 1.0,
+            "top of a Y-up box at NDC {top}"
+        );
     }
 
     #[test]
@@ -376,14 +400,25 @@ mod tests {
             min: Vec3::new(-1.0, -2.0, 0.0),
             max: Vec3::new(1.0, 2.0, 3.0),
         };
-        for eye in [Vec3::new(0.0, -10.0, 2.0), Vec3::new(7.0, 3.0, 8.0), Vec3::new(0.0, 0.0, 9.0)] {
+        for eye in [
+            Vec3::new(0.0, -10.0, 2.0),
+            Vec3::new(7.0, 3.0, 8.0),
+            Vec3::new(0.0, 0.0, 9.0),
+        ] {
             for ortho in [false, true] {
-                let cam = Camera::framing_from_eye(bounds, 656.0 / 861.0, ortho, eye, Vec3::Z).unwrap();
+                let cam =
+                    Camera::framing_from_eye(bounds, 656.0 / 861.0, ortho, eye, Vec3::Z).unwrap();
                 assert_eq!(cam.eye, eye);
-                assert_in_view(&cam, bounds, 656.0 / 861.0, &format!("eye {eye} ortho {ortho}"));
+                assert_in_view(
+                    &cam,
+                    bounds,
+                    656.0 / 861.0,
+                    &format!("eye {eye} ortho {ortho}"),
+                );
             }
         }
-        let inside = Camera::framing_from_eye(bounds, 1.0, false, Vec3::new(0.0, 0.0, 1.0), Vec3::Z);
+        let inside =
+            Camera::framing_from_eye(bounds, 1.0, false, Vec3::new(0.0, 0.0, 1.0), Vec3::Z);
         assert!(matches!(inside, Err(EyeInsideBounds { .. })));
         let nan = Camera::framing_from_eye(bounds, 1.0, false, Vec3::NAN, Vec3::Z);
         assert!(nan.is_err(), "a NaN eye must be refused");
@@ -405,10 +440,22 @@ mod tests {
 
     #[test]
     fn up_axis_follows_gravity() {
-        assert_eq!(UpAxis::detect(&hanging(Vec3::new(0.1, 0.2, -1.0))), UpAxis::Z);
-        assert_eq!(UpAxis::detect(&hanging(Vec3::new(0.1, -1.0, 0.2))), UpAxis::Y);
-        assert_eq!(UpAxis::detect(&hanging(Vec3::new(0.0, -0.5, -0.4))), UpAxis::Y);
+        assert_eq!(
+            UpAxis::detect(&hanging(Vec3::new(0.1, 0.2, -1.0))),
+            UpAxis::Z
+        );
+        assert_eq!(
+            UpAxis::detect(&hanging(Vec3::new(0.1, -1.0, 0.2))),
+            UpAxis::Y
+        );
+        assert_eq!(
+            UpAxis::detect(&hanging(Vec3::new(0.0, -0.5, -0.4))),
+            UpAxis::Y
+        );
         // Strands standing up give no evidence: the Y-up default.
-        assert_eq!(UpAxis::detect(&hanging(Vec3::new(0.0, 0.0, 1.0))), UpAxis::Y);
+        assert_eq!(
+            UpAxis::detect(&hanging(Vec3::new(0.0, 0.0, 1.0))),
+            UpAxis::Y
+        );
     }
 }
