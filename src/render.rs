@@ -80,7 +80,7 @@ pub struct RenderArgs {
     #[arg(long, value_enum, default_value = "perspective")]
     camera: CameraKind,
     /// The file's up axis; auto: Z when the strands hang along −z (Yuksel's .hair files), else Y.
-    /// The front is +z for Y-up and −y for Z-up.
+    /// The front (face side) is +z for Y-up and +y for Z-up.
     #[arg(long, value_enum, default_value = "auto")]
     up: UpChoice,
     /// Camera position X,Y,Z looking at the hair's centre (default: in front, framing the hair).

@@ -3,9 +3,11 @@
 //!
 //! Hair files disagree on their up axis: Cem Yuksel's `.hair` models (straight.hair, ...) are
 //! Z-up, TressFX and most game assets Y-up. [`UpAxis::detect`] guesses it from gravity: strands
-//! hang from their roots, so the mean root→tip vector points down. The "front" is then the
-//! conventional one of each system: +z toward the viewer for Y-up (OpenGL), −y for Z-up (the
-//! front view of Blender and 3ds Max); both have +x to the right of the picture.
+//! hang from their roots, so the mean root→tip vector points down. The "front" (the side the
+//! face is on) is +z for Y-up files (the OpenGL convention, TressFX) and +y for Z-up files:
+//! Yuksel's models face +y (straight.hair's face opening and hairline are on the +y side; seen
+//! from −y it shows the back of the head). So +x is to the right of the picture for Y-up files
+//! and to the left for Z-up ones (the model's own left and right).
 
 use glam::{Mat4, Vec3};
 
@@ -54,7 +56,7 @@ impl UpAxis {
     pub fn toward_front(self) -> Vec3 {
         match self {
             UpAxis::Y => Vec3::Z,
-            UpAxis::Z => -Vec3::Y,
+            UpAxis::Z => Vec3::Y,
         }
     }
 
@@ -361,7 +363,7 @@ mod tests {
         }
     }
 
-    /// The front view of a Z-up file: +z up in the picture, +x to the right, eye on −y;
+    /// The front view of a Z-up file: +z up in the picture, eye on +y, so +x to the left;
     /// checked through glam's matrices (NDC) and the hand-built basis alike.
     #[test]
     fn z_up_front_view_is_upright() {
@@ -370,21 +372,21 @@ mod tests {
             max: Vec3::splat(1.0),
         };
         let cam = Camera::framing_front(bounds, 1.0, false, UpAxis::Z);
-        assert!(cam.eye.y < -1.0 && cam.eye.x.abs() < 1e-6 && cam.eye.z.abs() < 1e-6);
+        assert!(cam.eye.y > 1.0 && cam.eye.x.abs() < 1e-6 && cam.eye.z.abs() < 1e-6);
         let vp = cam.projection_matrix(1.0) * cam.view();
         let top = vp.project_point3(Vec3::new(0.0, 0.0, 0.9));
-        let right = vp.project_point3(Vec3::new(0.9, 0.0, 0.0));
+        let plus_x = vp.project_point3(Vec3::new(0.9, 0.0, 0.0));
         assert!(
             top.y > 0.1 && top.x.abs() < 1e-5,
             "top of a Z-up box at NDC {top}"
         );
         assert!(
-            right.x > 0.1 && right.y.abs() < 1e-5,
-            "+x of a Z-up box at NDC {right}"
+            plus_x.x < -0.1 && plus_x.y.abs() < 1e-5,
+            "+x of a Z-up box at NDC {plus_x}"
         );
         let by_hand = camera_space(&cam, Vec3::new(0.9, 0.0, 0.9));
-        assert!(by_hand.x > 0.0 && by_hand.y > 0.0);
-        // Y-up: the same for +y.
+        assert!(by_hand.x < 0.0 && by_hand.y > 0.0);
+        // Y-up: +y up, eye on +z, +x to the right.
         let cam = Camera::framing_front(bounds, 1.0, false, UpAxis::Y);
         let vp = cam.projection_matrix(1.0) * cam.view();
         let top = vp.project_point3(Vec3::new(0.0, 0.9, 0.0));
@@ -392,6 +394,7 @@ mod tests {
             top.y > 0.1 && cam.eye.z > 1.0,
             "top of a Y-up box at NDC {top}"
         );
+        assert!(vp.project_point3(Vec3::new(0.9, 0.0, 0.0)).x > 0.1);
     }
 
     #[test]
