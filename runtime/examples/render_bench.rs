@@ -1,7 +1,8 @@
 //! Issue #5's benchmark: straight.hair at Hunz's viewport (656 × 861), one directional light,
 //! Kajiya-Kay shading; opaque, A-buffer and DBK, each without and with deep opacity maps.
 //!
-//! Each configuration renders once to warm up and `TIMED_RUNS` times timed; the table gives the
+//! Each configuration renders once to warm up and `TIMED_RUNS` times timed, the configurations
+//! interleaved round by round (load from others on a shared machine hits all alike); the table gives the
 //! median of each pass, GPU memory from the renderer's own accounting, fragments stored/dropped
 //! and the ratios of the same run. Hunz (2016) §6.3 measured, for the same model and viewport on
 //! a GTX 960: A-buffer 12,959,208 fragments in 150.46 MB, DBK 4,518,344 fragments in 53.86 MB
@@ -52,6 +53,7 @@ struct Measured {
     /// (pass, median ms) in the renderer's order.
     pass_ms: Vec<(String, f64)>,
     frame_ms: f64,
+    frame_min_ms: f64,
     total_ms: f64,
     memory: Vec<(String, u64)>,
     stored: Option<u64>,
@@ -79,56 +81,100 @@ impl Measured {
     }
 }
 
-fn measure(
-    gpu: &GpuContext,
-    model: &HairModel,
-    frame: &FrameParams,
-    name: &str,
+/// Every timed render of one configuration.
+struct Samples {
+    name: String,
     options: RenderOptions,
-    timed_runs: usize,
-) -> Result<Measured, BoxError> {
-    let warm: Frame = render_frame(gpu, model, frame, &options)?;
-    let mut per_pass: Vec<(String, Vec<f64>)> = warm
-        .stats
-        .timings
-        .iter()
-        .map(|t| (t.pass.clone(), Vec::new()))
-        .collect();
-    let mut frame_ms = Vec::new();
-    let mut total_ms = Vec::new();
-    let mut last = warm;
-    for _ in 0..timed_runs {
-        let out = render_frame(gpu, model, frame, &options)?;
-        for (slot, t) in per_pass.iter_mut().zip(&out.stats.timings) {
+    per_pass: Vec<(String, Vec<f64>)>,
+    frame_ms: Vec<f64>,
+    total_ms: Vec<f64>,
+    last: Option<Frame>,
+}
+
+impl Samples {
+    fn new(name: String, options: RenderOptions) -> Self {
+        Self {
+            name,
+            options,
+            per_pass: Vec::new(),
+            frame_ms: Vec::new(),
+            total_ms: Vec::new(),
+            last: None,
+        }
+    }
+
+    fn record(&mut self, out: Frame) {
+        let timings = &out.stats.timings;
+        if self.per_pass.is_empty() {
+            self.per_pass = timings
+                .iter()
+                .map(|t| (t.pass.clone(), Vec::new()))
+                .collect();
+        }
+        for (slot, t) in self.per_pass.iter_mut().zip(timings) {
             slot.1.push(t.milliseconds);
         }
-        let timings = &out.stats.timings;
-        frame_ms.push(
+        self.frame_ms.push(
             timings
                 .iter()
                 .filter(|t| !is_setup(&t.pass))
                 .map(|t| t.milliseconds)
                 .sum(),
         );
-        total_ms.push(timings.iter().map(|t| t.milliseconds).sum());
-        last = out;
+        self.total_ms
+            .push(timings.iter().map(|t| t.milliseconds).sum());
+        self.last = Some(out);
     }
-    let f = last.stats.fragments;
-    Ok(Measured {
-        name: name.to_string(),
-        pass_ms: per_pass
-            .into_iter()
-            .map(|(p, mut v)| (p, median(&mut v)))
-            .collect(),
-        frame_ms: median(&mut frame_ms),
-        total_ms: median(&mut total_ms),
-        memory: last.stats.memory_bytes.clone(),
-        stored: f.map(|f| f.stored),
-        dropped: f.map(|f| f.dropped),
-        truncated: f.map(|f| f.truncated),
-        capacity: f.map(|f| f.capacity),
-        covered: last.pixels.iter().filter(|p| p[3] > 0.0).count(),
-    })
+
+    fn summarize(mut self) -> Result<Measured, BoxError> {
+        let last = self.last.ok_or("no timed run")?;
+        let f = last.stats.fragments;
+        let frame_min = self.frame_ms.iter().copied().fold(f64::INFINITY, f64::min);
+        Ok(Measured {
+            name: self.name,
+            pass_ms: self
+                .per_pass
+                .into_iter()
+                .map(|(p, mut v)| (p, median(&mut v)))
+                .collect(),
+            frame_ms: median(&mut self.frame_ms),
+            frame_min_ms: frame_min,
+            total_ms: median(&mut self.total_ms),
+            memory: last.stats.memory_bytes.clone(),
+            stored: f.map(|f| f.stored),
+            dropped: f.map(|f| f.dropped),
+            truncated: f.map(|f| f.truncated),
+            capacity: f.map(|f| f.capacity),
+            covered: last.pixels.iter().filter(|p| p[3] > 0.0).count(),
+        })
+    }
+}
+
+/// One warm-up render per configuration, then `timed_runs` rounds that render every
+/// configuration in turn, so that load from other processes on a shared machine falls on all
+/// configurations alike rather than on whichever ran during it.
+fn measure_interleaved(
+    gpu: &GpuContext,
+    model: &HairModel,
+    frame: &FrameParams,
+    configs: Vec<(String, RenderOptions)>,
+    timed_runs: usize,
+) -> Result<Vec<Measured>, BoxError> {
+    let mut samples: Vec<Samples> = configs
+        .into_iter()
+        .map(|(name, options)| Samples::new(name, options))
+        .collect();
+    for s in &samples {
+        render_frame(gpu, model, frame, &s.options)?;
+    }
+    for round in 0..timed_runs {
+        eprintln!("round {} of {timed_runs} ...", round + 1);
+        for s in &mut samples {
+            let out = render_frame(gpu, model, frame, &s.options)?;
+            s.record(out);
+        }
+    }
+    samples.into_iter().map(Samples::summarize).collect()
 }
 
 /// Total fragments (stored + dropped) one list-building render produces, with the largest
@@ -250,7 +296,7 @@ fn main() -> Result<(), BoxError> {
         "probe (node buffer for {max_npp} nodes/pixel): A-buffer {all} fragments → {abuffer_npp} nodes/pixel; DBK (Δ = {delta:.4}, 5% of the diagonal) {dbk} fragments → {dbk_npp} nodes/pixel"
     );
     println!(
-        "runs: 1 warm-up + {timed_runs} timed per configuration; medians; timing = {}",
+        "runs: 1 warm-up + {timed_runs} timed per configuration, interleaved (round-robin); medians; timing = {}",
         "CPU wall clock around submit + wait for idle"
     );
 
@@ -285,11 +331,7 @@ fn main() -> Result<(), BoxError> {
             })
         })
         .collect();
-    let mut results = Vec::new();
-    for (name, options) in configs {
-        eprintln!("measuring {name} ...");
-        results.push(measure(&gpu, &model, &frame, &name, options, timed_runs)?);
-    }
+    let results = measure_interleaved(&gpu, &model, &frame, configs, timed_runs)?;
     print_table(&results);
     print_ratios(&results);
     Ok(())
@@ -310,18 +352,19 @@ fn count(v: Option<u64>) -> String {
 fn print_table(results: &[Measured]) {
     println!();
     println!(
-        "| configuration | deep opacity ms | strands ms | lists build+resolve+readback ms | readback ms | frame ms (no setup) | total ms (incl. pipelines, upload) | GPU MB total | node buffer MB (capacity) | lists used MB (stored × {NODE_BYTES} B + heads) | fragments stored | dropped | truncated at resolve | covered pixels |"
+        "| configuration | deep opacity ms | strands ms | lists build+resolve+readback ms | readback ms | frame ms (no setup) | fastest frame ms | total ms (incl. pipelines, upload) | GPU MB total | node buffer MB (capacity) | lists used MB (stored × {NODE_BYTES} B + heads) | fragments stored | dropped | truncated at resolve | covered pixels |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for m in results {
         println!(
-            "| {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.2} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {:.1} | {:.1} | {:.1} | {:.2} | {} | {} | {} | {} | {} | {} |",
             m.name,
             cell(pass_ms(m, "deep opacity")),
             cell(pass_ms(m, "strands")),
             cell(pass_ms(m, "abuffer build + resolve + readback")),
             cell(pass_ms(m, "readback")),
             m.frame_ms,
+            m.frame_min_ms,
             m.total_ms,
             mb(m.memory_total()),
             m.capacity.map_or("–".to_string(), |c| format!(
