@@ -296,8 +296,7 @@ fn main() -> Result<(), BoxError> {
         "probe (node buffer for {max_npp} nodes/pixel): A-buffer {all} fragments → {abuffer_npp} nodes/pixel; DBK (Δ = {delta:.4}, 5% of the diagonal) {dbk} fragments → {dbk_npp} nodes/pixel"
     );
     println!(
-        "runs: 1 warm-up + {timed_runs} timed per configuration, interleaved (round-robin); medians; timing = {}",
-        "CPU wall clock around submit + wait for idle"
+        "runs: 1 warm-up + {timed_runs} timed per configuration, interleaved (round-robin); medians; timing = CPU wall clock around submit + wait for idle"
     );
 
     let configs: Vec<(String, RenderOptions)> = [None, Some(dom)]

@@ -171,7 +171,8 @@ impl Camera {
         let center = bounds.center();
         let radius = (bounds.diagonal() * 0.5).max(1e-6);
         let distance = eye.distance(center);
-        if !(distance > radius * 1.0001) {
+        // Written so that a NaN distance (a NaN eye) is refused too.
+        if distance.is_nan() || distance <= radius * 1.0001 {
             return Err(EyeInsideBounds {
                 eye,
                 center,
