@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
-use strandlight_runtime::camera::Camera;
+use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::{self, GroomParams, HairModel};
 use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
@@ -76,9 +76,16 @@ pub struct RenderArgs {
     /// Image size WxH in pixels.
     #[arg(long, default_value = "512x512")]
     size: String,
-    /// The default camera looks along −z at the hair's bounds and frames them.
+    /// The default camera frames the hair's bounds from the front (see --up and --eye).
     #[arg(long, value_enum, default_value = "perspective")]
     camera: CameraKind,
+    /// The file's up axis; auto: Z when the strands hang along −z (Yuksel's .hair files), else Y.
+    /// The front (face side) is +z for Y-up and +y for Z-up.
+    #[arg(long, value_enum, default_value = "auto")]
+    up: UpChoice,
+    /// Camera position X,Y,Z looking at the hair's centre (default: in front, framing the hair).
+    #[arg(long)]
+    eye: Option<String>,
     /// Every fiber this many pixels wide (default: the file's thickness, projected).
     #[arg(long)]
     fiber_width_px: Option<f32>,
@@ -128,6 +135,45 @@ fn load_hair(path: Option<&Path>) -> anyhow::Result<(HairModel, String)> {
     }
 }
 
+#[derive(Clone, Copy, Debug, ValueEnum)]
+pub enum UpChoice {
+    Auto,
+    Y,
+    Z,
+}
+
+fn parse_vec3(flag: &str, text: &str) -> anyhow::Result<[f32; 3]> {
+    let values = text
+        .split(',')
+        .map(|s| s.trim().parse::<f32>().ok().filter(|v| v.is_finite()))
+        .collect::<Option<Vec<f32>>>();
+    match values.as_deref() {
+        Some(&[x, y, z]) => Ok([x, y, z]),
+        _ => bail!("{flag} {text:?}: expected three finite numbers X,Y,Z"),
+    }
+}
+
+/// The camera `--camera`, `--up` and `--eye` ask for.
+fn choose_camera(args: &RenderArgs, model: &HairModel, aspect: f32) -> anyhow::Result<Camera> {
+    let up = match args.up {
+        UpChoice::Auto => UpAxis::detect(model),
+        UpChoice::Y => UpAxis::Y,
+        UpChoice::Z => UpAxis::Z,
+    };
+    let orthographic = matches!(args.camera, CameraKind::Orthographic);
+    Ok(match &args.eye {
+        None => Camera::framing_front(model.bounds(), aspect, orthographic, up),
+        Some(text) => Camera::framing_from_eye(
+            model.bounds(),
+            aspect,
+            orthographic,
+            parse_vec3("--eye", text)?,
+            up.vector(),
+        )
+        .with_context(|| format!("--eye {text}"))?,
+    })
+}
+
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     match args.shading {
         Shading::KajiyaKay => {}
@@ -170,11 +216,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         other => other,
     };
     let gpu = GpuContext::new_headless()?;
-    let camera = Camera::framing(
-        model.bounds(),
-        width as f32 / height as f32,
-        matches!(args.camera, CameraKind::Orthographic),
-    );
+    let camera = choose_camera(&args, &model, width as f32 / height as f32)?;
     let frame = FrameParams {
         camera,
         width,

@@ -1,9 +1,17 @@
-//! The camera: a view and an orthographic or perspective projection, with a default that frames
-//! a bounding box.
+//! The camera: a view and an orthographic or perspective projection, with defaults that frame a
+//! bounding box from the front, whichever way the file's "up" points.
+//!
+//! Hair files disagree on their up axis: Cem Yuksel's `.hair` models (straight.hair, ...) are
+//! Z-up, TressFX and most game assets Y-up. [`UpAxis::detect`] guesses it from gravity: strands
+//! hang from their roots, so the mean root→tip vector points down. The "front" (the side the
+//! face is on) is +z for Y-up files (the OpenGL convention, TressFX) and +y for Z-up files:
+//! Yuksel's models face +y (straight.hair's face opening and hairline are on the +y side; seen
+//! from −y it shows the back of the head). So +x is to the right of the picture for Y-up files
+//! and to the left for Z-up ones (the model's own left and right).
 
 use glam::{Mat4, Vec3};
 
-use crate::hair::Aabb;
+use crate::hair::{Aabb, HairModel};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Projection {
@@ -26,10 +34,105 @@ pub struct Camera {
 /// The default vertical field of view of [`Camera::framing`], 30°.
 pub const DEFAULT_FOV_Y_DEGREES: f32 = 30.0;
 
+/// The widest vertical field of view [`Camera::framing_from_eye`] opens to fit the hair, 120°.
+pub const MAX_FOV_Y_DEGREES: f32 = 120.0;
+
+/// Which world axis points up in a hair file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum UpAxis {
+    Y,
+    Z,
+}
+
+impl UpAxis {
+    pub fn vector(self) -> Vec3 {
+        match self {
+            UpAxis::Y => Vec3::Y,
+            UpAxis::Z => Vec3::Z,
+        }
+    }
+
+    /// Unit direction from the hair toward a camera that sees it from the front.
+    pub fn toward_front(self) -> Vec3 {
+        match self {
+            UpAxis::Y => Vec3::Z,
+            UpAxis::Z => Vec3::Y,
+        }
+    }
+
+    /// Gravity heuristic: Z when the summed root→tip vector points more along −z than along −y,
+    /// Y otherwise (also for hair that does not hang, e.g. strands standing up or straight out).
+    pub fn detect(model: &HairModel) -> Self {
+        let hang: Vec3 = model
+            .strands()
+            .map(|s| s[s.len() - 1] - s[0])
+            .fold(Vec3::ZERO, |a, b| a + b);
+        if -hang.z > -hang.y && hang.z < 0.0 {
+            UpAxis::Z
+        } else {
+            UpAxis::Y
+        }
+    }
+}
+
+/// The eye lies inside the bounding sphere of what it should frame.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[error(
+    "camera eye {eye} is {distance} from the hair's centre {center}, inside its bounding sphere (radius {radius}); place it farther away"
+)]
+pub struct EyeInsideBounds {
+    pub eye: Vec3,
+    pub center: Vec3,
+    pub distance: f32,
+    pub radius: f32,
+}
+
+/// `up`, or another axis when `up` is (nearly) parallel to the view direction, where look-at
+/// would be undefined.
+fn usable_up(up: Vec3, toward_eye: Vec3) -> Vec3 {
+    let up = up.normalize_or(Vec3::Y);
+    if up.dot(toward_eye).abs() < 0.999 {
+        return up;
+    }
+    [Vec3::Y, Vec3::Z, Vec3::X]
+        .into_iter()
+        .find(|a| a.dot(toward_eye).abs() < 0.9)
+        .unwrap_or(Vec3::X)
+}
+
+/// Vertical half-angle whose narrower field (vertical or horizontal at `aspect`) is
+/// `half_min`.
+fn fov_y_for_narrow_half_angle(half_min: f32, aspect: f32) -> f32 {
+    if aspect >= 1.0 {
+        2.0 * half_min
+    } else {
+        2.0 * (half_min.tan() / aspect).atan()
+    }
+}
+
 impl Camera {
-    /// Looks along −z at the box's centre from far enough that its bounding sphere fits the
-    /// narrower of the two fields of view.
+    /// Looks along −z (Y up) at the box's centre from far enough that its bounding sphere fits
+    /// the narrower of the two fields of view.
     pub fn framing(bounds: Aabb, aspect: f32, orthographic: bool) -> Self {
+        Self::framing_along(bounds, aspect, orthographic, Vec3::Z, Vec3::Y)
+    }
+
+    /// Frames the box from the front for the given up axis (see [`UpAxis::toward_front`]).
+    pub fn framing_front(bounds: Aabb, aspect: f32, orthographic: bool, up: UpAxis) -> Self {
+        Self::framing_along(bounds, aspect, orthographic, up.toward_front(), up.vector())
+    }
+
+    /// Looks at the box's centre from direction `toward_eye` (need not be normalised), `up`
+    /// upward in the picture, at [`DEFAULT_FOV_Y_DEGREES`] and at the distance where the
+    /// bounding sphere just fits the narrower field of view.
+    pub fn framing_along(
+        bounds: Aabb,
+        aspect: f32,
+        orthographic: bool,
+        toward_eye: Vec3,
+        up: Vec3,
+    ) -> Self {
+        let toward_eye = toward_eye.normalize_or(Vec3::Z);
         let center = bounds.center();
         let radius = (bounds.diagonal() * 0.5).max(1e-6);
         let fov_y = DEFAULT_FOV_Y_DEGREES.to_radians();
@@ -45,13 +148,57 @@ impl Camera {
             Projection::Perspective { fov_y }
         };
         Self {
-            eye: center + Vec3::Z * distance,
+            eye: center + toward_eye * distance,
             target: center,
-            up: Vec3::Y,
+            up: usable_up(up, toward_eye),
             projection,
             near: (distance - radius) * 0.5,
             far: distance + radius * 2.0,
         }
+    }
+
+    /// A camera at `eye` looking at the box's centre; the perspective field of view opens just
+    /// enough for the bounding sphere (up to [`MAX_FOV_Y_DEGREES`], beyond which the hair is
+    /// cropped), the orthographic one as in [`Self::framing_along`].
+    pub fn framing_from_eye(
+        bounds: Aabb,
+        aspect: f32,
+        orthographic: bool,
+        eye: impl Into<Vec3>,
+        up: impl Into<Vec3>,
+    ) -> Result<Self, EyeInsideBounds> {
+        let (eye, up) = (eye.into(), up.into());
+        let center = bounds.center();
+        let radius = (bounds.diagonal() * 0.5).max(1e-6);
+        let distance = eye.distance(center);
+        // Written so that a NaN distance (a NaN eye) is refused too.
+        if distance.is_nan() || distance <= radius * 1.0001 {
+            return Err(EyeInsideBounds {
+                eye,
+                center,
+                distance,
+                radius,
+            });
+        }
+        let toward_eye = (eye - center) / distance;
+        let half_min = (radius / distance).asin();
+        let fov_y =
+            fov_y_for_narrow_half_angle(half_min, aspect).min(MAX_FOV_Y_DEGREES.to_radians());
+        let projection = if orthographic {
+            Projection::Orthographic {
+                half_height: radius / aspect.min(1.0),
+            }
+        } else {
+            Projection::Perspective { fov_y }
+        };
+        Ok(Self {
+            eye,
+            target: center,
+            up: usable_up(up, toward_eye),
+            projection,
+            near: (distance - radius) * 0.5,
+            far: distance + radius * 2.0,
+        })
     }
 
     pub fn view(&self) -> Mat4 {
@@ -130,5 +277,189 @@ mod tests {
                 }
             }
         }
+    }
+
+    fn corners(b: Aabb) -> impl Iterator<Item = Vec3> {
+        (0..8).map(move |i| {
+            Vec3::new(
+                if i & 1 == 0 { b.min.x } else { b.max.x },
+                if i & 2 == 0 { b.min.y } else { b.max.y },
+                if i & 4 == 0 { b.min.z } else { b.max.z },
+            )
+        })
+    }
+
+    /// Camera-space (right, up, forward) coordinates from a basis built by hand with cross
+    /// products, independent of glam's look-at and projection matrices.
+    fn camera_space(cam: &Camera, p: Vec3) -> Vec3 {
+        let forward = (cam.target - cam.eye).normalize();
+        let right = forward.cross(cam.up).normalize();
+        let up = right.cross(forward);
+        let d = p - cam.eye;
+        Vec3::new(d.dot(right), d.dot(up), d.dot(forward))
+    }
+
+    /// Every corner lies inside the view frustum, checked in camera space by hand: the slopes
+    /// x/z and y/z within tan of the half-angles (perspective) or |x|, |y| within the half
+    /// extents (orthographic), and depth between near and far.
+    fn assert_in_view(cam: &Camera, bounds: Aabb, aspect: f32, what: &str) -> f32 {
+        let mut widest = 0.0f32;
+        for corner in corners(bounds) {
+            let c = camera_space(cam, corner);
+            assert!(
+                c.z > cam.near && c.z < cam.far,
+                "{what}: {corner} depth {} outside {}..{}",
+                c.z,
+                cam.near,
+                cam.far
+            );
+            let (sx, sy) = match cam.projection {
+                Projection::Perspective { fov_y } => {
+                    let t = (fov_y * 0.5).tan();
+                    (c.x / c.z / (t * aspect), c.y / c.z / t)
+                }
+                Projection::Orthographic { half_height } => {
+                    (c.x / (half_height * aspect), c.y / half_height)
+                }
+            };
+            assert!(
+                sx.abs() <= 1.0 && sy.abs() <= 1.0,
+                "{what}: {corner} at screen ({sx}, {sy})"
+            );
+            widest = widest.max(sx.abs()).max(sy.abs());
+        }
+        widest
+    }
+
+    #[test]
+    fn front_framing_keeps_the_box_in_view_and_is_tight() {
+        let bounds = Aabb {
+            min: Vec3::new(-1.0, 2.0, -0.5),
+            max: Vec3::new(3.0, 5.0, 0.7),
+        };
+        let radius = bounds.diagonal() * 0.5;
+        for up in [UpAxis::Y, UpAxis::Z] {
+            for aspect in [0.5f32, 656.0 / 861.0, 1.0, 1.9] {
+                for ortho in [false, true] {
+                    let cam = Camera::framing_front(bounds, aspect, ortho, up);
+                    let what = format!("{up:?} aspect {aspect} ortho {ortho}");
+                    let widest = assert_in_view(&cam, bounds, aspect, &what);
+                    // Tightness: the bounding sphere seen from the eye spans exactly the
+                    // narrower half-field, tan(half_y)·min(1, aspect) as a slope.
+                    if let Projection::Perspective { fov_y } = cam.projection {
+                        let sphere_half = (radius / cam.eye.distance(bounds.center())).asin();
+                        let narrow_half = ((fov_y * 0.5).tan() * aspect.min(1.0)).atan();
+                        assert!(
+                            (sphere_half - narrow_half).abs() < 1e-5,
+                            "{what}: sphere {sphere_half} vs field {narrow_half}"
+                        );
+                    }
+                    eprintln!("{what}: widest corner at {widest:.3} of the half-screen");
+                    assert!(
+                        widest > 0.3,
+                        "{what}: the box is framed too loosely ({widest})"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The front view of a Z-up file: +z up in the picture, eye on +y, so +x to the left;
+    /// checked through glam's matrices (NDC) and the hand-built basis alike.
+    #[test]
+    fn z_up_front_view_is_upright() {
+        let bounds = Aabb {
+            min: Vec3::splat(-1.0),
+            max: Vec3::splat(1.0),
+        };
+        let cam = Camera::framing_front(bounds, 1.0, false, UpAxis::Z);
+        assert!(cam.eye.y > 1.0 && cam.eye.x.abs() < 1e-6 && cam.eye.z.abs() < 1e-6);
+        let vp = cam.projection_matrix(1.0) * cam.view();
+        let top = vp.project_point3(Vec3::new(0.0, 0.0, 0.9));
+        let plus_x = vp.project_point3(Vec3::new(0.9, 0.0, 0.0));
+        assert!(
+            top.y > 0.1 && top.x.abs() < 1e-5,
+            "top of a Z-up box at NDC {top}"
+        );
+        assert!(
+            plus_x.x < -0.1 && plus_x.y.abs() < 1e-5,
+            "+x of a Z-up box at NDC {plus_x}"
+        );
+        let by_hand = camera_space(&cam, Vec3::new(0.9, 0.0, 0.9));
+        assert!(by_hand.x < 0.0 && by_hand.y > 0.0);
+        // Y-up: +y up, eye on +z, +x to the right.
+        let cam = Camera::framing_front(bounds, 1.0, false, UpAxis::Y);
+        let vp = cam.projection_matrix(1.0) * cam.view();
+        let top = vp.project_point3(Vec3::new(0.0, 0.9, 0.0));
+        assert!(
+            top.y > 0.1 && cam.eye.z > 1.0,
+            "top of a Y-up box at NDC {top}"
+        );
+        assert!(vp.project_point3(Vec3::new(0.9, 0.0, 0.0)).x > 0.1);
+    }
+
+    #[test]
+    fn eye_placement_frames_the_box_or_refuses_an_eye_inside_it() {
+        let bounds = Aabb {
+            min: Vec3::new(-1.0, -2.0, 0.0),
+            max: Vec3::new(1.0, 2.0, 3.0),
+        };
+        for eye in [
+            Vec3::new(0.0, -10.0, 2.0),
+            Vec3::new(7.0, 3.0, 8.0),
+            Vec3::new(0.0, 0.0, 9.0),
+        ] {
+            for ortho in [false, true] {
+                let cam =
+                    Camera::framing_from_eye(bounds, 656.0 / 861.0, ortho, eye, Vec3::Z).unwrap();
+                assert_eq!(cam.eye, eye);
+                assert_in_view(
+                    &cam,
+                    bounds,
+                    656.0 / 861.0,
+                    &format!("eye {eye} ortho {ortho}"),
+                );
+            }
+        }
+        let inside =
+            Camera::framing_from_eye(bounds, 1.0, false, Vec3::new(0.0, 0.0, 1.0), Vec3::Z);
+        assert!(matches!(inside, Err(EyeInsideBounds { .. })));
+        let nan = Camera::framing_from_eye(bounds, 1.0, false, Vec3::NAN, Vec3::Z);
+        assert!(nan.is_err(), "a NaN eye must be refused");
+    }
+
+    fn hanging(direction: Vec3) -> HairModel {
+        let mut points = Vec::new();
+        let mut offsets = vec![0u32];
+        for s in 0..5 {
+            let root = Vec3::new(s as f32 * 0.1, 0.3, 0.2);
+            for k in 0..4 {
+                // Mostly along `direction`, with a sideways wiggle to make it less trivial.
+                points.push(root + direction * k as f32 + Vec3::X * 0.3 * (k % 2) as f32);
+            }
+            offsets.push(points.len() as u32);
+        }
+        HairModel::new(points, offsets, None, None, None).unwrap()
+    }
+
+    #[test]
+    fn up_axis_follows_gravity() {
+        assert_eq!(
+            UpAxis::detect(&hanging(Vec3::new(0.1, 0.2, -1.0))),
+            UpAxis::Z
+        );
+        assert_eq!(
+            UpAxis::detect(&hanging(Vec3::new(0.1, -1.0, 0.2))),
+            UpAxis::Y
+        );
+        assert_eq!(
+            UpAxis::detect(&hanging(Vec3::new(0.0, -0.5, -0.4))),
+            UpAxis::Y
+        );
+        // Strands standing up give no evidence: the Y-up default.
+        assert_eq!(
+            UpAxis::detect(&hanging(Vec3::new(0.0, 0.0, 1.0))),
+            UpAxis::Y
+        );
     }
 }
