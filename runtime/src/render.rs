@@ -11,6 +11,7 @@ use crate::passes::abuffer::{ABufferPass, ListMode};
 use crate::passes::deep_opacity::{
     DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError, light_camera,
 };
+use crate::passes::fiber_shading::ShadingModel;
 use crate::passes::strands::{
     FrameParams, RenderTarget, ShadowInput, StrandGeometry, StrandPass, TooManyPoints,
 };
@@ -29,6 +30,10 @@ pub enum RenderError {
     NoDirectionalLight,
     #[error(transparent)]
     Readback(#[from] ReadbackError),
+    #[error(
+        "shading model `{model}` is drawn by the opaque strand pass only; the A-buffer and DBK passes shade with Kajiya-Kay"
+    )]
+    ShadingNeedsOpaque { model: &'static str },
     #[error("the GPU reported an error: {0}")]
     Gpu(String),
 }
@@ -114,6 +119,23 @@ pub fn render_frame(
     frame: &FrameParams,
     options: &RenderOptions,
 ) -> Result<Frame, RenderError> {
+    render_frame_with_model(gpu, model, frame, options, &ShadingModel::KajiyaKay)
+}
+
+/// [`render_frame`] shading the fibers with `shading` (Kajiya-Kay takes its constants from
+/// `frame.shading`). Models other than Kajiya-Kay need [`Transparency::Opaque`].
+pub fn render_frame_with_model(
+    gpu: &GpuContext,
+    model: &HairModel,
+    frame: &FrameParams,
+    options: &RenderOptions,
+    shading: &ShadingModel,
+) -> Result<Frame, RenderError> {
+    if !matches!(shading, ShadingModel::KajiyaKay) && options.transparency != Transparency::Opaque {
+        return Err(RenderError::ShadingNeedsOpaque {
+            model: shading.name(),
+        });
+    }
     let shadowed_light = match options.shadows {
         None => None,
         Some(settings) => {
@@ -166,7 +188,7 @@ pub fn render_frame(
     let pixels = match options.transparency {
         Transparency::Opaque => {
             let pass = timed(&mut timings, gpu, "strand pipeline", || {
-                StrandPass::new(gpu)
+                StrandPass::with_model(gpu, shading)
             });
             let target = RenderTarget::new(gpu, frame.width, frame.height);
             timed(&mut timings, gpu, "strands", || {

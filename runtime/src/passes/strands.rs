@@ -1,5 +1,5 @@
-//! The strand pass: every hair segment drawn as a camera-facing quad, Kajiya-Kay shaded under
-//! several point lights, blended with pre-multiplied alpha into an HDR float target with a
+//! The strand pass: every hair segment drawn as a camera-facing quad, shaded under several
+//! lights with a [`ShadingModel`] (Kajiya-Kay, Marschner through lookup tables, artist-friendly), blended with pre-multiplied alpha into an HDR float target with a
 //! depth test. Inputs: [`StrandGeometry`] (the hair on the GPU), [`FrameParams`] (camera,
 //! shading constants, lights). Output: the colour texture of a [`RenderTarget`].
 
@@ -11,6 +11,7 @@ use crate::gpu::GpuContext;
 use crate::hair::HairModel;
 use crate::lights::{GpuLight, Light};
 use crate::passes::deep_opacity::{DeepOpacityMap, DomSettings};
+use crate::passes::fiber_shading::{ModelBinding, ShadingModel};
 
 /// Hair colour where the file has none (linear RGB, a mid brown).
 pub const DEFAULT_HAIR_COLOR: [f32; 3] = [0.35, 0.22, 0.12];
@@ -258,6 +259,8 @@ pub struct StrandPass {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     shadow_layout: wgpu::BindGroupLayout,
+    /// Group 2: the fiber model's constants and tables (none for Kajiya-Kay).
+    model: Option<ModelBinding>,
 }
 
 /// A deep opacity map that shadows light `light_index` of the frame.
@@ -311,23 +314,34 @@ pub fn shadow_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout 
 }
 
 impl StrandPass {
+    /// Kajiya-Kay shading with the constants of [`FrameParams::shading`].
     pub fn new(gpu: &GpuContext) -> Self {
+        Self::with_model(gpu, &ShadingModel::KajiyaKay)
+    }
+
+    /// Shading with `model`; its tables and constants are uploaded once, here.
+    pub fn with_model(gpu: &GpuContext, model: &ShadingModel) -> Self {
         let device = &gpu.device;
+        let source = [
+            include_str!("strand_quads.wgsl"),
+            include_str!("strands.wgsl"),
+            model.wgsl(),
+        ]
+        .concat();
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("strands.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(
-                concat!(
-                    include_str!("strand_quads.wgsl"),
-                    include_str!("strands.wgsl")
-                )
-                .into(),
-            ),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
         });
         let layout = strand_bind_group_layout(device);
         let shadow_layout = shadow_bind_group_layout(device);
+        let model = ModelBinding::new(gpu, model);
+        let mut group_layouts = vec![Some(&layout), Some(&shadow_layout)];
+        if let Some(m) = &model {
+            group_layouts.push(Some(&m.layout));
+        }
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("strands"),
-            bind_group_layouts: &[Some(&layout), Some(&shadow_layout)],
+            bind_group_layouts: &group_layouts,
             immediate_size: 0,
         });
         let premultiplied_over = wgpu::BlendComponent {
@@ -377,6 +391,7 @@ impl StrandPass {
             pipeline,
             layout,
             shadow_layout,
+            model,
         }
     }
 
@@ -422,6 +437,9 @@ impl StrandPass {
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &shadow_group, &[]);
+            if let Some(model) = &self.model {
+                pass.set_bind_group(2, &model.group, &[]);
+            }
             pass.draw(0..6, 0..geometry.segment_count);
         }
         gpu.queue.submit([encoder.finish()]);

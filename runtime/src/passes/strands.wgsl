@@ -1,17 +1,6 @@
-// Kajiya-Kay shading of the strand quads (strand_quads.wgsl) under several point lights,
-// written with pre-multiplied alpha.
-
-// Kajiya-Kay with t the tangent, l toward the light, e toward the eye:
-//   L = E · (kd · color · sin(t, l) + ks · max(0, sin(t, l) sin(t, e) − (t·l)(t·e))^p),
-// the specular term being cos of the angle between e and the cone of mirror directions.
-fn kajiya_kay(t: vec3<f32>, l: vec3<f32>, e: vec3<f32>, color: vec3<f32>) -> vec3<f32> {
-    let tl = dot(t, l);
-    let te = dot(t, e);
-    let sin_tl = sqrt(max(0.0, 1.0 - tl * tl));
-    let sin_te = sqrt(max(0.0, 1.0 - te * te));
-    let cone = max(0.0, sin_tl * sin_te - tl * te);
-    return frame.kd * color * sin_tl + vec3<f32>(frame.ks * pow(cone, frame.shininess));
-}
+// Shading of the strand quads (strand_quads.wgsl) under several lights, written with
+// pre-multiplied alpha. The fiber model is `fiber_radiance`, defined by one of the fiber_*.wgsl
+// files appended after this one (Kajiya-Kay, Marschner through lookup tables, artist-friendly).
 
 // Deep opacity map of one directional light (Svoboda §4, Hunz §4); light_index = 0xffffffff: none.
 struct ShadowParams {
@@ -82,7 +71,7 @@ fn shade(in: VertexOut) -> vec4<f32> {
         let li = light_at(lights[i], in.world);
         var visible = 1.0;
         if (i == shadow.light_index) { visible = shadow_transmittance(in.world); }
-        radiance += visible * li.w * kajiya_kay(t, li.xyz, e, in.color);
+        radiance += visible * li.w * fiber_radiance(t, li.xyz, e, in.color);
     }
     return vec4<f32>(radiance * in.alpha, in.alpha);
 }
