@@ -73,7 +73,7 @@ fn render(gpu: &GpuContext, light: Light, shading: &ShadingModel) -> Frame {
         shading: KajiyaKay::default(),
         width_override_px: Some(4.0),
     };
-    render_frame_with_model(&gpu, &strand(), &frame, &RenderOptions::default(), shading)
+    render_frame_with_model(gpu, &strand(), &frame, &RenderOptions::default(), shading)
         .unwrap_or_else(|e| panic!("{e}"))
 }
 

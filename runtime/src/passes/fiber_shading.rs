@@ -23,6 +23,8 @@ pub const MIN_COS2_THETA_D: f32 = 1e-8;
 pub const MIN_COS_THETA_D: f32 = 1e-4;
 
 /// How the strand pass shades a fiber.
+// Built once per pass, never in a hot loop: the variants' size difference does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, Default)]
 pub enum ShadingModel {
     #[default]
