@@ -188,7 +188,9 @@ pub fn render_frame_with_model(
         });
         for &(settings, index, direction) in &shadowed_lights {
             let map = DeepOpacityMap::new(gpu, light_camera(direction, model.bounds()), settings);
-            timed(&mut timings, gpu, "deep opacity", || {
+            // One entry per light, so that reports keyed by pass name keep them all.
+            let label = format!("deep opacity (light {index})");
+            timed(&mut timings, gpu, &label, || {
                 dom_pass.draw(gpu, &geometry, &map)
             });
             memory_bytes.extend(map.memory());

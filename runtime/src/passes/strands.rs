@@ -274,7 +274,9 @@ pub struct ShadowInput<'a> {
 pub const MAX_SHADOWED_LIGHTS: usize = 4;
 
 #[derive(Debug, thiserror::Error, PartialEq)]
-#[error("{maps} deep opacity maps given; the strand pass shadows at most {MAX_SHADOWED_LIGHTS} lights")]
+#[error(
+    "{maps} deep opacity maps given; the strand pass shadows at most {MAX_SHADOWED_LIGHTS} lights"
+)]
 pub struct TooManyShadowMaps {
     pub maps: usize,
 }
