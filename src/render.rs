@@ -325,3 +325,52 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: RenderArgs,
+    }
+
+    fn args(line: &[&str]) -> RenderArgs {
+        Cli::try_parse_from(std::iter::once("render").chain(line.iter().copied()))
+            .unwrap()
+            .args
+    }
+
+    #[test]
+    fn shading_choices_build_their_models_and_name_bad_parameters() {
+        let (model, text) =
+            shading_model(&args(&["--shading", "marschner", "--lut-size", "16"])).unwrap();
+        match model {
+            ShadingModel::MarschnerLut(luts) => {
+                assert_eq!(luts.lut_m().shape(), vec![16, 16, 4]);
+                assert_eq!(luts.lut_n().shape(), vec![16, 16, 3]);
+            }
+            other => panic!("{}", other.name()),
+        }
+        assert!(text.contains("brown") && text.contains("16²"), "{text}");
+        assert!(matches!(
+            shading_model(&args(&["--shading", "artist"])).unwrap().0,
+            ShadingModel::Artist(_)
+        ));
+        let e =
+            shading_model(&args(&["--shading", "marschner", "--preset", "purple"])).unwrap_err();
+        assert!(format!("{e:#}").contains("--preset \"purple\""), "{e:#}");
+        let e = shading_model(&args(&["--shading", "marschner", "--lut-size", "1"])).unwrap_err();
+        assert!(format!("{e:#}").contains("--lut-size 1"), "{e:#}");
+        let e = shading_model(&args(&[
+            "--shading",
+            "artist",
+            "--artist-params",
+            "/nonexistent/artist.json",
+        ]))
+        .unwrap_err();
+        assert!(format!("{e:#}").contains("artist.json"), "{e:#}");
+    }
+}
