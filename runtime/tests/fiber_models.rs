@@ -174,18 +174,19 @@ fn compare(samples: &[Sample], expected: impl Fn(&Sample) -> [f64; 3]) -> Errors
     }
 }
 
-/// A directional light (θ_i ≈ −16°, near the primary highlight for θ_o = 30°) and a point light
-/// close beside the strand, whose direction sweeps θ_i and φ along it. All inclinations stay
-/// within 60°, away from the grazing corners where the tables' error grows.
-fn lights() -> [(&'static str, Light); 2] {
+/// Directional lights at φ ≈ −47° (θ_i ≈ −16°, near the primary highlight for θ_o = 30°), ≈ 96°
+/// (side) and ≈ 164° (behind the fiber: transmission), and a point light close beside the
+/// strand whose direction sweeps θ_i along it (φ is constant along a straight fiber). All
+/// inclinations stay within 60°, away from the grazing corners where the tables' error grows.
+fn lights() -> [(&'static str, Light); 4] {
+    let directional = |x: f32, y: f32, z: f32, intensity| Light::Directional {
+        direction: Vec3::new(x, y, z).normalize(),
+        intensity,
+    };
     [
-        (
-            "directional",
-            Light::Directional {
-                direction: Vec3::new(1.0, -0.8, 0.6).normalize(),
-                intensity: 2.0,
-            },
-        ),
+        ("directional, front", directional(1.0, -0.8, 0.6, 2.0)),
+        ("directional, side", directional(1.0, 0.2, 0.0, 1.5)),
+        ("directional, behind", directional(0.3, 0.5, -0.9, 1.0)),
         (
             "point",
             Light::Point {
@@ -288,12 +289,20 @@ fn check_marschner_luts(gpu: &GpuContext, model: &Marschner, resolution: &LutRes
             "{name}: GPU vs CPU lookup {:.2e}",
             lookup.worst_relative
         );
-        // Bilinear tables at 128² err by ~0.3% RMS of max S below 45° (precompute's lut tests);
-        // the worst single sample near a lobe's peak is allowed 2% of the largest value.
+        // Against the model, the GPU can be no better than the tables themselves: its error
+        // must be the tables' own (the CPU f64 lookup's) to f32 rounding. Bilinear tables at
+        // 128² err by ~0.3% RMS of max S below 45° over all angles (precompute's LUT tests);
+        // here each light is measured against the peak of its own samples, which for the side
+        // light (10⁻⁴, off every lobe) and the light behind the fiber (on the tail of the narrow
+        // TT lobe, θ_h ≈ 14°) is small, so up to 3% of it is allowed (measured: 0.8%, 2.7%).
         assert!(
-            exact.worst_of_max < 2e-2 && exact.rms_of_max < 5e-3,
-            "{name}: GPU vs model worst {:.2e}, RMS {:.2e} of max",
-            exact.worst_of_max,
+            exact.worst_of_max <= table_error + 1e-4,
+            "{name}: GPU vs model {:.2e} of max, the tables alone {table_error:.2e}",
+            exact.worst_of_max
+        );
+        assert!(
+            table_error < 3e-2 && exact.rms_of_max < 2e-2,
+            "{name}: tables vs model worst {table_error:.2e}, GPU RMS {:.2e} of max",
             exact.rms_of_max
         );
     }
