@@ -5,14 +5,18 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
+use strandlight_precompute::point_light_luts::{LutResolution, bake_lut_m, bake_lut_n};
 use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::{self, GroomParams, HairModel};
 use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::DomSettings;
+use strandlight_runtime::passes::fiber_shading::{MarschnerLuts, ShadingModel};
 use strandlight_runtime::passes::strands::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{self, RenderOptions, render_frame};
+use strandlight_runtime::render::{self, RenderOptions, render_frame_with_model};
+use strandlight_tables::artist::{ArtistModel, ArtistParams};
+use strandlight_tables::marschner::{Marschner, MarschnerParams};
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
 pub enum Shading {
@@ -54,6 +58,15 @@ pub struct RenderArgs {
     lights: Vec<String>,
     #[arg(long, value_enum, default_value = "kajiya-kay")]
     shading: Shading,
+    /// Melanin preset of the Marschner fiber (--shading marschner): dark, brown, blonde, ...
+    #[arg(long, default_value = "brown")]
+    preset: String,
+    /// Nodes per axis of the Marschner lookup tables, baked at startup.
+    #[arg(long, default_value_t = 128)]
+    lut_size: usize,
+    /// JSON file of artist-model controls (--shading artist; default: the built-in light brown).
+    #[arg(long)]
+    artist_params: Option<PathBuf>,
     #[arg(long, value_enum, default_value = "none")]
     shadows: Shadows,
     #[arg(long, value_enum, default_value = "none")]
@@ -174,10 +187,60 @@ fn choose_camera(args: &RenderArgs, model: &HairModel, aspect: f32) -> anyhow::R
     })
 }
 
-pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+/// The fiber model, with its lookup tables baked now for Marschner (the runtime does not link
+/// the tabulation code), and a line describing it.
+fn shading_model(args: &RenderArgs) -> anyhow::Result<(ShadingModel, String)> {
     match args.shading {
-        Shading::KajiyaKay => {}
-        other => bail!("--shading {other:?} is not implemented yet; only kajiya-kay renders"),
+        Shading::KajiyaKay => Ok((
+            ShadingModel::KajiyaKay,
+            format!("Kajiya-Kay {:?}", KajiyaKay::default()),
+        )),
+        Shading::Marschner => {
+            let params = MarschnerParams::with_preset(&args.preset)
+                .with_context(|| format!("--preset {:?}", args.preset))?;
+            let model = Marschner::new(params)?;
+            let resolution = LutResolution::square(args.lut_size);
+            let lut_m = bake_lut_m(&model, &resolution)
+                .with_context(|| format!("--lut-size {}", args.lut_size))?;
+            let lut_n = bake_lut_n(&model, &resolution)
+                .with_context(|| format!("--lut-size {}", args.lut_size))?;
+            Ok((
+                ShadingModel::MarschnerLut(MarschnerLuts::new(lut_m, lut_n)?),
+                format!(
+                    "Marschner (preset {}) through {}² lookup tables (Hunz 2016 Algorithm 2)",
+                    args.preset, args.lut_size
+                ),
+            ))
+        }
+        Shading::Artist => {
+            let (params, from) = match &args.artist_params {
+                None => (ArtistParams::default(), "default controls".to_string()),
+                Some(path) => {
+                    let text = std::fs::read_to_string(path)
+                        .with_context(|| format!("--artist-params {}", path.display()))?;
+                    let params: ArtistParams = serde_json::from_str(&text)
+                        .with_context(|| format!("--artist-params {}", path.display()))?;
+                    (params, path.display().to_string())
+                }
+            };
+            let model = ArtistModel::new(params).context("--artist-params")?;
+            Ok((
+                ShadingModel::Artist(model),
+                format!("artist-friendly (Sadeghi 2010), {from}"),
+            ))
+        }
+    }
+}
+
+pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+    let (shading, shading_description) = shading_model(&args)?;
+    if !matches!(shading, ShadingModel::KajiyaKay)
+        && !matches!(args.transparency, Transparency::None)
+    {
+        bail!(
+            "--shading {:?} renders with --transparency none only; the A-buffer and DBK passes shade with Kajiya-Kay",
+            args.shading
+        );
     }
     let transparency = match args.transparency {
         Transparency::None => render::Transparency::Opaque,
@@ -233,7 +296,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             spacing: args.dom_spacing.unwrap_or(model.bounds().diagonal() * 0.01),
         }),
     };
-    let rendered = render_frame(
+    let rendered = render_frame_with_model(
         &gpu,
         &model,
         &frame,
@@ -241,13 +304,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             shadows,
             transparency,
         },
+        &shading,
     )?;
     let stem = output_stem(&args.out);
     let exr_path = stem.with_extension("exr");
     let png_path = stem.with_extension("png");
     let description = format!(
-        "{source}; {width}x{height}; Kajiya-Kay {:?}; shadows {shadows:?}; lights {}; camera {:?}",
-        frame.shading,
+        "{source}; {width}x{height}; {shading_description}; shadows {shadows:?}; lights {}; camera {:?}",
         args.lights.join(" "),
         args.camera
     );
@@ -261,6 +324,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             "strands": model.strand_count(),
             "segments": stats.segments,
             "size": [width, height],
+            "shading": shading_description,
             "adapter": {
                 "name": stats.adapter.name,
                 "backend": stats.adapter.backend,
@@ -280,6 +344,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
         println!("adapter: {}", stats.adapter);
+        println!("shading: {shading_description}");
         println!(
             "hair: {source}, {} strands, {} segments",
             model.strand_count(),
@@ -301,4 +366,53 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: RenderArgs,
+    }
+
+    fn args(line: &[&str]) -> RenderArgs {
+        Cli::try_parse_from(std::iter::once("render").chain(line.iter().copied()))
+            .unwrap()
+            .args
+    }
+
+    #[test]
+    fn shading_choices_build_their_models_and_name_bad_parameters() {
+        let (model, text) =
+            shading_model(&args(&["--shading", "marschner", "--lut-size", "16"])).unwrap();
+        match model {
+            ShadingModel::MarschnerLut(luts) => {
+                assert_eq!(luts.lut_m().shape(), vec![16, 16, 4]);
+                assert_eq!(luts.lut_n().shape(), vec![16, 16, 3]);
+            }
+            other => panic!("{}", other.name()),
+        }
+        assert!(text.contains("brown") && text.contains("16²"), "{text}");
+        assert!(matches!(
+            shading_model(&args(&["--shading", "artist"])).unwrap().0,
+            ShadingModel::Artist(_)
+        ));
+        let e =
+            shading_model(&args(&["--shading", "marschner", "--preset", "purple"])).unwrap_err();
+        assert!(format!("{e:#}").contains("--preset \"purple\""), "{e:#}");
+        let e = shading_model(&args(&["--shading", "marschner", "--lut-size", "1"])).unwrap_err();
+        assert!(format!("{e:#}").contains("--lut-size 1"), "{e:#}");
+        let e = shading_model(&args(&[
+            "--shading",
+            "artist",
+            "--artist-params",
+            "/nonexistent/artist.json",
+        ]))
+        .unwrap_err();
+        assert!(format!("{e:#}").contains("artist.json"), "{e:#}");
+    }
 }

@@ -11,8 +11,10 @@ use crate::passes::abuffer::{ABufferPass, ListMode};
 use crate::passes::deep_opacity::{
     DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError, light_camera,
 };
+use crate::passes::fiber_shading::ShadingModel;
 use crate::passes::strands::{
-    FrameParams, RenderTarget, ShadowInput, StrandGeometry, StrandPass, TooManyPoints,
+    FrameParams, MAX_SHADOWED_LIGHTS, RenderTarget, ShadowInput, StrandGeometry, StrandPass,
+    TooManyPoints, TooManyShadowMaps,
 };
 
 #[derive(Debug, thiserror::Error)]
@@ -28,7 +30,13 @@ pub enum RenderError {
     #[error("deep opacity maps need a directional light; the frame has none")]
     NoDirectionalLight,
     #[error(transparent)]
+    TooManyShadowMaps(#[from] TooManyShadowMaps),
+    #[error(transparent)]
     Readback(#[from] ReadbackError),
+    #[error(
+        "shading model `{model}` is drawn by the opaque strand pass only; the A-buffer and DBK passes shade with Kajiya-Kay"
+    )]
+    ShadingNeedsOpaque { model: &'static str },
     #[error("the GPU reported an error: {0}")]
     Gpu(String),
 }
@@ -77,7 +85,8 @@ pub enum Transparency {
 /// Everything besides the frame that changes how it is rendered.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RenderOptions {
-    /// Deep opacity maps for the first directional light.
+    /// Deep opacity maps for every directional light (at most
+    /// [`MAX_SHADOWED_LIGHTS`]); the A-buffer and DBK passes use the first light's only.
     pub shadows: Option<DomSettings>,
     pub transparency: Transparency,
 }
@@ -106,28 +115,56 @@ fn timed<T>(
     out
 }
 
-/// Renders `model` with `frame` and reads the picture back. With `shadows`, the first
-/// directional light is shadowed through a deep opacity map (other lights are unshadowed).
+/// Renders `model` with `frame` and reads the picture back. With `shadows`, every directional
+/// light is shadowed through its own deep opacity map (point and spot lights are unshadowed;
+/// the A-buffer and DBK passes shadow the first directional light only).
 pub fn render_frame(
     gpu: &GpuContext,
     model: &HairModel,
     frame: &FrameParams,
     options: &RenderOptions,
 ) -> Result<Frame, RenderError> {
-    let shadowed_light = match options.shadows {
-        None => None,
+    render_frame_with_model(gpu, model, frame, options, &ShadingModel::KajiyaKay)
+}
+
+/// [`render_frame`] shading the fibers with `shading` (Kajiya-Kay takes its constants from
+/// `frame.shading`). Models other than Kajiya-Kay need [`Transparency::Opaque`].
+pub fn render_frame_with_model(
+    gpu: &GpuContext,
+    model: &HairModel,
+    frame: &FrameParams,
+    options: &RenderOptions,
+    shading: &ShadingModel,
+) -> Result<Frame, RenderError> {
+    if !matches!(shading, ShadingModel::KajiyaKay) && options.transparency != Transparency::Opaque {
+        return Err(RenderError::ShadingNeedsOpaque {
+            model: shading.name(),
+        });
+    }
+    // Every directional light gets a deep opacity map (the opaque path shadows them all; the
+    // A-buffer and DBK passes the first only).
+    let shadowed_lights: Vec<(DomSettings, u32, glam::Vec3)> = match options.shadows {
+        None => Vec::new(),
         Some(settings) => {
             settings.check()?;
-            let (index, direction) = frame
+            let directional: Vec<_> = frame
                 .lights
                 .iter()
                 .enumerate()
-                .find_map(|(i, l)| match l {
-                    Light::Directional { direction, .. } => Some((i, *direction)),
+                .filter_map(|(i, l)| match l {
+                    Light::Directional { direction, .. } => Some((settings, i as u32, *direction)),
                     _ => None,
                 })
-                .ok_or(RenderError::NoDirectionalLight)?;
-            Some((settings, index as u32, direction))
+                .collect();
+            if directional.is_empty() {
+                return Err(RenderError::NoDirectionalLight);
+            }
+            if directional.len() > MAX_SHADOWED_LIGHTS {
+                return Err(RenderError::TooManyShadowMaps(TooManyShadowMaps {
+                    maps: directional.len(),
+                }));
+            }
+            directional
         }
     };
     let max = gpu.device.limits().max_texture_dimension_2d;
@@ -144,34 +181,40 @@ pub fn render_frame(
         StrandGeometry::upload(gpu, model)
     })?;
     let mut memory_bytes = geometry.memory();
-    let shadow_map = match shadowed_light {
-        None => None,
-        Some((settings, index, direction)) => {
-            let dom_pass = timed(&mut timings, gpu, "dom pipeline", || {
-                DeepOpacityPass::new(gpu)
-            });
+    let mut shadow_maps = Vec::new();
+    if !shadowed_lights.is_empty() {
+        let dom_pass = timed(&mut timings, gpu, "dom pipeline", || {
+            DeepOpacityPass::new(gpu)
+        });
+        for &(settings, index, direction) in &shadowed_lights {
             let map = DeepOpacityMap::new(gpu, light_camera(direction, model.bounds()), settings);
-            timed(&mut timings, gpu, "deep opacity", || {
+            // One entry per light, so that reports keyed by pass name keep them all.
+            let label = format!("deep opacity (light {index})");
+            timed(&mut timings, gpu, &label, || {
                 dom_pass.draw(gpu, &geometry, &map)
             });
             memory_bytes.extend(map.memory());
-            Some((map, index))
+            shadow_maps.push((map, index));
         }
-    };
-    let shadow = shadow_map.as_ref().map(|(map, light_index)| ShadowInput {
-        map,
-        light_index: *light_index,
-    });
+    }
+    let shadows: Vec<ShadowInput> = shadow_maps
+        .iter()
+        .map(|(map, light_index)| ShadowInput {
+            map,
+            light_index: *light_index,
+        })
+        .collect();
+    let shadow = shadows.first().copied();
     let mut fragments = None;
     let pixels = match options.transparency {
         Transparency::Opaque => {
             let pass = timed(&mut timings, gpu, "strand pipeline", || {
-                StrandPass::new(gpu)
+                StrandPass::with_model(gpu, shading)
             });
             let target = RenderTarget::new(gpu, frame.width, frame.height);
             timed(&mut timings, gpu, "strands", || {
-                pass.draw(gpu, &geometry, frame, &target, shadow)
-            });
+                pass.draw_shadowed(gpu, &geometry, frame, &target, &shadows)
+            })?;
             memory_bytes.extend(target.memory());
             timed(&mut timings, gpu, "readback", || {
                 read_texture_rgba(gpu, &target.color)

@@ -99,6 +99,7 @@ impl ABufferPass {
                 concat!(
                     include_str!("strand_quads.wgsl"),
                     include_str!("strands.wgsl"),
+                    include_str!("fiber_kajiya_kay.wgsl"),
                     include_str!("abuffer.wgsl")
                 )
                 .into(),

@@ -2,4 +2,5 @@
 
 pub mod abuffer;
 pub mod deep_opacity;
+pub mod fiber_shading;
 pub mod strands;

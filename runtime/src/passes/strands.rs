@@ -1,5 +1,5 @@
-//! The strand pass: every hair segment drawn as a camera-facing quad, Kajiya-Kay shaded under
-//! several point lights, blended with pre-multiplied alpha into an HDR float target with a
+//! The strand pass: every hair segment drawn as a camera-facing quad, shaded under several
+//! lights with a [`ShadingModel`] (Kajiya-Kay, Marschner through lookup tables, artist-friendly), blended with pre-multiplied alpha into an HDR float target with a
 //! depth test. Inputs: [`StrandGeometry`] (the hair on the GPU), [`FrameParams`] (camera,
 //! shading constants, lights). Output: the colour texture of a [`RenderTarget`].
 
@@ -11,6 +11,7 @@ use crate::gpu::GpuContext;
 use crate::hair::HairModel;
 use crate::lights::{GpuLight, Light};
 use crate::passes::deep_opacity::{DeepOpacityMap, DomSettings};
+use crate::passes::fiber_shading::{ModelBinding, ShadingModel};
 
 /// Hair colour where the file has none (linear RGB, a mid brown).
 pub const DEFAULT_HAIR_COLOR: [f32; 3] = [0.35, 0.22, 0.12];
@@ -258,12 +259,26 @@ pub struct StrandPass {
     pipeline: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     shadow_layout: wgpu::BindGroupLayout,
+    /// Group 2: the fiber model's constants and tables (none for Kajiya-Kay).
+    model: Option<ModelBinding>,
 }
 
 /// A deep opacity map that shadows light `light_index` of the frame.
+#[derive(Clone, Copy)]
 pub struct ShadowInput<'a> {
     pub map: &'a DeepOpacityMap,
     pub light_index: u32,
+}
+
+/// Directional lights the strand pass shadows at once (one deep opacity map each).
+pub const MAX_SHADOWED_LIGHTS: usize = 4;
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[error(
+    "{maps} deep opacity maps given; the strand pass shadows at most {MAX_SHADOWED_LIGHTS} lights"
+)]
+pub struct TooManyShadowMaps {
+    pub maps: usize,
 }
 
 #[repr(C)]
@@ -279,6 +294,9 @@ struct ShadowUniform {
     _pad: [f32; 2],
 }
 
+/// Group 1 of the shading passes: per slot (up to [`MAX_SHADOWED_LIGHTS`]) the nearest depth and
+/// the two layer textures of a deep opacity map (bindings 3k, 3k+1, 3k+2), then the uniform array
+/// of the slots' parameters (binding 12).
 pub fn shadow_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let texture = |binding, sample_type| wgpu::BindGroupLayoutEntry {
         binding,
@@ -290,44 +308,61 @@ pub fn shadow_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout 
         },
         count: None,
     };
+    let mut entries = Vec::new();
+    for slot in 0..MAX_SHADOWED_LIGHTS as u32 {
+        entries.push(texture(3 * slot, wgpu::TextureSampleType::Depth));
+        for layer in 1..3 {
+            entries.push(texture(
+                3 * slot + layer,
+                wgpu::TextureSampleType::Float { filterable: false },
+            ));
+        }
+    }
+    entries.push(wgpu::BindGroupLayoutEntry {
+        binding: 3 * MAX_SHADOWED_LIGHTS as u32,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    });
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("strand shadows"),
-        entries: &[
-            texture(0, wgpu::TextureSampleType::Depth),
-            texture(1, wgpu::TextureSampleType::Float { filterable: false }),
-            texture(2, wgpu::TextureSampleType::Float { filterable: false }),
-            wgpu::BindGroupLayoutEntry {
-                binding: 3,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-        ],
+        entries: &entries,
     })
 }
 
 impl StrandPass {
+    /// Kajiya-Kay shading with the constants of [`FrameParams::shading`].
     pub fn new(gpu: &GpuContext) -> Self {
+        Self::with_model(gpu, &ShadingModel::KajiyaKay)
+    }
+
+    /// Shading with `model`; its tables and constants are uploaded once, here.
+    pub fn with_model(gpu: &GpuContext, model: &ShadingModel) -> Self {
         let device = &gpu.device;
+        let source = [
+            include_str!("strand_quads.wgsl"),
+            include_str!("strands.wgsl"),
+            model.wgsl(),
+        ]
+        .concat();
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("strands.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(
-                concat!(
-                    include_str!("strand_quads.wgsl"),
-                    include_str!("strands.wgsl")
-                )
-                .into(),
-            ),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
         });
         let layout = strand_bind_group_layout(device);
         let shadow_layout = shadow_bind_group_layout(device);
+        let model = ModelBinding::new(gpu, model);
+        let mut group_layouts = vec![Some(&layout), Some(&shadow_layout)];
+        if let Some(m) = &model {
+            group_layouts.push(Some(&m.layout));
+        }
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("strands"),
-            bind_group_layouts: &[Some(&layout), Some(&shadow_layout)],
+            bind_group_layouts: &group_layouts,
             immediate_size: 0,
         });
         let premultiplied_over = wgpu::BlendComponent {
@@ -377,6 +412,7 @@ impl StrandPass {
             pipeline,
             layout,
             shadow_layout,
+            model,
         }
     }
 
@@ -389,9 +425,23 @@ impl StrandPass {
         target: &RenderTarget,
         shadow: Option<ShadowInput<'_>>,
     ) {
+        self.draw_shadowed(gpu, geometry, frame, target, shadow.as_slice())
+            .expect("one shadow map is within the limit");
+    }
+
+    /// [`StrandPass::draw`] with a deep opacity map for each of up to [`MAX_SHADOWED_LIGHTS`]
+    /// lights.
+    pub fn draw_shadowed(
+        &self,
+        gpu: &GpuContext,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        target: &RenderTarget,
+        shadows: &[ShadowInput<'_>],
+    ) -> Result<(), TooManyShadowMaps> {
         let device = &gpu.device;
+        let shadow_group = shadow_bind_group_for(gpu, &self.shadow_layout, frame, shadows)?;
         let bind_group = strand_bind_group(gpu, &self.layout, geometry, frame);
-        let shadow_group = shadow_bind_group(gpu, &self.shadow_layout, frame, shadow);
         let color_view = target.color.create_view(&Default::default());
         let depth_view = target.depth.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -422,9 +472,13 @@ impl StrandPass {
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &shadow_group, &[]);
+            if let Some(model) = &self.model {
+                pass.set_bind_group(2, &model.group, &[]);
+            }
             pass.draw(0..6, 0..geometry.segment_count);
         }
         gpu.queue.submit([encoder.finish()]);
+        Ok(())
     }
 }
 
@@ -515,74 +569,91 @@ pub fn strand_bind_group(
     })
 }
 
-/// Group 1 of the shading passes: the deep opacity map of one light, or a 1×1 placeholder.
+/// Group 1 of the shading passes with at most one shadowed light.
 pub fn shadow_bind_group(
     gpu: &GpuContext,
     layout: &wgpu::BindGroupLayout,
     frame: &FrameParams,
     shadow: Option<ShadowInput<'_>>,
 ) -> wgpu::BindGroup {
+    shadow_bind_group_for(gpu, layout, frame, shadow.as_slice())
+        .expect("one shadow map is within the limit")
+}
+
+/// Group 1 of the shading passes: one slot per map, 1×1 placeholders (shadowing no light) in the
+/// rest.
+pub fn shadow_bind_group_for(
+    gpu: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    frame: &FrameParams,
+    shadows: &[ShadowInput<'_>],
+) -> Result<wgpu::BindGroup, TooManyShadowMaps> {
+    if shadows.len() > MAX_SHADOWED_LIGHTS {
+        return Err(TooManyShadowMaps {
+            maps: shadows.len(),
+        });
+    }
     let device = &gpu.device;
-    // Without shadows a 1×1 map is bound and no light refers to it.
-    let placeholder;
-    let (map, light_index) = match shadow {
-        Some(s) => (s.map, s.light_index),
-        None => {
-            placeholder = DeepOpacityMap::new(
-                gpu,
-                frame.camera,
-                DomSettings {
-                    resolution: 1,
-                    layers: 1,
-                    spacing: 1.0,
-                },
-            );
-            (&placeholder, u32::MAX)
-        }
-    };
-    let shadow_uniform = ShadowUniform {
-        view_proj: (map.camera.projection_matrix(1.0) * map.camera.view()).to_cols_array_2d(),
-        near: map.camera.near,
-        far: map.camera.far,
-        spacing: map.settings.spacing,
-        layers: map.settings.layers,
-        light_index,
-        resolution: map.settings.resolution as f32,
-        _pad: [0.0; 2],
-    };
+    let placeholder = DeepOpacityMap::new(
+        gpu,
+        frame.camera,
+        DomSettings {
+            resolution: 1,
+            layers: 1,
+            spacing: 1.0,
+        },
+    );
+    let slots: Vec<(&DeepOpacityMap, u32)> = (0..MAX_SHADOWED_LIGHTS)
+        .map(|k| match shadows.get(k) {
+            Some(s) => (s.map, s.light_index),
+            None => (&placeholder, u32::MAX),
+        })
+        .collect();
+    let uniforms: Vec<ShadowUniform> = slots
+        .iter()
+        .map(|&(map, light_index)| ShadowUniform {
+            view_proj: (map.camera.projection_matrix(1.0) * map.camera.view()).to_cols_array_2d(),
+            near: map.camera.near,
+            far: map.camera.far,
+            spacing: map.settings.spacing,
+            layers: map.settings.layers,
+            light_index,
+            resolution: map.settings.resolution as f32,
+            _pad: [0.0; 2],
+        })
+        .collect();
     let shadow_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("strand shadow params"),
-        contents: bytemuck::bytes_of(&shadow_uniform),
+        contents: bytemuck::cast_slice(&uniforms),
         usage: wgpu::BufferUsages::UNIFORM,
     });
-    let views = [
-        map.nearest_depth.create_view(&Default::default()),
-        map.layers[0].create_view(&Default::default()),
-        map.layers[1].create_view(&Default::default()),
-    ];
-
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
+    let views: Vec<wgpu::TextureView> = slots
+        .iter()
+        .flat_map(|(map, _)| {
+            [
+                map.nearest_depth.create_view(&Default::default()),
+                map.layers[0].create_view(&Default::default()),
+                map.layers[1].create_view(&Default::default()),
+            ]
+        })
+        .collect();
+    let mut entries: Vec<wgpu::BindGroupEntry> = views
+        .iter()
+        .enumerate()
+        .map(|(i, view)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: wgpu::BindingResource::TextureView(view),
+        })
+        .collect();
+    entries.push(wgpu::BindGroupEntry {
+        binding: 3 * MAX_SHADOWED_LIGHTS as u32,
+        resource: shadow_buffer.as_entire_binding(),
+    });
+    Ok(device.create_bind_group(&wgpu::BindGroupDescriptor {
         label: Some("strand shadows"),
         layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&views[0]),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::TextureView(&views[1]),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::TextureView(&views[2]),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: shadow_buffer.as_entire_binding(),
-            },
-        ],
-    })
+        entries: &entries,
+    }))
 }
 
 #[cfg(test)]

@@ -1,19 +1,9 @@
-// Kajiya-Kay shading of the strand quads (strand_quads.wgsl) under several point lights,
-// written with pre-multiplied alpha.
+// Shading of the strand quads (strand_quads.wgsl) under several lights, written with
+// pre-multiplied alpha. The fiber model is `fiber_radiance`, defined by one of the fiber_*.wgsl
+// files appended after this one (Kajiya-Kay, Marschner through lookup tables, artist-friendly).
 
-// Kajiya-Kay with t the tangent, l toward the light, e toward the eye:
-//   L = E · (kd · color · sin(t, l) + ks · max(0, sin(t, l) sin(t, e) − (t·l)(t·e))^p),
-// the specular term being cos of the angle between e and the cone of mirror directions.
-fn kajiya_kay(t: vec3<f32>, l: vec3<f32>, e: vec3<f32>, color: vec3<f32>) -> vec3<f32> {
-    let tl = dot(t, l);
-    let te = dot(t, e);
-    let sin_tl = sqrt(max(0.0, 1.0 - tl * tl));
-    let sin_te = sqrt(max(0.0, 1.0 - te * te));
-    let cone = max(0.0, sin_tl * sin_te - tl * te);
-    return frame.kd * color * sin_tl + vec3<f32>(frame.ks * pow(cone, frame.shininess));
-}
-
-// Deep opacity map of one directional light (Svoboda §4, Hunz §4); light_index = 0xffffffff: none.
+// Deep opacity maps of up to four directional lights (Svoboda §4, Hunz §4); slot k shadows light
+// shadow[k].light_index, 0xffffffff: an unused slot (a 1×1 placeholder map is bound there).
 struct ShadowParams {
     view_proj: mat4x4<f32>,
     near: f32,
@@ -26,36 +16,71 @@ struct ShadowParams {
     _pad1: f32,
 };
 
-@group(1) @binding(0) var shadow_depth: texture_depth_2d;
-@group(1) @binding(1) var shadow_layers_a: texture_2d<f32>;
-@group(1) @binding(2) var shadow_layers_b: texture_2d<f32>;
-@group(1) @binding(3) var<uniform> shadow: ShadowParams;
+const SHADOW_SLOTS: u32 = 4u;
+
+@group(1) @binding(0) var shadow_depth_0: texture_depth_2d;
+@group(1) @binding(1) var shadow_layers_a_0: texture_2d<f32>;
+@group(1) @binding(2) var shadow_layers_b_0: texture_2d<f32>;
+@group(1) @binding(3) var shadow_depth_1: texture_depth_2d;
+@group(1) @binding(4) var shadow_layers_a_1: texture_2d<f32>;
+@group(1) @binding(5) var shadow_layers_b_1: texture_2d<f32>;
+@group(1) @binding(6) var shadow_depth_2: texture_depth_2d;
+@group(1) @binding(7) var shadow_layers_a_2: texture_2d<f32>;
+@group(1) @binding(8) var shadow_layers_b_2: texture_2d<f32>;
+@group(1) @binding(9) var shadow_depth_3: texture_depth_2d;
+@group(1) @binding(10) var shadow_layers_a_3: texture_2d<f32>;
+@group(1) @binding(11) var shadow_layers_b_3: texture_2d<f32>;
+@group(1) @binding(12) var<uniform> shadow: array<ShadowParams, 4>;
 
 fn layer_value(a: vec4<f32>, b: vec4<f32>, k: u32) -> f32 {
     if (k < 4u) { return a[k]; }
     return b[k - 4u];
 }
 
-// exp(−optical depth in front of `world`): the layers before its own, plus the part of its own
-// layer in front of it (linear within the layer), the last layer being spread over one spacing.
-fn shadow_transmittance(world: vec3<f32>) -> f32 {
-    let clip = shadow.view_proj * vec4<f32>(world, 1.0);
+// exp(−optical depth in front of `world`) in one map: the layers before its own, plus the part
+// of its own layer in front of it (linear within the layer), the last layer being spread over
+// one spacing.
+fn map_transmittance(
+    depth: texture_depth_2d,
+    layers_a: texture_2d<f32>,
+    layers_b: texture_2d<f32>,
+    p: ShadowParams,
+    world: vec3<f32>,
+) -> f32 {
+    let clip = p.view_proj * vec4<f32>(world, 1.0);
     let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
     if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }
-    let texel = vec2<i32>(uv * shadow.resolution);
-    let z0 = textureLoad(shadow_depth, texel, 0);
+    let texel = vec2<i32>(uv * p.resolution);
+    let z0 = textureLoad(depth, texel, 0);
     if (z0 >= 1.0) { return 1.0; }
-    let d0 = shadow.near + z0 * (shadow.far - shadow.near);
-    let d = shadow.near + clip.z * (shadow.far - shadow.near);
-    let position = max(d - d0, 0.0) / shadow.spacing;
-    let a = textureLoad(shadow_layers_a, texel, 0);
-    let b = textureLoad(shadow_layers_b, texel, 0);
+    let d0 = p.near + z0 * (p.far - p.near);
+    let d = p.near + clip.z * (p.far - p.near);
+    let position = max(d - d0, 0.0) / p.spacing;
+    let a = textureLoad(layers_a, texel, 0);
+    let b = textureLoad(layers_b, texel, 0);
     var tau = 0.0;
-    for (var k = 0u; k < shadow.layers; k++) {
+    for (var k = 0u; k < p.layers; k++) {
         let fraction = clamp(position - f32(k), 0.0, 1.0);
         tau += fraction * layer_value(a, b, k);
     }
     return exp(-tau);
+}
+
+// The fraction of light `light_index` that reaches `world`: 1 unless a slot shadows that light.
+fn shadow_transmittance(light_index: u32, world: vec3<f32>) -> f32 {
+    if (shadow[0].light_index == light_index) {
+        return map_transmittance(shadow_depth_0, shadow_layers_a_0, shadow_layers_b_0, shadow[0], world);
+    }
+    if (shadow[1].light_index == light_index) {
+        return map_transmittance(shadow_depth_1, shadow_layers_a_1, shadow_layers_b_1, shadow[1], world);
+    }
+    if (shadow[2].light_index == light_index) {
+        return map_transmittance(shadow_depth_2, shadow_layers_a_2, shadow_layers_b_2, shadow[2], world);
+    }
+    if (shadow[3].light_index == light_index) {
+        return map_transmittance(shadow_depth_3, shadow_layers_a_3, shadow_layers_b_3, shadow[3], world);
+    }
+    return 1.0;
 }
 
 // Direction toward the light and the irradiance it brings to `world`.
@@ -80,9 +105,8 @@ fn shade(in: VertexOut) -> vec4<f32> {
     var radiance = vec3<f32>(0.0);
     for (var i = 0u; i < frame.light_count; i++) {
         let li = light_at(lights[i], in.world);
-        var visible = 1.0;
-        if (i == shadow.light_index) { visible = shadow_transmittance(in.world); }
-        radiance += visible * li.w * kajiya_kay(t, li.xyz, e, in.color);
+        let visible = shadow_transmittance(i, in.world);
+        radiance += visible * li.w * fiber_radiance(t, li.xyz, e, in.color);
     }
     return vec4<f32>(radiance * in.alpha, in.alpha);
 }
