@@ -231,3 +231,33 @@ fn shading_behind_the_slab_is_dimmed_by_the_closed_form_transmittance() {
         );
     }
 }
+
+/// The reference renderer of the environment-lit pipeline draws one map per light for
+/// thousands of lights: one map re-aimed and redrawn must equal a fresh map for the new light
+/// (no state left over from the previous light), so its textures can be reused.
+#[test]
+fn a_reused_map_equals_a_fresh_one_for_each_light() {
+    let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+    let model = slab(4, 0.01);
+    let geometry = StrandGeometry::upload(&gpu, &model).unwrap();
+    let pass = DeepOpacityPass::new(&gpu);
+    let settings = DomSettings {
+        resolution: RES,
+        layers: 4,
+        spacing: 0.08,
+    };
+    let tilted = Camera {
+        eye: Vec3::new(1.5, 0.5, 4.6),
+        ..light_camera()
+    };
+    let mut reused = DeepOpacityMap::new(&gpu, light_camera(), settings);
+    pass.draw(&gpu, &geometry, &reused);
+    let first = reused.read_layers(&gpu).unwrap();
+    reused.camera = tilted;
+    pass.draw(&gpu, &geometry, &reused);
+    let fresh = DeepOpacityMap::new(&gpu, tilted, settings);
+    pass.draw(&gpu, &geometry, &fresh);
+    let (a, b) = (reused.read_layers(&gpu).unwrap(), fresh.read_layers(&gpu).unwrap());
+    assert_eq!(a, b, "a re-aimed map must hold exactly what a fresh one holds");
+    assert_ne!(a, first, "the two lights must see different optical depths");
+}
