@@ -234,14 +234,6 @@ fn shading_model(args: &RenderArgs) -> anyhow::Result<(ShadingModel, String)> {
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let (shading, shading_description) = shading_model(&args)?;
-    if !matches!(shading, ShadingModel::KajiyaKay)
-        && !matches!(args.transparency, Transparency::None)
-    {
-        bail!(
-            "--shading {:?} renders with --transparency none only; the A-buffer and DBK passes shade with Kajiya-Kay",
-            args.shading
-        );
-    }
     let transparency = match args.transparency {
         Transparency::None => render::Transparency::Opaque,
         Transparency::Abuffer => render::Transparency::ABuffer {

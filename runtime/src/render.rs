@@ -7,7 +7,7 @@ use crate::gpu::readback::ReadbackError;
 use crate::gpu::{AdapterReport, GpuContext, read_texture_rgba};
 use crate::hair::HairModel;
 use crate::lights::Light;
-use crate::passes::abuffer::{ABufferPass, ListMode};
+use crate::passes::abuffer::{ABufferError, ABufferPass, ListMode};
 use crate::passes::deep_opacity::{
     DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError, light_camera,
 };
@@ -33,10 +33,6 @@ pub enum RenderError {
     TooManyShadowMaps(#[from] TooManyShadowMaps),
     #[error(transparent)]
     Readback(#[from] ReadbackError),
-    #[error(
-        "shading model `{model}` is drawn by the opaque strand pass only; the A-buffer and DBK passes shade with Kajiya-Kay"
-    )]
-    ShadingNeedsOpaque { model: &'static str },
     #[error("the GPU reported an error: {0}")]
     Gpu(String),
 }
@@ -86,7 +82,7 @@ pub enum Transparency {
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RenderOptions {
     /// Deep opacity maps for every directional light (at most
-    /// [`MAX_SHADOWED_LIGHTS`]); the A-buffer and DBK passes use the first light's only.
+    /// [`MAX_SHADOWED_LIGHTS`]), used by every transparency mode.
     pub shadows: Option<DomSettings>,
     pub transparency: Transparency,
 }
@@ -116,8 +112,7 @@ fn timed<T>(
 }
 
 /// Renders `model` with `frame` and reads the picture back. With `shadows`, every directional
-/// light is shadowed through its own deep opacity map (point and spot lights are unshadowed;
-/// the A-buffer and DBK passes shadow the first directional light only).
+/// light is shadowed through its own deep opacity map (point and spot lights are unshadowed).
 pub fn render_frame(
     gpu: &GpuContext,
     model: &HairModel,
@@ -128,7 +123,7 @@ pub fn render_frame(
 }
 
 /// [`render_frame`] shading the fibers with `shading` (Kajiya-Kay takes its constants from
-/// `frame.shading`). Models other than Kajiya-Kay need [`Transparency::Opaque`].
+/// `frame.shading`), in any [`Transparency`] mode.
 pub fn render_frame_with_model(
     gpu: &GpuContext,
     model: &HairModel,
@@ -136,13 +131,7 @@ pub fn render_frame_with_model(
     options: &RenderOptions,
     shading: &ShadingModel,
 ) -> Result<Frame, RenderError> {
-    if !matches!(shading, ShadingModel::KajiyaKay) && options.transparency != Transparency::Opaque {
-        return Err(RenderError::ShadingNeedsOpaque {
-            model: shading.name(),
-        });
-    }
-    // Every directional light gets a deep opacity map (the opaque path shadows them all; the
-    // A-buffer and DBK passes the first only).
+    // Every directional light gets a deep opacity map; every pass shadows them all.
     let shadowed_lights: Vec<(DomSettings, u32, glam::Vec3)> = match options.shadows {
         None => Vec::new(),
         Some(settings) => {
@@ -204,7 +193,6 @@ pub fn render_frame_with_model(
             light_index: *light_index,
         })
         .collect();
-    let shadow = shadows.first().copied();
     let mut fragments = None;
     let pixels = match options.transparency {
         Transparency::Opaque => {
@@ -229,7 +217,7 @@ pub fn render_frame_with_model(
                 _ => ListMode::All,
             };
             let abuffer = timed(&mut timings, gpu, "abuffer pipeline", || {
-                ABufferPass::new(gpu)
+                ABufferPass::with_model(gpu, shading)
             });
             let wanted = frame.width as u64 * frame.height as u64 * nodes_per_pixel as u64;
             let capacity = ABufferPass::max_capacity(gpu, wanted);
@@ -237,8 +225,12 @@ pub fn render_frame_with_model(
                 &mut timings,
                 gpu,
                 "abuffer build + resolve + readback",
-                || abuffer.draw(gpu, &geometry, frame, shadow, capacity, list_mode),
-            )?;
+                || abuffer.draw_shadowed(gpu, &geometry, frame, &shadows, capacity, list_mode),
+            )
+            .map_err(|e| match e {
+                ABufferError::TooManyShadowMaps(e) => RenderError::TooManyShadowMaps(e),
+                ABufferError::Readback(e) => RenderError::Readback(e),
+            })?;
             memory_bytes.extend(out.memory_bytes);
             fragments = Some(FragmentCounts {
                 stored: out.fragments_stored,

@@ -1,17 +1,24 @@
 //! The A-buffer against independent expectations: a single strand resolves to what the
 //! hardware-blended pass draws; two overlapping sub-pixel strands composite as
 //! front + (1 − α_front)·back whatever their draw order; fragment counts match the number of
-//! pixel centres the strands cover, and a small node buffer drops exactly the excess.
+//! pixel centres the strands cover, and a small node buffer drops exactly the excess; with
+//! Marschner-LUT and artist shading and several shadow maps, a single strand through the A-buffer
+//! and DBK equals the opaque pass.
 
 use glam::Vec3;
+use strandlight_precompute::point_light_luts::{LutResolution, bake_lut_m, bake_lut_n};
 use strandlight_runtime::camera::{Camera, Projection};
 use strandlight_runtime::gpu::{GpuContext, read_texture_rgba};
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::abuffer::{ABufferPass, ListMode};
+use strandlight_runtime::passes::deep_opacity::{DeepOpacityMap, DeepOpacityPass, DomSettings};
+use strandlight_runtime::passes::fiber_shading::{MarschnerLuts, ShadingModel};
 use strandlight_runtime::passes::strands::{
-    FrameParams, KajiyaKay, RenderTarget, StrandGeometry, StrandPass,
+    FrameParams, KajiyaKay, RenderTarget, ShadowInput, StrandGeometry, StrandPass,
 };
+use strandlight_tables::artist::{ArtistModel, ArtistParams};
+use strandlight_tables::marschner::{Marschner, MarschnerParams};
 
 const SIZE: u32 = 64;
 
@@ -233,5 +240,151 @@ fn dbk_agrees_with_the_abuffer() {
             "{name}: only the front strand is listed"
         );
         assert!(thin_diff < 1e-6, "{name}");
+    }
+}
+
+/// `rows` rows of thick vertical fibers at z = 0.5 − 0.1·r, one per map texel column: an
+/// occluder drawn only into a deep opacity map (never into the picture), so the picture still
+/// holds a single strand.
+fn occluder(rows: usize) -> HairModel {
+    let mut points = Vec::new();
+    let mut offsets = vec![0u32];
+    for r in 0..rows {
+        let z = 0.5 - 0.1 * r as f32;
+        for c in 0..MAP_RES {
+            let x = (c as f32 + 0.5 + 0.13 * r as f32) / (MAP_RES as f32 / 2.0) - 1.0;
+            points.extend([Vec3::new(x, -0.9, z), Vec3::new(x, 0.9, z)]);
+            offsets.push(points.len() as u32);
+        }
+    }
+    // Half a texel wide: each row lets through about half the light.
+    let thickness = 0.5 * 2.0 / MAP_RES as f32;
+    HairModel::new(
+        points,
+        offsets,
+        Some(Attribute::Uniform(thickness)),
+        None,
+        None,
+    )
+    .unwrap()
+}
+
+const MAP_RES: u32 = 64;
+
+fn occluder_map(gpu: &GpuContext, rows: usize) -> DeepOpacityMap {
+    let geometry = StrandGeometry::upload(gpu, &occluder(rows)).unwrap();
+    let map = DeepOpacityMap::new(
+        gpu,
+        camera(),
+        DomSettings {
+            resolution: MAP_RES,
+            layers: 4,
+            spacing: 0.08,
+        },
+    );
+    DeepOpacityPass::new(gpu).draw(gpu, &geometry, &map);
+    map
+}
+
+fn max_abs_diff(a: &[[f32; 4]], b: &[[f32; 4]]) -> f32 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(p, q)| (0..4).map(move |k| (p[k] - q[k]).abs()))
+        .fold(0.0f32, f32::max)
+}
+
+/// Marschner (lookup tables) and artist shading with two shadowed directional lights and a point
+/// light: a single strand through the A-buffer equals the opaque pass (one fragment per pixel,
+/// nothing to sort), DBK with Δ covering the volume equals the A-buffer, and the second light's
+/// map visibly darkens the A-buffer picture (so every map is in play, not only the first).
+#[test]
+fn abuffer_and_dbk_shade_like_the_opaque_pass_for_every_model() {
+    let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+    let marschner = Marschner::new(MarschnerParams::with_preset("brown").unwrap()).unwrap();
+    let resolution = LutResolution::square(32);
+    let luts = MarschnerLuts::new(
+        bake_lut_m(&marschner, &resolution).unwrap(),
+        bake_lut_n(&marschner, &resolution).unwrap(),
+    )
+    .unwrap();
+    let models = [
+        ("marschner-lut", ShadingModel::MarschnerLut(luts)),
+        (
+            "artist",
+            ShadingModel::Artist(ArtistModel::new(ArtistParams::default()).unwrap()),
+        ),
+    ];
+    let frame = FrameParams {
+        lights: vec![
+            Light::Directional {
+                direction: Vec3::new(0.3, 0.4, 1.0).normalize(),
+                intensity: 1.5,
+            },
+            Light::Directional {
+                direction: Vec3::new(-0.4, 0.1, 1.0).normalize(),
+                intensity: 2.0,
+            },
+            Light::Point {
+                position: Vec3::new(-1.0, 1.0, 2.0),
+                intensity: 3.0,
+            },
+        ],
+        ..frame()
+    };
+    // Light 0 behind one occluding row, light 1 behind two; the strand lies behind both.
+    let (map0, map1) = (occluder_map(&gpu, 1), occluder_map(&gpu, 2));
+    let shadows = [
+        ShadowInput {
+            map: &map0,
+            light_index: 0,
+        },
+        ShadowInput {
+            map: &map1,
+            light_index: 1,
+        },
+    ];
+    let geometry =
+        StrandGeometry::upload(&gpu, &strands(&[(-0.2, Vec3::new(0.8, 0.5, 0.3))])).unwrap();
+    let capacity = ABufferPass::max_capacity(&gpu, 1 << 16);
+    for (name, model) in &models {
+        let target = RenderTarget::new(&gpu, SIZE, SIZE);
+        StrandPass::with_model(&gpu, model)
+            .draw_shadowed(&gpu, &geometry, &frame, &target, &shadows)
+            .unwrap();
+        let opaque = read_texture_rgba(&gpu, &target.color).unwrap();
+        let pass = ABufferPass::with_model(&gpu, model);
+        let draw = |shadows: &[ShadowInput], mode| {
+            pass.draw_shadowed(&gpu, &geometry, &frame, shadows, capacity, mode)
+                .unwrap_or_else(|e| panic!("{e}"))
+        };
+        let abuffer = draw(&shadows, ListMode::All);
+        let dbk = draw(&shadows, ListMode::Dbk { delta: 100.0 });
+        let first_map_only = draw(&shadows[..1], ListMode::All);
+        let peak = opaque
+            .iter()
+            .map(|p| p[0].max(p[1]).max(p[2]))
+            .fold(0.0f32, f32::max);
+        let abuffer_diff = max_abs_diff(&abuffer.pixels, &opaque);
+        let dbk_diff = max_abs_diff(&dbk.pixels, &abuffer.pixels);
+        let second_map_effect = max_abs_diff(&first_map_only.pixels, &abuffer.pixels);
+        eprintln!(
+            "{name}: peak radiance {peak:.4}; A-buffer vs opaque max |Δ| {abuffer_diff:.2e}; DBK(Δ = all) vs A-buffer max |Δ| {dbk_diff:.2e}; light 1's map changes the A-buffer by up to {second_map_effect:.4}; {} fragments",
+            abuffer.fragments_stored
+        );
+        assert!(peak > 1e-3, "{name}: the strand is lit");
+        assert_eq!(abuffer.fragments_stored, COVERED_ROWS, "{name}");
+        assert_eq!(dbk.fragments_stored, COVERED_ROWS, "{name}");
+        assert!(
+            abuffer_diff <= 1e-6 * peak.max(1.0),
+            "{name}: A-buffer vs opaque differ by {abuffer_diff}"
+        );
+        assert!(
+            dbk_diff <= 1e-6 * peak.max(1.0),
+            "{name}: DBK(Δ = all) vs A-buffer differ by {dbk_diff}"
+        );
+        assert!(
+            second_map_effect > 0.05 * peak,
+            "{name}: light 1's deep opacity map barely changes the A-buffer ({second_map_effect})"
+        );
     }
 }

@@ -2,17 +2,30 @@
 //! built with storage-buffer atomics (`abuffer.wgsl`), then sorted and composited front to back
 //! by a compute resolve (`abuffer_resolve.wgsl`). Node-buffer overflow and resolve truncation
 //! are counted and reported, never silent.
-//! Inputs: [`StrandGeometry`], [`FrameParams`], an optional shadow map, the node capacity.
+//! Fragments are shaded exactly as the opaque strand pass shades them: the same WGSL (any
+//! [`ShadingModel`], group 2) and a deep opacity map for each of up to
+//! [`MAX_SHADOWED_LIGHTS`](crate::passes::strands::MAX_SHADOWED_LIGHTS) lights (group 1).
+//! Inputs: [`StrandGeometry`], [`FrameParams`], the shadow maps, the node capacity.
 //! Output: [`ABufferFrame`].
 
 use wgpu::util::DeviceExt;
 
 use crate::gpu::GpuContext;
 use crate::gpu::readback::{ReadbackError, read_buffer};
+use crate::passes::fiber_shading::{ModelBinding, ShadingModel};
 use crate::passes::strands::{
-    DEPTH_FORMAT, FrameParams, RenderTarget, ShadowInput, StrandGeometry, shadow_bind_group,
-    shadow_bind_group_layout, strand_bind_group, strand_bind_group_layout,
+    DEPTH_FORMAT, FrameParams, RenderTarget, ShadowInput, StrandGeometry, TooManyShadowMaps,
+    shading_source, shadow_bind_group_for, shadow_bind_group_layout, strand_bind_group,
+    strand_bind_group_layout,
 };
+
+#[derive(Debug, thiserror::Error)]
+pub enum ABufferError {
+    #[error(transparent)]
+    TooManyShadowMaps(#[from] TooManyShadowMaps),
+    #[error(transparent)]
+    Readback(#[from] ReadbackError),
+}
 
 /// Bytes per list node (colour, depth, next, padding).
 pub const NODE_BYTES: u64 = 32;
@@ -53,11 +66,16 @@ pub struct ABufferPass {
     build: wgpu::RenderPipeline,
     dbk_build: wgpu::RenderPipeline,
     depth_prepass: wgpu::RenderPipeline,
-    dbk_layout: wgpu::BindGroupLayout,
     resolve: wgpu::ComputePipeline,
     strand_layout: wgpu::BindGroupLayout,
     shadow_layout: wgpu::BindGroupLayout,
+    /// Group 3 of the A-buffer build: heads, nodes, counters, parameters.
     lists_layout: wgpu::BindGroupLayout,
+    /// Group 3 of the DBK build: the lists' bindings, then the nearest depth and DBK parameters.
+    dbk_lists_layout: wgpu::BindGroupLayout,
+    /// Group 2: the fiber model's constants and tables (none for Kajiya-Kay), as in
+    /// [`StrandPass`](crate::passes::strands::StrandPass).
+    model: Option<ModelBinding>,
 }
 
 fn storage_entry(
@@ -91,20 +109,21 @@ fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGrou
 }
 
 impl ABufferPass {
+    /// Kajiya-Kay shading with the constants of [`FrameParams::shading`].
     pub fn new(gpu: &GpuContext) -> Self {
+        Self::with_model(gpu, &ShadingModel::KajiyaKay)
+    }
+
+    /// Fragments shaded with `model`; its tables and constants are uploaded once, here.
+    pub fn with_model(gpu: &GpuContext, shading: &ShadingModel) -> Self {
         let device = &gpu.device;
         let build_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("abuffer.wgsl"),
             source: wgpu::ShaderSource::Wgsl(
-                concat!(
-                    include_str!("strand_quads.wgsl"),
-                    include_str!("strands.wgsl"),
-                    include_str!("fiber_kajiya_kay.wgsl"),
-                    include_str!("abuffer.wgsl")
-                )
-                .into(),
+                shading_source(shading, include_str!("abuffer.wgsl")).into(),
             ),
         });
+        let model = ModelBinding::new(gpu, shading);
         let resolve_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("abuffer_resolve.wgsl"),
             source: wgpu::ShaderSource::Wgsl(include_str!("abuffer_resolve.wgsl").into()),
@@ -112,20 +131,23 @@ impl ABufferPass {
         let strand_layout = strand_bind_group_layout(device);
         let shadow_layout = shadow_bind_group_layout(device);
         let frag = wgpu::ShaderStages::FRAGMENT;
+        let list_entries = [
+            storage_entry(0, frag, false),
+            storage_entry(1, frag, false),
+            storage_entry(2, frag, false),
+            uniform_entry(3, frag),
+        ];
         let lists_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("abuffer lists"),
-            entries: &[
-                storage_entry(0, frag, false),
-                storage_entry(1, frag, false),
-                storage_entry(2, frag, false),
-                uniform_entry(3, frag),
-            ],
+            entries: &list_entries,
         });
+        let model_layout = model.as_ref().map(|m| &m.layout);
         let build_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("abuffer build"),
             bind_group_layouts: &[
                 Some(&strand_layout),
                 Some(&shadow_layout),
+                model_layout,
                 Some(&lists_layout),
             ],
             immediate_size: 0,
@@ -197,11 +219,15 @@ impl ABufferPass {
             compilation_options: Default::default(),
             cache: None,
         });
-        let dbk_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("dbk"),
+        let dbk_lists_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dbk lists"),
             entries: &[
+                list_entries[0],
+                list_entries[1],
+                list_entries[2],
+                list_entries[3],
                 wgpu::BindGroupLayoutEntry {
-                    binding: 0,
+                    binding: 4,
                     visibility: frag,
                     ty: wgpu::BindingType::Texture {
                         sample_type: wgpu::TextureSampleType::Depth,
@@ -210,7 +236,7 @@ impl ABufferPass {
                     },
                     count: None,
                 },
-                uniform_entry(1, frag),
+                uniform_entry(5, frag),
             ],
         });
         let depth_tested = wgpu::DepthStencilState {
@@ -252,8 +278,8 @@ impl ABufferPass {
             bind_group_layouts: &[
                 Some(&strand_layout),
                 Some(&shadow_layout),
-                Some(&lists_layout),
-                Some(&dbk_layout),
+                model_layout,
+                Some(&dbk_lists_layout),
             ],
             immediate_size: 0,
         });
@@ -281,61 +307,31 @@ impl ABufferPass {
             build,
             dbk_build,
             depth_prepass,
-            dbk_layout,
             resolve,
             strand_layout,
             shadow_layout,
             lists_layout,
+            dbk_lists_layout,
+            model,
         }
     }
 
     /// DBK: the nearest-depth prepass, then the build that sorts fragments into the lists or
     /// the depth-tested fallback.
-    #[allow(clippy::too_many_arguments)]
     fn encode_dbk(
         &self,
-        gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         geometry: &StrandGeometry,
-        frame: &FrameParams,
-        delta: f32,
-        nearest_depth: &wgpu::Texture,
+        nearest_view: &wgpu::TextureView,
         target: &RenderTarget,
         [strands, shadows, lists]: [&wgpu::BindGroup; 3],
     ) {
-        let device = &gpu.device;
-        let nearest_view = nearest_depth.create_view(&Default::default());
-        let camera = &frame.camera;
-        let dbk_params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("dbk params"),
-            contents: bytemuck::cast_slice(&[
-                camera.near,
-                camera.far,
-                delta,
-                f32::from_bits(camera.is_perspective() as u32),
-            ]),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let dbk_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("dbk"),
-            layout: &self.dbk_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&nearest_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: dbk_params.as_entire_binding(),
-                },
-            ],
-        });
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("dbk depth prepass"),
                 color_attachments: &[],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &nearest_view,
+                    view: nearest_view,
                     depth_ops: Some(wgpu::Operations {
                         load: wgpu::LoadOp::Clear(1.0),
                         store: wgpu::StoreOp::Store,
@@ -378,8 +374,10 @@ impl ABufferPass {
         pass.set_pipeline(&self.dbk_build);
         pass.set_bind_group(0, strands, &[]);
         pass.set_bind_group(1, shadows, &[]);
-        pass.set_bind_group(2, lists, &[]);
-        pass.set_bind_group(3, &dbk_group, &[]);
+        if let Some(model) = &self.model {
+            pass.set_bind_group(2, &model.group, &[]);
+        }
+        pass.set_bind_group(3, lists, &[]);
         pass.draw(0..6, 0..geometry.segment_count);
     }
 
@@ -399,6 +397,27 @@ impl ABufferPass {
         capacity: u32,
         mode: ListMode,
     ) -> Result<ABufferFrame, ReadbackError> {
+        match self.draw_shadowed(gpu, geometry, frame, shadow.as_slice(), capacity, mode) {
+            Ok(out) => Ok(out),
+            Err(ABufferError::Readback(e)) => Err(e),
+            Err(ABufferError::TooManyShadowMaps(_)) => {
+                unreachable!("one shadow map is within the limit")
+            }
+        }
+    }
+
+    /// [`Self::draw`] with a deep opacity map for each of up to
+    /// [`MAX_SHADOWED_LIGHTS`](crate::passes::strands::MAX_SHADOWED_LIGHTS) lights.
+    pub fn draw_shadowed(
+        &self,
+        gpu: &GpuContext,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        shadows: &[ShadowInput<'_>],
+        capacity: u32,
+        mode: ListMode,
+    ) -> Result<ABufferFrame, ABufferError> {
+        let shadow_group = shadow_bind_group_for(gpu, &self.shadow_layout, frame, shadows)?;
         let device = &gpu.device;
         let (width, height) = (frame.width, frame.height);
         let pixels = width as u64 * height as u64;
@@ -474,28 +493,57 @@ impl ABufferPass {
         };
         let fallback_view = fallback.create_view(&Default::default());
         let strands = strand_bind_group(gpu, &self.strand_layout, geometry, frame);
-        let shadows = shadow_bind_group(gpu, &self.shadow_layout, frame, shadow);
+        let nearest_view = nearest_depth.create_view(&Default::default());
+        let camera = &frame.camera;
+        let delta = match mode {
+            ListMode::Dbk { delta } => delta,
+            ListMode::All => 0.0,
+        };
+        let dbk_params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("dbk params"),
+            contents: bytemuck::cast_slice(&[
+                camera.near,
+                camera.far,
+                delta,
+                f32::from_bits(camera.is_perspective() as u32),
+            ]),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let mut list_entries = vec![
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: heads.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: nodes.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: counters.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: build_params.as_entire_binding(),
+            },
+        ];
+        let lists_layout = if is_dbk {
+            list_entries.push(wgpu::BindGroupEntry {
+                binding: 4,
+                resource: wgpu::BindingResource::TextureView(&nearest_view),
+            });
+            list_entries.push(wgpu::BindGroupEntry {
+                binding: 5,
+                resource: dbk_params.as_entire_binding(),
+            });
+            &self.dbk_lists_layout
+        } else {
+            &self.lists_layout
+        };
         let lists = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("abuffer lists"),
-            layout: &self.lists_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: heads.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: nodes.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: counters.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: build_params.as_entire_binding(),
-                },
-            ],
+            layout: lists_layout,
+            entries: &list_entries,
         });
         let resolve_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("abuffer resolve"),
@@ -529,16 +577,13 @@ impl ABufferPass {
         });
         let depth_view = target.depth.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
-        if let ListMode::Dbk { delta } = mode {
+        if is_dbk {
             self.encode_dbk(
-                gpu,
                 &mut encoder,
                 geometry,
-                frame,
-                delta,
-                &nearest_depth,
+                &nearest_view,
                 &target,
-                [&strands, &shadows, &lists],
+                [&strands, &shadow_group, &lists],
             );
         } else {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -558,8 +603,11 @@ impl ABufferPass {
             });
             pass.set_pipeline(&self.build);
             pass.set_bind_group(0, &strands, &[]);
-            pass.set_bind_group(1, &shadows, &[]);
-            pass.set_bind_group(2, &lists, &[]);
+            pass.set_bind_group(1, &shadow_group, &[]);
+            if let Some(model) = &self.model {
+                pass.set_bind_group(2, &model.group, &[]);
+            }
+            pass.set_bind_group(3, &lists, &[]);
             pass.draw(0..6, 0..geometry.segment_count);
         }
         {

@@ -1,4 +1,5 @@
-// A-buffer build (appended to strand_quads.wgsl + strands.wgsl): every shaded fragment goes into
+// A-buffer build (appended to strand_quads.wgsl + strands.wgsl + the fiber model, which holds
+// group 2, so the lists are group 3): every shaded fragment goes into
 // a per-pixel linked list in storage buffers (WebGPU has no fragment interlock, so lists are
 // built with atomics and sorted at resolve). A full node buffer drops the fragment and counts it.
 
@@ -19,11 +20,11 @@ struct ABufferParams {
 
 const END_OF_LIST: u32 = 0xffffffffu;
 
-@group(2) @binding(0) var<storage, read_write> heads: array<atomic<u32>>;
-@group(2) @binding(1) var<storage, read_write> nodes: array<Node>;
+@group(3) @binding(0) var<storage, read_write> heads: array<atomic<u32>>;
+@group(3) @binding(1) var<storage, read_write> nodes: array<Node>;
 // [0]: nodes requested, [1]: fragments dropped because the node buffer was full.
-@group(2) @binding(2) var<storage, read_write> counters: array<atomic<u32>, 2>;
-@group(2) @binding(3) var<uniform> abuffer: ABufferParams;
+@group(3) @binding(2) var<storage, read_write> counters: array<atomic<u32>, 2>;
+@group(3) @binding(3) var<uniform> abuffer: ABufferParams;
 
 @fragment
 fn fs_abuffer(in: VertexOut) {
@@ -51,8 +52,9 @@ struct DbkParams {
     perspective: u32,
 };
 
-@group(3) @binding(0) var view_nearest: texture_depth_2d;
-@group(3) @binding(1) var<uniform> dbk: DbkParams;
+// Bindings 4-5 of the lists' group: wgpu allows four groups and the model takes the third.
+@group(3) @binding(4) var view_nearest: texture_depth_2d;
+@group(3) @binding(5) var<uniform> dbk: DbkParams;
 
 // View depth from a depth-buffer value (wgpu's 0..1 depth of glam's "directx" projections).
 fn view_depth(z: f32) -> f32 {

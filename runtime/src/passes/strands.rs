@@ -343,12 +343,7 @@ impl StrandPass {
     /// Shading with `model`; its tables and constants are uploaded once, here.
     pub fn with_model(gpu: &GpuContext, model: &ShadingModel) -> Self {
         let device = &gpu.device;
-        let source = [
-            include_str!("strand_quads.wgsl"),
-            include_str!("strands.wgsl"),
-            model.wgsl(),
-        ]
-        .concat();
+        let source = shading_source(model, "");
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("strands.wgsl"),
             source: wgpu::ShaderSource::Wgsl(source.into()),
@@ -480,6 +475,18 @@ impl StrandPass {
         gpu.queue.submit([encoder.finish()]);
         Ok(())
     }
+}
+
+/// The WGSL of a pass that shades strand quads with `model`: the quads, `shade` with its shadow
+/// group 1, the model's `fiber_radiance` (group 2), then `tail` (the pass's own entry points).
+pub(crate) fn shading_source(model: &ShadingModel, tail: &str) -> String {
+    [
+        include_str!("strand_quads.wgsl"),
+        include_str!("strands.wgsl"),
+        model.wgsl(),
+        tail,
+    ]
+    .concat()
 }
 
 /// Group 0 of every pass that draws strand quads (`strand_quads.wgsl`): frame uniform, points,
