@@ -3,7 +3,6 @@
 //! narrow lobes and the TT region are all hit.
 
 use crate::convolution::convolve_reference;
-use crate::convolution_table::table_coordinates;
 use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -169,10 +168,6 @@ pub fn summarize(name: &str, table: &Table, table_max: f64, rows: &[(Vec<f64>, f
     .with_percentile(table)
 }
 
-/// Re-export for callers that build points themselves.
-pub fn coordinates(theta_xi: f64, theta_o: f64, delta_phi: f64, lambda: f64) -> [f64; 4] {
-    table_coordinates(theta_xi, theta_o, delta_phi, lambda)
-}
 
 #[cfg(test)]
 mod tests {
