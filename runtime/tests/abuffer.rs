@@ -5,6 +5,9 @@
 //! Marschner-LUT and artist shading and several shadow maps, a single strand through the A-buffer
 //! and DBK equals the opaque pass.
 
+mod common;
+use common::*;
+
 use glam::Vec3;
 use strandlight_precompute::point_light_luts::{LutResolution, bake_lut_m, bake_lut_n};
 use strandlight_runtime::camera::{Camera, Projection};
@@ -21,17 +24,6 @@ use strandlight_tables::artist::{ArtistModel, ArtistParams};
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 
 const SIZE: u32 = 64;
-
-fn camera() -> Camera {
-    Camera {
-        eye: Vec3::new(0.0, 0.0, 5.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        projection: Projection::Orthographic { half_height: 1.0 },
-        near: 1.0,
-        far: 10.0,
-    }
-}
 
 /// Vertical strands at x = 0.3 px right of column 32's left edge, y ∈ [−0.8, 0.8], one per
 /// (z, colour), in the given order.
@@ -57,7 +49,7 @@ fn strands(list: &[(f32, Vec3)]) -> HairModel {
 
 fn frame() -> FrameParams {
     FrameParams {
-        camera: camera(),
+        camera: ortho_camera(),
         width: SIZE,
         height: SIZE,
         lights: vec![
@@ -177,7 +169,7 @@ fn dbk_agrees_with_the_abuffer() {
             FrameParams {
                 camera: Camera {
                     projection: Projection::Perspective { fov_y: 0.5 },
-                    ..camera()
+                    ..ortho_camera()
                 },
                 ..frame()
             },
@@ -275,7 +267,7 @@ fn occluder_map(gpu: &GpuContext, rows: usize) -> DeepOpacityMap {
     let geometry = StrandGeometry::upload(gpu, &occluder(rows)).unwrap();
     let map = DeepOpacityMap::new(
         gpu,
-        camera(),
+        ortho_camera(),
         DomSettings {
             resolution: MAP_RES,
             layers: 4,

@@ -2,8 +2,11 @@
 //! diameter d spaced s apart, each row at an independent lateral offset, transmit (1 − d/s)
 //! per row, so the light reaching depth m rows in is (1 − d/s)^m.
 
+mod common;
+use common::*;
+
 use glam::Vec3;
-use strandlight_runtime::camera::{Camera, Projection};
+use strandlight_runtime::camera::Camera;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::gpu::read_texture_rgba;
 use strandlight_runtime::hair::{Attribute, HairModel};
@@ -15,45 +18,6 @@ use strandlight_runtime::passes::strands::{
     FrameParams, KajiyaKay, RenderTarget, ShadowInput, StrandGeometry, StrandPass,
 };
 
-const RES: u32 = 64;
-/// Light-map texels per world unit (2 units across 64 texels).
-const PER_UNIT: f64 = 32.0;
-
-/// Rows at z = 0.3 − 0.1·r (the light is at +z), one vertical fiber per texel column, each row
-/// shifted by its own sub-texel offset.
-fn slab(rows: usize, thickness: f32) -> HairModel {
-    let offsets = [0.17, -0.23, 0.05, 0.29, -0.11, -0.02];
-    let mut points = Vec::new();
-    let mut strand_offsets = vec![0u32];
-    for r in 0..rows {
-        let z = 0.3 - 0.1 * r as f32;
-        for c in 0..RES {
-            let x = ((c as f64 + 0.5 + offsets[r % offsets.len()]) / PER_UNIT - 1.0) as f32;
-            points.push(Vec3::new(x, -0.9, z));
-            points.push(Vec3::new(x, 0.9, z));
-            strand_offsets.push(points.len() as u32);
-        }
-    }
-    HairModel::new(
-        points,
-        strand_offsets,
-        Some(Attribute::Uniform(thickness)),
-        None,
-        None,
-    )
-    .unwrap()
-}
-
-fn light_camera() -> Camera {
-    Camera {
-        eye: Vec3::new(0.0, 0.0, 5.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        projection: Projection::Orthographic { half_height: 1.0 },
-        near: 1.0,
-        far: 10.0,
-    }
-}
 
 #[test]
 fn slab_of_parallel_strands_matches_the_closed_form() {
@@ -76,7 +40,7 @@ fn slab_of_parallel_strands_matches_the_closed_form() {
             spacing: 0.08,
         };
         settings.check().unwrap();
-        let map = DeepOpacityMap::new(&gpu, light_camera(), settings);
+        let map = DeepOpacityMap::new(&gpu, ortho_camera(), settings);
         pass.draw(&gpu, &geometry, &map);
         let texels = map.read_layers(&gpu).unwrap();
         let tau_row = -(1.0 - coverage).ln();
@@ -159,7 +123,7 @@ fn shading_behind_the_slab_is_dimmed_by_the_closed_form_transmittance() {
     let slab_geometry = StrandGeometry::upload(&gpu, &slab(4, thickness)).unwrap();
     let map = DeepOpacityMap::new(
         &gpu,
-        light_camera(),
+        ortho_camera(),
         DomSettings {
             resolution: RES,
             layers: 4,
@@ -187,7 +151,7 @@ fn shading_behind_the_slab_is_dimmed_by_the_closed_form_transmittance() {
         .unwrap();
         let geometry = StrandGeometry::upload(&gpu, &probe).unwrap();
         let frame = FrameParams {
-            camera: light_camera(),
+            camera: ortho_camera(),
             width: RES,
             height: RES,
             lights: vec![Light::Directional {
@@ -248,9 +212,9 @@ fn a_reused_map_equals_a_fresh_one_for_each_light() {
     };
     let tilted = Camera {
         eye: Vec3::new(1.5, 0.5, 4.6),
-        ..light_camera()
+        ..ortho_camera()
     };
-    let mut reused = DeepOpacityMap::new(&gpu, light_camera(), settings);
+    let mut reused = DeepOpacityMap::new(&gpu, ortho_camera(), settings);
     pass.draw(&gpu, &geometry, &reused);
     let first = reused.read_layers(&gpu).unwrap();
     reused.camera = tilted;

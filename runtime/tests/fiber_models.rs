@@ -9,11 +9,13 @@
 //! Expected pixel: `E · S(θ_i, θ_o, φ) · cos θ_i`, E = the light's intensity (directional) or
 //! intensity / d² (point), the angles from `FiberAngles::from_directions` in f64.
 
+mod common;
+use common::*;
+
 use glam::{DVec3, Vec3};
 use strandlight_precompute::point_light_luts::{
     AzimuthAxis, CosThetaDSource, LutResolution, bake_lut_m, bake_lut_n, reconstruct_s_from_sines,
 };
-use strandlight_runtime::camera::{Camera, Projection};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::lights::Light;
@@ -28,22 +30,6 @@ use strandlight_tables::scattering::{Rgb, ScatteringFunction};
 const SIZE: u32 = 64;
 /// The strand leans this far toward the camera (θ_o = TILT for every pixel).
 const TILT_DEG: f64 = 30.0;
-
-fn gpu() -> GpuContext {
-    GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// Orthographic, looking down −z, 2 world units tall: 32 pixels per unit.
-fn ortho_camera() -> Camera {
-    Camera {
-        eye: Vec3::new(0.0, 0.0, 5.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        projection: Projection::Orthographic { half_height: 1.0 },
-        near: 1.0,
-        far: 10.0,
-    }
-}
 
 fn tangent() -> DVec3 {
     let tilt = TILT_DEG.to_radians();

@@ -2,8 +2,10 @@
 //! opacity map, checked against the closed-form transmittance of a slab of parallel strands,
 //! (1 − d/s)^m after m rows of fibers of diameter d spaced s apart.
 
+mod common;
+use common::*;
+
 use glam::Vec3;
-use strandlight_runtime::camera::{Camera, Projection};
 use strandlight_runtime::gpu::{GpuContext, read_texture_rgba};
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::lights::Light;
@@ -13,51 +15,12 @@ use strandlight_runtime::passes::strands::{
     StrandPass, TooManyShadowMaps,
 };
 
-const RES: u32 = 64;
-/// Light-map texels per world unit (2 units across 64 texels).
-const PER_UNIT: f64 = 32.0;
-
-/// `rows` rows at z = 0.3 − 0.1·r (the lights are at +z), one vertical fiber per texel column,
-/// each row shifted by its own sub-texel offset.
-fn slab(rows: usize, thickness: f32) -> HairModel {
-    let offsets = [0.17, -0.23, 0.05, 0.29, -0.11, -0.02];
-    let mut points = Vec::new();
-    let mut strand_offsets = vec![0u32];
-    for r in 0..rows {
-        let z = 0.3 - 0.1 * r as f32;
-        for c in 0..RES {
-            let x = ((c as f64 + 0.5 + offsets[r % offsets.len()]) / PER_UNIT - 1.0) as f32;
-            points.push(Vec3::new(x, -0.9, z));
-            points.push(Vec3::new(x, 0.9, z));
-            strand_offsets.push(points.len() as u32);
-        }
-    }
-    HairModel::new(
-        points,
-        strand_offsets,
-        Some(Attribute::Uniform(thickness)),
-        None,
-        None,
-    )
-    .unwrap()
-}
-
-fn camera() -> Camera {
-    Camera {
-        eye: Vec3::new(0.0, 0.0, 5.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        projection: Projection::Orthographic { half_height: 1.0 },
-        near: 1.0,
-        far: 10.0,
-    }
-}
 
 fn map_of_slab(gpu: &GpuContext, rows: usize, thickness: f32) -> DeepOpacityMap {
     let geometry = StrandGeometry::upload(gpu, &slab(rows, thickness)).unwrap();
     let map = DeepOpacityMap::new(
         gpu,
-        camera(),
+        ortho_camera(),
         DomSettings {
             resolution: RES,
             layers: 4,
@@ -94,7 +57,7 @@ fn each_shadowed_light_is_dimmed_by_its_own_map() {
         intensity,
     };
     let frame = FrameParams {
-        camera: camera(),
+        camera: ortho_camera(),
         width: RES,
         height: RES,
         lights: vec![light(1.0), light(0.5), light(0.25)],

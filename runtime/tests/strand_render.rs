@@ -2,32 +2,17 @@
 //! strand at sampled pixels (f64, several lights of every kind), and the coverage alpha of
 //! sub-pixel strands summed across the strand against their width in pixels.
 
+mod common;
+use common::*;
+
 use glam::Vec3;
 use strandlight_runtime::camera::{Camera, Projection};
-use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::strands::{FrameParams, KajiyaKay};
 use strandlight_runtime::render::{RenderOptions, render_frame};
 
 const SIZE: u32 = 64;
-
-fn gpu() -> GpuContext {
-    GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// Orthographic, looking down −z, 2 world units tall: 32 pixels per unit, world x = 0 on the
-/// boundary between pixel columns 31 and 32.
-fn ortho_camera() -> Camera {
-    Camera {
-        eye: Vec3::new(0.0, 0.0, 5.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        projection: Projection::Orthographic { half_height: 1.0 },
-        near: 1.0,
-        far: 10.0,
-    }
-}
 
 fn straight_strand(
     from: Vec3,

@@ -1,0 +1,50 @@
+//! Scene pieces shared by the GPU tests: a device, the orthographic test camera and the slab of
+//! parallel strands whose transmittance has a closed form.
+#![allow(dead_code)] // each test binary uses its own subset
+
+use glam::Vec3;
+use strandlight_runtime::camera::{Camera, Projection};
+use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::hair::{Attribute, HairModel};
+
+/// Texels of the slab's light maps (and pixels of the test images) across.
+pub const RES: u32 = 64;
+/// Light-map texels per world unit (2 units across 64 texels).
+pub const PER_UNIT: f64 = 32.0;
+
+/// The software or hardware device; a test fails (with the install hint) when there is none.
+pub fn gpu() -> GpuContext {
+    GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Orthographic, looking down −z from +z, 2 world units tall: 32 pixels per unit for a 64-pixel
+/// image, world x = 0 on the boundary between pixel columns 31 and 32.
+pub fn ortho_camera() -> Camera {
+    Camera {
+        eye: Vec3::new(0.0, 0.0, 5.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        projection: Projection::Orthographic { half_height: 1.0 },
+        near: 1.0,
+        far: 10.0,
+    }
+}
+
+/// `rows` rows at z = 0.3 − 0.1·r (lights at +z), one vertical fiber per texel column, each row
+/// shifted by its own sub-texel offset: with fibers of diameter d spaced s = 1/PER_UNIT apart,
+/// each row transmits (1 − d/s).
+pub fn slab(rows: usize, thickness: f32) -> HairModel {
+    let offsets = [0.17, -0.23, 0.05, 0.29, -0.11, -0.02];
+    let mut points = Vec::new();
+    let mut strand_offsets = vec![0u32];
+    for r in 0..rows {
+        let z = 0.3 - 0.1 * r as f32;
+        for c in 0..RES {
+            let x = ((c as f64 + 0.5 + offsets[r % offsets.len()]) / PER_UNIT - 1.0) as f32;
+            points.push(Vec3::new(x, -0.9, z));
+            points.push(Vec3::new(x, 0.9, z));
+            strand_offsets.push(points.len() as u32);
+        }
+    }
+    HairModel::new(points, strand_offsets, Some(Attribute::Uniform(thickness)), None, None).unwrap()
+}
