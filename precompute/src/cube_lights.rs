@@ -19,9 +19,13 @@
 //! angle `Δφ (cos θ₀ − cos θ₁)` is given to the texel containing the sub-pixel's center, with
 //! the pixel's radiance. Every bit of solid angle is assigned exactly once, so the sum of all
 //! powers equals [`EnvMap::integral`] up to rounding. The only error is binning: a sub-pixel
-//! straddling a texel edge goes wholly to one side. Its size is measured in the tests against
-//! the closed-form texel solid angle (`cube_texel_solid_angle`); the default `s` is picked so
-//! that a texel spans at least [`SUBPIXELS_PER_TEXEL`] sub-pixels across.
+//! straddling a texel edge goes wholly to one side. The azimuth slices are also cut at the
+//! meridians that are texel edges of the side faces, so those edges (aligned with the pixel
+//! columns, hence the worst aliasing) are exact. Measured against the closed-form texel solid
+//! angle ([`cube_texel_solid_angle`]) for a constant 1024×512 map at n = 32, max (rms) relative
+//! error per texel: s = 1 9.3 % (2.0 %), s = 2 4.7 % (0.75 %), s = 4 1.6 % (0.26 %),
+//! s = 8 0.78 % (0.086 %), i.e. ≈ 1/s. The default `s` ([`default_subsamples`]) is picked so
+//! that a texel spans at least [`SUBPIXELS_PER_TEXEL`] sub-pixels across (s = 8 there).
 //!
 //! Sums run in fixed row bands, reduced in order: results are bitwise deterministic whatever
 //! the thread count.
