@@ -18,6 +18,7 @@ pub mod bake_plan;
 pub mod check_tables;
 pub mod convolution;
 pub mod convolution_table;
+pub mod cube_lights;
 pub mod envmap;
 pub mod envmap_error;
 pub mod envmap_io;
