@@ -1,7 +1,7 @@
 //! The table asset file: one [`Table`] with everything needed to know what it holds and
 //! whether it may be used — the format the offline baker writes and the runtime reads.
 //!
-//! # File layout (format version 1)
+//! # File layout (format version 2)
 //!
 //! | offset | size | content |
 //! | --- | --- | --- |
@@ -9,11 +9,13 @@
 //! | 8 | 4 | format version, u32 little-endian (= [`FORMAT_VERSION`]) |
 //! | 12 | 4 | metadata length `m` in bytes, u32 little-endian (≤ [`MAX_METADATA_BYTES`]) |
 //! | 16 | m | metadata: UTF-8 JSON, an [`AssetMetadata`] |
-//! | 16 + m | 0–15 | zero padding so that the payload starts at a multiple of 16 |
+//! | 16 + m | 32 | SHA-256 of the m metadata bytes |
+//! | 48 + m | 0–15 | zero padding so that the payload starts at a multiple of 16 |
 //! | p | n | payload: the table's values in [`Table`]'s layout (row-major, last axis fastest, channels innermost), f32 or f16 little-endian |
 //!
 //! The file ends exactly after the payload. `payload.sha256` in the metadata is the SHA-256 of
-//! the payload bytes (the metadata itself is covered by JSON parsing and the shape checks).
+//! the payload bytes; the metadata has its own digest, so a flipped digit in a fiber parameter
+//! is caught too (version 1 had none).
 //! Files are written atomically (see [`crate::atomic_write`]) and every way a file can be
 //! wrong on load is its own [`AssetError`] variant naming the file.
 
@@ -29,10 +31,12 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 pub const MAGIC: [u8; 8] = *b"STRNDLUT";
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 /// Metadata is a few kB; a larger length field means a corrupt file, refused before allocating.
 pub const MAX_METADATA_BYTES: u32 = 1 << 24;
 const HEADER_BYTES: u64 = 16;
+/// The SHA-256 of the metadata that follows it.
+const METADATA_DIGEST_BYTES: u64 = 32;
 const PAYLOAD_ALIGNMENT: u64 = 16;
 /// The only payload layout of format version 1, spelled out in every file for human readers.
 pub const PAYLOAD_LAYOUT: &str = "row-major, last axis fastest, channels innermost, little-endian";
@@ -67,6 +71,8 @@ pub enum AssetError {
     InvalidShape { path: PathBuf, source: TableError },
     #[error("{}: inconsistent file: {problem}", .path.display())]
     Inconsistent { path: PathBuf, problem: String },
+    #[error("{}: metadata checksum mismatch: the metadata block is corrupt", .path.display())]
+    MetadataChecksumMismatch { path: PathBuf },
     #[error("{}: payload checksum mismatch (stored SHA-256 {stored}, computed {computed}): the file is corrupt", .path.display())]
     ChecksumMismatch {
         path: PathBuf,
@@ -249,12 +255,13 @@ fn encode_asset(
     head.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
     head.extend_from_slice(&(json.len() as u32).to_le_bytes());
     head.extend_from_slice(&json);
+    head.extend_from_slice(&Sha256::digest(&json));
     head.resize(payload_offset(json.len() as u64) as usize, 0);
     Ok((metadata, head, payload))
 }
 
 fn payload_offset(metadata_len: u64) -> u64 {
-    (HEADER_BYTES + metadata_len).div_ceil(PAYLOAD_ALIGNMENT) * PAYLOAD_ALIGNMENT
+    (HEADER_BYTES + metadata_len + METADATA_DIGEST_BYTES).div_ceil(PAYLOAD_ALIGNMENT) * PAYLOAD_ALIGNMENT
 }
 
 fn encode_payload(path: &Path, table: &Table, storage: Storage) -> Result<Vec<u8>, AssetError> {
@@ -397,6 +404,15 @@ impl OpenedAsset {
         }
         let mut json = vec![0u8; metadata_len as usize];
         file.read_exact(&mut json).map_err(io_error)?;
+        let digest_end = HEADER_BYTES + metadata_len as u64 + METADATA_DIGEST_BYTES;
+        if file_len < digest_end {
+            return Err(truncated("metadata checksum", digest_end));
+        }
+        let mut digest = [0u8; METADATA_DIGEST_BYTES as usize];
+        file.read_exact(&mut digest).map_err(io_error)?;
+        if Sha256::digest(&json).as_slice() != digest {
+            return Err(AssetError::MetadataChecksumMismatch { path: path_buf });
+        }
         let metadata: AssetMetadata =
             serde_json::from_slice(&json).map_err(|source| AssetError::BadMetadata {
                 path: path_buf.clone(),
@@ -735,6 +751,7 @@ mod tests {
         bytes.extend_from_slice(&version.to_le_bytes());
         bytes.extend_from_slice(&(json.len() as u32).to_le_bytes());
         bytes.extend_from_slice(json);
+        bytes.extend_from_slice(&Sha256::digest(json));
         bytes.resize(payload_offset(json.len() as u64) as usize, 0);
         bytes.extend_from_slice(payload);
         bytes
@@ -775,12 +792,12 @@ mod tests {
         ));
 
         let mut b = good.clone();
-        b[8..12].copy_from_slice(&2u32.to_le_bytes());
+        b[8..12].copy_from_slice(&1u32.to_le_bytes());
         assert!(matches!(
             load(&dir, "version.sltab", &b),
             AssetError::UnsupportedVersion {
-                found: 2,
-                supported: 1,
+                found: 1,
+                supported: FORMAT_VERSION,
                 ..
             }
         ));
@@ -802,6 +819,19 @@ mod tests {
         b[json_start] = b'['; // the opening brace of the JSON object
         assert!(matches!(
             load(&dir, "json.sltab", &b),
+            AssetError::MetadataChecksumMismatch { .. }
+        ));
+        // A flipped digit inside a parameter still parses; only the digest catches it.
+        let mut b = good.clone();
+        let digit = json.windows(4).position(|w| w == b"1.55").unwrap() + json_start + 2;
+        b[digit] = b'6';
+        assert!(matches!(
+            load(&dir, "digit.sltab", &b),
+            AssetError::MetadataChecksumMismatch { .. }
+        ));
+        // JSON that is not an asset's metadata, with a valid digest.
+        assert!(matches!(
+            load(&dir, "notjson.sltab", &assemble(FORMAT_VERSION, b"[1, 2", payload)),
             AssetError::BadMetadata { .. }
         ));
 
@@ -829,7 +859,7 @@ mod tests {
         // Metadata that disagrees with the payload size it declares.
         let mut m = metadata.clone();
         m["payload"]["axes"][0]["count"] = json!(6);
-        let b = assemble(1, &serde_json::to_vec(&m).unwrap(), payload);
+        let b = assemble(FORMAT_VERSION, &serde_json::to_vec(&m).unwrap(), payload);
         assert!(matches!(
             load(&dir, "shape.sltab", &b),
             AssetError::Inconsistent { .. }
@@ -839,7 +869,7 @@ mod tests {
         let mut m = metadata.clone();
         m["payload"]["axes"][0]["count"] = json!(1u64 << 40);
         m["payload"]["payload_bytes"] = json!(1u64 << 50);
-        let b = assemble(1, &serde_json::to_vec(&m).unwrap(), payload);
+        let b = assemble(FORMAT_VERSION, &serde_json::to_vec(&m).unwrap(), payload);
         let err = load(&dir, "absurd.sltab", &b);
         assert!(
             matches!(
@@ -854,7 +884,7 @@ mod tests {
 
         let mut m = metadata.clone();
         m["payload"]["storage"] = json!("f64");
-        let b = assemble(1, &serde_json::to_vec(&m).unwrap(), payload);
+        let b = assemble(FORMAT_VERSION, &serde_json::to_vec(&m).unwrap(), payload);
         assert!(matches!(
             load(&dir, "storage.sltab", &b),
             AssetError::BadMetadata { .. }
