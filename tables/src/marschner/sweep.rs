@@ -6,6 +6,7 @@
 //!
 //! Public so that a benchmark mode can run it with 10⁸ samples; the unit test runs 10⁶.
 
+use crate::sweep::SweepRng;
 use super::{Lobe, Marschner, MarschnerParams};
 use crate::angles::FiberAngles;
 use crate::longitudinal::LongitudinalModel;
@@ -75,45 +76,27 @@ pub fn sweep_configurations() -> Vec<MarschnerParams> {
     out
 }
 
-/// SplitMix64: a tiny, dependency-free generator, plenty for spreading test inputs.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1).
-    fn unit(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-}
-
 /// An inclination biased toward the hard places: exactly ±90°, within 10⁻¹²…10⁻¹ of them,
 /// exactly 0, or uniform.
-fn hard_theta(rng: &mut SplitMix64) -> f64 {
-    let sign = if rng.unit() < 0.5 { -1.0 } else { 1.0 };
+fn hard_theta(rng: &mut SweepRng) -> f64 {
+    let sign = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
     match rng.next_u64() % 8 {
         0 => sign * FRAC_PI_2,
-        1 | 2 => sign * (FRAC_PI_2 - 10f64.powf(-1.0 - 11.0 * rng.unit())),
+        1 | 2 => sign * (FRAC_PI_2 - 10f64.powf(-1.0 - 11.0 * rng.uniform())),
         3 => 0.0,
-        _ => (rng.unit() - 0.5) * PI,
+        _ => (rng.uniform() - 0.5) * PI,
     }
 }
 
 /// A relative azimuth biased toward 0, ±π and tiny offsets from them.
-fn hard_phi(rng: &mut SplitMix64) -> f64 {
-    let sign = if rng.unit() < 0.5 { -1.0 } else { 1.0 };
+fn hard_phi(rng: &mut SweepRng) -> f64 {
+    let sign = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
     match rng.next_u64() % 8 {
         0 => 0.0,
         1 => PI,
-        2 => sign * 10f64.powf(-12.0 * rng.unit()),
-        3 => sign * (PI - 10f64.powf(-1.0 - 11.0 * rng.unit())),
-        _ => (2.0 * rng.unit() - 1.0) * PI,
+        2 => sign * 10f64.powf(-12.0 * rng.uniform()),
+        3 => sign * (PI - 10f64.powf(-1.0 - 11.0 * rng.uniform())),
+        _ => (2.0 * rng.uniform() - 1.0) * PI,
     }
 }
 
@@ -124,7 +107,7 @@ pub fn hard_case_sweep(samples: u64, seed: u64) -> SweepReport {
         .into_iter()
         .map(|p| Marschner::new(p).expect("sweep configurations are valid"))
         .collect();
-    let mut rng = SplitMix64(seed);
+    let mut rng = SweepRng::new(seed);
     let mut report = SweepReport {
         configurations: models.len(),
         ..SweepReport::default()
@@ -153,7 +136,7 @@ pub fn hard_case_sweep(samples: u64, seed: u64) -> SweepReport {
                 report.record(v);
             }
         }
-        let phi_h = (2.0 * rng.unit() - 1.0) * PI;
+        let phi_h = (2.0 * rng.uniform() - 1.0) * PI;
         for v in model.eval_oriented(&angles, phi_h) {
             report.record(v);
         }
