@@ -8,6 +8,7 @@
 //! Inputs: [`StrandGeometry`], [`FrameParams`], the shadow maps, the node capacity.
 //! Output: [`ABufferFrame`].
 
+use super::attachments::{cleared_color, cleared_depth};
 use wgpu::util::DeviceExt;
 
 use crate::gpu::GpuContext;
@@ -330,14 +331,7 @@ impl ABufferPass {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("dbk depth prepass"),
                 color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: nearest_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
+                depth_stencil_attachment: cleared_depth(&nearest_view, true),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,
@@ -350,23 +344,8 @@ impl ABufferPass {
         let depth_view = target.depth.create_view(&Default::default());
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("dbk build"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &color_view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Discard,
-                }),
-                stencil_ops: None,
-            }),
+            color_attachments: &[cleared_color(&color_view)],
+            depth_stencil_attachment: cleared_depth(&depth_view, false),
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,
@@ -589,14 +568,7 @@ impl ABufferPass {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("abuffer build"),
                 color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
+                depth_stencil_attachment: cleared_depth(&depth_view, false),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,

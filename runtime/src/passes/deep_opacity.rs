@@ -6,6 +6,7 @@
 //! The pipelines are built once and the per-light targets can be reused, so the pass repeats
 //! cheaply for many lights.
 
+use super::attachments::{cleared_color, cleared_depth};
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
@@ -323,14 +324,7 @@ impl DeepOpacityPass {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("dom depth"),
                 color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
+                depth_stencil_attachment: cleared_depth(&depth_view, true),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,
@@ -347,15 +341,7 @@ impl DeepOpacityPass {
         let attachments: Vec<_> = views
             .iter()
             .map(|view| {
-                Some(wgpu::RenderPassColorAttachment {
-                    view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })
+                cleared_color(view)
             })
             .collect();
         {

@@ -3,6 +3,7 @@
 //! depth test. Inputs: [`StrandGeometry`] (the hair on the GPU), [`FrameParams`] (camera,
 //! shading constants, lights). Output: the colour texture of a [`RenderTarget`].
 
+use super::attachments::{cleared_color, cleared_depth};
 use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
@@ -443,23 +444,8 @@ impl StrandPass {
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("strands"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &color_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
+                color_attachments: &[cleared_color(&color_view)],
+                depth_stencil_attachment: cleared_depth(&depth_view, true),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,
