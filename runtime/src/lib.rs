@@ -1,6 +1,7 @@
 //! The wgpu runtime: hair input, render passes, and the brute-force reference renderer.
 
 pub mod camera;
+pub mod env;
 pub mod gpu;
 pub mod hair;
 pub mod image_out;
