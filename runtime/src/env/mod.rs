@@ -66,3 +66,9 @@ pub trait ForwardScatteringSource {
     /// The grid (with values for every light in `lights`, in order).
     fn grid(&self, lights: &[EnvLight]) -> ForwardScatteringGrid;
 }
+
+pub mod render;
+pub use render::{
+    EnvFrame, EnvRenderError, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTableError, EnvTables,
+    render_env_frame,
+};

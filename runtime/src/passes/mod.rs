@@ -2,6 +2,10 @@
 
 pub mod abuffer;
 pub mod attachments;
+pub mod convolution_depth;
 pub mod deep_opacity;
+pub mod env_view;
 pub mod fiber_shading;
 pub mod strands;
+pub mod summed_area;
+pub mod transmittance_probe;

@@ -1,0 +1,425 @@
+//! One env-lit frame (Ren 2010): per batch of lights of one kind, the light pass (DODM), the
+//! summed-area tables, then the view pass whose images are summed on the GPU; one readback at
+//! the end. [`EnvRenderer`] keeps the pipelines across frames; [`render_env_frame`] builds them
+//! for one frame.
+
+use std::time::Instant;
+
+use strandlight_tables::table::Table;
+
+use super::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource};
+use crate::camera::Camera;
+use crate::gpu::readback::{ReadbackError, read_buffer};
+use crate::gpu::{AdapterReport, GpuContext};
+use crate::hair::HairModel;
+use crate::passes::convolution_depth::{
+    ConvolutionDepthPass, DodmBatch, DodmSettings, DodmSettingsError, SimplifiedSegments, check_kappa,
+};
+use crate::passes::env_view::{BatchBinding, EnvViewPass, EnvViewTargets, GridBinding, TableBinding};
+use crate::passes::strands::{FrameParams, KajiyaKay, StrandGeometry, TooManyPoints};
+use crate::passes::summed_area::{SatTooLarge, SummedAreaPass, SummedAreaTables};
+use crate::render::{PassTiming, Transparency};
+
+/// Axis names of the env tables (`strandlight_precompute::convolution_table` and
+/// `multiple_scattering_table`; the runtime never links the precompute crate).
+pub const AXIS_U_DOT_XI: &str = "u_dot_xi";
+pub const AXIS_U_DOT_WO: &str = "u_dot_wo";
+pub const AXIS_COS_DPHI: &str = "cos_dphi";
+pub const AXIS_INV_LAMBDA: &str = "inv_lambda";
+pub const AXIS_SIGMA_F: &str = "sigma_f";
+
+/// The tables a frame shades with. Each is an RGB [`Table`] with axes (u·ξ, u·ω_o, cos Δφ, w):
+/// * `srbf`: the convolution table I (I_M, `marschner_full` or the artist I_A), w = 1/λ;
+/// * `direct`: S(ω_i, ω_o)·cos θ_i for directional lights, w a one-node axis (any name);
+/// * `multiple`: I_G, w = σ̄_f (used only with a [`ForwardScatteringSource`]).
+#[derive(Clone, Debug, Default)]
+pub struct EnvTables {
+    pub srbf: Option<Table>,
+    pub direct: Option<Table>,
+    pub multiple: Option<Table>,
+}
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum EnvTableError {
+    #[error("env table `{table}` is needed ({needed_by}) but was not given")]
+    Missing { table: &'static str, needed_by: &'static str },
+    #[error("env table `{table}`: {problem}")]
+    Shape { table: &'static str, problem: String },
+}
+
+/// Checks an env table's layout: 4 axes, the three direction axes by name, the fourth named
+/// `fourth` (or any name with one node when `None`), 3 channels.
+pub fn check_env_table(table_name: &'static str, table: &Table, fourth: Option<&str>) -> Result<(), EnvTableError> {
+    let bad = |problem: String| EnvTableError::Shape { table: table_name, problem };
+    let axes = table.axes();
+    if axes.len() != 4 {
+        return Err(bad(format!("has {} axes, expected 4", axes.len())));
+    }
+    for (axis, name) in axes.iter().zip([AXIS_U_DOT_XI, AXIS_U_DOT_WO, AXIS_COS_DPHI]) {
+        if axis.name != name {
+            return Err(bad(format!("axis `{}` where `{name}` was expected", axis.name)));
+        }
+    }
+    match fourth {
+        Some(name) if axes[3].name != name => {
+            return Err(bad(format!("fourth axis `{}` where `{name}` was expected", axes[3].name)));
+        }
+        None if axes[3].count != 1 => {
+            return Err(bad(format!(
+                "fourth axis `{}` has {} nodes; a direct table has one",
+                axes[3].name, axes[3].count
+            )));
+        }
+        _ => {}
+    }
+    if table.channels() != 3 {
+        return Err(bad(format!("has {} channels, expected 3 (RGB)", table.channels())));
+    }
+    if u32::try_from(table.values().len()).is_err() {
+        return Err(bad("holds more than 2^32 values".into()));
+    }
+    Ok(())
+}
+
+/// Everything besides the scene that changes how a frame is rendered.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnvRenderOptions {
+    /// Light-pass map resolution, first-layer depth and lights per batch.
+    pub dodm: DodmSettings,
+    /// Stochastic simplification (Ren §7): the light pass draws this fraction of the strands
+    /// (τ scaled by 1/κ); 1 draws them all. Default 0.1.
+    pub kappa: f32,
+    /// Seed of the strand shuffle behind κ.
+    pub simplification_seed: u64,
+    /// Only [`Transparency::Opaque`] so far.
+    pub transparency: Transparency,
+    /// `false`: no self-shadowing (T̃ = 1; for tests and for comparisons).
+    pub shadowed: bool,
+}
+
+impl Default for EnvRenderOptions {
+    fn default() -> Self {
+        Self {
+            dodm: DodmSettings::default(),
+            kappa: 0.1,
+            simplification_seed: 0x5eed,
+            transparency: Transparency::Opaque,
+            shadowed: true,
+        }
+    }
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum EnvRenderError {
+    #[error("the environment has no lights")]
+    NoLights,
+    #[error("light {index}: {problem}")]
+    BadLight { index: usize, problem: String },
+    #[error("image size {width}×{height} must be between 1 and {max} on each side (the adapter's limit)")]
+    BadSize { width: u32, height: u32, max: u32 },
+    #[error(transparent)]
+    Settings(#[from] DodmSettingsError),
+    #[error(transparent)]
+    Table(#[from] EnvTableError),
+    #[error(transparent)]
+    GpuLimit(#[from] SatTooLarge),
+    #[error("forward-scattering grid: {0}")]
+    Grid(String),
+    #[error("transparency mode {0:?} is not supported by the env-lit renderer yet (only opaque)")]
+    UnsupportedTransparency(Transparency),
+    #[error(transparent)]
+    TooManyPoints(#[from] TooManyPoints),
+    #[error(transparent)]
+    Readback(#[from] ReadbackError),
+    #[error("the GPU reported an error: {0}")]
+    Gpu(String),
+}
+
+#[derive(Clone, Debug)]
+pub struct EnvRenderStats {
+    pub adapter: AdapterReport,
+    /// Per pass, summed over batches: "upload", "pipelines", "light pass", "summed-area tables",
+    /// "view", "multiple grid (CPU)", "readback".
+    pub timings: Vec<PassTiming>,
+    /// GPU memory held while one batch renders (the frame's buffers included), per resource.
+    pub memory_per_batch: Vec<(String, u64)>,
+    pub batches: u32,
+    pub lights: u32,
+    pub segments: u32,
+    /// Segments the light pass draws (κ of the strands).
+    pub light_pass_segments: u32,
+    pub timing_method: &'static str,
+}
+
+/// A rendered frame: linear, pre-multiplied RGBA, row-major from the top.
+#[derive(Clone, Debug)]
+pub struct EnvFrame {
+    pub width: u32,
+    pub height: u32,
+    /// single + multiple.
+    pub pixels: Vec<[f32; 4]>,
+    pub single_pixels: Vec<[f32; 4]>,
+    /// `None` without a forward-scattering source.
+    pub multiple_pixels: Option<Vec<[f32; 4]>>,
+    pub stats: EnvRenderStats,
+}
+
+fn check_light(index: usize, light: &EnvLight) -> Result<(), EnvRenderError> {
+    let bad = |problem: String| EnvRenderError::BadLight { index, problem };
+    if !light.direction.is_finite() || light.direction.length() < 1e-6 {
+        return Err(bad(format!("direction {:?} is not a usable unit vector", light.direction)));
+    }
+    if let Some(lambda) = light.lambda
+        && !(lambda.is_finite() && lambda > 0.0)
+    {
+        return Err(bad(format!("SRBF bandwidth λ = {lambda} must be positive and finite")));
+    }
+    if light.rgb.iter().any(|c| !c.is_finite()) {
+        return Err(bad(format!("rgb {:?} is not finite", light.rgb)));
+    }
+    Ok(())
+}
+
+fn check_grid(grid: &ForwardScatteringGrid, lights: usize) -> Result<(), EnvRenderError> {
+    let vertices = grid.dims.iter().map(|&d| d as usize).product::<usize>();
+    if vertices == 0 {
+        return Err(EnvRenderError::Grid(format!("dims {:?} has a zero", grid.dims)));
+    }
+    if grid.values.len() != vertices * lights {
+        return Err(EnvRenderError::Grid(format!(
+            "{} values for {lights} lights × {vertices} vertices",
+            grid.values.len()
+        )));
+    }
+    if !grid.origin.is_finite() || !grid.spacing.is_finite() || grid.spacing.min_element() <= 0.0 {
+        return Err(EnvRenderError::Grid(format!(
+            "origin {:?} / spacing {:?} must be finite, spacing positive",
+            grid.origin, grid.spacing
+        )));
+    }
+    if grid.values.iter().any(|v| v.iter().any(|c| !c.is_finite())) {
+        return Err(EnvRenderError::Grid("holds non-finite values".into()));
+    }
+    Ok(())
+}
+
+/// Wall-clock totals per pass name.
+struct Timings(Vec<PassTiming>);
+
+impl Timings {
+    fn time<T>(&mut self, gpu: &GpuContext, pass: &str, work: impl FnOnce() -> T) -> T {
+        let start = Instant::now();
+        let out = work();
+        gpu.wait_idle();
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        match self.0.iter_mut().find(|t| t.pass == pass) {
+            Some(t) => t.milliseconds += ms,
+            None => self.0.push(PassTiming { pass: pass.to_string(), milliseconds: ms }),
+        }
+        out
+    }
+}
+
+/// The pipelines of the env-lit renderer, reusable across frames.
+pub struct EnvRenderer {
+    depth: ConvolutionDepthPass,
+    sat: SummedAreaPass,
+    view: EnvViewPass,
+}
+
+impl EnvRenderer {
+    pub fn new(gpu: &GpuContext) -> Self {
+        Self { depth: ConvolutionDepthPass::new(gpu), sat: SummedAreaPass::new(gpu), view: EnvViewPass::new(gpu) }
+    }
+
+    /// Renders `model` seen by `camera` into `width`×`height` under `lights` (SRBFs shaded with
+    /// `tables.srbf`, directional lights with `tables.direct`), with multiple scattering from
+    /// `multiple` (and `tables.multiple`) when given.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render(
+        &self,
+        gpu: &GpuContext,
+        model: &HairModel,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        lights: &[EnvLight],
+        tables: &EnvTables,
+        options: &EnvRenderOptions,
+        multiple: Option<&dyn ForwardScatteringSource>,
+    ) -> Result<EnvFrame, EnvRenderError> {
+        let mut timings = Timings(Vec::new());
+        if lights.is_empty() {
+            return Err(EnvRenderError::NoLights);
+        }
+        for (i, l) in lights.iter().enumerate() {
+            check_light(i, l)?;
+        }
+        options.dodm.check()?;
+        check_kappa(options.kappa)?;
+        if options.transparency != Transparency::Opaque {
+            return Err(EnvRenderError::UnsupportedTransparency(options.transparency));
+        }
+        let max = gpu.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(EnvRenderError::BadSize { width, height, max });
+        }
+        let srbf_lights: Vec<EnvLight> = lights.iter().copied().filter(|l| l.lambda.is_some()).collect();
+        let directional: Vec<EnvLight> = lights.iter().copied().filter(|l| l.lambda.is_none()).collect();
+        if !srbf_lights.is_empty() {
+            let t = tables.srbf.as_ref().ok_or(EnvTableError::Missing { table: "srbf", needed_by: "SRBF lights" })?;
+            check_env_table("srbf", t, Some(AXIS_INV_LAMBDA))?;
+        }
+        if !directional.is_empty() {
+            let t = tables
+                .direct
+                .as_ref()
+                .ok_or(EnvTableError::Missing { table: "direct", needed_by: "directional lights" })?;
+            check_env_table("direct", t, None)?;
+        }
+        if multiple.is_some() {
+            let t = tables
+                .multiple
+                .as_ref()
+                .ok_or(EnvTableError::Missing { table: "multiple", needed_by: "multiple scattering" })?;
+            check_env_table("multiple", t, Some(AXIS_SIGMA_F))?;
+        }
+        let batch_size = options.dodm.batch_size as usize;
+        let slots = batch_size.min(srbf_lights.len().max(directional.len())) as u32;
+        let resolution = options.dodm.resolution;
+        // Checked before anything is allocated.
+        let sat = SummedAreaTables::new(gpu, resolution, slots)?;
+
+        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;
+        let simplified = (options.kappa < 1.0).then(|| SimplifiedSegments::new(gpu, model, options.simplification_seed));
+        let light_geometry = match &simplified {
+            Some(s) => s.geometry(&geometry, options.kappa),
+            None => StrandGeometry {
+                points: geometry.points.clone(),
+                segments: geometry.segments.clone(),
+                attributes: geometry.attributes.clone(),
+                segment_count: geometry.segment_count,
+                default_thickness: geometry.default_thickness,
+            },
+        };
+        let bounds = model.bounds();
+        let mut dodm = DodmBatch::new(gpu, resolution, slots, options.dodm.first_layer_for(bounds));
+        let targets = EnvViewTargets::new(gpu, width, height);
+        let sums = self.view.accumulator(gpu, &targets);
+        let frame = FrameParams {
+            camera: *camera,
+            width,
+            height,
+            lights: Vec::new(),
+            shading: KajiyaKay::default(),
+            width_override_px: None,
+        };
+        let table_bindings = timings.time(gpu, "table upload", || {
+            let multiple_table = multiple.and(tables.multiple.as_ref());
+            let bind = |t: &Option<Table>| t.as_ref().map(|t| TableBinding::new(gpu, &self.view.table_layout, t, multiple_table));
+            (
+                if srbf_lights.is_empty() { None } else { bind(&tables.srbf) },
+                if directional.is_empty() { None } else { bind(&tables.direct) },
+            )
+        });
+        let mut memory: Vec<(String, u64)> = geometry.memory();
+        memory.extend(dodm.memory());
+        memory.extend(sat.memory());
+        memory.extend(targets.memory());
+        memory.push(("env sums".into(), sums.sums.size()));
+        let mut table_bytes = 0;
+        let mut grid_bytes = 0u64;
+        let mut batches = 0u32;
+        for (kind_lights, binding) in [(&srbf_lights, &table_bindings.0), (&directional, &table_bindings.1)] {
+            let Some(binding) = binding else { continue };
+            table_bytes += binding.bytes;
+            for chunk in kind_lights.chunks(batch_size) {
+                batches += 1;
+                let grid = match multiple {
+                    Some(source) => {
+                        let grid = timings.time(gpu, "multiple grid (CPU)", || source.grid(chunk));
+                        check_grid(&grid, chunk.len())?;
+                        Some(grid)
+                    }
+                    None => None,
+                };
+                let directions: Vec<_> = chunk.iter().map(|l| l.direction).collect();
+                timings.time(gpu, "light pass", || {
+                    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                    self.depth.encode(gpu, &mut encoder, &light_geometry, &directions, bounds, 1.0 / options.kappa, &mut dodm);
+                    gpu.queue.submit([encoder.finish()]);
+                });
+                timings.time(gpu, "summed-area tables", || {
+                    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                    self.sat.encode(gpu, &mut encoder, &dodm.optical_depth, &sat);
+                    gpu.queue.submit([encoder.finish()]);
+                });
+                timings.time(gpu, "view", || {
+                    let batch =
+                        BatchBinding::new(gpu, &self.view.batch_layout, chunk, &dodm, &sat, options.shadowed, grid.is_some());
+                    let grid_binding = GridBinding::new(gpu, &self.view.grid_layout, grid.as_ref());
+                    grid_bytes = grid_bytes.max(grid_binding.bytes);
+                    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+                    self.view.encode(gpu, &mut encoder, &geometry, &frame, &batch, binding, &grid_binding, &targets, &sums);
+                    gpu.queue.submit([encoder.finish()]);
+                });
+            }
+        }
+        memory.push(("env tables".into(), table_bytes));
+        memory.push(("forward-scattering grid".into(), grid_bytes));
+        let bytes = timings.time(gpu, "readback", || read_buffer(gpu, &sums.sums))?;
+        if let Some(error) = pollster::block_on(scope.pop()) {
+            return Err(EnvRenderError::Gpu(error.to_string()));
+        }
+        let all: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        let n = width as usize * height as usize;
+        let single_pixels = all[..n].to_vec();
+        let multiple_pixels = multiple.map(|_| all[n..2 * n].to_vec());
+        let pixels = match &multiple_pixels {
+            None => single_pixels.clone(),
+            Some(m) => single_pixels
+                .iter()
+                .zip(m)
+                .map(|(s, m)| [s[0] + m[0], s[1] + m[1], s[2] + m[2], s[3]])
+                .collect(),
+        };
+        Ok(EnvFrame {
+            width,
+            height,
+            pixels,
+            single_pixels,
+            multiple_pixels,
+            stats: EnvRenderStats {
+                adapter: gpu.report.clone(),
+                timings: timings.0,
+                memory_per_batch: memory,
+                batches,
+                lights: lights.len() as u32,
+                segments: geometry.segment_count,
+                light_pass_segments: light_geometry.segment_count,
+                timing_method: "CPU wall clock around submit + wait for idle, summed over batches",
+            },
+        })
+    }
+}
+
+/// [`EnvRenderer::render`] with pipelines built for this one frame.
+#[allow(clippy::too_many_arguments)]
+pub fn render_env_frame(
+    gpu: &GpuContext,
+    model: &HairModel,
+    camera: &Camera,
+    width: u32,
+    height: u32,
+    lights: &[EnvLight],
+    tables: &EnvTables,
+    options: &EnvRenderOptions,
+    multiple: Option<&dyn ForwardScatteringSource>,
+) -> Result<EnvFrame, EnvRenderError> {
+    let mut timings = Timings(Vec::new());
+    let renderer = timings.time(gpu, "pipelines", || EnvRenderer::new(gpu));
+    let mut frame = renderer.render(gpu, model, camera, width, height, lights, tables, options, multiple)?;
+    frame.stats.timings.splice(0..0, timings.0);
+    Ok(frame)
+}

@@ -1,0 +1,475 @@
+//! The light pass of the convolution optical depth map (Ren 2010 §5): for a batch of lights, per
+//! light an orthographic camera along its direction around the hair ([`light_camera`]), a depth
+//! prepass (nearest fiber z₀ per texel, one `Depth32Float` array layer per light slot), then an
+//! additive pass into an RGBA float array layer holding the cumulative optical depths at the
+//! boundaries z_k = k(k+1)d/2, k = 1..3, behind z₀ and everything in the fourth channel
+//! (`convolution_depth.wgsl`). All lights of a batch are encoded into one command encoder.
+//! Inputs: [`StrandGeometry`] (possibly the simplified segment order of
+//! [`SimplifiedSegments`]), light directions, hair bounds, [`DodmSettings`].
+//! Output: [`DodmBatch`] (textures + the lights' cameras), read by `summed_area` and the view pass.
+
+use glam::Vec3;
+use strandlight_tables::sweep::SweepRng;
+use wgpu::util::DeviceExt;
+
+use super::attachments::{cleared_color, cleared_depth};
+use super::deep_opacity::light_camera;
+use super::strands::{
+    DEPTH_FORMAT, FrameParams, KajiyaKay, StrandGeometry, segment_table, strand_bind_group,
+    strand_bind_group_layout,
+};
+use crate::camera::{Camera, Projection};
+use crate::gpu::GpuContext;
+use crate::hair::{Aabb, HairModel};
+
+/// The largest DODM side the SAT's u32 fixed point is specified for (see `summed_area`).
+pub const MAX_DODM_RESOLUTION: u32 = 2048;
+
+/// Boundaries z_k (k = 1..4, the fourth standing for ∞ when accumulating) in units of d.
+pub const LAYER_BOUNDARIES: [f32; 4] = [1.0, 3.0, 6.0, 10.0];
+
+/// The light pass's settings.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DodmSettings {
+    /// Texels across each light's map (default 512, at most [`MAX_DODM_RESOLUTION`]).
+    pub resolution: u32,
+    /// d, the first layer's depth in world units; `None`: [`default_first_layer`] of the hair.
+    pub first_layer: Option<f32>,
+    /// Lights per batch (one map each, drawn in one submit; default 16).
+    pub batch_size: u32,
+}
+
+impl Default for DodmSettings {
+    fn default() -> Self {
+        Self { resolution: 512, first_layer: None, batch_size: 16 }
+    }
+}
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum DodmSettingsError {
+    #[error("DODM resolution {0}: must be 1..={MAX_DODM_RESOLUTION}")]
+    Resolution(u32),
+    #[error("DODM first layer depth {0}: must be positive and finite")]
+    FirstLayer(f32),
+    #[error("light batch size 0: must be at least 1")]
+    BatchSize,
+    #[error("stochastic simplification fraction κ = {0}: must be in (0, 1]")]
+    Kappa(f32),
+}
+
+impl DodmSettings {
+    pub fn check(&self) -> Result<(), DodmSettingsError> {
+        if !(1..=MAX_DODM_RESOLUTION).contains(&self.resolution) {
+            return Err(DodmSettingsError::Resolution(self.resolution));
+        }
+        if let Some(d) = self.first_layer
+            && !(d.is_finite() && d > 0.0)
+        {
+            return Err(DodmSettingsError::FirstLayer(d));
+        }
+        if self.batch_size == 0 {
+            return Err(DodmSettingsError::BatchSize);
+        }
+        Ok(())
+    }
+
+    /// d for `bounds`: the setting, else [`default_first_layer`].
+    pub fn first_layer_for(&self, bounds: Aabb) -> f32 {
+        self.first_layer.unwrap_or_else(|| default_first_layer(bounds))
+    }
+}
+
+/// 1% of the bounds' diagonal. The boundaries then lie at 1, 3, 6 and 10% of the diagonal
+/// behind the first fiber: a scalp's hair layer is a few percent of the head's diagonal thick,
+/// and light is mostly gone a few layers in, so the resolution goes where the optical depth
+/// still changes the transmittance (the triangular spacing of eq. 10 coarsens with depth).
+pub fn default_first_layer(bounds: Aabb) -> f32 {
+    (bounds.diagonal() * 0.01).max(1e-6)
+}
+
+/// Checks κ ∈ (0, 1].
+pub fn check_kappa(kappa: f32) -> Result<(), DodmSettingsError> {
+    if kappa > 0.0 && kappa <= 1.0 {
+        Ok(())
+    } else {
+        Err(DodmSettingsError::Kappa(kappa))
+    }
+}
+
+/// Stochastic simplification (Ren 2010 §7): the segment table with whole strands in an order
+/// shuffled once by a seeded random key, so the light pass may draw only the segments of the
+/// first κ fraction of strands (and scale τ by 1/κ).
+pub struct SimplifiedSegments {
+    pub segments: wgpu::Buffer,
+    /// `segments_before[s]`: segments of the first s shuffled strands (strand_count + 1 entries).
+    pub segments_before: Vec<u32>,
+}
+
+/// The strands of `model` in the shuffled order (a permutation of 0..strand_count).
+pub fn shuffled_strand_order(model: &HairModel, seed: u64) -> Vec<u32> {
+    let mut rng = SweepRng::new(seed);
+    let mut keyed: Vec<(u64, u32)> =
+        (0..model.strand_count() as u32).map(|s| (rng.next_u64(), s)).collect();
+    keyed.sort_unstable();
+    keyed.into_iter().map(|(_, s)| s).collect()
+}
+
+impl SimplifiedSegments {
+    pub fn new(gpu: &GpuContext, model: &HairModel, seed: u64) -> Self {
+        let table = segment_table(model);
+        // Segment range of each strand in the original table.
+        let mut first = Vec::with_capacity(model.strand_count() + 1);
+        first.push(0usize);
+        for w in model.strand_offsets().windows(2) {
+            first.push(first.last().unwrap() + (w[1] - w[0]).saturating_sub(1) as usize);
+        }
+        let mut shuffled = Vec::with_capacity(table.len());
+        let mut segments_before = vec![0u32];
+        for s in shuffled_strand_order(model, seed) {
+            shuffled.extend_from_slice(&table[first[s as usize]..first[s as usize + 1]]);
+            segments_before.push(shuffled.len() as u32);
+        }
+        // A storage binding may not be empty.
+        if shuffled.is_empty() {
+            shuffled.push(0);
+        }
+        let segments = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("hair segments (shuffled strands)"),
+            contents: bytemuck::cast_slice(&shuffled),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        Self { segments, segments_before }
+    }
+
+    /// Segments to draw for fraction κ: those of the first ⌈κ·strands⌉ shuffled strands.
+    pub fn segment_count(&self, kappa: f32) -> u32 {
+        let strands = self.segments_before.len() - 1;
+        let drawn = ((kappa as f64 * strands as f64).ceil() as usize).min(strands);
+        self.segments_before[drawn]
+    }
+
+    /// `geometry` drawing the first κ fraction of strands in shuffled order.
+    pub fn geometry(&self, geometry: &StrandGeometry, kappa: f32) -> StrandGeometry {
+        StrandGeometry {
+            points: geometry.points.clone(),
+            segments: self.segments.clone(),
+            attributes: geometry.attributes.clone(),
+            segment_count: self.segment_count(kappa),
+            default_thickness: geometry.default_thickness,
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct DodmUniform {
+    near: f32,
+    far: f32,
+    first_layer: f32,
+    tau_scale: f32,
+}
+
+/// The maps of one batch: layer `slot` of each array belongs to light `slot`.
+pub struct DodmBatch {
+    pub resolution: u32,
+    pub slots: u32,
+    pub first_layer: f32,
+    pub cameras: Vec<Camera>,
+    /// Nearest fiber depth z₀ (0..1 between the camera's near and far planes).
+    pub nearest_depth: wgpu::Texture,
+    /// Cumulative optical depths at the four boundaries.
+    pub optical_depth: wgpu::Texture,
+}
+
+impl DodmBatch {
+    pub fn new(gpu: &GpuContext, resolution: u32, slots: u32, first_layer: f32) -> Self {
+        let size = wgpu::Extent3d {
+            width: resolution,
+            height: resolution,
+            depth_or_array_layers: slots.max(1),
+        };
+        let texture = |label, format, usage| {
+            gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        Self {
+            resolution,
+            slots,
+            first_layer,
+            cameras: Vec::new(),
+            nearest_depth: texture("dodm nearest depth", DEPTH_FORMAT, usage),
+            optical_depth: texture(
+                "dodm optical depth",
+                gpu.hdr_format(),
+                usage | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST,
+            ),
+        }
+    }
+
+    /// One array layer as a 2D view.
+    pub fn layer_view(texture: &wgpu::Texture, slot: u32) -> wgpu::TextureView {
+        texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2),
+            base_array_layer: slot,
+            array_layer_count: Some(1),
+            ..Default::default()
+        })
+    }
+
+    /// The whole array as a 2D-array view.
+    pub fn array_view(texture: &wgpu::Texture) -> wgpu::TextureView {
+        texture.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        })
+    }
+
+    /// Texels per world unit of slot `slot`'s map.
+    pub fn texels_per_unit(&self, slot: usize) -> f32 {
+        match self.cameras[slot].projection {
+            Projection::Orthographic { half_height } => self.resolution as f32 / (2.0 * half_height),
+            Projection::Perspective { .. } => 0.0,
+        }
+    }
+
+    pub fn memory(&self) -> Vec<(String, u64)> {
+        let texels = self.resolution as u64 * self.resolution as u64 * self.slots.max(1) as u64;
+        let texel = self.optical_depth.format().block_copy_size(None).unwrap_or(16) as u64;
+        vec![
+            ("dodm nearest depth".into(), texels * 4),
+            ("dodm optical depth".into(), texels * texel),
+        ]
+    }
+}
+
+/// The two pipelines of the light pass, built once.
+pub struct ConvolutionDepthPass {
+    depth_pipeline: wgpu::RenderPipeline,
+    layer_pipeline: wgpu::RenderPipeline,
+    strand_layout: wgpu::BindGroupLayout,
+    dodm_layout: wgpu::BindGroupLayout,
+}
+
+impl ConvolutionDepthPass {
+    pub fn new(gpu: &GpuContext) -> Self {
+        let device = &gpu.device;
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("convolution_depth.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(
+                concat!(include_str!("strand_quads.wgsl"), include_str!("convolution_depth.wgsl"))
+                    .into(),
+            ),
+        });
+        let strand_layout = strand_bind_group_layout(device);
+        let dodm_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dodm"),
+            entries: &[
+                wgpu::BindGroupLayoutEntry {
+                    binding: 0,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let layout = |label, groups: &[Option<&wgpu::BindGroupLayout>]| {
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(label),
+                bind_group_layouts: groups,
+                immediate_size: 0,
+            })
+        };
+        let depth_layout = layout("dodm depth", &[Some(&strand_layout)]);
+        let layer_layout = layout("dodm layers", &[Some(&strand_layout), Some(&dodm_layout)]);
+        let vertex = wgpu::VertexState {
+            module: &shader,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        };
+        let primitive = wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            cull_mode: None,
+            ..Default::default()
+        };
+        let depth_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("dodm depth"),
+            layout: Some(&depth_layout),
+            vertex: vertex.clone(),
+            fragment: None,
+            primitive,
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        let additive = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let layer_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("dodm layers"),
+            layout: Some(&layer_layout),
+            vertex,
+            fragment: Some(wgpu::FragmentState {
+                module: &shader,
+                entry_point: Some("fs_dodm"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: gpu.hdr_format(),
+                    blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            primitive,
+            depth_stencil: None,
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        Self { depth_pipeline, layer_pipeline, strand_layout, dodm_layout }
+    }
+
+    /// Encodes the maps of `toward_lights` (one slot each, at most `batch.slots`) into `encoder`;
+    /// `tau_scale` = 1/κ for a simplified `geometry`. Sets `batch.cameras`.
+    pub fn encode(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &StrandGeometry,
+        toward_lights: &[Vec3],
+        bounds: Aabb,
+        tau_scale: f32,
+        batch: &mut DodmBatch,
+    ) {
+        let device = &gpu.device;
+        let res = batch.resolution;
+        batch.cameras = toward_lights.iter().map(|&l| light_camera(l, bounds)).collect();
+        for (slot, camera) in batch.cameras.iter().enumerate() {
+            let slot = slot as u32;
+            let frame = FrameParams {
+                camera: *camera,
+                width: res,
+                height: res,
+                lights: Vec::new(),
+                shading: KajiyaKay::default(),
+                width_override_px: None,
+            };
+            let strands = strand_bind_group(gpu, &self.strand_layout, geometry, &frame);
+            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("dodm params"),
+                contents: bytemuck::bytes_of(&DodmUniform {
+                    near: camera.near,
+                    far: camera.far,
+                    first_layer: batch.first_layer,
+                    tau_scale,
+                }),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let depth_view = DodmBatch::layer_view(&batch.nearest_depth, slot);
+            let optical_view = DodmBatch::layer_view(&batch.optical_depth, slot);
+            let dodm_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("dodm"),
+                layout: &self.dodm_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&depth_view),
+                    },
+                    wgpu::BindGroupEntry { binding: 1, resource: uniform.as_entire_binding() },
+                ],
+            });
+            {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("dodm depth"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: cleared_depth(&depth_view, true),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.depth_pipeline);
+                pass.set_bind_group(0, &strands, &[]);
+                pass.draw(0..6, 0..geometry.segment_count);
+            }
+            {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("dodm layers"),
+                    color_attachments: &[cleared_color(&optical_view)],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.layer_pipeline);
+                pass.set_bind_group(0, &strands, &[]);
+                pass.set_bind_group(1, &dodm_group, &[]);
+                pass.draw(0..6, 0..geometry.segment_count);
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kappa_and_settings_are_checked() {
+        assert!(check_kappa(0.1).is_ok());
+        assert!(check_kappa(1.0).is_ok());
+        for bad in [0.0, -0.5, 1.5, f32::NAN] {
+            assert_eq!(check_kappa(bad), Err(DodmSettingsError::Kappa(bad)).map_err(|e| e), "{bad}");
+        }
+        let ok = DodmSettings::default();
+        assert!(ok.check().is_ok());
+        let e = DodmSettings { resolution: 4096, ..ok }.check().unwrap_err();
+        assert!(e.to_string().contains("4096"), "{e}");
+        assert_eq!(DodmSettings { batch_size: 0, ..ok }.check(), Err(DodmSettingsError::BatchSize));
+        assert!(DodmSettings { first_layer: Some(-1.0), ..ok }.check().is_err());
+    }
+
+    #[test]
+    fn shuffle_is_a_seeded_permutation() {
+        let points = (0..30).map(|i| Vec3::new(i as f32, 0.0, 0.0)).collect();
+        let offsets = (0..=10).map(|s| 3 * s).collect();
+        let model = HairModel::new(points, offsets, None, None, None).unwrap();
+        let a = shuffled_strand_order(&model, 7);
+        let mut sorted = a.clone();
+        sorted.sort();
+        assert_eq!(sorted, (0..10).collect::<Vec<_>>());
+        assert_eq!(a, shuffled_strand_order(&model, 7));
+        assert_ne!(a, shuffled_strand_order(&model, 8));
+        assert_ne!(a, sorted, "a shuffle of 10 strands that is the identity is 1 in 3.6M");
+    }
+}

@@ -1,0 +1,99 @@
+// Effective transmittance of an SRBF light through the convolution optical depth map (Ren 2010
+// §5), view side. Bind group 1 of the env view pass and of the transmittance probe: the batch's
+// lights (each with its light camera), the DODM nearest depths (one array layer per slot) and
+// the summed-area tables of the cumulative optical depths (summed_area.wgsl).
+//
+// For a point x: project into the light's map; z0 at its texel; δ = z − z0; the averaging
+// radius on the effective occlusion plane R = δ/2 · tan α (α: the SRBF support where G = 10⁻³);
+// a square box of half-size R (in texels) averages each boundary's optical depth through the
+// SAT; l(δ) interpolates linearly between (0, 0) and the boundaries (z_k, l̄_k); T̃ = exp(−l).
+// Directional lights (tan α = 0) read the single texel: a plain per-light deep opacity map.
+
+struct EnvLightGpu {
+    view_proj: mat4x4<f32>,
+    // xyz: unit vector toward the light (ξ); w: 1/λ (0 for a directional light).
+    direction: vec4<f32>,
+    // xyz: L_j (SRBF) or irradiance (directional); w: tan α (0 for a directional light).
+    rgb: vec4<f32>,
+    // xyz: EnvLight::power(); w unused.
+    power: vec4<f32>,
+    near: f32,
+    far: f32,
+    first_layer: f32,
+    texels_per_unit: f32,
+};
+
+struct BatchParams {
+    light_count: u32,
+    resolution: u32,
+    max_half_size: u32,
+    // Bit 0: skip shadowing (T̃ = 1). Bit 1: a forward-scattering grid is bound.
+    flags: u32,
+};
+
+@group(1) @binding(0) var<uniform> batch: BatchParams;
+@group(1) @binding(1) var<storage, read> env_lights: array<EnvLightGpu>;
+@group(1) @binding(2) var dodm_depth: texture_depth_2d_array;
+@group(1) @binding(3) var<storage, read> sat: array<vec4<u32>>;
+
+const SAT_FIXED_POINT_SCALE: f32 = 256.0;
+const FLAG_UNSHADOWED: u32 = 1u;
+const FLAG_GRID: u32 = 2u;
+
+fn sat_at(slot: u32, x: i32, y: i32) -> vec4<u32> {
+    if (x < 0 || y < 0) { return vec4<u32>(0u); }
+    let res = batch.resolution;
+    return sat[(slot * res + u32(y)) * res + u32(x)];
+}
+
+// Σ of the quantized texels in [lo, hi] (inclusive, clamped to the map), exact modulo 2³².
+fn sat_box_sum(slot: u32, lo_in: vec2<i32>, hi_in: vec2<i32>) -> vec4<u32> {
+    let last = i32(batch.resolution) - 1;
+    let lo = clamp(lo_in, vec2<i32>(0), vec2<i32>(last));
+    let hi = clamp(hi_in, vec2<i32>(0), vec2<i32>(last));
+    // u32 arithmetic wraps: the partial sums may overflow, the box sum is exact.
+    return sat_at(slot, hi.x, hi.y) - sat_at(slot, lo.x - 1, hi.y) - sat_at(slot, hi.x, lo.y - 1)
+        + sat_at(slot, lo.x - 1, lo.y - 1);
+}
+
+fn box_area(lo_in: vec2<i32>, hi_in: vec2<i32>) -> f32 {
+    let last = i32(batch.resolution) - 1;
+    let lo = clamp(lo_in, vec2<i32>(0), vec2<i32>(last));
+    let hi = clamp(hi_in, vec2<i32>(0), vec2<i32>(last));
+    return f32((hi.x - lo.x + 1) * (hi.y - lo.y + 1));
+}
+
+// Optical depth at δ behind z0 from the cumulative depths at the boundaries d, 3d, 6d, 10d,
+// linear in between (and from 0 at δ = 0); beyond 10d the last (everything) value.
+fn layered_optical_depth(l: vec4<f32>, delta: f32, d: f32) -> f32 {
+    var previous_z = 0.0;
+    var previous_l = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        let z = f32((k + 1u) * (k + 2u) / 2u) * d;
+        if (delta < z) {
+            return mix(previous_l, l[k], (delta - previous_z) / (z - previous_z));
+        }
+        previous_z = z;
+        previous_l = l[k];
+    }
+    return l.w;
+}
+
+fn effective_transmittance(slot: u32, world: vec3<f32>) -> f32 {
+    if ((batch.flags & FLAG_UNSHADOWED) != 0u) { return 1.0; }
+    let light = env_lights[slot];
+    let clip = light.view_proj * vec4<f32>(world, 1.0);
+    let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
+    if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }
+    let res = f32(batch.resolution);
+    let texel = min(vec2<i32>(uv * res), vec2<i32>(i32(batch.resolution) - 1));
+    let z0 = textureLoad(dodm_depth, texel, i32(slot), 0);
+    if (z0 >= 1.0) { return 1.0; }
+    let delta = max(clip.z - z0, 0.0) * (light.far - light.near);
+    let radius = 0.5 * delta * light.rgb.w * light.texels_per_unit;
+    let half_size = i32(min(floor(radius + 0.5), f32(batch.max_half_size)));
+    let lo = texel - vec2<i32>(half_size);
+    let hi = texel + vec2<i32>(half_size);
+    let mean = vec4<f32>(sat_box_sum(slot, lo, hi)) / (box_area(lo, hi) * SAT_FIXED_POINT_SCALE);
+    return exp(-layered_optical_depth(mean, delta, light.first_layer));
+}

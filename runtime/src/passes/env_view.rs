@@ -1,0 +1,558 @@
+//! The env-lit view pass (Ren 2010 §3.1, §5–6): the hair rasterized from the camera with the
+//! strand pass's quads, blending and depth conventions; each fragment loops over a batch's
+//! lights and sums T̃ × table lookup × light weight (single scattering) and, with a
+//! forward-scattering grid, power × T_f × I_G (multiple scattering) into two targets
+//! (`env_view.wgsl`). A small compute pass adds each batch's images into running float sums
+//! (`env_accumulate.wgsl`).
+//! Inputs: [`StrandGeometry`], [`FrameParams`] (camera), [`BatchBinding`] (lights + DODM + SAT),
+//! [`TableBinding`] (the tables and the grid). Output: the sums buffer of [`EnvAccumulator`].
+
+use glam::Vec3;
+use strandlight_tables::srbf::support_angle;
+use strandlight_tables::table::{AxisGpu, Table};
+use wgpu::util::DeviceExt;
+
+use super::attachments::{cleared_color, cleared_depth};
+use super::convolution_depth::DodmBatch;
+use super::strands::{DEPTH_FORMAT, FrameParams, StrandGeometry, strand_bind_group, strand_bind_group_layout};
+use super::summed_area::{MAX_BOX_HALF_SIZE, SummedAreaTables};
+use crate::env::{EnvLight, ForwardScatteringGrid};
+use crate::gpu::GpuContext;
+
+/// The largest tan α used for the averaging radius: SRBFs wider than ~89° (λ < ~7) are limited
+/// by the box size anyway.
+const MAX_TAN_SUPPORT: f32 = 64.0;
+
+/// tan α of light `light`'s support (G = 10⁻³), 0 for a directional light.
+pub fn tan_support(light: &EnvLight) -> f32 {
+    match light.lambda {
+        None => 0.0,
+        Some(lambda) => {
+            let alpha = support_angle(lambda as f64);
+            if alpha >= std::f64::consts::FRAC_PI_2 {
+                MAX_TAN_SUPPORT
+            } else {
+                (alpha.tan() as f32).min(MAX_TAN_SUPPORT)
+            }
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct EnvLightGpu {
+    view_proj: [[f32; 4]; 4],
+    direction: [f32; 4],
+    rgb: [f32; 4],
+    power: [f32; 4],
+    near: f32,
+    far: f32,
+    first_layer: f32,
+    texels_per_unit: f32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct BatchUniform {
+    light_count: u32,
+    resolution: u32,
+    max_half_size: u32,
+    flags: u32,
+}
+
+const FLAG_UNSHADOWED: u32 = 1;
+const FLAG_GRID: u32 = 2;
+
+fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+/// Group 1 of the view pass and the probe (`convolution_transmittance.wgsl`).
+pub fn transmittance_bind_group_layout(
+    device: &wgpu::Device,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayout {
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("convolution transmittance"),
+        entries: &[
+            uniform_entry(0, visibility),
+            storage_entry(1, visibility, true),
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Depth,
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                    multisampled: false,
+                },
+                count: None,
+            },
+            storage_entry(3, visibility, true),
+        ],
+    })
+}
+
+/// Group 1's resources for one batch: its lights, DODM and SATs.
+pub struct BatchBinding {
+    pub group: wgpu::BindGroup,
+}
+
+impl BatchBinding {
+    /// `lights[slot]` must be the light of DODM slot `slot`; `shadowed = false` forces T̃ = 1.
+    pub fn new(
+        gpu: &GpuContext,
+        layout: &wgpu::BindGroupLayout,
+        lights: &[EnvLight],
+        dodm: &DodmBatch,
+        sat: &SummedAreaTables,
+        shadowed: bool,
+        with_grid: bool,
+    ) -> Self {
+        let device = &gpu.device;
+        let mut gpu_lights: Vec<EnvLightGpu> = lights
+            .iter()
+            .enumerate()
+            .map(|(slot, light)| {
+                let camera = dodm.cameras[slot];
+                let view_proj = camera.projection_matrix(1.0) * camera.view();
+                let inv_lambda = light.lambda.map_or(0.0, |l| 1.0 / l);
+                let power = light.power();
+                EnvLightGpu {
+                    view_proj: view_proj.to_cols_array_2d(),
+                    direction: light.direction.normalize().extend(inv_lambda).into(),
+                    rgb: Vec3::from(light.rgb).extend(tan_support(light)).into(),
+                    power: [power[0], power[1], power[2], 0.0],
+                    near: camera.near,
+                    far: camera.far,
+                    first_layer: dodm.first_layer,
+                    texels_per_unit: dodm.texels_per_unit(slot),
+                }
+            })
+            .collect();
+        if gpu_lights.is_empty() {
+            gpu_lights.push(bytemuck::Zeroable::zeroed());
+        }
+        let flags = if shadowed { 0 } else { FLAG_UNSHADOWED } | if with_grid { FLAG_GRID } else { 0 };
+        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("env batch"),
+            contents: bytemuck::bytes_of(&BatchUniform {
+                light_count: lights.len() as u32,
+                resolution: dodm.resolution,
+                max_half_size: MAX_BOX_HALF_SIZE,
+                flags,
+            }),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let light_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("env lights"),
+            contents: bytemuck::cast_slice(&gpu_lights),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let depth_view = DodmBatch::array_view(&dodm.nearest_depth);
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("env batch"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: light_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&depth_view),
+                },
+                wgpu::BindGroupEntry { binding: 3, resource: sat.buffer.as_entire_binding() },
+            ],
+        });
+        Self { group }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct TableLayoutUniform {
+    axes: [AxisGpu; 4],
+    strides: [u32; 4],
+}
+
+/// A four-axis RGB table's uniform: axes and element strides (row-major, channels innermost).
+fn table_layout(table: &Table) -> TableLayoutUniform {
+    let axes = table.gpu_axes();
+    let shape = table.shape();
+    let c = table.channels();
+    TableLayoutUniform {
+        axes: [axes[0], axes[1], axes[2], axes[3]],
+        strides: [
+            (shape[1] * shape[2] * shape[3] * c) as u32,
+            (shape[2] * shape[3] * c) as u32,
+            (shape[3] * c) as u32,
+            c as u32,
+        ],
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct GridUniform {
+    origin: [f32; 4],
+    spacing: [f32; 4],
+    dims: [u32; 4],
+}
+
+/// Group 2: the single-scattering table (the SRBF convolution table, or the direct table for
+/// directional lights) and the multiple-scattering table (a 1-element placeholder where absent).
+/// Built once per light kind per frame.
+pub struct TableBinding {
+    pub group: wgpu::BindGroup,
+    pub bytes: u64,
+}
+
+fn bind_buffers(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+) -> (wgpu::BindGroup, u64) {
+    let entries: Vec<_> = buffers
+        .iter()
+        .enumerate()
+        .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+        .collect();
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries });
+    (group, buffers.iter().map(|b| b.size()).sum())
+}
+
+fn init_buffer(device: &wgpu::Device, label: &str, contents: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+}
+
+impl TableBinding {
+    /// Tables must have 4 axes and 3 channels (checked by the caller).
+    pub fn new(gpu: &GpuContext, layout: &wgpu::BindGroupLayout, single: &Table, multiple: Option<&Table>) -> Self {
+        let device = &gpu.device;
+        let storage = wgpu::BufferUsages::STORAGE;
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        let single_layout = init_buffer(device, "env single layout", bytemuck::bytes_of(&table_layout(single)), uniform);
+        let single_values = init_buffer(device, "env single table", single.as_bytes(), storage);
+        let multiple_table = multiple.unwrap_or(single);
+        let multiple_layout =
+            init_buffer(device, "env multiple layout", bytemuck::bytes_of(&table_layout(multiple_table)), uniform);
+        let multiple_values = match multiple {
+            Some(t) => init_buffer(device, "env multiple table", t.as_bytes(), storage),
+            None => init_buffer(device, "env multiple table", &[0u8; 16], storage),
+        };
+        let (group, bytes) = bind_buffers(
+            device,
+            "env tables",
+            layout,
+            &[&single_layout, &single_values, &multiple_layout, &multiple_values],
+        );
+        Self { group, bytes }
+    }
+}
+
+/// Group 3: one batch's forward-scattering grid (a placeholder without multiple scattering).
+pub struct GridBinding {
+    pub group: wgpu::BindGroup,
+    pub bytes: u64,
+}
+
+impl GridBinding {
+    /// `grid.values` must hold `lights × dims` entries (checked by the caller).
+    pub fn new(gpu: &GpuContext, layout: &wgpu::BindGroupLayout, grid: Option<&ForwardScatteringGrid>) -> Self {
+        let device = &gpu.device;
+        let (uniform, values) = match grid {
+            Some(g) => (
+                GridUniform {
+                    origin: g.origin.extend(0.0).into(),
+                    spacing: g.spacing.extend(0.0).into(),
+                    dims: [g.dims[0], g.dims[1], g.dims[2], 0],
+                },
+                init_buffer(device, "env forward-scattering grid", bytemuck::cast_slice(&g.values), wgpu::BufferUsages::STORAGE),
+            ),
+            None => (
+                GridUniform { origin: [0.0; 4], spacing: [1.0; 4], dims: [1, 1, 1, 0] },
+                init_buffer(device, "env forward-scattering grid", &[0u8; 16], wgpu::BufferUsages::STORAGE),
+            ),
+        };
+        let params = init_buffer(device, "env grid params", bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
+        let (group, bytes) = bind_buffers(device, "env grid", layout, &[&params, &values]);
+        Self { group, bytes }
+    }
+}
+
+/// Two HDR targets (single, multiple) and a depth buffer for one batch's view pass.
+pub struct EnvViewTargets {
+    pub single: wgpu::Texture,
+    pub multiple: wgpu::Texture,
+    pub depth: wgpu::Texture,
+}
+
+impl EnvViewTargets {
+    pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Self {
+        let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
+        let texture = |label, format, usage| {
+            gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let color = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        Self {
+            single: texture("env single", gpu.hdr_format(), color),
+            multiple: texture("env multiple", gpu.hdr_format(), color),
+            depth: texture("env depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT),
+        }
+    }
+
+    pub fn memory(&self) -> Vec<(String, u64)> {
+        let bytes = |t: &wgpu::Texture| {
+            t.width() as u64 * t.height() as u64 * t.format().block_copy_size(None).unwrap_or(4) as u64
+        };
+        vec![
+            ("env single target".into(), bytes(&self.single)),
+            ("env multiple target".into(), bytes(&self.multiple)),
+            ("env depth".into(), bytes(&self.depth)),
+        ]
+    }
+}
+
+/// Running sums over batches: `2·width·height` RGBA f32 (single, then multiple).
+pub struct EnvAccumulator {
+    pub sums: wgpu::Buffer,
+    pub width: u32,
+    pub height: u32,
+    group: wgpu::BindGroup,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct AccumulateUniform {
+    width: u32,
+    height: u32,
+    _pad: [u32; 2],
+}
+
+/// The view and accumulate pipelines, built once.
+pub struct EnvViewPass {
+    pipeline: wgpu::RenderPipeline,
+    accumulate: wgpu::ComputePipeline,
+    accumulate_layout: wgpu::BindGroupLayout,
+    pub strand_layout: wgpu::BindGroupLayout,
+    pub batch_layout: wgpu::BindGroupLayout,
+    pub table_layout: wgpu::BindGroupLayout,
+    pub grid_layout: wgpu::BindGroupLayout,
+}
+
+impl EnvViewPass {
+    pub fn new(gpu: &GpuContext) -> Self {
+        let device = &gpu.device;
+        let source = [
+            include_str!("strand_quads.wgsl"),
+            include_str!("fiber_frame.wgsl"),
+            include_str!("convolution_transmittance.wgsl"),
+            include_str!("env_view.wgsl"),
+        ]
+        .concat();
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("env_view.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let strand_layout = strand_bind_group_layout(device);
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let batch_layout = transmittance_bind_group_layout(device, fragment);
+        let table_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("env tables"),
+            entries: &[
+                uniform_entry(0, fragment),
+                storage_entry(1, fragment, true),
+                uniform_entry(2, fragment),
+                storage_entry(3, fragment, true),
+            ],
+        });
+        let grid_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("env grid"),
+            entries: &[uniform_entry(0, fragment), storage_entry(1, fragment, true)],
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("env view"),
+            bind_group_layouts: &[Some(&strand_layout), Some(&batch_layout), Some(&table_layout), Some(&grid_layout)],
+            immediate_size: 0,
+        });
+        let premultiplied_over = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let target = Some(wgpu::ColorTargetState {
+            format: gpu.hdr_format(),
+            blend: Some(wgpu::BlendState { color: premultiplied_over, alpha: premultiplied_over }),
+            write_mask: wgpu::ColorWrites::ALL,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("env view"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &shader,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &shader,
+                entry_point: Some("fs_env"),
+                compilation_options: Default::default(),
+                targets: &[target.clone(), target],
+            }),
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let float_texture = |binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: compute,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        };
+        let accumulate_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("env accumulate"),
+            entries: &[float_texture(0), float_texture(1), storage_entry(2, compute, false), uniform_entry(3, compute)],
+        });
+        let accumulate_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("env_accumulate.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("env_accumulate.wgsl").into()),
+        });
+        let accumulate_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("env accumulate"),
+            bind_group_layouts: &[Some(&accumulate_layout)],
+            immediate_size: 0,
+        });
+        let accumulate = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("env accumulate"),
+            layout: Some(&accumulate_pipeline_layout),
+            module: &accumulate_shader,
+            entry_point: Some("accumulate"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Self { pipeline, accumulate, accumulate_layout, strand_layout, batch_layout, table_layout, grid_layout }
+    }
+
+    /// Zeroed sums for a `width`×`height` frame, bound to `targets`.
+    pub fn accumulator(&self, gpu: &GpuContext, targets: &EnvViewTargets) -> EnvAccumulator {
+        let device = &gpu.device;
+        let (width, height) = (targets.single.width(), targets.single.height());
+        let sums = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("env sums"),
+            size: 2 * width as u64 * height as u64 * 16,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("env accumulate params"),
+            contents: bytemuck::bytes_of(&AccumulateUniform { width, height, _pad: [0; 2] }),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let single = targets.single.create_view(&Default::default());
+        let multiple = targets.multiple.create_view(&Default::default());
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("env accumulate"),
+            layout: &self.accumulate_layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&single) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&multiple) },
+                wgpu::BindGroupEntry { binding: 2, resource: sums.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: uniform.as_entire_binding() },
+            ],
+        });
+        EnvAccumulator { sums, width, height, group }
+    }
+
+    /// Encodes one batch: the view pass into `targets`, then its addition into `sums`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        batch: &BatchBinding,
+        tables: &TableBinding,
+        grid: &GridBinding,
+        targets: &EnvViewTargets,
+        sums: &EnvAccumulator,
+    ) {
+        let strands = strand_bind_group(gpu, &self.strand_layout, geometry, frame);
+        let single = targets.single.create_view(&Default::default());
+        let multiple = targets.multiple.create_view(&Default::default());
+        let depth = targets.depth.create_view(&Default::default());
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("env view"),
+                color_attachments: &[cleared_color(&single), cleared_color(&multiple)],
+                depth_stencil_attachment: cleared_depth(&depth, false),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &strands, &[]);
+            pass.set_bind_group(1, &batch.group, &[]);
+            pass.set_bind_group(2, &tables.group, &[]);
+            pass.set_bind_group(3, &grid.group, &[]);
+            pass.draw(0..6, 0..geometry.segment_count);
+        }
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("env accumulate"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.accumulate);
+        pass.set_bind_group(0, &sums.group, &[]);
+        pass.dispatch_workgroups(sums.width.div_ceil(8), sums.height.div_ceil(8), 1);
+    }
+}

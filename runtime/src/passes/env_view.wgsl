@@ -1,0 +1,178 @@
+// The env-lit view pass (Ren 2010 §3.1, §5, §6), appended to strand_quads.wgsl, fiber_frame.wgsl
+// and convolution_transmittance.wgsl: every fragment loops over the batch's lights and sums
+//   single:   T̃_j(x) · I(u·ξ_j, u·ω_o, cos Δφ, 1/λ_j) · L_j
+//   multiple: power_j · T_f,j(x) · I_G(u·ξ_j, u·ω_o, cos Δφ, σ̄_f,j(x))
+// writing each with pre-multiplied alpha into its own target. For directional lights `I` is the
+// direct table S·cos θ_i (its fourth axis has one node) and L_j the irradiance.
+// Tables are strandlight `Table`s (row-major, channels innermost, RGB) uploaded as-is and
+// interpolated quadrilinearly exactly like `Table::lookup`.
+
+struct TableAxis {
+    min: f32,
+    inv_range: f32,
+    last_index: f32,
+    inv_exponent: f32,
+    // 0: x itself; 1: asin(x); 2: −acos(x).
+    warp: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+};
+
+struct TableLayout {
+    axes: array<TableAxis, 4>,
+    // Element strides of the four axes.
+    strides: vec4<u32>,
+};
+
+struct GridParams {
+    // xyz: world position of vertex (0,0,0).
+    origin: vec4<f32>,
+    // xyz: spacing between vertices.
+    spacing: vec4<f32>,
+    // xyz: vertices per axis.
+    dims: vec4<u32>,
+};
+
+@group(2) @binding(0) var<uniform> single_layout: TableLayout;
+@group(2) @binding(1) var<storage, read> single_table: array<f32>;
+@group(2) @binding(2) var<uniform> multiple_layout: TableLayout;
+@group(2) @binding(3) var<storage, read> multiple_table: array<f32>;
+@group(3) @binding(0) var<uniform> grid: GridParams;
+@group(3) @binding(1) var<storage, read> grid_values: array<vec4<f32>>;
+
+struct TableCell {
+    lower: u32,
+    upper_weight: f32,
+};
+
+// `Axis::cell`: the lower node of the cell holding x and the upper node's weight.
+fn table_cell(a: TableAxis, x: f32) -> TableCell {
+    if (a.last_index < 1.0) { return TableCell(0u, 0.0); }
+    var w = x;
+    if (a.warp == 1u) { w = asin(clamp(x, -1.0, 1.0)); }
+    if (a.warp == 2u) { w = -acos(clamp(x, -1.0, 1.0)); }
+    var t = clamp((w - a.min) * a.inv_range, 0.0, 1.0);
+    if (a.inv_exponent != 1.0) { t = pow(t, a.inv_exponent); }
+    let f = t * a.last_index;
+    let lower = min(floor(f), a.last_index - 1.0);
+    return TableCell(u32(lower), f - lower);
+}
+
+// The 16 corners of a 4D cell: base offset, per-axis steps (0 on one-node axes), weights.
+struct Cell4 {
+    base: u32,
+    step: vec4<u32>,
+    w: vec4<f32>,
+};
+
+fn cell4(layout: TableLayout, coords: vec4<f32>) -> Cell4 {
+    var out: Cell4;
+    out.base = 0u;
+    for (var k = 0u; k < 4u; k++) {
+        let c = table_cell(layout.axes[k], coords[k]);
+        out.base += c.lower * layout.strides[k];
+        out.w[k] = c.upper_weight;
+        out.step[k] = select(0u, layout.strides[k], layout.axes[k].last_index >= 1.0);
+    }
+    return out;
+}
+
+fn corner_weight(c: Cell4, corner: u32) -> f32 {
+    var weight = 1.0;
+    for (var k = 0u; k < 4u; k++) {
+        if (((corner >> k) & 1u) == 1u) {
+            weight *= c.w[k];
+        } else {
+            weight *= 1.0 - c.w[k];
+        }
+    }
+    return weight;
+}
+
+fn corner_offset(c: Cell4, corner: u32) -> u32 {
+    var offset = c.base;
+    for (var k = 0u; k < 4u; k++) {
+        if (((corner >> k) & 1u) == 1u) { offset += c.step[k]; }
+    }
+    return offset;
+}
+
+fn single_lookup(coords: vec4<f32>) -> vec3<f32> {
+    let c = cell4(single_layout, coords);
+    var acc = vec3<f32>(0.0);
+    for (var corner = 0u; corner < 16u; corner++) {
+        let w = corner_weight(c, corner);
+        // Zero weights are skipped, as on the CPU.
+        if (w == 0.0) { continue; }
+        let o = corner_offset(c, corner);
+        acc += w * vec3<f32>(single_table[o], single_table[o + 1u], single_table[o + 2u]);
+    }
+    return acc;
+}
+
+fn multiple_lookup(coords: vec4<f32>) -> vec3<f32> {
+    let c = cell4(multiple_layout, coords);
+    var acc = vec3<f32>(0.0);
+    for (var corner = 0u; corner < 16u; corner++) {
+        let w = corner_weight(c, corner);
+        if (w == 0.0) { continue; }
+        let o = corner_offset(c, corner);
+        acc += w * vec3<f32>(multiple_table[o], multiple_table[o + 1u], multiple_table[o + 2u]);
+    }
+    return acc;
+}
+
+fn grid_vertex(slot: u32, i: vec3<u32>) -> vec4<f32> {
+    let d = grid.dims.xyz;
+    return grid_values[((slot * d.z + i.z) * d.y + i.y) * d.x + i.x];
+}
+
+// [T_r, T_g, T_b, σ̄_f] of light `slot` at `world`: trilinear, clamped at the border.
+fn forward_scattering(slot: u32, world: vec3<f32>) -> vec4<f32> {
+    let d = grid.dims.xyz;
+    let last = vec3<f32>(d) - vec3<f32>(1.0);
+    let f = clamp((world - grid.origin.xyz) / grid.spacing.xyz, vec3<f32>(0.0), last);
+    let lower = min(floor(f), max(last - vec3<f32>(1.0), vec3<f32>(0.0)));
+    let w = select(f - lower, vec3<f32>(0.0), last < vec3<f32>(1.0));
+    let i = vec3<u32>(lower);
+    let step = vec3<u32>(select(vec3<f32>(1.0), vec3<f32>(0.0), last < vec3<f32>(1.0)));
+    var acc = vec4<f32>(0.0);
+    for (var corner = 0u; corner < 8u; corner++) {
+        let bits = vec3<u32>(corner & 1u, (corner >> 1u) & 1u, (corner >> 2u) & 1u);
+        let wb = select(vec3<f32>(1.0) - w, w, bits == vec3<u32>(1u));
+        acc += wb.x * wb.y * wb.z * grid_vertex(slot, i + bits * step);
+    }
+    return acc;
+}
+
+struct EnvOut {
+    @location(0) single: vec4<f32>,
+    @location(1) multiple: vec4<f32>,
+};
+
+@fragment
+fn fs_env(in: VertexOut) -> EnvOut {
+    let t = normalize(in.tangent);
+    var e = frame.toward_eye.xyz;
+    if (frame.eye.w > 0.5) { e = normalize(frame.eye.xyz - in.world); }
+    var single = vec3<f32>(0.0);
+    var multiple = vec3<f32>(0.0);
+    let with_grid = (batch.flags & FLAG_GRID) != 0u;
+    for (var i = 0u; i < batch.light_count; i++) {
+        let light = env_lights[i];
+        let f = fiber_frame(t, light.direction.xyz, e);
+        let coords = vec4<f32>(f.sin_theta_i, f.sin_theta_o, f.cos_phi, light.direction.w);
+        let visible = effective_transmittance(i, in.world);
+        single += visible * single_lookup(coords) * light.rgb.xyz;
+        if (with_grid) {
+            let g = forward_scattering(i, in.world);
+            let cm = vec4<f32>(coords.xyz, g.w);
+            multiple += light.power.xyz * g.xyz * multiple_lookup(cm);
+        }
+    }
+    var out: EnvOut;
+    out.single = vec4<f32>(single * in.alpha, in.alpha);
+    out.multiple = vec4<f32>(multiple * in.alpha, in.alpha);
+    return out;
+}
