@@ -66,14 +66,14 @@ struct Cell4 {
     w: vec4<f32>,
 };
 
-fn cell4(layout: TableLayout, coords: vec4<f32>) -> Cell4 {
+fn cell4(t: TableLayout, coords: vec4<f32>) -> Cell4 {
     var out: Cell4;
     out.base = 0u;
     for (var k = 0u; k < 4u; k++) {
-        let c = table_cell(layout.axes[k], coords[k]);
-        out.base += c.lower * layout.strides[k];
+        let c = table_cell(t.axes[k], coords[k]);
+        out.base += c.lower * t.strides[k];
         out.w[k] = c.upper_weight;
-        out.step[k] = select(0u, layout.strides[k], layout.axes[k].last_index >= 1.0);
+        out.step[k] = select(0u, t.strides[k], t.axes[k].last_index >= 1.0);
     }
     return out;
 }
