@@ -259,8 +259,11 @@ fn synthetic_table(fourth: Axis) -> Table {
     .unwrap()
 }
 
+/// A strand's unit tangent and the pixel holding its centre.
+type StrandProbe = (DVec3, (usize, usize));
+
 /// Three short straight strands with known tangents, far apart in a 64² orthographic image.
-fn three_strands() -> (HairModel, Vec<(DVec3, (usize, usize))>) {
+fn three_strands() -> (HairModel, Vec<StrandProbe>) {
     let specs = [
         (Vec3::new(-0.5, 0.5, 0.0), Vec3::new(1.0, 0.0, 0.0)),
         (Vec3::new(0.5, 0.5, 0.0), Vec3::new(0.6, 0.8, 0.3)),
@@ -316,11 +319,11 @@ fn render_unshadowed_with(
     (frame.pixels, frame.multiple_pixels)
 }
 
-fn compare(pixels: &[[f32; 4]], probes: &[(DVec3, (usize, usize))], mut expected: impl FnMut(DVec3) -> [f64; 3]) {
+fn compare(pixels: &[[f32; 4]], probes: &[StrandProbe], mut expected: impl FnMut(DVec3) -> [f64; 3]) {
     compare_at(pixels, probes, |t, _| expected(t))
 }
 
-fn compare_at(pixels: &[[f32; 4]], probes: &[(DVec3, (usize, usize))], mut expected: impl FnMut(DVec3, (usize, usize)) -> [f64; 3]) {
+fn compare_at(pixels: &[[f32; 4]], probes: &[StrandProbe], mut expected: impl FnMut(DVec3, (usize, usize)) -> [f64; 3]) {
     let e = DVec3::Z;
     let mut worst = 0.0f64;
     for &(t, (px, py)) in probes {
@@ -466,4 +469,45 @@ fn multiple_scattering_is_power_times_attenuation_times_the_spread_table() {
         }
         sum
     });
+}
+
+#[test]
+fn bad_inputs_are_typed_errors() {
+    use strandlight_runtime::env::{EnvRenderError, EnvTableError};
+    let gpu = gpu();
+    let (model, _) = three_strands();
+    let camera = ortho_camera();
+    let srbf = synthetic_table(Axis::uniform("inv_lambda", 1.0 / 64.0, 1.0 / 8.0, 3));
+    let tables = EnvTables { srbf: Some(srbf.clone()), ..Default::default() };
+    let light = [EnvLight::srbf(Vec3::Z, 20.0, [1.0; 3])];
+    let options = EnvRenderOptions::default();
+    let render = |lights: &[EnvLight], tables: &EnvTables, options: &EnvRenderOptions| {
+        render_env_frame(&gpu, &model, &camera, 16, 16, lights, tables, options, None).expect_err("an error")
+    };
+    assert!(matches!(render(&[], &tables, &options), EnvRenderError::NoLights));
+    let zero_batch = EnvRenderOptions { dodm: DodmSettings { batch_size: 0, ..options.dodm }, ..options };
+    let e = render(&light, &tables, &zero_batch);
+    assert!(e.to_string().contains("batch size 0"), "{e}");
+    let e = render(&light, &tables, &EnvRenderOptions { kappa: 0.0, ..options });
+    assert!(e.to_string().contains("κ = 0"), "{e}");
+    // A direct table (one-node fourth axis named otherwise) where the SRBF table belongs.
+    let wrong = synthetic_table(Axis::uniform("sigma_f", 0.0, 1.0, 3));
+    let e = render(&light, &EnvTables { srbf: Some(wrong), ..Default::default() }, &options);
+    assert!(matches!(e, EnvRenderError::Table(EnvTableError::Shape { table: "srbf", .. })), "{e}");
+    println!("{e}");
+    let e = render(&[EnvLight::directional(Vec3::Z, [1.0; 3])], &tables, &options);
+    assert!(matches!(e, EnvRenderError::Table(EnvTableError::Missing { table: "direct", .. })), "{e}");
+    let e = render(&[EnvLight::srbf(Vec3::Z, f32::NAN, [1.0; 3])], &tables, &options);
+    assert!(matches!(e, EnvRenderError::BadLight { index: 0, .. }), "{e}");
+    // More SAT bytes than the adapter binds: a batch of 2048² maps sized past the limit.
+    let limit = gpu.device.limits().max_storage_buffer_binding_size;
+    let slots = (limit / (2048 * 2048 * 16) + 1) as u32;
+    let many: Vec<EnvLight> = (0..slots).map(|_| light[0]).collect();
+    let big = EnvRenderOptions {
+        dodm: DodmSettings { resolution: 2048, first_layer: None, batch_size: slots },
+        ..options
+    };
+    let e = render(&many, &tables, &big);
+    assert!(matches!(e, EnvRenderError::GpuLimit(_)), "{e}");
+    println!("{e}");
 }

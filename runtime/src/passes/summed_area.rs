@@ -45,7 +45,7 @@ pub struct SatTooLarge {
 pub fn sat_bytes(gpu: &GpuContext, resolution: u32, slots: u32) -> Result<u64, SatTooLarge> {
     let bytes = resolution as u64 * resolution as u64 * slots.max(1) as u64 * SAT_TEXEL_BYTES;
     let limits = gpu.device.limits();
-    let limit = (limits.max_storage_buffer_binding_size as u64).min(limits.max_buffer_size);
+    let limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
     if bytes > limit {
         return Err(SatTooLarge { slots, resolution, bytes, limit });
     }
