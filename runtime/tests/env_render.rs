@@ -511,3 +511,46 @@ fn bad_inputs_are_typed_errors() {
     assert!(matches!(e, EnvRenderError::GpuLimit(_)), "{e}");
     println!("{e}");
 }
+
+#[test]
+fn stochastic_simplification_keeps_the_mean_optical_depth() {
+    use strandlight_runtime::passes::convolution_depth::SimplifiedSegments;
+    let gpu = gpu();
+    let rows = 6;
+    let model = slab(rows, (0.2 / PER_UNIT) as f32);
+    let geometry = StrandGeometry::upload(&gpu, &model).unwrap();
+    let simplified = SimplifiedSegments::new(&gpu, &model, 3);
+    let pass = ConvolutionDepthPass::new(&gpu);
+    let probe = TransmittanceProbe::new(&gpu);
+    // Behind all six rows, over the slab's interior.
+    let points: Vec<Vec3> = (0..30)
+        .flat_map(|i| (0..30).map(move |j| Vec3::new(-0.8 + 1.6 * i as f32 / 29.0, -0.7 + 1.4 * j as f32 / 29.0, -0.6)))
+        .collect();
+    let light = [EnvLight::directional(Vec3::Z, [1.0; 3])];
+    let mean_depth = |kappa: f32| {
+        let drawn = simplified.geometry(&geometry, kappa);
+        let mut batch = DodmBatch::new(&gpu, 64, 1, 0.045);
+        let sat = SummedAreaTables::new(&gpu, 64, 1).unwrap();
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        pass.encode(&gpu, &mut encoder, &drawn, &[Vec3::Z], model.bounds(), 1.0 / kappa, &mut batch);
+        SummedAreaPass::new(&gpu).encode(&gpu, &mut encoder, &batch.optical_depth, &sat);
+        gpu.queue.submit([encoder.finish()]);
+        let binding = BatchBinding::new(&gpu, &probe.batch_layout, &light, &batch, &sat, true, false);
+        let t = probe.transmittance(&gpu, &binding, 0, &points).unwrap();
+        (t.iter().map(|&t| -(t as f64).ln()).sum::<f64>() / t.len() as f64, drawn.segment_count)
+    };
+    let (full, all_segments) = mean_depth(1.0);
+    // The closed form: six rows each transmitting 1 − d/s = 0.8.
+    let closed = -(rows as f64) * 0.8f64.ln();
+    println!("κ = 1: mean optical depth {full:.4} ({all_segments} segments); closed form {closed:.4}");
+    assert!((full - closed).abs() < 0.1 * closed, "κ = 1 map {full} vs closed form {closed}");
+    for kappa in [0.5f32, 0.25] {
+        let (depth, segments) = mean_depth(kappa);
+        let strands = model.strand_count() as f64;
+        println!("κ = {kappa}: mean optical depth {depth:.4} ({segments} segments), relative to κ = 1: {:.4}", depth / full - 1.0);
+        assert_eq!(segments as f64, (kappa as f64 * strands).ceil(), "one segment per slab strand");
+        // ~κ·384 strands drawn at random: the mean over the slab fluctuates by ~1/√(κ·384)
+        // (5–10%); 20% is more than 2σ at κ = 0.25.
+        assert!((depth / full - 1.0).abs() < 0.2, "κ = {kappa}: {depth} vs {full}");
+    }
+}
