@@ -554,3 +554,53 @@ fn stochastic_simplification_keeps_the_mean_optical_depth() {
         assert!((depth / full - 1.0).abs() < 0.2, "κ = {kappa}: {depth} vs {full}");
     }
 }
+
+/// Strand B (probed) at y = −0.5, z = 0; a thick strand A at y = 0, z = 0.5 lies between B and
+/// light 1 (toward (0, 1, 1)) but nowhere near B on screen or toward light 2 (toward (0, −1, 1)).
+#[test]
+fn shadowing_reaches_the_right_light_in_every_batch() {
+    let points = vec![
+        Vec3::new(-0.4, -0.5, 0.0),
+        Vec3::new(0.4, -0.5, 0.0),
+        Vec3::new(-0.6, 0.0, 0.5),
+        Vec3::new(0.6, 0.0, 0.5),
+    ];
+    let thickness = Attribute::PerPoint(vec![3.0 / 32.0, 3.0 / 32.0, 0.25, 0.25]);
+    let model = HairModel::new(points, vec![0, 2, 4], Some(thickness), None, None).unwrap();
+    let direct = synthetic_table(Axis::uniform("none", 0.0, 0.0, 1));
+    let tables = EnvTables { direct: Some(direct.clone()), ..Default::default() };
+    let lights = [
+        EnvLight::directional(Vec3::new(0.0, 1.0, 1.0), [1.0, 0.8, 0.6]),
+        EnvLight::directional(Vec3::new(0.0, -1.0, 1.0), [0.5, 0.7, 0.9]),
+    ];
+    let gpu = gpu();
+    let probe = (32usize, ((1.0 - -0.5f32) * 32.0) as usize);
+    let contribution = |l: &EnvLight| -> [f64; 3] {
+        let [a, b, c] = coordinates(DVec3::X, l.direction.as_dvec3(), DVec3::Z);
+        let v = direct.lookup_rgb(&[a, b, c, 0.0]).unwrap();
+        std::array::from_fn(|k| v[k] as f64 * l.rgb[k] as f64)
+    };
+    let (lit1, lit2) = (contribution(&lights[0]), contribution(&lights[1]));
+    for batch_size in [1u32, 2] {
+        let options = EnvRenderOptions {
+            dodm: DodmSettings { resolution: 64, first_layer: Some(0.05), batch_size },
+            kappa: 1.0,
+            ..Default::default()
+        };
+        let frame = render_env_frame(&gpu, &model, &ortho_camera(), RES, RES, &lights, &tables, &options, None)
+            .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(frame.stats.batches, 2 / batch_size);
+        let p = frame.pixels[probe.1 * RES as usize + probe.0];
+        // Light 1 reaches B through A and B's own fiber (the last DODM boundary holds both):
+        // T ≤ 0.001² of an opaque fiber; light 2 is unshadowed (T = 1 at B's own depth).
+        for k in 0..3 {
+            let want = lit2[k];
+            let rel = (p[k] as f64 - want).abs() / want;
+            println!(
+                "batch {batch_size}, channel {k}: GPU {:.6}, light 2 alone {want:.6} (light 1 unshadowed would add {:.6})",
+                p[k], lit1[k]
+            );
+            assert!(rel < 2e-3, "channel {k}: {} vs {want}", p[k]);
+        }
+    }
+}
