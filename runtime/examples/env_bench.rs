@@ -22,7 +22,11 @@ type BoxError = Box<dyn std::error::Error>;
 fn median(values: &mut [f64]) -> f64 {
     values.sort_by(f64::total_cmp);
     let n = values.len();
-    if n % 2 == 1 { values[n / 2] } else { 0.5 * (values[n / 2 - 1] + values[n / 2]) }
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
 }
 
 fn table() -> Result<Table, BoxError> {
@@ -45,23 +49,46 @@ fn lights(n: usize) -> Vec<EnvLight> {
             let z = rng.range(-1.0, 1.0) as f32;
             let phi = rng.range(0.0, std::f64::consts::TAU) as f32;
             let r = (1.0 - z * z).sqrt();
-            EnvLight::srbf(Vec3::new(r * phi.cos(), z, r * phi.sin()), rng.range(16.0, 64.0) as f32, [0.3; 3])
+            EnvLight::srbf(
+                Vec3::new(r * phi.cos(), z, r * phi.sin()),
+                rng.range(16.0, 64.0) as f32,
+                [0.3; 3],
+            )
         })
         .collect()
 }
 
 fn main() -> Result<(), BoxError> {
-    let runs: usize = std::env::args().nth(1).map(|a| a.parse()).transpose()?.unwrap_or(3);
+    let runs: usize = std::env::args()
+        .nth(1)
+        .map(|a| a.parse())
+        .transpose()?
+        .unwrap_or(3);
     let gpu = GpuContext::new_headless()?;
-    let model = generate_groom(&GroomParams { strand_count: 2000, ..Default::default() })?;
-    let tables = EnvTables { srbf: Some(table()?), ..Default::default() };
+    let model = generate_groom(&GroomParams {
+        strand_count: 2000,
+        ..Default::default()
+    })?;
+    let tables = EnvTables {
+        srbf: Some(table()?),
+        ..Default::default()
+    };
     let renderer = EnvRenderer::new(&gpu);
     let options = EnvRenderOptions {
-        dodm: DodmSettings { resolution: 256, first_layer: None, batch_size: 16 },
+        dodm: DodmSettings {
+            resolution: 256,
+            first_layer: None,
+            batch_size: 16,
+        },
         ..Default::default()
     };
     println!("adapter: {}", gpu.report);
-    println!("model: {} strands, {} segments; DODM 256², batch 16, κ = {}", model.strand_count(), model.segment_count(), options.kappa);
+    println!(
+        "model: {} strands, {} segments; DODM 256², batch 16, κ = {}",
+        model.strand_count(),
+        model.segment_count(),
+        options.kappa
+    );
     println!("| lights | image | light pass ms | SAT ms | view ms | frame ms | frame ms / light |");
     println!("|---|---|---|---|---|---|---|");
     let mut configs: Vec<(usize, u32)> = [4, 8, 16, 32].iter().map(|&n| (n, 256)).collect();
@@ -71,7 +98,9 @@ fn main() -> Result<(), BoxError> {
         let ls = lights(n);
         let mut per_pass: Vec<(String, Vec<f64>)> = Vec::new();
         for run in 0..=runs {
-            let frame = renderer.render(&gpu, &model, &camera, size, size, &ls, &tables, &options, None)?;
+            let frame = renderer.render(
+                &gpu, &model, &camera, size, size, &ls, &tables, &options, None,
+            )?;
             if run == 0 {
                 continue;
             }
@@ -83,11 +112,17 @@ fn main() -> Result<(), BoxError> {
             }
         }
         let mut ms = |name: &str| {
-            per_pass.iter_mut().find(|(p, _)| p == name).map_or(0.0, |(_, v)| median(v))
+            per_pass
+                .iter_mut()
+                .find(|(p, _)| p == name)
+                .map_or(0.0, |(_, v)| median(v))
         };
         let (light, sat, view) = (ms("light pass"), ms("summed-area tables"), ms("view"));
         let frame = light + sat + view + ms("readback");
-        println!("| {n} | {size}² | {light:.1} | {sat:.1} | {view:.1} | {frame:.1} | {:.2} |", frame / n as f64);
+        println!(
+            "| {n} | {size}² | {light:.1} | {sat:.1} | {view:.1} | {frame:.1} | {:.2} |",
+            frame / n as f64
+        );
     }
     Ok(())
 }

@@ -13,12 +13,14 @@ use strandlight_runtime::env::{
 };
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::{Attribute, HairModel};
-use strandlight_runtime::passes::convolution_depth::{ConvolutionDepthPass, DodmBatch, DodmSettings};
+use strandlight_runtime::passes::convolution_depth::{
+    ConvolutionDepthPass, DodmBatch, DodmSettings,
+};
 use strandlight_runtime::passes::env_view::BatchBinding;
+use strandlight_runtime::passes::strands::StrandGeometry;
 use strandlight_runtime::passes::summed_area::{
     MAX_BOX_HALF_SIZE, SummedAreaPass, SummedAreaTables, quantize_optical_depth,
 };
-use strandlight_runtime::passes::strands::StrandGeometry;
 use strandlight_runtime::passes::transmittance_probe::{ProbeBox, TransmittanceProbe};
 use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
@@ -34,7 +36,11 @@ fn upload_optical_depth(gpu: &GpuContext, batch: &DodmBatch, texels: &[[f32; 4]]
     let (bytes, texel_bytes): (Vec<u8>, u32) = match format {
         wgpu::TextureFormat::Rgba32Float => (bytemuck::cast_slice(texels).to_vec(), 16),
         _ => {
-            let h: Vec<half::f16> = texels.iter().flatten().map(|&v| half::f16::from_f32(v)).collect();
+            let h: Vec<half::f16> = texels
+                .iter()
+                .flatten()
+                .map(|&v| half::f16::from_f32(v))
+                .collect();
             (bytemuck::cast_slice(&h).to_vec(), 8)
         }
     };
@@ -46,8 +52,16 @@ fn upload_optical_depth(gpu: &GpuContext, batch: &DodmBatch, texels: &[[f32; 4]]
             aspect: wgpu::TextureAspect::All,
         },
         &bytes,
-        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(res * texel_bytes), rows_per_image: Some(res) },
-        wgpu::Extent3d { width: res, height: res, depth_or_array_layers: 1 },
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(res * texel_bytes),
+            rows_per_image: Some(res),
+        },
+        wgpu::Extent3d {
+            width: res,
+            height: res,
+            depth_or_array_layers: 1,
+        },
     );
 }
 
@@ -62,7 +76,10 @@ fn summed_area_box_sums_are_exact_at_the_largest_map() {
     let texels: Vec<[f32; 4]> = (0..res * res)
         .map(|_| std::array::from_fn(|_| (rng.range(0.0, 24.0) * 64.0).floor() as f32 / 64.0))
         .collect();
-    let quantized: Vec<[u32; 4]> = texels.iter().map(|t| t.map(quantize_optical_depth)).collect();
+    let quantized: Vec<[u32; 4]> = texels
+        .iter()
+        .map(|t| t.map(quantize_optical_depth))
+        .collect();
     let batch = DodmBatch::new(&gpu, res, 1, 1.0);
     upload_optical_depth(&gpu, &batch, &texels);
     let sat = SummedAreaTables::new(&gpu, res, 1).unwrap_or_else(|e| panic!("{e}"));
@@ -116,7 +133,9 @@ fn summed_area_box_sums_are_exact_at_the_largest_map() {
 fn row_fibers(r: usize) -> (f64, Vec<f64>) {
     let offsets = [0.17, -0.23, 0.05, 0.29, -0.11, -0.02];
     let z = 0.3 - 0.1 * r as f64;
-    let xs = (0..RES).map(|c| (c as f64 + 0.5 + offsets[r % offsets.len()]) / PER_UNIT - 1.0).collect();
+    let xs = (0..RES)
+        .map(|c| (c as f64 + 0.5 + offsets[r % offsets.len()]) / PER_UNIT - 1.0)
+        .collect();
     (z, xs)
 }
 
@@ -168,24 +187,49 @@ fn slab_convolution_transmittance_follows_the_cone_integral() {
     let model = slab(rows, thickness as f32);
     let geometry = StrandGeometry::upload(&gpu, &model).unwrap();
     // Boundaries 0.045, 0.135, 0.27, 0.45 behind the first row: rows (0.1 apart) never sit on one.
-    let settings = DodmSettings { resolution: 64, first_layer: Some(0.045), batch_size: 2 };
+    let settings = DodmSettings {
+        resolution: 64,
+        first_layer: Some(0.045),
+        batch_size: 2,
+    };
     let mut batch = DodmBatch::new(&gpu, settings.resolution, 2, 0.045);
     let sat = SummedAreaTables::new(&gpu, settings.resolution, 2).unwrap();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    ConvolutionDepthPass::new(&gpu).encode(&gpu, &mut encoder, &geometry, &[Vec3::Z, Vec3::Z], model.bounds(), 1.0, &mut batch);
+    ConvolutionDepthPass::new(&gpu).encode(
+        &gpu,
+        &mut encoder,
+        &geometry,
+        &[Vec3::Z, Vec3::Z],
+        model.bounds(),
+        1.0,
+        &mut batch,
+    );
     SummedAreaPass::new(&gpu).encode(&gpu, &mut encoder, &batch.optical_depth, &sat);
     gpu.queue.submit([encoder.finish()]);
     let probe = TransmittanceProbe::new(&gpu);
     // Slot 0: the SRBF; slot 1: the same direction as a directional light (one texel: the
     // transmittance at the SRBF centre through a plain deep opacity map).
-    let lights = [EnvLight::srbf(Vec3::Z, lambda, [1.0; 3]), EnvLight::directional(Vec3::Z, [1.0; 3])];
-    let binding = BatchBinding::new(&gpu, &probe.batch_layout, &lights, &batch, &sat, true, false);
+    let lights = [
+        EnvLight::srbf(Vec3::Z, lambda, [1.0; 3]),
+        EnvLight::directional(Vec3::Z, [1.0; 3]),
+    ];
+    let binding = BatchBinding::new(
+        &gpu,
+        &probe.batch_layout,
+        &lights,
+        &batch,
+        &sat,
+        true,
+        false,
+    );
     // Sites behind the first row, between rows, behind the slab, and near its top (y = 0.9)
     // and right (x ≈ 0.99) edges. The map has 1.35 fibers per texel, so nothing drawn from it can
     // follow the transmittance's structure below one fiber spacing (whether the few rays near
     // the centre graze a fiber or not): every estimate and the reference are averaged over 8
     // points spread across 1.5 fiber spacings in x around each site.
-    let jitter: Vec<f32> = (0..8).map(|k| (k as f32 - 3.5) / 7.0 * 1.5 / PER_UNIT as f32).collect();
+    let jitter: Vec<f32> = (0..8)
+        .map(|k| (k as f32 - 3.5) / 7.0 * 1.5 / PER_UNIT as f32)
+        .collect();
     let mut sites = Vec::new();
     for z in [0.25f32, 0.15, 0.05, -0.2, -0.4] {
         for y in [0.0f32, 0.5, 0.8, 0.86] {
@@ -194,21 +238,32 @@ fn slab_convolution_transmittance_follows_the_cone_integral() {
             }
         }
     }
-    let points: Vec<Vec3> = sites.iter().flat_map(|s| jitter.iter().map(move |&dx| *s + Vec3::X * dx)).collect();
+    let points: Vec<Vec3> = sites
+        .iter()
+        .flat_map(|s| jitter.iter().map(move |&dx| *s + Vec3::X * dx))
+        .collect();
     let dodm = probe.transmittance(&gpu, &binding, 0, &points).unwrap();
     let centre_map = probe.transmittance(&gpu, &binding, 1, &points).unwrap();
     let n = jitter.len();
     let site_mean = |v: &[f64], i: usize| v[i * n..(i + 1) * n].iter().sum::<f64>() / n as f64;
     let to64 = |v: &[f32]| v.iter().map(|&x| x as f64).collect::<Vec<f64>>();
     let (dodm, centre_map) = (to64(&dodm), to64(&centre_map));
-    let truth: Vec<f64> =
-        points.iter().map(|p| cone_transmittance(p.as_dvec3(), lambda as f64, rows, thickness)).collect();
-    let centre_ray: Vec<f64> =
-        points.iter().map(|p| ray_visible(p.as_dvec3(), DVec3::Z, rows, thickness) as u8 as f64).collect();
+    let truth: Vec<f64> = points
+        .iter()
+        .map(|p| cone_transmittance(p.as_dvec3(), lambda as f64, rows, thickness))
+        .collect();
+    let centre_ray: Vec<f64> = points
+        .iter()
+        .map(|p| ray_visible(p.as_dvec3(), DVec3::Z, rows, thickness) as u8 as f64)
+        .collect();
     let (mut e_dodm, mut e_centre_map, mut e_centre_ray, mut norm) = (0.0, 0.0, 0.0, 0.0);
     for (i, p) in sites.iter().enumerate() {
         let t = site_mean(&truth, i);
-        let (d, m, r) = (site_mean(&dodm, i), site_mean(&centre_map, i), site_mean(&centre_ray, i));
+        let (d, m, r) = (
+            site_mean(&dodm, i),
+            site_mean(&centre_map, i),
+            site_mean(&centre_ray, i),
+        );
         e_dodm += (d - t).powi(2);
         e_centre_map += (m - t).powi(2);
         e_centre_ray += (r - t).powi(2);
@@ -227,8 +282,14 @@ fn slab_convolution_transmittance_follows_the_cone_integral() {
          centre-direction deep opacity map {r_map:.4}, exact centre-direction ray {r_ray:.4}",
         sites.len()
     );
-    assert!(r_dodm < TOLERANCE, "convolution DODM relative RMSE {r_dodm}");
-    assert!(r_dodm < r_map, "DODM {r_dodm} not better than the centre direction {r_map}");
+    assert!(
+        r_dodm < TOLERANCE,
+        "convolution DODM relative RMSE {r_dodm}"
+    );
+    assert!(
+        r_dodm < r_map,
+        "DODM {r_dodm} not better than the centre direction {r_map}"
+    );
 }
 
 /// Relative RMSE allowed for the convolution DODM against the cone integral. The method itself
@@ -281,7 +342,14 @@ fn three_strands() -> (HairModel, Vec<StrandProbe>) {
         probes.push((dir.as_dvec3(), (px, py)));
     }
     // 3 px wide: full coverage (alpha 1) around the centre line.
-    let model = HairModel::new(points, vec![0, 2, 4, 6], Some(Attribute::Uniform(3.0 / 32.0)), None, None).unwrap();
+    let model = HairModel::new(
+        points,
+        vec![0, 2, 4, 6],
+        Some(Attribute::Uniform(3.0 / 32.0)),
+        None,
+        None,
+    )
+    .unwrap();
     (model, probes)
 }
 
@@ -290,7 +358,11 @@ fn coordinates(t: DVec3, l: DVec3, e: DVec3) -> [f64; 3] {
     let (si, so) = (t.dot(l), t.dot(e));
     let (lp, ep) = (l - si * t, e - so * t);
     let norms = lp.length_squared() * ep.length_squared();
-    let cos_phi = if norms > 1e-20 { (lp.dot(ep) / norms.sqrt()).clamp(-1.0, 1.0) } else { 1.0 };
+    let cos_phi = if norms > 1e-20 {
+        (lp.dot(ep) / norms.sqrt()).clamp(-1.0, 1.0)
+    } else {
+        1.0
+    };
     [si, so, cos_phi]
 }
 
@@ -307,37 +379,71 @@ fn render_unshadowed_with(
 ) -> (Vec<[f32; 4]>, Option<Vec<[f32; 4]>>) {
     let gpu = gpu();
     let options = EnvRenderOptions {
-        dodm: DodmSettings { resolution: 64, first_layer: None, batch_size: 2 },
+        dodm: DodmSettings {
+            resolution: 64,
+            first_layer: None,
+            batch_size: 2,
+        },
         kappa: 1.0,
         shadowed: false,
         ..Default::default()
     };
     let camera: Camera = ortho_camera();
-    let frame = render_env_frame(&gpu, model, &camera, RES, RES, lights, tables, &options, multiple)
-        .unwrap_or_else(|e| panic!("{e}"));
-    println!("timings: {:?}", frame.stats.timings.iter().map(|t| (t.pass.clone(), t.milliseconds)).collect::<Vec<_>>());
+    let frame = render_env_frame(
+        &gpu, model, &camera, RES, RES, lights, tables, &options, multiple,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    println!(
+        "timings: {:?}",
+        frame
+            .stats
+            .timings
+            .iter()
+            .map(|t| (t.pass.clone(), t.milliseconds))
+            .collect::<Vec<_>>()
+    );
     (frame.pixels, frame.multiple_pixels)
 }
 
-fn compare(pixels: &[[f32; 4]], probes: &[StrandProbe], mut expected: impl FnMut(DVec3) -> [f64; 3]) {
+fn compare(
+    pixels: &[[f32; 4]],
+    probes: &[StrandProbe],
+    mut expected: impl FnMut(DVec3) -> [f64; 3],
+) {
     compare_at(pixels, probes, |t, _| expected(t))
 }
 
-fn compare_at(pixels: &[[f32; 4]], probes: &[StrandProbe], mut expected: impl FnMut(DVec3, (usize, usize)) -> [f64; 3]) {
+fn compare_at(
+    pixels: &[[f32; 4]],
+    probes: &[StrandProbe],
+    mut expected: impl FnMut(DVec3, (usize, usize)) -> [f64; 3],
+) {
     let e = DVec3::Z;
     let mut worst = 0.0f64;
     for &(t, (px, py)) in probes {
         let p = pixels[py * RES as usize + px];
-        assert!((p[3] - 1.0).abs() < 1e-4, "pixel ({px},{py}) alpha {}", p[3]);
+        assert!(
+            (p[3] - 1.0).abs() < 1e-4,
+            "pixel ({px},{py}) alpha {}",
+            p[3]
+        );
         let want = expected(t, (px, py));
         for c in 0..3 {
             let rel = (p[c] as f64 - want[c]).abs() / want[c].abs().max(1e-3);
             worst = worst.max(rel);
-            assert!(rel < 1e-3, "pixel ({px},{py}) channel {c}: GPU {} vs CPU {}", p[c], want[c]);
+            assert!(
+                rel < 1e-3,
+                "pixel ({px},{py}) channel {c}: GPU {} vs CPU {}",
+                p[c],
+                want[c]
+            );
         }
         let _ = e;
     }
-    println!("worst relative difference GPU vs CPU over {} strands: {worst:.2e}", probes.len());
+    println!(
+        "worst relative difference GPU vs CPU over {} strands: {worst:.2e}",
+        probes.len()
+    );
 }
 
 #[test]
@@ -349,13 +455,18 @@ fn unshadowed_srbf_image_is_the_sum_of_table_lookups() {
         EnvLight::srbf(Vec3::new(-0.7, 0.1, 0.7), 40.0, [0.2, 0.9, 0.4]),
         EnvLight::srbf(Vec3::new(0.1, -0.6, -0.8), 11.0, [0.7, 0.7, 1.3]),
     ];
-    let tables = EnvTables { srbf: Some(table.clone()), ..Default::default() };
+    let tables = EnvTables {
+        srbf: Some(table.clone()),
+        ..Default::default()
+    };
     let pixels = render_unshadowed(&model, &lights, &tables);
     compare(&pixels, &probes, |t| {
         let mut sum = [0.0f64; 3];
         for l in &lights {
             let [a, b, c] = coordinates(t, l.direction.as_dvec3(), DVec3::Z);
-            let v = table.lookup_rgb(&[a, b, c, 1.0 / l.lambda.unwrap() as f64]).unwrap();
+            let v = table
+                .lookup_rgb(&[a, b, c, 1.0 / l.lambda.unwrap() as f64])
+                .unwrap();
             for k in 0..3 {
                 sum[k] += l.rgb[k] as f64 * v[k] as f64;
             }
@@ -375,7 +486,11 @@ fn directional_light_image_is_s_cos_theta_times_irradiance() {
         Axis::uniform("inv_lambda", 0.0, 0.0, 1),
     ];
     let direct = Table::from_fn(axes, 3, |x, out| {
-        let angles = FiberAngles::new(x[0].clamp(-1.0, 1.0).asin(), x[1].clamp(-1.0, 1.0).asin(), x[2].clamp(-1.0, 1.0).acos());
+        let angles = FiberAngles::new(
+            x[0].clamp(-1.0, 1.0).asin(),
+            x[1].clamp(-1.0, 1.0).asin(),
+            x[2].clamp(-1.0, 1.0).acos(),
+        );
         let s = marschner.eval(&angles);
         let cos_i = angles.theta_i.cos();
         for k in 0..3 {
@@ -385,7 +500,10 @@ fn directional_light_image_is_s_cos_theta_times_irradiance() {
     .unwrap();
     let irradiance = [2.0f32, 1.0, 0.5];
     let light = EnvLight::directional(Vec3::new(0.2, 0.9, 0.4), irradiance);
-    let tables = EnvTables { direct: Some(direct.clone()), ..Default::default() };
+    let tables = EnvTables {
+        direct: Some(direct.clone()),
+        ..Default::default()
+    };
     let pixels = render_unshadowed(&model, &[light], &tables);
     let mut worst_model = 0.0f64;
     compare(&pixels, &probes, |t| {
@@ -396,11 +514,14 @@ fn directional_light_image_is_s_cos_theta_times_irradiance() {
         let exact = marschner.eval(&FiberAngles::from_directions(t, l, DVec3::Z));
         let cos_i = a.asin().cos();
         for k in 0..3 {
-            worst_model = worst_model.max((v[k] as f64 - exact[k] * cos_i).abs() / (exact[k] * cos_i).abs().max(1e-3));
+            worst_model = worst_model
+                .max((v[k] as f64 - exact[k] * cos_i).abs() / (exact[k] * cos_i).abs().max(1e-3));
         }
         std::array::from_fn(|k| v[k] as f64 * irradiance[k] as f64)
     });
-    println!("direct table vs Marschner S·cos θ_i at the probed strands: worst relative {worst_model:.3}");
+    println!(
+        "direct table vs Marschner S·cos θ_i at the probed strands: worst relative {worst_model:.3}"
+    );
 }
 
 /// A forward-scattering grid linear in y (so trilinear interpolation is exact), different per
@@ -409,7 +530,12 @@ struct LinearGrid;
 
 fn linear_grid_value(light: usize, y: f64) -> [f64; 4] {
     let j = light as f64;
-    [0.3 + 0.2 * j + 0.1 * y, 0.5 - 0.1 * j + 0.05 * y, 0.7 + 0.1 * y, 0.2 + 0.1 * j + 0.15 * y]
+    [
+        0.3 + 0.2 * j + 0.1 * y,
+        0.5 - 0.1 * j + 0.05 * y,
+        0.7 + 0.1 * y,
+        0.2 + 0.1 * j + 0.15 * y,
+    ]
 }
 
 impl ForwardScatteringSource for LinearGrid {
@@ -427,7 +553,12 @@ impl ForwardScatteringSource for LinearGrid {
                 }
             }
         }
-        ForwardScatteringGrid { origin, spacing, dims, values }
+        ForwardScatteringGrid {
+            origin,
+            spacing,
+            dims,
+            values,
+        }
     }
 }
 
@@ -435,7 +566,10 @@ impl ForwardScatteringSource for LinearGrid {
 /// `centre` (orthographic camera down −z, 32 px per unit): the point of the strand's axis whose
 /// screen position projects on the pixel centre.
 fn strand_point_at_pixel(centre: DVec3, t: DVec3, (px, py): (usize, usize)) -> DVec3 {
-    let pixel = glam::DVec2::new((px as f64 + 0.5) / 32.0 - 1.0, 1.0 - (py as f64 + 0.5) / 32.0);
+    let pixel = glam::DVec2::new(
+        (px as f64 + 0.5) / 32.0 - 1.0,
+        1.0 - (py as f64 + 0.5) / 32.0,
+    );
     let axis = t.truncate();
     let s = (pixel - centre.truncate()).dot(axis) / axis.length_squared();
     centre + t * s
@@ -444,14 +578,22 @@ fn strand_point_at_pixel(centre: DVec3, t: DVec3, (px, py): (usize, usize)) -> D
 #[test]
 fn multiple_scattering_is_power_times_attenuation_times_the_spread_table() {
     let (model, probes) = three_strands();
-    let centres = [DVec3::new(-0.5, 0.5, 0.0), DVec3::new(0.5, 0.5, 0.0), DVec3::new(0.0, -0.5, 0.0)];
+    let centres = [
+        DVec3::new(-0.5, 0.5, 0.0),
+        DVec3::new(0.5, 0.5, 0.0),
+        DVec3::new(0.0, -0.5, 0.0),
+    ];
     let single = synthetic_table(Axis::uniform("inv_lambda", 1.0 / 64.0, 1.0 / 8.0, 3));
     let multiple = synthetic_table(Axis::uniform("sigma_f", 0.0, 0.6, 7));
     let lights = [
         EnvLight::srbf(Vec3::new(0.3, 0.8, 0.5), 20.0, [1.0, 0.5, 0.25]),
         EnvLight::srbf(Vec3::new(-0.7, 0.1, 0.7), 40.0, [0.2, 0.9, 0.4]),
     ];
-    let tables = EnvTables { srbf: Some(single), direct: None, multiple: Some(multiple.clone()) };
+    let tables = EnvTables {
+        srbf: Some(single),
+        direct: None,
+        multiple: Some(multiple.clone()),
+    };
     let (_, multiple_pixels) = render_unshadowed_with(&model, &lights, &tables, Some(&LinearGrid));
     let multiple_pixels = multiple_pixels.expect("a source was given");
     compare_at(&multiple_pixels, &probes, |t, pixel| {
@@ -478,33 +620,90 @@ fn bad_inputs_are_typed_errors() {
     let (model, _) = three_strands();
     let camera = ortho_camera();
     let srbf = synthetic_table(Axis::uniform("inv_lambda", 1.0 / 64.0, 1.0 / 8.0, 3));
-    let tables = EnvTables { srbf: Some(srbf.clone()), ..Default::default() };
+    let tables = EnvTables {
+        srbf: Some(srbf.clone()),
+        ..Default::default()
+    };
     let light = [EnvLight::srbf(Vec3::Z, 20.0, [1.0; 3])];
     let options = EnvRenderOptions::default();
     let render = |lights: &[EnvLight], tables: &EnvTables, options: &EnvRenderOptions| {
-        render_env_frame(&gpu, &model, &camera, 16, 16, lights, tables, options, None).expect_err("an error")
+        render_env_frame(&gpu, &model, &camera, 16, 16, lights, tables, options, None)
+            .expect_err("an error")
     };
-    assert!(matches!(render(&[], &tables, &options), EnvRenderError::NoLights));
-    let zero_batch = EnvRenderOptions { dodm: DodmSettings { batch_size: 0, ..options.dodm }, ..options };
+    assert!(matches!(
+        render(&[], &tables, &options),
+        EnvRenderError::NoLights
+    ));
+    let zero_batch = EnvRenderOptions {
+        dodm: DodmSettings {
+            batch_size: 0,
+            ..options.dodm
+        },
+        ..options
+    };
     let e = render(&light, &tables, &zero_batch);
     assert!(e.to_string().contains("batch size 0"), "{e}");
-    let e = render(&light, &tables, &EnvRenderOptions { kappa: 0.0, ..options });
+    let e = render(
+        &light,
+        &tables,
+        &EnvRenderOptions {
+            kappa: 0.0,
+            ..options
+        },
+    );
     assert!(e.to_string().contains("κ = 0"), "{e}");
     // A direct table (one-node fourth axis named otherwise) where the SRBF table belongs.
     let wrong = synthetic_table(Axis::uniform("sigma_f", 0.0, 1.0, 3));
-    let e = render(&light, &EnvTables { srbf: Some(wrong), ..Default::default() }, &options);
-    assert!(matches!(e, EnvRenderError::Table(EnvTableError::Shape { table: "srbf", .. })), "{e}");
+    let e = render(
+        &light,
+        &EnvTables {
+            srbf: Some(wrong),
+            ..Default::default()
+        },
+        &options,
+    );
+    assert!(
+        matches!(
+            e,
+            EnvRenderError::Table(EnvTableError::Shape { table: "srbf", .. })
+        ),
+        "{e}"
+    );
     println!("{e}");
-    let e = render(&[EnvLight::directional(Vec3::Z, [1.0; 3])], &tables, &options);
-    assert!(matches!(e, EnvRenderError::Table(EnvTableError::Missing { table: "direct", .. })), "{e}");
-    let e = render(&[EnvLight::srbf(Vec3::Z, f32::NAN, [1.0; 3])], &tables, &options);
-    assert!(matches!(e, EnvRenderError::BadLight { index: 0, .. }), "{e}");
+    let e = render(
+        &[EnvLight::directional(Vec3::Z, [1.0; 3])],
+        &tables,
+        &options,
+    );
+    assert!(
+        matches!(
+            e,
+            EnvRenderError::Table(EnvTableError::Missing {
+                table: "direct",
+                ..
+            })
+        ),
+        "{e}"
+    );
+    let e = render(
+        &[EnvLight::srbf(Vec3::Z, f32::NAN, [1.0; 3])],
+        &tables,
+        &options,
+    );
+    assert!(
+        matches!(e, EnvRenderError::BadLight { index: 0, .. }),
+        "{e}"
+    );
     // More SAT bytes than the adapter binds: a batch of 2048² maps sized past the limit.
     let limit = gpu.device.limits().max_storage_buffer_binding_size;
     let slots = (limit / (2048 * 2048 * 16) + 1) as u32;
     let many: Vec<EnvLight> = (0..slots).map(|_| light[0]).collect();
     let big = EnvRenderOptions {
-        dodm: DodmSettings { resolution: 2048, first_layer: None, batch_size: slots },
+        dodm: DodmSettings {
+            resolution: 2048,
+            first_layer: None,
+            batch_size: slots,
+        },
         ..options
     };
     let e = render(&many, &tables, &big);
@@ -524,7 +723,15 @@ fn stochastic_simplification_keeps_the_mean_optical_depth() {
     let probe = TransmittanceProbe::new(&gpu);
     // Behind all six rows, over the slab's interior.
     let points: Vec<Vec3> = (0..30)
-        .flat_map(|i| (0..30).map(move |j| Vec3::new(-0.8 + 1.6 * i as f32 / 29.0, -0.7 + 1.4 * j as f32 / 29.0, -0.6)))
+        .flat_map(|i| {
+            (0..30).map(move |j| {
+                Vec3::new(
+                    -0.8 + 1.6 * i as f32 / 29.0,
+                    -0.7 + 1.4 * j as f32 / 29.0,
+                    -0.6,
+                )
+            })
+        })
         .collect();
     let light = [EnvLight::directional(Vec3::Z, [1.0; 3])];
     let mean_depth = |kappa: f32| {
@@ -532,26 +739,53 @@ fn stochastic_simplification_keeps_the_mean_optical_depth() {
         let mut batch = DodmBatch::new(&gpu, 64, 1, 0.045);
         let sat = SummedAreaTables::new(&gpu, 64, 1).unwrap();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        pass.encode(&gpu, &mut encoder, &drawn, &[Vec3::Z], model.bounds(), 1.0 / kappa, &mut batch);
+        pass.encode(
+            &gpu,
+            &mut encoder,
+            &drawn,
+            &[Vec3::Z],
+            model.bounds(),
+            1.0 / kappa,
+            &mut batch,
+        );
         SummedAreaPass::new(&gpu).encode(&gpu, &mut encoder, &batch.optical_depth, &sat);
         gpu.queue.submit([encoder.finish()]);
-        let binding = BatchBinding::new(&gpu, &probe.batch_layout, &light, &batch, &sat, true, false);
+        let binding =
+            BatchBinding::new(&gpu, &probe.batch_layout, &light, &batch, &sat, true, false);
         let t = probe.transmittance(&gpu, &binding, 0, &points).unwrap();
-        (t.iter().map(|&t| -(t as f64).ln()).sum::<f64>() / t.len() as f64, drawn.segment_count)
+        (
+            t.iter().map(|&t| -(t as f64).ln()).sum::<f64>() / t.len() as f64,
+            drawn.segment_count,
+        )
     };
     let (full, all_segments) = mean_depth(1.0);
     // The closed form: six rows each transmitting 1 − d/s = 0.8.
     let closed = -(rows as f64) * 0.8f64.ln();
-    println!("κ = 1: mean optical depth {full:.4} ({all_segments} segments); closed form {closed:.4}");
-    assert!((full - closed).abs() < 0.1 * closed, "κ = 1 map {full} vs closed form {closed}");
+    println!(
+        "κ = 1: mean optical depth {full:.4} ({all_segments} segments); closed form {closed:.4}"
+    );
+    assert!(
+        (full - closed).abs() < 0.1 * closed,
+        "κ = 1 map {full} vs closed form {closed}"
+    );
     for kappa in [0.5f32, 0.25] {
         let (depth, segments) = mean_depth(kappa);
         let strands = model.strand_count() as f64;
-        println!("κ = {kappa}: mean optical depth {depth:.4} ({segments} segments), relative to κ = 1: {:.4}", depth / full - 1.0);
-        assert_eq!(segments as f64, (kappa as f64 * strands).ceil(), "one segment per slab strand");
+        println!(
+            "κ = {kappa}: mean optical depth {depth:.4} ({segments} segments), relative to κ = 1: {:.4}",
+            depth / full - 1.0
+        );
+        assert_eq!(
+            segments as f64,
+            (kappa as f64 * strands).ceil(),
+            "one segment per slab strand"
+        );
         // ~κ·384 strands drawn at random: the mean over the slab fluctuates by ~1/√(κ·384)
         // (5–10%); 20% is more than 2σ at κ = 0.25.
-        assert!((depth / full - 1.0).abs() < 0.2, "κ = {kappa}: {depth} vs {full}");
+        assert!(
+            (depth / full - 1.0).abs() < 0.2,
+            "κ = {kappa}: {depth} vs {full}"
+        );
     }
 }
 
@@ -568,7 +802,10 @@ fn shadowing_reaches_the_right_light_in_every_batch() {
     let thickness = Attribute::PerPoint(vec![3.0 / 32.0, 3.0 / 32.0, 0.25, 0.25]);
     let model = HairModel::new(points, vec![0, 2, 4], Some(thickness), None, None).unwrap();
     let direct = synthetic_table(Axis::uniform("none", 0.0, 0.0, 1));
-    let tables = EnvTables { direct: Some(direct.clone()), ..Default::default() };
+    let tables = EnvTables {
+        direct: Some(direct.clone()),
+        ..Default::default()
+    };
     let lights = [
         EnvLight::directional(Vec3::new(0.0, 1.0, 1.0), [1.0, 0.8, 0.6]),
         EnvLight::directional(Vec3::new(0.0, -1.0, 1.0), [0.5, 0.7, 0.9]),
@@ -583,12 +820,26 @@ fn shadowing_reaches_the_right_light_in_every_batch() {
     let (lit1, lit2) = (contribution(&lights[0]), contribution(&lights[1]));
     for batch_size in [1u32, 2] {
         let options = EnvRenderOptions {
-            dodm: DodmSettings { resolution: 64, first_layer: Some(0.05), batch_size },
+            dodm: DodmSettings {
+                resolution: 64,
+                first_layer: Some(0.05),
+                batch_size,
+            },
             kappa: 1.0,
             ..Default::default()
         };
-        let frame = render_env_frame(&gpu, &model, &ortho_camera(), RES, RES, &lights, &tables, &options, None)
-            .unwrap_or_else(|e| panic!("{e}"));
+        let frame = render_env_frame(
+            &gpu,
+            &model,
+            &ortho_camera(),
+            RES,
+            RES,
+            &lights,
+            &tables,
+            &options,
+            None,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(frame.stats.batches, 2 / batch_size);
         let p = frame.pixels[probe.1 * RES as usize + probe.0];
         // Light 1 reaches B through A and B's own fiber (the last DODM boundary holds both):

@@ -13,9 +13,12 @@ use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::gpu::{AdapterReport, GpuContext};
 use crate::hair::HairModel;
 use crate::passes::convolution_depth::{
-    ConvolutionDepthPass, DodmBatch, DodmSettings, DodmSettingsError, SimplifiedSegments, check_kappa,
+    ConvolutionDepthPass, DodmBatch, DodmSettings, DodmSettingsError, SimplifiedSegments,
+    check_kappa,
 };
-use crate::passes::env_view::{BatchBinding, EnvViewPass, EnvViewTargets, GridBinding, TableBinding};
+use crate::passes::env_view::{
+    BatchBinding, EnvViewPass, EnvViewTargets, GridBinding, TableBinding,
+};
 use crate::passes::strands::{FrameParams, KajiyaKay, StrandGeometry, TooManyPoints};
 use crate::passes::summed_area::{SatTooLarge, SummedAreaPass, SummedAreaTables};
 use crate::render::{PassTiming, Transparency};
@@ -42,27 +45,49 @@ pub struct EnvTables {
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum EnvTableError {
     #[error("env table `{table}` is needed ({needed_by}) but was not given")]
-    Missing { table: &'static str, needed_by: &'static str },
+    Missing {
+        table: &'static str,
+        needed_by: &'static str,
+    },
     #[error("env table `{table}`: {problem}")]
-    Shape { table: &'static str, problem: String },
+    Shape {
+        table: &'static str,
+        problem: String,
+    },
 }
 
 /// Checks an env table's layout: 4 axes, the three direction axes by name, the fourth named
 /// `fourth` (or any name with one node when `None`), 3 channels.
-pub fn check_env_table(table_name: &'static str, table: &Table, fourth: Option<&str>) -> Result<(), EnvTableError> {
-    let bad = |problem: String| EnvTableError::Shape { table: table_name, problem };
+pub fn check_env_table(
+    table_name: &'static str,
+    table: &Table,
+    fourth: Option<&str>,
+) -> Result<(), EnvTableError> {
+    let bad = |problem: String| EnvTableError::Shape {
+        table: table_name,
+        problem,
+    };
     let axes = table.axes();
     if axes.len() != 4 {
         return Err(bad(format!("has {} axes, expected 4", axes.len())));
     }
-    for (axis, name) in axes.iter().zip([AXIS_U_DOT_XI, AXIS_U_DOT_WO, AXIS_COS_DPHI]) {
+    for (axis, name) in axes
+        .iter()
+        .zip([AXIS_U_DOT_XI, AXIS_U_DOT_WO, AXIS_COS_DPHI])
+    {
         if axis.name != name {
-            return Err(bad(format!("axis `{}` where `{name}` was expected", axis.name)));
+            return Err(bad(format!(
+                "axis `{}` where `{name}` was expected",
+                axis.name
+            )));
         }
     }
     match fourth {
         Some(name) if axes[3].name != name => {
-            return Err(bad(format!("fourth axis `{}` where `{name}` was expected", axes[3].name)));
+            return Err(bad(format!(
+                "fourth axis `{}` where `{name}` was expected",
+                axes[3].name
+            )));
         }
         None if axes[3].count != 1 => {
             return Err(bad(format!(
@@ -73,7 +98,10 @@ pub fn check_env_table(table_name: &'static str, table: &Table, fourth: Option<&
         _ => {}
     }
     if table.channels() != 3 {
-        return Err(bad(format!("has {} channels, expected 3 (RGB)", table.channels())));
+        return Err(bad(format!(
+            "has {} channels, expected 3 (RGB)",
+            table.channels()
+        )));
     }
     if u32::try_from(table.values().len()).is_err() {
         return Err(bad("holds more than 2^32 values".into()));
@@ -115,7 +143,9 @@ pub enum EnvRenderError {
     NoLights,
     #[error("light {index}: {problem}")]
     BadLight { index: usize, problem: String },
-    #[error("image size {width}×{height} must be between 1 and {max} on each side (the adapter's limit)")]
+    #[error(
+        "image size {width}×{height} must be between 1 and {max} on each side (the adapter's limit)"
+    )]
     BadSize { width: u32, height: u32, max: u32 },
     #[error(transparent)]
     Settings(#[from] DodmSettingsError),
@@ -167,12 +197,17 @@ pub struct EnvFrame {
 fn check_light(index: usize, light: &EnvLight) -> Result<(), EnvRenderError> {
     let bad = |problem: String| EnvRenderError::BadLight { index, problem };
     if !light.direction.is_finite() || light.direction.length() < 1e-6 {
-        return Err(bad(format!("direction {:?} is not a usable unit vector", light.direction)));
+        return Err(bad(format!(
+            "direction {:?} is not a usable unit vector",
+            light.direction
+        )));
     }
     if let Some(lambda) = light.lambda
         && !(lambda.is_finite() && lambda > 0.0)
     {
-        return Err(bad(format!("SRBF bandwidth λ = {lambda} must be positive and finite")));
+        return Err(bad(format!(
+            "SRBF bandwidth λ = {lambda} must be positive and finite"
+        )));
     }
     if light.rgb.iter().any(|c| !c.is_finite()) {
         return Err(bad(format!("rgb {:?} is not finite", light.rgb)));
@@ -183,7 +218,10 @@ fn check_light(index: usize, light: &EnvLight) -> Result<(), EnvRenderError> {
 fn check_grid(grid: &ForwardScatteringGrid, lights: usize) -> Result<(), EnvRenderError> {
     let vertices = grid.dims.iter().map(|&d| d as usize).product::<usize>();
     if vertices == 0 {
-        return Err(EnvRenderError::Grid(format!("dims {:?} has a zero", grid.dims)));
+        return Err(EnvRenderError::Grid(format!(
+            "dims {:?} has a zero",
+            grid.dims
+        )));
     }
     if grid.values.len() != vertices * lights {
         return Err(EnvRenderError::Grid(format!(
@@ -214,7 +252,10 @@ impl Timings {
         let ms = start.elapsed().as_secs_f64() * 1e3;
         match self.0.iter_mut().find(|t| t.pass == pass) {
             Some(t) => t.milliseconds += ms,
-            None => self.0.push(PassTiming { pass: pass.to_string(), milliseconds: ms }),
+            None => self.0.push(PassTiming {
+                pass: pass.to_string(),
+                milliseconds: ms,
+            }),
         }
         out
     }
@@ -229,7 +270,11 @@ pub struct EnvRenderer {
 
 impl EnvRenderer {
     pub fn new(gpu: &GpuContext) -> Self {
-        Self { depth: ConvolutionDepthPass::new(gpu), sat: SummedAreaPass::new(gpu), view: EnvViewPass::new(gpu) }
+        Self {
+            depth: ConvolutionDepthPass::new(gpu),
+            sat: SummedAreaPass::new(gpu),
+            view: EnvViewPass::new(gpu),
+        }
     }
 
     /// Renders `model` seen by `camera` into `width`×`height` under `lights` (SRBFs shaded with
@@ -258,30 +303,43 @@ impl EnvRenderer {
         options.dodm.check()?;
         check_kappa(options.kappa)?;
         if options.transparency != Transparency::Opaque {
-            return Err(EnvRenderError::UnsupportedTransparency(options.transparency));
+            return Err(EnvRenderError::UnsupportedTransparency(
+                options.transparency,
+            ));
         }
         let max = gpu.device.limits().max_texture_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(EnvRenderError::BadSize { width, height, max });
         }
-        let srbf_lights: Vec<EnvLight> = lights.iter().copied().filter(|l| l.lambda.is_some()).collect();
-        let directional: Vec<EnvLight> = lights.iter().copied().filter(|l| l.lambda.is_none()).collect();
+        let srbf_lights: Vec<EnvLight> = lights
+            .iter()
+            .copied()
+            .filter(|l| l.lambda.is_some())
+            .collect();
+        let directional: Vec<EnvLight> = lights
+            .iter()
+            .copied()
+            .filter(|l| l.lambda.is_none())
+            .collect();
         if !srbf_lights.is_empty() {
-            let t = tables.srbf.as_ref().ok_or(EnvTableError::Missing { table: "srbf", needed_by: "SRBF lights" })?;
+            let t = tables.srbf.as_ref().ok_or(EnvTableError::Missing {
+                table: "srbf",
+                needed_by: "SRBF lights",
+            })?;
             check_env_table("srbf", t, Some(AXIS_INV_LAMBDA))?;
         }
         if !directional.is_empty() {
-            let t = tables
-                .direct
-                .as_ref()
-                .ok_or(EnvTableError::Missing { table: "direct", needed_by: "directional lights" })?;
+            let t = tables.direct.as_ref().ok_or(EnvTableError::Missing {
+                table: "direct",
+                needed_by: "directional lights",
+            })?;
             check_env_table("direct", t, None)?;
         }
         if multiple.is_some() {
-            let t = tables
-                .multiple
-                .as_ref()
-                .ok_or(EnvTableError::Missing { table: "multiple", needed_by: "multiple scattering" })?;
+            let t = tables.multiple.as_ref().ok_or(EnvTableError::Missing {
+                table: "multiple",
+                needed_by: "multiple scattering",
+            })?;
             check_env_table("multiple", t, Some(AXIS_SIGMA_F))?;
         }
         let batch_size = options.dodm.batch_size as usize;
@@ -292,7 +350,8 @@ impl EnvRenderer {
 
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;
-        let simplified = (options.kappa < 1.0).then(|| SimplifiedSegments::new(gpu, model, options.simplification_seed));
+        let simplified = (options.kappa < 1.0)
+            .then(|| SimplifiedSegments::new(gpu, model, options.simplification_seed));
         let light_geometry = match &simplified {
             Some(s) => s.geometry(&geometry, options.kappa),
             None => StrandGeometry {
@@ -317,10 +376,21 @@ impl EnvRenderer {
         };
         let table_bindings = timings.time(gpu, "table upload", || {
             let multiple_table = multiple.and(tables.multiple.as_ref());
-            let bind = |t: &Option<Table>| t.as_ref().map(|t| TableBinding::new(gpu, &self.view.table_layout, t, multiple_table));
+            let bind = |t: &Option<Table>| {
+                t.as_ref()
+                    .map(|t| TableBinding::new(gpu, &self.view.table_layout, t, multiple_table))
+            };
             (
-                if srbf_lights.is_empty() { None } else { bind(&tables.srbf) },
-                if directional.is_empty() { None } else { bind(&tables.direct) },
+                if srbf_lights.is_empty() {
+                    None
+                } else {
+                    bind(&tables.srbf)
+                },
+                if directional.is_empty() {
+                    None
+                } else {
+                    bind(&tables.direct)
+                },
             )
         });
         let mut memory: Vec<(String, u64)> = geometry.memory();
@@ -331,7 +401,10 @@ impl EnvRenderer {
         let mut table_bytes = 0;
         let mut grid_bytes = 0u64;
         let mut batches = 0u32;
-        for (kind_lights, binding) in [(&srbf_lights, &table_bindings.0), (&directional, &table_bindings.1)] {
+        for (kind_lights, binding) in [
+            (&srbf_lights, &table_bindings.0),
+            (&directional, &table_bindings.1),
+        ] {
             let Some(binding) = binding else { continue };
             table_bytes += binding.bytes;
             for chunk in kind_lights.chunks(batch_size) {
@@ -347,21 +420,47 @@ impl EnvRenderer {
                 let directions: Vec<_> = chunk.iter().map(|l| l.direction).collect();
                 timings.time(gpu, "light pass", || {
                     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                    self.depth.encode(gpu, &mut encoder, &light_geometry, &directions, bounds, 1.0 / options.kappa, &mut dodm);
+                    self.depth.encode(
+                        gpu,
+                        &mut encoder,
+                        &light_geometry,
+                        &directions,
+                        bounds,
+                        1.0 / options.kappa,
+                        &mut dodm,
+                    );
                     gpu.queue.submit([encoder.finish()]);
                 });
                 timings.time(gpu, "summed-area tables", || {
                     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                    self.sat.encode(gpu, &mut encoder, &dodm.optical_depth, &sat);
+                    self.sat
+                        .encode(gpu, &mut encoder, &dodm.optical_depth, &sat);
                     gpu.queue.submit([encoder.finish()]);
                 });
                 timings.time(gpu, "view", || {
-                    let batch =
-                        BatchBinding::new(gpu, &self.view.batch_layout, chunk, &dodm, &sat, options.shadowed, grid.is_some());
+                    let batch = BatchBinding::new(
+                        gpu,
+                        &self.view.batch_layout,
+                        chunk,
+                        &dodm,
+                        &sat,
+                        options.shadowed,
+                        grid.is_some(),
+                    );
                     let grid_binding = GridBinding::new(gpu, &self.view.grid_layout, grid.as_ref());
                     grid_bytes = grid_bytes.max(grid_binding.bytes);
                     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                    self.view.encode(gpu, &mut encoder, &geometry, &frame, &batch, binding, &grid_binding, &targets, &sums);
+                    self.view.encode(
+                        gpu,
+                        &mut encoder,
+                        &geometry,
+                        &frame,
+                        &batch,
+                        binding,
+                        &grid_binding,
+                        &targets,
+                        &sums,
+                    );
                     gpu.queue.submit([encoder.finish()]);
                 });
             }
@@ -419,7 +518,9 @@ pub fn render_env_frame(
 ) -> Result<EnvFrame, EnvRenderError> {
     let mut timings = Timings(Vec::new());
     let renderer = timings.time(gpu, "pipelines", || EnvRenderer::new(gpu));
-    let mut frame = renderer.render(gpu, model, camera, width, height, lights, tables, options, multiple)?;
+    let mut frame = renderer.render(
+        gpu, model, camera, width, height, lights, tables, options, multiple,
+    )?;
     frame.stats.timings.splice(0..0, timings.0);
     Ok(frame)
 }

@@ -41,7 +41,11 @@ pub struct DodmSettings {
 
 impl Default for DodmSettings {
     fn default() -> Self {
-        Self { resolution: 512, first_layer: None, batch_size: 16 }
+        Self {
+            resolution: 512,
+            first_layer: None,
+            batch_size: 16,
+        }
     }
 }
 
@@ -75,7 +79,8 @@ impl DodmSettings {
 
     /// d for `bounds`: the setting, else [`default_first_layer`].
     pub fn first_layer_for(&self, bounds: Aabb) -> f32 {
-        self.first_layer.unwrap_or_else(|| default_first_layer(bounds))
+        self.first_layer
+            .unwrap_or_else(|| default_first_layer(bounds))
     }
 }
 
@@ -108,8 +113,9 @@ pub struct SimplifiedSegments {
 /// The strands of `model` in the shuffled order (a permutation of 0..strand_count).
 pub fn shuffled_strand_order(model: &HairModel, seed: u64) -> Vec<u32> {
     let mut rng = SweepRng::new(seed);
-    let mut keyed: Vec<(u64, u32)> =
-        (0..model.strand_count() as u32).map(|s| (rng.next_u64(), s)).collect();
+    let mut keyed: Vec<(u64, u32)> = (0..model.strand_count() as u32)
+        .map(|s| (rng.next_u64(), s))
+        .collect();
     keyed.sort_unstable();
     keyed.into_iter().map(|(_, s)| s).collect()
 }
@@ -133,12 +139,17 @@ impl SimplifiedSegments {
         if shuffled.is_empty() {
             shuffled.push(0);
         }
-        let segments = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("hair segments (shuffled strands)"),
-            contents: bytemuck::cast_slice(&shuffled),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
-        Self { segments, segments_before }
+        let segments = gpu
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("hair segments (shuffled strands)"),
+                contents: bytemuck::cast_slice(&shuffled),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
+        Self {
+            segments,
+            segments_before,
+        }
     }
 
     /// Segments to draw for fraction κ: those of the first ⌈κ·strands⌉ shuffled strands.
@@ -236,14 +247,20 @@ impl DodmBatch {
     /// Texels per world unit of slot `slot`'s map.
     pub fn texels_per_unit(&self, slot: usize) -> f32 {
         match self.cameras[slot].projection {
-            Projection::Orthographic { half_height } => self.resolution as f32 / (2.0 * half_height),
+            Projection::Orthographic { half_height } => {
+                self.resolution as f32 / (2.0 * half_height)
+            }
             Projection::Perspective { .. } => 0.0,
         }
     }
 
     pub fn memory(&self) -> Vec<(String, u64)> {
         let texels = self.resolution as u64 * self.resolution as u64 * self.slots.max(1) as u64;
-        let texel = self.optical_depth.format().block_copy_size(None).unwrap_or(16) as u64;
+        let texel = self
+            .optical_depth
+            .format()
+            .block_copy_size(None)
+            .unwrap_or(16) as u64;
         vec![
             ("dodm nearest depth".into(), texels * 4),
             ("dodm optical depth".into(), texels * texel),
@@ -265,8 +282,11 @@ impl ConvolutionDepthPass {
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("convolution_depth.wgsl"),
             source: wgpu::ShaderSource::Wgsl(
-                concat!(include_str!("strand_quads.wgsl"), include_str!("convolution_depth.wgsl"))
-                    .into(),
+                concat!(
+                    include_str!("strand_quads.wgsl"),
+                    include_str!("convolution_depth.wgsl")
+                )
+                .into(),
             ),
         });
         let strand_layout = strand_bind_group_layout(device);
@@ -347,7 +367,10 @@ impl ConvolutionDepthPass {
                 compilation_options: Default::default(),
                 targets: &[Some(wgpu::ColorTargetState {
                     format: gpu.hdr_format(),
-                    blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
+                    blend: Some(wgpu::BlendState {
+                        color: additive,
+                        alpha: additive,
+                    }),
                     write_mask: wgpu::ColorWrites::ALL,
                 })],
             }),
@@ -357,7 +380,12 @@ impl ConvolutionDepthPass {
             multiview_mask: None,
             cache: None,
         });
-        Self { depth_pipeline, layer_pipeline, strand_layout, dodm_layout }
+        Self {
+            depth_pipeline,
+            layer_pipeline,
+            strand_layout,
+            dodm_layout,
+        }
     }
 
     /// Encodes the maps of `toward_lights` (one slot each, at most `batch.slots`) into `encoder`;
@@ -375,7 +403,10 @@ impl ConvolutionDepthPass {
     ) {
         let device = &gpu.device;
         let res = batch.resolution;
-        batch.cameras = toward_lights.iter().map(|&l| light_camera(l, bounds)).collect();
+        batch.cameras = toward_lights
+            .iter()
+            .map(|&l| light_camera(l, bounds))
+            .collect();
         for (slot, camera) in batch.cameras.iter().enumerate() {
             let slot = slot as u32;
             let frame = FrameParams {
@@ -407,7 +438,10 @@ impl ConvolutionDepthPass {
                         binding: 0,
                         resource: wgpu::BindingResource::TextureView(&depth_view),
                     },
-                    wgpu::BindGroupEntry { binding: 1, resource: uniform.as_entire_binding() },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: uniform.as_entire_binding(),
+                    },
                 ],
             });
             {
@@ -456,10 +490,29 @@ mod tests {
         }
         let ok = DodmSettings::default();
         assert!(ok.check().is_ok());
-        let e = DodmSettings { resolution: 4096, ..ok }.check().unwrap_err();
+        let e = DodmSettings {
+            resolution: 4096,
+            ..ok
+        }
+        .check()
+        .unwrap_err();
         assert!(e.to_string().contains("4096"), "{e}");
-        assert_eq!(DodmSettings { batch_size: 0, ..ok }.check(), Err(DodmSettingsError::BatchSize));
-        assert!(DodmSettings { first_layer: Some(-1.0), ..ok }.check().is_err());
+        assert_eq!(
+            DodmSettings {
+                batch_size: 0,
+                ..ok
+            }
+            .check(),
+            Err(DodmSettingsError::BatchSize)
+        );
+        assert!(
+            DodmSettings {
+                first_layer: Some(-1.0),
+                ..ok
+            }
+            .check()
+            .is_err()
+        );
     }
 
     #[test]
@@ -473,6 +526,9 @@ mod tests {
         assert_eq!(sorted, (0..10).collect::<Vec<_>>());
         assert_eq!(a, shuffled_strand_order(&model, 7));
         assert_ne!(a, shuffled_strand_order(&model, 8));
-        assert_ne!(a, sorted, "a shuffle of 10 strands that is the identity is 1 in 3.6M");
+        assert_ne!(
+            a, sorted,
+            "a shuffle of 10 strands that is the identity is 1 in 3.6M"
+        );
     }
 }

@@ -14,7 +14,9 @@ use wgpu::util::DeviceExt;
 
 use super::attachments::{cleared_color, cleared_depth};
 use super::convolution_depth::DodmBatch;
-use super::strands::{DEPTH_FORMAT, FrameParams, StrandGeometry, strand_bind_group, strand_bind_group_layout};
+use super::strands::{
+    DEPTH_FORMAT, FrameParams, StrandGeometry, strand_bind_group, strand_bind_group_layout,
+};
 use super::summed_area::{MAX_BOX_HALF_SIZE, SummedAreaTables};
 use crate::env::{EnvLight, ForwardScatteringGrid};
 use crate::gpu::GpuContext;
@@ -76,7 +78,11 @@ fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGrou
     }
 }
 
-fn storage_entry(binding: u32, visibility: wgpu::ShaderStages, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+fn storage_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    read_only: bool,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility,
@@ -154,7 +160,8 @@ impl BatchBinding {
         if gpu_lights.is_empty() {
             gpu_lights.push(bytemuck::Zeroable::zeroed());
         }
-        let flags = if shadowed { 0 } else { FLAG_UNSHADOWED } | if with_grid { FLAG_GRID } else { 0 };
+        let flags =
+            if shadowed { 0 } else { FLAG_UNSHADOWED } | if with_grid { FLAG_GRID } else { 0 };
         let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("env batch"),
             contents: bytemuck::bytes_of(&BatchUniform {
@@ -175,13 +182,22 @@ impl BatchBinding {
             label: Some("env batch"),
             layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: light_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: uniform.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: light_buffer.as_entire_binding(),
+                },
                 wgpu::BindGroupEntry {
                     binding: 2,
                     resource: wgpu::BindingResource::TextureView(&depth_view),
                 },
-                wgpu::BindGroupEntry { binding: 3, resource: sat.buffer.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: sat.buffer.as_entire_binding(),
+                },
             ],
         });
         Self { group }
@@ -236,27 +252,57 @@ fn bind_buffers(
     let entries: Vec<_> = buffers
         .iter()
         .enumerate()
-        .map(|(i, b)| wgpu::BindGroupEntry { binding: i as u32, resource: b.as_entire_binding() })
+        .map(|(i, b)| wgpu::BindGroupEntry {
+            binding: i as u32,
+            resource: b.as_entire_binding(),
+        })
         .collect();
-    let group = device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries });
+    let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    });
     (group, buffers.iter().map(|b| b.size()).sum())
 }
 
-fn init_buffer(device: &wgpu::Device, label: &str, contents: &[u8], usage: wgpu::BufferUsages) -> wgpu::Buffer {
-    device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+fn init_buffer(
+    device: &wgpu::Device,
+    label: &str,
+    contents: &[u8],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents,
+        usage,
+    })
 }
 
 impl TableBinding {
     /// Tables must have 4 axes and 3 channels (checked by the caller).
-    pub fn new(gpu: &GpuContext, layout: &wgpu::BindGroupLayout, single: &Table, multiple: Option<&Table>) -> Self {
+    pub fn new(
+        gpu: &GpuContext,
+        layout: &wgpu::BindGroupLayout,
+        single: &Table,
+        multiple: Option<&Table>,
+    ) -> Self {
         let device = &gpu.device;
         let storage = wgpu::BufferUsages::STORAGE;
         let uniform = wgpu::BufferUsages::UNIFORM;
-        let single_layout = init_buffer(device, "env single layout", bytemuck::bytes_of(&table_layout(single)), uniform);
+        let single_layout = init_buffer(
+            device,
+            "env single layout",
+            bytemuck::bytes_of(&table_layout(single)),
+            uniform,
+        );
         let single_values = init_buffer(device, "env single table", single.as_bytes(), storage);
         let multiple_table = multiple.unwrap_or(single);
-        let multiple_layout =
-            init_buffer(device, "env multiple layout", bytemuck::bytes_of(&table_layout(multiple_table)), uniform);
+        let multiple_layout = init_buffer(
+            device,
+            "env multiple layout",
+            bytemuck::bytes_of(&table_layout(multiple_table)),
+            uniform,
+        );
         let multiple_values = match multiple {
             Some(t) => init_buffer(device, "env multiple table", t.as_bytes(), storage),
             None => init_buffer(device, "env multiple table", &[0u8; 16], storage),
@@ -265,7 +311,12 @@ impl TableBinding {
             device,
             "env tables",
             layout,
-            &[&single_layout, &single_values, &multiple_layout, &multiple_values],
+            &[
+                &single_layout,
+                &single_values,
+                &multiple_layout,
+                &multiple_values,
+            ],
         );
         Self { group, bytes }
     }
@@ -279,7 +330,11 @@ pub struct GridBinding {
 
 impl GridBinding {
     /// `grid.values` must hold `lights × dims` entries (checked by the caller).
-    pub fn new(gpu: &GpuContext, layout: &wgpu::BindGroupLayout, grid: Option<&ForwardScatteringGrid>) -> Self {
+    pub fn new(
+        gpu: &GpuContext,
+        layout: &wgpu::BindGroupLayout,
+        grid: Option<&ForwardScatteringGrid>,
+    ) -> Self {
         let device = &gpu.device;
         let (uniform, values) = match grid {
             Some(g) => (
@@ -288,14 +343,33 @@ impl GridBinding {
                     spacing: g.spacing.extend(0.0).into(),
                     dims: [g.dims[0], g.dims[1], g.dims[2], 0],
                 },
-                init_buffer(device, "env forward-scattering grid", bytemuck::cast_slice(&g.values), wgpu::BufferUsages::STORAGE),
+                init_buffer(
+                    device,
+                    "env forward-scattering grid",
+                    bytemuck::cast_slice(&g.values),
+                    wgpu::BufferUsages::STORAGE,
+                ),
             ),
             None => (
-                GridUniform { origin: [0.0; 4], spacing: [1.0; 4], dims: [1, 1, 1, 0] },
-                init_buffer(device, "env forward-scattering grid", &[0u8; 16], wgpu::BufferUsages::STORAGE),
+                GridUniform {
+                    origin: [0.0; 4],
+                    spacing: [1.0; 4],
+                    dims: [1, 1, 1, 0],
+                },
+                init_buffer(
+                    device,
+                    "env forward-scattering grid",
+                    &[0u8; 16],
+                    wgpu::BufferUsages::STORAGE,
+                ),
             ),
         };
-        let params = init_buffer(device, "env grid params", bytemuck::bytes_of(&uniform), wgpu::BufferUsages::UNIFORM);
+        let params = init_buffer(
+            device,
+            "env grid params",
+            bytemuck::bytes_of(&uniform),
+            wgpu::BufferUsages::UNIFORM,
+        );
         let (group, bytes) = bind_buffers(device, "env grid", layout, &[&params, &values]);
         Self { group, bytes }
     }
@@ -310,7 +384,11 @@ pub struct EnvViewTargets {
 
 impl EnvViewTargets {
     pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Self {
-        let size = wgpu::Extent3d { width, height, depth_or_array_layers: 1 };
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
         let texture = |label, format, usage| {
             gpu.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
@@ -329,13 +407,19 @@ impl EnvViewTargets {
         Self {
             single: texture("env single", gpu.hdr_format(), color),
             multiple: texture("env multiple", gpu.hdr_format(), color),
-            depth: texture("env depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT),
+            depth: texture(
+                "env depth",
+                DEPTH_FORMAT,
+                wgpu::TextureUsages::RENDER_ATTACHMENT,
+            ),
         }
     }
 
     pub fn memory(&self) -> Vec<(String, u64)> {
         let bytes = |t: &wgpu::Texture| {
-            t.width() as u64 * t.height() as u64 * t.format().block_copy_size(None).unwrap_or(4) as u64
+            t.width() as u64
+                * t.height() as u64
+                * t.format().block_copy_size(None).unwrap_or(4) as u64
         };
         vec![
             ("env single target".into(), bytes(&self.single)),
@@ -404,7 +488,12 @@ impl EnvViewPass {
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("env view"),
-            bind_group_layouts: &[Some(&strand_layout), Some(&batch_layout), Some(&table_layout), Some(&grid_layout)],
+            bind_group_layouts: &[
+                Some(&strand_layout),
+                Some(&batch_layout),
+                Some(&table_layout),
+                Some(&grid_layout),
+            ],
             immediate_size: 0,
         });
         let premultiplied_over = wgpu::BlendComponent {
@@ -414,7 +503,10 @@ impl EnvViewPass {
         };
         let target = Some(wgpu::ColorTargetState {
             format: gpu.hdr_format(),
-            blend: Some(wgpu::BlendState { color: premultiplied_over, alpha: premultiplied_over }),
+            blend: Some(wgpu::BlendState {
+                color: premultiplied_over,
+                alpha: premultiplied_over,
+            }),
             write_mask: wgpu::ColorWrites::ALL,
         });
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -461,17 +553,23 @@ impl EnvViewPass {
         };
         let accumulate_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("env accumulate"),
-            entries: &[float_texture(0), float_texture(1), storage_entry(2, compute, false), uniform_entry(3, compute)],
+            entries: &[
+                float_texture(0),
+                float_texture(1),
+                storage_entry(2, compute, false),
+                uniform_entry(3, compute),
+            ],
         });
         let accumulate_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("env_accumulate.wgsl"),
             source: wgpu::ShaderSource::Wgsl(include_str!("env_accumulate.wgsl").into()),
         });
-        let accumulate_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("env accumulate"),
-            bind_group_layouts: &[Some(&accumulate_layout)],
-            immediate_size: 0,
-        });
+        let accumulate_pipeline_layout =
+            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("env accumulate"),
+                bind_group_layouts: &[Some(&accumulate_layout)],
+                immediate_size: 0,
+            });
         let accumulate = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("env accumulate"),
             layout: Some(&accumulate_pipeline_layout),
@@ -480,7 +578,15 @@ impl EnvViewPass {
             compilation_options: Default::default(),
             cache: None,
         });
-        Self { pipeline, accumulate, accumulate_layout, strand_layout, batch_layout, table_layout, grid_layout }
+        Self {
+            pipeline,
+            accumulate,
+            accumulate_layout,
+            strand_layout,
+            batch_layout,
+            table_layout,
+            grid_layout,
+        }
     }
 
     /// Zeroed sums for a `width`×`height` frame, bound to `targets`.
@@ -495,7 +601,11 @@ impl EnvViewPass {
         });
         let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("env accumulate params"),
-            contents: bytemuck::bytes_of(&AccumulateUniform { width, height, _pad: [0; 2] }),
+            contents: bytemuck::bytes_of(&AccumulateUniform {
+                width,
+                height,
+                _pad: [0; 2],
+            }),
             usage: wgpu::BufferUsages::UNIFORM,
         });
         let single = targets.single.create_view(&Default::default());
@@ -504,13 +614,30 @@ impl EnvViewPass {
             label: Some("env accumulate"),
             layout: &self.accumulate_layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&single) },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&multiple) },
-                wgpu::BindGroupEntry { binding: 2, resource: sums.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: uniform.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&single),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(&multiple),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: sums.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: uniform.as_entire_binding(),
+                },
             ],
         });
-        EnvAccumulator { sums, width, height, group }
+        EnvAccumulator {
+            sums,
+            width,
+            height,
+            group,
+        }
     }
 
     /// Encodes one batch: the view pass into `targets`, then its addition into `sums`.

@@ -45,9 +45,16 @@ pub struct SatTooLarge {
 pub fn sat_bytes(gpu: &GpuContext, resolution: u32, slots: u32) -> Result<u64, SatTooLarge> {
     let bytes = resolution as u64 * resolution as u64 * slots.max(1) as u64 * SAT_TEXEL_BYTES;
     let limits = gpu.device.limits();
-    let limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    let limit = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size);
     if bytes > limit {
-        return Err(SatTooLarge { slots, resolution, bytes, limit });
+        return Err(SatTooLarge {
+            slots,
+            resolution,
+            bytes,
+            limit,
+        });
     }
     Ok(bytes)
 }
@@ -68,7 +75,11 @@ impl SummedAreaTables {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        Ok(Self { buffer, resolution, slots })
+        Ok(Self {
+            buffer,
+            resolution,
+            slots,
+        })
     }
 
     pub fn memory(&self) -> Vec<(String, u64)> {
@@ -148,7 +159,11 @@ impl SummedAreaPass {
                 cache: None,
             })
         };
-        Self { rows: pipeline("scan_rows"), columns: pipeline("scan_columns"), layout }
+        Self {
+            rows: pipeline("scan_rows"),
+            columns: pipeline("scan_columns"),
+            layout,
+        }
     }
 
     /// Encodes the SATs of every slot of `optical_depth` (an RGBA float array texture of
@@ -175,9 +190,18 @@ impl SummedAreaPass {
             label: Some("summed area"),
             layout: &self.layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&view) },
-                wgpu::BindGroupEntry { binding: 1, resource: tables.buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: uniform.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::TextureView(&view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: tables.buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: uniform.as_entire_binding(),
+                },
             ],
         });
         let groups = tables.resolution.div_ceil(64);

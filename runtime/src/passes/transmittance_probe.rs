@@ -26,7 +26,11 @@ pub struct ProbeBox {
 
 impl ProbeBox {
     pub fn new(slot: u32, x0: i32, y0: i32, x1: i32, y1: i32) -> Self {
-        Self { corners: [x0, y0, x1, y1], slot, _pad: [0; 3] }
+        Self {
+            corners: [x0, y0, x1, y1],
+            slot,
+            _pad: [0; 3],
+        }
     }
 }
 
@@ -63,7 +67,12 @@ impl TransmittanceProbe {
         };
         let probe_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe"),
-            entries: &[storage(0, true), storage(1, false), storage(2, true), storage(3, false)],
+            entries: &[
+                storage(0, true),
+                storage(1, false),
+                storage(2, true),
+                storage(3, false),
+            ],
         });
         let batch_layout = transmittance_bind_group_layout(device, compute);
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -122,14 +131,29 @@ impl TransmittanceProbe {
             label: Some("probe"),
             layout: &self.probe_layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: points_in.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: points_out.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: boxes_in.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: boxes_out.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: points_in.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: points_out.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: boxes_in.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: boxes_out.as_entire_binding(),
+                },
             ],
         });
         let mut encoder = device.create_command_encoder(&Default::default());
-        for (pipeline, n) in [(&self.transmittance, points.len()), (&self.boxes, boxes.len())] {
+        for (pipeline, n) in [
+            (&self.transmittance, points.len()),
+            (&self.boxes, boxes.len()),
+        ] {
             if n == 0 {
                 continue;
             }
@@ -153,8 +177,12 @@ impl TransmittanceProbe {
         slot: u32,
         points: &[Vec3],
     ) -> Result<Vec<f32>, ReadbackError> {
-        let points: Vec<ProbePoint> =
-            points.iter().map(|p| ProbePoint { position: p.extend(slot as f32).into() }).collect();
+        let points: Vec<ProbePoint> = points
+            .iter()
+            .map(|p| ProbePoint {
+                position: p.extend(slot as f32).into(),
+            })
+            .collect();
         Ok(self.run(gpu, batch, &points, &[])?.0)
     }
 
