@@ -123,6 +123,9 @@ pub struct EnvRenderOptions {
     pub transparency: Transparency,
     /// `false`: no self-shadowing (T̃ = 1; for tests and for comparisons).
     pub shadowed: bool,
+    /// View pass only: every fiber this many pixels wide instead of its projected thickness (as
+    /// `FrameParams::width_override_px`); the light pass always uses the file's thickness.
+    pub width_override_px: Option<f32>,
 }
 
 impl Default for EnvRenderOptions {
@@ -133,6 +136,7 @@ impl Default for EnvRenderOptions {
             simplification_seed: 0x5eed,
             transparency: Transparency::Opaque,
             shadowed: true,
+            width_override_px: None,
         }
     }
 }
@@ -372,7 +376,7 @@ impl EnvRenderer {
             height,
             lights: Vec::new(),
             shading: KajiyaKay::default(),
-            width_override_px: None,
+            width_override_px: options.width_override_px,
         };
         let table_bindings = timings.time(gpu, "table upload", || {
             let multiple_table = multiple.and(tables.multiple.as_ref());
