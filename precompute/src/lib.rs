@@ -19,6 +19,7 @@ pub mod check_tables;
 pub mod convolution;
 pub mod convolution_table;
 pub mod cube_lights;
+pub mod direct_table;
 pub mod envmap;
 pub mod envmap_error;
 pub mod envmap_io;
