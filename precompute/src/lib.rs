@@ -23,6 +23,7 @@ pub mod direct_table;
 pub mod envmap;
 pub mod envmap_error;
 pub mod envmap_io;
+pub mod env_lights;
 pub mod median_cut;
 pub mod multiple_scattering_table;
 pub mod nnls;
