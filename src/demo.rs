@@ -22,7 +22,7 @@ pub const ENVMAP_DIR: &str = "envmaps";
 pub const DEMO_PRESET: &str = "brown";
 /// Nodes per direction axis of the demo's tables (1/λ gets twice as many): chosen so the bake
 /// fits the two-minute budget on 2 cores (docs/BENCHMARKS.md has the timing and the accuracy).
-pub const DEMO_TABLE_NODES: usize = 16;
+pub const DEMO_TABLE_NODES: usize = 32;
 pub const DEMO_SIZE: (u32, u32) = (640, 480);
 pub const OUT_DIR: &str = "out";
 pub const CACHE_DIR: &str = "out/cache";
