@@ -91,21 +91,19 @@ fn validate(args: &CompareArgs) -> anyhow::Result<usize> {
     if args.timing_runs == 0 {
         bail!("--timing-runs 0: at least one render per timing");
     }
-    if let Some(n) = args.table_resolution {
-        if !(2..=256).contains(&n) {
-            bail!("--table-resolution {n}: use 2 to 256 nodes per direction axis");
-        }
+    if let Some(n) = args.table_resolution
+        && !(2..=256).contains(&n)
+    {
+        bail!("--table-resolution {n}: use 2 to 256 nodes per direction axis");
     }
     face_resolution_for(args.reference_lights).with_context(|| {
         format!("--reference-lights {}: must be 6n² for a cube of n×n texels per face (e.g. 6, 24, 96, 384, 1536, 6144)", args.reference_lights)
     })
 }
 
-/// Loads, fits, bakes and builds the light sets (every step timed into `steps`).
+/// Loads the hair file, fits, bakes and builds the light sets (every step timed into `steps`).
 pub fn prepare(args: &CompareArgs, steps: &mut Steps) -> anyhow::Result<CompareScene> {
-    let face_resolution = validate(args)?;
-    let (width, height) = crate::render::parse_size(&args.size)?;
-    let fiber = FiberDescription::preset(&args.preset).with_context(|| format!("--preset {:?}", args.preset))?;
+    validate(args)?;
     let (hair, hair_sha256) = steps.run(
         "hair",
         || {
@@ -115,6 +113,14 @@ pub fn prepare(args: &CompareArgs, steps: &mut Steps) -> anyhow::Result<CompareS
         },
         |(m, _): &(HairModel, String)| format!("{} ({} strands)", args.hair.display(), m.strand_count()),
     )?;
+    prepare_with_hair(args, hair, hair_sha256, steps)
+}
+
+/// [`prepare`] for a hair already loaded (`hair_sha256` identifies it in the reference cache).
+pub fn prepare_with_hair(args: &CompareArgs, hair: HairModel, hair_sha256: String, steps: &mut Steps) -> anyhow::Result<CompareScene> {
+    let face_resolution = validate(args)?;
+    let (width, height) = crate::render::parse_size(&args.size)?;
+    let fiber = FiberDescription::preset(&args.preset).with_context(|| format!("--preset {:?}", args.preset))?;
     let env = steps.run("environment", || load_env(&args.env, args.sanitize), |e| format!("{} {}x{}", e.name, e.map.width(), e.map.height()))?;
     let options = FitOptions { max_lobes: args.lobes, initial_lobes: args.lobes.min(FitOptions::default().initial_lobes), rotate_degrees: args.rotate, ..FitOptions::default() };
     let fit = steps.run("fit", || fit_cached(&env, &options, &args.cache), |f| {
@@ -143,12 +149,15 @@ pub fn prepare(args: &CompareArgs, steps: &mut Steps) -> anyhow::Result<CompareS
     Ok(CompareScene { hair, hair_sha256, camera, up, size: (width, height), tables, srbf, reference, map: env.map, map_sha256: env.sha256, fiber })
 }
 
+/// The function that renders a frame: [`render_lights`] in the program, a stand-in in tests.
+pub type Renderer<'r> = &'r dyn Fn(&EnvFrame) -> anyhow::Result<RenderedEnv>;
+
 /// Renders `runs` times and keeps the last image with the median time.
-fn timed_render(frame: &EnvFrame, runs: usize) -> anyhow::Result<RenderedEnv> {
+fn timed_render(render: Renderer, frame: &EnvFrame, runs: usize) -> anyhow::Result<RenderedEnv> {
     let mut times = Vec::with_capacity(runs);
     let mut last = None;
     for _ in 0..runs {
-        let r = render_lights(frame)?;
+        let r = render(frame)?;
         times.push(r.milliseconds);
         last = Some(r);
     }
@@ -189,9 +198,9 @@ fn reference_inputs(scene: &CompareScene, args: &CompareArgs, mode: ScatteringMo
     }))
 }
 
-fn run_mode(scene: &CompareScene, args: &CompareArgs, mode: ScatteringMode, steps: &mut Steps) -> anyhow::Result<ModeResult> {
+fn run_mode(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: ScatteringMode, steps: &mut Steps) -> anyhow::Result<ModeResult> {
     let m = mode.name();
-    let srbf = steps.run(&format!("{m}: SRBF"), || timed_render(&frame(scene, args, &scene.srbf, mode), args.timing_runs), |r| format!("{:.2} ms/frame, {} lights", r.milliseconds, scene.srbf.len()))?;
+    let srbf = steps.run(&format!("{m}: SRBF"), || timed_render(render, &frame(scene, args, &scene.srbf, mode), args.timing_runs), |r| format!("{:.2} ms/frame, {} lights", r.milliseconds, scene.srbf.len()))?;
     let cache = ReferenceCache::new(args.cache.join("reference"));
     let inputs = reference_inputs(scene, args, mode)?;
     let reference = steps.run(
@@ -199,7 +208,7 @@ fn run_mode(scene: &CompareScene, args: &CompareArgs, mode: ScatteringMode, step
         || match cache.load(&inputs) {
             Some((image, record)) => Ok((image, record, true)),
             None => {
-                let r = render_lights(&frame(scene, args, &scene.reference, mode))?;
+                let r = render(&frame(scene, args, &scene.reference, mode))?;
                 let record = ReferenceRecord { inputs: inputs.clone(), lights: scene.reference.len(), milliseconds: r.milliseconds };
                 cache.store(&r.image, &record)?;
                 Ok((r.image, record, false))
@@ -213,13 +222,13 @@ fn run_mode(scene: &CompareScene, args: &CompareArgs, mode: ScatteringMode, step
         || {
             equal_time_lights(&search, |n| {
                 let lights = to_env_lights(&median_cut_lights(&scene.map, n, args.rotate), scene.up);
-                Ok::<f64, anyhow::Error>(timed_render(&frame(scene, args, &lights, mode), args.timing_runs)?.milliseconds)
+                Ok::<f64, anyhow::Error>(timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)?.milliseconds)
             })
         },
         |f| format!("{} median-cut lights at {:.2} ms/frame ({} searches{})", f.lights, f.milliseconds, f.measurements.len(), if f.at_bound { ", at the search bound" } else { "" }),
     )?;
     let lights = to_env_lights(&median_cut_lights(&scene.map, found.lights, args.rotate), scene.up);
-    let baseline = timed_render(&frame(scene, args, &lights, mode), args.timing_runs)?;
+    let baseline = timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)?;
     Ok(ModeResult { srbf, reference, baseline, baseline_lights: found.lights, baseline_search: found.measurements })
 }
 
@@ -241,13 +250,23 @@ fn write_mode_images(args: &CompareArgs, mode: ScatteringMode, r: &ModeResult, d
 pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     let mut steps = Steps::new(args.json);
     let scene = prepare(&args, &mut steps)?;
+    let report = execute(&args, &scene, &mut steps, &render_lights)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    }
+    Ok(())
+}
+
+/// Renders both modes three ways with `render`, writes the images and returns the report
+/// (`{"single": {...}, "full": {...}, "steps": [...]}`; the shape of the JSON).
+pub fn execute(args: &CompareArgs, scene: &CompareScene, steps: &mut Steps, render: Renderer) -> anyhow::Result<Value> {
     let mut report = serde_json::Map::new();
     let description = format!("strandlight compare: {} under {} ({:?}, preset {})", args.hair.display(), args.env, args.shading, args.preset);
     for mode in [ScatteringMode::Single, ScatteringMode::Full] {
-        let r = run_mode(&scene, &args, mode, &mut steps)?;
+        let r = run_mode(render, scene, args, mode, steps)?;
         let srbf_error = relative_rmse(&r.srbf.image, &r.reference.0)?;
         let baseline_error = relative_rmse(&r.baseline.image, &r.reference.0)?;
-        let written = write_mode_images(&args, mode, &r, &description)?;
+        let written = write_mode_images(args, mode, &r, &description)?;
         let reference_ms = r.reference.1.milliseconds;
         report.insert(
             mode.name().into(),
@@ -265,17 +284,15 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
         ));
     }
     steps.say(error_legend());
-    if args.json {
-        report.insert("steps".into(), json!(steps.done.iter().map(|(n, s, note)| json!({"step": n, "seconds": s, "note": note})).collect::<Vec<_>>()));
-        println!("{}", serde_json::to_string_pretty(&Value::Object(report))?);
-    }
-    Ok(())
+    report.insert("steps".into(), json!(steps.done.iter().map(|(n, s, note)| json!({"step": n, "seconds": s, "note": note})).collect::<Vec<_>>()));
+    Ok(Value::Object(report))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use clap::Parser;
+    use crate::env_scene::fit_cached;
 
     #[derive(Parser)]
     struct Cli {
@@ -306,5 +323,68 @@ mod tests {
         let a = args(&["--hair", "/nonexistent/straight.hair", "--env", "procedural:studio", "--reference-lights", "96"]).unwrap();
         let e = prepare(&a, &mut Steps::new(true)).err().expect("must fail");
         assert!(format!("{e:#}").contains("/nonexistent/straight.hair"), "{e:#}");
+    }
+
+    /// A stand-in renderer whose picture is known without a GPU: every pixel of a central
+    /// block (alpha 1) holds the set's total power Σ power() per channel, the rest is empty;
+    /// a frame costs 1 ms + 0.01 ms per light.
+    fn power_renderer(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
+        let total = frame.lights.iter().fold([0f32; 3], |a, l| {
+            let p = l.power();
+            [a[0] + p[0], a[1] + p[1], a[2] + p[2]]
+        });
+        let (w, h) = (frame.width, frame.height);
+        let pixels = (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                if (w / 4..3 * w / 4).contains(&x) && (h / 4..3 * h / 4).contains(&y) { [total[0], total[1], total[2], 1.0] } else { [0.0; 4] }
+            })
+            .collect();
+        Ok(RenderedEnv { image: Image::new(w, h, pixels), milliseconds: 1.0 + 0.01 * frame.lights.len() as f64 })
+    }
+
+    #[test]
+    fn the_whole_comparison_runs_with_a_stand_in_renderer() {
+        let dir = std::env::temp_dir().join(format!("strandlight-compare-e2e-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let (out, cache) = (dir.join("out").display().to_string(), dir.join("cache").display().to_string());
+        let a = args(&[
+            "--hair", "groom", "--env", "procedural:studio", "--lobes", "8", "--size", "32x24", "--reference-lights", "96",
+            "--table-resolution", "4", "--timing-runs", "1", "--out", &out, "--cache", &cache, "--json",
+        ])
+        .unwrap();
+        let groom = strandlight_runtime::hair::generate_groom(&strandlight_runtime::hair::GroomParams { strand_count: 40, clump_count: 8, ..Default::default() }).unwrap();
+        let mut steps = Steps::new(true);
+        let scene = prepare_with_hair(&a, groom.clone(), "groom".into(), &mut steps).unwrap();
+        let report = execute(&a, &scene, &mut steps, &power_renderer).unwrap();
+        println!("{}", serde_json::to_string_pretty(&report).unwrap());
+        // Independent expectations: the reference and the median cut both carry the map's
+        // integral exactly, the SRBFs carry it times the fit's own measured power ratio.
+        let fit = fit_cached(&load_env("procedural:studio", false).unwrap(), &FitOptions { max_lobes: 8, initial_lobes: 8, ..FitOptions::default() }, &dir.join("cache")).unwrap();
+        assert!(fit.cached, "compare stored its fit in the cache");
+        let integral = scene.map.integral();
+        let num: f64 = (0..3).map(|c| ((fit.set.power_ratio[c] - 1.0) * integral[c]).powi(2)).sum();
+        let den: f64 = integral.iter().map(|v| v * v).sum();
+        let want_srbf = (num / den).sqrt();
+        let n_srbf = scene.srbf.len();
+        for mode in ["single", "full"] {
+            let m = &report[mode];
+            let srbf = m["srbf"]["relative_rmse"].as_f64().unwrap();
+            assert!((srbf - want_srbf).abs() < 1e-5, "{mode}: {srbf} vs {want_srbf}");
+            assert!(m["baseline"]["relative_rmse"].as_f64().unwrap() < 1e-5, "{mode}: median cut carries the whole map");
+            let lights = m["baseline"]["lights"].as_u64().unwrap() as usize;
+            assert!(lights.abs_diff(n_srbf) <= 1, "{mode}: equal time ⇔ equal light count here ({lights} vs {n_srbf})");
+            assert_eq!(m["reference"]["lights"], 96);
+            assert!((m["speedup_vs_reference"].as_f64().unwrap() - (1.96 / (1.0 + 0.01 * n_srbf as f64))).abs() < 1e-9);
+            assert_eq!(m["reference"]["cached"], false);
+            for image in m["images"].as_array().unwrap() {
+                assert!(std::path::Path::new(image.as_str().unwrap()).is_file(), "{image}");
+            }
+        }
+        // Again: the reference comes from its cache.
+        let report = execute(&a, &scene, &mut Steps::new(true), &power_renderer).unwrap();
+        assert_eq!(report["single"]["reference"]["cached"], true);
+        assert_eq!(report["full"]["reference"]["cached"], true);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -21,7 +21,7 @@ impl Steps {
         let value = f().map_err(|e| e.context(format!("step `{name}`")))?;
         let seconds = t.elapsed().as_secs_f64();
         let note = note(&value);
-        self.say(format!("{name:<14} {seconds:>8.2} s  {note}"));
+        self.say(format!("{name:<18} {seconds:>8.2} s  {note}"));
         self.done.push((name.to_string(), seconds, note));
         Ok(value)
     }

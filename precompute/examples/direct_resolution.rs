@@ -18,8 +18,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let dir = std::env::temp_dir().join(format!("strandlight-direct-res-{}", std::process::id()));
     println!("fiber {preset}; errors relative to each table's maximum; 4000 points");
     for n in counts {
-        let mut resolution = BakeResolution::default();
-        resolution.direct_direction_nodes = n;
+        let resolution = BakeResolution { direct_direction_nodes: n, ..BakeResolution::default() };
         let options = PlanOptions { models: vec![Model::Marschner, Model::Artist], resolution, ..Default::default() };
         for job in plan(&fiber, &options)?.jobs.into_iter().filter(|j| j.name.ends_with("_direct")) {
             let t = Instant::now();

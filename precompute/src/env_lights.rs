@@ -78,7 +78,7 @@ pub fn median_cut_lights(map: &EnvMap, count: usize, rotate_degrees: f64) -> Vec
 /// Face resolution n of a reference with `count` = 6n² lights, or None when `count` is not of
 /// that form.
 pub fn face_resolution_for(count: usize) -> Option<usize> {
-    if count == 0 || count % 6 != 0 {
+    if count == 0 || !count.is_multiple_of(6) {
         return None;
     }
     let n = ((count / 6) as f64).sqrt().round() as usize;
