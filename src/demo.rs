@@ -45,11 +45,15 @@ pub fn ensure_procedural_envmap(dir: &Path, name: &str) -> anyhow::Result<(PathB
 
 pub fn run(_args: DemoArgs) -> anyhow::Result<()> {
     let mut steps = Steps::new(false);
-    let (env_path, written) = steps.run("environment", || ensure_procedural_envmap(Path::new(ENVMAP_DIR), DEMO_ENVIRONMENT), |(p, w)| {
-        format!("{} ({})", p.display(), if *w { "generated now" } else { "already there" })
-    })?;
-    let _ = written;
-    let env = load_env(&env_path.to_string_lossy(), false)?;
+    let env = steps.run(
+        "environment",
+        || {
+            let (path, written) = ensure_procedural_envmap(Path::new(ENVMAP_DIR), DEMO_ENVIRONMENT)?;
+            Ok((load_env(&path.to_string_lossy(), false)?, path, written))
+        },
+        |(_, p, w)| format!("{} ({}, read back)", p.display(), if *w { "generated now by procedural_env" } else { "already there" }),
+    )?
+    .0;
     let hair = steps.run("groom", || Ok(generate_groom(&GroomParams::default())?), |h| format!("procedural groom, {} strands", h.strand_count()))?;
     let cache = Path::new(CACHE_DIR);
     let fit = steps.run("fit", || fit_cached(&env, &FitOptions::default(), cache), |f| {
