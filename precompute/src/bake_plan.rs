@@ -150,7 +150,8 @@ impl BakeResolution {
         r.srbf_spread = [n, 2 * n];
         r.fiber_average_thetas = 4 * n;
         r.kajiya_kay_direction_nodes = 3 * n;
-        r.direct_direction_nodes = 4 * n;
+        // 3D and cheap, so 4n, but never above the full-resolution count (1024³ would be 13 GB).
+        r.direct_direction_nodes = (4 * n).min(DEFAULT_DIRECT_NODES);
         r.settings = ConvolutionSettingsSerde { theta_panels: 48, phi_panels: 16 };
         r
     }
