@@ -1,8 +1,16 @@
 //! `strandlight`: the command-line front end. Parsing, progress and dispatch only; the work
 //! lives in the library crates.
 
+mod compare;
+mod demo;
+mod env_lights;
+mod env_scene;
+mod equal_time;
 mod fit;
+mod image_compare;
+mod reference_cache;
 mod render;
+mod steps;
 mod summary;
 mod sweep;
 mod tables_cmd;
@@ -36,6 +44,11 @@ enum Command {
     Inspect(tables_cmd::InspectArgs),
     /// Render a hair model headless under point lights to EXR (linear) and PNG (tonemapped).
     Render(render::RenderArgs),
+    /// SRBF lights vs the brute-force cube-texel reference and the equal-time median-cut
+    /// baseline (Ren 2010 §8): frame times, relative RMSE over hair pixels, images side by side.
+    Compare(compare::CompareArgs),
+    /// The procedural groom under the project's sun-and-sky: fit → bake → env-lit render.
+    Demo(demo::DemoArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -49,5 +62,7 @@ fn main() -> anyhow::Result<()> {
         Command::CheckTables(args) => tables_cmd::check(args),
         Command::Inspect(args) => tables_cmd::inspect(args),
         Command::Render(args) => render::run(args),
+        Command::Compare(args) => compare::run(args),
+        Command::Demo(args) => demo::run(args),
     }
 }

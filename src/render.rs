@@ -110,7 +110,7 @@ pub struct RenderArgs {
     json: bool,
 }
 
-fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
+pub(crate) fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
     let (w, h) = text
         .split_once(['x', 'X'])
         .with_context(|| format!("--size {text:?}: expected WxH, e.g. 656x861"))?;
@@ -135,7 +135,7 @@ fn output_stem(out: &Path) -> PathBuf {
     }
 }
 
-fn load_hair(path: Option<&Path>) -> anyhow::Result<(HairModel, String)> {
+pub(crate) fn load_hair(path: Option<&Path>) -> anyhow::Result<(HairModel, String)> {
     match path {
         Some(path) => {
             let loaded = hair::load(path)?;

@@ -88,17 +88,22 @@ fn progress(len: u64, hidden: bool) -> ProgressBar {
     bar
 }
 
-/// λ range of an SRBF set with a 10% margin, clamped to what tables can hold.
+/// λ range of an SRBF set file with a 10% margin, clamped to what tables can hold.
 fn lambda_range_of(path: &Path) -> anyhow::Result<(f64, f64)> {
     let set = SrbfSet::load(path)?;
+    lambda_range_of_set(&set).with_context(|| path.display().to_string())
+}
+
+/// λ range of an SRBF set with a 10% margin (the bake's 1/λ axis spans only this).
+pub fn lambda_range_of_set(set: &SrbfSet) -> anyhow::Result<(f64, f64)> {
     let lambdas = set.lobes.iter().map(|l| l.lambda);
     let (lo, hi) = lambdas.fold((f64::INFINITY, 0.0f64), |(lo, hi), l| (lo.min(l), hi.max(l)));
     if !(lo.is_finite() && hi > 0.0) {
-        bail!("{}: holds no lobes", path.display());
+        bail!("the SRBF set holds no lobes");
     }
     let (lo, hi) = (lo / 1.1, hi * 1.1);
     if hi > 1e4 {
-        bail!("{}: λ up to {hi:.0} (directional lights?); bake tables for SRBF sets, not directional baselines", path.display());
+        bail!("λ up to {hi:.0} (directional lights?); bake tables for SRBF sets, not directional baselines");
     }
     Ok((lo, if hi > lo * 1.01 { hi } else { lo * 1.01 }))
 }

@@ -5,6 +5,7 @@ use crate::attenuation_ratio::attenuation_ratio_table;
 use crate::bake::{BuildError, TableJob};
 use crate::convolution::{convolve_grid, ConvolutionGrid, ConvolutionSettings};
 use crate::convolution_table::{bake_convolution_table, ConvolutionResolution};
+use crate::direct_table::{bake_direct_table, DirectResolution};
 use crate::multiple_scattering_table::{bake_multiple_scattering_table, MultipleScatteringResolution};
 use crate::point_light_luts::{bake_lut_m, bake_lut_n, LutResolution};
 use crate::srbf_spread::srbf_spread_table;
@@ -92,6 +93,9 @@ pub struct BakeResolution {
     /// Nodes per direction axis of the Kajiya-Kay tables: cheap (at most 3D, monochrome), so
     /// they get enough nodes to follow the specular lobe (p = 40 is ~9° wide).
     pub kajiya_kay_direction_nodes: usize,
+    /// Nodes per direction axis of the direct tables (S·cos θ_i for directional lights): 3D,
+    /// so they can afford enough nodes to follow the narrow R lobe.
+    pub direct_direction_nodes: usize,
 }
 
 /// [`ConvolutionSettings`] as it is written into cache keys.
@@ -122,11 +126,20 @@ impl Default for BakeResolution {
             srbf_spread: [32, 64],
             fiber_average_thetas: 128,
             kajiya_kay_direction_nodes: 96,
+            direct_direction_nodes: DEFAULT_DIRECT_NODES,
         }
     }
 }
 
+/// Direct-table nodes per direction axis at full resolution (measured: docs/BENCHMARKS.md).
+pub const DEFAULT_DIRECT_NODES: usize = 128;
+
 impl BakeResolution {
+    /// The layout of the direct tables: the convolution tables' direction axes, `n` nodes each.
+    pub fn direct(&self) -> DirectResolution {
+        DirectResolution::cube(self.direct_direction_nodes, self.convolution.axes)
+    }
+
     /// Every direction axis with `n` nodes, λ and σ̄_f with `2n`: for quick runs and CI.
     pub fn reduced(n: usize) -> Self {
         let mut r = Self::default();
@@ -137,6 +150,8 @@ impl BakeResolution {
         r.srbf_spread = [n, 2 * n];
         r.fiber_average_thetas = 4 * n;
         r.kajiya_kay_direction_nodes = 3 * n;
+        // 3D and cheap, so 4n, but never above the full-resolution count (1024³ would be 13 GB).
+        r.direct_direction_nodes = (4 * n).min(DEFAULT_DIRECT_NODES);
         r.settings = ConvolutionSettingsSerde { theta_panels: 48, phi_panels: 16 };
         r
     }
@@ -230,6 +245,8 @@ pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan,
             settings: conv_settings.clone(),
             build: Box::new(move || Ok(bake_convolution_table(&|a: &FiberAngles| b.eval(a), &r2.convolution, &settings)?)),
         });
+        push_direct(&mut jobs, "marschner_direct", "S(ω_i, ω_o)·cos θ_i of Marschner for a directional light, RGB", "marschner", params.clone(), &options.resolution, m.clone());
+        push_direct(&mut jobs, "marschner_full_direct", "(S + d_b S_back)·cos θ_i for a directional light (Ren §7), RGB", "marschner+dual-scattering-back", full_params.clone(), &options.resolution, bcsdf.clone());
         push_fiber_averages(&mut jobs, averages.clone(), full_params.clone(), options.resolution.fiber_average_thetas);
         let (mm, mn) = (m.clone(), m.clone());
         let (luts_m, luts_n) = (options.resolution.luts, options.resolution.luts);
@@ -268,6 +285,7 @@ pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan,
             settings: conv_settings.clone(),
             build: Box::new(move || Ok(bake_convolution_table(&|x: &FiberAngles| s.eval(x), &r.convolution, &settings)?)),
         });
+        push_direct(&mut jobs, "artist_direct", "f'_s(ω_i, ω_o)·cos θ_i of the artist-friendly model for a directional light, RGB", "artist", json!({ "artist": fiber.artist }), &options.resolution, a.clone());
         if multiple_source.is_none() {
             let normalized = a.normalized(Normalization::PeakPerChannel);
             let averages = DualScatteringAverages::new(&normalized as &dyn LobeDecomposition, fiber.dual_scattering).map_err(param_error("[artist] dual-scattering averages"))?;
@@ -328,6 +346,20 @@ pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan,
         });
     }
     Ok(BakePlan { jobs, skipped, multiple_scattering_share: share })
+}
+
+/// A direct table of `model` (see [`crate::direct_table`]): same fiber parameters as the
+/// convolution table it stands beside, so one parameter check serves both.
+fn push_direct(jobs: &mut Vec<TableJob>, name: &'static str, quantity: &str, scattering_function: &str, fiber_parameters: serde_json::Value, res: &BakeResolution, model: Arc<dyn ScatteringFunction>) {
+    let direct = res.direct();
+    jobs.push(TableJob {
+        name,
+        quantity: quantity.into(),
+        scattering_function: scattering_function.into(),
+        fiber_parameters,
+        settings: json!({ "direct": direct }),
+        build: Box::new(move || Ok(bake_direct_table(&|a: &FiberAngles| model.eval(a), &direct)?)),
+    });
 }
 
 /// The single-event albedo ā_f + ā_b averaged over incident directions (cos θ-weighted over

@@ -5,6 +5,7 @@
 use crate::attenuation_ratio::attenuation_ratio;
 
 use crate::convolution::convolve_reference;
+use crate::direct_table::direct_value;
 use crate::multiple_scattering_table::multiple_scattering_reference;
 use crate::srbf_spread::srbf_longitudinal_variance;
 use crate::table_check::{stratified_points, summarize, TableAccuracy};
@@ -53,6 +54,15 @@ pub fn check_asset(asset: &TableAsset, samples: usize, seed: u64) -> Result<Tabl
                 let v = convolve_reference(&|a: &FiberAngles| s.eval(a), x[0].asin(), x[1].asin(), x[2].clamp(-1.0, 1.0).acos(), 1.0 / x[3], REFERENCE_PANELS);
                 v.to_vec()
             });
+            (r, pts)
+        }
+        "marschner_direct" | "marschner_full_direct" | "artist_direct" => {
+            let s = scattering_from(name.trim_end_matches("_direct"), params).map_err(bad)?;
+            // The convolution tables' stratification (grazing ends, Δφ strata), at the one
+            // 1/λ node; the reference evaluates the model itself in f64.
+            let inv = axes[3].min;
+            let pts = stratified_points(samples, 16.0, 64.0, seed).into_iter().map(|p| vec![p[0], p[1], p[2], inv]).collect();
+            let r: Reference = Arc::new(move |x: &[f64]| direct_value(&|a: &FiberAngles| s.eval(a), x).to_vec());
             (r, pts)
         }
         "kk_diffuse" | "kk_specular" => {
@@ -161,7 +171,7 @@ fn compare(asset: &TableAsset, name: &str, reference: &Reference, points: &[Vec<
         })
         .collect();
     let rows = rows.into_iter().collect::<Result<Vec<_>, _>>()?;
-    let directional = matches!(name, "marschner" | "marschner_full" | "artist" | "multiple" | "kk_specular");
+    let directional = matches!(name, "marschner" | "marschner_full" | "artist" | "multiple" | "kk_specular" | "marschner_direct" | "marschner_full_direct" | "artist_direct");
     Ok(summarize(name, table, table_max, &rows, directional))
 }
 

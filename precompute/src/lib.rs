@@ -3,10 +3,12 @@
 //! Environment input: [`envmap`] (the in-memory map and THE direction convention),
 //! [`envmap_io`] (files), [`radiance_hdr`], [`procedural_env`]. Lights: [`srbf_fit`] (the
 //! adaptive SRBF fit), [`median_cut`] (the directional baseline), [`srbf_set`] (the file the
-//! runtime reads), [`preview`] (a picture of what the fit lost).
+//! runtime reads), [`preview`] (a picture of what the fit lost), [`cube_lights`] (the
+//! brute-force reference's texel lights), [`env_lights`] (the three light sets of `compare`).
 //!
 //! Tables: [`convolution`] (the SRBF–fiber convolution engine and its brute-force reference),
-//! [`convolution_table`] (I_M, I_A, I_d, I_s as tables), [`multiple_scattering_table`] (I_G),
+//! [`convolution_table`] (I_M, I_A, I_d, I_s as tables), [`direct_table`] (S·cos θ_i for
+//! directional lights, on the same axes), [`multiple_scattering_table`] (I_G),
 //! [`attenuation_ratio`], [`srbf_spread`], [`point_light_luts`] (Hunz Algorithm 2),
 //! [`bake_plan`] (which tables a fiber needs), [`bake`] (assets and the cache),
 //! [`table_check`] and [`check_tables`] (accuracy against f64 references).
@@ -19,9 +21,11 @@ pub mod check_tables;
 pub mod convolution;
 pub mod convolution_table;
 pub mod cube_lights;
+pub mod direct_table;
 pub mod envmap;
 pub mod envmap_error;
 pub mod envmap_io;
+pub mod env_lights;
 pub mod median_cut;
 pub mod multiple_scattering_table;
 pub mod nnls;

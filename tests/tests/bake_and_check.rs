@@ -53,7 +53,7 @@ fn assert_within(results: &[(String, f64, f64)], max_bound: f64, rms_bound: f64)
 #[test]
 fn brown_fiber_tables_match_direct_integration() {
     let r = bake_and_check(&FiberDescription::preset("brown").unwrap(), "brown", false);
-    assert_eq!(r.len(), 11, "every table of every model");
+    assert_eq!(r.len(), 14, "every table of every model (11 + 3 direct)");
     assert_within(&r, 0.1, 0.02);
 }
 

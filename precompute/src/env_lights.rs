@@ -1,0 +1,204 @@
+//! The three light sets `strandlight compare` renders one environment with (Ren 2010 §8), as
+//! plain descriptions the CLI turns into the runtime's `EnvLight`s (precompute does not link
+//! the runtime): the fitted SRBFs, the brute-force cube-texel reference and the median-cut
+//! baseline.
+//!
+//! Directions are in the map's frame of [`crate::envmap`] (+Y up, image center toward −Z),
+//! turned by `rotate_degrees` about +Y exactly as [`crate::srbf_set::SrbfSet`] stores its
+//! lobes, so all three sets of one map agree.
+
+use crate::cube_lights::{cube_face_lights, CubeLightsError};
+use crate::envmap::{rotate_about_up, EnvMap};
+use crate::median_cut::{median_cut, DirectionalLight};
+use crate::srbf_set::{LightKind, SrbfSet};
+use glam::DVec3;
+use strandlight_tables::srbf;
+
+/// One light: an SRBF (`lambda` = Some, `rgb` its amplitude, radiance) or a directional light
+/// (`lambda` = None, `rgb` its irradiance at normal incidence = ∫ L dω of the region it stands
+/// for).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LightSpec {
+    /// Unit vector toward the light.
+    pub direction: DVec3,
+    pub lambda: Option<f64>,
+    pub rgb: [f64; 3],
+}
+
+impl LightSpec {
+    /// ∫ L dω it delivers per channel: amplitude · 2π/λ · (1 − e^{−2λ}) for an SRBF, the
+    /// irradiance for a directional light.
+    pub fn power(&self) -> [f64; 3] {
+        match self.lambda {
+            Some(l) => self.rgb.map(|a| a * srbf::integral(l)),
+            None => self.rgb,
+        }
+    }
+}
+
+/// Σ power over a set, per channel.
+pub fn total_power(lights: &[LightSpec]) -> [f64; 3] {
+    lights.iter().fold([0.0; 3], |acc, l| {
+        let p = l.power();
+        std::array::from_fn(|c| acc[c] + p[c])
+    })
+}
+
+/// The lights of a fitted set. A set of kind `directional` (the median-cut baseline saved by
+/// `fit --directional`, stored as very narrow lobes) becomes directional lights carrying each
+/// lobe's power.
+pub fn srbf_set_lights(set: &SrbfSet) -> Vec<LightSpec> {
+    set.lobes
+        .iter()
+        .map(|l| match set.kind {
+            LightKind::Srbf => LightSpec { direction: l.center().normalize(), lambda: Some(l.lambda), rgb: l.amplitude },
+            LightKind::Directional => LightSpec { direction: l.center().normalize(), lambda: None, rgb: crate::srbf_set::power(l) },
+        })
+        .collect()
+}
+
+fn directional(lights: Vec<DirectionalLight>, rotate_degrees: f64) -> Vec<LightSpec> {
+    lights
+        .into_iter()
+        .map(|l| LightSpec { direction: rotate_about_up(l.direction, rotate_degrees).normalize(), lambda: None, rgb: l.power })
+        .collect()
+}
+
+/// The brute-force reference: `6 · face_resolution²` directional lights, one per cube texel
+/// (32 → the paper's 6144), each carrying its texels' ∫ L dω ([`cube_face_lights`]).
+pub fn reference_lights(map: &EnvMap, face_resolution: usize, rotate_degrees: f64) -> Result<Vec<LightSpec>, CubeLightsError> {
+    Ok(directional(cube_face_lights(map, face_resolution)?, rotate_degrees))
+}
+
+/// The equal-cost baseline: `count` median-cut directional lights (Debevec 2005).
+pub fn median_cut_lights(map: &EnvMap, count: usize, rotate_degrees: f64) -> Vec<LightSpec> {
+    directional(median_cut(map, count.max(1)), rotate_degrees)
+}
+
+/// Face resolution n of a reference with `count` = 6n² lights, or None when `count` is not of
+/// that form.
+pub fn face_resolution_for(count: usize) -> Option<usize> {
+    if count == 0 || !count.is_multiple_of(6) {
+        return None;
+    }
+    let n = ((count / 6) as f64).sqrt().round() as usize;
+    (6 * n * n == count).then_some(n)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::procedural_env;
+    use crate::srbf_fit::FitOptions;
+    use crate::srbf_set::{Source, FORMAT, FORMAT_VERSION};
+    use std::f64::consts::PI;
+    use strandlight_tables::srbf::SrbfLobe;
+
+    /// ∫ L dω by the definition, written out here: Σ pixel radiance × pixel solid angle, the
+    /// solid angle of a row of an equirectangular map being (2π/W)(cos θ_top − cos θ_bottom).
+    fn pixel_sum_integral(map: &EnvMap) -> [f64; 3] {
+        let (w, h) = (map.width(), map.height());
+        let mut sum = [0.0f64; 3];
+        for y in 0..h {
+            let (t0, t1) = (PI * y as f64 / h as f64, PI * (y + 1) as f64 / h as f64);
+            let d_omega = 2.0 * PI / w as f64 * (t0.cos() - t1.cos());
+            for x in 0..w {
+                let p = map.pixel(x, y);
+                for c in 0..3 {
+                    sum[c] += p[c] as f64 * d_omega;
+                }
+            }
+        }
+        sum
+    }
+
+    fn relative_gap(a: [f64; 3], b: [f64; 3]) -> f64 {
+        (0..3).map(|c| ((a[c] - b[c]) / b[c]).abs()).fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn reference_and_median_cut_carry_the_whole_map() {
+        let map = procedural_env::by_name("sun_and_sky", 256).unwrap();
+        let truth = pixel_sum_integral(&map);
+        // Both partition the map's solid angle (every sub-pixel / pixel goes to exactly one
+        // light), so only f64 summation order separates them from the pixel sum: 1e-9.
+        for n in [4, 8] {
+            let lights = reference_lights(&map, n, 30.0).unwrap();
+            assert_eq!(lights.len(), 6 * n * n);
+            let gap = relative_gap(total_power(&lights), truth);
+            println!("cube reference n = {n}: {} lights, relative power gap {gap:.2e}", lights.len());
+            assert!(gap < 1e-9, "{gap}");
+        }
+        for count in [1, 17, 64] {
+            let lights = median_cut_lights(&map, count, -45.0);
+            assert_eq!(lights.len(), count);
+            let gap = relative_gap(total_power(&lights), truth);
+            println!("median cut {count}: relative power gap {gap:.2e}");
+            assert!(gap < 1e-9, "{gap}");
+            assert!(lights.iter().all(|l| (l.direction.length() - 1.0).abs() < 1e-12 && l.lambda.is_none()));
+        }
+    }
+
+    #[test]
+    fn rotation_moves_the_reference_lights_about_up() {
+        let map = procedural_env::by_name("studio", 128).unwrap();
+        let a = reference_lights(&map, 4, 0.0).unwrap();
+        let b = reference_lights(&map, 4, 90.0).unwrap();
+        for (x, y) in a.iter().zip(&b) {
+            // +90° about +Y takes azimuth φ to φ + 90°: with ω = (sinθ sinφ, cosθ, −sinθ cosφ),
+            // (x, y, z) ↦ (−z, y, x).
+            let want = DVec3::new(-x.direction.z, x.direction.y, x.direction.x);
+            assert!((y.direction - want).length() < 1e-12);
+            assert_eq!(x.rgb, y.rgb);
+        }
+    }
+
+    fn set_of(kind: LightKind, lobes: Vec<SrbfLobe>, map: &EnvMap) -> SrbfSet {
+        let mut set = SrbfSet::directional(&Source { map, name: "test".into(), sha256: String::new(), sanitized: Default::default() }, 1, &FitOptions::default());
+        set.format = FORMAT.into();
+        set.version = FORMAT_VERSION;
+        set.kind = kind;
+        set.lobes = lobes;
+        set
+    }
+
+    #[test]
+    fn srbf_lights_carry_the_power_of_the_map_they_describe() {
+        // A map made of known lobes: its pixel-sum integral is an independent estimate of the
+        // lobes' ∫ L dω. The midpoint rule on 1024×512 pixels (0.35°) against lobes ≥ 7° wide
+        // (λ ≤ 64) errs by O((pixel/width)²) ≲ 2.5e-3 · (curvature terms that largely cancel
+        // over a smooth lobe); measured 1.9e-6, bound 1e-4. A wrong λ, a missing 2π or a lost
+        // lobe is off by far more.
+        let lobes = vec![
+            SrbfLobe { center: DVec3::new(0.3, 0.8, -0.5).normalize().to_array(), lambda: 64.0, amplitude: [2.0, 1.5, 1.0] },
+            SrbfLobe { center: DVec3::new(-0.9, 0.1, 0.2).normalize().to_array(), lambda: 16.0, amplitude: [0.2, 0.3, 0.5] },
+            SrbfLobe { center: DVec3::new(0.0, -1.0, 0.0).to_array(), lambda: 30.0, amplitude: [0.1, 0.1, 0.05] },
+        ];
+        let map = procedural_env::from_srbf_lobes(1024, &lobes);
+        let set = set_of(LightKind::Srbf, lobes.clone(), &map);
+        let lights = srbf_set_lights(&set);
+        let gap = relative_gap(total_power(&lights), pixel_sum_integral(&map));
+        println!("SRBF set vs pixel-sum integral of its own map: relative gap {gap:.2e}");
+        assert!(gap < 1e-4, "{gap}");
+        for (l, lobe) in lights.iter().zip(&lobes) {
+            assert_eq!(l.lambda, Some(lobe.lambda));
+            assert_eq!(l.rgb, lobe.amplitude);
+            assert!((l.direction - lobe.center()).length() < 1e-12);
+        }
+        // A directional set (narrow stand-in lobes) becomes directional lights of equal power.
+        let dir = set_of(LightKind::Directional, vec![SrbfLobe { center: [0.0, 1.0, 0.0], lambda: 1e4, amplitude: [3.0, 2.0, 1.0] }], &map);
+        let d = srbf_set_lights(&dir);
+        let want = 2.0 * PI / 1e4 * (1.0 - (-2e4f64).exp());
+        assert!(d[0].lambda.is_none() && (d[0].rgb[0] - 3.0 * want).abs() < 1e-15);
+    }
+
+    #[test]
+    fn reference_counts_are_six_squares() {
+        assert_eq!(face_resolution_for(6144), Some(32));
+        assert_eq!(face_resolution_for(6), Some(1));
+        assert_eq!(face_resolution_for(600), Some(10));
+        assert_eq!(face_resolution_for(100), None);
+        assert_eq!(face_resolution_for(0), None);
+        assert_eq!(face_resolution_for(12), None);
+    }
+}

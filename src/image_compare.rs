@@ -1,0 +1,281 @@
+//! Comparing a rendering with the reference (Ren 2010 §8): relative RMSE in linear radiance over
+//! the pixels the reference's hair covers, a false-colour error picture, and the side-by-side
+//! PNG `compare` writes (SRBF | reference | baseline | error).
+
+use std::path::{Path, PathBuf};
+use strandlight_runtime::image_out::{tonemap_channel, PNG_TONEMAP};
+use strandlight_tables::atomic_write::write_atomically;
+use thiserror::Error;
+
+/// A linear RGBA float image, row-major from the top row (as the renderer returns it).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<[f32; 4]>,
+}
+
+/// Pixels whose reference alpha (coverage) exceeds this count as hair.
+pub const HAIR_ALPHA: f32 = 1e-3;
+
+/// What the error panel shows, per pixel: max over RGB of |a − r| divided by the largest
+/// reference value over the hair (one scale for the whole picture), through [`COLORMAP`] from 0
+/// to this value (clamped above).
+pub const ERROR_SCALE: f64 = 0.1;
+pub const COLORMAP: &str = "viridis (matplotlib, 9-point piecewise-linear)";
+
+/// Matplotlib's viridis at t = 0, 1/8, …, 1 (sRGB bytes).
+const VIRIDIS: [[u8; 3]; 9] = [
+    [68, 1, 84],
+    [71, 44, 122],
+    [59, 81, 139],
+    [44, 113, 142],
+    [33, 144, 141],
+    [39, 173, 129],
+    [92, 200, 99],
+    [170, 220, 50],
+    [253, 231, 37],
+];
+
+/// Height in pixels of the legend strip under the side-by-side picture.
+const LEGEND_ROWS: u32 = 12;
+
+#[derive(Debug, Error)]
+pub enum CompareError {
+    #[error("{what} is {w}x{h} but the reference is {rw}x{rh}")]
+    SizeMismatch { what: String, w: u32, h: u32, rw: u32, rh: u32 },
+    #[error("{what}: {count} pixel value(s) are NaN or infinite (first at pixel {first})")]
+    NotFinite { what: String, count: usize, first: usize },
+    #[error("the reference covers no hair pixels (alpha > {HAIR_ALPHA}): nothing to compare")]
+    NoHair,
+    #[error("the reference is black over the hair (Σ|r|² = 0): relative error undefined")]
+    BlackReference,
+    #[error("{}: {source}", .path.display())]
+    Write { path: PathBuf, source: std::io::Error },
+}
+
+impl Image {
+    pub fn new(width: u32, height: u32, pixels: Vec<[f32; 4]>) -> Self {
+        assert_eq!(pixels.len(), width as usize * height as usize, "pixel count must equal width × height");
+        Self { width, height, pixels }
+    }
+
+    fn check_against(&self, what: &str, reference: &Image) -> Result<(), CompareError> {
+        if (self.width, self.height) != (reference.width, reference.height) {
+            return Err(CompareError::SizeMismatch { what: what.into(), w: self.width, h: self.height, rw: reference.width, rh: reference.height });
+        }
+        check_finite(what, self)
+    }
+}
+
+fn check_finite(what: &str, image: &Image) -> Result<(), CompareError> {
+    let mut bad = image.pixels.iter().enumerate().filter(|(_, p)| p.iter().any(|c| !c.is_finite()));
+    if let Some((first, _)) = bad.next() {
+        return Err(CompareError::NotFinite { what: what.into(), count: 1 + bad.count(), first });
+    }
+    Ok(())
+}
+
+fn is_hair(p: &[f32; 4]) -> bool {
+    p[3] > HAIR_ALPHA
+}
+
+/// √(Σ‖a − r‖² / Σ‖r‖²) over RGB of the pixels where the reference has hair.
+pub fn relative_rmse(approx: &Image, reference: &Image) -> Result<f64, CompareError> {
+    check_finite("the reference", reference)?;
+    approx.check_against("the image", reference)?;
+    let (mut num, mut den, mut hair) = (0.0f64, 0.0f64, 0usize);
+    for (a, r) in approx.pixels.iter().zip(&reference.pixels) {
+        if !is_hair(r) {
+            continue;
+        }
+        hair += 1;
+        for c in 0..3 {
+            let d = a[c] as f64 - r[c] as f64;
+            num += d * d;
+            den += (r[c] as f64).powi(2);
+        }
+    }
+    if hair == 0 {
+        return Err(CompareError::NoHair);
+    }
+    if den == 0.0 {
+        return Err(CompareError::BlackReference);
+    }
+    Ok((num / den).sqrt())
+}
+
+/// [`VIRIDIS`] at t ∈ [0, 1] (clamped), linearly interpolated between its samples.
+pub fn colormap(t: f64) -> [u8; 3] {
+    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 1.0 };
+    let x = t * (VIRIDIS.len() - 1) as f64;
+    let i = (x.floor() as usize).min(VIRIDIS.len() - 2);
+    let f = x - i as f64;
+    std::array::from_fn(|c| ((1.0 - f) * VIRIDIS[i][c] as f64 + f * VIRIDIS[i + 1][c] as f64).round() as u8)
+}
+
+/// The false-colour error panel (sRGB bytes, row-major): hair pixels coloured by
+/// max_c |a − r| / max(reference over the hair) on [0, [`ERROR_SCALE`]], others black.
+/// Also returns the largest normalized error found.
+pub fn error_panel(approx: &Image, reference: &Image) -> Result<(Vec<[u8; 3]>, f64), CompareError> {
+    check_finite("the reference", reference)?;
+    approx.check_against("the image", reference)?;
+    let peak = reference.pixels.iter().filter(|p| is_hair(p)).flat_map(|p| p[..3].iter().map(|c| *c as f64)).fold(0.0f64, f64::max);
+    if reference.pixels.iter().all(|p| !is_hair(p)) {
+        return Err(CompareError::NoHair);
+    }
+    if peak <= 0.0 {
+        return Err(CompareError::BlackReference);
+    }
+    let mut worst = 0.0f64;
+    let panel = approx
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .map(|(a, r)| {
+            if !is_hair(r) {
+                return [0, 0, 0];
+            }
+            let e = (0..3).map(|c| (a[c] as f64 - r[c] as f64).abs()).fold(0.0, f64::max) / peak;
+            worst = worst.max(e);
+            colormap(e / ERROR_SCALE)
+        })
+        .collect();
+    Ok((panel, worst))
+}
+
+/// A line for the log saying how to read the error panel.
+pub fn error_legend() -> String {
+    format!(
+        "error panel: max over RGB of |image − reference| / (largest reference value over the hair), {COLORMAP}: 0 → dark violet, {ERROR_SCALE} and above → yellow; the strip under it is the scale; non-hair pixels black"
+    )
+}
+
+/// One tonemapped panel ([`PNG_TONEMAP`]).
+fn tonemapped(image: &Image) -> Vec<[u8; 3]> {
+    image.pixels.iter().map(|p| [tonemap_channel(p[0]), tonemap_channel(p[1]), tonemap_channel(p[2])]).collect()
+}
+
+/// Writes `srbf | reference | baseline | error` side by side as one 8-bit PNG, atomically, with
+/// a legend strip under the error panel (the colormap from 0 to [`ERROR_SCALE`]).
+pub fn write_side_by_side(path: &Path, srbf: &Image, reference: &Image, baseline: &Image, description: &str) -> Result<(), CompareError> {
+    srbf.check_against("the SRBF image", reference)?;
+    baseline.check_against("the baseline image", reference)?;
+    let (error, _) = error_panel(srbf, reference)?;
+    let panels = [tonemapped(srbf), tonemapped(reference), tonemapped(baseline), error];
+    let (w, h) = (reference.width as usize, reference.height as usize);
+    let total_w = 4 * w;
+    let total_h = h + LEGEND_ROWS as usize;
+    let mut bytes = vec![0u8; total_w * total_h * 3];
+    for (k, panel) in panels.iter().enumerate() {
+        for y in 0..h {
+            for x in 0..w {
+                let o = (y * total_w + k * w + x) * 3;
+                bytes[o..o + 3].copy_from_slice(&panel[y * w + x]);
+            }
+        }
+    }
+    for y in h..total_h {
+        for x in 0..w {
+            let c = colormap(x as f64 / (w.max(2) - 1) as f64);
+            let o = (y * total_w + 3 * w + x) * 3;
+            bytes[o..o + 3].copy_from_slice(&c);
+        }
+    }
+    let legend = format!("{description}; panels: SRBF | reference | baseline | error; images: {PNG_TONEMAP}; {}", error_legend());
+    let encode = |out: &mut std::io::BufWriter<std::fs::File>| -> Result<(), png::EncodingError> {
+        let mut encoder = png::Encoder::new(out, total_w as u32, total_h as u32);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.set_depth(png::BitDepth::Eight);
+        encoder.add_itxt_chunk("Description".into(), legend.clone())?;
+        let mut writer = encoder.write_header()?;
+        writer.write_image_data(&bytes)?;
+        writer.finish()
+    };
+    write_atomically(path, |out| encode(out).map_err(std::io::Error::other)).map_err(|source| CompareError::Write { path: path.into(), source })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(pixels: Vec<[f32; 4]>) -> Image {
+        Image::new(pixels.len() as u32, 1, pixels)
+    }
+
+    #[test]
+    fn relative_rmse_by_hand() {
+        // Hair pixels r = (1,0,0), (0,2,0); errors 0.1 and 0.2 → Σ|a−r|² = 0.01 + 0.04 = 0.05,
+        // Σ|r|² = 1 + 4 = 5, √(0.05/5) = 0.1. The third pixel has no hair in the reference and
+        // a huge difference that must not count.
+        let reference = image(vec![[1.0, 0.0, 0.0, 1.0], [0.0, 2.0, 0.0, 0.5], [0.0, 0.0, 0.0, 0.0]]);
+        let approx = image(vec![[1.1, 0.0, 0.0, 1.0], [0.0, 2.0, 0.2, 0.5], [50.0, 50.0, 50.0, 1.0]]);
+        let e = relative_rmse(&approx, &reference).unwrap();
+        assert!((e - 0.1).abs() < 1e-7, "{e}");
+        assert_eq!(relative_rmse(&reference, &reference).unwrap(), 0.0);
+    }
+
+    #[test]
+    fn bad_inputs_are_named() {
+        let reference = image(vec![[1.0, 0.0, 0.0, 1.0], [0.0; 4]]);
+        let short = image(vec![[1.0, 0.0, 0.0, 1.0]]);
+        assert!(matches!(relative_rmse(&short, &reference), Err(CompareError::SizeMismatch { w: 1, rw: 2, .. })));
+        let nan = image(vec![[1.0, 0.0, 0.0, 1.0], [f32::NAN, 0.0, 0.0, 0.0]]);
+        let e = relative_rmse(&nan, &reference).unwrap_err();
+        assert!(matches!(e, CompareError::NotFinite { count: 1, first: 1, .. }), "{e}");
+        let empty = image(vec![[1.0, 0.0, 0.0, 0.0], [0.0; 4]]);
+        assert!(matches!(relative_rmse(&reference, &empty), Err(CompareError::NoHair)));
+        let black = image(vec![[0.0, 0.0, 0.0, 1.0], [0.0; 4]]);
+        assert!(matches!(relative_rmse(&reference, &black), Err(CompareError::BlackReference)));
+    }
+
+    #[test]
+    fn colormap_hits_its_samples_and_interpolates() {
+        assert_eq!(colormap(0.0), [68, 1, 84]);
+        assert_eq!(colormap(1.0), [253, 231, 37]);
+        assert_eq!(colormap(0.5), [33, 144, 141]);
+        assert_eq!(colormap(7.0), [253, 231, 37]);
+        assert_eq!(colormap(-1.0), [68, 1, 84]);
+        // Halfway between t = 0 and 1/8: the rounded mean of (68,1,84) and (71,44,122).
+        assert_eq!(colormap(1.0 / 16.0), [70, 23, 103]);
+    }
+
+    #[test]
+    fn error_panel_by_hand() {
+        // Peak reference value over the hair = 2 (pixel 1's green). Pixel 0: max|Δ| = 0.1 →
+        // 0.05 → t = 0.5 at scale 0.1; pixel 1: exact → t = 0; pixel 2: not hair → black.
+        let reference = image(vec![[1.0, 0.0, 0.0, 1.0], [0.0, 2.0, 0.0, 1.0], [9.0, 9.0, 9.0, 0.0]]);
+        let approx = image(vec![[1.1, 0.05, 0.0, 1.0], [0.0, 2.0, 0.0, 1.0], [0.0, 0.0, 0.0, 1.0]]);
+        let (panel, worst) = error_panel(&approx, &reference).unwrap();
+        assert!((worst - 0.05).abs() < 1e-6, "{worst}");
+        assert_eq!(panel, vec![colormap(0.5), colormap(0.0), [0, 0, 0]]);
+    }
+
+    #[test]
+    fn side_by_side_png_has_four_panels_and_a_legend() {
+        let reference = Image::new(2, 1, vec![[1.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.0, 0.0]]);
+        let srbf = Image::new(2, 1, vec![[1.1, 0.0, 0.0, 1.0], [0.0, 0.0, 0.0, 0.0]]);
+        let baseline = Image::new(2, 1, vec![[3.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.0, 0.0]]);
+        let dir = std::env::temp_dir().join(format!("strandlight-sbs-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("side.png");
+        write_side_by_side(&path, &srbf, &reference, &baseline, "test").unwrap();
+        let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!((info.width, info.height), (8, 1 + LEGEND_ROWS));
+        let px = |x: usize, y: usize| [buf[(y * 8 + x) * 3], buf[(y * 8 + x) * 3 + 1], buf[(y * 8 + x) * 3 + 2]];
+        // Reinhard 1.0 → 0.5 → sRGB 0.7354 → 188; 3.0 → 0.75 → 225 (by hand from the sRGB curve).
+        assert_eq!(px(2, 0), [188, 0, 0]);
+        assert_eq!(px(4, 0), [225, 0, 0]);
+        // Error: |1.1 − 1| / 1 = 0.1 → the top of the scale.
+        assert_eq!(px(6, 0), colormap(1.0));
+        assert_eq!(px(7, 0), [0, 0, 0]);
+        // Legend strip: the colormap's two ends under the error panel.
+        assert_eq!(px(6, 5), colormap(0.0));
+        assert_eq!(px(7, 5), colormap(1.0));
+        assert!(std::fs::read_dir(&dir).unwrap().count() == 1, "no temporary file left behind");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,109 @@
+//! The brute-force reference image, cached by everything it depends on (it may take minutes):
+//! `DIR/KEY.exr` (linear RGBA) beside `DIR/KEY.json` (the inputs and the measured time), both
+//! written atomically. A hit needs both files and the same inputs recorded in the JSON.
+
+use crate::env_scene::sha256_hex;
+use crate::image_compare::Image;
+use anyhow::Context;
+use serde::{Deserialize, Serialize};
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use strandlight_runtime::image_out::write_exr;
+
+/// What is stored beside the image.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ReferenceRecord {
+    /// Everything the image depends on (hair file hash, camera, size, map hash, light count,
+    /// fiber and table settings, scattering mode, program version).
+    pub inputs: Value,
+    pub lights: usize,
+    /// Frame time of the reference render.
+    pub milliseconds: f64,
+}
+
+pub struct ReferenceCache {
+    pub dir: PathBuf,
+}
+
+impl ReferenceCache {
+    pub fn new(dir: impl Into<PathBuf>) -> Self {
+        Self { dir: dir.into() }
+    }
+
+    pub fn key(inputs: &Value) -> String {
+        sha256_hex(inputs.to_string().as_bytes())[..32].to_string()
+    }
+
+    fn paths(&self, inputs: &Value) -> (PathBuf, PathBuf) {
+        let key = Self::key(inputs);
+        (self.dir.join(format!("{key}.exr")), self.dir.join(format!("{key}.json")))
+    }
+
+    /// The cached image for `inputs`, or None (absent, unreadable or recorded for other inputs).
+    pub fn load(&self, inputs: &Value) -> Option<(Image, ReferenceRecord)> {
+        let (exr_path, json_path) = self.paths(inputs);
+        let record: ReferenceRecord = serde_json::from_slice(&std::fs::read(&json_path).ok()?).ok()?;
+        if &record.inputs != inputs {
+            return None;
+        }
+        match read_rgba_exr(&exr_path) {
+            Ok(image) => Some((image, record)),
+            Err(e) => {
+                eprintln!("reference cache: ignoring {}: {e:#}", exr_path.display());
+                None
+            }
+        }
+    }
+
+    /// Stores the image (EXR first, then the JSON that makes it a hit).
+    pub fn store(&self, image: &Image, record: &ReferenceRecord) -> anyhow::Result<PathBuf> {
+        std::fs::create_dir_all(&self.dir).with_context(|| format!("cannot create the cache folder {}", self.dir.display()))?;
+        let (exr_path, json_path) = self.paths(&record.inputs);
+        write_exr(&exr_path, image.width, image.height, &image.pixels, "strandlight brute-force reference")?;
+        let json = serde_json::to_vec_pretty(record)?;
+        strandlight_tables::atomic_write::write_atomically(&json_path, |out| std::io::Write::write_all(out, &json))
+            .with_context(|| json_path.display().to_string())?;
+        Ok(exr_path)
+    }
+}
+
+/// A linear RGBA EXR as written by `strandlight_runtime::image_out::write_exr`.
+pub fn read_rgba_exr(path: &Path) -> anyhow::Result<crate::image_compare::Image> {
+    use exr::prelude::*;
+    let image = read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| (resolution.width(), vec![[0f32; 4]; resolution.width() * resolution.height()]),
+        |(w, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| pixels[position.y() * *w + position.x()] = [r, g, b, a],
+    )
+    .with_context(|| format!("{}: not a readable RGBA EXR", path.display()))?;
+    let size = image.layer_data.size;
+    let (_, pixels) = image.layer_data.channel_data.pixels;
+    Ok(crate::image_compare::Image::new(size.width() as u32, size.height() as u32, pixels))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn stores_and_finds_by_inputs_only() {
+        let dir = std::env::temp_dir().join(format!("strandlight-refcache-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let cache = ReferenceCache::new(&dir);
+        let inputs = json!({ "hair_sha256": "ab", "size": [3, 2], "lights": 6144 });
+        let image = Image::new(3, 2, (0..6).map(|i| [i as f32, 0.5, -1.0, 0.25 * i as f32]).collect());
+        assert!(cache.load(&inputs).is_none());
+        let record = ReferenceRecord { inputs: inputs.clone(), lights: 6144, milliseconds: 1234.5 };
+        cache.store(&image, &record).unwrap();
+        let (back, rec) = cache.load(&inputs).unwrap();
+        assert_eq!(back, image, "f32 EXR round trip is exact");
+        assert_eq!(rec, record);
+        assert!(cache.load(&json!({ "hair_sha256": "ab", "size": [3, 2], "lights": 96 })).is_none());
+        // A truncated image is a miss, not a crash.
+        let (exr_path, _) = cache.paths(&inputs);
+        std::fs::write(&exr_path, b"not an exr").unwrap();
+        assert!(cache.load(&inputs).is_none());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
