@@ -63,6 +63,9 @@ pub struct CompareArgs {
     /// Nodes per direction axis of the tables (default: the paper's resolution).
     #[arg(long, value_name = "N")]
     pub table_resolution: Option<usize>,
+    /// Which modes to compare: single scattering, full (single + multiple), or both.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "single,full")]
+    pub modes: Vec<ScatteringMode>,
     /// Renders per timing (the median is reported).
     #[arg(long, default_value_t = 3)]
     pub timing_runs: usize,
@@ -129,7 +132,7 @@ pub fn prepare_with_hair(args: &CompareArgs, hair: HairModel, hair_sha256: Strin
     let lambda_range = crate::tables_cmd::lambda_range_of_set(&fit.set)?;
     let resolution = args.table_resolution.map(BakeResolution::reduced).unwrap_or_default();
     let mut wanted: Vec<&str> = MULTIPLE_TABLES.to_vec();
-    for mode in [ScatteringMode::Single, ScatteringMode::Full] {
+    for &mode in &args.modes {
         wanted.extend([args.shading.srbf_table(mode), args.shading.direct_table(mode)]);
     }
     let table_dir = args.cache.join("tables").join(format!("{}-{:?}", args.preset, args.shading).to_lowercase());
@@ -262,7 +265,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
 pub fn execute(args: &CompareArgs, scene: &CompareScene, steps: &mut Steps, render: Renderer) -> anyhow::Result<Value> {
     let mut report = serde_json::Map::new();
     let description = format!("strandlight compare: {} under {} ({:?}, preset {})", args.hair.display(), args.env, args.shading, args.preset);
-    for mode in [ScatteringMode::Single, ScatteringMode::Full] {
+    for &mode in &args.modes {
         let r = run_mode(render, scene, args, mode, steps)?;
         let srbf_error = relative_rmse(&r.srbf.image, &r.reference.0)?;
         let baseline_error = relative_rmse(&r.baseline.image, &r.reference.0)?;

@@ -15,7 +15,9 @@ use strandlight_precompute::envmap_io::{self, LoadOptions};
 use strandlight_precompute::srbf_set::{Source, SrbfSet};
 use strandlight_precompute::{procedural_env, EnvMap, FitOptions};
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env::EnvLight;
+use std::sync::OnceLock;
+use strandlight_runtime::env::{EnvLight, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables};
+use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
 use strandlight_tables::asset::{expect_parameters, read_asset, Storage, TableAsset};
 
@@ -113,7 +115,7 @@ pub enum EnvShading {
 }
 
 /// Single scattering only, or with multiple scattering (Ren §3.2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum ScatteringMode {
     Single,
@@ -213,8 +215,6 @@ pub fn bake_scene_tables(
 
 /// One frame for the environment-lit renderer: a hair, a camera and one set of lights (all
 /// SRBFs or all directional), shaded in `mode` with `tables`.
-// The renderer reads every field once [`render_lights`] is wired; until then only a few are.
-#[allow(dead_code)]
 pub struct EnvFrame<'a> {
     pub hair: &'a HairModel,
     pub camera: Camera,
@@ -232,19 +232,75 @@ pub struct RenderedEnv {
     pub milliseconds: f64,
 }
 
+/// The GPU device and the renderer's pipelines, created on first use and kept for every frame
+/// of the run (pipeline creation is a one-time cost, not part of a frame).
+struct GpuRenderer {
+    gpu: GpuContext,
+    renderer: EnvRenderer,
+}
+
+fn gpu_renderer() -> anyhow::Result<&'static GpuRenderer> {
+    static RENDERER: OnceLock<Result<GpuRenderer, String>> = OnceLock::new();
+    RENDERER
+        .get_or_init(|| {
+            let gpu = GpuContext::new_headless().map_err(|e| e.to_string())?;
+            let renderer = EnvRenderer::new(&gpu);
+            Ok(GpuRenderer { gpu, renderer })
+        })
+        .as_ref()
+        .map_err(|e| anyhow::anyhow!("no GPU device for the environment-lit renderer: {e}"))
+}
+
+/// Passes an application pays once (device, pipelines, uploads of hair and tables), not per
+/// frame; everything else the renderer times is the frame.
+const SETUP_PASSES: [&str; 3] = ["pipelines", "upload", "table upload"];
+
+/// Milliseconds of one frame: the renderer's passes without the one-time setup.
+pub fn frame_milliseconds(stats: &EnvRenderStats) -> f64 {
+    stats.timings.iter().filter(|t| !SETUP_PASSES.contains(&t.pass.as_str())).map(|t| t.milliseconds).sum()
+}
+
+/// Stochastic simplification (Ren §7) is part of the SRBF method; the directional reference and
+/// baseline draw every fiber into every light's map (plain deep opacity maps).
+fn render_options(lights: &[EnvLight]) -> EnvRenderOptions {
+    let srbf = lights.iter().all(|l| l.lambda.is_some());
+    let kappa = std::env::var("STRANDLIGHT_KAPPA").ok().and_then(|v| v.parse().ok()).unwrap_or(EnvRenderOptions::default().kappa);
+    EnvRenderOptions { kappa: if srbf { kappa } else { 1.0 }, ..EnvRenderOptions::default() }
+}
+
+/// The runtime's tables for `frame`: the SRBF or direct table of its mode, and in full mode I_G.
+fn env_tables(frame: &EnvFrame) -> anyhow::Result<EnvTables> {
+    let srbf = frame.lights.iter().all(|l| l.lambda.is_some());
+    let mut tables = EnvTables::default();
+    if srbf {
+        tables.srbf = Some(frame.tables.get(frame.shading.srbf_table(frame.mode))?.table.clone());
+    } else {
+        tables.direct = Some(frame.tables.get(frame.shading.direct_table(frame.mode))?.table.clone());
+    }
+    if frame.mode == ScatteringMode::Full {
+        tables.multiple = Some(frame.tables.get("multiple")?.table.clone());
+    }
+    Ok(tables)
+}
+
 /// THE call into the environment-lit renderer. The SRBF path reads
 /// `tables.get(shading.srbf_table(mode))`, directional lights `tables.get(shading.direct_table(mode))`
 /// (4 axes, the 1/λ axis a single node), and the full mode also [`MULTIPLE_TABLES`].
 pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
-    // Wire to `strandlight_runtime::env::render_env_frame` when it lands.
-    let kind = if frame.lights.iter().all(|l| l.lambda.is_some()) { "SRBF" } else { "directional" };
-    bail!(
-        "env renderer not merged yet: cannot render {} {kind} lights ({} scattering, {}x{})",
-        frame.lights.len(),
-        frame.mode.name(),
-        frame.width,
-        frame.height
-    )
+    let r = gpu_renderer()?;
+    let tables = env_tables(frame)?;
+    let multiple = match frame.mode {
+        ScatteringMode::Single => None,
+        ScatteringMode::Full => bail!("multiple scattering is not wired into the renderer yet"),
+    };
+    let out = r
+        .renderer
+        .render(&r.gpu, frame.hair, &frame.camera, frame.width, frame.height, frame.lights, &tables, &render_options(frame.lights), multiple)
+        .with_context(|| format!("rendering {} lights ({} scattering)", frame.lights.len(), frame.mode.name()))?;
+    if std::env::var_os("STRANDLIGHT_TIMINGS").is_some() {
+        eprintln!("{:?}", out.stats.timings);
+    }
+    Ok(RenderedEnv { milliseconds: frame_milliseconds(&out.stats), image: Image { width: out.width, height: out.height, pixels: out.pixels } })
 }
 
 #[cfg(test)]

@@ -22,7 +22,7 @@
 //! parallel sums are reduced in a fixed order.
 
 use crate::envmap::{EnvMap, rotate_about_up};
-use crate::srbf_objective::{FitGrid, evaluate};
+use crate::srbf_objective::{FitGrid, evaluate, power_matched_amplitudes, relative_mse_of};
 use argmin::core::{CostFunction, Error as ArgminError, Executor, Gradient};
 use argmin::solver::linesearch::MoreThuenteLineSearch;
 use argmin::solver::quasinewton::LBFGS;
@@ -59,6 +59,15 @@ pub struct FitOptions {
     pub final_iterations: u64,
     /// Environment rotation about +Y in degrees, applied to the fitted lobe centers.
     pub rotate_degrees: f64,
+    /// Re-solve the final amplitudes so the lobes carry exactly the map's power per channel
+    /// (see [`crate::srbf_objective::power_matched_amplitudes`]). On by default: rendering
+    /// integrates light, so power matters more than the last digits of the L2 error.
+    #[serde(default = "default_true")]
+    pub preserve_power: bool,
+}
+
+fn default_true() -> bool {
+    true
 }
 
 impl Default for FitOptions {
@@ -73,6 +82,7 @@ impl Default for FitOptions {
             iterations_per_round: 10,
             final_iterations: 100,
             rotate_degrees: 0.0,
+            preserve_power: true,
         }
     }
 }
@@ -254,7 +264,12 @@ pub fn fit(
             best_lobes = polished;
         }
     }
-    let ev = evaluate(&grid, &centers(&best_lobes), &lambdas(&best_lobes));
+    let mut ev = evaluate(&grid, &centers(&best_lobes), &lambdas(&best_lobes));
+    if options.preserve_power {
+        let power = grid_map.integral().map(|p| p / grid.scale);
+        ev.amplitudes = power_matched_amplitudes(&grid, &centers(&best_lobes), &lambdas(&best_lobes), power);
+        ev.relative_mse = relative_mse_of(&grid, &centers(&best_lobes), &lambdas(&best_lobes), &ev.amplitudes);
+    }
     let lobes = best_lobes
         .iter()
         .zip(&ev.amplitudes)
