@@ -7,12 +7,14 @@
 //! * [`fiber_tables`]: checked accessors for the baked `fiber_averages`, `attenuation_ratio`
 //!   and `srbf_spread` tables;
 //! * [`shadow_paths`]: the expected-value shadow-path march;
+//! * [`light_sweep`]: the same paths for a whole volume at once (dense sampling);
 //! * [`forward_scattering`]: [`CpuForwardScattering`], the `ForwardScatteringSource`.
 
 pub mod direction_deviation;
 pub mod fiber_tables;
 pub mod forward_scattering;
 pub mod hair_volume;
+pub mod light_sweep;
 pub mod shadow_paths;
 
 #[cfg(test)]

@@ -203,7 +203,51 @@ pub struct MarchSettings {
     pub density_forward: f64,
 }
 
-/// [T_r, T_g, T_b, σ̄_f] at one sample point for one light.
+/// Sums the paths that make one sample (box-filter taps, interpolated neighbours) and turns
+/// them into [T_r, T_g, T_b, σ̄_f].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SampleAccumulator {
+    transmittance: [f64; 3],
+    variance_numerator: [f64; 3],
+    plain_variance: f64,
+    paths: f64,
+}
+
+impl SampleAccumulator {
+    /// Adds one path; `direct_variance` is the spread of direct light at the sample (the
+    /// SRBF's own width seen by the fiber there, 0 for a directional light).
+    pub fn add(&mut self, path: &ExpectedShadowPath, density_forward: f64, direct_variance: f64) {
+        let t = path.transmittance(density_forward);
+        let num = path.variance_numerator(density_forward, direct_variance);
+        for c in 0..3 {
+            self.transmittance[c] += t[c];
+            self.variance_numerator[c] += num[c];
+        }
+        self.plain_variance += 4.0 * path.plain_variance + direct_variance;
+        self.paths += 1.0;
+    }
+
+    /// Mean T_f per channel and σ̄_f = √(energy-weighted variance); where nothing gets through
+    /// (T_f = 0 in every channel) σ̄_f falls back to the unweighted expected spread.
+    pub fn value(&self) -> [f32; 4] {
+        let n = self.paths.max(1.0);
+        let total: f64 = self.transmittance.iter().sum();
+        let variance = if total > 1e-20 {
+            self.variance_numerator.iter().sum::<f64>() / total
+        } else {
+            self.plain_variance / n
+        };
+        [
+            (self.transmittance[0] / n) as f32,
+            (self.transmittance[1] / n) as f32,
+            (self.transmittance[2] / n) as f32,
+            variance.max(0.0).sqrt() as f32,
+        ]
+    }
+}
+
+/// [T_r, T_g, T_b, σ̄_f] at one sample point for one light: the mean of `filter_taps³` paths
+/// started over the voxel-sized box around the point (§6's one-voxel box filter).
 pub fn sample_value(
     volume: &HairVolume,
     medium: &LightMedium,
@@ -214,33 +258,16 @@ pub fn sample_value(
     let taps = settings.filter_taps.max(1);
     let h = volume.grid.voxel_size;
     let step = settings.step_fraction * h;
-    let d_f = settings.density_forward;
-    let (mut t_sum, mut num_sum, mut plain) = ([0.0f64; 3], [0.0f64; 3], 0.0f64);
+    let mut acc = SampleAccumulator::default();
     for i in 0..taps.pow(3) {
         let ijk = [i % taps, (i / taps) % taps, i / (taps * taps)];
         let offset = Vec3::from_array(ijk.map(|j| ((j as f32 + 0.5) / taps as f32 - 0.5) * h));
         let p = point + offset;
         let path = march(volume, medium, p, xi, step);
-        // Direct light still has the SRBF's own width, seen by the fiber at the sample.
         let direct_variance = medium.srbf_variance[volume.grid.voxel_clamped(p)] as f64;
-        let t = path.transmittance(d_f);
-        let num = path.variance_numerator(d_f, direct_variance);
-        for c in 0..3 {
-            t_sum[c] += t[c];
-            num_sum[c] += num[c];
-        }
-        plain += 4.0 * path.plain_variance + direct_variance;
+        acc.add(&path, settings.density_forward, direct_variance);
     }
-    let n = taps.pow(3) as f64;
-    let total_t: f64 = t_sum.iter().sum();
-    let variance = if total_t > 1e-20 { num_sum.iter().sum::<f64>() / total_t } else { plain / n };
-    let sigma = variance.max(0.0).sqrt();
-    [
-        (t_sum[0] / n) as f32,
-        (t_sum[1] / n) as f32,
-        (t_sum[2] / n) as f32,
-        sigma as f32,
-    ]
+    acc.value()
 }
 
 /// Values for every point in `points` under one light (parallel over points).

@@ -76,6 +76,7 @@ fn settings(voxels: u32, taps: u32, step: f32) -> ForwardScatteringSettings {
         step_fraction: step,
         filter_taps: taps,
         density_forward: 0.7,
+        light_sweep: false,
     }
 }
 
@@ -356,4 +357,61 @@ fn bad_settings_are_typed_errors() {
         println!("{err}");
         assert!(matches!(err, ForwardScatteringError::InvalidSetting { .. }));
     }
+}
+
+#[test]
+fn light_sweep_matches_the_slab_closed_form() {
+    let d = 0.15f32;
+    let point = Vec3::new(4.0, 13.0, 6.0);
+    let mu = d as f64 * 12.0;
+    let s = ForwardScatteringSettings { light_sweep: true, ..settings(8, 1, 0.05) };
+    let source = CpuForwardScattering::new(&parallel_block(Some(d)), tables(), s).unwrap();
+    for (l, srbf_var) in [
+        (EnvLight::directional(Vec3::X, [1.0; 3]), 0.0),
+        (EnvLight::srbf(Vec3::X, 100.0, [1.0; 3]), SRBF_VARIANCE),
+    ] {
+        let got = source.values_at(&l, &[point])[0];
+        let (want, sigma) = poisson_closed_form(mu, srbf_var, 0.7);
+        println!("sweep: T_f {:?} σ̄_f {:.6}; closed form {want:.6?} σ̄ {sigma:.6}", &got[..3], got[3]);
+        for c in 0..3 {
+            assert!((got[c] as f64 - want[c]).abs() < 1e-3, "channel {c}");
+        }
+        assert!((got[3] as f64 / sigma - 1.0).abs() < 1e-3);
+    }
+}
+
+#[test]
+fn light_sweep_agrees_with_per_point_marching_on_tangled_hair() {
+    // Random walks in a box, oblique light: the two ways of computing the same expected paths
+    // differ only by their filters (tent over one voxel vs 2³ taps over one voxel).
+    let mut rng = Rng(777);
+    let mut points = Vec::new();
+    let mut offsets = vec![0u32];
+    for _ in 0..300 {
+        let mut p = Vec3::new(rng.unit() as f32, rng.unit() as f32, rng.unit() as f32) * 8.0;
+        for _ in 0..100 {
+            points.push(p);
+            let z = 2.0 * rng.unit() - 1.0;
+            let a = 2.0 * std::f64::consts::PI * rng.unit();
+            let s = (1.0 - z * z).sqrt();
+            p += 0.15 * Vec3::new((s * a.cos()) as f32, (s * a.sin()) as f32, z as f32);
+        }
+        offsets.push(points.len() as u32);
+    }
+    let model = HairModel::new(points, offsets, Some(Attribute::Uniform(0.02)), None, None).unwrap();
+    let light = EnvLight::directional(Vec3::new(0.3, -0.5, 0.8), [1.0; 3]);
+    let probes: Vec<Vec3> = model.points().iter().step_by(97).copied().collect();
+    let march = CpuForwardScattering::new(&model, tables(), settings(16, 4, 0.25)).unwrap();
+    let sweep = CpuForwardScattering::new(&model, tables(), ForwardScatteringSettings { light_sweep: true, ..settings(16, 4, 0.25) }).unwrap();
+    let (a, b) = (march.values_at(&light, &probes), sweep.values_at(&light, &probes));
+    let (mut sum, mut max, mut mean) = (0.0f64, 0.0f64, 0.0f64);
+    for (x, y) in a.iter().zip(&b) {
+        let dt = (x[0] - y[0]).abs() as f64;
+        sum += dt * dt;
+        max = max.max(dt);
+        mean += x[0] as f64;
+    }
+    let rms = (sum / a.len() as f64).sqrt();
+    println!("{} probes: mean T_f(red) {:.4}, RMS |Δ| {rms:.4}, max {max:.4}", a.len(), mean / a.len() as f64);
+    assert!(rms < 0.03 && max < 0.15);
 }
