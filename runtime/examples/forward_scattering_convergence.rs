@@ -14,6 +14,7 @@ use strandlight_precompute::attenuation_ratio::attenuation_ratio_table;
 use strandlight_precompute::srbf_spread::srbf_spread_table;
 use strandlight_runtime::env::{EnvLight, ForwardScatteringSource};
 use strandlight_runtime::hair::HairModel;
+use strandlight_runtime::multiple::shadow_paths::LightMedium;
 use strandlight_runtime::multiple::{
     CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, HairVolume,
     VoxelSettings, interpolate_grid,
@@ -122,7 +123,12 @@ fn main() {
     let tables = ForwardScatteringTables::from_tables(&fiber, &ratio, &spread).expect("table shapes");
     println!("tables built in {:.2} s (bake-time work, not part of the runtime)", t0.elapsed().as_secs_f64());
 
+    // Optional section names on the command line (voxels, paths, medium, convergence).
+    let only: Vec<String> = std::env::args().skip(1).collect();
+    let want = |section: &str| only.is_empty() || only.iter().any(|s| s == section);
+
     // --- Voxelization time (dynamic hair rebuilds it every frame).
+    if want("voxels") {
     println!("\n## Voxelization (median of 5)");
     println!("| voxels (longest side) | grid | occupied | voxel side | max σ_t⊥·h | mean σ_t⊥·h (occupied) | median ms |");
     println!("|---|---|---|---|---|---|---|");
@@ -148,28 +154,36 @@ fn main() {
         );
     }
 
+    }
+
     // --- Shadow-path time per light batch.
+    if want("paths") {
     println!("\n## Shadow paths (grid() for a batch; median of 3)");
-    println!("| voxels | coarse factor | filter taps | step | lights | kind | sample vertices | batch ms | ms / light |");
+    println!("| voxels | coarse factor | method | step | lights | kind | sample vertices | batch ms | ms / light |");
     println!("|---|---|---|---|---|---|---|---|---|");
     let timing_cases = [
-        (64u32, 4u32, 2u32, 0.5f32),
-        (64, 4, 1, 0.5),
-        (90, 4, 2, 0.5),
-        (64, 1, 2, 0.25),
+        (64u32, 4u32, 2u32, 0.5f32, false),
+        (64, 4, 1, 0.5, false),
+        (64, 4, 1, 0.5, true),
+        (90, 4, 2, 0.5, false),
+        (90, 4, 1, 0.5, true),
+        (64, 1, 1, 0.25, true),
+        (90, 1, 1, 0.25, true),
+        (64, 1, 2, 0.25, false),
     ];
-    for &(voxels, coarse, taps, step) in &timing_cases {
+    for &(voxels, coarse, taps, step, sweep) in &timing_cases {
         let settings = ForwardScatteringSettings {
             voxels: VoxelSettings { voxels_longest_side: voxels, default_diameter: None },
             coarse_factor: coarse,
             step_fraction: step,
             filter_taps: taps,
+            light_sweep: sweep,
             ..Default::default()
         };
         let source = CpuForwardScattering::new(&model, tables.clone(), settings).expect("source");
         for &count in &[16usize, 50] {
-            if coarse == 1 && count == 50 {
-                continue; // the dense mode is timed per light with 16
+            if coarse == 1 && !sweep && count == 50 {
+                continue; // per-vertex marching of the dense grid is timed with 16 lights only
             }
             for srbf in [true, false] {
                 let lights: Vec<EnvLight> = sphere_directions(count)
@@ -184,8 +198,9 @@ fn main() {
                     assert!(grid.values.iter().all(|v| v.iter().all(|x| x.is_finite())));
                 }
                 let ms = median(times);
+                let method = if sweep { "light sweep".to_string() } else { format!("march, {taps}³ taps") };
                 println!(
-                    "| {voxels} | {coarse} | {taps} | {step} | {count} | {} | {} | {ms:.1} | {:.2} |",
+                    "| {voxels} | {coarse} | {method} | {step} | {count} | {} | {} | {ms:.1} | {:.2} |",
                     if srbf { "SRBF λ=32" } else { "directional" },
                     source.sample_grid().vertex_count(),
                     ms / count as f64
@@ -194,7 +209,34 @@ fn main() {
         }
     }
 
+    }
+
+    // --- Where a light's time goes: the per-voxel table lookups (LightMedium) vs the paths.
+    if want("medium") {
+    println!("\n## Per-light table lookups (LightMedium::new, median of 5)");
+    println!("| voxels | occupied | ms |");
+    println!("|---|---|---|");
+    for &voxels in &[64u32, 90] {
+        let settings = VoxelSettings { voxels_longest_side: voxels, default_diameter: None };
+        let volume = HairVolume::build(&model, &settings, 1.0).expect("voxelization");
+        let light = EnvLight::srbf(Vec3::new(0.3, 0.5, 0.8), 32.0, [1.0; 3]);
+        let times: Vec<f64> = (0..5)
+            .map(|_| {
+                let t = Instant::now();
+                let m = LightMedium::new(&volume, &tables, &light);
+                std::hint::black_box(&m);
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        println!("| {voxels} | {} | {:.1} |", volume.occupied_voxels(), median(times));
+    }
+
+    }
+
     // --- Convergence at fixed points on the hair.
+    if !want("convergence") {
+        return;
+    }
     let probes = probe_points(&model, 1000);
     let lights: Vec<EnvLight> = sphere_directions(8).into_iter().map(|d| EnvLight::directional(d, [1.0; 3])).collect();
     let base = ForwardScatteringSettings::default();
@@ -203,8 +245,10 @@ fn main() {
         coarse_factor: coarse,
         step_fraction: step,
         filter_taps: taps,
+        light_sweep: false,
         ..base
     };
+    let swept = |voxels: u32, coarse: u32, step: f32| ForwardScatteringSettings { light_sweep: true, ..with(voxels, coarse, step, 1) };
     let probe_values = |source: &CpuForwardScattering| -> Vec<[f32; 4]> {
         lights.iter().flat_map(|l| source.values_at(l, &probes)).collect()
     };
@@ -226,6 +270,19 @@ fn main() {
         let (a, b, c, d) = differences(&grid_values(&s), &exact);
         println!("| {coarse} | {} | {a:.4} | {b:.4} | {c:.4} | {d:.4} |", s.sample_grid().vertex_count());
     }
+
+    println!("\n## Light-sweep grids vs the same per-point reference (64 voxels, step 0.5)");
+    println!("| coarse factor | vertices | RMS ΔT_f | max ΔT_f | RMS Δσ̄_f | max Δσ̄_f |");
+    println!("|---|---|---|---|---|---|");
+    for &coarse in &[4u32, 2, 1] {
+        let s = CpuForwardScattering::new(&model, tables.clone(), swept(64, coarse, 0.5)).expect("source");
+        let (a, b, c, d) = differences(&grid_values(&s), &exact);
+        println!("| {coarse} | {} | {a:.4} | {b:.4} | {c:.4} | {d:.4} |", s.sample_grid().vertex_count());
+    }
+    println!("light sweep evaluated at the probes themselves (no grid):");
+    let s = CpuForwardScattering::new(&model, tables.clone(), swept(64, 4, 0.5)).expect("source");
+    let (a, b, c, d) = differences(&probe_values(&s), &exact);
+    println!("| at probes | - | {a:.4} | {b:.4} | {c:.4} | {d:.4} |");
 
     println!("\n## Convergence vs step size (values at the probes, 64 voxels, taps 2; reference step 1/16 voxel)");
     let reference = probe_values(&CpuForwardScattering::new(&model, tables.clone(), with(64, 4, 1.0 / 16.0, 2)).expect("source"));

@@ -49,7 +49,9 @@ impl LightMedium {
     /// Table lookups for every occupied voxel under `light` (parallel over voxels).
     pub fn new(volume: &HairVolume, tables: &ForwardScatteringTables, light: &EnvLight) -> Self {
         let xi = light_direction(light);
-        let empty_srbf = light.lambda.map_or(0.0, |l| tables.srbf_spread.variance(0.0, l as f64));
+        let srbf = light.lambda.map(|l| tables.srbf_spread.for_bandwidth(l as f64));
+        let srbf_at = |s: f64| srbf.as_ref().map_or(0.0, |c| c.variance(s));
+        let empty_srbf = srbf_at(0.0);
         let per_voxel: Vec<(f32, ForwardEvent, f32)> = (0..volume.sigma_perp.len())
             .into_par_iter()
             .with_min_len(1024)
@@ -61,8 +63,7 @@ impl LightMedium {
                 }
                 let s = volume.mean_direction[v].dot(xi).clamp(-1.0, 1.0) as f64;
                 let alpha = tables.attenuation_ratio.at(volume.deviation[v] as f64, s);
-                let srbf = light.lambda.map_or(0.0, |l| tables.srbf_spread.variance(s, l as f64));
-                (sigma * alpha, tables.fiber_averages.at(s), srbf)
+                (sigma * alpha, tables.fiber_averages.at(s), srbf_at(s))
             })
             .collect();
         let mut medium = Self {
