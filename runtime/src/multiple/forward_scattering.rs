@@ -182,7 +182,8 @@ impl CpuForwardScattering {
         let march = self.settings.march();
         if self.settings.light_sweep {
             let h = self.volume.grid.voxel_size;
-            let sweep = LightSweep::new(&self.volume, &medium, xi, h, march.step_fraction * h);
+            let substeps = (1.0 / march.step_fraction).ceil() as u32;
+            let sweep = LightSweep::new(&self.volume, &medium, xi, h, substeps);
             return points
                 .par_iter()
                 .with_min_len(64)

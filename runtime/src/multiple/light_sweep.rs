@@ -67,8 +67,14 @@ pub struct LightSweep {
 
 impl LightSweep {
     /// Marches every lattice ray through `volume` (parallel over rays). `lateral` is the ray
-    /// spacing and `delta` the step (model units, both > 0).
-    pub fn new(volume: &HairVolume, medium: &LightMedium, xi: Vec3, lateral: f32, delta: f32) -> Self {
+    /// spacing and the depth between stored nodes; each node interval is marched in
+    /// `substeps` steps (model units > 0, substeps ≥ 1). Storing every voxel rather than every
+    /// step keeps the lattice at 40 bytes per voxel-sized cell: its size, not the marching,
+    /// sets the cost (memory traffic).
+    pub fn new(volume: &HairVolume, medium: &LightMedium, xi: Vec3, lateral: f32, substeps: u32) -> Self {
+        let substeps = substeps.max(1);
+        let delta = lateral;
+        let step = delta / substeps as f32;
         let (e1, e2) = xi.any_orthonormal_pair();
         let g = &volume.grid;
         let (lo, hi) = (g.origin, g.origin + g.extent());
@@ -98,11 +104,13 @@ impl LightSweep {
             let mut path = ExpectedShadowPath::default();
             column[0] = StoredPath::from(&path);
             for (k, node) in column.iter_mut().enumerate().skip(1) {
-                let w_mid = w_top - (k as f32 - 0.5) * delta;
-                if let Some(v) = g.voxel_of(base + xi * w_mid) {
-                    let ext = medium.extinction[v];
-                    if ext > 0.0 {
-                        path.step(ext as f64, delta as f64, &medium.event[v], medium.srbf_variance[v] as f64);
+                for sub in 0..substeps {
+                    let w_mid = w_top - (k - 1) as f32 * delta - (sub as f32 + 0.5) * step;
+                    if let Some(v) = g.voxel_of(base + xi * w_mid) {
+                        let ext = medium.extinction[v];
+                        if ext > 0.0 {
+                            path.step(ext as f64, step as f64, &medium.event[v], medium.srbf_variance[v] as f64);
+                        }
                     }
                 }
                 *node = StoredPath::from(&path);
