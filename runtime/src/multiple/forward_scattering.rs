@@ -221,11 +221,15 @@ impl ForwardScatteringSource for CpuForwardScattering {
 }
 
 /// Trilinear value of light `light` of `grid` at `p`, clamped at the border (what the view
-/// pass does on the GPU; used by the CPU tests and the convergence study).
-pub fn interpolate_grid(grid: &ForwardScatteringGrid, light: usize, p: Vec3) -> [f32; 4] {
+/// pass does on the GPU; used by the CPU tests and the convergence study). `None` when the
+/// grid has no block for `light` or no vertices.
+pub fn interpolate_grid(grid: &ForwardScatteringGrid, light: usize, p: Vec3) -> Option<[f32; 4]> {
     let [nx, ny, nz] = grid.dims.map(|d| d as usize);
     let block = nx * ny * nz;
-    let values = &grid.values[light * block..(light + 1) * block];
+    if block == 0 {
+        return None;
+    }
+    let values = grid.values.get(light * block..(light + 1) * block)?;
     let q = (p - grid.origin) / grid.spacing;
     let cell = |k: usize, n: usize| -> (usize, f32) {
         let v = if q[k].is_finite() { q[k].clamp(0.0, (n - 1) as f32) } else { 0.0 };
@@ -248,5 +252,5 @@ pub fn interpolate_grid(grid: &ForwardScatteringGrid, light: usize, p: Vec3) -> 
             out[c] += w * v[c];
         }
     }
-    out
+    Some(out)
 }

@@ -337,11 +337,12 @@ fn the_grid_covers_the_hair_and_holds_every_light() {
     let p = grid.origin + grid.spacing * Vec3::new(1.0, 1.0, 1.0);
     for (l, light) in lights.iter().enumerate() {
         let direct = source.values_at(light, &[p])[0];
-        let interpolated = interpolate_grid(&grid, l, p);
+        let interpolated = interpolate_grid(&grid, l, p).unwrap();
         for c in 0..4 {
             assert!((direct[c] - interpolated[c]).abs() < 1e-5, "light {l}: {direct:?} vs {interpolated:?}");
         }
     }
+    assert_eq!(interpolate_grid(&grid, lights.len(), p), None);
 }
 
 #[test]
