@@ -6,5 +6,6 @@ pub mod gpu;
 pub mod hair;
 pub mod image_out;
 pub mod lights;
+pub mod multiple;
 pub mod passes;
 pub mod render;
