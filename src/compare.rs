@@ -4,7 +4,7 @@
 //! against the reference over hair pixels, and the speed ratios; the images side by side.
 
 use crate::env_lights::to_env_lights;
-use crate::env_scene::{
+use crate::env_scene::{forward_settings, FrameRole, 
     bake_scene_tables, fit_cached, load_env, render_lights, sha256_hex, EnvFrame, EnvShading, RenderedEnv, ScatteringMode, SceneTables, MULTIPLE_TABLES,
 };
 use crate::equal_time::{equal_time_lights, EqualTimeSearch};
@@ -18,7 +18,7 @@ use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_precompute::env_lights::{face_resolution_for, median_cut_lights, reference_lights, srbf_set_lights};
 use strandlight_precompute::FitOptions;
 use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_runtime::env::EnvLight;
+use strandlight_runtime::env::{EnvLight, EnvRenderOptions};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::image_out::{write_exr, write_png};
 
@@ -66,6 +66,10 @@ pub struct CompareArgs {
     /// Which modes to compare: single scattering, full (single + multiple), or both.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "single,full")]
     pub modes: Vec<ScatteringMode>,
+    /// Stochastic simplification of the SRBF light pass (Ren §7): the fraction of strands drawn
+    /// into the light maps (1 = all). The reference and the baseline always draw all.
+    #[arg(long, default_value_t = 0.1)]
+    pub kappa: f32,
     /// Renders per timing (the median is reported).
     #[arg(long, default_value_t = 3)]
     pub timing_runs: usize,
@@ -180,7 +184,11 @@ struct ModeResult {
 }
 
 fn frame<'a>(scene: &'a CompareScene, args: &CompareArgs, lights: &'a [EnvLight], mode: ScatteringMode) -> EnvFrame<'a> {
-    EnvFrame { hair: &scene.hair, camera: scene.camera, width: scene.size.0, height: scene.size.1, lights, tables: &scene.tables, shading: args.shading, mode }
+    EnvFrame { hair: &scene.hair, camera: scene.camera, width: scene.size.0, height: scene.size.1, lights, tables: &scene.tables, shading: args.shading, mode, role: FrameRole::Interactive { kappa: args.kappa } }
+}
+
+fn reference_frame<'a>(scene: &'a CompareScene, args: &CompareArgs, mode: ScatteringMode) -> EnvFrame<'a> {
+    EnvFrame { role: FrameRole::Reference, ..frame(scene, args, &scene.reference, mode) }
 }
 
 fn reference_inputs(scene: &CompareScene, args: &CompareArgs, mode: ScatteringMode) -> anyhow::Result<Value> {
@@ -198,6 +206,7 @@ fn reference_inputs(scene: &CompareScene, args: &CompareArgs, mode: ScatteringMo
         "direct_table_inputs": direct.metadata.description.inputs_key,
         "multiple_tables_inputs": MULTIPLE_TABLES.iter().filter_map(|n| scene.tables.assets.get(*n)).map(|a| a.metadata.description.inputs_key.clone()).collect::<Vec<_>>(),
         "generator": env!("CARGO_PKG_VERSION"),
+        "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
     }))
 }
 
@@ -211,7 +220,7 @@ fn run_mode(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: Sc
         || match cache.load(&inputs) {
             Some((image, record)) => Ok((image, record, true)),
             None => {
-                let r = render(&frame(scene, args, &scene.reference, mode))?;
+                let r = render(&reference_frame(scene, args, mode))?;
                 let record = ReferenceRecord { inputs: inputs.clone(), lights: scene.reference.len(), milliseconds: r.milliseconds };
                 cache.store(&r.image, &record)?;
                 Ok((r.image, record, false))
@@ -220,18 +229,28 @@ fn run_mode(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: Sc
         |(_, rec, cached): &(Image, ReferenceRecord, bool)| format!("{:.1} ms/frame, {} lights{}", rec.milliseconds, rec.lights, if *cached { " (cached)" } else { "" }),
     )?;
     let search = EqualTimeSearch { max_lights: scene.reference.len().max(16), ..EqualTimeSearch::new(srbf.milliseconds) };
+    // Every image the search renders is kept, so the chosen count need not be rendered again.
+    let mut searched: std::collections::HashMap<usize, RenderedEnv> = std::collections::HashMap::new();
     let found = steps.run(
         &format!("{m}: baseline"),
         || {
             equal_time_lights(&search, |n| {
                 let lights = to_env_lights(&median_cut_lights(&scene.map, n, args.rotate), scene.up);
-                Ok::<f64, anyhow::Error>(timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)?.milliseconds)
+                let r = timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)?;
+                let ms = r.milliseconds;
+                searched.insert(n, r);
+                Ok::<f64, anyhow::Error>(ms)
             })
         },
         |f| format!("{} median-cut lights at {:.2} ms/frame ({} searches{})", f.lights, f.milliseconds, f.measurements.len(), if f.at_bound { ", at the search bound" } else { "" }),
     )?;
-    let lights = to_env_lights(&median_cut_lights(&scene.map, found.lights, args.rotate), scene.up);
-    let baseline = timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)?;
+    let baseline = match searched.remove(&found.lights) {
+        Some(r) => r,
+        None => {
+            let lights = to_env_lights(&median_cut_lights(&scene.map, found.lights, args.rotate), scene.up);
+            timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)?
+        }
+    };
     Ok(ModeResult { srbf, reference, baseline, baseline_lights: found.lights, baseline_search: found.measurements })
 }
 

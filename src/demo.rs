@@ -4,7 +4,8 @@
 //! and prints each step's time.
 
 use crate::env_lights::to_env_lights;
-use crate::env_scene::{bake_scene_tables, fit_cached, load_env, render_lights, EnvFrame, EnvShading, ScatteringMode, MULTIPLE_TABLES};
+use strandlight_runtime::env::EnvRenderOptions;
+use crate::env_scene::{FrameRole, bake_scene_tables, fit_cached, load_env, render_lights, EnvFrame, EnvShading, ScatteringMode, MULTIPLE_TABLES};
 use crate::steps::Steps;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
@@ -19,7 +20,7 @@ use strandlight_runtime::image_out::{write_exr, write_png, PNG_TONEMAP};
 pub const DEMO_ENVIRONMENT: &str = "sun_and_sky";
 pub const ENVMAP_DIR: &str = "envmaps";
 /// Fiber preset (bright enough that multiple scattering is baked and rendered).
-pub const DEMO_PRESET: &str = "brown";
+pub const DEMO_PRESET: &str = "blonde";
 /// Nodes per direction axis of the demo's tables (1/λ gets twice as many): chosen so the bake
 /// fits the two-minute budget on 2 cores (docs/BENCHMARKS.md has the timing and the accuracy).
 pub const DEMO_TABLE_NODES: usize = 32;
@@ -78,7 +79,7 @@ pub fn run(_args: DemoArgs) -> anyhow::Result<()> {
     let camera = Camera::framing_front(hair.bounds(), width as f32 / height as f32, false, up);
     let lights = to_env_lights(&srbf_set_lights(&fit.set), up);
     let mode = if tables.assets.contains_key("multiple") { ScatteringMode::Full } else { ScatteringMode::Single };
-    let frame = EnvFrame { hair: &hair, camera, width, height, lights: &lights, tables: &tables, shading, mode };
+    let frame = EnvFrame { hair: &hair, camera, width, height, lights: &lights, tables: &tables, shading, mode, role: FrameRole::Interactive { kappa: EnvRenderOptions::default().kappa } };
     let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {} SRBF lights, {} scattering", r.milliseconds, lights.len(), mode.name()))?;
     let out = Path::new(OUT_DIR);
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;

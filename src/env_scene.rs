@@ -16,7 +16,8 @@ use strandlight_precompute::srbf_set::{Source, SrbfSet};
 use strandlight_precompute::{procedural_env, EnvMap, FitOptions};
 use strandlight_runtime::camera::Camera;
 use std::sync::OnceLock;
-use strandlight_runtime::env::{EnvLight, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables};
+use strandlight_runtime::multiple::{CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables};
+use strandlight_runtime::env::{ForwardScatteringSource, EnvLight, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
 use strandlight_tables::asset::{expect_parameters, read_asset, Storage, TableAsset};
@@ -224,6 +225,7 @@ pub struct EnvFrame<'a> {
     pub tables: &'a SceneTables,
     pub shading: EnvShading,
     pub mode: ScatteringMode,
+    pub role: FrameRole,
 }
 
 /// A rendered frame and its GPU time.
@@ -260,12 +262,39 @@ pub fn frame_milliseconds(stats: &EnvRenderStats) -> f64 {
     stats.timings.iter().filter(|t| !SETUP_PASSES.contains(&t.pass.as_str())).map(|t| t.milliseconds).sum()
 }
 
-/// Stochastic simplification (Ren §7) is part of the SRBF method; the directional reference and
-/// baseline draw every fiber into every light's map (plain deep opacity maps).
-fn render_options(lights: &[EnvLight]) -> EnvRenderOptions {
-    let srbf = lights.iter().all(|l| l.lambda.is_some());
-    let kappa = std::env::var("STRANDLIGHT_KAPPA").ok().and_then(|v| v.parse().ok()).unwrap_or(EnvRenderOptions::default().kappa);
-    EnvRenderOptions { kappa: if srbf { kappa } else { 1.0 }, ..EnvRenderOptions::default() }
+/// Which renderer settings a frame uses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FrameRole {
+    /// The interactive method: SRBF lights (or the equal-cost directional baseline) with the
+    /// paper's sparse forward-scattering grid and, for SRBFs, stochastic simplification κ.
+    Interactive { kappa: f32 },
+    /// The brute-force reference: every fiber in every light's map (κ = 1) and the forward
+    /// scattering from the dense grid ([`ForwardScatteringSettings::dense_reference`]).
+    Reference,
+}
+
+fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
+    let srbf = frame.lights.iter().all(|l| l.lambda.is_some());
+    let kappa = match frame.role {
+        FrameRole::Interactive { kappa } if srbf => kappa,
+        _ => 1.0,
+    };
+    EnvRenderOptions { kappa, ..EnvRenderOptions::default() }
+}
+
+/// Forward-scattering settings of `role`.
+pub fn forward_settings(role: FrameRole) -> ForwardScatteringSettings {
+    match role {
+        FrameRole::Interactive { .. } => ForwardScatteringSettings::default(),
+        FrameRole::Reference => ForwardScatteringSettings::dense_reference(),
+    }
+}
+
+/// The CPU forward-scattering source of Ren §6 for `frame` (voxelization included: a static
+/// hair pays it once, outside the frame time; dynamic hair per frame — see docs/BENCHMARKS.md).
+fn forward_scattering(frame: &EnvFrame) -> anyhow::Result<CpuForwardScattering> {
+    let tables = ForwardScatteringTables::from_tables(&frame.tables.get("fiber_averages")?.table, &frame.tables.get("attenuation_ratio")?.table, &frame.tables.get("srbf_spread")?.table)?;
+    Ok(CpuForwardScattering::new(frame.hair, tables, forward_settings(frame.role))?)
 }
 
 /// The runtime's tables for `frame`: the SRBF or direct table of its mode, and in full mode I_G.
@@ -289,13 +318,14 @@ fn env_tables(frame: &EnvFrame) -> anyhow::Result<EnvTables> {
 pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
     let r = gpu_renderer()?;
     let tables = env_tables(frame)?;
-    let multiple = match frame.mode {
+    let source = match frame.mode {
         ScatteringMode::Single => None,
-        ScatteringMode::Full => bail!("multiple scattering is not wired into the renderer yet"),
+        ScatteringMode::Full => Some(forward_scattering(frame)?),
     };
+    let multiple = source.as_ref().map(|s| s as &dyn ForwardScatteringSource);
     let out = r
         .renderer
-        .render(&r.gpu, frame.hair, &frame.camera, frame.width, frame.height, frame.lights, &tables, &render_options(frame.lights), multiple)
+        .render(&r.gpu, frame.hair, &frame.camera, frame.width, frame.height, frame.lights, &tables, &render_options(frame), multiple)
         .with_context(|| format!("rendering {} lights ({} scattering)", frame.lights.len(), frame.mode.name()))?;
     if std::env::var_os("STRANDLIGHT_TIMINGS").is_some() {
         eprintln!("{:?}", out.stats.timings);
