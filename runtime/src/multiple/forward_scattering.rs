@@ -34,6 +34,10 @@ pub struct ForwardScatteringSettings {
     /// (`filter_taps` is then unused: the lateral interpolation is the filter). Faster for
     /// dense sample grids, slower for the coarse interactive one.
     pub light_sweep: bool,
+    /// T_f also counts the direct light (zero-hit paths, T = 1), as `ForwardScatteringPath`.
+    /// Off by default: the view pass adds T_f·I_G ON TOP of single scattering, which already
+    /// carries the direct light, so T_f must be Zinke's scattered part (T_f − direct fraction).
+    pub include_direct: bool,
 }
 
 impl Default for ForwardScatteringSettings {
@@ -46,6 +50,7 @@ impl Default for ForwardScatteringSettings {
             filter_taps: 2,
             density_forward: strandlight_tables::dual_scattering::DEFAULT_DENSITY_FACTOR,
             light_sweep: false,
+            include_direct: false,
         }
     }
 }
@@ -82,6 +87,7 @@ impl ForwardScatteringSettings {
             step_fraction: self.step_fraction,
             filter_taps: self.filter_taps,
             density_forward: self.density_forward,
+            include_direct: self.include_direct,
         }
     }
 }
@@ -190,7 +196,7 @@ impl CpuForwardScattering {
                 .map(|&p| {
                     let mut acc = SampleAccumulator::default();
                     let direct = medium.srbf_variance[self.volume.grid.voxel_clamped(p)] as f64;
-                    acc.add(&sweep.path_at(p), march.density_forward, direct);
+                    acc.add(&sweep.path_at(p), march.density_forward, direct, march.include_direct);
                     acc.value()
                 })
                 .collect();

@@ -150,6 +150,14 @@ impl ExpectedShadowPath {
         self.product.map(|m| self.no_hit + density_forward * (m - self.no_hit).max(0.0))
     }
 
+    /// The forward-SCATTERED part of E[T_f]: d_f (E[∏ā_f] − P₀), paths with at least one hit.
+    /// Zinke 2008's global term is (T_f − direct fraction): the directly transmitted light is
+    /// single scattering's (shadowed by the DODM, with d_b·S_back in `marschner_full`, Ren §7),
+    /// so counting it again in the multiple term would light every exposed fiber twice.
+    pub fn scattered_transmittance(&self, density_forward: f64) -> [f64; 3] {
+        self.product.map(|m| density_forward * (m - self.no_hit).max(0.0))
+    }
+
     /// Numerators of the energy-weighted variance of the incident inclination, per channel
     /// (rad²), with `direct_variance` the spread of direct light (the SRBF's, or 0).
     pub fn variance_numerator(&self, density_forward: f64, direct_variance: f64) -> [f64; 3] {
@@ -202,6 +210,9 @@ pub struct MarchSettings {
     pub filter_taps: u32,
     /// d_f of Zinke eq. 5.
     pub density_forward: f64,
+    /// Count direct (zero-hit) light in T_f (as `ForwardScatteringPath` does) or only the
+    /// forward-scattered paths (Zinke's global multiple scattering; the renderer's default).
+    pub include_direct: bool,
 }
 
 /// Sums the paths that make one sample (box-filter taps, interpolated neighbours) and turns
@@ -217,9 +228,14 @@ pub struct SampleAccumulator {
 impl SampleAccumulator {
     /// Adds one path; `direct_variance` is the spread of direct light at the sample (the
     /// SRBF's own width seen by the fiber there, 0 for a directional light).
-    pub fn add(&mut self, path: &ExpectedShadowPath, density_forward: f64, direct_variance: f64) {
-        let t = path.transmittance(density_forward);
-        let num = path.variance_numerator(density_forward, direct_variance);
+    /// With `include_direct` false only the scattered paths count (see
+    /// [`ExpectedShadowPath::scattered_transmittance`]).
+    pub fn add(&mut self, path: &ExpectedShadowPath, density_forward: f64, direct_variance: f64, include_direct: bool) {
+        let (t, num) = if include_direct {
+            (path.transmittance(density_forward), path.variance_numerator(density_forward, direct_variance))
+        } else {
+            (path.scattered_transmittance(density_forward), path.variance_numerator(density_forward, 0.0))
+        };
         for c in 0..3 {
             self.transmittance[c] += t[c];
             self.variance_numerator[c] += num[c];
@@ -266,7 +282,7 @@ pub fn sample_value(
         let p = point + offset;
         let path = march(volume, medium, p, xi, step);
         let direct_variance = medium.srbf_variance[volume.grid.voxel_clamped(p)] as f64;
-        acc.add(&path, settings.density_forward, direct_variance);
+        acc.add(&path, settings.density_forward, direct_variance, settings.include_direct);
     }
     acc.value()
 }

@@ -76,6 +76,7 @@ fn settings(voxels: u32, taps: u32, step: f32) -> ForwardScatteringSettings {
         step_fraction: step,
         filter_taps: taps,
         density_forward: 0.7,
+        include_direct: true,
         light_sweep: false,
     }
 }
@@ -222,6 +223,21 @@ fn slab_attenuation_matches_the_expected_value_closed_form() {
             assert!((got[3] as f64 / sigma - 1.0).abs() < 2e-6);
         }
     }
+    // The renderer's default: only paths with ≥ 1 hit, T = d_f (E[a^N] − P₀) (Zinke's global
+    // term without the direct fraction), σ̄_f weighted by those paths alone.
+    let scattered = CpuForwardScattering::new(&model, tables(), ForwardScatteringSettings { include_direct: false, ..settings(8, 1, 0.5) }).unwrap();
+    let got = scattered.values_at(&srbf, &[point])[0];
+    let p0 = (-mu).exp();
+    let (mut num, mut den) = (0.0, 0.0);
+    for c in 0..3 {
+        let m = (-mu * (1.0 - A_F[c])).exp();
+        let want = 0.7 * (m - p0);
+        println!("scattered only: channel {c} T_f {} closed form {want:.6}", got[c]);
+        assert!((got[c] as f64 - want).abs() < 2e-6, "channel {c}");
+        num += 0.7 * (4.0 * BETA2_F * mu * A_F[c] * m + SRBF_VARIANCE * (m - p0));
+        den += want;
+    }
+    assert!((got[3] as f64 / (num / den).sqrt() - 1.0).abs() < 2e-6);
 }
 
 #[test]
@@ -294,11 +310,15 @@ fn degenerate_hair_gives_finite_values() {
     ];
     for (points, offsets) in cases {
         let model = HairModel::new(points, offsets, None, None, None).unwrap();
-        let source = CpuForwardScattering::new(&model, tables(), ForwardScatteringSettings::default()).unwrap();
+        let with_direct = ForwardScatteringSettings { include_direct: true, ..Default::default() };
+        let source = CpuForwardScattering::new(&model, tables(), with_direct).unwrap();
         let lights = [
             EnvLight::directional(Vec3::new(0.3, 0.4, 0.5), [1.0; 3]),
             EnvLight::srbf(Vec3::new(-1.0, 0.0, 0.0), 50.0, [1.0; 3]),
         ];
+        // The renderer's default counts only forward-scattered light: none without fibers.
+        let scattered = CpuForwardScattering::new(&model, tables(), ForwardScatteringSettings::default()).unwrap().grid(&lights);
+        assert!(scattered.values.iter().all(|v| v[..3] == [0.0; 3] && v[3].is_finite()));
         let grid = source.grid(&lights);
         let volume = source.volume();
         println!(
