@@ -286,7 +286,12 @@ fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
 pub fn forward_settings(role: FrameRole) -> ForwardScatteringSettings {
     match role {
         FrameRole::Interactive { .. } => ForwardScatteringSettings::default(),
-        FrameRole::Reference => ForwardScatteringSettings::dense_reference(),
+        FrameRole::Reference => match std::env::var("STRANDLIGHT_REF_FORWARD").as_deref() {
+            Ok("coarse") => ForwardScatteringSettings::default(),
+            Ok("march") => ForwardScatteringSettings { light_sweep: false, ..ForwardScatteringSettings::dense_reference() },
+            Ok("coarse2") => ForwardScatteringSettings { coarse_factor: 2, ..ForwardScatteringSettings::default() },
+            _ => ForwardScatteringSettings::dense_reference(),
+        },
     }
 }
 
@@ -329,6 +334,8 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
         .with_context(|| format!("rendering {} lights ({} scattering)", frame.lights.len(), frame.mode.name()))?;
     if std::env::var_os("STRANDLIGHT_TIMINGS").is_some() {
         eprintln!("{:?}", out.stats.timings);
+        let sum = |px: &[[f32; 4]]| px.iter().fold([0.0f64; 3], |a, p| [a[0] + p[0] as f64, a[1] + p[1] as f64, a[2] + p[2] as f64]);
+        eprintln!("single Σ {:?} multiple Σ {:?} lights {} power Σ {:?}", sum(&out.single_pixels), out.multiple_pixels.as_deref().map(sum), frame.lights.len(), frame.lights.iter().fold([0.0f64; 3], |a, l| { let p = l.power(); [a[0] + p[0] as f64, a[1] + p[1] as f64, a[2] + p[2] as f64] }));
     }
     Ok(RenderedEnv { milliseconds: frame_milliseconds(&out.stats), image: Image { width: out.width, height: out.height, pixels: out.pixels } })
 }
