@@ -18,7 +18,7 @@ use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::{EnvLight, EnvRenderOptions, EnvRenderer, EnvTables, ForwardScatteringSource};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::{generate_groom, GroomParams, HairModel};
-use strandlight_runtime::multiple::{CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables};
+use strandlight_runtime::multiple::{CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, VoxelSettings};
 use strandlight_tables::asset::{read_asset, Storage};
 use strandlight_tables::table::Table;
 
@@ -26,6 +26,18 @@ const WIDTH: u32 = 128;
 const HEIGHT: u32 = 96;
 /// Cube texels per face edge of the reference: 6·8² = 384 lights.
 const REFERENCE_FACE: usize = 8;
+/// Nodes per direction axis of the single-scattering tables (`marschner`, `marschner_direct`,
+/// and their `_full` variants). Measured on this scene, the SRBF image against the directional
+/// reference of the same lobes (unshadowed): 0.28 at 8 nodes, 0.071 at 16, 0.020 at 24: the
+/// convolution table's interpolation dominates below 24.
+const SINGLE_TABLE_NODES: usize = 24;
+/// Nodes of the multiple-scattering tables (I_G and the fiber averages are smooth).
+const MULTIPLE_TABLE_NODES: usize = 8;
+const SINGLE_TABLES: [&str; 4] = ["marschner", "marschner_direct", "marschner_full", "marschner_full_direct"];
+const MULTIPLE_TABLES: [&str; 4] = ["multiple", "fiber_averages", "attenuation_ratio", "srbf_spread"];
+/// Light-pass map resolution for every light of both paths (half the default: the groom spans
+/// ~100 pixels, and the light pass dominates the reference's 384 lights).
+const DODM_RESOLUTION: u32 = 256;
 /// Pixels whose reference alpha exceeds this are hair (as `src/image_compare.rs`).
 const HAIR_ALPHA: f32 = 1e-3;
 
@@ -37,6 +49,8 @@ struct Scene {
     camera: Camera,
     srbf: Vec<EnvLight>,
     reference: Vec<EnvLight>,
+    /// The cube-texel reference of the map the fitted lobes draw.
+    fitted_reference: Vec<EnvLight>,
     srbf_specs: Vec<LightSpec>,
     reference_specs: Vec<LightSpec>,
     up: UpAxis,
@@ -80,39 +94,50 @@ fn build_scene() -> Result<Scene, String> {
 
     let t = Instant::now();
     let map = procedural_env::by_name("studio", 256).expect("studio is a procedural map");
-    let options = FitOptions { initial_lobes: 8, max_lobes: 16, grid_width: 64, iterations_per_round: 10, final_iterations: 40, ..FitOptions::default() };
+    let options = FitOptions { initial_lobes: 8, max_lobes: 24, target_relative_mse: 0.03, grid_width: 64, iterations_per_round: 10, final_iterations: 40, ..FitOptions::default() };
     let source = Source { map: &map, name: "procedural:studio".into(), sha256: String::new(), sanitized: Default::default() };
     let set = SrbfSet::fit(&source, &options, &mut |_| {}).expect("fit");
     let srbf_specs = srbf_set_lights(&set);
     let reference_specs = reference_lights(&map, REFERENCE_FACE, 0.0).expect("reference lights");
-    eprintln!("fit: {} lobes in {:.2} s; reference: {} lights", srbf_specs.len(), t.elapsed().as_secs_f64(), reference_specs.len());
+    // The reference of the fitted lobes themselves: separates the fit's error from the method's.
+    let fitted_map = procedural_env::from_srbf_lobes(256, &set.lobes);
+    let fitted_reference_specs = reference_lights(&fitted_map, REFERENCE_FACE, 0.0).expect("reference lights");
+    eprintln!(
+        "fit: {} lobes in {:.2} s (relative MSE {:.4} on the fit grid, {:.4} at full resolution); reference: {} lights",
+        srbf_specs.len(),
+        t.elapsed().as_secs_f64(),
+        set.relative_mse,
+        set.full_resolution_relative_mse,
+        reference_specs.len()
+    );
 
     let t = Instant::now();
     let (lo, hi) = srbf_specs.iter().filter_map(|s| s.lambda).fold((f64::INFINITY, 0.0f64), |(lo, hi), l| (lo.min(l), hi.max(l)));
     let (lo, hi) = (lo / 1.1, (hi * 1.1).max(lo * 1.01 / 1.1));
     // Blonde: light enough that the plan bakes `multiple` (dark hair skips it).
     let fiber = FiberDescription::preset("blonde").expect("preset");
-    let plan_options = PlanOptions {
-        models: vec![Model::Marschner],
-        resolution: BakeResolution::reduced(8).with_lambda_range(lo, hi),
-        force_multiple: false,
-        multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD,
-    };
-    let wanted = ["marschner", "marschner_direct", "marschner_full", "marschner_full_direct", "multiple", "fiber_averages", "attenuation_ratio", "srbf_spread"];
     let dir = std::env::temp_dir().join(format!("strandlight-env-vs-reference-{}", std::process::id()));
     let mut tables = BTreeMap::new();
-    for job in plan(&fiber, &plan_options).expect("plan").jobs.into_iter().filter(|j| wanted.contains(&j.name)) {
-        let baked = bake_job(job, &dir, Storage::F32).expect("bake");
-        eprintln!("  baked {:<22} {:.2} s", baked.name, baked.seconds);
-        tables.insert(baked.name.clone(), read_asset(&baked.path).expect("read table").table);
+    for (nodes, wanted) in [(SINGLE_TABLE_NODES, &SINGLE_TABLES[..]), (MULTIPLE_TABLE_NODES, &MULTIPLE_TABLES[..])] {
+        let plan_options = PlanOptions {
+            models: vec![Model::Marschner],
+            resolution: BakeResolution::reduced(nodes).with_lambda_range(lo, hi),
+            force_multiple: false,
+            multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD,
+        };
+        for job in plan(&fiber, &plan_options).expect("plan").jobs.into_iter().filter(|j| wanted.contains(&j.name)) {
+            let baked = bake_job(job, &dir.join(nodes.to_string()), Storage::F32).expect("bake");
+            eprintln!("  baked {:<22} at {nodes:>2} nodes: {:.2} s", baked.name, baked.seconds);
+            tables.insert(baked.name.clone(), read_asset(&baked.path).expect("read table").table);
+        }
+        for name in wanted {
+            assert!(tables.contains_key(*name), "table {name} was not baked");
+        }
     }
     let _ = std::fs::remove_dir_all(&dir);
-    for name in wanted {
-        assert!(tables.contains_key(name), "table {name} was not baked");
-    }
-    eprintln!("bake (reduced 8, λ ∈ [{lo:.1}, {hi:.1}]): {:.2} s", t.elapsed().as_secs_f64());
+    eprintln!("bake (λ ∈ [{lo:.1}, {hi:.1}]): {:.2} s", t.elapsed().as_secs_f64());
 
-    let hair = generate_groom(&GroomParams { strand_count: 400, points_per_strand: 16, clump_count: 20, ..GroomParams::default() }).expect("groom");
+    let hair = generate_groom(&GroomParams { strand_count: 1000, points_per_strand: 12, clump_count: 40, ..GroomParams::default() }).expect("groom");
     let up = UpAxis::detect(&hair);
     let camera = Camera::framing_front(hair.bounds(), WIDTH as f32 / HEIGHT as f32, false, up);
     Ok(Scene {
@@ -120,6 +145,7 @@ fn build_scene() -> Result<Scene, String> {
         renderer,
         srbf: to_env_lights(&srbf_specs, up),
         reference: to_env_lights(&reference_specs, up),
+        fitted_reference: to_env_lights(&fitted_reference_specs, up),
         srbf_specs,
         reference_specs,
         hair,
@@ -133,8 +159,12 @@ fn build_scene() -> Result<Scene, String> {
 /// `forward`. Returns the pixels and the seconds taken.
 fn render(scene: &Scene, lights: &[EnvLight], tables: EnvTables, shadowed: bool, forward: Option<&dyn ForwardScatteringSource>) -> (Vec<[f32; 4]>, f64) {
     let t = Instant::now();
-    let options = EnvRenderOptions { kappa: 1.0, shadowed, ..EnvRenderOptions::default() };
+    let mut options = EnvRenderOptions { kappa: 1.0, shadowed, ..EnvRenderOptions::default() };
+    options.dodm.resolution = DODM_RESOLUTION;
     let frame = scene.renderer.render(&scene.gpu, &scene.hair, &scene.camera, WIDTH, HEIGHT, lights, &tables, &options, forward).expect("render");
+    if std::env::var_os("STRANDLIGHT_TIMINGS").is_some() {
+        eprintln!("    {} lights: {:?}", lights.len(), frame.stats.timings.iter().map(|t| format!("{} {:.0} ms", t.pass, t.milliseconds)).collect::<Vec<_>>());
+    }
     (frame.pixels, t.elapsed().as_secs_f64())
 }
 
@@ -208,6 +238,10 @@ fn srbf_single_scattering_matches_the_directional_reference() {
         assert_eq!(coverage(&a), coverage(&r), "both paths rasterize the same hair");
         assert!(coverage(&r) > 500, "the groom covers {} pixels", coverage(&r));
         let e = relative_rmse(&a, &r);
+        let (f, tf) = render(scene, &scene.fitted_reference, direct_tables.clone(), shadowed, None);
+        let e_method = relative_rmse(&a, &f);
+        let e_fit = relative_rmse(&f, &r);
+        eprintln!("shadowed {shadowed:5}: SRBF vs reference of the fitted lobes {e_method:.4}; fitted-lobe reference vs map reference {e_fit:.4} ({tf:.2} s)");
         eprintln!(
             "shadowed {shadowed:5}: relative RMSE {e:.4} over {} hair pixels; mean SRBF {:.4e}, reference {:.4e}; SRBF {ta:.2} s, reference {tr:.2} s",
             coverage(&r),
@@ -217,18 +251,22 @@ fn srbf_single_scattering_matches_the_directional_reference() {
         let (turned, _) = render(scene, &rotated(&scene.srbf, scene.up, 90.0), srbf_tables.clone(), shadowed, None);
         let e_turned = relative_rmse(&turned, &r);
         eprintln!("shadowed {shadowed:5}: SRBF lights turned 90° about up: relative RMSE {e_turned:.4}");
-        errors.push((shadowed, e, e_turned));
+        errors.push((shadowed, e, e_turned, e_method));
     }
     eprintln!("total {:.2} s", start.elapsed().as_secs_f64());
-    for (shadowed, e, e_turned) in errors {
+    for (shadowed, e, e_turned, e_method) in errors {
+        let method_bound = if shadowed { METHOD_SHADOWED_BOUND } else { METHOD_UNSHADOWED_BOUND };
+        assert!(e_method < method_bound, "shadowed {shadowed}: SRBF vs the directional reference of the same lobes {e_method} ≥ {method_bound}");
         let bound = if shadowed { SHADOWED_BOUND } else { UNSHADOWED_BOUND };
         assert!(e < bound, "shadowed {shadowed}: relative RMSE {e} ≥ {bound}");
         assert!(e_turned > bound, "shadowed {shadowed}: a 90°-turned environment gives {e_turned}, not above {bound}: the test cannot see a wrong light set");
     }
 }
 
-const UNSHADOWED_BOUND: f64 = 1.0;
-const SHADOWED_BOUND: f64 = 1.0;
+const UNSHADOWED_BOUND: f64 = 0.15;
+const SHADOWED_BOUND: f64 = 0.15;
+const METHOD_UNSHADOWED_BOUND: f64 = 0.05;
+const METHOD_SHADOWED_BOUND: f64 = 0.10;
 
 #[test]
 fn srbf_full_scattering_matches_the_directional_reference() {
@@ -242,8 +280,9 @@ fn srbf_full_scattering_matches_the_directional_reference() {
     };
     let forward_tables = || ForwardScatteringTables::from_tables(&scene.tables["fiber_averages"], &scene.tables["attenuation_ratio"], &scene.tables["srbf_spread"]).expect("forward-scattering tables");
     let t = Instant::now();
-    let interactive = CpuForwardScattering::new(&scene.hair, forward_tables(), ForwardScatteringSettings::default()).expect("voxelize");
-    let dense = CpuForwardScattering::new(&scene.hair, forward_tables(), ForwardScatteringSettings::dense_reference()).expect("voxelize");
+    let voxels = VoxelSettings { voxels_longest_side: FORWARD_VOXELS, ..VoxelSettings::default() };
+    let interactive = CpuForwardScattering::new(&scene.hair, forward_tables(), ForwardScatteringSettings { voxels, ..ForwardScatteringSettings::default() }).expect("voxelize");
+    let dense = CpuForwardScattering::new(&scene.hair, forward_tables(), ForwardScatteringSettings { voxels, ..ForwardScatteringSettings::dense_reference() }).expect("voxelize");
     eprintln!("voxelization (both): {:.2} s", t.elapsed().as_secs_f64());
     let srbf_tables = EnvTables { srbf: Some(table(scene, "marschner_full")), multiple: Some(table(scene, "multiple")), ..EnvTables::default() };
     let direct_tables = EnvTables { direct: Some(table(scene, "marschner_full_direct")), multiple: Some(table(scene, "multiple")), ..EnvTables::default() };
@@ -261,4 +300,7 @@ fn srbf_full_scattering_matches_the_directional_reference() {
     assert!(e_turned > FULL_BOUND, "full: a 90°-turned environment gives {e_turned}, not above {FULL_BOUND}");
 }
 
-const FULL_BOUND: f64 = 1.0;
+const FULL_BOUND: f64 = 0.18;
+/// Voxels along the groom's longest side for both forward-scattering grids (half the default:
+/// the groom spans ~100 pixels here, and the dense reference's 384 per-light sweeps dominate).
+const FORWARD_VOXELS: u32 = 32;
