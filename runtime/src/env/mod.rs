@@ -22,11 +22,19 @@ pub struct EnvLight {
 
 impl EnvLight {
     pub fn srbf(direction: Vec3, lambda: f32, amplitude: [f32; 3]) -> Self {
-        Self { direction: direction.normalize(), lambda: Some(lambda), rgb: amplitude }
+        Self {
+            direction: direction.normalize(),
+            lambda: Some(lambda),
+            rgb: amplitude,
+        }
     }
 
     pub fn directional(direction: Vec3, irradiance: [f32; 3]) -> Self {
-        Self { direction: direction.normalize(), lambda: None, rgb: irradiance }
+        Self {
+            direction: direction.normalize(),
+            lambda: None,
+            rgb: irradiance,
+        }
     }
 
     /// What the light delivers to a fiber facing it, before shadowing: for an SRBF its
@@ -69,6 +77,6 @@ pub trait ForwardScatteringSource {
 
 pub mod render;
 pub use render::{
-    EnvFrame, EnvRenderError, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTableError, EnvTables,
-    render_env_frame,
+    EnvFrame, EnvRenderError, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTableError,
+    EnvTables, TransmittanceFilter, render_env_frame,
 };

@@ -21,6 +21,7 @@ use crate::passes::env_view::{
 };
 use crate::passes::strands::{FrameParams, KajiyaKay, StrandGeometry, TooManyPoints};
 use crate::passes::summed_area::{SatTooLarge, SummedAreaPass, SummedAreaTables};
+pub use crate::passes::transmittance_filter::TransmittanceFilter;
 use crate::render::{PassTiming, Transparency};
 
 /// Axis names of the env tables (`strandlight_precompute::convolution_table` and
@@ -114,8 +115,8 @@ pub fn check_env_table(
 pub struct EnvRenderOptions {
     /// Light-pass map resolution, first-layer depth and lights per batch.
     pub dodm: DodmSettings,
-    /// Stochastic simplification (Ren §7): the light pass draws this fraction of the strands
-    /// (τ scaled by 1/κ); 1 draws them all. Default 0.1.
+    /// Stochastic simplification (Ren §7): the light pass draws this fraction of the strands (their width
+    /// enlarged by 1/κ, τ scaled by 1/κ); 1 draws them all. Default 0.1.
     pub kappa: f32,
     /// Seed of the strand shuffle behind κ.
     pub simplification_seed: u64,
@@ -123,6 +124,9 @@ pub struct EnvRenderOptions {
     pub transparency: Transparency,
     /// `false`: no self-shadowing (T̃ = 1; for tests and for comparisons).
     pub shadowed: bool,
+    /// The averaging box of the effective transmittance (default
+    /// [`TransmittanceFilter::MatchedVariance`], the best measured: docs/BENCHMARKS.md).
+    pub transmittance_filter: TransmittanceFilter,
     /// View pass only: every fiber this many pixels wide instead of its projected thickness (as
     /// `FrameParams::width_override_px`); the light pass always uses the file's thickness.
     pub width_override_px: Option<f32>,
@@ -136,6 +140,7 @@ impl Default for EnvRenderOptions {
             simplification_seed: 0x5eed,
             transparency: Transparency::Opaque,
             shadowed: true,
+            transmittance_filter: TransmittanceFilter::default(),
             width_override_px: None,
         }
     }
@@ -431,6 +436,7 @@ impl EnvRenderer {
                         &directions,
                         bounds,
                         1.0 / options.kappa,
+                        1.0 / options.kappa,
                         &mut dodm,
                     );
                     gpu.queue.submit([encoder.finish()]);
@@ -442,7 +448,7 @@ impl EnvRenderer {
                     gpu.queue.submit([encoder.finish()]);
                 });
                 timings.time(gpu, "view", || {
-                    let batch = BatchBinding::new(
+                    let batch = BatchBinding::with_filter(
                         gpu,
                         &self.view.batch_layout,
                         chunk,
@@ -450,6 +456,7 @@ impl EnvRenderer {
                         &sat,
                         options.shadowed,
                         grid.is_some(),
+                        options.transmittance_filter,
                     );
                     let grid_binding = GridBinding::new(gpu, &self.view.grid_layout, grid.as_ref());
                     grid_bytes = grid_bytes.max(grid_binding.bytes);

@@ -15,8 +15,8 @@ use wgpu::util::DeviceExt;
 use super::attachments::{cleared_color, cleared_depth};
 use super::deep_opacity::light_camera;
 use super::strands::{
-    DEPTH_FORMAT, FrameParams, KajiyaKay, StrandGeometry, segment_table, strand_bind_group,
-    strand_bind_group_layout,
+    DEPTH_FORMAT, FrameParams, KajiyaKay, StrandGeometry, segment_table, strand_bind_group_layout,
+    strand_bind_group_scaled,
 };
 use crate::camera::{Camera, Projection};
 use crate::gpu::GpuContext;
@@ -103,7 +103,7 @@ pub fn check_kappa(kappa: f32) -> Result<(), DodmSettingsError> {
 
 /// Stochastic simplification (Ren 2010 §7): the segment table with whole strands in an order
 /// shuffled once by a seeded random key, so the light pass may draw only the segments of the
-/// first κ fraction of strands (and scale τ by 1/κ).
+/// first κ fraction of strands (enlarged by 1/κ, `ConvolutionDepthPass::encode`).
 pub struct SimplifiedSegments {
     pub segments: wgpu::Buffer,
     /// `segments_before[s]`: segments of the first s shuffled strands (strand_count + 1 entries).
@@ -217,7 +217,12 @@ impl DodmBatch {
             slots,
             first_layer,
             cameras: Vec::new(),
-            nearest_depth: texture("dodm nearest depth", DEPTH_FORMAT, usage),
+            // COPY_SRC: tests read the coverage back.
+            nearest_depth: texture(
+                "dodm nearest depth",
+                DEPTH_FORMAT,
+                usage | wgpu::TextureUsages::COPY_SRC,
+            ),
             optical_depth: texture(
                 "dodm optical depth",
                 gpu.hdr_format(),
@@ -389,7 +394,9 @@ impl ConvolutionDepthPass {
     }
 
     /// Encodes the maps of `toward_lights` (one slot each, at most `batch.slots`) into `encoder`;
-    /// `tau_scale` = 1/κ for a simplified `geometry`. Sets `batch.cameras`.
+    /// for a simplified `geometry`, `tau_scale` = 1/κ and `width_scale` = 1/κ (Ren 2010 §7: the
+    /// drawn fibers enlarged, so the map keeps the coverage of the fibers left out; 1 keeps the
+    /// file's width). Sets `batch.cameras`.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -399,6 +406,7 @@ impl ConvolutionDepthPass {
         toward_lights: &[Vec3],
         bounds: Aabb,
         tau_scale: f32,
+        width_scale: f32,
         batch: &mut DodmBatch,
     ) {
         let device = &gpu.device;
@@ -417,7 +425,8 @@ impl ConvolutionDepthPass {
                 shading: KajiyaKay::default(),
                 width_override_px: None,
             };
-            let strands = strand_bind_group(gpu, &self.strand_layout, geometry, &frame);
+            let strands =
+                strand_bind_group_scaled(gpu, &self.strand_layout, geometry, &frame, width_scale);
             let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("dodm params"),
                 contents: bytemuck::bytes_of(&DodmUniform {

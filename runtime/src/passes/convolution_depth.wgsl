@@ -4,7 +4,8 @@
 // boundaries z_k = k(k+1)d/2 (k = 1, 2, 3) behind z0, the fourth channel everything (z_4 = ∞):
 // a fragment at relative depth δ adds its τ to every boundary with z_k > δ. τ = −ln(1 − α) per
 // fragment as in deep_opacity.wgsl, scaled by 1/κ when only a κ fraction of the strands is drawn
-// (stochastic simplification, §7).
+// (stochastic simplification, §7; the vertex stage has then also widened the fibers by 1/κ,
+// spreading each one's optical depth, so the map keeps the coverage of those left out).
 
 struct DodmParams {
     near: f32,

@@ -4,16 +4,17 @@
 // the summed-area tables of the cumulative optical depths (summed_area.wgsl).
 //
 // For a point x: project into the light's map; z0 at its texel; δ = z − z0; the averaging
-// radius on the effective occlusion plane R = δ/2 · tan α (α: the SRBF support where G = 10⁻³);
-// a square box of half-size R (in texels) averages each boundary's optical depth through the
-// SAT; l(δ) interpolates linearly between (0, 0) and the boundaries (z_k, l̄_k); T̃ = exp(−l).
+// radius on the effective occlusion plane R = δ/2 · s (s from transmittance_filter.rs, carried in
+// rgb.w: tan α of the G = 10⁻³ support for the paper's box); a square box of half-width R (in
+// texels, blended between the two nearest texel boxes) averages each boundary's optical depth
+// through the SAT; l(δ) interpolates linearly between (0, 0) and the boundaries (z_k, l̄_k); T̃ = exp(−l).
 // Directional lights (tan α = 0) read the single texel: a plain per-light deep opacity map.
 
 struct EnvLightGpu {
     view_proj: mat4x4<f32>,
     // xyz: unit vector toward the light (ξ); w: 1/λ (0 for a directional light).
     direction: vec4<f32>,
-    // xyz: L_j (SRBF) or irradiance (directional); w: tan α (0 for a directional light).
+    // xyz: L_j (SRBF) or irradiance (directional); w: the box slope s (0 for a directional light).
     rgb: vec4<f32>,
     // xyz: EnvLight::power(); w unused.
     power: vec4<f32>,
@@ -79,6 +80,29 @@ fn layered_optical_depth(l: vec4<f32>, delta: f32, d: f32) -> f32 {
     return l.w;
 }
 
+// Mean of the quantized cumulative depths over the square of half-size h texels around `texel`.
+fn box_mean(slot: u32, texel: vec2<i32>, h: i32) -> vec4<f32> {
+    let lo = texel - vec2<i32>(h);
+    let hi = texel + vec2<i32>(h);
+    return vec4<f32>(sat_box_sum(slot, lo, hi)) / (box_area(lo, hi) * SAT_FIXED_POINT_SCALE);
+}
+
+// Texels searched around an empty texel for the hair's front (5 × 5).
+const EMPTY_TEXEL_SEARCH: i32 = 2;
+
+// The nearest depth within EMPTY_TEXEL_SEARCH texels of `texel` (1 when all are empty).
+fn nearest_depth_around(slot: u32, texel: vec2<i32>) -> f32 {
+    let last = i32(batch.resolution) - 1;
+    var z0 = 1.0;
+    for (var dy = -EMPTY_TEXEL_SEARCH; dy <= EMPTY_TEXEL_SEARCH; dy++) {
+        for (var dx = -EMPTY_TEXEL_SEARCH; dx <= EMPTY_TEXEL_SEARCH; dx++) {
+            let t = clamp(texel + vec2<i32>(dx, dy), vec2<i32>(0), vec2<i32>(last));
+            z0 = min(z0, textureLoad(dodm_depth, t, i32(slot), 0));
+        }
+    }
+    return z0;
+}
+
 fn effective_transmittance(slot: u32, world: vec3<f32>) -> f32 {
     if ((batch.flags & FLAG_UNSHADOWED) != 0u) { return 1.0; }
     let light = env_lights[slot];
@@ -87,13 +111,25 @@ fn effective_transmittance(slot: u32, world: vec3<f32>) -> f32 {
     if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }
     let res = f32(batch.resolution);
     let texel = min(vec2<i32>(uv * res), vec2<i32>(i32(batch.resolution) - 1));
-    let z0 = textureLoad(dodm_depth, texel, i32(slot), 0);
-    if (z0 >= 1.0) { return 1.0; }
+    var z0 = textureLoad(dodm_depth, texel, i32(slot), 0);
+    if (z0 >= 1.0) {
+        // Nothing drawn on this texel: the point's own fiber fell in a gap of the map (left out
+        // by the simplification, or thinner than a texel). A one-texel box (directional light)
+        // reads no depth there; an SRBF's box measures δ from the hair's front around it.
+        if (light.rgb.w <= 0.0) { return 1.0; }
+        z0 = nearest_depth_around(slot, texel);
+        if (z0 >= 1.0) { return 1.0; }
+    }
     let delta = max(clip.z - z0, 0.0) * (light.far - light.near);
+    // Continuous box half-width in texels (R = δ/2 · slope); the texel box of half-size h spans
+    // h + 1/2 each side, so blend the two integer boxes around h = R − 1/2 (smooth in R).
     let radius = 0.5 * delta * light.rgb.w * light.texels_per_unit;
-    let half_size = i32(min(floor(radius + 0.5), f32(batch.max_half_size)));
-    let lo = texel - vec2<i32>(half_size);
-    let hi = texel + vec2<i32>(half_size);
-    let mean = vec4<f32>(sat_box_sum(slot, lo, hi)) / (box_area(lo, hi) * SAT_FIXED_POINT_SCALE);
+    let h = clamp(radius - 0.5, 0.0, f32(batch.max_half_size));
+    let h0 = i32(floor(h));
+    let f = h - f32(h0);
+    var mean = box_mean(slot, texel, h0);
+    if (f > 0.0 && h0 < i32(batch.max_half_size)) {
+        mean = mix(mean, box_mean(slot, texel, h0 + 1), f);
+    }
     return exp(-layered_optical_depth(mean, delta, light.first_layer));
 }

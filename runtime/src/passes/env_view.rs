@@ -18,6 +18,7 @@ use super::strands::{
     DEPTH_FORMAT, FrameParams, StrandGeometry, strand_bind_group, strand_bind_group_layout,
 };
 use super::summed_area::{MAX_BOX_HALF_SIZE, SummedAreaTables};
+use super::transmittance_filter::TransmittanceFilter;
 use crate::env::{EnvLight, ForwardScatteringGrid};
 use crate::gpu::GpuContext;
 
@@ -127,6 +128,7 @@ pub struct BatchBinding {
 
 impl BatchBinding {
     /// `lights[slot]` must be the light of DODM slot `slot`; `shadowed = false` forces T̃ = 1.
+    /// The default [`TransmittanceFilter`].
     pub fn new(
         gpu: &GpuContext,
         layout: &wgpu::BindGroupLayout,
@@ -135,6 +137,30 @@ impl BatchBinding {
         sat: &SummedAreaTables,
         shadowed: bool,
         with_grid: bool,
+    ) -> Self {
+        Self::with_filter(
+            gpu,
+            layout,
+            lights,
+            dodm,
+            sat,
+            shadowed,
+            with_grid,
+            TransmittanceFilter::default(),
+        )
+    }
+
+    /// [`Self::new`] with the averaging box of `filter`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_filter(
+        gpu: &GpuContext,
+        layout: &wgpu::BindGroupLayout,
+        lights: &[EnvLight],
+        dodm: &DodmBatch,
+        sat: &SummedAreaTables,
+        shadowed: bool,
+        with_grid: bool,
+        filter: TransmittanceFilter,
     ) -> Self {
         let device = &gpu.device;
         let mut gpu_lights: Vec<EnvLightGpu> = lights
@@ -148,7 +174,7 @@ impl BatchBinding {
                 EnvLightGpu {
                     view_proj: view_proj.to_cols_array_2d(),
                     direction: light.direction.normalize().extend(inv_lambda).into(),
-                    rgb: Vec3::from(light.rgb).extend(tan_support(light)).into(),
+                    rgb: Vec3::from(light.rgb).extend(filter.slope(light)).into(),
                     power: [power[0], power[1], power[2], 0.0],
                     near: camera.near,
                     far: camera.far,

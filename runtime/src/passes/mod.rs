@@ -8,4 +8,5 @@ pub mod env_view;
 pub mod fiber_shading;
 pub mod strands;
 pub mod summed_area;
+pub mod transmittance_filter;
 pub mod transmittance_probe;

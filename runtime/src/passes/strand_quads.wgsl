@@ -21,6 +21,8 @@ struct Frame {
     ks: f32,
     shininess: f32,
     light_count: u32,
+    // Light pass of stochastic simplification: fibers 1/κ times wider (1 elsewhere).
+    width_scale: f32,
 };
 
 struct PointAttributes {
@@ -113,8 +115,18 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment:
     let attr = attributes[index];
     var width_px = attr.thickness * frame.focal_px / clip.w;
     if (frame.width_override_px > 0.0) { width_px = frame.width_override_px; }
-    let quad_px = max(width_px, 1.0);
-    let coverage = width_px / quad_px;
+    var quad_px = max(width_px, 1.0);
+    var alpha = width_px / quad_px * attr.opacity;
+    if (frame.width_scale != 1.0) {
+        // Enlarged fiber (Ren 2010 §7): the QUAD (at least a pixel) grows by 1/κ, so the drawn
+        // fibers cover the texels of those left out even when thinner than a texel; its optical
+        // depth is spread over it, keeping −ln(1 − α)·quad_px summed across the fiber (the light
+        // pass then scales τ by 1/κ: each drawn fiber carries the depth of 1/κ fibers).
+        let scaled_quad_px = quad_px * frame.width_scale;
+        let tau = -log(1.0 - min(alpha, 0.999));
+        alpha = 1.0 - exp(-tau * quad_px / scaled_quad_px);
+        quad_px = scaled_quad_px;
+    }
     let offset_px = normal * (c.y * 0.5 * quad_px);
     clip = vec4<f32>(clip.xy + offset_px / half_viewport * clip.w, clip.zw);
 
@@ -123,7 +135,7 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment:
     out.world = world;
     out.tangent = tangent;
     out.color = attr.color;
-    out.alpha = coverage * attr.opacity;
+    out.alpha = alpha;
     return out;
 }
 

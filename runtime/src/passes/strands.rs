@@ -169,10 +169,14 @@ struct FrameUniform {
     ks: f32,
     shininess: f32,
     light_count: u32,
+    /// Fiber width multiplier (the light pass's stochastic simplification enlarges fibers by
+    /// 1/κ); 1 elsewhere.
+    width_scale: f32,
+    _pad: [f32; 3],
 }
 
 impl FrameParams {
-    fn uniform(&self) -> FrameUniform {
+    fn uniform(&self, width_scale: f32) -> FrameUniform {
         let aspect = self.width as f32 / self.height as f32;
         let proj = self.camera.projection_matrix(aspect);
         let view_proj: Mat4 = proj * self.camera.view();
@@ -195,6 +199,8 @@ impl FrameParams {
             ks: self.shading.ks,
             shininess: self.shading.shininess,
             light_count: self.lights.len() as u32,
+            width_scale,
+            _pad: [0.0; 3],
         }
     }
 }
@@ -517,10 +523,22 @@ pub fn strand_bind_group(
     geometry: &StrandGeometry,
     frame: &FrameParams,
 ) -> wgpu::BindGroup {
+    strand_bind_group_scaled(gpu, layout, geometry, frame, 1.0)
+}
+
+/// [`strand_bind_group`] with every fiber `width_scale` times wider, its optical depth summed
+/// across kept (`strand_quads.wgsl`): the light pass's enlargement by 1/κ (Ren 2010 §7).
+pub fn strand_bind_group_scaled(
+    gpu: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    geometry: &StrandGeometry,
+    frame: &FrameParams,
+    width_scale: f32,
+) -> wgpu::BindGroup {
     let device = &gpu.device;
     let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("strand frame"),
-        contents: bytemuck::bytes_of(&frame.uniform()),
+        contents: bytemuck::bytes_of(&frame.uniform(width_scale)),
         usage: wgpu::BufferUsages::UNIFORM,
     });
     // A storage binding may not be empty: pad with one unused light.
