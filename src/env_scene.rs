@@ -232,6 +232,8 @@ pub struct EnvFrame<'a> {
 pub struct RenderedEnv {
     pub image: Image,
     pub milliseconds: f64,
+    /// Per pass (summed over batches), milliseconds; empty for stand-in renderers.
+    pub passes: Vec<(String, f64)>,
 }
 
 /// The GPU device and the renderer's pipelines, created on first use and kept for every frame
@@ -337,7 +339,11 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
         let sum = |px: &[[f32; 4]]| px.iter().fold([0.0f64; 3], |a, p| [a[0] + p[0] as f64, a[1] + p[1] as f64, a[2] + p[2] as f64]);
         eprintln!("single Σ {:?} multiple Σ {:?} lights {} power Σ {:?}", sum(&out.single_pixels), out.multiple_pixels.as_deref().map(sum), frame.lights.len(), frame.lights.iter().fold([0.0f64; 3], |a, l| { let p = l.power(); [a[0] + p[0] as f64, a[1] + p[1] as f64, a[2] + p[2] as f64] }));
     }
-    Ok(RenderedEnv { milliseconds: frame_milliseconds(&out.stats), image: Image { width: out.width, height: out.height, pixels: out.pixels } })
+    Ok(RenderedEnv {
+        milliseconds: frame_milliseconds(&out.stats),
+        passes: out.stats.timings.iter().map(|t| (t.pass.clone(), t.milliseconds)).collect(),
+        image: Image { width: out.width, height: out.height, pixels: out.pixels },
+    })
 }
 
 #[cfg(test)]

@@ -25,13 +25,13 @@ pub enum Shading {
     Artist,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
 pub enum Shadows {
     None,
     Dom,
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
 pub enum Transparency {
     None,
     Abuffer,
@@ -56,8 +56,19 @@ pub struct RenderArgs {
     /// spot:X,Y,Z:DX,DY,DZ:HALF_ANGLE_DEGREES[:I].
     #[arg(long = "light", default_value = DEFAULT_LIGHT)]
     lights: Vec<String>,
-    #[arg(long, value_enum, default_value = "kajiya-kay")]
-    shading: Shading,
+    /// Fiber model (default: kajiya-kay for point lights, marschner with --env).
+    #[arg(long, value_enum)]
+    shading: Option<Shading>,
+    /// Light the hair with an environment instead: a .hdr/.exr map or procedural:NAME, fitted
+    /// with SRBFs (cached) and rendered by Ren 2010's method (marschner or artist shading).
+    #[arg(long, value_name = "MAP")]
+    pub env: Option<String>,
+    /// With --env: single scattering, or full (single + multiple; skipped for dark hair).
+    #[arg(long, value_enum, default_value = "full")]
+    pub scattering: crate::env_scene::ScatteringMode,
+    /// With --env: fraction of the strands drawn into the light maps (Ren §7; 1 = all).
+    #[arg(long, default_value_t = 0.1)]
+    pub kappa: f32,
     /// Melanin preset of the Marschner fiber (--shading marschner): dark, brown, blonde, ...
     #[arg(long, default_value = "brown")]
     preset: String,
@@ -190,7 +201,7 @@ fn choose_camera(args: &RenderArgs, model: &HairModel, aspect: f32) -> anyhow::R
 /// The fiber model, with its lookup tables baked now for Marschner (the runtime does not link
 /// the tabulation code), and a line describing it.
 fn shading_model(args: &RenderArgs) -> anyhow::Result<(ShadingModel, String)> {
-    match args.shading {
+    match args.shading.unwrap_or(Shading::KajiyaKay) {
         Shading::KajiyaKay => Ok((
             ShadingModel::KajiyaKay,
             format!("Kajiya-Kay {:?}", KajiyaKay::default()),
@@ -233,6 +244,9 @@ fn shading_model(args: &RenderArgs) -> anyhow::Result<(ShadingModel, String)> {
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+    if let Some(env) = args.env.clone() {
+        return run_env(&args, &env);
+    }
     let (shading, shading_description) = shading_model(&args)?;
     let transparency = match args.transparency {
         Transparency::None => render::Transparency::Opaque,
@@ -407,4 +421,68 @@ mod tests {
         .unwrap_err();
         assert!(format!("{e:#}").contains("artist.json"), "{e:#}");
     }
+}
+
+/// `render --env MAP`: the SRBF path alone (fit and tables cached under out/cache).
+fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
+    use crate::env_scene::{bake_scene_tables, fit_cached, load_env, render_lights, EnvFrame, EnvShading, FrameRole, ScatteringMode, MULTIPLE_TABLES};
+    use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
+    use strandlight_precompute::env_lights::srbf_set_lights;
+    let shading = match args.shading.unwrap_or(Shading::Marschner) {
+        Shading::Marschner => EnvShading::Marschner,
+        Shading::Artist => EnvShading::Artist,
+        Shading::KajiyaKay => bail!("--shading kajiya-kay with --env: the env renderer reads one RGB 4D table (Marschner I_M or the artist I_A); use --shading marschner or artist"),
+    };
+    if args.transparency != Transparency::None || args.shadows != Shadows::None {
+        bail!("--env shadows every SRBF light with its convolution optical depth map and renders opaque; --shadows/--transparency apply to point lights only");
+    }
+    let (width, height) = parse_size(&args.size)?;
+    let mut steps = crate::steps::Steps::new(args.json);
+    let (model, source) = steps.run("hair", || load_hair(args.hair.as_deref()), |(m, s)| format!("{s} ({} strands)", m.strand_count()))?;
+    let env = steps.run("environment", || load_env(env_spec, false), |e| format!("{} {}x{}", e.name, e.map.width(), e.map.height()))?;
+    let cache = Path::new("out/cache");
+    let fit = steps.run("fit", || fit_cached(&env, &strandlight_precompute::FitOptions::default(), cache), |f| format!("{} SRBFs{}", f.set.lobes.len(), if f.cached { " (cached)" } else { "" }))?;
+    let fiber = FiberDescription::preset(&args.preset).with_context(|| format!("--preset {:?}", args.preset))?;
+    let mut wanted: Vec<&str> = MULTIPLE_TABLES.to_vec();
+    wanted.push(shading.srbf_table(args.scattering));
+    let lambda_range = crate::tables_cmd::lambda_range_of_set(&fit.set)?;
+    let dir = cache.join("tables").join(format!("{}-{:?}", args.preset, shading).to_lowercase());
+    let tables = steps.run("bake", || bake_scene_tables(&fiber, shading, BakeResolution::default(), lambda_range, &wanted, &dir, &mut |_| {}), |t| format!("{} tables ({} cached)", t.baked.len(), t.baked.iter().filter(|b| b.cached).count()))?;
+    let mode = if args.scattering == ScatteringMode::Full && !tables.assets.contains_key("multiple") {
+        for (name, reason) in &tables.skipped {
+            steps.say(format!("skipped {name}: {reason}"));
+        }
+        ScatteringMode::Single
+    } else {
+        args.scattering
+    };
+    let camera = choose_camera(args, &model, width as f32 / height as f32)?;
+    let up = UpAxis::detect(&model);
+    let lights = crate::env_lights::to_env_lights(&srbf_set_lights(&fit.set), up);
+    let frame = EnvFrame { hair: &model, camera, width, height, lights: &lights, tables: &tables, shading, mode, role: FrameRole::Interactive { kappa: args.kappa } };
+    let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {} SRBF lights, {} scattering", r.milliseconds, lights.len(), mode.name()))?;
+    let stem = output_stem(&args.out);
+    let (exr_path, png_path) = (stem.with_extension("exr"), stem.with_extension("png"));
+    let description = format!("{source}; {width}x{height}; env {env_spec}, {} SRBFs; {shading:?} ({}), {} scattering", lights.len(), args.preset, mode.name());
+    let image = &rendered.image;
+    write_exr(&exr_path, width, height, &image.pixels, &description)?;
+    write_png(&png_path, width, height, &image.pixels, &description)?;
+    if args.json {
+        let report = serde_json::json!({
+            "hair": source,
+            "env": env_spec,
+            "srbf_lights": lights.len(),
+            "size": [width, height],
+            "mode": mode.name(),
+            "frame_ms": rendered.milliseconds,
+            "pass_ms": rendered.passes.iter().map(|(n, ms)| (n.clone(), serde_json::json!(ms))).collect::<serde_json::Map<_, _>>(),
+            "timing_method": "CPU wall clock around submit + wait for idle, summed over batches",
+            "exr": exr_path,
+            "png": png_path,
+        });
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        steps.say(format!("wrote {} and {}", exr_path.display(), png_path.display()));
+    }
+    Ok(())
 }
