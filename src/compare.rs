@@ -7,7 +7,7 @@ use crate::env_lights::to_env_lights;
 use crate::env_scene::{forward_settings, FrameRole, 
     bake_scene_tables, fit_cached, load_env, render_lights, sha256_hex, EnvFrame, EnvShading, RenderedEnv, ScatteringMode, SceneTables, MULTIPLE_TABLES,
 };
-use crate::equal_time::{equal_time_lights, EqualTimeSearch};
+use crate::equal_time::{equal_error_lights, equal_time_lights, EqualTimeSearch};
 use crate::image_compare::{error_legend, relative_rmse, write_side_by_side, Image};
 use crate::reference_cache::{ReferenceCache, ReferenceRecord};
 use crate::steps::Steps;
@@ -73,6 +73,15 @@ pub struct CompareArgs {
     /// Renders per timing (the median is reported).
     #[arg(long, default_value_t = 3)]
     pub timing_runs: usize,
+    /// Also search the fewest median-cut lights whose error is at most the SRBF frame's
+    /// (Ren Fig. 6) and report the speed-up at equal error. Slow: it renders up to
+    /// --reference-lights baseline lights.
+    #[arg(long)]
+    pub equal_error: bool,
+    /// Diagnostic: every single-scattering transmittance 1 in all three renders, so the error
+    /// left is the lighting (fit, median cut) and table error without the shadowing error.
+    #[arg(long)]
+    pub unshadowed: bool,
 }
 
 /// Everything fixed before the first render.
@@ -89,6 +98,8 @@ pub struct CompareScene {
     pub map: strandlight_precompute::EnvMap,
     pub map_sha256: String,
     pub fiber: FiberDescription,
+    /// The fit's relative L2 error against the map (what the SRBF path starts from).
+    pub fit_relative_l2_error: f64,
 }
 
 fn validate(args: &CompareArgs) -> anyhow::Result<usize> {
@@ -153,7 +164,8 @@ pub fn prepare_with_hair(args: &CompareArgs, hair: HairModel, hair_sha256: Strin
         || Ok(to_env_lights(&reference_lights(&env.map, face_resolution, args.rotate)?, up)),
         |r: &Vec<EnvLight>| format!("{} cube-texel directional lights ({face_resolution}×{face_resolution}×6)", r.len()),
     )?;
-    Ok(CompareScene { hair, hair_sha256, camera, up, size: (width, height), tables, srbf, reference, map: env.map, map_sha256: env.sha256, fiber })
+    let fit_relative_l2_error = fit.set.relative_l2_error;
+    Ok(CompareScene { hair, hair_sha256, camera, up, size: (width, height), tables, srbf, reference, map: env.map, map_sha256: env.sha256, fiber, fit_relative_l2_error })
 }
 
 /// The function that renders a frame: [`render_lights`] in the program, a stand-in in tests.
@@ -181,10 +193,37 @@ struct ModeResult {
     baseline: RenderedEnv,
     baseline_lights: usize,
     baseline_search: Vec<(usize, f64)>,
+    equal_error: Option<EqualErrorResult>,
+}
+
+/// The equal-error baseline: the count found and (lights, ms, relative RMSE) of every render.
+struct EqualErrorResult {
+    lights: usize,
+    at_bound: bool,
+    renders: Vec<(usize, f64, f64)>,
+}
+
+impl EqualErrorResult {
+    fn chosen(&self) -> (usize, f64, f64) {
+        *self.renders.iter().find(|r| r.0 == self.lights).expect("the chosen count was rendered")
+    }
+}
+
+/// Median-cut baselines of growing size until one is as accurate as `target_error`.
+fn equal_error_baseline(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: ScatteringMode, reference: &Image, target_error: f64, start: usize) -> anyhow::Result<EqualErrorResult> {
+    let mut renders = Vec::new();
+    let found = equal_error_lights(target_error, start, scene.reference.len().max(16), 0.1, 10, |n| {
+        let lights = to_env_lights(&median_cut_lights(&scene.map, n, args.rotate), scene.up);
+        let r = timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)?;
+        let error = relative_rmse(&r.image, reference)?;
+        renders.push((n, r.milliseconds, error));
+        Ok::<f64, anyhow::Error>(error)
+    })?;
+    Ok(EqualErrorResult { lights: found.lights, at_bound: found.at_bound, renders })
 }
 
 fn frame<'a>(scene: &'a CompareScene, args: &CompareArgs, lights: &'a [EnvLight], mode: ScatteringMode) -> EnvFrame<'a> {
-    EnvFrame { hair: &scene.hair, camera: scene.camera, width: scene.size.0, height: scene.size.1, lights, tables: &scene.tables, shading: args.shading, mode, role: FrameRole::Interactive { kappa: args.kappa } }
+    EnvFrame { hair: &scene.hair, camera: scene.camera, width: scene.size.0, height: scene.size.1, lights, tables: &scene.tables, shading: args.shading, mode, role: FrameRole::Interactive { kappa: args.kappa }, shadowed: !args.unshadowed }
 }
 
 fn reference_frame<'a>(scene: &'a CompareScene, args: &CompareArgs, mode: ScatteringMode) -> EnvFrame<'a> {
@@ -206,7 +245,7 @@ fn reference_inputs(scene: &CompareScene, args: &CompareArgs, mode: ScatteringMo
         "direct_table_inputs": direct.metadata.description.inputs_key,
         "multiple_tables_inputs": MULTIPLE_TABLES.iter().filter_map(|n| scene.tables.assets.get(*n)).map(|a| a.metadata.description.inputs_key.clone()).collect::<Vec<_>>(),
         "generator": env!("CARGO_PKG_VERSION"),
-        "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
+        "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
     }))
 }
 
@@ -251,7 +290,20 @@ fn run_mode(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: Sc
             timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)?
         }
     };
-    Ok(ModeResult { srbf, reference, baseline, baseline_lights: found.lights, baseline_search: found.measurements })
+    let equal_error = if args.equal_error {
+        let target = relative_rmse(&srbf.image, &reference.0)?;
+        Some(steps.run(
+            &format!("{m}: equal-error baseline"),
+            || equal_error_baseline(render, scene, args, mode, &reference.0, target, found.lights),
+            |e: &EqualErrorResult| {
+                let (n, ms, err) = e.chosen();
+                format!("{n} median-cut lights reach rel. RMSE {err:.4} ≤ {target:.4} at {ms:.2} ms/frame ({} renders{})", e.renders.len(), if e.at_bound { ", NOT reached at the search bound" } else { "" })
+            },
+        )?)
+    } else {
+        None
+    };
+    Ok(ModeResult { srbf, reference, baseline, baseline_lights: found.lights, baseline_search: found.measurements, equal_error })
 }
 
 fn write_mode_images(args: &CompareArgs, mode: ScatteringMode, r: &ModeResult, description: &str) -> anyhow::Result<Vec<PathBuf>> {
@@ -290,22 +342,33 @@ pub fn execute(args: &CompareArgs, scene: &CompareScene, steps: &mut Steps, rend
         let baseline_error = relative_rmse(&r.baseline.image, &r.reference.0)?;
         let written = write_mode_images(args, mode, &r, &description)?;
         let reference_ms = r.reference.1.milliseconds;
-        report.insert(
-            mode.name().into(),
-            json!({
+        let mut entry = json!({
                 "srbf": { "lights": scene.srbf.len(), "ms": r.srbf.milliseconds, "relative_rmse": srbf_error },
                 "baseline": { "lights": r.baseline_lights, "ms": r.baseline.milliseconds, "relative_rmse": baseline_error, "search": r.baseline_search },
                 "reference": { "lights": r.reference.1.lights, "ms": reference_ms, "cached": r.reference.2 },
                 "speedup_vs_reference": reference_ms / r.srbf.milliseconds,
                 "images": written,
-            }),
-        );
+        });
+        if let Some(e) = &r.equal_error {
+            let (lights, ms, error) = e.chosen();
+            entry["baseline_equal_error"] = json!({ "lights": lights, "ms": ms, "relative_rmse": error, "at_bound": e.at_bound, "renders": e.renders });
+            entry["speedup_at_equal_error"] = json!(ms / r.srbf.milliseconds);
+        }
+        report.insert(mode.name().into(), entry);
         steps.say(format!(
             "{:<6} SRBF {:>8.2} ms rel. RMSE {:.4} | baseline {} lights {:>8.2} ms rel. RMSE {:.4} | reference {} lights {:>10.1} ms | speed-up vs reference {:.0}×",
             mode.name(), r.srbf.milliseconds, srbf_error, r.baseline_lights, r.baseline.milliseconds, baseline_error, r.reference.1.lights, reference_ms, reference_ms / r.srbf.milliseconds
         ));
     }
     steps.say(error_legend());
+    report.insert(
+        "scene".into(),
+        json!({
+            "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
+            "preset": args.preset, "kappa": args.kappa, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "fit_relative_l2_error": scene.fit_relative_l2_error,
+        }),
+    );
     report.insert("steps".into(), json!(steps.done.iter().map(|(n, s, note)| json!({"step": n, "seconds": s, "note": note})).collect::<Vec<_>>()));
     Ok(Value::Object(report))
 }

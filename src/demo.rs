@@ -79,7 +79,7 @@ pub fn run(_args: DemoArgs) -> anyhow::Result<()> {
     let camera = Camera::framing_front(hair.bounds(), width as f32 / height as f32, false, up);
     let lights = to_env_lights(&srbf_set_lights(&fit.set), up);
     let mode = if tables.assets.contains_key("multiple") { ScatteringMode::Full } else { ScatteringMode::Single };
-    let frame = EnvFrame { hair: &hair, camera, width, height, lights: &lights, tables: &tables, shading, mode, role: FrameRole::Interactive { kappa: EnvRenderOptions::default().kappa } };
+    let frame = EnvFrame { hair: &hair, camera, width, height, lights: &lights, tables: &tables, shading, mode, role: FrameRole::Interactive { kappa: EnvRenderOptions::default().kappa }, shadowed: true };
     let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {} SRBF lights, {} scattering", r.milliseconds, lights.len(), mode.name()))?;
     let out = Path::new(OUT_DIR);
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;

@@ -226,6 +226,9 @@ pub struct EnvFrame<'a> {
     pub shading: EnvShading,
     pub mode: ScatteringMode,
     pub role: FrameRole,
+    /// False sets every single-scattering transmittance to 1 (a diagnostic: what is left is
+    /// the lighting and table error alone).
+    pub shadowed: bool,
 }
 
 /// A rendered frame and its GPU time.
@@ -281,19 +284,14 @@ fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
         FrameRole::Interactive { kappa } if srbf => kappa,
         _ => 1.0,
     };
-    EnvRenderOptions { kappa, ..EnvRenderOptions::default() }
+    EnvRenderOptions { kappa, shadowed: frame.shadowed, ..EnvRenderOptions::default() }
 }
 
 /// Forward-scattering settings of `role`.
 pub fn forward_settings(role: FrameRole) -> ForwardScatteringSettings {
     match role {
         FrameRole::Interactive { .. } => ForwardScatteringSettings::default(),
-        FrameRole::Reference => match std::env::var("STRANDLIGHT_REF_FORWARD").as_deref() {
-            Ok("coarse") => ForwardScatteringSettings::default(),
-            Ok("march") => ForwardScatteringSettings { light_sweep: false, ..ForwardScatteringSettings::dense_reference() },
-            Ok("coarse2") => ForwardScatteringSettings { coarse_factor: 2, ..ForwardScatteringSettings::default() },
-            _ => ForwardScatteringSettings::dense_reference(),
-        },
+        FrameRole::Reference => ForwardScatteringSettings::dense_reference(),
     }
 }
 
@@ -334,11 +332,6 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
         .renderer
         .render(&r.gpu, frame.hair, &frame.camera, frame.width, frame.height, frame.lights, &tables, &render_options(frame), multiple)
         .with_context(|| format!("rendering {} lights ({} scattering)", frame.lights.len(), frame.mode.name()))?;
-    if std::env::var_os("STRANDLIGHT_TIMINGS").is_some() {
-        eprintln!("{:?}", out.stats.timings);
-        let sum = |px: &[[f32; 4]]| px.iter().fold([0.0f64; 3], |a, p| [a[0] + p[0] as f64, a[1] + p[1] as f64, a[2] + p[2] as f64]);
-        eprintln!("single Σ {:?} multiple Σ {:?} lights {} power Σ {:?}", sum(&out.single_pixels), out.multiple_pixels.as_deref().map(sum), frame.lights.len(), frame.lights.iter().fold([0.0f64; 3], |a, l| { let p = l.power(); [a[0] + p[0] as f64, a[1] + p[1] as f64, a[2] + p[2] as f64] }));
-    }
     Ok(RenderedEnv {
         milliseconds: frame_milliseconds(&out.stats),
         passes: out.stats.timings.iter().map(|t| (t.pass.clone(), t.milliseconds)).collect(),

@@ -87,6 +87,65 @@ pub fn equal_time_lights<E>(search: &EqualTimeSearch, mut time_ms: impl FnMut(us
     Ok(EqualTime { lights, milliseconds, measurements, at_bound })
 }
 
+/// The equal-error baseline (Ren 2010 Fig. 6: 450 directional lights to match 50 SRBFs): the
+/// fewest median-cut lights whose image is at least as accurate as the SRBF frame's.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EqualError {
+    /// The fewest measured lights with an error ≤ the target, or `max_lights` when none was.
+    pub lights: usize,
+    /// (light count, error) in the order measured.
+    pub measurements: Vec<(usize, f64)>,
+    /// True when even `max_lights` stayed above the target error.
+    pub at_bound: bool,
+}
+
+/// Doubles from `start` until `error(count)` ≤ `target` (halves while it already is), then bisects the last bracket down to
+/// `relative_width`, within `max_measurements` renders. Assumes the error falls as lights are
+/// added, which median cut only does on average: the answer is the smallest count *measured* to
+/// reach the target, so a noisy curve can only make it larger (the SRBF's advantage smaller).
+pub fn equal_error_lights<E>(
+    target: f64,
+    start: usize,
+    max_lights: usize,
+    relative_width: f64,
+    max_measurements: usize,
+    mut error: impl FnMut(usize) -> Result<f64, E>,
+) -> Result<EqualError, E> {
+    let max = max_lights.max(1);
+    let mut measurements: Vec<(usize, f64)> = Vec::new();
+    let mut n = start.clamp(1, max);
+    let mut below: Option<usize> = None; // largest count known to miss the target
+    let mut reached: Option<usize> = None; // smallest count known to reach it
+    // Bracket: double while missing, halve while reaching.
+    while measurements.len() < max_measurements.max(1) {
+        let e = error(n)?;
+        measurements.push((n, e));
+        if e <= target {
+            reached = Some(n);
+            if below.is_some() || n == 1 {
+                break;
+            }
+            n = (n / 2).max(1);
+        } else {
+            below = Some(n);
+            if reached.is_some() || n == max {
+                break;
+            }
+            n = (n * 2).min(max);
+        }
+    }
+    if let (Some(mut lo), Some(mut hi)) = (below, reached) {
+        while measurements.len() < max_measurements && hi - lo > ((relative_width * lo as f64) as usize).max(1) {
+            let mid = lo + (hi - lo) / 2;
+            let e = error(mid)?;
+            measurements.push((mid, e));
+            if e <= target { hi = mid } else { lo = mid }
+        }
+    }
+    let best = measurements.iter().filter(|(_, e)| *e <= target).map(|(n, _)| *n).min();
+    Ok(EqualError { lights: best.unwrap_or(max), at_bound: best.is_none(), measurements })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -138,5 +197,21 @@ mod tests {
         assert!(r.at_bound);
         let failing = |_: usize| -> Result<f64, String> { Err("device lost".into()) };
         assert_eq!(equal_time_lights(&EqualTimeSearch::new(1.0), failing).unwrap_err(), "device lost");
+    }
+    #[test]
+    fn equal_error_finds_the_fewest_lights_reaching_the_target() {
+        // A 1/√n error curve: 0.5/√n ≤ 0.05 ⇔ n ≥ 100.
+        let err = |n: usize| -> Result<f64, Infallible> { Ok(0.5 / (n as f64).sqrt()) };
+        let r = equal_error_lights(0.05, 16, 8192, 0.1, 12, err).unwrap();
+        println!("{r:?}");
+        assert!(!r.at_bound);
+        assert!(r.lights >= 100 && r.lights as f64 <= 110.0, "{}", r.lights);
+        assert!(r.measurements.iter().all(|&(n, e)| e == err(n).unwrap()));
+        // Unreachable within the bound: the bound, flagged.
+        let r = equal_error_lights(0.001, 16, 256, 0.1, 12, err).unwrap();
+        assert_eq!((r.lights, r.at_bound), (256, true));
+        // Already reached at the start: halves down to the crossing (0.5/√n ≤ 0.2 ⇔ n ≥ 6.25).
+        let r = equal_error_lights(0.2, 16, 256, 0.1, 12, err).unwrap();
+        assert_eq!((r.lights, r.at_bound), (7, false), "{r:?}");
     }
 }

@@ -2,6 +2,7 @@
 //! lives in the library crates.
 
 mod compare;
+mod compare_table;
 mod demo;
 mod env_lights;
 mod env_scene;
@@ -47,6 +48,8 @@ enum Command {
     /// SRBF lights vs the brute-force cube-texel reference and the equal-time median-cut
     /// baseline (Ren 2010 §8): frame times, relative RMSE over hair pixels, images side by side.
     Compare(compare::CompareArgs),
+    /// The markdown table of docs/BENCHMARKS.md from `compare --json` reports.
+    CompareTable(compare_table::CompareTableArgs),
     /// The procedural groom under the project's sun-and-sky: fit → bake → env-lit render.
     Demo(demo::DemoArgs),
 }
@@ -63,6 +66,7 @@ fn main() -> anyhow::Result<()> {
         Command::Inspect(args) => tables_cmd::inspect(args),
         Command::Render(args) => render::run(args),
         Command::Compare(args) => compare::run(args),
+        Command::CompareTable(args) => compare_table::run(args),
         Command::Demo(args) => demo::run(args),
     }
 }

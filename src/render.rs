@@ -459,7 +459,7 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
     let camera = choose_camera(args, &model, width as f32 / height as f32)?;
     let up = UpAxis::detect(&model);
     let lights = crate::env_lights::to_env_lights(&srbf_set_lights(&fit.set), up);
-    let frame = EnvFrame { hair: &model, camera, width, height, lights: &lights, tables: &tables, shading, mode, role: FrameRole::Interactive { kappa: args.kappa } };
+    let frame = EnvFrame { hair: &model, camera, width, height, lights: &lights, tables: &tables, shading, mode, role: FrameRole::Interactive { kappa: args.kappa }, shadowed: true };
     let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {} SRBF lights, {} scattering", r.milliseconds, lights.len(), mode.name()))?;
     let stem = output_stem(&args.out);
     let (exr_path, png_path) = (stem.with_extension("exr"), stem.with_extension("png"));
