@@ -9,6 +9,7 @@ mod env_scene;
 mod equal_time;
 mod fit;
 mod image_compare;
+mod image_error;
 mod reference_cache;
 mod render;
 mod steps;
@@ -50,6 +51,8 @@ enum Command {
     Compare(compare::CompareArgs),
     /// The markdown table of docs/BENCHMARKS.md from `compare --json` reports.
     CompareTable(compare_table::CompareTableArgs),
+    /// Relative RMSE between two EXR images over the reference's hair pixels.
+    ImageError(image_error::ImageErrorArgs),
     /// The procedural groom under the project's sun-and-sky: fit → bake → env-lit render.
     Demo(demo::DemoArgs),
 }
@@ -67,6 +70,7 @@ fn main() -> anyhow::Result<()> {
         Command::Render(args) => render::run(args),
         Command::Compare(args) => compare::run(args),
         Command::CompareTable(args) => compare_table::run(args),
+        Command::ImageError(args) => image_error::run(args),
         Command::Demo(args) => demo::run(args),
     }
 }
