@@ -209,12 +209,17 @@ impl EqualErrorResult {
     }
 }
 
+/// The median-cut baseline with `lights` directional lights.
+fn render_baseline(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: ScatteringMode, lights: usize) -> anyhow::Result<RenderedEnv> {
+    let lights = to_env_lights(&median_cut_lights(&scene.map, lights, args.rotate), scene.up);
+    timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)
+}
+
 /// Median-cut baselines of growing size until one is as accurate as `target_error`.
 fn equal_error_baseline(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: ScatteringMode, reference: &Image, target_error: f64, start: usize) -> anyhow::Result<EqualErrorResult> {
     let mut renders = Vec::new();
     let found = equal_error_lights(target_error, start, scene.reference.len().max(16), 0.1, 10, |n| {
-        let lights = to_env_lights(&median_cut_lights(&scene.map, n, args.rotate), scene.up);
-        let r = timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)?;
+        let r = render_baseline(render, scene, args, mode, n)?;
         let error = relative_rmse(&r.image, reference)?;
         renders.push((n, r.milliseconds, error));
         Ok::<f64, anyhow::Error>(error)
@@ -274,8 +279,7 @@ fn run_mode(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: Sc
         &format!("{m}: baseline"),
         || {
             equal_time_lights(&search, |n| {
-                let lights = to_env_lights(&median_cut_lights(&scene.map, n, args.rotate), scene.up);
-                let r = timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)?;
+                let r = render_baseline(render, scene, args, mode, n)?;
                 let ms = r.milliseconds;
                 searched.insert(n, r);
                 Ok::<f64, anyhow::Error>(ms)
@@ -285,10 +289,7 @@ fn run_mode(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: Sc
     )?;
     let baseline = match searched.remove(&found.lights) {
         Some(r) => r,
-        None => {
-            let lights = to_env_lights(&median_cut_lights(&scene.map, found.lights, args.rotate), scene.up);
-            timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)?
-        }
+        None => render_baseline(render, scene, args, mode, found.lights)?,
     };
     let equal_error = if args.equal_error {
         let target = relative_rmse(&srbf.image, &reference.0)?;
