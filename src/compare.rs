@@ -82,6 +82,9 @@ pub struct CompareArgs {
     /// left is the lighting (fit, median cut) and table error without the shadowing error.
     #[arg(long)]
     pub unshadowed: bool,
+    /// The look of all three renders.
+    #[command(flatten)]
+    pub look: crate::env_scene::LookArgs,
 }
 
 /// Everything fixed before the first render.
@@ -109,6 +112,7 @@ fn validate(args: &CompareArgs) -> anyhow::Result<usize> {
     if args.timing_runs == 0 {
         bail!("--timing-runs 0: at least one render per timing");
     }
+    args.look.look()?;
     if let Some(n) = args.table_resolution
         && !(2..=256).contains(&n)
     {
@@ -228,7 +232,12 @@ fn equal_error_baseline(render: Renderer, scene: &CompareScene, args: &CompareAr
 }
 
 fn frame<'a>(scene: &'a CompareScene, args: &CompareArgs, lights: &'a [EnvLight], mode: ScatteringMode) -> EnvFrame<'a> {
-    EnvFrame { hair: &scene.hair, camera: scene.camera, width: scene.size.0, height: scene.size.1, lights, tables: &scene.tables, shading: args.shading, mode, role: FrameRole::Interactive { kappa: args.kappa }, shadowed: !args.unshadowed }
+    EnvFrame { hair: &scene.hair, camera: scene.camera, width: scene.size.0, height: scene.size.1, lights, tables: &scene.tables, shading: args.shading, mode, role: FrameRole::Interactive { kappa: args.kappa }, look: look(args) }
+}
+
+/// The renderer choices of every frame (checked by `validate`).
+fn look(args: &CompareArgs) -> crate::env_scene::EnvLook {
+    crate::env_scene::EnvLook { shadowed: !args.unshadowed, ..args.look.look().expect("checked by validate") }
 }
 
 fn reference_frame<'a>(scene: &'a CompareScene, args: &CompareArgs, mode: ScatteringMode) -> EnvFrame<'a> {
@@ -250,7 +259,7 @@ fn reference_inputs(scene: &CompareScene, args: &CompareArgs, mode: ScatteringMo
         "direct_table_inputs": direct.metadata.description.inputs_key,
         "multiple_tables_inputs": MULTIPLE_TABLES.iter().filter_map(|n| scene.tables.assets.get(*n)).map(|a| a.metadata.description.inputs_key.clone()).collect::<Vec<_>>(),
         "generator": env!("CARGO_PKG_VERSION"),
-        "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
+        "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, transparency: look(args).transparency, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
     }))
 }
 
@@ -426,7 +435,7 @@ mod tests {
                 if (w / 4..3 * w / 4).contains(&x) && (h / 4..3 * h / 4).contains(&y) { [total[0], total[1], total[2], 1.0] } else { [0.0; 4] }
             })
             .collect();
-        Ok(RenderedEnv { image: Image::new(w, h, pixels), milliseconds: 1.0 + 0.01 * frame.lights.len() as f64, passes: Vec::new() })
+        Ok(RenderedEnv { image: Image::new(w, h, pixels), milliseconds: 1.0 + 0.01 * frame.lights.len() as f64, passes: Vec::new(), fragments: None })
     }
 
     #[test]

@@ -17,7 +17,7 @@ use strandlight_precompute::{procedural_env, EnvMap, FitOptions};
 use strandlight_runtime::camera::Camera;
 use std::sync::OnceLock;
 use strandlight_runtime::multiple::{CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables};
-use strandlight_runtime::env::{ForwardScatteringSource, EnvLight, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables};
+use strandlight_runtime::env::{ForwardScatteringSource, EnvLight, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables, FragmentCounts, ViewTransparency, BoxAverage};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
 use strandlight_tables::asset::{expect_parameters, read_asset, Storage, TableAsset};
@@ -113,6 +113,76 @@ pub fn fit_cached(env: &LoadedEnv, options: &FitOptions, cache_dir: &Path) -> an
 pub enum EnvShading {
     Marschner,
     Artist,
+}
+
+/// What the view shows of each pixel's fibers (Ren §8).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EnvTransparency {
+    /// The nearest fiber, weighted by its coverage.
+    Opaque,
+    /// Every fiber, weighted by coverage × its visibility through the occupancy map.
+    Occupancy,
+}
+
+/// What the effective transmittance's box averages (the CLI's names for [`BoxAverage`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BoxAverageArg {
+    /// Ren 2010: exp(−mean optical depth).
+    OpticalDepth,
+    /// The mean of exp(−optical depth).
+    Transmittance,
+}
+
+/// The renderer choices of the env-lit commands.
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct LookArgs {
+    /// The nearest fiber of each pixel (opaque), or every fiber weighted by its visibility
+    /// through an occupancy map (Ren §8; order-independent transparency; costs about as many
+    /// times the view pass as the hair has fragments per pixel).
+    #[arg(long, value_enum, default_value = "opaque")]
+    pub transparency: EnvTransparency,
+    /// With occupancy: fragments seen less than this fraction are not shaded (early termination).
+    #[arg(long, default_value_t = ViewTransparency::DEFAULT_CUTOFF)]
+    pub visibility_cutoff: f32,
+    /// What the SRBF transmittance's box averages over the convolution optical depth map.
+    #[arg(long, value_enum, default_value = "optical-depth")]
+    pub box_average: BoxAverageArg,
+}
+
+impl Default for LookArgs {
+    fn default() -> Self {
+        Self { transparency: EnvTransparency::Opaque, visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF, box_average: BoxAverageArg::OpticalDepth }
+    }
+}
+
+impl LookArgs {
+    /// The look these arguments ask for (`shadowed` and no fragment counts).
+    pub fn look(&self) -> anyhow::Result<EnvLook> {
+        let transparency = match self.transparency {
+            EnvTransparency::Opaque => ViewTransparency::Opaque,
+            EnvTransparency::Occupancy => ViewTransparency::Occupancy { visibility_cutoff: self.visibility_cutoff },
+        };
+        transparency.check().with_context(|| format!("--visibility-cutoff {}", self.visibility_cutoff))?;
+        let box_average = match self.box_average {
+            BoxAverageArg::OpticalDepth => BoxAverage::OpticalDepth,
+            BoxAverageArg::Transmittance => BoxAverage::Transmittance,
+        };
+        Ok(EnvLook { shadowed: true, transparency, box_average, count_fragments: false })
+    }
+}
+
+/// How a frame is rendered besides its scene and lights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnvLook {
+    /// False sets every single-scattering transmittance to 1 (a diagnostic: what is left is
+    /// the lighting and table error alone).
+    pub shadowed: bool,
+    pub transparency: ViewTransparency,
+    pub box_average: BoxAverage,
+    /// Count the fragments rasterized and shaded (two extra passes, outside the frame time).
+    pub count_fragments: bool,
 }
 
 /// Single scattering only, or with multiple scattering (Ren §3.2).
@@ -226,9 +296,7 @@ pub struct EnvFrame<'a> {
     pub shading: EnvShading,
     pub mode: ScatteringMode,
     pub role: FrameRole,
-    /// False sets every single-scattering transmittance to 1 (a diagnostic: what is left is
-    /// the lighting and table error alone).
-    pub shadowed: bool,
+    pub look: EnvLook,
 }
 
 /// A rendered frame and its GPU time.
@@ -237,6 +305,8 @@ pub struct RenderedEnv {
     pub milliseconds: f64,
     /// Per pass (summed over batches), milliseconds; empty for stand-in renderers.
     pub passes: Vec<(String, f64)>,
+    /// With [`EnvLook::count_fragments`].
+    pub fragments: Option<FragmentCounts>,
 }
 
 /// The GPU device and the renderer's pipelines, created on first use and kept for every frame
@@ -284,7 +354,8 @@ fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
         FrameRole::Interactive { kappa } if srbf => kappa,
         _ => 1.0,
     };
-    EnvRenderOptions { kappa, shadowed: frame.shadowed, ..EnvRenderOptions::default() }
+    let look = frame.look;
+    EnvRenderOptions { kappa, shadowed: look.shadowed, transparency: look.transparency, box_average: look.box_average, count_fragments: look.count_fragments, ..EnvRenderOptions::default() }
 }
 
 /// Forward-scattering settings of `role`.
@@ -335,6 +406,7 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
     Ok(RenderedEnv {
         milliseconds: frame_milliseconds(&out.stats),
         passes: out.stats.timings.iter().map(|t| (t.pass.clone(), t.milliseconds)).collect(),
+        fragments: out.stats.fragments,
         image: Image { width: out.width, height: out.height, pixels: out.pixels },
     })
 }

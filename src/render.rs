@@ -36,6 +36,8 @@ pub enum Transparency {
     None,
     Abuffer,
     Dbk,
+    /// With --env only: every fiber weighted by its visibility through an occupancy map.
+    Occupancy,
 }
 
 #[derive(Clone, Copy, Debug, ValueEnum)]
@@ -82,6 +84,13 @@ pub struct RenderArgs {
     shadows: Shadows,
     #[arg(long, value_enum, default_value = "none")]
     transparency: Transparency,
+    /// With --env --transparency occupancy: fragments seen less than this fraction are not
+    /// shaded (early termination).
+    #[arg(long, default_value_t = strandlight_runtime::env::ViewTransparency::DEFAULT_CUTOFF)]
+    visibility_cutoff: f32,
+    /// With --env: what the SRBF transmittance's box averages (Ren 2010: the optical depth).
+    #[arg(long, value_enum, default_value = "optical-depth")]
+    box_average: crate::env_scene::BoxAverageArg,
     /// Deep opacity map layers (1..=8), with --shadows dom.
     #[arg(long, default_value_t = 4)]
     dom_layers: u32,
@@ -257,6 +266,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             nodes_per_pixel: args.abuffer_nodes_per_pixel,
             delta: args.dbk_delta.unwrap_or(0.0),
         },
+        Transparency::Occupancy => bail!("--transparency occupancy is the view of --env (environment lighting); with point lights use none, abuffer or dbk"),
     };
     let (width, height) = parse_size(&args.size)?;
     if let Some(w) = args.fiber_width_px
@@ -433,9 +443,15 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
         Shading::Artist => EnvShading::Artist,
         Shading::KajiyaKay => bail!("--shading kajiya-kay with --env: the env renderer reads one RGB 4D table (Marschner I_M or the artist I_A); use --shading marschner or artist"),
     };
-    if args.transparency != Transparency::None || args.shadows != Shadows::None {
-        bail!("--env shadows every SRBF light with its convolution optical depth map and renders opaque; --shadows/--transparency apply to point lights only");
+    if matches!(args.transparency, Transparency::Abuffer | Transparency::Dbk) || args.shadows != Shadows::None {
+        bail!("--env shadows every SRBF light with its convolution optical depth map and renders opaque (none) or through an occupancy map (occupancy); --shadows, --transparency abuffer/dbk apply to point lights only");
     }
+    let look_args = crate::env_scene::LookArgs {
+        transparency: if args.transparency == Transparency::Occupancy { crate::env_scene::EnvTransparency::Occupancy } else { crate::env_scene::EnvTransparency::Opaque },
+        visibility_cutoff: args.visibility_cutoff,
+        box_average: args.box_average,
+    };
+    let look = crate::env_scene::EnvLook { count_fragments: args.json, ..look_args.look()? };
     let (width, height) = parse_size(&args.size)?;
     let mut steps = crate::steps::Steps::new(args.json);
     let (model, source) = steps.run("hair", || load_hair(args.hair.as_deref()), |(m, s)| format!("{s} ({} strands)", m.strand_count()))?;
@@ -459,7 +475,7 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
     let camera = choose_camera(args, &model, width as f32 / height as f32)?;
     let up = UpAxis::detect(&model);
     let lights = crate::env_lights::to_env_lights(&srbf_set_lights(&fit.set), up);
-    let frame = EnvFrame { hair: &model, camera, width, height, lights: &lights, tables: &tables, shading, mode, role: FrameRole::Interactive { kappa: args.kappa }, shadowed: true };
+    let frame = EnvFrame { hair: &model, camera, width, height, lights: &lights, tables: &tables, shading, mode, role: FrameRole::Interactive { kappa: args.kappa }, look };
     let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {} SRBF lights, {} scattering", r.milliseconds, lights.len(), mode.name()))?;
     let stem = output_stem(&args.out);
     let (exr_path, png_path) = (stem.with_extension("exr"), stem.with_extension("png"));
@@ -475,6 +491,10 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
             "size": [width, height],
             "mode": mode.name(),
             "frame_ms": rendered.milliseconds,
+            "transparency": look_args.transparency,
+            "box_average": look_args.box_average,
+            "visibility_cutoff": args.visibility_cutoff,
+            "fragments": rendered.fragments.map(|f| serde_json::json!({ "rasterized": f.rasterized, "shaded": f.shaded, "note": "per batch (each batch draws the same fragments)" })),
             "pass_ms": rendered.passes.iter().map(|(n, ms)| (n.clone(), serde_json::json!(ms))).collect::<serde_json::Map<_, _>>(),
             "timing_method": "CPU wall clock around submit + wait for idle, summed over batches",
             "exr": exr_path,

@@ -78,5 +78,6 @@ pub trait ForwardScatteringSource {
 pub mod render;
 pub use render::{
     EnvFrame, EnvRenderError, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTableError,
-    EnvTables, TransmittanceFilter, render_env_frame,
+    BoxAverage, EnvTables, FragmentCounts, OccupancyError, TransmittanceFilter, ViewTransparency,
+    render_env_frame,
 };

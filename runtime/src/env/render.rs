@@ -9,7 +9,7 @@ use strandlight_tables::table::Table;
 
 use super::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource};
 use crate::camera::Camera;
-use crate::gpu::readback::{ReadbackError, read_buffer};
+use crate::gpu::readback::{ReadbackError, read_buffer, read_texture_rgba};
 use crate::gpu::{AdapterReport, GpuContext};
 use crate::hair::HairModel;
 use crate::passes::convolution_depth::{
@@ -17,12 +17,16 @@ use crate::passes::convolution_depth::{
     check_kappa,
 };
 use crate::passes::env_view::{
-    BatchBinding, EnvViewPass, EnvViewTargets, GridBinding, TableBinding,
+    BatchBinding, EnvViewPass, EnvViewTargets, FrameVisibility, TableBinding, ViewBinding,
 };
+use crate::passes::strands::RenderTarget;
 use crate::passes::strands::{FrameParams, KajiyaKay, StrandGeometry, TooManyPoints};
+pub use crate::passes::summed_area::BoxAverage;
 use crate::passes::summed_area::{SatTooLarge, SummedAreaPass, SummedAreaTables};
 pub use crate::passes::transmittance_filter::TransmittanceFilter;
-use crate::render::{PassTiming, Transparency};
+pub use crate::passes::view_visibility::{FragmentCounts, OccupancyError, ViewTransparency};
+use crate::passes::view_visibility::{OccupancyMap, sum_counts};
+use crate::render::PassTiming;
 
 /// Axis names of the env tables (`strandlight_precompute::convolution_table` and
 /// `multiple_scattering_table`; the runtime never links the precompute crate).
@@ -120,13 +124,20 @@ pub struct EnvRenderOptions {
     pub kappa: f32,
     /// Seed of the strand shuffle behind κ.
     pub simplification_seed: u64,
-    /// Only [`Transparency::Opaque`] so far.
-    pub transparency: Transparency,
+    /// What the view sees of each pixel's fibers: the nearest one (default) or all of them
+    /// through the occupancy map (Ren §8).
+    pub transparency: ViewTransparency,
+    /// Count the fragments rasterized and shaded ([`EnvRenderStats::fragments`]; two extra
+    /// passes over the hair, outside the timed passes).
+    pub count_fragments: bool,
     /// `false`: no self-shadowing (T̃ = 1; for tests and for comparisons).
     pub shadowed: bool,
     /// The averaging box of the effective transmittance (default
     /// [`TransmittanceFilter::MatchedVariance`], the best measured: docs/BENCHMARKS.md).
     pub transmittance_filter: TransmittanceFilter,
+    /// What that box averages for SRBF lights (directional lights read one texel, where both
+    /// agree): Ren's optical depth or the transmittance (docs/BENCHMARKS.md).
+    pub box_average: BoxAverage,
     /// View pass only: every fiber this many pixels wide instead of its projected thickness (as
     /// `FrameParams::width_override_px`); the light pass always uses the file's thickness.
     pub width_override_px: Option<f32>,
@@ -138,9 +149,11 @@ impl Default for EnvRenderOptions {
             dodm: DodmSettings::default(),
             kappa: 0.1,
             simplification_seed: 0x5eed,
-            transparency: Transparency::Opaque,
+            transparency: ViewTransparency::Opaque,
+            count_fragments: false,
             shadowed: true,
             transmittance_filter: TransmittanceFilter::default(),
+            box_average: BoxAverage::default(),
             width_override_px: None,
         }
     }
@@ -164,8 +177,8 @@ pub enum EnvRenderError {
     GpuLimit(#[from] SatTooLarge),
     #[error("forward-scattering grid: {0}")]
     Grid(String),
-    #[error("transparency mode {0:?} is not supported by the env-lit renderer yet (only opaque)")]
-    UnsupportedTransparency(Transparency),
+    #[error(transparent)]
+    Transparency(#[from] OccupancyError),
     #[error(transparent)]
     TooManyPoints(#[from] TooManyPoints),
     #[error(transparent)]
@@ -188,6 +201,8 @@ pub struct EnvRenderStats {
     /// Segments the light pass draws (κ of the strands).
     pub light_pass_segments: u32,
     pub timing_method: &'static str,
+    /// With [`EnvRenderOptions::count_fragments`]: the fragments of one batch's view pass.
+    pub fragments: Option<FragmentCounts>,
 }
 
 /// A rendered frame: linear, pre-multiplied RGBA, row-major from the top.
@@ -311,11 +326,7 @@ impl EnvRenderer {
         }
         options.dodm.check()?;
         check_kappa(options.kappa)?;
-        if options.transparency != Transparency::Opaque {
-            return Err(EnvRenderError::UnsupportedTransparency(
-                options.transparency,
-            ));
-        }
+        options.transparency.check()?;
         let max = gpu.device.limits().max_texture_dimension_2d;
         if width == 0 || height == 0 || width > max || height > max {
             return Err(EnvRenderError::BadSize { width, height, max });
@@ -355,7 +366,8 @@ impl EnvRenderer {
         let slots = batch_size.min(srbf_lights.len().max(directional.len())) as u32;
         let resolution = options.dodm.resolution;
         // Checked before anything is allocated.
-        let sat = SummedAreaTables::new(gpu, resolution, slots)?;
+        let mut sat = SummedAreaTables::new(gpu, resolution, slots)?;
+        let occupancy = OccupancyMap::new(gpu, options.transparency, width, height)?;
 
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;
@@ -406,7 +418,48 @@ impl EnvRenderer {
         memory.extend(dodm.memory());
         memory.extend(sat.memory());
         memory.extend(targets.memory());
+        memory.push(occupancy.memory());
         memory.push(("env sums".into(), sums.sums.size()));
+        let strands = self.view.strands(gpu, &geometry, &frame);
+        let visibility = FrameVisibility {
+            map: &occupancy,
+            transparency: options.transparency,
+            width,
+            height,
+        };
+        let depth_view = targets.depth.create_view(&Default::default());
+        timings.time(gpu, "view visibility", || {
+            let view = ViewBinding::new(gpu, &self.view.view_layout, None, &visibility);
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            self.view.visibility.encode(
+                &mut encoder,
+                options.transparency,
+                &strands,
+                &view.group,
+                &depth_view,
+                &occupancy,
+                geometry.segment_count,
+            );
+            gpu.queue.submit([encoder.finish()]);
+        });
+        let fragments = if options.count_fragments {
+            let counts = RenderTarget::new(gpu, width, height);
+            let view = ViewBinding::new(gpu, &self.view.view_layout, None, &visibility);
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            self.view.visibility.encode_counts(
+                &mut encoder,
+                options.transparency,
+                &strands,
+                &view.group,
+                &depth_view,
+                &counts.color.create_view(&Default::default()),
+                geometry.segment_count,
+            );
+            gpu.queue.submit([encoder.finish()]);
+            Some(sum_counts(&read_texture_rgba(gpu, &counts.color)?))
+        } else {
+            None
+        };
         let mut table_bytes = 0;
         let mut grid_bytes = 0u64;
         let mut batches = 0u32;
@@ -416,6 +469,11 @@ impl EnvRenderer {
         ] {
             let Some(binding) = binding else { continue };
             table_bytes += binding.bytes;
+            sat.average = if kind_lights.first().is_some_and(|l| l.lambda.is_some()) {
+                options.box_average
+            } else {
+                BoxAverage::OpticalDepth
+            };
             for chunk in kind_lights.chunks(batch_size) {
                 batches += 1;
                 let grid = match multiple {
@@ -458,17 +516,18 @@ impl EnvRenderer {
                         grid.is_some(),
                         options.transmittance_filter,
                     );
-                    let grid_binding = GridBinding::new(gpu, &self.view.grid_layout, grid.as_ref());
-                    grid_bytes = grid_bytes.max(grid_binding.bytes);
+                    let view =
+                        ViewBinding::new(gpu, &self.view.view_layout, grid.as_ref(), &visibility);
+                    grid_bytes = grid_bytes.max(view.bytes);
                     let mut encoder = gpu.device.create_command_encoder(&Default::default());
                     self.view.encode(
-                        gpu,
                         &mut encoder,
                         &geometry,
-                        &frame,
+                        &strands,
+                        options.transparency,
                         &batch,
                         binding,
-                        &grid_binding,
+                        &view,
                         &targets,
                         &sums,
                     );
@@ -479,6 +538,7 @@ impl EnvRenderer {
         memory.push(("env tables".into(), table_bytes));
         memory.push(("forward-scattering grid".into(), grid_bytes));
         let bytes = timings.time(gpu, "readback", || read_buffer(gpu, &sums.sums))?;
+
         if let Some(error) = pollster::block_on(scope.pop()) {
             return Err(EnvRenderError::Gpu(error.to_string()));
         }
@@ -509,6 +569,7 @@ impl EnvRenderer {
                 segments: geometry.segment_count,
                 light_pass_segments: light_geometry.segment_count,
                 timing_method: "CPU wall clock around submit + wait for idle, summed over batches",
+                fragments,
             },
         })
     }

@@ -1,24 +1,26 @@
 //! The env-lit view pass (Ren 2010 §3.1, §5–6): the hair rasterized from the camera with the
-//! strand pass's quads, blending and depth conventions; each fragment loops over a batch's
-//! lights and sums T̃ × table lookup × light weight (single scattering) and, with a
-//! forward-scattering grid, power × T_f × I_G (multiple scattering) into two targets
-//! (`env_view.wgsl`). A small compute pass adds each batch's images into running float sums
-//! (`env_accumulate.wgsl`).
+//! strand pass's quads; each fragment the frame's visibility lets through ([`ViewTransparency`],
+//! built once per frame by [`ViewVisibilityPass`]) loops over a batch's lights and sums
+//! T̃ × table lookup × light weight (single scattering) and, with a forward-scattering grid,
+//! power × T_f × I_G (multiple scattering) into two targets (`env_view.wgsl`). A small compute
+//! pass adds each batch's images into running float sums (`env_accumulate.wgsl`).
 //! Inputs: [`StrandGeometry`], [`FrameParams`] (camera), [`BatchBinding`] (lights + DODM + SAT),
-//! [`TableBinding`] (the tables and the grid). Output: the sums buffer of [`EnvAccumulator`].
+//! [`TableBinding`] (the tables), [`ViewBinding`] (the batch's grid and the frame's occupancy
+//! map). Output: the sums buffer of [`EnvAccumulator`].
 
 use glam::Vec3;
 use strandlight_tables::srbf::support_angle;
 use strandlight_tables::table::{AxisGpu, Table};
 use wgpu::util::DeviceExt;
 
-use super::attachments::{cleared_color, cleared_depth};
+use super::attachments::{cleared_color, prepassed_depth};
 use super::convolution_depth::DodmBatch;
 use super::strands::{
     DEPTH_FORMAT, FrameParams, StrandGeometry, strand_bind_group, strand_bind_group_layout,
 };
-use super::summed_area::{MAX_BOX_HALF_SIZE, SummedAreaTables};
+use super::summed_area::{BoxAverage, MAX_BOX_HALF_SIZE, SummedAreaTables};
 use super::transmittance_filter::TransmittanceFilter;
+use super::view_visibility::{OccupancyMap, ViewTransparency, ViewVisibilityPass};
 use crate::env::{EnvLight, ForwardScatteringGrid};
 use crate::gpu::GpuContext;
 
@@ -65,6 +67,7 @@ struct BatchUniform {
 
 const FLAG_UNSHADOWED: u32 = 1;
 const FLAG_GRID: u32 = 2;
+const FLAG_SAT_TRANSMITTANCE: u32 = 4;
 
 fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
@@ -186,8 +189,13 @@ impl BatchBinding {
         if gpu_lights.is_empty() {
             gpu_lights.push(bytemuck::Zeroable::zeroed());
         }
-        let flags =
-            if shadowed { 0 } else { FLAG_UNSHADOWED } | if with_grid { FLAG_GRID } else { 0 };
+        let flags = if shadowed { 0 } else { FLAG_UNSHADOWED }
+            | if with_grid { FLAG_GRID } else { 0 }
+            | if sat.average == BoxAverage::Transmittance {
+                FLAG_SAT_TRANSMITTANCE
+            } else {
+                0
+            };
         let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("env batch"),
             contents: bytemuck::bytes_of(&BatchUniform {
@@ -255,10 +263,14 @@ fn table_layout(table: &Table) -> TableLayoutUniform {
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct GridUniform {
+struct ViewUniform {
     origin: [f32; 4],
     spacing: [f32; 4],
     dims: [u32; 4],
+    width: u32,
+    height: u32,
+    visibility_cutoff: f32,
+    _pad: u32,
 }
 
 /// Group 2: the single-scattering table (the SRBF convolution table, or the direct table for
@@ -348,56 +360,75 @@ impl TableBinding {
     }
 }
 
-/// Group 3: one batch's forward-scattering grid (a placeholder without multiple scattering).
-pub struct GridBinding {
+/// Group 3: one batch's forward-scattering grid (a placeholder without multiple scattering) and
+/// the frame's occupancy map.
+pub struct ViewBinding {
     pub group: wgpu::BindGroup,
+    /// Bytes of the grid.
     pub bytes: u64,
 }
 
-impl GridBinding {
+/// What group 3 is built from besides the grid.
+pub struct FrameVisibility<'a> {
+    pub map: &'a OccupancyMap,
+    pub transparency: ViewTransparency,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl ViewBinding {
     /// `grid.values` must hold `lights × dims` entries (checked by the caller).
     pub fn new(
         gpu: &GpuContext,
         layout: &wgpu::BindGroupLayout,
         grid: Option<&ForwardScatteringGrid>,
+        visibility: &FrameVisibility,
     ) -> Self {
         let device = &gpu.device;
-        let (uniform, values) = match grid {
-            Some(g) => (
-                GridUniform {
-                    origin: g.origin.extend(0.0).into(),
-                    spacing: g.spacing.extend(0.0).into(),
-                    dims: [g.dims[0], g.dims[1], g.dims[2], 0],
-                },
+        let mut uniform = ViewUniform {
+            origin: [0.0; 4],
+            spacing: [1.0; 4],
+            dims: [1, 1, 1, 0],
+            width: visibility.width,
+            height: visibility.height,
+            visibility_cutoff: visibility.transparency.visibility_cutoff(),
+            _pad: 0,
+        };
+        let values = match grid {
+            Some(g) => {
+                uniform.origin = g.origin.extend(0.0).into();
+                uniform.spacing = g.spacing.extend(0.0).into();
+                uniform.dims = [g.dims[0], g.dims[1], g.dims[2], 0];
                 init_buffer(
                     device,
                     "env forward-scattering grid",
                     bytemuck::cast_slice(&g.values),
                     wgpu::BufferUsages::STORAGE,
-                ),
-            ),
-            None => (
-                GridUniform {
-                    origin: [0.0; 4],
-                    spacing: [1.0; 4],
-                    dims: [1, 1, 1, 0],
-                },
-                init_buffer(
-                    device,
-                    "env forward-scattering grid",
-                    &[0u8; 16],
-                    wgpu::BufferUsages::STORAGE,
-                ),
+                )
+            }
+            None => init_buffer(
+                device,
+                "env forward-scattering grid",
+                &[0u8; 16],
+                wgpu::BufferUsages::STORAGE,
             ),
         };
         let params = init_buffer(
             device,
-            "env grid params",
+            "env view params",
             bytemuck::bytes_of(&uniform),
             wgpu::BufferUsages::UNIFORM,
         );
-        let (group, bytes) = bind_buffers(device, "env grid", layout, &[&params, &values]);
-        Self { group, bytes }
+        let (group, _) = bind_buffers(
+            device,
+            "env view",
+            layout,
+            &[&params, &values, &visibility.map.buffer],
+        );
+        Self {
+            group,
+            bytes: grid.map_or(0, |_| values.size()),
+        }
     }
 }
 
@@ -471,15 +502,17 @@ struct AccumulateUniform {
     _pad: [u32; 2],
 }
 
-/// The view and accumulate pipelines, built once.
+/// The view, visibility and accumulate pipelines, built once.
 pub struct EnvViewPass {
-    pipeline: wgpu::RenderPipeline,
+    opaque: wgpu::RenderPipeline,
+    transparent: wgpu::RenderPipeline,
+    pub visibility: ViewVisibilityPass,
     accumulate: wgpu::ComputePipeline,
     accumulate_layout: wgpu::BindGroupLayout,
     pub strand_layout: wgpu::BindGroupLayout,
     pub batch_layout: wgpu::BindGroupLayout,
     pub table_layout: wgpu::BindGroupLayout,
-    pub grid_layout: wgpu::BindGroupLayout,
+    pub view_layout: wgpu::BindGroupLayout,
 }
 
 impl EnvViewPass {
@@ -489,7 +522,9 @@ impl EnvViewPass {
             include_str!("strand_quads.wgsl"),
             include_str!("fiber_frame.wgsl"),
             include_str!("convolution_transmittance.wgsl"),
+            include_str!("occupancy_map.wgsl"),
             include_str!("env_view.wgsl"),
+            include_str!("view_visibility.wgsl"),
         ]
         .concat();
         let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -508,9 +543,13 @@ impl EnvViewPass {
                 storage_entry(3, fragment, true),
             ],
         });
-        let grid_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("env grid"),
-            entries: &[uniform_entry(0, fragment), storage_entry(1, fragment, true)],
+        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("env view"),
+            entries: &[
+                uniform_entry(0, fragment),
+                storage_entry(1, fragment, true),
+                storage_entry(2, fragment, false),
+            ],
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("env view"),
@@ -518,54 +557,79 @@ impl EnvViewPass {
                 Some(&strand_layout),
                 Some(&batch_layout),
                 Some(&table_layout),
-                Some(&grid_layout),
+                Some(&view_layout),
             ],
             immediate_size: 0,
         });
+        let visibility_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("view visibility"),
+            bind_group_layouts: &[Some(&strand_layout), None, None, Some(&view_layout)],
+            immediate_size: 0,
+        });
+        let visibility =
+            ViewVisibilityPass::new(device, &shader, &visibility_layout, gpu.hdr_format());
         let premultiplied_over = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,
             dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
             operation: wgpu::BlendOperation::Add,
         };
-        let target = Some(wgpu::ColorTargetState {
-            format: gpu.hdr_format(),
-            blend: Some(wgpu::BlendState {
-                color: premultiplied_over,
-                alpha: premultiplied_over,
-            }),
-            write_mask: wgpu::ColorWrites::ALL,
-        });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("env view"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_env"),
-                compilation_options: Default::default(),
-                targets: &[target.clone(), target],
-            }),
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        });
+        let additive = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let view_pipeline = |label: &str, entry: &str, blend: wgpu::BlendComponent, depth| {
+            let target = Some(wgpu::ColorTargetState {
+                format: gpu.hdr_format(),
+                blend: Some(wgpu::BlendState {
+                    color: blend,
+                    alpha: blend,
+                }),
+                write_mask: wgpu::ColorWrites::ALL,
+            });
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&layout),
+                vertex: wgpu::VertexState {
+                    module: &shader,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                fragment: Some(wgpu::FragmentState {
+                    module: &shader,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    targets: &[target.clone(), target],
+                }),
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: depth,
+                multisample: Default::default(),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        // After the depth prepass only the nearest fragments are at an Equal depth; nothing
+        // writes depth, so early depth testing rejects the rest before the fragment shader.
+        let nearest_only = wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(false),
+            depth_compare: Some(wgpu::CompareFunction::Equal),
+            stencil: Default::default(),
+            bias: Default::default(),
+        };
+        let opaque = view_pipeline(
+            "env view (opaque)",
+            "fs_env_opaque",
+            premultiplied_over,
+            Some(nearest_only),
+        );
+        let transparent =
+            view_pipeline("env view (occupancy)", "fs_env_transparent", additive, None);
         let compute = wgpu::ShaderStages::COMPUTE;
         let float_texture = |binding| wgpu::BindGroupLayoutEntry {
             binding,
@@ -605,13 +669,15 @@ impl EnvViewPass {
             cache: None,
         });
         Self {
-            pipeline,
+            opaque,
+            transparent,
+            visibility,
             accumulate,
             accumulate_layout,
             strand_layout,
             batch_layout,
             table_layout,
-            grid_layout,
+            view_layout,
         }
     }
 
@@ -666,38 +732,52 @@ impl EnvViewPass {
         }
     }
 
-    /// Encodes one batch: the view pass into `targets`, then its addition into `sums`.
+    /// The strands' bind group of the view (group 0 of every view and visibility pass).
+    pub fn strands(
+        &self,
+        gpu: &GpuContext,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+    ) -> wgpu::BindGroup {
+        strand_bind_group(gpu, &self.strand_layout, geometry, frame)
+    }
+
+    /// Encodes one batch: the view pass into `targets` (reading the depth prepass of the frame
+    /// when opaque), then its addition into `sums`.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
-        gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         geometry: &StrandGeometry,
-        frame: &FrameParams,
+        strands: &wgpu::BindGroup,
+        transparency: ViewTransparency,
         batch: &BatchBinding,
         tables: &TableBinding,
-        grid: &GridBinding,
+        view: &ViewBinding,
         targets: &EnvViewTargets,
         sums: &EnvAccumulator,
     ) {
-        let strands = strand_bind_group(gpu, &self.strand_layout, geometry, frame);
         let single = targets.single.create_view(&Default::default());
         let multiple = targets.multiple.create_view(&Default::default());
         let depth = targets.depth.create_view(&Default::default());
+        let (pipeline, depth_attachment) = match transparency {
+            ViewTransparency::Opaque => (&self.opaque, prepassed_depth(&depth)),
+            ViewTransparency::Occupancy { .. } => (&self.transparent, None),
+        };
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("env view"),
                 color_attachments: &[cleared_color(&single), cleared_color(&multiple)],
-                depth_stencil_attachment: cleared_depth(&depth, false),
+                depth_stencil_attachment: depth_attachment,
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &strands, &[]);
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, strands, &[]);
             pass.set_bind_group(1, &batch.group, &[]);
             pass.set_bind_group(2, &tables.group, &[]);
-            pass.set_bind_group(3, &grid.group, &[]);
+            pass.set_bind_group(3, &view.group, &[]);
             pass.draw(0..6, 0..geometry.segment_count);
         }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

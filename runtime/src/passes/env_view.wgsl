@@ -1,11 +1,19 @@
-// The env-lit view pass (Ren 2010 §3.1, §5, §6), appended to strand_quads.wgsl, fiber_frame.wgsl
-// and convolution_transmittance.wgsl: every fragment loops over the batch's lights and sums
+// The env-lit view pass (Ren 2010 §3.1, §5, §6), appended to strand_quads.wgsl, fiber_frame.wgsl,
+// convolution_transmittance.wgsl and occupancy_map.wgsl: every fragment loops over the batch's
+// lights and sums
 //   single:   T̃_j(x) · I(u·ξ_j, u·ω_o, cos Δφ, 1/λ_j) · L_j
 //   multiple: power_j · T_f,j(x) · I_G(u·ξ_j, u·ω_o, cos Δφ, σ̄_f,j(x))
-// writing each with pre-multiplied alpha into its own target. For directional lights `I` is the
-// direct table S·cos θ_i (its fourth axis has one node) and L_j the irradiance.
-// Tables are strandlight `Table`s (row-major, channels innermost, RGB) uploaded as-is and
-// interpolated quadrilinearly exactly like `Table::lookup`.
+// writing each, weighted by what the viewer sees of the fragment, into its own target. For
+// directional lights `I` is the direct table S·cos θ_i (its fourth axis has one node) and L_j the
+// irradiance. Tables are strandlight `Table`s (row-major, channels innermost, RGB) uploaded as-is
+// and interpolated quadrilinearly exactly like `Table::lookup`.
+//
+// Two fragment entry points, one per view transparency (view_visibility.rs):
+//   fs_env_opaque:      after a depth prepass, only the nearest fragments pass the depth test
+//                       (Equal); each is weighted by its coverage and blended "over".
+//   fs_env_transparent: every fragment is weighted by coverage × its visibility through the
+//                       fragments in front (the occupancy map) and added; fragments that can no
+//                       longer contribute stop before any light is evaluated (early termination).
 
 struct TableAxis {
     min: f32,
@@ -25,21 +33,30 @@ struct TableLayout {
     strides: vec4<u32>,
 };
 
-struct GridParams {
-    // xyz: world position of vertex (0,0,0).
+// Group 3: what the view pass reads besides lights and tables: the batch's forward-scattering
+// grid and the frame's occupancy map.
+struct ViewParams {
+    // Grid: xyz the world position of vertex (0,0,0).
     origin: vec4<f32>,
-    // xyz: spacing between vertices.
+    // Grid: xyz the spacing between vertices.
     spacing: vec4<f32>,
-    // xyz: vertices per axis.
+    // Grid: xyz the vertices per axis.
     dims: vec4<u32>,
+    // Image width and height (occupancy records).
+    width: u32,
+    height: u32,
+    // Fragments seen less than this stop before shading (transparent view).
+    visibility_cutoff: f32,
+    _pad: u32,
 };
 
 @group(2) @binding(0) var<uniform> single_layout: TableLayout;
 @group(2) @binding(1) var<storage, read> single_table: array<f32>;
 @group(2) @binding(2) var<uniform> multiple_layout: TableLayout;
 @group(2) @binding(3) var<storage, read> multiple_table: array<f32>;
-@group(3) @binding(0) var<uniform> grid: GridParams;
+@group(3) @binding(0) var<uniform> view: ViewParams;
 @group(3) @binding(1) var<storage, read> grid_values: array<vec4<f32>>;
+@group(3) @binding(2) var<storage, read_write> occupancy_map: array<atomic<u32>>;
 
 struct TableCell {
     lower: u32,
@@ -124,15 +141,15 @@ fn multiple_lookup(coords: vec4<f32>) -> vec3<f32> {
 }
 
 fn grid_vertex(slot: u32, i: vec3<u32>) -> vec4<f32> {
-    let d = grid.dims.xyz;
+    let d = view.dims.xyz;
     return grid_values[((slot * d.z + i.z) * d.y + i.y) * d.x + i.x];
 }
 
 // [T_r, T_g, T_b, σ̄_f] of light `slot` at `world`: trilinear, clamped at the border.
 fn forward_scattering(slot: u32, world: vec3<f32>) -> vec4<f32> {
-    let d = grid.dims.xyz;
+    let d = view.dims.xyz;
     let last = vec3<f32>(d) - vec3<f32>(1.0);
-    let f = clamp((world - grid.origin.xyz) / grid.spacing.xyz, vec3<f32>(0.0), last);
+    let f = clamp((world - view.origin.xyz) / view.spacing.xyz, vec3<f32>(0.0), last);
     let lower = min(floor(f), max(last - vec3<f32>(1.0), vec3<f32>(0.0)));
     let w = select(f - lower, vec3<f32>(0.0), last < vec3<f32>(1.0));
     let i = vec3<u32>(lower);
@@ -151,8 +168,9 @@ struct EnvOut {
     @location(1) multiple: vec4<f32>,
 };
 
-@fragment
-fn fs_env(in: VertexOut) -> EnvOut {
+// Single and multiple scattering of one fragment under the batch's lights, times `weight`
+// (pre-multiplied; the weight is also the alpha written).
+fn shade(in: VertexOut, weight: f32) -> EnvOut {
     let t = normalize(in.tangent);
     var e = frame.toward_eye.xyz;
     if (frame.eye.w > 0.5) { e = normalize(frame.eye.xyz - in.world); }
@@ -172,7 +190,20 @@ fn fs_env(in: VertexOut) -> EnvOut {
         }
     }
     var out: EnvOut;
-    out.single = vec4<f32>(single * in.alpha, in.alpha);
-    out.multiple = vec4<f32>(multiple * in.alpha, in.alpha);
+    out.single = vec4<f32>(single * weight, weight);
+    out.multiple = vec4<f32>(multiple * weight, weight);
     return out;
+}
+
+// No side effects here: the depth test may then run before the shader.
+@fragment
+fn fs_env_opaque(in: VertexOut) -> EnvOut {
+    return shade(in, in.alpha);
+}
+
+@fragment
+fn fs_env_transparent(in: VertexOut) -> EnvOut {
+    let seen = occupancy_visibility(in);
+    if (seen < view.visibility_cutoff) { discard; }
+    return shade(in, in.alpha * seen);
 }

@@ -10,3 +10,4 @@ pub mod strands;
 pub mod summed_area;
 pub mod transmittance_filter;
 pub mod transmittance_probe;
+pub mod view_visibility;

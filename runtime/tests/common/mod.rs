@@ -46,5 +46,12 @@ pub fn slab(rows: usize, thickness: f32) -> HairModel {
             strand_offsets.push(points.len() as u32);
         }
     }
-    HairModel::new(points, strand_offsets, Some(Attribute::Uniform(thickness)), None, None).unwrap()
+    HairModel::new(
+        points,
+        strand_offsets,
+        Some(Attribute::Uniform(thickness)),
+        None,
+        None,
+    )
+    .unwrap()
 }

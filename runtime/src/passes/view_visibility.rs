@@ -1,0 +1,318 @@
+//! What the env view pass sees of each pixel's fibers (Ren 2010 §8, "Transparency"): built once
+//! per frame, before the light batches, and read by every batch's view pass, so that the costly
+//! per-fragment loop over lights runs only for fragments that reach the image.
+//! * [`ViewTransparency::Opaque`]: a depth prepass; the view pass then shades only the fragments
+//!   at each pixel's nearest depth (depth test Equal).
+//! * [`ViewTransparency::Occupancy`]: the occupancy and slab maps of Sintorn & Assarsson 2009
+//!   (`occupancy_map.wgsl`, `view_visibility.wgsl`): two passes record each pixel's depth range,
+//!   which of its 128 depth slices hold fragments and the optical depth per slab of 32 slices;
+//!   the view pass weighs every fragment by its coverage × exp(−optical depth in front) and adds
+//!   the results (order-independent), stopping before any light for fragments seen less than
+//!   the cutoff (the paper's early opacity culling).
+//!
+//! Inputs: the strands' bind group and the view group (group 3, holding the [`OccupancyMap`]).
+//! Outputs: the view's depth texture (opaque) or the occupancy map (occupancy).
+
+use super::attachments::{cleared_color, cleared_depth, prepassed_depth};
+use super::strands::DEPTH_FORMAT;
+use crate::gpu::GpuContext;
+
+/// How the env view pass weighs the fragments of a pixel.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ViewTransparency {
+    /// Each pixel shows its nearest fiber, weighted by the fiber's coverage.
+    Opaque,
+    /// Every fiber in front weighs in by coverage × visibility; fragments seen less than
+    /// `visibility_cutoff` (in [0, 1)) are not shaded.
+    Occupancy { visibility_cutoff: f32 },
+}
+
+impl ViewTransparency {
+    /// Below 8-bit display precision: what is culled changes a pixel by at most 1/256 of the
+    /// brightest fragment behind the cut.
+    pub const DEFAULT_CUTOFF: f32 = 1.0 / 256.0;
+
+    pub fn occupancy() -> Self {
+        Self::Occupancy {
+            visibility_cutoff: Self::DEFAULT_CUTOFF,
+        }
+    }
+
+    /// The cutoff the view pass applies (0 for opaque: nothing is culled by visibility).
+    pub fn visibility_cutoff(&self) -> f32 {
+        match self {
+            Self::Opaque => 0.0,
+            Self::Occupancy { visibility_cutoff } => *visibility_cutoff,
+        }
+    }
+
+    pub fn check(&self) -> Result<(), OccupancyError> {
+        match self {
+            Self::Occupancy { visibility_cutoff } if !(0.0..1.0).contains(visibility_cutoff) => {
+                Err(OccupancyError::Cutoff(*visibility_cutoff))
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+impl Default for ViewTransparency {
+    fn default() -> Self {
+        Self::Opaque
+    }
+}
+
+/// u32 per pixel (`OCC_RECORD`): depth range, 4 words of occupancy bits, 4 slab optical depths.
+pub const RECORD_WORDS: u64 = 10;
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum OccupancyError {
+    #[error("transparency visibility cutoff {0}: must be in [0, 1)")]
+    Cutoff(f32),
+    #[error(
+        "the occupancy map of a {width}×{height} image needs {bytes} bytes, over the adapter's storage-binding limit of {limit} bytes; render a smaller image or use opaque"
+    )]
+    TooLarge {
+        width: u32,
+        height: u32,
+        bytes: u64,
+        limit: u64,
+    },
+}
+
+/// Fragment counts of one batch's view pass (every batch draws the same fragments).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FragmentCounts {
+    /// Fragments the hair rasterizes into.
+    pub rasterized: u64,
+    /// Fragments the view pass shades (runs the loop over lights for).
+    pub shaded: u64,
+}
+
+/// The per-pixel records of the occupancy map (a 16-byte placeholder for
+/// [`ViewTransparency::Opaque`], which reads none).
+pub struct OccupancyMap {
+    pub buffer: wgpu::Buffer,
+}
+
+impl OccupancyMap {
+    pub fn bytes(transparency: ViewTransparency, width: u32, height: u32) -> u64 {
+        match transparency {
+            ViewTransparency::Opaque => 16,
+            ViewTransparency::Occupancy { .. } => width as u64 * height as u64 * RECORD_WORDS * 4,
+        }
+    }
+
+    pub fn new(
+        gpu: &GpuContext,
+        transparency: ViewTransparency,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, OccupancyError> {
+        transparency.check()?;
+        let bytes = Self::bytes(transparency, width, height);
+        let limits = gpu.device.limits();
+        let limit = (limits.max_storage_buffer_binding_size as u64).min(limits.max_buffer_size);
+        if bytes > limit {
+            return Err(OccupancyError::TooLarge {
+                width,
+                height,
+                bytes,
+                limit,
+            });
+        }
+        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("occupancy map"),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Ok(Self { buffer })
+    }
+
+    pub fn memory(&self) -> (String, u64) {
+        ("occupancy map".into(), self.buffer.size())
+    }
+}
+
+/// The build pipelines, made from the env view module so that they rasterize exactly the
+/// fragments the view pass shades (the depth prepass's Equal test needs bit-identical depths).
+pub struct ViewVisibilityPass {
+    depth_prepass: wgpu::RenderPipeline,
+    range: wgpu::RenderPipeline,
+    slices: wgpu::RenderPipeline,
+    count_rasterized: wgpu::RenderPipeline,
+    count_nearest: wgpu::RenderPipeline,
+    count_visible: wgpu::RenderPipeline,
+}
+
+impl ViewVisibilityPass {
+    /// `layout` binds the strands at group 0 and the view group at group 3; `count_format` is
+    /// the (blendable) format of the counts target.
+    pub fn new(
+        device: &wgpu::Device,
+        module: &wgpu::ShaderModule,
+        layout: &wgpu::PipelineLayout,
+        count_format: wgpu::TextureFormat,
+    ) -> Self {
+        let additive = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let count_target = [Some(wgpu::ColorTargetState {
+            format: count_format,
+            blend: Some(wgpu::BlendState {
+                color: additive,
+                alpha: additive,
+            }),
+            write_mask: wgpu::ColorWrites::ALL,
+        })];
+        let pipeline = |label: &str,
+                        fragment: Option<&str>,
+                        compare: wgpu::CompareFunction,
+                        depth_write: bool| {
+            let targets: &[Option<wgpu::ColorTargetState>] =
+                if fragment.is_some_and(|f| f.starts_with("fs_count")) {
+                    &count_target
+                } else {
+                    &[]
+                };
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(layout),
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[],
+                },
+                fragment: fragment.map(|entry| wgpu::FragmentState {
+                    module,
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    targets,
+                }),
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    cull_mode: None,
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    depth_write_enabled: Some(depth_write),
+                    depth_compare: Some(compare),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        use wgpu::CompareFunction::{Always, Equal, Less};
+        Self {
+            depth_prepass: pipeline("view depth prepass", None, Less, true),
+            range: pipeline(
+                "occupancy depth range",
+                Some("fs_occupancy_range"),
+                Always,
+                false,
+            ),
+            slices: pipeline(
+                "occupancy slices",
+                Some("fs_occupancy_slices"),
+                Always,
+                false,
+            ),
+            count_rasterized: pipeline(
+                "count rasterized",
+                Some("fs_count_rasterized"),
+                Always,
+                false,
+            ),
+            count_nearest: pipeline("count nearest", Some("fs_count_nearest"), Equal, false),
+            count_visible: pipeline("count visible", Some("fs_count_visible"), Always, false),
+        }
+    }
+
+    /// Encodes the frame's build: the depth prepass into `depth` (opaque, kept for the view
+    /// passes), or the occupancy map zeroed and its two passes. `view` must bind `map`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        transparency: ViewTransparency,
+        strands: &wgpu::BindGroup,
+        view: &wgpu::BindGroup,
+        depth: &wgpu::TextureView,
+        map: &OccupancyMap,
+        segments: u32,
+    ) {
+        let passes: &[&wgpu::RenderPipeline] = match transparency {
+            ViewTransparency::Opaque => &[&self.depth_prepass],
+            ViewTransparency::Occupancy { .. } => {
+                encoder.clear_buffer(&map.buffer, 0, None);
+                &[&self.range, &self.slices]
+            }
+        };
+        for pipeline in passes {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("view visibility"),
+                color_attachments: &[],
+                depth_stencil_attachment: cleared_depth(depth, true),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, strands, &[]);
+            pass.set_bind_group(3, view, &[]);
+            pass.draw(0..6, 0..segments);
+        }
+    }
+
+    /// Benchmarks: counts into `counts` (cleared here; red rasterized, green shaded per pixel)
+    /// after [`Self::encode`] built the frame's visibility (its depth is read, not changed).
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode_counts(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        transparency: ViewTransparency,
+        strands: &wgpu::BindGroup,
+        view: &wgpu::BindGroup,
+        depth: &wgpu::TextureView,
+        counts: &wgpu::TextureView,
+        segments: u32,
+    ) {
+        let shaded = match transparency {
+            ViewTransparency::Opaque => &self.count_nearest,
+            ViewTransparency::Occupancy { .. } => &self.count_visible,
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("count fragments"),
+            color_attachments: &[cleared_color(counts)],
+            depth_stencil_attachment: prepassed_depth(depth),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, strands, &[]);
+        pass.set_bind_group(3, view, &[]);
+        for pipeline in [&self.count_rasterized, shaded] {
+            pass.set_pipeline(pipeline);
+            pass.draw(0..6, 0..segments);
+        }
+    }
+}
+
+/// Sums the per-pixel counts of [`ViewVisibilityPass::encode_counts`] (RGBA f32 texels).
+pub fn sum_counts(texels: &[[f32; 4]]) -> FragmentCounts {
+    let (rasterized, shaded) = texels.iter().fold((0.0f64, 0.0f64), |(r, s), t| {
+        (r + t[0] as f64, s + t[1] as f64)
+    });
+    FragmentCounts {
+        rasterized: rasterized.round() as u64,
+        shaded: shaded.round() as u64,
+    }
+}

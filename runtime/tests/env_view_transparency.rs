@@ -1,0 +1,278 @@
+//! The env view pass's transparency (Ren 2010 §8): fibers stacked in depth under one pixel,
+//! drawn in a shuffled order, against front-to-back "over" compositing done here in f64 —
+//! Σ_k c_k α Π_{j<k} (1 − α) — with each fiber's colour c_k from `Table::lookup`.
+
+mod common;
+use common::*;
+
+use glam::{DVec3, Vec3};
+use strandlight_runtime::env::{
+    EnvLight, EnvRenderError, EnvRenderOptions, EnvTables, FragmentCounts, OccupancyError,
+    ViewTransparency, render_env_frame,
+};
+use strandlight_runtime::hair::{Attribute, HairModel};
+use strandlight_runtime::passes::convolution_depth::DodmSettings;
+use strandlight_tables::table::{Axis, Table};
+
+/// The light: directional, toward +x (in the image plane), unit irradiance per channel.
+const LIGHT: Vec3 = Vec3::X;
+/// The pixel every strand crosses: world (0, 0) is the corner of pixels 31 and 32, so use the
+/// centre of pixel (32, 31) at world (1/64, 1/64).
+const PIXEL: (usize, usize) = (32, 31);
+const CENTRE: Vec3 = Vec3::new(1.0 / 64.0, 1.0 / 64.0, 0.0);
+
+/// A direct table (one-node fourth axis) that varies with u·ξ, so strands at different angles to
+/// the light have different colours and the compositing order shows.
+fn direct_table() -> Table {
+    let axes = vec![
+        Axis::uniform("u_dot_xi", -1.0, 1.0, 33),
+        Axis::uniform("u_dot_wo", -1.0, 1.0, 3),
+        Axis::uniform("cos_dphi", -1.0, 1.0, 3),
+        Axis::uniform("w", 0.0, 0.0, 1),
+    ];
+    Table::from_fn(axes, 3, |x, out| {
+        out[0] = (1.0 + x[0]) as f32;
+        out[1] = (2.0 - x[0] * x[0]) as f32;
+        out[2] = (0.5 + 0.25 * x[0]) as f32;
+    })
+    .unwrap()
+}
+
+/// `layers` straight strands through CENTRE at depths z_k = 0.5 − 0.1·k (k = 0 nearest the
+/// camera at +z), the k-th at 10° + 17°·k in the image plane, each 3 pixels wide (coverage 1) with
+/// opacity `opacity`; listed in the file in a shuffled order. Returns the model and the strands'
+/// tangents front to back.
+fn stacked_strands(layers: usize, opacity: f32) -> (HairModel, Vec<DVec3>) {
+    let tangents: Vec<Vec3> = (0..layers)
+        .map(|k| {
+            let a = (10.0 + 17.0 * k as f32).to_radians();
+            Vec3::new(a.cos(), a.sin(), 0.0)
+        })
+        .collect();
+    // A fixed permutation: the draw order must not matter.
+    let mut order: Vec<usize> = (0..layers).collect();
+    order.sort_by_key(|&k| (k * 7 + 3) % layers);
+    let mut points = Vec::new();
+    let mut offsets = vec![0u32];
+    for &k in &order {
+        let centre = CENTRE + Vec3::Z * (0.5 - 0.1 * k as f32);
+        points.push(centre - tangents[k] * 0.3);
+        points.push(centre + tangents[k] * 0.3);
+        offsets.push(points.len() as u32);
+    }
+    let model = HairModel::new(
+        points,
+        offsets,
+        Some(Attribute::Uniform(3.0 / 32.0)),
+        Some(Attribute::Uniform(1.0 - opacity)),
+        None,
+    )
+    .unwrap();
+    (model, tangents.iter().map(|t| t.as_dvec3()).collect())
+}
+
+/// The colour of a strand with tangent `t` under LIGHT, seen by the orthographic camera.
+fn colour(table: &Table, t: DVec3) -> [f64; 3] {
+    let (l, e) = (LIGHT.as_dvec3(), DVec3::Z);
+    let (si, so) = (t.dot(l), t.dot(e));
+    let (lp, ep) = (l - si * t, e - so * t);
+    let cos_phi = (lp.dot(ep) / (lp.length() * ep.length())).clamp(-1.0, 1.0);
+    table
+        .lookup_rgb(&[si, so, cos_phi, 0.0])
+        .unwrap()
+        .map(|c| c as f64)
+}
+
+/// Front-to-back "over" of the first `kept` layers (RGB and alpha), in f64.
+fn composite(table: &Table, tangents: &[DVec3], alpha: f64, kept: usize) -> [f64; 4] {
+    let mut out = [0.0; 4];
+    let mut seen = 1.0;
+    for t in tangents.iter().take(kept) {
+        let c = colour(table, *t);
+        for i in 0..3 {
+            out[i] += seen * alpha * c[i];
+        }
+        out[3] += seen * alpha;
+        seen *= 1.0 - alpha;
+    }
+    out
+}
+
+fn render(
+    model: &HairModel,
+    table: &Table,
+    transparency: ViewTransparency,
+) -> Result<(Vec<[f32; 4]>, Option<FragmentCounts>), EnvRenderError> {
+    render_sized(model, table, transparency, RES, RES)
+}
+
+fn render_sized(
+    model: &HairModel,
+    table: &Table,
+    transparency: ViewTransparency,
+    width: u32,
+    height: u32,
+) -> Result<(Vec<[f32; 4]>, Option<FragmentCounts>), EnvRenderError> {
+    let gpu = gpu();
+    let options = EnvRenderOptions {
+        dodm: DodmSettings {
+            resolution: 64,
+            first_layer: None,
+            batch_size: 4,
+        },
+        kappa: 1.0,
+        shadowed: false,
+        transparency,
+        count_fragments: true,
+        ..Default::default()
+    };
+    let tables = EnvTables {
+        direct: Some(table.clone()),
+        ..Default::default()
+    };
+    let lights = [EnvLight::directional(LIGHT, [1.0; 3])];
+    let frame = render_env_frame(
+        &gpu,
+        model,
+        &ortho_camera(),
+        width,
+        height,
+        &lights,
+        &tables,
+        &options,
+        None,
+    )?;
+    Ok((frame.pixels, frame.stats.fragments))
+}
+
+fn at_pixel(pixels: &[[f32; 4]]) -> [f64; 4] {
+    pixels[PIXEL.1 * RES as usize + PIXEL.0].map(|c| c as f64)
+}
+
+fn assert_close(got: [f64; 4], want: [f64; 4], tolerance: f64, what: &str) {
+    for c in 0..4 {
+        let scale = want[c].abs().max(1e-3);
+        assert!(
+            (got[c] - want[c]).abs() <= tolerance * scale,
+            "{what}: channel {c}: got {:?}, want {:?}",
+            got,
+            want
+        );
+    }
+}
+
+#[test]
+fn occupancy_view_composites_stacked_fibers_front_to_back_in_any_draw_order() {
+    let (layers, opacity) = (8, 0.4);
+    let (model, tangents) = stacked_strands(layers, opacity);
+    let table = direct_table();
+    let (pixels, counts) = render(
+        &model,
+        &table,
+        ViewTransparency::Occupancy {
+            visibility_cutoff: 0.0,
+        },
+    )
+    .unwrap();
+    let want = composite(&table, &tangents, opacity as f64, layers);
+    let got = at_pixel(&pixels);
+    println!("occupancy view: got {got:?}, front-to-back over {want:?}");
+    // Per fragment the occupancy map rounds τ = −ln(1 − α) to 1/4096: well below 1e-3.
+    assert_close(got, want, 1e-3, "occupancy view");
+    // The draw order reversed (the layers' order in the file) gives the same pixel.
+    let reversed = composite(
+        &table,
+        &tangents.iter().rev().cloned().collect::<Vec<_>>(),
+        0.4,
+        layers,
+    );
+    assert!(
+        (reversed[0] - want[0]).abs() > 0.05 * want[0],
+        "the scene must tell the orders apart: {reversed:?} vs {want:?}"
+    );
+    let counts = counts.unwrap();
+    assert_eq!(
+        counts.shaded, counts.rasterized,
+        "a zero cutoff culls nothing: {counts:?}"
+    );
+}
+
+#[test]
+fn occupancy_view_stops_shading_fragments_below_the_visibility_cutoff() {
+    // Visibility through k layers of opacity 0.7 is 0.3^k: 0.09 at k = 2, 0.027 at k = 3, so a
+    // cutoff of 0.05 keeps the three nearest layers and culls the rest (2.7% of the pixel).
+    let (layers, opacity, cutoff) = (6, 0.7, 0.05);
+    let (model, tangents) = stacked_strands(layers, opacity);
+    let table = direct_table();
+    let (pixels, counts) = render(
+        &model,
+        &table,
+        ViewTransparency::Occupancy {
+            visibility_cutoff: cutoff,
+        },
+    )
+    .unwrap();
+    let got = at_pixel(&pixels);
+    let kept = composite(&table, &tangents, opacity as f64, 3);
+    let all = composite(&table, &tangents, opacity as f64, layers);
+    println!("cutoff {cutoff}: got {got:?}; three layers {kept:?}; all {all:?}; {counts:?}");
+    assert_close(got, kept, 1e-3, "culled view");
+    assert!(
+        (all[3] - kept[3]) > 0.02,
+        "the cut must be measurable: {all:?} vs {kept:?}"
+    );
+    let counts = counts.unwrap();
+    assert!(
+        counts.shaded < counts.rasterized,
+        "culled fragments are not shaded: {counts:?}"
+    );
+}
+
+#[test]
+fn opaque_view_shows_the_nearest_fiber_with_its_coverage() {
+    let (layers, opacity) = (5, 0.6);
+    let (model, tangents) = stacked_strands(layers, opacity);
+    let table = direct_table();
+    let (pixels, counts) = render(&model, &table, ViewTransparency::Opaque).unwrap();
+    let want = composite(&table, &tangents, opacity as f64, 1);
+    assert_close(at_pixel(&pixels), want, 1e-4, "opaque view");
+    let counts = counts.unwrap();
+    // Only the nearest fragment of each covered pixel is shaded.
+    let covered = pixels.iter().filter(|p| p[3] > 0.0).count() as u64;
+    println!("opaque: {counts:?}, {covered} covered pixels");
+    assert!(
+        counts.shaded >= covered && counts.shaded < counts.rasterized,
+        "{counts:?}"
+    );
+}
+
+#[test]
+fn transparency_settings_and_limits_are_typed_errors() {
+    let (model, _) = stacked_strands(2, 0.5);
+    let table = direct_table();
+    for cutoff in [-0.1, 1.0, f32::NAN] {
+        let e = render(
+            &model,
+            &table,
+            ViewTransparency::Occupancy {
+                visibility_cutoff: cutoff,
+            },
+        )
+        .unwrap_err();
+        assert!(
+            matches!(e, EnvRenderError::Transparency(OccupancyError::Cutoff(_))),
+            "cutoff {cutoff}: {e}"
+        );
+    }
+    // The largest image the adapter allows needs an occupancy map over its binding limit.
+    let max = gpu().device.limits().max_texture_dimension_2d;
+    let e = render_sized(&model, &table, ViewTransparency::occupancy(), max, max).unwrap_err();
+    println!("{max}×{max}: {e}");
+    assert!(
+        matches!(
+            e,
+            EnvRenderError::Transparency(OccupancyError::TooLarge { .. })
+        ),
+        "{e}"
+    );
+}
