@@ -346,6 +346,10 @@ pub fn run(args: CompareArgs) -> anyhow::Result<()> {
 pub fn execute(args: &CompareArgs, scene: &CompareScene, steps: &mut Steps, render: Renderer) -> anyhow::Result<Value> {
     let mut report = serde_json::Map::new();
     let description = format!("strandlight compare: {} under {} ({:?}, preset {})", args.hair.display(), args.env, args.shading, args.preset);
+    if let Some(&first) = args.modes.first() {
+        // Drivers compile shader variants at their first draw (lavapipe: seconds): not a frame's cost.
+        steps.run("warm-up", || render(&frame(scene, args, &scene.srbf, first)), |r| format!("{:.0} ms, untimed", r.milliseconds))?;
+    }
     for &mode in &args.modes {
         let r = run_mode(render, scene, args, mode, steps)?;
         let srbf_error = relative_rmse(&r.srbf.image, &r.reference.0)?;

@@ -1,6 +1,8 @@
-//! Cost of the env-lit single-scattering path (Ren 2010): frame time vs the number of SRBF
-//! lights (fixed image) and vs the image size (fixed lights), on the procedural groom, with
-//! synthetic RGB tables of the convolution tables' paper size (32³ × 64 nodes). Is each linear?
+//! Cost of the env-lit single-scattering path (Ren 2010 §8): frame time vs the number of SRBF
+//! lights (fixed image) and vs the image size (fixed lights), for the opaque and the occupancy
+//! (transparent) view, on the procedural groom, with synthetic RGB tables of the convolution
+//! tables' paper size (32³ × 64 nodes). Is the cost linear in the lights and in the fragments
+//! shaded (counted by the renderer)?
 //!
 //! Each configuration renders once to warm up, then `TIMED_RUNS` times; the table gives medians
 //! of the renderer's own per-pass wall-clock timings (summed over batches), pipelines built once
@@ -10,7 +12,9 @@
 
 use glam::Vec3;
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env::{EnvLight, EnvRenderOptions, EnvRenderer, EnvTables};
+use strandlight_runtime::env::{
+    EnvLight, EnvRenderOptions, EnvRenderer, EnvTables, ViewTransparency,
+};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
@@ -74,12 +78,13 @@ fn main() -> Result<(), BoxError> {
         ..Default::default()
     };
     let renderer = EnvRenderer::new(&gpu);
-    let options = EnvRenderOptions {
+    let base = EnvRenderOptions {
         dodm: DodmSettings {
             resolution: 256,
             first_layer: None,
             batch_size: 16,
         },
+        count_fragments: true,
         ..Default::default()
     };
     println!("adapter: {}", gpu.report);
@@ -87,42 +92,61 @@ fn main() -> Result<(), BoxError> {
         "model: {} strands, {} segments; DODM 256², batch 16, κ = {}",
         model.strand_count(),
         model.segment_count(),
-        options.kappa
+        base.kappa
     );
-    println!("| lights | image | light pass ms | SAT ms | view ms | frame ms | frame ms / light |");
-    println!("|---|---|---|---|---|---|---|");
-    let mut configs: Vec<(usize, u32)> = [4, 8, 16, 32].iter().map(|&n| (n, 256)).collect();
+    println!(
+        "| view | lights | image | shaded fragments (per batch) | light pass ms | SAT ms | visibility ms | view ms | frame ms | frame ms / light | view µs / (light · 1k shaded fragments) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    let mut configs: Vec<(usize, u32)> = [4, 8, 16, 32, 64].iter().map(|&n| (n, 256)).collect();
     configs.extend([(16, 128), (16, 512)]);
-    for (n, size) in configs {
-        let camera = Camera::framing(model.bounds(), 1.0, false);
-        let ls = lights(n);
-        let mut per_pass: Vec<(String, Vec<f64>)> = Vec::new();
-        for run in 0..=runs {
-            let frame = renderer.render(
-                &gpu, &model, &camera, size, size, &ls, &tables, &options, None,
-            )?;
-            if run == 0 {
-                continue;
-            }
-            for t in frame.stats.timings {
-                match per_pass.iter_mut().find(|(p, _)| *p == t.pass) {
-                    Some((_, v)) => v.push(t.milliseconds),
-                    None => per_pass.push((t.pass, vec![t.milliseconds])),
+    for (name, transparency) in [
+        ("opaque", ViewTransparency::Opaque),
+        ("occupancy", ViewTransparency::occupancy()),
+    ] {
+        let options = EnvRenderOptions {
+            transparency,
+            ..base
+        };
+        for &(n, size) in &configs {
+            let camera = Camera::framing(model.bounds(), 1.0, false);
+            let ls = lights(n);
+            let mut per_pass: Vec<(String, Vec<f64>)> = Vec::new();
+            let mut shaded = 0;
+            for run in 0..=runs {
+                let frame = renderer.render(
+                    &gpu, &model, &camera, size, size, &ls, &tables, &options, None,
+                )?;
+                shaded = frame.stats.fragments.map_or(0, |f| f.shaded);
+                if run == 0 {
+                    continue;
+                }
+                for t in frame.stats.timings {
+                    match per_pass.iter_mut().find(|(p, _)| *p == t.pass) {
+                        Some((_, v)) => v.push(t.milliseconds),
+                        None => per_pass.push((t.pass, vec![t.milliseconds])),
+                    }
                 }
             }
+            let mut ms = |name: &str| {
+                per_pass
+                    .iter_mut()
+                    .find(|(p, _)| p == name)
+                    .map_or(0.0, |(_, v)| median(v))
+            };
+            let (light, sat, visibility, view) = (
+                ms("light pass"),
+                ms("summed-area tables"),
+                ms("view visibility"),
+                ms("view"),
+            );
+            let frame = light + sat + visibility + view + ms("readback");
+            println!(
+                "| {name} | {n} | {size}² | {shaded} | {light:.1} | {sat:.1} | {visibility:.1} | {view:.1} | {frame:.1} | {:.2} | {:.2} |",
+                frame / n as f64,
+                view * 1e3 / (n as f64 * shaded as f64 / 1e3)
+            );
         }
-        let mut ms = |name: &str| {
-            per_pass
-                .iter_mut()
-                .find(|(p, _)| p == name)
-                .map_or(0.0, |(_, v)| median(v))
-        };
-        let (light, sat, view) = (ms("light pass"), ms("summed-area tables"), ms("view"));
-        let frame = light + sat + view + ms("readback");
-        println!(
-            "| {n} | {size}² | {light:.1} | {sat:.1} | {view:.1} | {frame:.1} | {:.2} |",
-            frame / n as f64
-        );
     }
     Ok(())
 }
