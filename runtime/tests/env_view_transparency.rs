@@ -229,12 +229,20 @@ fn occupancy_view_stops_shading_fragments_below_the_visibility_cutoff() {
 }
 
 #[test]
-fn opaque_view_shows_the_nearest_fiber_with_its_coverage() {
+fn opaque_view_shows_the_nearest_fiber_with_the_coverage_of_all() {
     let (layers, opacity) = (5, 0.6);
     let (model, tangents) = stacked_strands(layers, opacity);
     let table = direct_table();
     let (pixels, counts) = render(&model, &table, ViewTransparency::Opaque).unwrap();
-    let want = composite(&table, &tangents, opacity as f64, 1);
+    // The nearest fiber's colour at the pixel's total coverage 1 − (1 − α)^N.
+    let coverage = 1.0 - (1.0 - opacity as f64).powi(layers as i32);
+    let front = colour(&table, tangents[0]);
+    let want = [
+        front[0] * coverage,
+        front[1] * coverage,
+        front[2] * coverage,
+        coverage,
+    ];
     assert_close(at_pixel(&pixels), want, 1e-4, "opaque view");
     let counts = counts.unwrap();
     // Only the nearest fragment of each covered pixel is shaded.

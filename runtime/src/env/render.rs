@@ -385,7 +385,7 @@ impl EnvRenderer {
         };
         let bounds = model.bounds();
         let mut dodm = DodmBatch::new(gpu, resolution, slots, options.dodm.first_layer_for(bounds));
-        let targets = EnvViewTargets::new(gpu, width, height);
+        let targets = EnvViewTargets::new(gpu, width, height, options.transparency);
         let sums = self.view.accumulator(gpu, &targets);
         let frame = FrameParams {
             camera: *camera,
@@ -421,8 +421,10 @@ impl EnvRenderer {
         memory.push(occupancy.memory());
         memory.push(("env sums".into(), sums.sums.size()));
         let strands = self.view.strands(gpu, &geometry, &frame);
+        let coverage_view = targets.coverage.create_view(&Default::default());
         let visibility = FrameVisibility {
             map: &occupancy,
+            coverage: &coverage_view,
             transparency: options.transparency,
             width,
             height,
@@ -437,6 +439,7 @@ impl EnvRenderer {
                 &strands,
                 &view.group,
                 &depth_view,
+                &coverage_view,
                 &occupancy,
                 geometry.segment_count,
             );

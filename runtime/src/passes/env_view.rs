@@ -371,6 +371,8 @@ pub struct ViewBinding {
 /// What group 3 is built from besides the grid.
 pub struct FrameVisibility<'a> {
     pub map: &'a OccupancyMap,
+    /// [`EnvViewTargets::coverage`].
+    pub coverage: &'a wgpu::TextureView,
     pub transparency: ViewTransparency,
     pub width: u32,
     pub height: u32,
@@ -419,12 +421,28 @@ impl ViewBinding {
             bytemuck::bytes_of(&uniform),
             wgpu::BufferUsages::UNIFORM,
         );
-        let (group, _) = bind_buffers(
-            device,
-            "env view",
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("env view"),
             layout,
-            &[&params, &values, &visibility.map.buffer],
-        );
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: values.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: visibility.map.buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(visibility.coverage),
+                },
+            ],
+        });
         Self {
             group,
             bytes: grid.map_or(0, |_| values.size()),
@@ -432,15 +450,18 @@ impl ViewBinding {
     }
 }
 
-/// Two HDR targets (single, multiple) and a depth buffer for one batch's view pass.
+/// Two HDR targets (single, multiple) and a depth buffer for one batch's view pass, and the
+/// frame's coverage (red: Σ −ln(1 − α) of a pixel's fragments; the opaque view's alpha; 1×1 and
+/// unused for the transparent view).
 pub struct EnvViewTargets {
     pub single: wgpu::Texture,
     pub multiple: wgpu::Texture,
     pub depth: wgpu::Texture,
+    pub coverage: wgpu::Texture,
 }
 
 impl EnvViewTargets {
-    pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Self {
+    pub fn new(gpu: &GpuContext, width: u32, height: u32, transparency: ViewTransparency) -> Self {
         let size = wgpu::Extent3d {
             width,
             height,
@@ -469,6 +490,24 @@ impl EnvViewTargets {
                 DEPTH_FORMAT,
                 wgpu::TextureUsages::RENDER_ATTACHMENT,
             ),
+            coverage: gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("env coverage"),
+                size: match transparency {
+                    ViewTransparency::Opaque => size,
+                    ViewTransparency::Occupancy { .. } => wgpu::Extent3d {
+                        width: 1,
+                        height: 1,
+                        depth_or_array_layers: 1,
+                    },
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: gpu.hdr_format(),
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            }),
         }
     }
 
@@ -482,6 +521,7 @@ impl EnvViewTargets {
             ("env single target".into(), bytes(&self.single)),
             ("env multiple target".into(), bytes(&self.multiple)),
             ("env depth".into(), bytes(&self.depth)),
+            ("env coverage".into(), bytes(&self.coverage)),
         ]
     }
 }
@@ -549,6 +589,16 @@ impl EnvViewPass {
                 uniform_entry(0, fragment),
                 storage_entry(1, fragment, true),
                 storage_entry(2, fragment, false),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 3,
+                    visibility: fragment,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
             ],
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -566,53 +616,57 @@ impl EnvViewPass {
             bind_group_layouts: &[Some(&strand_layout), None, None, Some(&view_layout)],
             immediate_size: 0,
         });
-        let visibility =
-            ViewVisibilityPass::new(device, &shader, &visibility_layout, gpu.hdr_format());
-        let premultiplied_over = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
-            operation: wgpu::BlendOperation::Add,
-        };
+        // The coverage pass writes the texture group 3 reads: it binds the strands alone.
+        let strands_only = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("view coverage"),
+            bind_group_layouts: &[Some(&strand_layout)],
+            immediate_size: 0,
+        });
+        let visibility = ViewVisibilityPass::new(
+            device,
+            &shader,
+            &visibility_layout,
+            &strands_only,
+            gpu.hdr_format(),
+        );
         let additive = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,
             dst_factor: wgpu::BlendFactor::One,
             operation: wgpu::BlendOperation::Add,
         };
-        let view_pipeline = |label: &str, entry: &str, blend: wgpu::BlendComponent, depth| {
-            let target = Some(wgpu::ColorTargetState {
-                format: gpu.hdr_format(),
-                blend: Some(wgpu::BlendState {
-                    color: blend,
-                    alpha: blend,
-                }),
-                write_mask: wgpu::ColorWrites::ALL,
-            });
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&layout),
-                vertex: wgpu::VertexState {
-                    module: &shader,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                fragment: Some(wgpu::FragmentState {
-                    module: &shader,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    targets: &[target.clone(), target],
-                }),
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: depth,
-                multisample: Default::default(),
-                multiview_mask: None,
-                cache: None,
-            })
-        };
+        let view_pipeline =
+            |label: &str, entry: &str, blend: Option<wgpu::BlendComponent>, depth| {
+                let target = Some(wgpu::ColorTargetState {
+                    format: gpu.hdr_format(),
+                    blend: blend.map(|b| wgpu::BlendState { color: b, alpha: b }),
+                    write_mask: wgpu::ColorWrites::ALL,
+                });
+                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                    label: Some(label),
+                    layout: Some(&layout),
+                    vertex: wgpu::VertexState {
+                        module: &shader,
+                        entry_point: Some("vs_main"),
+                        compilation_options: Default::default(),
+                        buffers: &[],
+                    },
+                    fragment: Some(wgpu::FragmentState {
+                        module: &shader,
+                        entry_point: Some(entry),
+                        compilation_options: Default::default(),
+                        targets: &[target.clone(), target],
+                    }),
+                    primitive: wgpu::PrimitiveState {
+                        topology: wgpu::PrimitiveTopology::TriangleList,
+                        cull_mode: None,
+                        ..Default::default()
+                    },
+                    depth_stencil: depth,
+                    multisample: Default::default(),
+                    multiview_mask: None,
+                    cache: None,
+                })
+            };
         // After the depth prepass only the nearest fragments are at an Equal depth; nothing
         // writes depth, so early depth testing rejects the rest before the fragment shader.
         let nearest_only = wgpu::DepthStencilState {
@@ -622,14 +676,19 @@ impl EnvViewPass {
             stencil: Default::default(),
             bias: Default::default(),
         };
+        // Fragments tied at the nearest depth (segment joints) replace, not add to, each other.
         let opaque = view_pipeline(
             "env view (opaque)",
             "fs_env_opaque",
-            premultiplied_over,
+            None,
             Some(nearest_only),
         );
-        let transparent =
-            view_pipeline("env view (occupancy)", "fs_env_transparent", additive, None);
+        let transparent = view_pipeline(
+            "env view (occupancy)",
+            "fs_env_transparent",
+            Some(additive),
+            None,
+        );
         let compute = wgpu::ShaderStages::COMPUTE;
         let float_texture = |binding| wgpu::BindGroupLayoutEntry {
             binding,

@@ -10,7 +10,8 @@
 //
 // Two fragment entry points, one per view transparency (view_visibility.rs):
 //   fs_env_opaque:      after a depth prepass, only the nearest fragments pass the depth test
-//                       (Equal); each is weighted by its coverage and blended "over".
+//                       (Equal); the nearest fiber's radiance stands for the pixel's, weighted
+//                       by the coverage of all its fibers, 1 − exp(−Σ τ).
 //   fs_env_transparent: every fragment is weighted by coverage × its visibility through the
 //                       fragments in front (the occupancy map) and added; fragments that can no
 //                       longer contribute stop before any light is evaluated (early termination).
@@ -57,6 +58,8 @@ struct ViewParams {
 @group(3) @binding(0) var<uniform> view: ViewParams;
 @group(3) @binding(1) var<storage, read> grid_values: array<vec4<f32>>;
 @group(3) @binding(2) var<storage, read_write> occupancy_map: array<atomic<u32>>;
+// Red: the optical depth Σ −ln(1 − α) of all the pixel's fragments (opaque view).
+@group(3) @binding(3) var coverage: texture_2d<f32>;
 
 struct TableCell {
     lower: u32,
@@ -198,7 +201,8 @@ fn shade(in: VertexOut, weight: f32) -> EnvOut {
 // No side effects here: the depth test may then run before the shader.
 @fragment
 fn fs_env_opaque(in: VertexOut) -> EnvOut {
-    return shade(in, in.alpha);
+    let tau = textureLoad(coverage, vec2<i32>(in.clip.xy), 0).r;
+    return shade(in, 1.0 - exp(-tau));
 }
 
 @fragment

@@ -139,6 +139,7 @@ impl OccupancyMap {
 /// fragments the view pass shades (the depth prepass's Equal test needs bit-identical depths).
 pub struct ViewVisibilityPass {
     depth_prepass: wgpu::RenderPipeline,
+    coverage: wgpu::RenderPipeline,
     range: wgpu::RenderPipeline,
     slices: wgpu::RenderPipeline,
     count_rasterized: wgpu::RenderPipeline,
@@ -147,37 +148,38 @@ pub struct ViewVisibilityPass {
 }
 
 impl ViewVisibilityPass {
-    /// `layout` binds the strands at group 0 and the view group at group 3; `count_format` is
-    /// the (blendable) format of the counts target.
+    /// `layout` binds the strands at group 0 and the view group at group 3, `strands_only` the
+    /// strands alone; `float_format` is the (blendable) format of the coverage and count targets.
     pub fn new(
         device: &wgpu::Device,
         module: &wgpu::ShaderModule,
         layout: &wgpu::PipelineLayout,
-        count_format: wgpu::TextureFormat,
+        strands_only: &wgpu::PipelineLayout,
+        float_format: wgpu::TextureFormat,
     ) -> Self {
         let additive = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,
             dst_factor: wgpu::BlendFactor::One,
             operation: wgpu::BlendOperation::Add,
         };
-        let count_target = [Some(wgpu::ColorTargetState {
-            format: count_format,
+        let float_target = [Some(wgpu::ColorTargetState {
+            format: float_format,
             blend: Some(wgpu::BlendState {
                 color: additive,
                 alpha: additive,
             }),
             write_mask: wgpu::ColorWrites::ALL,
         })];
+        // A fragment entry point writes the additive float target; `depth`: the depth test and
+        // whether it writes, None without a depth attachment.
         let pipeline = |label: &str,
+                        layout: &wgpu::PipelineLayout,
                         fragment: Option<&str>,
-                        compare: wgpu::CompareFunction,
-                        depth_write: bool| {
-            let targets: &[Option<wgpu::ColorTargetState>] =
-                if fragment.is_some_and(|f| f.starts_with("fs_count")) {
-                    &count_target
-                } else {
-                    &[]
-                };
+                        depth: Option<(wgpu::CompareFunction, bool)>| {
+            let targets: &[Option<wgpu::ColorTargetState>] = match fragment {
+                Some(f) if f.starts_with("fs_count") || f == "fs_coverage" => &float_target,
+                _ => &[],
+            };
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
                 layout: Some(layout),
@@ -198,9 +200,9 @@ impl ViewVisibilityPass {
                     cull_mode: None,
                     ..Default::default()
                 },
-                depth_stencil: Some(wgpu::DepthStencilState {
+                depth_stencil: depth.map(|(compare, write)| wgpu::DepthStencilState {
                     format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(depth_write),
+                    depth_write_enabled: Some(write),
                     depth_compare: Some(compare),
                     stencil: Default::default(),
                     bias: Default::default(),
@@ -211,33 +213,22 @@ impl ViewVisibilityPass {
             })
         };
         use wgpu::CompareFunction::{Always, Equal, Less};
+        let reading =
+            |label, entry, compare| pipeline(label, layout, Some(entry), Some((compare, false)));
         Self {
-            depth_prepass: pipeline("view depth prepass", None, Less, true),
-            range: pipeline(
-                "occupancy depth range",
-                Some("fs_occupancy_range"),
-                Always,
-                false,
-            ),
-            slices: pipeline(
-                "occupancy slices",
-                Some("fs_occupancy_slices"),
-                Always,
-                false,
-            ),
-            count_rasterized: pipeline(
-                "count rasterized",
-                Some("fs_count_rasterized"),
-                Always,
-                false,
-            ),
-            count_nearest: pipeline("count nearest", Some("fs_count_nearest"), Equal, false),
-            count_visible: pipeline("count visible", Some("fs_count_visible"), Always, false),
+            depth_prepass: pipeline("view depth prepass", strands_only, None, Some((Less, true))),
+            coverage: pipeline("view coverage", strands_only, Some("fs_coverage"), None),
+            range: reading("occupancy depth range", "fs_occupancy_range", Always),
+            slices: reading("occupancy slices", "fs_occupancy_slices", Always),
+            count_rasterized: reading("count rasterized", "fs_count_rasterized", Always),
+            count_nearest: reading("count nearest", "fs_count_nearest", Equal),
+            count_visible: reading("count visible", "fs_count_visible", Always),
         }
     }
 
-    /// Encodes the frame's build: the depth prepass into `depth` (opaque, kept for the view
-    /// passes), or the occupancy map zeroed and its two passes. `view` must bind `map`.
+    /// Encodes the frame's build: the depth prepass into `depth` and the coverage into
+    /// `coverage` (opaque, both kept for the view passes), or the occupancy map zeroed and its
+    /// two passes. `view` must bind `map`.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -246,28 +237,58 @@ impl ViewVisibilityPass {
         strands: &wgpu::BindGroup,
         view: &wgpu::BindGroup,
         depth: &wgpu::TextureView,
+        coverage: &wgpu::TextureView,
         map: &OccupancyMap,
         segments: u32,
     ) {
-        let passes: &[&wgpu::RenderPipeline] = match transparency {
-            ViewTransparency::Opaque => &[&self.depth_prepass],
+        // (label, colour target, with the depth attachment, pipeline, binds group 3).
+        let passes: Vec<(
+            &str,
+            Option<&wgpu::TextureView>,
+            bool,
+            &wgpu::RenderPipeline,
+            bool,
+        )> = match transparency {
+            ViewTransparency::Opaque => vec![
+                ("view depth prepass", None, true, &self.depth_prepass, false),
+                (
+                    "view coverage",
+                    Some(coverage),
+                    false,
+                    &self.coverage,
+                    false,
+                ),
+            ],
             ViewTransparency::Occupancy { .. } => {
                 encoder.clear_buffer(&map.buffer, 0, None);
-                &[&self.range, &self.slices]
+                vec![
+                    ("occupancy depth range", None, true, &self.range, true),
+                    ("occupancy slices", None, true, &self.slices, true),
+                ]
             }
         };
-        for pipeline in passes {
+        for (label, color, with_depth, pipeline, bind_view) in passes {
+            let color_attachments = match color {
+                Some(c) => vec![cleared_color(c)],
+                None => vec![],
+            };
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("view visibility"),
-                color_attachments: &[],
-                depth_stencil_attachment: cleared_depth(depth, true),
+                label: Some(label),
+                color_attachments: &color_attachments,
+                depth_stencil_attachment: if with_depth {
+                    cleared_depth(depth, true)
+                } else {
+                    None
+                },
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, strands, &[]);
-            pass.set_bind_group(3, view, &[]);
+            if bind_view {
+                pass.set_bind_group(3, view, &[]);
+            }
             pass.draw(0..6, 0..segments);
         }
     }

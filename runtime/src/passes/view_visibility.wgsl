@@ -2,6 +2,13 @@
 // the transparent view pass. Appended to the env view module (env_view.wgsl declares
 // `occupancy_map` and `view`) so that the build rasterizes exactly the view pass's fragments.
 
+// Opaque view: the optical depth of all of a pixel's fragments (additive blending). Capped so
+// that one opaque fiber covers its pixel to 1e-6, not to the light pass's 0.999.
+@fragment
+fn fs_coverage(in: VertexOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(-log(max(1.0 - in.alpha, 1e-6)), 0.0, 0.0, 0.0);
+}
+
 // Pass 1: the nearest and farthest view depth of each pixel's fragments.
 @fragment
 fn fs_occupancy_range(in: VertexOut) {
