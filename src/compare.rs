@@ -439,7 +439,7 @@ mod tests {
                 if (w / 4..3 * w / 4).contains(&x) && (h / 4..3 * h / 4).contains(&y) { [total[0], total[1], total[2], 1.0] } else { [0.0; 4] }
             })
             .collect();
-        Ok(RenderedEnv { image: Image::new(w, h, pixels), milliseconds: 1.0 + 0.01 * frame.lights.len() as f64, passes: Vec::new(), fragments: None })
+        Ok(RenderedEnv { image: Image::new(w, h, pixels), milliseconds: 1.0 + 0.01 * frame.lights.len() as f64, passes: Vec::new(), fragments: None, memory_per_batch: Vec::new() })
     }
 
     #[test]

@@ -307,6 +307,8 @@ pub struct RenderedEnv {
     pub passes: Vec<(String, f64)>,
     /// With [`EnvLook::count_fragments`].
     pub fragments: Option<FragmentCounts>,
+    /// GPU memory held while one batch renders, per resource (bytes); empty for stand-ins.
+    pub memory_per_batch: Vec<(String, u64)>,
 }
 
 /// The GPU device and the renderer's pipelines, created on first use and kept for every frame
@@ -407,6 +409,7 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
         milliseconds: frame_milliseconds(&out.stats),
         passes: out.stats.timings.iter().map(|t| (t.pass.clone(), t.milliseconds)).collect(),
         fragments: out.stats.fragments,
+        memory_per_batch: out.stats.memory_per_batch.clone(),
         image: Image { width: out.width, height: out.height, pixels: out.pixels },
     })
 }

@@ -494,6 +494,8 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
             "transparency": look_args.transparency,
             "box_average": look_args.box_average,
             "visibility_cutoff": args.visibility_cutoff,
+            "memory_per_batch_bytes": rendered.memory_per_batch.iter().map(|(n, b)| (n.clone(), serde_json::json!(b))).collect::<serde_json::Map<_, _>>(),
+            "memory_per_batch_total_bytes": rendered.memory_per_batch.iter().map(|(_, b)| b).sum::<u64>(),
             "fragments": rendered.fragments.map(|f| serde_json::json!({ "rasterized": f.rasterized, "shaded": f.shaded, "note": "per batch (each batch draws the same fragments)" })),
             "pass_ms": rendered.passes.iter().map(|(n, ms)| (n.clone(), serde_json::json!(ms))).collect::<serde_json::Map<_, _>>(),
             "timing_method": "CPU wall clock around submit + wait for idle, summed over batches",
@@ -502,6 +504,8 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
         });
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
+        let memory: u64 = rendered.memory_per_batch.iter().map(|(_, b)| b).sum();
+        steps.say(format!("GPU memory per batch of {} lights: {:.1} MB (--json lists it per resource)", strandlight_runtime::passes::convolution_depth::DodmSettings::default().batch_size, memory as f64 / 1e6));
         steps.say(format!("wrote {} and {}", exr_path.display(), png_path.display()));
     }
     Ok(())
