@@ -33,6 +33,10 @@ pub struct CompareArgs {
     /// Most SRBF lobes the fit may use.
     #[arg(long, default_value_t = 64)]
     pub lobes: usize,
+    /// Most compact bright sources (suns, lamps) the fit takes out as directional lights
+    /// rendered beside the SRBFs; 0: SRBFs alone, as the paper.
+    #[arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().max_sources)]
+    pub sources: usize,
     /// Image size WxH (the paper's 640x480).
     #[arg(long, default_value = "640x480")]
     pub size: String,
@@ -101,8 +105,11 @@ pub struct CompareScene {
     pub map: strandlight_precompute::EnvMap,
     pub map_sha256: String,
     pub fiber: FiberDescription,
-    /// The fit's relative L2 error against the map (what the SRBF path starts from).
+    /// The fit's relative L2 error against the map without its compact sources (what the SRBF
+    /// path starts from).
     pub fit_relative_l2_error: f64,
+    /// The compact sources the fit took out (rendered as directional lights in the SRBF frame).
+    pub compact_sources: Vec<strandlight_precompute::compact_sources::CompactSource>,
 }
 
 fn validate(args: &CompareArgs) -> anyhow::Result<usize> {
@@ -144,16 +151,14 @@ pub fn prepare_with_hair(args: &CompareArgs, hair: HairModel, hair_sha256: Strin
     let (width, height) = crate::render::parse_size(&args.size)?;
     let fiber = FiberDescription::preset(&args.preset).with_context(|| format!("--preset {:?}", args.preset))?;
     let env = steps.run("environment", || load_env(&args.env, args.sanitize), |e| format!("{} {}x{}", e.name, e.map.width(), e.map.height()))?;
-    let options = FitOptions { max_lobes: args.lobes, initial_lobes: args.lobes.min(FitOptions::default().initial_lobes), rotate_degrees: args.rotate, ..FitOptions::default() };
+    let sources = strandlight_precompute::compact_sources::SourceOptions { max_sources: args.sources, ..Default::default() };
+    let options = FitOptions { max_lobes: args.lobes, initial_lobes: args.lobes.min(FitOptions::default().initial_lobes), rotate_degrees: args.rotate, sources, ..FitOptions::default() };
     let fit = steps.run("fit", || fit_cached(&env, &options, &args.cache), |f| {
-        format!("{} SRBFs, relative L2 error {:.3}{} → {}", f.set.lobes.len(), f.set.relative_l2_error, if f.cached { " (cached)" } else { "" }, f.path.display())
+        format!("{}{} → {}", crate::env_scene::fit_summary(&f.set), if f.cached { " (cached)" } else { "" }, f.path.display())
     })?;
     let lambda_range = crate::tables_cmd::lambda_range_of_set(&fit.set)?;
     let resolution = args.table_resolution.map(BakeResolution::reduced).unwrap_or_default();
-    let mut wanted: Vec<&str> = MULTIPLE_TABLES.to_vec();
-    for &mode in &args.modes {
-        wanted.extend([args.shading.srbf_table(mode), args.shading.direct_table(mode)]);
-    }
+    let wanted = crate::env_scene::wanted_tables(args.shading, &args.modes, true);
     let table_dir = args.cache.join("tables").join(format!("{}-{:?}", args.preset, args.shading).to_lowercase());
     let tables = steps.run(
         "bake",
@@ -169,7 +174,7 @@ pub fn prepare_with_hair(args: &CompareArgs, hair: HairModel, hair_sha256: Strin
         |r: &Vec<EnvLight>| format!("{} cube-texel directional lights ({face_resolution}×{face_resolution}×6)", r.len()),
     )?;
     let fit_relative_l2_error = fit.set.relative_l2_error;
-    Ok(CompareScene { hair, hair_sha256, camera, up, size: (width, height), tables, srbf, reference, map: env.map, map_sha256: env.sha256, fiber, fit_relative_l2_error })
+    Ok(CompareScene { hair, hair_sha256, camera, up, size: (width, height), tables, srbf, reference, map: env.map, map_sha256: env.sha256, fiber, fit_relative_l2_error, compact_sources: fit.set.sources.clone() })
 }
 
 /// The function that renders a frame: [`render_lights`] in the program, a stand-in in tests.
@@ -380,7 +385,9 @@ pub fn execute(args: &CompareArgs, scene: &CompareScene, steps: &mut Steps, rend
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
             "preset": args.preset, "kappa": args.kappa, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "transparency": args.look.transparency, "visibility_cutoff": args.look.visibility_cutoff, "box_average": args.look.box_average,
             "fit_relative_l2_error": scene.fit_relative_l2_error,
+            "compact_sources": scene.compact_sources,
         }),
     );
     report.insert("steps".into(), json!(steps.done.iter().map(|(n, s, note)| json!({"step": n, "seconds": s, "note": note})).collect::<Vec<_>>()));

@@ -14,7 +14,7 @@ pub struct CompareTableArgs {
     pub reports: Vec<PathBuf>,
 }
 
-const HEADER: &str = "| map | fit L2 err | mode | SRBF lights | SRBF ms | SRBF rel. RMSE | baseline lights | baseline ms | baseline rel. RMSE | reference lights | reference ms | speed-up vs reference | equal-error baseline lights | speed-up at equal error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
+const HEADER: &str = "| map | fit L2 err | mode | SRBF lights (+ compact sources) | SRBF ms | SRBF rel. RMSE | baseline lights | baseline ms | baseline rel. RMSE | reference lights | reference ms | speed-up vs reference | equal-error baseline lights | speed-up at equal error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
 
 fn number(v: &Value, path: &[&str], file: &Path) -> anyhow::Result<f64> {
     let mut at = v;
@@ -50,9 +50,15 @@ pub fn rows(report: &Value, file: &Path) -> anyhow::Result<Vec<String>> {
                 }
             }
         };
+        // "N + k sun": N SRBFs and k compact sources rendered as directional lights.
+        let sources = report["scene"]["compact_sources"].as_array().map_or(0, |s| s.len());
+        let srbf_lights = n(&["srbf", "lights"])? as usize;
+        let srbf_lights = match sources {
+            0 => srbf_lights.to_string(),
+            k => format!("{} + {k} src", srbf_lights - k),
+        };
         out.push(format!(
-            "| {name} | {fit_error} | {mode} | {:.0} | {:.0} | {:.4} | {:.0} | {:.0} | {:.4} | {:.0} | {:.0} | {:.1}× | {equal_lights} | {equal_speedup} |",
-            n(&["srbf", "lights"])?,
+            "| {name} | {fit_error} | {mode} | {srbf_lights} | {:.0} | {:.4} | {:.0} | {:.0} | {:.4} | {:.0} | {:.0} | {:.1}× | {equal_lights} | {equal_speedup} |",
             n(&["srbf", "ms"])?,
             n(&["srbf", "relative_rmse"])?,
             n(&["baseline", "lights"])?,

@@ -5,7 +5,7 @@
 
 use crate::env_lights::to_env_lights;
 use strandlight_runtime::env::EnvRenderOptions;
-use crate::env_scene::{FrameRole, bake_scene_tables, fit_cached, load_env, render_lights, EnvFrame, EnvShading, ScatteringMode, MULTIPLE_TABLES};
+use crate::env_scene::{FrameRole, bake_scene_tables, fit_cached, load_env, render_lights, EnvFrame, EnvShading, ScatteringMode};
 use crate::steps::Steps;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
@@ -64,12 +64,11 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let hair = steps.run("groom", || Ok(generate_groom(&GroomParams::default())?), |h| format!("procedural groom, {} strands", h.strand_count()))?;
     let cache = Path::new(CACHE_DIR);
     let fit = steps.run("fit", || fit_cached(&env, &FitOptions::default(), cache), |f| {
-        format!("{} SRBFs, relative L2 error {:.3}{}", f.set.lobes.len(), f.set.relative_l2_error, if f.cached { " (cached)" } else { "" })
+        format!("{}{}", crate::env_scene::fit_summary(&f.set), if f.cached { " (cached)" } else { "" })
     })?;
     let fiber = FiberDescription::preset(DEMO_PRESET)?;
     let shading = EnvShading::Marschner;
-    let mut wanted: Vec<&str> = MULTIPLE_TABLES.to_vec();
-    wanted.extend([shading.srbf_table(ScatteringMode::Single), shading.srbf_table(ScatteringMode::Full)]);
+    let wanted = crate::env_scene::wanted_tables(shading, &[ScatteringMode::Single, ScatteringMode::Full], !fit.set.sources.is_empty());
     let lambda_range = crate::tables_cmd::lambda_range_of_set(&fit.set)?;
     let table_dir = cache.join("tables").join("demo");
     let tables = steps.run(

@@ -233,6 +233,36 @@ impl EnvShading {
 /// The tables multiple scattering reads (the first is absent for hair too dark to need it).
 pub const MULTIPLE_TABLES: [&str; 4] = ["multiple", "fiber_averages", "attenuation_ratio", "srbf_spread"];
 
+/// The tables a frame in any of `modes` may read: the multiple-scattering tables, the SRBF
+/// tables and, with `directional` lights (baselines, references, a fit's compact sources), the
+/// direct tables.
+pub fn wanted_tables(shading: EnvShading, modes: &[ScatteringMode], directional: bool) -> Vec<&'static str> {
+    let mut wanted: Vec<&str> = MULTIPLE_TABLES.to_vec();
+    for &mode in modes {
+        wanted.push(shading.srbf_table(mode));
+        if directional {
+            wanted.push(shading.direct_table(mode));
+        }
+    }
+    wanted.dedup();
+    wanted
+}
+
+/// "N SRBFs + k compact sources (x% of the power), relative L2 error e" for a fitted set.
+pub fn fit_summary(set: &SrbfSet) -> String {
+    let sources = match set.sources.len() {
+        0 => String::new(),
+        n => format!(
+            " + {n} compact source{} as directional light{} ({:.0}% of the power)",
+            if n == 1 { "" } else { "s" },
+            if n == 1 { "" } else { "s" },
+            100.0 * set.sources.iter().map(|s| s.power_share).sum::<f64>()
+        ),
+    };
+    let without = if set.sources.is_empty() { "" } else { " (of the rest)" };
+    format!("{} SRBFs{sources}, relative L2 error {:.3}{without}", set.lobes.len(), set.relative_l2_error)
+}
+
 /// Loaded tables by name, each checked against the fiber parameters it was asked for.
 pub struct SceneTables {
     pub assets: BTreeMap<String, TableAsset>,
@@ -351,7 +381,8 @@ pub enum FrameRole {
 }
 
 fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
-    let srbf = frame.lights.iter().all(|l| l.lambda.is_some());
+    // κ thins the SRBF lights' light passes (the runtime never thins a directional light's).
+    let srbf = frame.lights.iter().any(|l| l.lambda.is_some());
     let kappa = match frame.role {
         FrameRole::Interactive { kappa } if srbf => kappa,
         _ => 1.0,
@@ -375,13 +406,15 @@ fn forward_scattering(frame: &EnvFrame) -> anyhow::Result<CpuForwardScattering> 
     Ok(CpuForwardScattering::new(frame.hair, tables, forward_settings(frame.role))?)
 }
 
-/// The runtime's tables for `frame`: the SRBF or direct table of its mode, and in full mode I_G.
+/// The runtime's tables for `frame`: the SRBF table of its mode for SRBF lights, the direct
+/// table for directional ones (the baselines, the reference, a fit's compact sources), and in
+/// full mode I_G.
 fn env_tables(frame: &EnvFrame) -> anyhow::Result<EnvTables> {
-    let srbf = frame.lights.iter().all(|l| l.lambda.is_some());
     let mut tables = EnvTables::default();
-    if srbf {
+    if frame.lights.iter().any(|l| l.lambda.is_some()) {
         tables.srbf = Some(frame.tables.get(frame.shading.srbf_table(frame.mode))?.table.clone());
-    } else {
+    }
+    if frame.lights.iter().any(|l| l.lambda.is_none()) {
         tables.direct = Some(frame.tables.get(frame.shading.direct_table(frame.mode))?.table.clone());
     }
     if frame.mode == ScatteringMode::Full {

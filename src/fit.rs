@@ -32,6 +32,17 @@ pub struct FitArgs {
     /// Rotate the environment about +Y (up) by this many degrees.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub rotate: f64,
+    /// Most compact bright sources (suns, lamps) taken out as directional lights before the
+    /// fit; 0 fits SRBFs alone, as the paper.
+    #[arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().max_sources)]
+    pub sources: usize,
+    /// Angular radius of a compact source, degrees.
+    #[arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().radius_degrees)]
+    pub source_radius: f64,
+    /// Least share of the (remaining) map's squared norm Σ w‖L‖² a compact source must hold
+    /// above its surroundings.
+    #[arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().min_norm_share)]
+    pub source_min_share: f64,
     /// Replace NaN/negative values by 0 and +Inf by the largest finite value instead of refusing.
     #[arg(long)]
     pub sanitize: bool,
@@ -84,6 +95,11 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
         lambda_max: args.lambda_max,
         grid_width: args.grid_width,
         rotate_degrees: args.rotate,
+        sources: strandlight_precompute::compact_sources::SourceOptions {
+            max_sources: if args.directional.is_some() { 0 } else { args.sources },
+            radius_degrees: args.source_radius,
+            min_norm_share: args.source_min_share,
+        },
         ..FitOptions::default()
     };
     let source = Source {
@@ -126,6 +142,12 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
             .with_context(|| format!("writing {}", png.display()))?;
         eprintln!("preview: {} (tonemap: {})", png.display(), preview::TONEMAP);
     }
+    for s in &set.sources {
+        eprintln!(
+            "compact source toward ({:.4}, {:.4}, {:.4}): power {:.4e} {:.4e} {:.4e} ({:.1}% of the map's), a directional light",
+            s.direction[0], s.direction[1], s.direction[2], s.power[0], s.power[1], s.power[2], 100.0 * s.power_share
+        );
+    }
     eprintln!(
         "{}: {} {} lights, relative L2 error {:.4}, relative MSE {:.4} (full resolution {:.4}), {:.2} s → {}",
         name,
@@ -146,6 +168,7 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
             "source": set.source,
             "kind": set.kind,
             "lobes": set.lobes.len(),
+            "sources": set.sources,
             "relative_l2_error": set.relative_l2_error,
             "relative_mse": set.relative_mse,
             "full_resolution_relative_mse": set.full_resolution_relative_mse,

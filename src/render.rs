@@ -435,7 +435,7 @@ mod tests {
 
 /// `render --env MAP`: the SRBF path alone (fit and tables cached under out/cache).
 fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
-    use crate::env_scene::{bake_scene_tables, fit_cached, load_env, render_lights, EnvFrame, EnvShading, FrameRole, ScatteringMode, MULTIPLE_TABLES};
+    use crate::env_scene::{bake_scene_tables, fit_cached, load_env, render_lights, EnvFrame, EnvShading, FrameRole, ScatteringMode};
     use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
     use strandlight_precompute::env_lights::srbf_set_lights;
     let shading = match args.shading.unwrap_or(Shading::Marschner) {
@@ -457,10 +457,9 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
     let (model, source) = steps.run("hair", || load_hair(args.hair.as_deref()), |(m, s)| format!("{s} ({} strands)", m.strand_count()))?;
     let env = steps.run("environment", || load_env(env_spec, false), |e| format!("{} {}x{}", e.name, e.map.width(), e.map.height()))?;
     let cache = Path::new("out/cache");
-    let fit = steps.run("fit", || fit_cached(&env, &strandlight_precompute::FitOptions::default(), cache), |f| format!("{} SRBFs{}", f.set.lobes.len(), if f.cached { " (cached)" } else { "" }))?;
+    let fit = steps.run("fit", || fit_cached(&env, &strandlight_precompute::FitOptions::default(), cache), |f| format!("{}{}", crate::env_scene::fit_summary(&f.set), if f.cached { " (cached)" } else { "" }))?;
     let fiber = FiberDescription::preset(&args.preset).with_context(|| format!("--preset {:?}", args.preset))?;
-    let mut wanted: Vec<&str> = MULTIPLE_TABLES.to_vec();
-    wanted.push(shading.srbf_table(args.scattering));
+    let wanted = crate::env_scene::wanted_tables(shading, &[args.scattering], !fit.set.sources.is_empty());
     let lambda_range = crate::tables_cmd::lambda_range_of_set(&fit.set)?;
     let dir = cache.join("tables").join(format!("{}-{:?}", args.preset, shading).to_lowercase());
     let tables = steps.run("bake", || bake_scene_tables(&fiber, shading, BakeResolution::default(), lambda_range, &wanted, &dir, &mut |_| {}), |t| format!("{} tables ({} cached)", t.baked.len(), t.baked.iter().filter(|b| b.cached).count()))?;

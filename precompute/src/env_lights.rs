@@ -47,14 +47,14 @@ pub fn total_power(lights: &[LightSpec]) -> [f64; 3] {
 /// The lights of a fitted set. A set of kind `directional` (the median-cut baseline saved by
 /// `fit --directional`, stored as very narrow lobes) becomes directional lights carrying each
 /// lobe's power.
+/// The set's compact sources follow as directional lights carrying their power.
 pub fn srbf_set_lights(set: &SrbfSet) -> Vec<LightSpec> {
-    set.lobes
-        .iter()
-        .map(|l| match set.kind {
-            LightKind::Srbf => LightSpec { direction: l.center().normalize(), lambda: Some(l.lambda), rgb: l.amplitude },
-            LightKind::Directional => LightSpec { direction: l.center().normalize(), lambda: None, rgb: crate::srbf_set::power(l) },
-        })
-        .collect()
+    let lobes = set.lobes.iter().map(|l| match set.kind {
+        LightKind::Srbf => LightSpec { direction: l.center().normalize(), lambda: Some(l.lambda), rgb: l.amplitude },
+        LightKind::Directional => LightSpec { direction: l.center().normalize(), lambda: None, rgb: crate::srbf_set::power(l) },
+    });
+    let sources = set.sources.iter().map(|s| LightSpec { direction: DVec3::from(s.direction).normalize(), lambda: None, rgb: s.power });
+    lobes.chain(sources).collect()
 }
 
 fn directional(lights: Vec<DirectionalLight>, rotate_degrees: f64) -> Vec<LightSpec> {

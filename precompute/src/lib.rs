@@ -18,6 +18,7 @@ pub mod attenuation_ratio;
 pub mod bake;
 pub mod bake_plan;
 pub mod check_tables;
+pub mod compact_sources;
 pub mod convolution;
 pub mod convolution_table;
 pub mod cube_lights;

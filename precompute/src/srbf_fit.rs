@@ -64,6 +64,11 @@ pub struct FitOptions {
     /// integrates light, so power matters more than the last digits of the L2 error.
     #[serde(default = "default_true")]
     pub preserve_power: bool,
+    /// Compact bright sources (suns, lamps) taken out as directional lights before the fit
+    /// ([`crate::compact_sources`]); `max_sources = 0` is the paper's pure SRBF fit. Applied by
+    /// [`crate::SrbfSet::fit`]; [`fit`] fits the map it is given.
+    #[serde(default)]
+    pub sources: crate::compact_sources::SourceOptions,
 }
 
 fn default_true() -> bool {
@@ -83,6 +88,7 @@ impl Default for FitOptions {
             final_iterations: 100,
             rotate_degrees: 0.0,
             preserve_power: true,
+            sources: Default::default(),
         }
     }
 }
@@ -129,6 +135,24 @@ impl FitOptions {
             "must be ≤ grid_width²/64 (a narrower lobe falls between the fit grid's pixels; raise the grid width)",
         )?;
         check("rotate", self.rotate_degrees, |_| true, "")?;
+        check(
+            "max_sources",
+            self.sources.max_sources as f64,
+            |v| v <= 64.0,
+            "must be in [0, 64]",
+        )?;
+        check(
+            "source_radius_degrees",
+            self.sources.radius_degrees,
+            |v| v > 0.0 && v <= 20.0,
+            "must be in (0, 20]",
+        )?;
+        check(
+            "source_min_norm_share",
+            self.sources.min_norm_share,
+            |v| v > 0.0 && v <= 1.0,
+            "must be in (0, 1]",
+        )?;
         Ok(())
     }
 }

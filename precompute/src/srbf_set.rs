@@ -7,6 +7,7 @@
 //! light's power (∫ L dω of its region), so one format serves both; a renderer that wants delta
 //! lights uses `power()` and the center.
 
+use crate::compact_sources::CompactSource;
 use crate::envmap::BadPixelCounts;
 use crate::srbf_fit::{FitOptions, RoundRecord};
 use serde::{Deserialize, Serialize};
@@ -31,6 +32,10 @@ pub struct SrbfSet {
     pub version: u32,
     pub kind: LightKind,
     pub lobes: Vec<SrbfLobe>,
+    /// Compact sources taken out of the map before the fit, as directional lights (directions
+    /// rotated like the lobes); the lobes fit the map without them.
+    #[serde(default)]
+    pub sources: Vec<CompactSource>,
     /// The environment map's file name (no directories) and the SHA-256 of its bytes.
     pub source: String,
     pub source_sha256: String,
@@ -39,14 +44,15 @@ pub struct SrbfSet {
     pub sanitized: BadPixelCounts,
     /// Size of the prefiltered grid the errors below are measured on.
     pub fit_grid: [usize; 2],
-    /// √(Σ w‖fit − map‖² / Σ w‖map‖²) over RGB, w the pixel solid angle, on the fit grid.
+    /// √(Σ w‖fit − map‖² / Σ w‖map‖²) over RGB, w the pixel solid angle, on the fit grid; "map"
+    /// is the map without its compact [`Self::sources`] (what the lobes fit).
     pub relative_l2_error: f64,
     /// The paper's criterion: Σ w‖fit − map‖² / Σ w‖map‖² (= relative_l2_error²).
     pub relative_mse: f64,
     /// The same relative MSE against the full-resolution map (a sun narrower than the fit
     /// grid's pixels counts fully here).
     pub full_resolution_relative_mse: f64,
-    /// ∫ fit dω / ∫ map dω per channel. An L2 fit does not preserve power: a source narrower
+    /// (∫ lobes dω + Σ source power) / ∫ map dω per channel, against the whole map. An L2 fit does not preserve power: a source narrower
     /// than any allowed lobe is fitted with about twice its power (for a point source the
     /// optimal lobe carries ∫G/‖G‖² = 2× its power), so sun maps come out too bright overall.
     pub power_ratio: [f64; 3],
@@ -143,7 +149,22 @@ pub fn power(lobe: &SrbfLobe) -> [f64; 3] {
     lobe.amplitude.map(|a| a * srbf::integral(lobe.lambda))
 }
 
+/// (Σ lobe power + Σ source power) / ∫ map dω per channel.
+fn power_ratio(map: &crate::envmap::EnvMap, lobes: &[SrbfLobe], sources: &[CompactSource]) -> [f64; 3] {
+    let map_power = map.integral();
+    std::array::from_fn(|c| {
+        let fit: f64 = lobes.iter().map(|l| power(l)[c]).sum::<f64>()
+            + sources.iter().map(|s| s.power[c]).sum::<f64>();
+        if map_power[c] > 0.0 {
+            fit / map_power[c]
+        } else {
+            0.0
+        }
+    })
+}
+
 /// What a light set was made from.
+#[derive(Clone)]
 pub struct Source<'a> {
     pub map: &'a crate::envmap::EnvMap,
     /// File name (no directories) or `procedural:NAME`.
@@ -164,25 +185,52 @@ pub fn unrotated(lobes: &[SrbfLobe], rotate_degrees: f64) -> Vec<SrbfLobe> {
 }
 
 impl SrbfSet {
-    /// Runs the adaptive fit and measures its error independently (direct pixel sums, on the
-    /// fit grid and on the full-resolution map).
+    /// Takes the compact sources out of the map (`options.sources`), runs the adaptive fit on
+    /// the rest and measures its error independently (direct pixel sums, on the fit grid and on
+    /// the full-resolution map without the sources).
     pub fn fit(
         source: &Source,
         options: &FitOptions,
         progress: &mut dyn FnMut(&RoundRecord),
     ) -> Result<SrbfSet, crate::srbf_fit::FitError> {
         let start = std::time::Instant::now();
-        let fit = crate::srbf_fit::fit(source.map, options, progress)?;
+        options.validate()?;
+        let (sources, residual) = crate::compact_sources::extract(source.map, &options.sources);
+        let (lobes, grid_map, history) = match crate::srbf_fit::fit(&residual, options, progress) {
+            Ok(fit) => (fit.lobes, fit.grid_map, fit.history),
+            // Nothing but the sources: no lobes.
+            Err(crate::srbf_fit::FitError::BlackMap) if !sources.is_empty() => (
+                Vec::new(),
+                residual.downsampled(options.grid_width, options.grid_width / 2),
+                Vec::new(),
+            ),
+            Err(e) => return Err(e),
+        };
         let seconds = start.elapsed().as_secs_f64();
-        Ok(Self::measured(
-            source,
+        let rotated = sources
+            .iter()
+            .map(|s| CompactSource {
+                direction: crate::envmap::rotate_about_up(s.direction.into(), options.rotate_degrees)
+                    .to_array(),
+                ..*s
+            })
+            .collect();
+        let residual_source = Source {
+            map: &residual,
+            ..source.clone()
+        };
+        let mut set = Self::measured(
+            &residual_source,
             options,
             LightKind::Srbf,
-            fit.lobes,
-            &fit.grid_map,
-            fit.history,
+            lobes,
+            &grid_map,
+            history,
             seconds,
-        ))
+        );
+        set.sources = rotated;
+        set.power_ratio = power_ratio(source.map, &set.lobes, &set.sources);
+        Ok(set)
     }
 
     /// The median-cut baseline with `count` directional lights, in the same format.
@@ -227,20 +275,13 @@ impl SrbfSet {
         let own_frame = unrotated(&lobes, options.rotate_degrees);
         let relative_mse = relative_mse_by_pixels(grid_map, &own_frame);
         let full_resolution_relative_mse = relative_mse_by_pixels(source.map, &own_frame);
-        let map_power = source.map.integral();
-        let power_ratio = std::array::from_fn(|c| {
-            let fit: f64 = lobes.iter().map(|l| power(l)[c]).sum();
-            if map_power[c] > 0.0 {
-                fit / map_power[c]
-            } else {
-                0.0
-            }
-        });
+        let power_ratio = power_ratio(source.map, &lobes, &[]);
         SrbfSet {
             format: FORMAT.into(),
             version: FORMAT_VERSION,
             kind,
             lobes,
+            sources: Vec::new(),
             source: source.name.clone(),
             source_sha256: source.sha256.clone(),
             options: options.clone(),

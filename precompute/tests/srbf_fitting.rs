@@ -3,6 +3,7 @@
 
 use glam::DVec3;
 use std::f64::consts::PI;
+use strandlight_precompute::compact_sources::SourceOptions;
 use strandlight_precompute::envmap::{EnvMap, rotate_about_up, uv_to_direction};
 use strandlight_precompute::procedural_env::{SunSky, from_srbf_lobes};
 use strandlight_precompute::srbf_fit::{FitError, FitOptions, fit};
@@ -152,10 +153,12 @@ fn independent_relative_mse(map: &EnvMap, lobes: &[SrbfLobe]) -> f64 {
 #[test]
 fn reported_errors_equal_an_independent_recomputation_and_rotation_is_consistent() {
     let map = SunSky::default().to_map(128).downsampled(64, 32);
+    // The lobes alone against the whole map: no compact source taken out.
     let options = FitOptions {
         initial_lobes: 8,
         max_lobes: 10,
         grid_width: 64,
+        sources: SourceOptions::none(),
         ..FitOptions::default()
     };
     let set = SrbfSet::fit(&source(&map), &options, &mut |_| {}).unwrap();
@@ -309,6 +312,8 @@ fn a_sun_narrower_than_any_lobe_doubles_its_power_unless_power_is_preserved() {
             target_relative_mse: 0.0,
             grid_width: 64,
             preserve_power,
+            // The SRBF fit itself: no compact source taken out first.
+            sources: SourceOptions::none(),
             ..FitOptions::default()
         };
         let set = SrbfSet::fit(&source(&map), &options, &mut |_| {}).unwrap();
@@ -335,4 +340,28 @@ fn a_sun_narrower_than_any_lobe_doubles_its_power_unless_power_is_preserved() {
     // Halving the power costs L2 error, but it must stay a fit (a black map scores 1.0).
     assert!(preserved.relative_mse >= least_squares.relative_mse - 1e-9);
     assert!(preserved.relative_mse < 1.0);
+}
+
+#[test]
+fn by_default_a_sun_is_taken_out_as_a_directional_light_with_its_power() {
+    // The map of the test above: four pixels of 1e4 on black. Its power, summed here from
+    // the pixels' exact solid angles, must come out as one source and no lobe.
+    let mut px = vec![[0.0f32; 3]; 256 * 128];
+    let mut expected = 0.0;
+    for (x, y) in [(150, 40), (151, 40), (150, 41), (151, 41)] {
+        px[y * 256 + x] = [1.0e4; 3];
+        expected += 1.0e4 * strandlight_precompute::envmap::row_solid_angle(y, 256, 128);
+    }
+    let map = EnvMap::from_pixels(256, 128, px);
+    let options = FitOptions {
+        grid_width: 64,
+        ..FitOptions::default()
+    };
+    let set = SrbfSet::fit(&source(&map), &options, &mut |_| {}).unwrap();
+    assert!(set.lobes.is_empty(), "{:?}", set.lobes);
+    assert_eq!(set.sources.len(), 1, "{:?}", set.sources);
+    for c in 0..3 {
+        assert!((set.sources[0].power[c] - expected).abs() < 1e-9 * expected);
+        assert!((set.power_ratio[c] - 1.0).abs() < 1e-9, "{:?}", set.power_ratio);
+    }
 }

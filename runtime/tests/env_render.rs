@@ -334,8 +334,17 @@ fn slab_convolution_transmittance_follows_the_cone_integral() {
         rel[4],
         rel[5]
     );
-    assert!(rel[5] < TOLERANCE, "transmittance average: relative RMSE {}", rel[5]);
-    assert!(rel[5] < rel[2], "transmittance average {} not better than the centre texel {}", rel[5], rel[2]);
+    assert!(
+        rel[5] < TOLERANCE,
+        "transmittance average: relative RMSE {}",
+        rel[5]
+    );
+    assert!(
+        rel[5] < rel[2],
+        "transmittance average {} not better than the centre texel {}",
+        rel[5],
+        rel[2]
+    );
     // The centre filter is the directional light's single texel.
     assert!((rel[2] - rel[3]).abs() < 1e-6, "{} vs {}", rel[2], rel[3]);
     for (filter, r) in filters.iter().zip(&rel).take(2) {
@@ -1121,17 +1130,29 @@ fn empty_texel_points_read_the_box_around_them() {
             }
         }
     }
-    assert!(points.len() >= 32, "only {} probe points on empty texels", points.len());
+    assert!(
+        points.len() >= 32,
+        "only {} probe points on empty texels",
+        points.len()
+    );
     let truth: Vec<f64> = points
         .iter()
         .map(|p| cone_transmittance(p.as_dvec3(), lambda as f64, rows, thickness))
         .collect();
     let norm: f64 = truth.iter().map(|t| t * t).sum();
     let rel = |v: &[f64]| {
-        (v.iter().zip(&truth).map(|(a, t)| (a - t).powi(2)).sum::<f64>() / norm).sqrt()
+        (v.iter()
+            .zip(&truth)
+            .map(|(a, t)| (a - t).powi(2))
+            .sum::<f64>()
+            / norm)
+            .sqrt()
     };
     let unlit = rel(&vec![1.0; points.len()]);
-    for filter in [TransmittanceFilter::PaperSupport, TransmittanceFilter::MatchedVariance] {
+    for filter in [
+        TransmittanceFilter::PaperSupport,
+        TransmittanceFilter::MatchedVariance,
+    ] {
         let binding = BatchBinding::with_filter(
             &gpu,
             &probe.batch_layout,
@@ -1157,4 +1178,74 @@ fn empty_texel_points_read_the_box_around_them() {
         );
         assert!(rel(&t) < unlit, "{filter:?}: {} vs {unlit}", rel(&t));
     }
+}
+
+/// A fit's compact sources render as directional lights in the same frame as the SRBFs: the
+/// frame is the sum of the SRBF-only and directional-only frames (each kind its own batches,
+/// maps and table), and a directional light's light pass draws every strand whatever κ (its
+/// one sharp shadow is what the simplification would blur), so its image does not depend on κ.
+#[test]
+fn srbf_and_directional_lights_in_one_frame_add_and_directional_ignores_kappa() {
+    let gpu = gpu();
+    let model = generate_groom(&GroomParams {
+        strand_count: 300,
+        ..Default::default()
+    })
+    .unwrap();
+    let camera = Camera::framing(model.bounds(), 1.0, false);
+    let tables = EnvTables {
+        srbf: Some(synthetic_table(Axis::uniform(
+            "inv_lambda",
+            1.0 / 64.0,
+            1.0 / 8.0,
+            5,
+        ))),
+        direct: Some(synthetic_table(Axis::uniform("none", 0.0, 0.0, 1))),
+        ..Default::default()
+    };
+    let srbf = [
+        EnvLight::srbf(Vec3::new(0.3, 1.0, 0.4), 20.0, [0.5, 0.4, 0.3]),
+        EnvLight::srbf(Vec3::new(-0.8, 0.2, 0.5), 40.0, [0.2, 0.3, 0.4]),
+    ];
+    let sun = [EnvLight::directional(
+        Vec3::new(0.5, 0.7, 0.6),
+        [2.0, 1.8, 1.5],
+    )];
+    let render = |lights: &[EnvLight], kappa: f32| {
+        let options = EnvRenderOptions {
+            dodm: DodmSettings {
+                resolution: 128,
+                first_layer: None,
+                batch_size: 2,
+            },
+            kappa,
+            ..Default::default()
+        };
+        render_env_frame(
+            &gpu, &model, &camera, RES, RES, lights, &tables, &options, None,
+        )
+        .unwrap_or_else(|e| panic!("{e}"))
+        .pixels
+    };
+    let both: Vec<EnvLight> = srbf.iter().chain(&sun).copied().collect();
+    let (mixed, srbf_only, sun_only) = (render(&both, 0.1), render(&srbf, 0.1), render(&sun, 0.1));
+    let sun_full = render(&sun, 1.0);
+    let (mut worst_sum, mut worst_kappa, mut lit) = (0.0f64, 0.0f64, 0usize);
+    for i in 0..mixed.len() {
+        for c in 0..3 {
+            let sum = srbf_only[i][c] as f64 + sun_only[i][c] as f64;
+            worst_sum = worst_sum.max((mixed[i][c] as f64 - sum).abs() / sum.abs().max(1e-3));
+            worst_kappa = worst_kappa.max((sun_only[i][c] - sun_full[i][c]).abs() as f64);
+        }
+        lit += (sun_only[i][0] > 0.0) as usize;
+    }
+    println!(
+        "{lit} sunlit pixels; mixed vs sum: worst relative {worst_sum:.2e}; sun at κ 0.1 vs 1: worst {worst_kappa:.2e}"
+    );
+    assert!(lit > 100, "the sun must light the groom");
+    assert!(worst_sum < 1e-4, "mixed frame vs sum of parts: {worst_sum}");
+    assert_eq!(
+        worst_kappa, 0.0,
+        "a directional light's map must not depend on κ"
+    );
 }

@@ -16,6 +16,7 @@ use glam::DVec3;
 use std::collections::BTreeMap;
 use std::sync::OnceLock;
 use std::time::Instant;
+use strandlight_precompute::compact_sources::SourceOptions;
 use strandlight_precompute::bake::bake_job;
 use strandlight_precompute::bake_plan::{plan, BakeResolution, FiberDescription, Model, PlanOptions, DEFAULT_MULTIPLE_THRESHOLD};
 use strandlight_precompute::env_lights::{reference_lights, srbf_set_lights, total_power, LightSpec};
@@ -101,7 +102,8 @@ fn build_scene() -> Result<Scene, String> {
 
     let t = Instant::now();
     let map = procedural_env::by_name("studio", 256).expect("studio is a procedural map");
-    let options = FitOptions { initial_lobes: 8, max_lobes: 24, target_relative_mse: 0.03, grid_width: 64, iterations_per_round: 10, final_iterations: 40, ..FitOptions::default() };
+    // The paper's pure SRBF fit (no compact source taken out): this test measures its method.
+    let options = FitOptions { initial_lobes: 8, max_lobes: 24, target_relative_mse: 0.03, grid_width: 64, iterations_per_round: 10, final_iterations: 40, sources: SourceOptions::none(), ..FitOptions::default() };
     let source = Source { map: &map, name: "procedural:studio".into(), sha256: String::new(), sanitized: Default::default() };
     let set = SrbfSet::fit(&source, &options, &mut |_| {}).expect("fit");
     let srbf_specs = srbf_set_lights(&set);

@@ -9,7 +9,7 @@ use strandlight_tables::table::Table;
 
 use super::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource};
 use crate::camera::Camera;
-use crate::gpu::readback::{ReadbackError, read_buffer, read_texture_rgba};
+use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::gpu::{AdapterReport, GpuContext};
 use crate::hair::HairModel;
 use crate::passes::convolution_depth::{
@@ -19,13 +19,12 @@ use crate::passes::convolution_depth::{
 use crate::passes::env_view::{
     BatchBinding, EnvViewPass, EnvViewTargets, FrameVisibility, TableBinding, ViewBinding,
 };
-use crate::passes::strands::RenderTarget;
 use crate::passes::strands::{FrameParams, KajiyaKay, StrandGeometry, TooManyPoints};
 pub use crate::passes::summed_area::BoxAverage;
 use crate::passes::summed_area::{SatTooLarge, SummedAreaPass, SummedAreaTables};
 pub use crate::passes::transmittance_filter::TransmittanceFilter;
+use crate::passes::view_visibility::OccupancyMap;
 pub use crate::passes::view_visibility::{FragmentCounts, OccupancyError, ViewTransparency};
-use crate::passes::view_visibility::{OccupancyMap, sum_counts};
 use crate::render::PassTiming;
 
 /// Axis names of the env tables (`strandlight_precompute::convolution_table` and
@@ -119,8 +118,10 @@ pub fn check_env_table(
 pub struct EnvRenderOptions {
     /// Light-pass map resolution, first-layer depth and lights per batch.
     pub dodm: DodmSettings,
-    /// Stochastic simplification (Ren §7): the light pass draws this fraction of the strands (their width
-    /// enlarged by 1/κ, τ scaled by 1/κ); 1 draws them all. Default 0.1.
+    /// Stochastic simplification (Ren §7): the light pass of SRBF lights draws this fraction of
+    /// the strands (their width enlarged by 1/κ, τ scaled by 1/κ); 1 draws them all. Default
+    /// 0.1. Directional lights (a sun taken out of the map) always draw every strand: one sharp
+    /// shadow is what the simplification would blur.
     pub kappa: f32,
     /// Seed of the strand shuffle behind κ.
     pub simplification_seed: u64,
@@ -446,20 +447,16 @@ impl EnvRenderer {
             gpu.queue.submit([encoder.finish()]);
         });
         let fragments = if options.count_fragments {
-            let counts = RenderTarget::new(gpu, width, height);
             let view = ViewBinding::new(gpu, &self.view.view_layout, None, &visibility);
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            self.view.visibility.encode_counts(
-                &mut encoder,
+            Some(self.view.visibility.count_fragments(
+                gpu,
                 options.transparency,
                 &strands,
                 &view.group,
                 &depth_view,
-                &counts.color.create_view(&Default::default()),
+                (width, height),
                 geometry.segment_count,
-            );
-            gpu.queue.submit([encoder.finish()]);
-            Some(sum_counts(&read_texture_rgba(gpu, &counts.color)?))
+            )?)
         } else {
             None
         };
@@ -472,10 +469,16 @@ impl EnvRenderer {
         ] {
             let Some(binding) = binding else { continue };
             table_bytes += binding.bytes;
-            sat.average = if kind_lights.first().is_some_and(|l| l.lambda.is_some()) {
+            let srbf_kind = kind_lights.first().is_some_and(|l| l.lambda.is_some());
+            sat.average = if srbf_kind {
                 options.box_average
             } else {
                 BoxAverage::OpticalDepth
+            };
+            let (kind_geometry, enlargement) = if srbf_kind {
+                (&light_geometry, 1.0 / options.kappa)
+            } else {
+                (&geometry, 1.0)
             };
             for chunk in kind_lights.chunks(batch_size) {
                 batches += 1;
@@ -493,11 +496,11 @@ impl EnvRenderer {
                     self.depth.encode(
                         gpu,
                         &mut encoder,
-                        &light_geometry,
+                        kind_geometry,
                         &directions,
                         bounds,
-                        1.0 / options.kappa,
-                        1.0 / options.kappa,
+                        enlargement,
+                        enlargement,
                         &mut dodm,
                     );
                     gpu.queue.submit([encoder.finish()]);

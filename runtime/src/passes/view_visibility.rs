@@ -1,8 +1,9 @@
 //! What the env view pass sees of each pixel's fibers (Ren 2010 §8, "Transparency"): built once
 //! per frame, before the light batches, and read by every batch's view pass, so that the costly
 //! per-fragment loop over lights runs only for fragments that reach the image.
-//! * [`ViewTransparency::Opaque`]: a depth prepass; the view pass then shades only the fragments
-//!   at each pixel's nearest depth (depth test Equal).
+//! * [`ViewTransparency::Opaque`]: a depth prepass and a coverage pass (Σ −ln(1 − α) of each
+//!   pixel's fragments); the view pass then shades only the fragments at each pixel's nearest
+//!   depth (depth test Equal) and weights the nearest fiber's radiance by the coverage of all.
 //! * [`ViewTransparency::Occupancy`]: the occupancy and slab maps of Sintorn & Assarsson 2009
 //!   (`occupancy_map.wgsl`, `view_visibility.wgsl`): two passes record each pixel's depth range,
 //!   which of its 128 depth slices hold fragments and the optical depth per slab of 32 slices;
@@ -11,16 +12,19 @@
 //!   the cutoff (the paper's early opacity culling).
 //!
 //! Inputs: the strands' bind group and the view group (group 3, holding the [`OccupancyMap`]).
-//! Outputs: the view's depth texture (opaque) or the occupancy map (occupancy).
+//! Outputs: the view's depth and coverage textures (opaque) or the occupancy map (occupancy).
 
 use super::attachments::{cleared_color, cleared_depth, prepassed_depth};
-use super::strands::DEPTH_FORMAT;
+use super::strands::{DEPTH_FORMAT, RenderTarget};
 use crate::gpu::GpuContext;
+use crate::gpu::readback::{ReadbackError, read_texture_rgba};
 
 /// How the env view pass weighs the fragments of a pixel.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum ViewTransparency {
-    /// Each pixel shows its nearest fiber, weighted by the fiber's coverage.
+    /// Each pixel shows its nearest fiber's radiance, weighted by the coverage of all its
+    /// fibers (1 − exp(−Σ τ)): one fragment shaded per pixel.
+    #[default]
     Opaque,
     /// Every fiber in front weighs in by coverage × visibility; fragments seen less than
     /// `visibility_cutoff` (in [0, 1)) are not shaded.
@@ -53,12 +57,6 @@ impl ViewTransparency {
             }
             _ => Ok(()),
         }
-    }
-}
-
-impl Default for ViewTransparency {
-    fn default() -> Self {
-        Self::Opaque
     }
 }
 
@@ -293,42 +291,50 @@ impl ViewVisibilityPass {
         }
     }
 
-    /// Benchmarks: counts into `counts` (cleared here; red rasterized, green shaded per pixel)
-    /// after [`Self::encode`] built the frame's visibility (its depth is read, not changed).
+    /// Benchmarks: the fragments one batch's view pass rasterizes and shades, counted into a
+    /// float target (red rasterized, green shaded per pixel) after [`Self::encode`] built the
+    /// frame's visibility (its depth is read, not changed), then summed on the CPU.
     #[allow(clippy::too_many_arguments)]
-    pub fn encode_counts(
+    pub fn count_fragments(
         &self,
-        encoder: &mut wgpu::CommandEncoder,
+        gpu: &GpuContext,
         transparency: ViewTransparency,
         strands: &wgpu::BindGroup,
         view: &wgpu::BindGroup,
         depth: &wgpu::TextureView,
-        counts: &wgpu::TextureView,
+        (width, height): (u32, u32),
         segments: u32,
-    ) {
+    ) -> Result<FragmentCounts, ReadbackError> {
+        let counts = RenderTarget::new(gpu, width, height);
         let shaded = match transparency {
             ViewTransparency::Opaque => &self.count_nearest,
             ViewTransparency::Occupancy { .. } => &self.count_visible,
         };
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("count fragments"),
-            color_attachments: &[cleared_color(counts)],
-            depth_stencil_attachment: prepassed_depth(depth),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_bind_group(0, strands, &[]);
-        pass.set_bind_group(3, view, &[]);
-        for pipeline in [&self.count_rasterized, shaded] {
-            pass.set_pipeline(pipeline);
-            pass.draw(0..6, 0..segments);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        {
+            let target = counts.color.create_view(&Default::default());
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("count fragments"),
+                color_attachments: &[cleared_color(&target)],
+                depth_stencil_attachment: prepassed_depth(depth),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_bind_group(0, strands, &[]);
+            pass.set_bind_group(3, view, &[]);
+            for pipeline in [&self.count_rasterized, shaded] {
+                pass.set_pipeline(pipeline);
+                pass.draw(0..6, 0..segments);
+            }
         }
+        gpu.queue.submit([encoder.finish()]);
+        Ok(sum_counts(&read_texture_rgba(gpu, &counts.color)?))
     }
 }
 
-/// Sums the per-pixel counts of [`ViewVisibilityPass::encode_counts`] (RGBA f32 texels).
-pub fn sum_counts(texels: &[[f32; 4]]) -> FragmentCounts {
+/// Sums the per-pixel counts of [`ViewVisibilityPass::count_fragments`] (RGBA f32 texels).
+fn sum_counts(texels: &[[f32; 4]]) -> FragmentCounts {
     let (rasterized, shaded) = texels.iter().fold((0.0f64, 0.0f64), |(r, s), t| {
         (r + t[0] as f64, s + t[1] as f64)
     });
