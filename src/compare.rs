@@ -5,7 +5,7 @@
 
 use crate::env_lights::to_env_lights;
 use crate::env_scene::{forward_settings, FrameRole, 
-    bake_scene_tables, fit_cached, load_env, render_lights, sha256_hex, EnvFrame, EnvShading, RenderedEnv, ScatteringMode, SceneTables, MULTIPLE_TABLES,
+    bake_scene_tables, fit_cached, load_env, render_lights, sha256_hex, EnvFrame, EnvShading, RenderedEnv, ScatteringMode, SceneTables,
 };
 use crate::equal_time::{equal_error_lights, equal_time_lights, EqualTimeSearch};
 use crate::image_compare::{error_legend, relative_rmse, write_side_by_side, Image};
@@ -249,6 +249,11 @@ fn reference_frame<'a>(scene: &'a CompareScene, args: &CompareArgs, mode: Scatte
     EnvFrame { role: FrameRole::Reference, ..frame(scene, args, &scene.reference, mode) }
 }
 
+/// The multiple-scattering tables a directional reference reads (`srbf_spread` serves SRBF
+/// lights only; it follows the fit's λ range, which must not invalidate a reference).
+const REFERENCE_MULTIPLE_TABLES: [&str; 3] = ["multiple", "fiber_averages", "attenuation_ratio"];
+
+/// What identifies a reference image: everything its render reads, nothing else.
 fn reference_inputs(scene: &CompareScene, args: &CompareArgs, mode: ScatteringMode) -> anyhow::Result<Value> {
     let direct = scene.tables.get(args.shading.direct_table(mode))?;
     Ok(json!({
@@ -262,7 +267,7 @@ fn reference_inputs(scene: &CompareScene, args: &CompareArgs, mode: ScatteringMo
         "shading": args.shading,
         "fiber": scene.fiber,
         "direct_table_inputs": direct.metadata.description.inputs_key,
-        "multiple_tables_inputs": MULTIPLE_TABLES.iter().filter_map(|n| scene.tables.assets.get(*n)).map(|a| a.metadata.description.inputs_key.clone()).collect::<Vec<_>>(),
+        "multiple_tables_inputs": REFERENCE_MULTIPLE_TABLES.iter().filter(|_| mode == ScatteringMode::Full).filter_map(|n| scene.tables.assets.get(*n)).map(|a| a.metadata.description.inputs_key.clone()).collect::<Vec<_>>(),
         "generator": env!("CARGO_PKG_VERSION"),
         "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, transparency: look(args).transparency, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
     }))

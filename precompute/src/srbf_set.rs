@@ -87,6 +87,12 @@ pub enum SrbfSetError {
         index: usize,
         problem: String,
     },
+    #[error("{path}: compact source {index} is invalid: {problem}")]
+    BadSource {
+        path: PathBuf,
+        index: usize,
+        problem: String,
+    },
 }
 
 impl SrbfSet {
@@ -137,6 +143,26 @@ impl SrbfSet {
                 return Err(bad(format!(
                     "amplitude {:?} must be finite and ≥ 0",
                     lobe.amplitude
+                )));
+            }
+        }
+        for (index, source) in set.sources.iter().enumerate() {
+            let bad = |problem: String| SrbfSetError::BadSource {
+                path: path.into(),
+                index,
+                problem,
+            };
+            let len = glam::DVec3::from(source.direction).length();
+            if !len.is_finite() || (len - 1.0).abs() > 1e-6 {
+                return Err(bad(format!(
+                    "direction {:?} is not a unit vector",
+                    source.direction
+                )));
+            }
+            if source.power.iter().any(|p| !p.is_finite() || *p < 0.0) {
+                return Err(bad(format!(
+                    "power {:?} must be finite and ≥ 0",
+                    source.power
                 )));
             }
         }

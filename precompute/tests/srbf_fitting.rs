@@ -364,4 +364,18 @@ fn by_default_a_sun_is_taken_out_as_a_directional_light_with_its_power() {
         assert!((set.sources[0].power[c] - expected).abs() < 1e-9 * expected);
         assert!((set.power_ratio[c] - 1.0).abs() < 1e-9, "{:?}", set.power_ratio);
     }
+    // The sources round-trip through the set file, and a corrupted one is refused by index.
+    let dir = std::env::temp_dir().join(format!("strandlight-set-sources-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("set.json");
+    set.save(&path).unwrap();
+    assert_eq!(SrbfSet::load(&path).unwrap(), set);
+    let mut corrupt = set.clone();
+    corrupt.sources[0].power[1] = -1.0;
+    corrupt.save(&path).unwrap();
+    assert!(matches!(
+        SrbfSet::load(&path),
+        Err(SrbfSetError::BadSource { index: 0, .. })
+    ));
+    std::fs::remove_dir_all(&dir).unwrap();
 }
