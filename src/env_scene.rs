@@ -16,7 +16,7 @@ use strandlight_precompute::srbf_set::{Source, SrbfSet};
 use strandlight_precompute::{procedural_env, EnvMap, FitOptions};
 use strandlight_runtime::camera::Camera;
 use std::sync::OnceLock;
-use strandlight_runtime::multiple::{CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables};
+use strandlight_runtime::multiple::{CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering};
 use strandlight_runtime::env::{ForwardScatteringSource, EnvLight, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables, FragmentCounts, ViewTransparency, BoxAverage};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
@@ -125,6 +125,17 @@ pub enum EnvTransparency {
     Occupancy,
 }
 
+/// Where the forward-scattering shadow paths are marched (Ren §6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ForwardDevice {
+    /// The GPU on a hardware adapter, rayon on a software one (lavapipe runs compute shaders on
+    /// the same CPU cores, where rayon was measured faster: docs/BENCHMARKS.md).
+    Auto,
+    Cpu,
+    Gpu,
+}
+
 /// What the effective transmittance's box averages (the CLI's names for [`BoxAverage`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -149,11 +160,15 @@ pub struct LookArgs {
     /// What the SRBF transmittance's box averages over the convolution optical depth map.
     #[arg(long, value_enum, default_value = "optical-depth")]
     pub box_average: BoxAverageArg,
+    /// Where multiple scattering's shadow paths are marched (the brute-force reference's dense
+    /// grid always uses the CPU light sweep).
+    #[arg(long, value_enum, default_value = "auto")]
+    pub forward_scattering: ForwardDevice,
 }
 
 impl Default for LookArgs {
     fn default() -> Self {
-        Self { transparency: EnvTransparency::Opaque, visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF, box_average: BoxAverageArg::OpticalDepth }
+        Self { transparency: EnvTransparency::Opaque, visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF, box_average: BoxAverageArg::OpticalDepth, forward_scattering: ForwardDevice::Auto }
     }
 }
 
@@ -169,7 +184,7 @@ impl LookArgs {
             BoxAverageArg::OpticalDepth => BoxAverage::OpticalDepth,
             BoxAverageArg::Transmittance => BoxAverage::Transmittance,
         };
-        Ok(EnvLook { shadowed: true, transparency, box_average, count_fragments: false })
+        Ok(EnvLook { shadowed: true, transparency, box_average, count_fragments: false, forward_scattering: self.forward_scattering })
     }
 }
 
@@ -183,6 +198,7 @@ pub struct EnvLook {
     pub box_average: BoxAverage,
     /// Count the fragments rasterized and shaded (two extra passes, outside the frame time).
     pub count_fragments: bool,
+    pub forward_scattering: ForwardDevice,
 }
 
 /// Single scattering only, or with multiple scattering (Ren §3.2).
@@ -399,11 +415,19 @@ pub fn forward_settings(role: FrameRole) -> ForwardScatteringSettings {
     }
 }
 
-/// The CPU forward-scattering source of Ren §6 for `frame` (voxelization included: a static
-/// hair pays it once, outside the frame time; dynamic hair per frame — see docs/BENCHMARKS.md).
-fn forward_scattering(frame: &EnvFrame) -> anyhow::Result<CpuForwardScattering> {
+/// The forward-scattering source of Ren §6 for `frame` on the device its look asks for
+/// (voxelization included: a static hair pays it once, outside the frame time; dynamic hair per
+/// frame — see docs/BENCHMARKS.md). The reference's light sweep runs on the CPU only.
+fn forward_scattering<'g>(frame: &EnvFrame, gpu: &'g GpuContext) -> anyhow::Result<Box<dyn ForwardScatteringSource + 'g>> {
     let tables = ForwardScatteringTables::from_tables(&frame.tables.get("fiber_averages")?.table, &frame.tables.get("attenuation_ratio")?.table, &frame.tables.get("srbf_spread")?.table)?;
-    Ok(CpuForwardScattering::new(frame.hair, tables, forward_settings(frame.role))?)
+    let cpu = CpuForwardScattering::new(frame.hair, tables, forward_settings(frame.role))?;
+    let on_gpu = match frame.look.forward_scattering {
+        _ if frame.role == FrameRole::Reference => false,
+        ForwardDevice::Auto => !gpu.report.is_software,
+        ForwardDevice::Cpu => false,
+        ForwardDevice::Gpu => true,
+    };
+    Ok(if on_gpu { Box::new(GpuForwardScattering::new(gpu, cpu)?) } else { Box::new(cpu) })
 }
 
 /// The runtime's tables for `frame`: the SRBF table of its mode for SRBF lights, the direct
@@ -431,9 +455,9 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
     let tables = env_tables(frame)?;
     let source = match frame.mode {
         ScatteringMode::Single => None,
-        ScatteringMode::Full => Some(forward_scattering(frame)?),
+        ScatteringMode::Full => Some(forward_scattering(frame, &r.gpu)?),
     };
-    let multiple = source.as_ref().map(|s| s as &dyn ForwardScatteringSource);
+    let multiple = source.as_deref();
     let out = r
         .renderer
         .render(&r.gpu, frame.hair, &frame.camera, frame.width, frame.height, frame.lights, &tables, &render_options(frame), multiple)

@@ -91,6 +91,9 @@ pub struct RenderArgs {
     /// With --env: what the SRBF transmittance's box averages (Ren 2010: the optical depth).
     #[arg(long, value_enum, default_value = "optical-depth")]
     box_average: crate::env_scene::BoxAverageArg,
+    /// With --env --scattering full: where the forward-scattering shadow paths are marched.
+    #[arg(long, value_enum, default_value = "auto")]
+    forward_scattering: crate::env_scene::ForwardDevice,
     /// Deep opacity map layers (1..=8), with --shadows dom.
     #[arg(long, default_value_t = 4)]
     dom_layers: u32,
@@ -450,6 +453,7 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
         transparency: if args.transparency == Transparency::Occupancy { crate::env_scene::EnvTransparency::Occupancy } else { crate::env_scene::EnvTransparency::Opaque },
         visibility_cutoff: args.visibility_cutoff,
         box_average: args.box_average,
+        forward_scattering: args.forward_scattering,
     };
     let look = crate::env_scene::EnvLook { count_fragments: args.json, ..look_args.look()? };
     let (width, height) = parse_size(&args.size)?;
@@ -492,6 +496,7 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
             "frame_ms": rendered.milliseconds,
             "transparency": look_args.transparency,
             "box_average": look_args.box_average,
+            "forward_scattering": look_args.forward_scattering,
             "visibility_cutoff": args.visibility_cutoff,
             "memory_per_batch_bytes": rendered.memory_per_batch.iter().map(|(n, b)| (n.clone(), serde_json::json!(b))).collect::<serde_json::Map<_, _>>(),
             "memory_per_batch_total_bytes": rendered.memory_per_batch.iter().map(|(_, b)| b).sum::<u64>(),

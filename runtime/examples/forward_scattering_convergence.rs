@@ -13,10 +13,11 @@ use glam::Vec3;
 use strandlight_precompute::attenuation_ratio::attenuation_ratio_table;
 use strandlight_precompute::srbf_spread::srbf_spread_table;
 use strandlight_runtime::env::{EnvLight, ForwardScatteringSource};
+use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::multiple::shadow_paths::LightMedium;
 use strandlight_runtime::multiple::{
-    CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, HairVolume,
+    CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering, HairVolume,
     VoxelSettings, interpolate_grid,
 };
 use strandlight_tables::dual_scattering::{DualScatteringAverages, DualScatteringConfig, LobeDecomposition};
@@ -102,6 +103,56 @@ fn mean_t(v: &[[f32; 4]]) -> (f64, f64) {
     )
 }
 
+/// CPU (rayon) vs GPU (compute shader) forward-scattering grids for the same batches: medians
+/// of 5 after one warm-up, and the largest difference between the two grids.
+fn compare_devices(model: &HairModel, tables: &ForwardScatteringTables) {
+    let gpu = match GpuContext::new_headless() {
+        Ok(gpu) => gpu,
+        Err(e) => return println!("\n## CPU vs GPU march: skipped ({e})"),
+    };
+    println!("\n## CPU vs GPU march (grid() for a batch of SRBF lights λ=32; median of 5 after a warm-up)");
+    println!("GPU: {}; CPU: rayon, {} threads. Both include the per-light table lookups on the CPU.", gpu.report, rayon::current_num_threads());
+    println!("| voxels | coarse factor | taps | sample vertices | lights | CPU ms | GPU ms | GPU / CPU | max |ΔT_f| | max |Δσ̄_f| |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    for &(voxels, coarse, taps) in &[(64u32, 4u32, 2u32), (90, 4, 2), (64, 2, 2), (64, 1, 1)] {
+        let settings = ForwardScatteringSettings {
+            voxels: VoxelSettings { voxels_longest_side: voxels, default_diameter: None },
+            coarse_factor: coarse,
+            filter_taps: taps,
+            ..Default::default()
+        };
+        let cpu = CpuForwardScattering::new(model, tables.clone(), settings).expect("source");
+        let vertices = cpu.sample_grid().vertex_count();
+        let on_gpu = GpuForwardScattering::new(&gpu, cpu.clone()).expect("GPU source");
+        for &count in &[16usize, 50] {
+            let lights: Vec<EnvLight> =
+                sphere_directions(count).into_iter().map(|d| EnvLight::srbf(d, 32.0, [1.0; 3])).collect();
+            let time = |source: &dyn ForwardScatteringSource| {
+                let mut last = source.grid(&lights).expect("grid");
+                let times = (0..5)
+                    .map(|_| {
+                        let t = Instant::now();
+                        last = source.grid(&lights).expect("grid");
+                        t.elapsed().as_secs_f64() * 1e3
+                    })
+                    .collect();
+                (median(times), last)
+            };
+            let (cpu_ms, a) = time(&cpu);
+            let (gpu_ms, b) = time(&on_gpu);
+            let (mut dt, mut ds) = (0.0f32, 0.0f32);
+            for (x, y) in a.values.iter().zip(&b.values) {
+                dt = dt.max((0..3).map(|c| (x[c] - y[c]).abs()).fold(0.0, f32::max));
+                ds = ds.max((x[3] - y[3]).abs());
+            }
+            println!(
+                "| {voxels} | {coarse} | {taps}³ | {vertices} | {count} | {cpu_ms:.1} | {gpu_ms:.1} | {:.2} | {dt:.1e} | {ds:.1e} |",
+                gpu_ms / cpu_ms
+            );
+        }
+    }
+}
+
 fn main() {
     let Some(path) = strandlight_tables::shared_data::shared_file("hair/straight.hair") else {
         return;
@@ -123,7 +174,7 @@ fn main() {
     let tables = ForwardScatteringTables::from_tables(&fiber, &ratio, &spread).expect("table shapes");
     println!("tables built in {:.2} s (bake-time work, not part of the runtime)", t0.elapsed().as_secs_f64());
 
-    // Optional section names on the command line (voxels, paths, medium, convergence).
+    // Optional section names on the command line (voxels, paths, gpu, medium, convergence).
     let only: Vec<String> = std::env::args().skip(1).collect();
     let want = |section: &str| only.is_empty() || only.iter().any(|s| s == section);
 
@@ -194,7 +245,7 @@ fn main() {
                 let reps = if coarse == 1 && !sweep { 1 } else { 3 };
                 for _ in 0..reps {
                     let t = Instant::now();
-                    let grid = source.grid(&lights);
+                    let grid = source.grid(&lights).expect("grid");
                     times.push(t.elapsed().as_secs_f64() * 1e3);
                     assert!(grid.values.iter().all(|v| v.iter().all(|x| x.is_finite())));
                 }
@@ -210,6 +261,11 @@ fn main() {
         }
     }
 
+    }
+
+    // --- The same march on the GPU (compute shader) vs rayon: which source the device wants.
+    if want("gpu") {
+        compare_devices(&model, &tables);
     }
 
     // --- Where a light's time goes: the per-voxel table lookups (LightMedium) vs the paths.
@@ -254,7 +310,7 @@ fn main() {
         lights.iter().flat_map(|l| source.values_at(l, &probes)).collect()
     };
     let grid_values = |source: &CpuForwardScattering| -> Vec<[f32; 4]> {
-        let grid = source.grid(&lights);
+        let grid = source.grid(&lights).expect("grid");
         (0..lights.len()).flat_map(|l| probes.iter().map(move |&p| (l, p))).map(|(l, p)| interpolate_grid(&grid, l, p).expect("light index within the batch")).collect()
     };
 

@@ -13,6 +13,7 @@ use strandlight_runtime::env::{
     render_env_frame,
 };
 use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::multiple::ForwardScatteringError;
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::passes::convolution_depth::{
@@ -615,7 +616,7 @@ fn linear_grid_value(light: usize, y: f64) -> [f64; 4] {
 }
 
 impl ForwardScatteringSource for LinearGrid {
-    fn grid(&self, lights: &[EnvLight]) -> ForwardScatteringGrid {
+    fn grid(&self, lights: &[EnvLight]) -> Result<ForwardScatteringGrid, ForwardScatteringError> {
         let dims = [3u32, 5, 4];
         let (origin, spacing) = (Vec3::new(-1.0, -1.0, -0.5), Vec3::new(1.0, 0.5, 1.0 / 3.0));
         let mut values = Vec::new();
@@ -629,12 +630,16 @@ impl ForwardScatteringSource for LinearGrid {
                 }
             }
         }
-        ForwardScatteringGrid {
+        Ok(ForwardScatteringGrid {
             origin,
             spacing,
             dims,
             values,
-        }
+        })
+    }
+
+    fn device(&self) -> &'static str {
+        "test"
     }
 }
 

@@ -26,7 +26,7 @@ use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::{EnvLight, EnvRenderOptions, EnvRenderer, EnvTables, ForwardScatteringSource};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::{generate_groom, GroomParams, HairModel};
-use strandlight_runtime::multiple::{CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, VoxelSettings};
+use strandlight_runtime::multiple::{CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering, VoxelSettings};
 use strandlight_tables::asset::{read_asset, Storage};
 use strandlight_tables::table::Table;
 
@@ -319,6 +319,12 @@ fn srbf_full_scattering_matches_the_directional_reference() {
     assert_eq!(coverage(&a), coverage(&r));
     let e = relative_rmse(&a, &r);
     eprintln!("full: relative RMSE {e:.4}; mean SRBF {:.4e}, reference {:.4e}; SRBF {ta:.2} s, reference {tr:.2} s", mean_hair(&a), mean_hair(&r));
+    // The same frame with the shadow paths marched by the compute shader: the same image.
+    let on_gpu = GpuForwardScattering::new(&scene.gpu, interactive.clone()).expect("GPU march");
+    let (g, tg) = render(scene, &scene.srbf, srbf_tables.clone(), true, Some(&on_gpu));
+    let e_devices = relative_rmse(&g, &a);
+    eprintln!("full: GPU-marched grid vs CPU-marched grid: relative RMSE {e_devices:.2e} ({tg:.2} s vs {ta:.2} s)");
+    assert!(e_devices < 1e-4, "GPU and CPU forward scattering differ: {e_devices}");
     let (turned, _) = render(scene, &rotated(&scene.srbf, scene.up, 90.0), srbf_tables, true, Some(&interactive));
     let e_turned = relative_rmse(&turned, &r);
     eprintln!("full: SRBF lights turned 90° about up: relative RMSE {e_turned:.4}; total {:.2} s", start.elapsed().as_secs_f64());

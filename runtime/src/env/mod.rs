@@ -69,11 +69,16 @@ pub struct ForwardScatteringGrid {
 }
 
 /// Computes [`ForwardScatteringGrid`]s for batches of lights (the multiple-scattering module
-/// implements it on the CPU; a frame asks once per batch).
+/// implements it on the CPU and on the GPU; a frame asks once per batch).
 pub trait ForwardScatteringSource {
     /// The grid (with values for every light in `lights`, in order).
-    fn grid(&self, lights: &[EnvLight]) -> ForwardScatteringGrid;
+    fn grid(&self, lights: &[EnvLight]) -> Result<ForwardScatteringGrid, ForwardScatteringError>;
+
+    /// Where the march runs ("CPU", "GPU"): names the pass in the frame's timings.
+    fn device(&self) -> &'static str;
 }
+
+use crate::multiple::ForwardScatteringError;
 
 pub mod render;
 pub use render::{

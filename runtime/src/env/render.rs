@@ -484,7 +484,10 @@ impl EnvRenderer {
                 batches += 1;
                 let grid = match multiple {
                     Some(source) => {
-                        let grid = timings.time(gpu, "multiple grid (CPU)", || source.grid(chunk));
+                        let pass = format!("multiple grid ({})", source.device());
+                        let grid = timings
+                            .time(gpu, &pass, || source.grid(chunk))
+                            .map_err(|e| EnvRenderError::Grid(e.to_string()))?;
                         check_grid(&grid, chunk.len())?;
                         Some(grid)
                     }

@@ -28,6 +28,13 @@ pub enum ForwardScatteringError {
     TableShape { table: &'static str, problem: String },
     #[error("forward-scattering setting `{parameter}` = {value}: {problem}")]
     InvalidSetting { parameter: &'static str, value: String, problem: String },
+    #[error(
+        "GPU limit exceeded: {what} needs {bytes} (bytes or workgroups); this adapter allows at \
+         most {limit} (lower voxels_longest_side or raise coarse_factor)"
+    )]
+    GpuLimit { what: &'static str, bytes: u64, limit: u64 },
+    #[error("the GPU march failed: {0}")]
+    Gpu(String),
 }
 
 /// Checks axis names/counts and the channel count of a baked table.

@@ -2,8 +2,9 @@
 //! march expected shadow paths from the vertices of a coarse sample grid (¼ of the voxel
 //! resolution per axis, as the paper) toward every light, in parallel with rayon.
 //!
-//! The paper runs both steps in CUDA; the task's runtime is measured on the CPU (no GPU here),
-//! see `examples/forward_scattering_convergence.rs` for timings and the convergence study.
+//! The paper runs both steps in CUDA; [`super::gpu_shadow_paths`] marches on the GPU from the
+//! same medium. `examples/forward_scattering_convergence.rs` times both and holds the
+//! convergence study.
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -179,11 +180,21 @@ impl CpuForwardScattering {
         &self.sample_grid
     }
 
+    /// The sample grid's vertex positions, in the grid's order.
+    pub fn sample_points(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    /// The per-voxel medium under `light` (table lookups; what both sources march).
+    pub fn medium(&self, light: &EnvLight) -> LightMedium {
+        LightMedium::new(&self.volume, &self.tables, light)
+    }
+
     /// [T_r, T_g, T_b, σ̄_f] at arbitrary points for one light (no grid interpolation): the
     /// convergence study and tests probe fixed points with it.
     /// Uses the light sweep when the settings ask for it.
     pub fn values_at(&self, light: &EnvLight, points: &[Vec3]) -> Vec<[f32; 4]> {
-        let medium = LightMedium::new(&self.volume, &self.tables, light);
+        let medium = self.medium(light);
         let xi = light_direction(light);
         let march = self.settings.march();
         if self.settings.light_sweep {
@@ -211,18 +222,22 @@ impl CpuForwardScattering {
 impl ForwardScatteringSource for CpuForwardScattering {
     /// One light after another (each light's medium is built in parallel over voxels, then its
     /// samples are marched in parallel): memory stays at one light's medium.
-    fn grid(&self, lights: &[EnvLight]) -> ForwardScatteringGrid {
+    fn grid(&self, lights: &[EnvLight]) -> Result<ForwardScatteringGrid, ForwardScatteringError> {
         let n = self.positions.len();
         let mut values = Vec::with_capacity(n * lights.len());
         for light in lights {
             values.extend(self.values_at(light, &self.positions));
         }
-        ForwardScatteringGrid {
+        Ok(ForwardScatteringGrid {
             origin: self.sample_grid.origin,
             spacing: self.sample_grid.spacing,
             dims: self.sample_grid.dims,
             values,
-        }
+        })
+    }
+
+    fn device(&self) -> &'static str {
+        "CPU"
     }
 }
 

@@ -317,9 +317,9 @@ fn degenerate_hair_gives_finite_values() {
             EnvLight::srbf(Vec3::new(-1.0, 0.0, 0.0), 50.0, [1.0; 3]),
         ];
         // The renderer's default counts only forward-scattered light: none without fibers.
-        let scattered = CpuForwardScattering::new(&model, tables(), ForwardScatteringSettings::default()).unwrap().grid(&lights);
+        let scattered = CpuForwardScattering::new(&model, tables(), ForwardScatteringSettings::default()).unwrap().grid(&lights).unwrap();
         assert!(scattered.values.iter().all(|v| v[..3] == [0.0; 3] && v[3].is_finite()));
-        let grid = source.grid(&lights);
+        let grid = source.grid(&lights).unwrap();
         let volume = source.volume();
         println!(
             "grid {:?} voxel size {} σ_max {}, first value {:?}",
@@ -346,7 +346,7 @@ fn the_grid_covers_the_hair_and_holds_every_light() {
         EnvLight::directional(Vec3::new(-1.0, 0.2, 0.3), [1.0; 3]),
         EnvLight::srbf(Vec3::Z, 64.0, [1.0; 3]),
     ];
-    let grid = source.grid(&lights);
+    let grid = source.grid(&lights).unwrap();
     let n = grid.dims.iter().product::<u32>() as usize;
     println!("dims {:?} origin {} spacing {}", grid.dims, grid.origin, grid.spacing);
     assert_eq!(grid.values.len(), n * lights.len());
@@ -444,4 +444,58 @@ fn light_sweep_agrees_with_per_point_marching_on_tangled_hair() {
     let rms = (sum / a.len() as f64).sqrt();
     println!("{} probes: mean T_f(red) {:.4}, RMS |Δ| {rms:.4}, max {max:.4}", a.len(), mean / a.len() as f64);
     assert!(rms < 0.03 && max < 0.15);
+}
+
+#[test]
+fn gpu_march_matches_the_cpu_march() {
+    // Tangled hair (random walks), 18 lights (two dispatches of at most 16), SRBF and
+    // directional, one along a grid axis (the ray-box test's parallel branch), with and without
+    // the direct paths. Both sources march the same f32 positions through the same medium; the
+    // recursion runs in f64 on the CPU and f32 on the GPU.
+    let mut rng = Rng(4242);
+    let mut points = Vec::new();
+    let mut offsets = vec![0u32];
+    for _ in 0..200 {
+        let mut p = Vec3::new(rng.unit() as f32, rng.unit() as f32, rng.unit() as f32) * 8.0;
+        for _ in 0..60 {
+            points.push(p);
+            let z = 2.0 * rng.unit() - 1.0;
+            let a = 2.0 * std::f64::consts::PI * rng.unit();
+            let s = (1.0 - z * z).sqrt();
+            p += 0.2 * Vec3::new((s * a.cos()) as f32, (s * a.sin()) as f32, z as f32);
+        }
+        offsets.push(points.len() as u32);
+    }
+    let model = HairModel::new(points, offsets, Some(Attribute::Uniform(0.1)), None, None).unwrap();
+    let mut lights = vec![EnvLight::directional(Vec3::Z, [1.0; 3]), EnvLight::srbf(Vec3::X, 30.0, [1.0; 3])];
+    while lights.len() < 18 {
+        let d = Vec3::new(rng.unit() as f32, rng.unit() as f32, rng.unit() as f32) * 2.0 - 1.0;
+        lights.push(match lights.len() % 2 {
+            0 => EnvLight::directional(d, [1.0; 3]),
+            _ => EnvLight::srbf(d, 10.0 + 50.0 * rng.unit() as f32, [1.0; 3]),
+        });
+    }
+    let gpu = crate::gpu::GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+    for include_direct in [true, false] {
+        let s = ForwardScatteringSettings { coarse_factor: 2, include_direct, ..settings(16, 2, 0.5) };
+        let cpu = CpuForwardScattering::new(&model, tables(), s).unwrap();
+        let want = cpu.grid(&lights).unwrap();
+        let got = GpuForwardScattering::new(&gpu, cpu).unwrap().grid(&lights).unwrap();
+        assert_eq!((got.dims, got.values.len()), (want.dims, want.values.len()));
+        let (mut worst_t, mut worst_sigma, mut mean_t) = (0.0f32, 0.0f32, 0.0f32);
+        for (g, w) in got.values.iter().zip(&want.values) {
+            for c in 0..3 {
+                worst_t = worst_t.max((g[c] - w[c]).abs());
+                mean_t += w[c] / (3 * want.values.len()) as f32;
+            }
+            worst_sigma = worst_sigma.max((g[3] - w[3]).abs());
+        }
+        println!(
+            "include_direct {include_direct}: {} values, mean T_f {mean_t:.4}, max |ΔT_f| {worst_t:.2e}, max |Δσ̄_f| {worst_sigma:.2e} rad",
+            want.values.len()
+        );
+        // The hair must matter: it takes light away from the direct paths and scatters some.
+        assert!(if include_direct { mean_t < 0.9 } else { mean_t > 0.05 }, "mean T_f {mean_t}");
+        assert!(worst_t < 1e-4 && worst_sigma < 1e-4);
+    }
 }

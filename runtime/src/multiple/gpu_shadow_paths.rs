@@ -1,0 +1,232 @@
+//! The forward-scattering grid with the shadow-path march on the GPU (`gpu_shadow_paths.wgsl`),
+//! as the paper does it (Ren 2010 §6, in CUDA there): the CPU still voxelizes and looks the
+//! per-voxel medium up in the tables for each light (the part that needs the baked tables), the
+//! GPU marches every sample of the coarse grid toward every light of a batch at once.
+//!
+//! Inputs: a [`CpuForwardScattering`] (volume, tables, settings, sample grid) and a device.
+//! Output: the same [`ForwardScatteringGrid`] as the CPU source, within f32 rounding (the test
+//! beside the CPU closed-form tests checks it). Which source is faster depends on the device:
+//! `examples/forward_scattering_convergence.rs` times both (on lavapipe the "GPU" is the same
+//! two CPU cores, see docs/BENCHMARKS.md).
+
+use wgpu::util::DeviceExt;
+
+use super::fiber_tables::ForwardScatteringError;
+use super::forward_scattering::CpuForwardScattering;
+use super::shadow_paths::{LightMedium, light_direction};
+use crate::env::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource};
+use crate::gpu::{GpuContext, read_buffer};
+
+const WORKGROUP_SIZE: u32 = 64;
+/// Two vec4 per voxel per light (see the shader's layout).
+const MEDIUM_BYTES_PER_VOXEL: u64 = 32;
+/// Lights marched by one dispatch at most (bounds the medium buffer to 16 lights' worth).
+const MAX_LIGHTS_PER_DISPATCH: u32 = 16;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct MarchParams {
+    origin: [f32; 3],
+    voxel_size: f32,
+    dims: [u32; 3],
+    samples: u32,
+    lights: u32,
+    taps: u32,
+    step_fraction: f32,
+    density_forward: f32,
+    include_direct: u32,
+    _pad: [u32; 3],
+}
+
+/// T_f and σ̄_f for batches of lights, marched by a compute shader.
+pub struct GpuForwardScattering<'g> {
+    gpu: &'g GpuContext,
+    cpu: CpuForwardScattering,
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    sample_points: wgpu::Buffer,
+    lights_per_dispatch: u32,
+}
+
+impl<'g> GpuForwardScattering<'g> {
+    /// Builds the pipeline and uploads the sample points; checks the adapter's limits against
+    /// the volume (one light's medium must fit one storage binding) and the sample count.
+    pub fn new(gpu: &'g GpuContext, cpu: CpuForwardScattering) -> Result<Self, ForwardScatteringError> {
+        if cpu.settings().light_sweep {
+            return Err(ForwardScatteringError::InvalidSetting {
+                parameter: "light_sweep",
+                value: "true".into(),
+                problem: "the light sweep runs on the CPU only; the GPU marches from every sample".into(),
+            });
+        }
+        let limits = gpu.device.limits();
+        let binding_limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        let voxels = cpu.volume().grid.voxel_count() as u64;
+        let per_light = voxels * MEDIUM_BYTES_PER_VOXEL;
+        let samples = cpu.sample_grid().vertex_count() as u64;
+        let output_per_light = samples * 16;
+        if per_light > binding_limit || output_per_light > binding_limit {
+            return Err(ForwardScatteringError::GpuLimit {
+                what: if per_light > binding_limit { "one light's voxel medium" } else { "one light's sample values" },
+                bytes: per_light.max(output_per_light),
+                limit: binding_limit,
+            });
+        }
+        let groups = samples.div_ceil(WORKGROUP_SIZE as u64);
+        if groups > limits.max_compute_workgroups_per_dimension as u64 {
+            return Err(ForwardScatteringError::GpuLimit {
+                what: "workgroups for the sample grid",
+                bytes: groups,
+                limit: limits.max_compute_workgroups_per_dimension as u64,
+            });
+        }
+        let fit = (binding_limit / per_light.max(output_per_light)).min(MAX_LIGHTS_PER_DISPATCH as u64);
+        let lights_per_dispatch = (fit as u32)
+            .min(limits.max_compute_workgroups_per_dimension)
+            .max(1);
+        let points: Vec<[f32; 4]> =
+            cpu.sample_points().iter().map(|p| [p.x, p.y, p.z, 1.0]).collect();
+        let sample_points = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("forward-scattering sample points"),
+            contents: bytemuck::cast_slice(&points),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let (pipeline, layout) = build_pipeline(gpu);
+        Ok(Self { gpu, cpu, pipeline, layout, sample_points, lights_per_dispatch })
+    }
+
+    pub fn cpu(&self) -> &CpuForwardScattering {
+        &self.cpu
+    }
+
+    /// Marches `lights` (at most `lights_per_dispatch`) in one dispatch; values per light, in order.
+    fn march_chunk(&self, lights: &[EnvLight]) -> Result<Vec<[f32; 4]>, ForwardScatteringError> {
+        let device = &self.gpu.device;
+        let volume = self.cpu.volume();
+        let settings = self.cpu.settings();
+        let samples = self.cpu.sample_grid().vertex_count() as u32;
+        let mut medium = Vec::with_capacity(volume.grid.voxel_count() * 2 * lights.len());
+        for light in lights {
+            pack_medium(&self.cpu.medium(light), &mut medium);
+        }
+        let directions: Vec<[f32; 4]> = lights
+            .iter()
+            .map(|l| light_direction(l).extend(0.0).to_array())
+            .collect();
+        let g = &volume.grid;
+        let params = MarchParams {
+            origin: g.origin.to_array(),
+            voxel_size: g.voxel_size,
+            dims: g.dims,
+            samples,
+            lights: lights.len() as u32,
+            taps: settings.filter_taps.max(1),
+            step_fraction: settings.step_fraction,
+            density_forward: settings.density_forward as f32,
+            include_direct: settings.include_direct as u32,
+            _pad: [0; 3],
+        };
+        let init = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        let storage = wgpu::BufferUsages::STORAGE;
+        let params = init("march params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
+        let medium = init("voxel medium", bytemuck::cast_slice(&medium), storage);
+        let directions = init("light directions", bytemuck::cast_slice(&directions), storage);
+        let values = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("forward-scattering values"),
+            size: samples as u64 * lights.len() as u64 * 16,
+            usage: storage | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadow paths"),
+            layout: &self.layout,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: medium.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: self.sample_points.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: directions.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: values.as_entire_binding() },
+            ],
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("shadow paths"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &group, &[]);
+            pass.dispatch_workgroups(samples.div_ceil(WORKGROUP_SIZE), lights.len() as u32, 1);
+        }
+        self.gpu.queue.submit([encoder.finish()]);
+        let bytes = read_buffer(self.gpu, &values)
+            .map_err(|e| ForwardScatteringError::Gpu(e.to_string()))?;
+        Ok(bytemuck::pod_collect_to_vec(&bytes))
+    }
+}
+
+impl ForwardScatteringSource for GpuForwardScattering<'_> {
+    fn grid(&self, lights: &[EnvLight]) -> Result<ForwardScatteringGrid, ForwardScatteringError> {
+        let mut values = Vec::with_capacity(self.cpu.sample_points().len() * lights.len());
+        for chunk in lights.chunks(self.lights_per_dispatch as usize) {
+            values.extend(self.march_chunk(chunk)?);
+        }
+        let grid = self.cpu.sample_grid();
+        Ok(ForwardScatteringGrid { origin: grid.origin, spacing: grid.spacing, dims: grid.dims, values })
+    }
+
+    fn device(&self) -> &'static str {
+        "GPU"
+    }
+}
+
+/// Appends one light's medium in the shader's layout: [k, ā_f.rgb], [β̄_f².rgb, σ²_SRBF] per voxel.
+fn pack_medium(medium: &LightMedium, out: &mut Vec<[f32; 4]>) {
+    for v in 0..medium.extinction.len() {
+        let e = &medium.event[v];
+        let [a, b2] = [e.attenuation, e.variance];
+        out.push([medium.extinction[v], a[0], a[1], a[2]]);
+        out.push([b2[0], b2[1], b2[2], medium.srbf_variance[v]]);
+    }
+}
+
+fn build_pipeline(gpu: &GpuContext) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
+    let device = &gpu.device;
+    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("gpu_shadow_paths.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(include_str!("gpu_shadow_paths.wgsl").into()),
+    });
+    let buffer = |binding, ty| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+        count: None,
+    };
+    let read_only = wgpu::BufferBindingType::Storage { read_only: true };
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("shadow paths"),
+        entries: &[
+            buffer(0, wgpu::BufferBindingType::Uniform),
+            buffer(1, read_only),
+            buffer(2, read_only),
+            buffer(3, read_only),
+            buffer(4, wgpu::BufferBindingType::Storage { read_only: false }),
+        ],
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("shadow paths"),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("march_samples"),
+        layout: Some(&pipeline_layout),
+        module: &shader,
+        entry_point: Some("march_samples"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    (pipeline, layout)
+}
