@@ -158,7 +158,7 @@ pub fn prepare_with_hair(args: &CompareArgs, hair: HairModel, hair_sha256: Strin
     })?;
     let lambda_range = crate::tables_cmd::lambda_range_of_set(&fit.set)?;
     let resolution = args.table_resolution.map(BakeResolution::reduced).unwrap_or_default();
-    let wanted = crate::env_scene::wanted_tables(args.shading, &args.modes, true);
+    let wanted = crate::env_scene::wanted_tables(args.shading, &args.modes, !fit.set.lobes.is_empty(), true);
     let table_dir = args.cache.join("tables").join(format!("{}-{:?}", args.preset, args.shading).to_lowercase());
     let tables = steps.run(
         "bake",

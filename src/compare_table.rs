@@ -14,7 +14,7 @@ pub struct CompareTableArgs {
     pub reports: Vec<PathBuf>,
 }
 
-const HEADER: &str = "| map | fit L2 err | mode | SRBF lights (+ compact sources) | SRBF ms | SRBF rel. RMSE | baseline lights | baseline ms | baseline rel. RMSE | reference lights | reference ms | speed-up vs reference | equal-error baseline lights | speed-up at equal error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
+const HEADER: &str = "| map | fit L2 err (map without its sources) | mode | SRBF lights (+ compact sources) | SRBF ms | SRBF rel. RMSE | baseline lights | baseline ms | baseline rel. RMSE | reference lights | reference ms | speed-up vs reference | equal-error baseline lights | speed-up at equal error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
 
 fn number(v: &Value, path: &[&str], file: &Path) -> anyhow::Result<f64> {
     let mut at = v;
@@ -55,7 +55,10 @@ pub fn rows(report: &Value, file: &Path) -> anyhow::Result<Vec<String>> {
         let srbf_lights = n(&["srbf", "lights"])? as usize;
         let srbf_lights = match sources {
             0 => srbf_lights.to_string(),
-            k => format!("{} + {k} src", srbf_lights - k),
+            k => match srbf_lights.checked_sub(k) {
+                Some(lobes) => format!("{lobes} + {k} src"),
+                None => bail!("{}: {mode}: {srbf_lights} lights cannot hold {k} compact sources", file.display()),
+            },
         };
         out.push(format!(
             "| {name} | {fit_error} | {mode} | {srbf_lights} | {:.0} | {:.4} | {:.0} | {:.0} | {:.4} | {:.0} | {:.0} | {:.1}× | {equal_lights} | {equal_speedup} |",

@@ -68,7 +68,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     })?;
     let fiber = FiberDescription::preset(DEMO_PRESET)?;
     let shading = EnvShading::Marschner;
-    let wanted = crate::env_scene::wanted_tables(shading, &[ScatteringMode::Single, ScatteringMode::Full], !fit.set.sources.is_empty());
+    let wanted = crate::env_scene::wanted_tables(shading, &[ScatteringMode::Single, ScatteringMode::Full], !fit.set.lobes.is_empty(), !fit.set.sources.is_empty());
     let lambda_range = crate::tables_cmd::lambda_range_of_set(&fit.set)?;
     let table_dir = cache.join("tables").join("demo");
     let tables = steps.run(
@@ -85,10 +85,10 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let lights = to_env_lights(&srbf_set_lights(&fit.set), up);
     let mode = if tables.assets.contains_key("multiple") { ScatteringMode::Full } else { ScatteringMode::Single };
     let frame = EnvFrame { hair: &hair, camera, width, height, lights: &lights, tables: &tables, shading, mode, role: FrameRole::Interactive { kappa: EnvRenderOptions::default().kappa }, look };
-    let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {} SRBF lights, {} scattering, {:?} view", r.milliseconds, lights.len(), mode.name(), args.transparency))?;
+    let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {}, {} scattering, {:?} view", r.milliseconds, crate::env_scene::light_summary(&lights), mode.name(), args.transparency))?;
     let out = Path::new(OUT_DIR);
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let description = format!("strandlight demo: procedural groom under procedural:{DEMO_ENVIRONMENT}, {} SRBFs, Marschner ({DEMO_PRESET}), {} scattering", lights.len(), mode.name());
+    let description = format!("strandlight demo: procedural groom under procedural:{DEMO_ENVIRONMENT}, {}, Marschner ({DEMO_PRESET}), {} scattering", crate::env_scene::light_summary(&lights), mode.name());
     let (exr, png) = (out.join("demo.exr"), out.join("demo.png"));
     let image = &rendered.image;
     write_exr(&exr, image.width, image.height, &image.pixels, &description)?;

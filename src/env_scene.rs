@@ -252,16 +252,27 @@ pub const MULTIPLE_TABLES: [&str; 4] = ["multiple", "fiber_averages", "attenuati
 /// The tables a frame in any of `modes` may read: the multiple-scattering tables, the SRBF
 /// tables and, with `directional` lights (baselines, references, a fit's compact sources), the
 /// direct tables.
-pub fn wanted_tables(shading: EnvShading, modes: &[ScatteringMode], directional: bool) -> Vec<&'static str> {
+pub fn wanted_tables(shading: EnvShading, modes: &[ScatteringMode], srbf: bool, directional: bool) -> Vec<&'static str> {
     let mut wanted: Vec<&str> = MULTIPLE_TABLES.to_vec();
     for &mode in modes {
-        wanted.push(shading.srbf_table(mode));
+        if srbf {
+            wanted.push(shading.srbf_table(mode));
+        }
         if directional {
             wanted.push(shading.direct_table(mode));
         }
     }
     wanted.dedup();
     wanted
+}
+
+/// "N SRBF lights" or "N SRBF lights + k directional" for a frame's lights.
+pub fn light_summary(lights: &[EnvLight]) -> String {
+    let srbf = lights.iter().filter(|l| l.lambda.is_some()).count();
+    match lights.len() - srbf {
+        0 => format!("{srbf} SRBF lights"),
+        k => format!("{srbf} SRBF lights + {k} directional"),
+    }
 }
 
 /// "N SRBFs + k compact sources (x% of the power), relative L2 error e" for a fitted set.
@@ -331,7 +342,7 @@ pub fn bake_scene_tables(
 }
 
 /// One frame for the environment-lit renderer: a hair, a camera and one set of lights (all
-/// SRBFs or all directional), shaded in `mode` with `tables`.
+/// SRBFs, directional lights, or SRBFs with a fit's compact sources as directional lights), shaded in `mode` with `tables`.
 pub struct EnvFrame<'a> {
     pub hair: &'a HairModel,
     pub camera: Camera,
@@ -421,13 +432,17 @@ pub fn forward_settings(role: FrameRole) -> ForwardScatteringSettings {
 fn forward_scattering<'g>(frame: &EnvFrame, gpu: &'g GpuContext) -> anyhow::Result<Box<dyn ForwardScatteringSource + 'g>> {
     let tables = ForwardScatteringTables::from_tables(&frame.tables.get("fiber_averages")?.table, &frame.tables.get("attenuation_ratio")?.table, &frame.tables.get("srbf_spread")?.table)?;
     let cpu = CpuForwardScattering::new(frame.hair, tables, forward_settings(frame.role))?;
-    let on_gpu = match frame.look.forward_scattering {
-        _ if frame.role == FrameRole::Reference => false,
-        ForwardDevice::Auto => !gpu.report.is_software,
-        ForwardDevice::Cpu => false,
-        ForwardDevice::Gpu => true,
-    };
-    Ok(if on_gpu { Box::new(GpuForwardScattering::new(gpu, cpu)?) } else { Box::new(cpu) })
+    Ok(match frame.look.forward_scattering {
+        _ if frame.role == FrameRole::Reference => Box::new(cpu),
+        ForwardDevice::Cpu => Box::new(cpu),
+        ForwardDevice::Gpu => Box::new(GpuForwardScattering::new(gpu, cpu).context("--forward-scattering gpu")?),
+        ForwardDevice::Auto if gpu.report.is_software => Box::new(cpu),
+        // A volume beyond the adapter's limits is still rendered, by rayon.
+        ForwardDevice::Auto => match GpuForwardScattering::new(gpu, cpu.clone()) {
+            Ok(on_gpu) => Box::new(on_gpu),
+            Err(_) => Box::new(cpu),
+        },
+    })
 }
 
 /// The runtime's tables for `frame`: the SRBF table of its mode for SRBF lights, the direct

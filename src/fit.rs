@@ -52,7 +52,8 @@ pub struct FitArgs {
     /// Output file (default: ENVMAP's stem + .srbf.json or .directional-N.json, here).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Write original | reconstruction | |error| side by side as a PNG.
+    /// Write original | reconstruction | |error| side by side as a PNG. The reconstruction is
+    /// the lobes alone: compact sources (listed on stderr) show in the error panel.
     #[arg(long, value_name = "FILE.png")]
     pub preview: Option<PathBuf>,
     /// Print one JSON object with the result on stdout.

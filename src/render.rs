@@ -463,7 +463,13 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
     let cache = Path::new("out/cache");
     let fit = steps.run("fit", || fit_cached(&env, &strandlight_precompute::FitOptions::default(), cache), |f| format!("{}{}", crate::env_scene::fit_summary(&f.set), if f.cached { " (cached)" } else { "" }))?;
     let fiber = FiberDescription::preset(&args.preset).with_context(|| format!("--preset {:?}", args.preset))?;
-    let wanted = crate::env_scene::wanted_tables(shading, &[args.scattering], !fit.set.sources.is_empty());
+    // Full asks for the single-scattering tables too: dark hair skips the multiple table and the
+    // frame falls back to single scattering (below).
+    let modes: &[ScatteringMode] = match args.scattering {
+        ScatteringMode::Single => &[ScatteringMode::Single],
+        ScatteringMode::Full => &[ScatteringMode::Single, ScatteringMode::Full],
+    };
+    let wanted = crate::env_scene::wanted_tables(shading, modes, !fit.set.lobes.is_empty(), !fit.set.sources.is_empty());
     let lambda_range = crate::tables_cmd::lambda_range_of_set(&fit.set)?;
     let dir = cache.join("tables").join(format!("{}-{:?}", args.preset, shading).to_lowercase());
     let tables = steps.run("bake", || bake_scene_tables(&fiber, shading, BakeResolution::default(), lambda_range, &wanted, &dir, &mut |_| {}), |t| format!("{} tables ({} cached)", t.baked.len(), t.baked.iter().filter(|b| b.cached).count()))?;
@@ -479,10 +485,10 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
     let up = UpAxis::detect(&model);
     let lights = crate::env_lights::to_env_lights(&srbf_set_lights(&fit.set), up);
     let frame = EnvFrame { hair: &model, camera, width, height, lights: &lights, tables: &tables, shading, mode, role: FrameRole::Interactive { kappa: args.kappa }, look };
-    let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {} SRBF lights, {} scattering", r.milliseconds, lights.len(), mode.name()))?;
+    let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {}, {} scattering", r.milliseconds, crate::env_scene::light_summary(&lights), mode.name()))?;
     let stem = output_stem(&args.out);
     let (exr_path, png_path) = (stem.with_extension("exr"), stem.with_extension("png"));
-    let description = format!("{source}; {width}x{height}; env {env_spec}, {} SRBFs; {shading:?} ({}), {} scattering", lights.len(), args.preset, mode.name());
+    let description = format!("{source}; {width}x{height}; env {env_spec}, {}; {shading:?} ({}), {} scattering", crate::env_scene::light_summary(&lights), args.preset, mode.name());
     let image = &rendered.image;
     write_exr(&exr_path, width, height, &image.pixels, &description)?;
     write_png(&png_path, width, height, &image.pixels, &description)?;
@@ -490,7 +496,8 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
         let report = serde_json::json!({
             "hair": source,
             "env": env_spec,
-            "srbf_lights": lights.len(),
+            "srbf_lights": lights.iter().filter(|l| l.lambda.is_some()).count(),
+            "directional_lights": lights.iter().filter(|l| l.lambda.is_none()).count(),
             "size": [width, height],
             "mode": mode.name(),
             "frame_ms": rendered.milliseconds,

@@ -94,12 +94,18 @@ fn lambda_range_of(path: &Path) -> anyhow::Result<(f64, f64)> {
     lambda_range_of_set(&set).with_context(|| path.display().to_string())
 }
 
-/// λ range of an SRBF set with a 10% margin (the bake's 1/λ axis spans only this).
+/// λ range of an SRBF set with a 10% margin (the bake's 1/λ axis spans only this). A set of
+/// compact sources alone (a sun on black: no lobes) gets the fit's default range, which no
+/// table uses (`wanted_tables` then asks for no SRBF table).
 pub fn lambda_range_of_set(set: &SrbfSet) -> anyhow::Result<(f64, f64)> {
     let lambdas = set.lobes.iter().map(|l| l.lambda);
     let (lo, hi) = lambdas.fold((f64::INFINITY, 0.0f64), |(lo, hi), l| (lo.min(l), hi.max(l)));
     if !(lo.is_finite() && hi > 0.0) {
-        bail!("the SRBF set holds no lobes");
+        if set.sources.is_empty() {
+            bail!("the SRBF set holds no lobes and no compact sources (a black map?)");
+        }
+        let defaults = strandlight_precompute::FitOptions::default();
+        return Ok((defaults.lambda_min, defaults.lambda_max));
     }
     let (lo, hi) = (lo / 1.1, hi * 1.1);
     if hi > 1e4 {

@@ -70,6 +70,10 @@ fn luminance(p: [f32; 3]) -> f64 {
     (0..3).map(|c| LUMINANCE[c] * p[c] as f64).sum()
 }
 
+/// Fewest pixels in the ring around a candidate for its median to stand for the background;
+/// a map too coarse for that (pixels wider than the disc) gets no sources.
+const MIN_RING_PIXELS: usize = 8;
+
 fn median(values: &mut [f64]) -> f64 {
     if values.is_empty() {
         return 0.0;
@@ -129,6 +133,9 @@ pub fn extract(map: &EnvMap, options: &SourceOptions) -> (Vec<CompactSource>, En
             .into_iter()
             .filter(|&(_, _, c)| c < radius.cos())
             .collect();
+        if ring.len() < MIN_RING_PIXELS {
+            break; // pixels as wide as the disc: no background to tell a source from
+        }
         let background: [f64; 3] = std::array::from_fn(|ch| {
             let mut v: Vec<f64> = ring
                 .iter()
@@ -237,6 +244,14 @@ mod tests {
         // A black map has nothing to extract.
         let black = EnvMap::from_pixels(8, 4, vec![[0.0; 3]; 32]);
         assert!(extract(&black, &SourceOptions::default()).0.is_empty());
+        // Pixels (11° at 32 × 16) wider than the 2.5° disc: no ring to measure a background
+        // against, so a bright pixel of a coarse map is left to the fit.
+        let mut coarse = vec![[0.2f32; 3]; 32 * 16];
+        coarse[5 * 32 + 7] = [500.0; 3];
+        let coarse = EnvMap::from_pixels(32, 16, coarse);
+        let (found, residual) = extract(&coarse, &SourceOptions::default());
+        assert!(found.is_empty(), "{found:?}");
+        assert_eq!(residual, coarse);
     }
 
     #[test]

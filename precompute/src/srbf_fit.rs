@@ -66,8 +66,9 @@ pub struct FitOptions {
     pub preserve_power: bool,
     /// Compact bright sources (suns, lamps) taken out as directional lights before the fit
     /// ([`crate::compact_sources`]); `max_sources = 0` is the paper's pure SRBF fit. Applied by
-    /// [`crate::SrbfSet::fit`]; [`fit`] fits the map it is given.
-    #[serde(default)]
+    /// [`crate::SrbfSet::fit`]; [`fit`] fits the map it is given. Options saved without the
+    /// field predate extraction: none.
+    #[serde(default = "crate::compact_sources::SourceOptions::none")]
     pub sources: crate::compact_sources::SourceOptions,
 }
 

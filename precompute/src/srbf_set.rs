@@ -15,7 +15,8 @@ use std::path::{Path, PathBuf};
 use strandlight_tables::srbf::{self, SrbfLobe};
 
 pub const FORMAT: &str = "strandlight-srbf-set";
-pub const FORMAT_VERSION: u32 = 1;
+/// 2: compact sources (`sources`) beside the lobes; a version-1 reader would drop them silently.
+pub const FORMAT_VERSION: u32 = 2;
 /// Bandwidth that stands for a directional light (support ≈ 2.1°).
 pub const DIRECTIONAL_LAMBDA: f64 = 1.0e4;
 
@@ -49,8 +50,9 @@ pub struct SrbfSet {
     pub relative_l2_error: f64,
     /// The paper's criterion: Σ w‖fit − map‖² / Σ w‖map‖² (= relative_l2_error²).
     pub relative_mse: f64,
-    /// The same relative MSE against the full-resolution map (a sun narrower than the fit
-    /// grid's pixels counts fully here).
+    /// The same relative MSE against the full-resolution map (without its compact sources,
+    /// like `relative_mse`; a bright spot narrower than the fit grid's pixels that was not
+    /// extracted counts fully here).
     pub full_resolution_relative_mse: f64,
     /// (∫ lobes dω + Σ source power) / ∫ map dω per channel, against the whole map. An L2 fit does not preserve power: a source narrower
     /// than any allowed lobe is fitted with about twice its power (for a point source the

@@ -191,15 +191,15 @@ pub enum EnvRenderError {
 #[derive(Clone, Debug)]
 pub struct EnvRenderStats {
     pub adapter: AdapterReport,
-    /// Per pass, summed over batches: "upload", "pipelines", "light pass", "summed-area tables",
-    /// "view", "multiple grid (CPU)", "readback".
+    /// Per pass, summed over batches: "upload", "pipelines", "view visibility", "light pass",
+    /// "summed-area tables", "view", "multiple grid (CPU)" or "multiple grid (GPU)", "readback".
     pub timings: Vec<PassTiming>,
     /// GPU memory held while one batch renders (the frame's buffers included), per resource.
     pub memory_per_batch: Vec<(String, u64)>,
     pub batches: u32,
     pub lights: u32,
     pub segments: u32,
-    /// Segments the light pass draws (κ of the strands).
+    /// Segments an SRBF batch's light pass draws (κ of the strands; directional batches draw all).
     pub light_pass_segments: u32,
     pub timing_method: &'static str,
     /// With [`EnvRenderOptions::count_fragments`]: the fragments of one batch's view pass.

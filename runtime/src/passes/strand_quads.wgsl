@@ -53,7 +53,9 @@ struct Light {
 @group(0) @binding(4) var<storage, read> lights: array<Light>;
 
 struct VertexOut {
-    @builtin(position) clip: vec4<f32>,
+    // Invariant: the env view's depth prepass and its Equal-depth shading pass are different
+    // pipelines over this vertex stage and must produce bit-identical depths.
+    @builtin(position) @invariant clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) tangent: vec3<f32>,
     @location(2) color: vec3<f32>,

@@ -71,7 +71,9 @@ pub enum BoxAverage {
     #[default]
     OpticalDepth,
     /// T̃ = mean exp(−l) at each layer boundary, interpolated geometrically in depth between
-    /// them: the average of the transmittance over the directions the box stands for.
+    /// them: the average of the transmittance over the directions the box stands for. Stored
+    /// in steps of 1/4096, so T̃ never falls below 1/4096: a fully shadowed point still gets
+    /// 2.4·10⁻⁴ of the light (the optical-depth average reaches e⁻¹⁶).
     Transmittance,
 }
 
