@@ -390,7 +390,7 @@ pub fn execute(args: &CompareArgs, scene: &CompareScene, steps: &mut Steps, rend
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
             "preset": args.preset, "kappa": args.kappa, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
-            "transparency": args.look.transparency, "visibility_cutoff": args.look.visibility_cutoff, "box_average": args.look.box_average, "forward_scattering": args.look.forward_scattering,
+            "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,
             "compact_sources": scene.compact_sources,
         }),

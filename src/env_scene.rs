@@ -154,6 +154,14 @@ pub struct LookArgs {
     /// times the view pass as the hair has fragments per pixel).
     #[arg(long, value_enum, default_value = "opaque")]
     pub transparency: EnvTransparency,
+    #[command(flatten)]
+    pub view: ViewArgs,
+}
+
+/// The env-lit renderer's choices besides the transparency (which `render` names its own way,
+/// sharing `--transparency` with the point-light renderer).
+#[derive(clap::Args, Debug, Clone, Copy)]
+pub struct ViewArgs {
     /// With occupancy: fragments seen less than this fraction are not shaded (early termination).
     #[arg(long, default_value_t = ViewTransparency::DEFAULT_CUTOFF)]
     pub visibility_cutoff: f32,
@@ -166,25 +174,32 @@ pub struct LookArgs {
     pub forward_scattering: ForwardDevice,
 }
 
+impl Default for ViewArgs {
+    fn default() -> Self {
+        Self { visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF, box_average: BoxAverageArg::OpticalDepth, forward_scattering: ForwardDevice::Auto }
+    }
+}
+
 impl Default for LookArgs {
     fn default() -> Self {
-        Self { transparency: EnvTransparency::Opaque, visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF, box_average: BoxAverageArg::OpticalDepth, forward_scattering: ForwardDevice::Auto }
+        Self { transparency: EnvTransparency::Opaque, view: ViewArgs::default() }
     }
 }
 
 impl LookArgs {
     /// The look these arguments ask for (`shadowed` and no fragment counts).
     pub fn look(&self) -> anyhow::Result<EnvLook> {
+        let view = &self.view;
         let transparency = match self.transparency {
             EnvTransparency::Opaque => ViewTransparency::Opaque,
-            EnvTransparency::Occupancy => ViewTransparency::Occupancy { visibility_cutoff: self.visibility_cutoff },
+            EnvTransparency::Occupancy => ViewTransparency::Occupancy { visibility_cutoff: view.visibility_cutoff },
         };
-        transparency.check().with_context(|| format!("--visibility-cutoff {}", self.visibility_cutoff))?;
-        let box_average = match self.box_average {
+        transparency.check().with_context(|| format!("--visibility-cutoff {}", view.visibility_cutoff))?;
+        let box_average = match view.box_average {
             BoxAverageArg::OpticalDepth => BoxAverage::OpticalDepth,
             BoxAverageArg::Transmittance => BoxAverage::Transmittance,
         };
-        Ok(EnvLook { shadowed: true, transparency, box_average, count_fragments: false, forward_scattering: self.forward_scattering })
+        Ok(EnvLook { shadowed: true, transparency, box_average, count_fragments: false, forward_scattering: view.forward_scattering })
     }
 }
 

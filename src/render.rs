@@ -84,16 +84,9 @@ pub struct RenderArgs {
     shadows: Shadows,
     #[arg(long, value_enum, default_value = "none")]
     transparency: Transparency,
-    /// With --env --transparency occupancy: fragments seen less than this fraction are not
-    /// shaded (early termination).
-    #[arg(long, default_value_t = strandlight_runtime::env::ViewTransparency::DEFAULT_CUTOFF)]
-    visibility_cutoff: f32,
-    /// With --env: what the SRBF transmittance's box averages (Ren 2010: the optical depth).
-    #[arg(long, value_enum, default_value = "optical-depth")]
-    box_average: crate::env_scene::BoxAverageArg,
-    /// With --env --scattering full: where the forward-scattering shadow paths are marched.
-    #[arg(long, value_enum, default_value = "auto")]
-    forward_scattering: crate::env_scene::ForwardDevice,
+    /// With --env: the env-lit renderer's view choices.
+    #[command(flatten)]
+    env_view: crate::env_scene::ViewArgs,
     /// Deep opacity map layers (1..=8), with --shadows dom.
     #[arg(long, default_value_t = 4)]
     dom_layers: u32,
@@ -451,9 +444,7 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
     }
     let look_args = crate::env_scene::LookArgs {
         transparency: if args.transparency == Transparency::Occupancy { crate::env_scene::EnvTransparency::Occupancy } else { crate::env_scene::EnvTransparency::Opaque },
-        visibility_cutoff: args.visibility_cutoff,
-        box_average: args.box_average,
-        forward_scattering: args.forward_scattering,
+        view: args.env_view,
     };
     let look = crate::env_scene::EnvLook { count_fragments: args.json, ..look_args.look()? };
     let (width, height) = parse_size(&args.size)?;
@@ -502,9 +493,9 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
             "mode": mode.name(),
             "frame_ms": rendered.milliseconds,
             "transparency": look_args.transparency,
-            "box_average": look_args.box_average,
-            "forward_scattering": look_args.forward_scattering,
-            "visibility_cutoff": args.visibility_cutoff,
+            "box_average": look_args.view.box_average,
+            "forward_scattering": look_args.view.forward_scattering,
+            "visibility_cutoff": look_args.view.visibility_cutoff,
             "memory_per_batch_bytes": rendered.memory_per_batch.iter().map(|(n, b)| (n.clone(), serde_json::json!(b))).collect::<serde_json::Map<_, _>>(),
             "memory_per_batch_total_bytes": rendered.memory_per_batch.iter().map(|(_, b)| b).sum::<u64>(),
             "fragments": rendered.fragments.map(|f| serde_json::json!({ "rasterized": f.rasterized, "shaded": f.shaded, "note": "per batch (each batch draws the same fragments)" })),
