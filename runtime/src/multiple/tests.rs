@@ -52,6 +52,25 @@ fn tables() -> ForwardScatteringTables {
     ForwardScatteringTables::from_tables(&fiber, &ratio, &spread).unwrap()
 }
 
+/// `strands` random walks of `points` points with isotropic steps of length `step`, starting
+/// uniformly in an 8-cube, fibers of diameter `diameter`.
+fn tangled_hair(rng: &mut Rng, strands: usize, points: usize, step: f32, diameter: f32) -> HairModel {
+    let mut positions = Vec::new();
+    let mut offsets = vec![0u32];
+    for _ in 0..strands {
+        let mut p = Vec3::new(rng.unit() as f32, rng.unit() as f32, rng.unit() as f32) * 8.0;
+        for _ in 0..points {
+            positions.push(p);
+            let z = 2.0 * rng.unit() - 1.0;
+            let a = 2.0 * std::f64::consts::PI * rng.unit();
+            let s = (1.0 - z * z).sqrt();
+            p += step * Vec3::new((s * a.cos()) as f32, (s * a.sin()) as f32, z as f32);
+        }
+        offsets.push(positions.len() as u32);
+    }
+    HairModel::new(positions, offsets, Some(Attribute::Uniform(diameter)), None, None).unwrap()
+}
+
 /// 16 × 16 strands along +y at x, z = 0.5, 1.5, …, 15.5 (spacing 1), y from 0 to 32 in unit
 /// segments. With 8 voxels on the longest side (y) voxels are 4-cubes whose faces fall on
 /// 0, 4, 8, …: each voxel holds exactly 16 fibers 4 long.
@@ -158,20 +177,7 @@ fn fibers_drawn_around_an_axis_give_back_their_deviation() {
 fn random_directions_give_a_large_deviation() {
     // Random walks with isotropic steps: E[sin² r] = 2/3, beyond the table's ν range.
     let mut rng = Rng(12345);
-    let mut points = Vec::new();
-    let mut offsets = vec![0u32];
-    for _ in 0..400 {
-        let mut p = Vec3::new(rng.unit() as f32, rng.unit() as f32, rng.unit() as f32) * 8.0;
-        for _ in 0..200 {
-            points.push(p);
-            let z = 2.0 * rng.unit() - 1.0;
-            let a = 2.0 * std::f64::consts::PI * rng.unit();
-            let s = (1.0 - z * z).sqrt();
-            p += 0.1 * Vec3::new((s * a.cos()) as f32, (s * a.sin()) as f32, z as f32);
-        }
-        offsets.push(points.len() as u32);
-    }
-    let model = HairModel::new(points, offsets, Some(Attribute::Uniform(0.01)), None, None).unwrap();
+    let model = tangled_hair(&mut rng, 400, 200, 0.1, 0.01);
     let volume = HairVolume::build(&model, &settings(4, 1, 0.5).voxels, 1.0).unwrap();
     let occupied: Vec<f32> = (0..volume.deviation.len())
         .filter(|&v| volume.fiber_length[v] > 5.0)
@@ -415,20 +421,7 @@ fn light_sweep_agrees_with_per_point_marching_on_tangled_hair() {
     // Random walks in a box, oblique light: the two ways of computing the same expected paths
     // differ only by their filters (tent over one voxel vs 2³ taps over one voxel).
     let mut rng = Rng(777);
-    let mut points = Vec::new();
-    let mut offsets = vec![0u32];
-    for _ in 0..300 {
-        let mut p = Vec3::new(rng.unit() as f32, rng.unit() as f32, rng.unit() as f32) * 8.0;
-        for _ in 0..100 {
-            points.push(p);
-            let z = 2.0 * rng.unit() - 1.0;
-            let a = 2.0 * std::f64::consts::PI * rng.unit();
-            let s = (1.0 - z * z).sqrt();
-            p += 0.15 * Vec3::new((s * a.cos()) as f32, (s * a.sin()) as f32, z as f32);
-        }
-        offsets.push(points.len() as u32);
-    }
-    let model = HairModel::new(points, offsets, Some(Attribute::Uniform(0.02)), None, None).unwrap();
+    let model = tangled_hair(&mut rng, 300, 100, 0.15, 0.02);
     let light = EnvLight::directional(Vec3::new(0.3, -0.5, 0.8), [1.0; 3]);
     let probes: Vec<Vec3> = model.points().iter().step_by(97).copied().collect();
     let march = CpuForwardScattering::new(&model, tables(), settings(16, 4, 0.25)).unwrap();
@@ -453,20 +446,7 @@ fn gpu_march_matches_the_cpu_march() {
     // the direct paths. Both sources march the same f32 positions through the same medium; the
     // recursion runs in f64 on the CPU and f32 on the GPU.
     let mut rng = Rng(4242);
-    let mut points = Vec::new();
-    let mut offsets = vec![0u32];
-    for _ in 0..200 {
-        let mut p = Vec3::new(rng.unit() as f32, rng.unit() as f32, rng.unit() as f32) * 8.0;
-        for _ in 0..60 {
-            points.push(p);
-            let z = 2.0 * rng.unit() - 1.0;
-            let a = 2.0 * std::f64::consts::PI * rng.unit();
-            let s = (1.0 - z * z).sqrt();
-            p += 0.2 * Vec3::new((s * a.cos()) as f32, (s * a.sin()) as f32, z as f32);
-        }
-        offsets.push(points.len() as u32);
-    }
-    let model = HairModel::new(points, offsets, Some(Attribute::Uniform(0.1)), None, None).unwrap();
+    let model = tangled_hair(&mut rng, 200, 60, 0.2, 0.1);
     let mut lights = vec![EnvLight::directional(Vec3::Z, [1.0; 3]), EnvLight::srbf(Vec3::X, 30.0, [1.0; 3])];
     while lights.len() < 18 {
         let d = Vec3::new(rng.unit() as f32, rng.unit() as f32, rng.unit() as f32) * 2.0 - 1.0;
