@@ -324,10 +324,12 @@ fn mangled_real_files_never_panic() {
         };
         *tally.entry(key).or_default() += 1;
     };
+    let mut real_files = 0;
     for name in names {
         let Some(path) = shared_file(&format!("hair/{name}")) else {
             continue;
         };
+        real_files += 1;
         let original = std::fs::read(&path).unwrap();
         let big = original.len() > 1_000_000;
         for _ in 0..if big { 6 } else { 60 } {
@@ -388,8 +390,11 @@ fn mangled_real_files_never_panic() {
     for message in examples.values() {
         eprintln!("  e.g. {message}");
     }
+    // Random bytes alone reach five kinds of error; mangled real files (when the shared data
+    // is there) also reach loads that succeed or fail deeper in the file.
+    let kinds = if real_files > 0 { 6 } else { 5 };
     assert!(
-        tally.len() > 5,
-        "the mangling should reach several distinct errors: {tally:?}"
+        tally.len() >= kinds,
+        "the mangling should reach at least {kinds} distinct outcomes over {real_files} real files: {tally:?}"
     );
 }
