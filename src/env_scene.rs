@@ -130,7 +130,8 @@ pub enum EnvTransparency {
 #[serde(rename_all = "kebab-case")]
 pub enum ForwardDevice {
     /// The GPU on a hardware adapter, rayon on a software one (lavapipe runs compute shaders on
-    /// the same CPU cores, where rayon was measured faster: docs/BENCHMARKS.md).
+    /// the same CPU cores, where rayon measured 4–9% faster at the interactive grid:
+    /// docs/BENCHMARKS.md, "CPU vs GPU march").
     Auto,
     Cpu,
     Gpu,
