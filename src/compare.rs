@@ -3,9 +3,10 @@
 //! the equal-time median-cut baseline; per scattering mode the frame times, the relative RMSE
 //! against the reference over hair pixels, and the speed ratios; the images side by side.
 
+use strandlight_tables::checksum::sha256_hex;
 use crate::env_lights::to_env_lights;
 use crate::env_scene::{forward_settings, FrameRole, 
-    bake_scene_tables, fit_cached, load_env, render_lights, sha256_hex, EnvFrame, EnvShading, RenderedEnv, ScatteringMode, SceneTables,
+    bake_scene_tables, fit_cached, load_env, render_lights, EnvFrame, EnvShading, RenderedEnv, ScatteringMode, SceneTables,
 };
 use crate::equal_time::{equal_error_lights, equal_time_lights, EqualTimeSearch};
 use crate::image_compare::{error_legend, relative_rmse, write_side_by_side, Image};

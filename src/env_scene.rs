@@ -20,15 +20,11 @@ use strandlight_runtime::multiple::{CpuForwardScattering, ForwardScatteringSetti
 use strandlight_runtime::env::{ForwardScatteringSource, EnvLight, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables, FragmentCounts, ViewTransparency, BoxAverage};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
+use strandlight_tables::checksum::sha256_hex;
 use strandlight_tables::asset::{expect_parameters, read_asset, Storage, TableAsset};
 
 /// Width at which procedural environments are generated (as `fit` does).
 pub const PROCEDURAL_WIDTH: usize = 1024;
-
-/// SHA-256 (hex) of bytes.
-pub fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes).iter().map(|b| format!("{b:02x}")).collect()
-}
 
 /// SHA-256 of a map's size and pixel values (little-endian f32): identifies a procedural map
 /// by what it is, so a change to its generator invalidates every cache keyed by it.

@@ -2,7 +2,7 @@
 //! `DIR/KEY.exr` (linear RGBA) beside `DIR/KEY.json` (the inputs and the measured time), both
 //! written atomically. A hit needs both files and the same inputs recorded in the JSON.
 
-use crate::env_scene::sha256_hex;
+use strandlight_tables::checksum::sha256_hex;
 use crate::image_compare::Image;
 use anyhow::Context;
 use serde::{Deserialize, Serialize};

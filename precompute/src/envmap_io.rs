@@ -4,7 +4,8 @@
 
 use crate::envmap::{BadPixelCounts, EnvMap};
 use crate::envmap_error::EnvMapError;
-use sha2::{Digest, Sha256};
+use strandlight_tables::atomic_write::write_atomically;
+use strandlight_tables::checksum::sha256_hex;
 use std::path::{Path, PathBuf};
 
 /// How to treat a map's bad pixels (NaN, ±Inf, negative).
@@ -31,7 +32,7 @@ pub fn load(path: &Path, options: LoadOptions) -> Result<LoadedEnvMap, EnvMapErr
         path: path.into(),
         source,
     })?;
-    let sha256 = hex(&Sha256::digest(&bytes));
+    let sha256 = sha256_hex(&bytes);
     let mut map = decode(path, &bytes)?;
     if map.width() != 2 * map.height() {
         return Err(EnvMapError::NotTwoToOne {
@@ -102,24 +103,19 @@ fn decode_exr(path: &Path, bytes: &[u8]) -> Result<EnvMap, EnvMapError> {
     Ok(EnvMap::from_pixels(pixels.width, height, pixels.data))
 }
 
-fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02x}")).collect()
-}
-
 /// Writes an EXR (f32, RGB) atomically: used for tests and for debugging output.
 pub fn write_exr(map: &EnvMap, path: &Path) -> Result<(), EnvMapError> {
     use exr::prelude::*;
-    let tmp = crate::atomic::temp_path(path);
     let w = map.width();
-    write_rgb_file(&tmp, w, map.height(), |x, y| {
-        let p = map.pixel(x, y);
-        (p[0], p[1], p[2])
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let [r, g, b] = map.pixel(p.x(), p.y());
+        (r, g, b)
+    });
+    let image = Image::from_channels((w, map.height()), channels);
+    write_atomically(path, |out| {
+        image.write().to_buffered(out).map_err(std::io::Error::other)
     })
-    .map_err(|e| EnvMapError::Exr {
-        path: path.into(),
-        message: e.to_string(),
-    })?;
-    std::fs::rename(&tmp, path).map_err(|source| EnvMapError::Io {
+    .map_err(|source| EnvMapError::Io {
         path: path.into(),
         source,
     })

@@ -13,7 +13,6 @@
 //! [`bake_plan`] (which tables a fiber needs), [`bake`] (assets and the cache),
 //! [`table_check`] and [`check_tables`] (accuracy against f64 references).
 
-pub mod atomic;
 pub mod attenuation_ratio;
 pub mod bake;
 pub mod bake_plan;

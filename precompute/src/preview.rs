@@ -5,6 +5,7 @@
 //! per channel, then the sRGB transfer curve. The error panel shows |fit − original| with the
 //! same exposure, so equal brightness means equal radiance in all three panels.
 
+use strandlight_tables::atomic_write::write_atomically;
 use crate::envmap::EnvMap;
 use std::path::Path;
 use strandlight_tables::srbf::SrbfLobe;
@@ -62,7 +63,8 @@ pub fn write_preview(
         image::ImageFormat::Png,
     )
     .map_err(|e| write_err(e.to_string()))?;
-    crate::atomic::write(path, &bytes).map_err(|e| write_err(e.to_string()))
+    write_atomically(path, |out| std::io::Write::write_all(out, &bytes))
+        .map_err(|e: std::io::Error| write_err(e.to_string()))
 }
 
 fn encode(x: f64) -> u8 {

@@ -7,6 +7,7 @@
 //! light's power (∫ L dω of its region), so one format serves both; a renderer that wants delta
 //! lights uses `power()` and the center.
 
+use strandlight_tables::atomic_write::write_atomically;
 use crate::compact_sources::CompactSource;
 use crate::envmap::BadPixelCounts;
 use crate::srbf_fit::{FitOptions, RoundRecord};
@@ -100,7 +101,7 @@ pub enum SrbfSetError {
 impl SrbfSet {
     pub fn save(&self, path: &Path) -> Result<(), SrbfSetError> {
         let json = serde_json::to_vec_pretty(self).expect("an SrbfSet always serializes");
-        crate::atomic::write(path, &json).map_err(|source| SrbfSetError::Io {
+        write_atomically(path, |out| std::io::Write::write_all(out, &json)).map_err(|source| SrbfSetError::Io {
             path: path.into(),
             source,
         })

@@ -24,6 +24,7 @@ use crate::table::{Axis, Table, TableError, checked_value_count};
 use half::f16;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
+use crate::checksum::sha256_hex;
 use sha2::{Digest, Sha256};
 use std::fs::File;
 use std::io::{self, Read, Seek, SeekFrom, Write};
@@ -296,13 +297,6 @@ fn encode_payload(path: &Path, table: &Table, storage: Storage) -> Result<Vec<u8
         }
     }
     Ok(bytes)
-}
-
-fn sha256_hex(bytes: &[u8]) -> String {
-    Sha256::digest(bytes)
-        .iter()
-        .map(|b| format!("{b:02x}"))
-        .collect()
 }
 
 /// Reads and checks an asset: header, metadata, shape, payload size and checksum.

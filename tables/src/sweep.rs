@@ -4,9 +4,10 @@
 //! `hard_case_sweep(samples, seed) -> SweepReport`; tests assert a clean report and print it,
 //! and a benchmark CLI can call the same functions.
 //!
-//! The generator is a self-contained SplitMix64 so that the library needs no `rand` dependency
+//! The generator is the crate's [`SplitMix64`] so that the library needs no `rand` dependency
 //! and a sweep is reproducible from its seed alone.
 
+use crate::split_mix::SplitMix64;
 use std::f64::consts::{FRAC_PI_2, PI};
 use std::fmt;
 
@@ -92,26 +93,22 @@ impl fmt::Display for SweepReport {
     }
 }
 
-/// SplitMix64 (Steele, Lea, Flood 2014): tiny, fast, and good enough for test sampling.
+/// [`SplitMix64`] with the samplers of hard cases the sweeps draw.
 #[derive(Debug, Clone)]
-pub struct SweepRng(u64);
+pub struct SweepRng(SplitMix64);
 
 impl SweepRng {
     pub fn new(seed: u64) -> Self {
-        Self(seed ^ 0x9E37_79B9_7F4A_7C15)
+        Self(SplitMix64::new(seed ^ 0x9E37_79B9_7F4A_7C15))
     }
 
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
 
     /// Uniform in [0, 1).
     pub fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+        self.0.uniform()
     }
 
     pub fn range(&mut self, a: f64, b: f64) -> f64 {

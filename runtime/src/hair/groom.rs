@@ -8,7 +8,7 @@
 //! each strand exactly its drawn length and, with the scalp as a convex collider, keeps every
 //! point outside the head. Y is up; units are the caller's (the defaults read as centimetres).
 //!
-//! The random numbers come from a local SplitMix64 so that a seed gives the same groom whatever
+//! The random numbers come from the tables crate's SplitMix64 so that a seed gives the same groom whatever
 //! version of an RNG crate is linked: this model is embedded, and its bytes are tested.
 
 use std::f32::consts::TAU;
@@ -16,6 +16,7 @@ use std::f32::consts::TAU;
 use glam::Vec3;
 use strandlight_tables::ParamError;
 use strandlight_tables::error::check;
+use strandlight_tables::split_mix::SplitMix64;
 
 use super::{Attribute, HairError, HairModel};
 
@@ -160,28 +161,6 @@ impl GroomParams {
     }
 }
 
-/// SplitMix64 (Steele, Lea, Flood 2014): tiny, fast, and fixed forever.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-
-    /// Uniform in [0, 1) with 24 bits, exact in f32.
-    fn unit(&mut self) -> f32 {
-        (self.next_u64() >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
-    }
-
-    fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        lo + (hi - lo) * self.unit()
-    }
-}
-
 /// How steeply strands leave the scalp: the normal's weight against the (unit) comb direction.
 const ROOT_LIFT: f32 = 0.35;
 
@@ -197,7 +176,7 @@ struct StrandSeed {
 /// Grows the groom described by `params`. The same parameters give the same bytes.
 pub fn generate_groom(params: &GroomParams) -> Result<HairModel, HairError> {
     params.validate()?;
-    let mut rng = SplitMix64(params.seed);
+    let mut rng = SplitMix64::new(params.seed);
     let seeds: Vec<StrandSeed> = (0..params.strand_count)
         .map(|_| draw_strand(&mut rng, params))
         .collect();
@@ -254,8 +233,8 @@ fn draw_strand(rng: &mut SplitMix64, params: &GroomParams) -> StrandSeed {
     // Uniform on the unit-sphere cap, rejecting the part below the (front) hairline.
     let cos_max = scalp.max_polar_angle.max(scalp.front_polar_angle).cos();
     let d = loop {
-        let cos_theta = 1.0 - rng.unit() * (1.0 - cos_max);
-        let phi = TAU * rng.unit();
+        let cos_theta = 1.0 - rng.unit_f32() * (1.0 - cos_max);
+        let phi = TAU * rng.unit_f32();
         let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
         let d = Vec3::new(sin_theta * phi.cos(), cos_theta, sin_theta * phi.sin());
         if cos_theta.clamp(-1.0, 1.0).acos() <= scalp.polar_limit(d) {
@@ -264,16 +243,16 @@ fn draw_strand(rng: &mut SplitMix64, params: &GroomParams) -> StrandSeed {
     };
     let root = scalp.center + scalp.radii * d;
     let lean = Vec3::new(
-        rng.range(-1.0, 1.0),
-        rng.range(-1.0, 1.0),
-        rng.range(-1.0, 1.0),
+        rng.range_f32(-1.0, 1.0),
+        rng.range_f32(-1.0, 1.0),
+        rng.range_f32(-1.0, 1.0),
     );
     StrandSeed {
         root,
-        length: rng.range(params.length_min, params.length_max),
+        length: rng.range_f32(params.length_min, params.length_max),
         lean,
-        curl_radius: params.curl_radius * rng.range(0.7, 1.3),
-        curl_phase: TAU * rng.unit(),
+        curl_radius: params.curl_radius * rng.range_f32(0.7, 1.3),
+        curl_phase: TAU * rng.unit_f32(),
     }
 }
 

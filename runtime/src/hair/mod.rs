@@ -50,24 +50,16 @@ fn read_file(path: &Path) -> Result<Vec<u8>, HairError> {
     })
 }
 
-/// Writes through a temporary file beside `path` and renames it, so that a failure never leaves
-/// a half-written file under the final name.
+/// Writes `bytes` through [`strandlight_tables::atomic_write`], so that a failure never leaves a
+/// half-written file under the final name.
 fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), HairError> {
-    let mut tmp_name = path.file_name().unwrap_or_default().to_os_string();
-    tmp_name.push(format!(".{}.tmp", std::process::id()));
-    let tmp = path.with_file_name(tmp_name);
-    let io = |action, source| HairError::Io {
+    strandlight_tables::atomic_write::write_atomically(path, |out| {
+        std::io::Write::write_all(out, bytes)
+    })
+    .map_err(|source| HairError::Io {
         file: path.into(),
-        action,
+        action: "write",
         source,
-    };
-    std::fs::write(&tmp, bytes).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        io("write", e)
-    })?;
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        io("rename the temporary file onto", e)
     })
 }
 
