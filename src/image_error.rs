@@ -7,8 +7,8 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 
-use crate::image_compare::relative_rmse;
-use crate::reference_cache::read_rgba_exr;
+use strandlight_scene::image_metrics::relative_rmse;
+use strandlight_scene::reference_cache::read_rgba_exr;
 
 #[derive(Args, Debug)]
 pub struct ImageErrorArgs {

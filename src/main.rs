@@ -4,15 +4,9 @@
 mod compare;
 mod compare_table;
 mod demo;
-mod env_lights;
-mod env_scene;
-mod equal_time;
 mod fit;
-mod image_compare;
 mod image_error;
-mod reference_cache;
 mod render;
-mod steps;
 mod summary;
 mod sweep;
 mod tables_cmd;
@@ -48,7 +42,7 @@ enum Command {
     Render(render::RenderArgs),
     /// SRBF lights vs the brute-force cube-texel reference and the equal-time median-cut
     /// baseline (Ren 2010 §8): frame times, relative RMSE over hair pixels, images side by side.
-    Compare(compare::CompareArgs),
+    Compare(strandlight_scene::compare::CompareArgs),
     /// The markdown table of docs/BENCHMARKS.md from `compare --json` reports.
     CompareTable(compare_table::CompareTableArgs),
     /// Relative RMSE between two EXR images over the reference's hair pixels.

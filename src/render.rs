@@ -1,6 +1,7 @@
 //! `strandlight render`: one headless frame of a hair model under point lights, written as a
 //! linear EXR and a tonemapped PNG, with timings and GPU memory on request.
 
+use strandlight_scene::hair_input::{load_hair, parse_size};
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
@@ -8,7 +9,7 @@ use clap::{Args, ValueEnum};
 use strandlight_precompute::point_light_luts::{LutResolution, bake_lut_m, bake_lut_n};
 use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::gpu::GpuContext;
-use strandlight_runtime::hair::{self, GroomParams, HairModel};
+use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::DomSettings;
@@ -67,7 +68,7 @@ pub struct RenderArgs {
     pub env: Option<String>,
     /// With --env: single scattering, or full (single + multiple; skipped for dark hair).
     #[arg(long, value_enum, default_value = "full")]
-    pub scattering: crate::env_scene::ScatteringMode,
+    pub scattering: strandlight_scene::scene_tables::ScatteringMode,
     /// With --env: fraction of the strands drawn into the light maps (Ren §7; 1 = all).
     #[arg(long, default_value_t = 0.1)]
     pub kappa: f32,
@@ -86,7 +87,7 @@ pub struct RenderArgs {
     transparency: Transparency,
     /// With --env: the env-lit renderer's view choices.
     #[command(flatten)]
-    env_view: crate::env_scene::ViewArgs,
+    env_view: strandlight_scene::look::ViewArgs,
     /// Deep opacity map layers (1..=8), with --shadows dom.
     #[arg(long, default_value_t = 4)]
     dom_layers: u32,
@@ -126,41 +127,11 @@ pub struct RenderArgs {
     json: bool,
 }
 
-pub(crate) fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
-    let (w, h) = text
-        .split_once(['x', 'X'])
-        .with_context(|| format!("--size {text:?}: expected WxH, e.g. 656x861"))?;
-    let parse = |s: &str| -> anyhow::Result<u32> {
-        let v: u32 = s
-            .trim()
-            .parse()
-            .with_context(|| format!("--size {text:?}: {s:?} is not a whole number"))?;
-        if v == 0 {
-            bail!("--size {text:?}: sides must be at least 1 pixel");
-        }
-        Ok(v)
-    };
-    Ok((parse(w)?, parse(h)?))
-}
-
 /// `render.exr` → `render`: the stem may be given with either extension.
 fn output_stem(out: &Path) -> PathBuf {
     match out.extension().and_then(|e| e.to_str()) {
         Some("exr" | "png") => out.with_extension(""),
         _ => out.to_path_buf(),
-    }
-}
-
-pub(crate) fn load_hair(path: Option<&Path>) -> anyhow::Result<(HairModel, String)> {
-    match path {
-        Some(path) => {
-            let loaded = hair::load(path)?;
-            Ok((loaded.model, path.display().to_string()))
-        }
-        None => Ok((
-            hair::generate_groom(&GroomParams::default())?,
-            "procedural groom (default parameters)".to_string(),
-        )),
     }
 }
 
@@ -431,7 +402,11 @@ mod tests {
 
 /// `render --env MAP`: the SRBF path alone (fit and tables cached under out/cache).
 fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
-    use crate::env_scene::{bake_scene_tables, fit_cached, load_env, render_lights, EnvFrame, EnvShading, FrameRole, ScatteringMode};
+    use strandlight_scene::env_frame::{EnvFrame, FrameRole, fit_summary, light_summary, render_lights};
+    use strandlight_scene::environment::load_env;
+    use strandlight_scene::fit_cache::fit_cached;
+    use strandlight_scene::look::{EnvLook, EnvTransparency, LookArgs};
+    use strandlight_scene::scene_tables::{EnvShading, ScatteringMode, bake_scene_tables, lambda_range_of_set, wanted_tables};
     use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
     use strandlight_precompute::env_lights::srbf_set_lights;
     let shading = match args.shading.unwrap_or(Shading::Marschner) {
@@ -442,17 +417,17 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
     if matches!(args.transparency, Transparency::Abuffer | Transparency::Dbk) || args.shadows != Shadows::None {
         bail!("--env shadows every SRBF light with its convolution optical depth map and renders opaque (none) or through an occupancy map (occupancy); --shadows, --transparency abuffer/dbk apply to point lights only");
     }
-    let look_args = crate::env_scene::LookArgs {
-        transparency: if args.transparency == Transparency::Occupancy { crate::env_scene::EnvTransparency::Occupancy } else { crate::env_scene::EnvTransparency::Opaque },
+    let look_args = LookArgs {
+        transparency: if args.transparency == Transparency::Occupancy { EnvTransparency::Occupancy } else { EnvTransparency::Opaque },
         view: args.env_view,
     };
-    let look = crate::env_scene::EnvLook { count_fragments: args.json, ..look_args.look()? };
+    let look = EnvLook { count_fragments: args.json, ..look_args.look()? };
     let (width, height) = parse_size(&args.size)?;
-    let mut steps = crate::steps::Steps::new(args.json);
+    let mut steps = strandlight_scene::steps::Steps::new(args.json);
     let (model, source) = steps.run("hair", || load_hair(args.hair.as_deref()), |(m, s)| format!("{s} ({} strands)", m.strand_count()))?;
     let env = steps.run("environment", || load_env(env_spec, false), |e| format!("{} {}x{}", e.name, e.map.width(), e.map.height()))?;
     let cache = Path::new("out/cache");
-    let fit = steps.run("fit", || fit_cached(&env, &strandlight_precompute::FitOptions::default(), cache), |f| format!("{}{}", crate::env_scene::fit_summary(&f.set), if f.cached { " (cached)" } else { "" }))?;
+    let fit = steps.run("fit", || fit_cached(&env, &strandlight_precompute::FitOptions::default(), cache), |f| format!("{}{}", fit_summary(&f.set), if f.cached { " (cached)" } else { "" }))?;
     let fiber = FiberDescription::preset(&args.preset).with_context(|| format!("--preset {:?}", args.preset))?;
     // Full asks for the single-scattering tables too: dark hair skips the multiple table and the
     // frame falls back to single scattering (below).
@@ -460,8 +435,8 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
         ScatteringMode::Single => &[ScatteringMode::Single],
         ScatteringMode::Full => &[ScatteringMode::Single, ScatteringMode::Full],
     };
-    let wanted = crate::env_scene::wanted_tables(shading, modes, !fit.set.lobes.is_empty(), !fit.set.sources.is_empty());
-    let lambda_range = crate::tables_cmd::lambda_range_of_set(&fit.set)?;
+    let wanted = wanted_tables(shading, modes, !fit.set.lobes.is_empty(), !fit.set.sources.is_empty());
+    let lambda_range = lambda_range_of_set(&fit.set)?;
     let dir = cache.join("tables").join(format!("{}-{:?}", args.preset, shading).to_lowercase());
     let tables = steps.run("bake", || bake_scene_tables(&fiber, shading, BakeResolution::default(), lambda_range, &wanted, &dir, &mut |_| {}), |t| format!("{} tables ({} cached)", t.baked.len(), t.baked.iter().filter(|b| b.cached).count()))?;
     let mode = if args.scattering == ScatteringMode::Full && !tables.assets.contains_key("multiple") {
@@ -474,12 +449,12 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
     };
     let camera = choose_camera(args, &model, width as f32 / height as f32)?;
     let up = UpAxis::detect(&model);
-    let lights = crate::env_lights::to_env_lights(&srbf_set_lights(&fit.set), up);
+    let lights = strandlight_scene::world_lights::to_env_lights(&srbf_set_lights(&fit.set), up);
     let frame = EnvFrame { hair: &model, camera, width, height, lights: &lights, tables: &tables, shading, mode, role: FrameRole::Interactive { kappa: args.kappa }, look };
-    let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {}, {} scattering", r.milliseconds, crate::env_scene::light_summary(&lights), mode.name()))?;
+    let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {}, {} scattering", r.milliseconds, light_summary(&lights), mode.name()))?;
     let stem = output_stem(&args.out);
     let (exr_path, png_path) = (stem.with_extension("exr"), stem.with_extension("png"));
-    let description = format!("{source}; {width}x{height}; env {env_spec}, {}; {shading:?} ({}), {} scattering", crate::env_scene::light_summary(&lights), args.preset, mode.name());
+    let description = format!("{source}; {width}x{height}; env {env_spec}, {}; {shading:?} ({}), {} scattering", light_summary(&lights), args.preset, mode.name());
     let image = &rendered.image;
     write_exr(&exr_path, width, height, &image.pixels, &description)?;
     write_png(&png_path, width, height, &image.pixels, &description)?;

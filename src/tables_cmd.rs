@@ -1,6 +1,7 @@
 //! `strandlight bake`, `check-tables` and `inspect`: the convolution tables of Ren 2010 §4/§6
 //! and the point-light lookup textures, baked, checked against f64 integration, and pictured.
 
+use strandlight_scene::scene_tables::lambda_range_of_set;
 use anyhow::{bail, Context};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
@@ -92,26 +93,6 @@ fn progress(len: u64, hidden: bool) -> ProgressBar {
 fn lambda_range_of(path: &Path) -> anyhow::Result<(f64, f64)> {
     let set = SrbfSet::load(path)?;
     lambda_range_of_set(&set).with_context(|| path.display().to_string())
-}
-
-/// λ range of an SRBF set with a 10% margin (the bake's 1/λ axis spans only this). A set of
-/// compact sources alone (a sun on black: no lobes) gets the fit's default range, which no
-/// table uses (`wanted_tables` then asks for no SRBF table).
-pub fn lambda_range_of_set(set: &SrbfSet) -> anyhow::Result<(f64, f64)> {
-    let lambdas = set.lobes.iter().map(|l| l.lambda);
-    let (lo, hi) = lambdas.fold((f64::INFINITY, 0.0f64), |(lo, hi), l| (lo.min(l), hi.max(l)));
-    if !(lo.is_finite() && hi > 0.0) {
-        if set.sources.is_empty() {
-            bail!("the SRBF set holds no lobes and no compact sources (a black map?)");
-        }
-        let defaults = strandlight_precompute::FitOptions::default();
-        return Ok((defaults.lambda_min, defaults.lambda_max));
-    }
-    let (lo, hi) = (lo / 1.1, hi * 1.1);
-    if hi > 1e4 {
-        bail!("λ up to {hi:.0} (directional lights?); bake tables for SRBF sets, not directional baselines");
-    }
-    Ok((lo, if hi > lo * 1.01 { hi } else { lo * 1.01 }))
 }
 
 pub fn bake(args: BakeArgs) -> anyhow::Result<()> {

@@ -46,7 +46,7 @@ const MULTIPLE_TABLES: [&str; 4] = ["multiple", "fiber_averages", "attenuation_r
 /// Light-pass map resolution for every light of both paths (half the default: the groom spans
 /// ~100 pixels, and the light pass dominates the reference's 384 lights).
 const DODM_RESOLUTION: u32 = 256;
-/// Pixels whose reference alpha exceeds this are hair (as `src/image_compare.rs`).
+/// Pixels whose reference alpha exceeds this are hair (as `scene/src/image_metrics.rs`).
 const HAIR_ALPHA: f32 = 1e-3;
 
 /// Everything both tests share: built once per test binary.
@@ -178,7 +178,7 @@ fn render(scene: &Scene, lights: &[EnvLight], tables: EnvTables, shadowed: bool,
 }
 
 /// √(Σ‖a − r‖² / Σ‖r‖²) over RGB of the pixels where the reference's alpha exceeds
-/// [`HAIR_ALPHA`] (the definition of `src/image_compare.rs`).
+/// [`HAIR_ALPHA`] (the definition of `scene/src/image_metrics.rs`).
 fn relative_rmse(a: &[[f32; 4]], r: &[[f32; 4]]) -> f64 {
     let (mut num, mut den) = (0.0f64, 0.0f64);
     for (a, r) in a.iter().zip(r).filter(|(_, r)| r[3] > HAIR_ALPHA) {

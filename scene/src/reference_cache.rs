@@ -3,7 +3,7 @@
 //! written atomically. A hit needs both files and the same inputs recorded in the JSON.
 
 use strandlight_tables::checksum::sha256_hex;
-use crate::image_compare::Image;
+use crate::image_metrics::Image;
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
@@ -68,7 +68,7 @@ impl ReferenceCache {
 }
 
 /// A linear RGBA EXR as written by `strandlight_runtime::image_out::write_exr`.
-pub fn read_rgba_exr(path: &Path) -> anyhow::Result<crate::image_compare::Image> {
+pub fn read_rgba_exr(path: &Path) -> anyhow::Result<crate::image_metrics::Image> {
     use exr::prelude::*;
     let image = read_first_rgba_layer_from_file(
         path,
@@ -78,7 +78,7 @@ pub fn read_rgba_exr(path: &Path) -> anyhow::Result<crate::image_compare::Image>
     .with_context(|| format!("{}: not a readable RGBA EXR", path.display()))?;
     let size = image.layer_data.size;
     let (_, pixels) = image.layer_data.channel_data.pixels;
-    Ok(crate::image_compare::Image::new(size.width() as u32, size.height() as u32, pixels))
+    Ok(crate::image_metrics::Image::new(size.width() as u32, size.height() as u32, pixels))
 }
 
 #[cfg(test)]

@@ -1,0 +1,184 @@
+//! THE call into the environment-lit renderer: one frame (hair, camera, lights, tables, look)
+//! rendered on a GPU device created once per process, with its frame time.
+
+use crate::image_metrics::Image;
+use crate::look::{EnvLook, ForwardDevice};
+use crate::scene_tables::{EnvShading, SceneTables, ScatteringMode};
+use anyhow::Context;
+use std::sync::OnceLock;
+use strandlight_precompute::srbf_set::SrbfSet;
+use strandlight_runtime::camera::Camera;
+use strandlight_runtime::env::{EnvLight, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables, ForwardScatteringSource, FragmentCounts};
+use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::hair::HairModel;
+use strandlight_runtime::multiple::{CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering};
+
+/// "N SRBF lights" or "N SRBF lights + k directional" for a frame's lights.
+pub fn light_summary(lights: &[EnvLight]) -> String {
+    let srbf = lights.iter().filter(|l| l.lambda.is_some()).count();
+    match lights.len() - srbf {
+        0 => format!("{srbf} SRBF lights"),
+        k => format!("{srbf} SRBF lights + {k} directional"),
+    }
+}
+
+/// "N SRBFs + k compact sources (x% of the power), relative L2 error e" for a fitted set.
+pub fn fit_summary(set: &SrbfSet) -> String {
+    let sources = match set.sources.len() {
+        0 => String::new(),
+        n => format!(
+            " + {n} compact source{} as directional light{} ({:.0}% of the power)",
+            if n == 1 { "" } else { "s" },
+            if n == 1 { "" } else { "s" },
+            100.0 * set.sources.iter().map(|s| s.power_share).sum::<f64>()
+        ),
+    };
+    let without = if set.sources.is_empty() { "" } else { " (of the rest)" };
+    format!("{} SRBFs{sources}, relative L2 error {:.3}{without}", set.lobes.len(), set.relative_l2_error)
+}
+
+/// One frame for the environment-lit renderer: a hair, a camera and one set of lights (all
+/// SRBFs, directional lights, or SRBFs with a fit's compact sources as directional lights), shaded in `mode` with `tables`.
+pub struct EnvFrame<'a> {
+    pub hair: &'a HairModel,
+    pub camera: Camera,
+    pub width: u32,
+    pub height: u32,
+    pub lights: &'a [EnvLight],
+    pub tables: &'a SceneTables,
+    pub shading: EnvShading,
+    pub mode: ScatteringMode,
+    pub role: FrameRole,
+    pub look: EnvLook,
+}
+
+/// A rendered frame and its GPU time.
+pub struct RenderedEnv {
+    pub image: Image,
+    pub milliseconds: f64,
+    /// Per pass (summed over batches), milliseconds; empty for stand-in renderers.
+    pub passes: Vec<(String, f64)>,
+    /// With [`EnvLook::count_fragments`].
+    pub fragments: Option<FragmentCounts>,
+    /// GPU memory held while one batch renders, per resource (bytes); empty for stand-ins.
+    pub memory_per_batch: Vec<(String, u64)>,
+}
+
+/// The GPU device and the renderer's pipelines, created on first use and kept for every frame
+/// of the run (pipeline creation is a one-time cost, not part of a frame).
+struct GpuRenderer {
+    gpu: GpuContext,
+    renderer: EnvRenderer,
+}
+
+fn gpu_renderer() -> anyhow::Result<&'static GpuRenderer> {
+    static RENDERER: OnceLock<Result<GpuRenderer, String>> = OnceLock::new();
+    RENDERER
+        .get_or_init(|| {
+            let gpu = GpuContext::new_headless().map_err(|e| e.to_string())?;
+            let renderer = EnvRenderer::new(&gpu);
+            Ok(GpuRenderer { gpu, renderer })
+        })
+        .as_ref()
+        .map_err(|e| anyhow::anyhow!("no GPU device for the environment-lit renderer: {e}"))
+}
+
+/// Passes an application pays once (device, pipelines, uploads of hair and tables), not per
+/// frame; everything else the renderer times is the frame.
+const SETUP_PASSES: [&str; 3] = ["pipelines", "upload", "table upload"];
+
+/// Milliseconds of one frame: the renderer's passes without the one-time setup.
+pub fn frame_milliseconds(stats: &EnvRenderStats) -> f64 {
+    stats.timings.iter().filter(|t| !SETUP_PASSES.contains(&t.pass.as_str())).map(|t| t.milliseconds).sum()
+}
+
+/// Which renderer settings a frame uses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FrameRole {
+    /// The interactive method: SRBF lights (or the equal-cost directional baseline) with the
+    /// paper's sparse forward-scattering grid and, for SRBFs, stochastic simplification κ.
+    Interactive { kappa: f32 },
+    /// The brute-force reference: every fiber in every light's map (κ = 1) and the forward
+    /// scattering from the dense grid ([`ForwardScatteringSettings::dense_reference`]).
+    Reference,
+}
+
+fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
+    // κ thins the SRBF lights' light passes (the runtime never thins a directional light's).
+    let srbf = frame.lights.iter().any(|l| l.lambda.is_some());
+    let kappa = match frame.role {
+        FrameRole::Interactive { kappa } if srbf => kappa,
+        _ => 1.0,
+    };
+    let look = frame.look;
+    EnvRenderOptions { kappa, shadowed: look.shadowed, transparency: look.transparency, box_average: look.box_average, count_fragments: look.count_fragments, ..EnvRenderOptions::default() }
+}
+
+/// Forward-scattering settings of `role`.
+pub fn forward_settings(role: FrameRole) -> ForwardScatteringSettings {
+    match role {
+        FrameRole::Interactive { .. } => ForwardScatteringSettings::default(),
+        FrameRole::Reference => ForwardScatteringSettings::dense_reference(),
+    }
+}
+
+/// The forward-scattering source of Ren §6 for `frame` on the device its look asks for
+/// (voxelization included: a static hair pays it once, outside the frame time; dynamic hair per
+/// frame — see docs/BENCHMARKS.md). The reference's light sweep runs on the CPU only.
+fn forward_scattering<'g>(frame: &EnvFrame, gpu: &'g GpuContext) -> anyhow::Result<Box<dyn ForwardScatteringSource + 'g>> {
+    let tables = ForwardScatteringTables::from_tables(&frame.tables.get("fiber_averages")?.table, &frame.tables.get("attenuation_ratio")?.table, &frame.tables.get("srbf_spread")?.table)?;
+    let cpu = CpuForwardScattering::new(frame.hair, tables, forward_settings(frame.role))?;
+    Ok(match frame.look.forward_scattering {
+        _ if frame.role == FrameRole::Reference => Box::new(cpu),
+        ForwardDevice::Cpu => Box::new(cpu),
+        ForwardDevice::Gpu => Box::new(GpuForwardScattering::new(gpu, cpu).context("--forward-scattering gpu")?),
+        ForwardDevice::Auto if gpu.report.is_software => Box::new(cpu),
+        // A volume beyond the adapter's limits is still rendered, by rayon.
+        ForwardDevice::Auto => match GpuForwardScattering::new(gpu, cpu.clone()) {
+            Ok(on_gpu) => Box::new(on_gpu),
+            Err(_) => Box::new(cpu),
+        },
+    })
+}
+
+/// The runtime's tables for `frame`: the SRBF table of its mode for SRBF lights, the direct
+/// table for directional ones (the baselines, the reference, a fit's compact sources), and in
+/// full mode I_G.
+fn env_tables(frame: &EnvFrame) -> anyhow::Result<EnvTables> {
+    let mut tables = EnvTables::default();
+    if frame.lights.iter().any(|l| l.lambda.is_some()) {
+        tables.srbf = Some(frame.tables.get(frame.shading.srbf_table(frame.mode))?.table.clone());
+    }
+    if frame.lights.iter().any(|l| l.lambda.is_none()) {
+        tables.direct = Some(frame.tables.get(frame.shading.direct_table(frame.mode))?.table.clone());
+    }
+    if frame.mode == ScatteringMode::Full {
+        tables.multiple = Some(frame.tables.get("multiple")?.table.clone());
+    }
+    Ok(tables)
+}
+
+/// THE call into the environment-lit renderer. The SRBF path reads
+/// `tables.get(shading.srbf_table(mode))`, directional lights `tables.get(shading.direct_table(mode))`
+/// (4 axes, the 1/λ axis a single node), and the full mode also [`MULTIPLE_TABLES`].
+pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
+    let r = gpu_renderer()?;
+    let tables = env_tables(frame)?;
+    let source = match frame.mode {
+        ScatteringMode::Single => None,
+        ScatteringMode::Full => Some(forward_scattering(frame, &r.gpu)?),
+    };
+    let multiple = source.as_deref();
+    let out = r
+        .renderer
+        .render(&r.gpu, frame.hair, &frame.camera, frame.width, frame.height, frame.lights, &tables, &render_options(frame), multiple)
+        .with_context(|| format!("rendering {} lights ({} scattering)", frame.lights.len(), frame.mode.name()))?;
+    Ok(RenderedEnv {
+        milliseconds: frame_milliseconds(&out.stats),
+        passes: out.stats.timings.iter().map(|t| (t.pass.clone(), t.milliseconds)).collect(),
+        fragments: out.stats.fragments,
+        memory_per_batch: out.stats.memory_per_batch.clone(),
+        image: Image { width: out.width, height: out.height, pixels: out.pixels },
+    })
+}
+

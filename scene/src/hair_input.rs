@@ -1,0 +1,39 @@
+//! A scene's hair and image size as a user names them: a hair file (or the procedural groom when
+//! none is given) and `WxH`.
+
+use anyhow::{Context, bail};
+use std::path::Path;
+use strandlight_runtime::hair::{self, GroomParams, HairModel};
+
+/// The hair file at `path` (format by extension), or the procedural groom, with a description.
+pub fn load_hair(path: Option<&Path>) -> anyhow::Result<(HairModel, String)> {
+    match path {
+        Some(path) => {
+            let loaded = hair::load(path)?;
+            Ok((loaded.model, path.display().to_string()))
+        }
+        None => Ok((
+            hair::generate_groom(&GroomParams::default())?,
+            "procedural groom (default parameters)".to_string(),
+        )),
+    }
+}
+
+/// `WxH` (e.g. `656x861`) as two positive sides. Whether the GPU can hold that image is checked
+/// where its textures are declared.
+pub fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .with_context(|| format!("--size {text:?}: expected WxH, e.g. 656x861"))?;
+    let parse = |s: &str| -> anyhow::Result<u32> {
+        let v: u32 = s
+            .trim()
+            .parse()
+            .with_context(|| format!("--size {text:?}: {s:?} is not a whole number"))?;
+        if v == 0 {
+            bail!("--size {text:?}: sides must be at least 1 pixel");
+        }
+        Ok(v)
+    };
+    Ok((parse(w)?, parse(h)?))
+}

@@ -1,0 +1,21 @@
+//! The scene layer: what the `strandlight` command line, the viewer and `bench` share (the way
+//! Filament's `libs/ibl` serves both `cmgen` and its runtime). It loads a scene's hair and
+//! environment, fits and bakes with on-disk caches, renders an environment-lit frame through
+//! the one GPU renderer of the process, measures images against a reference, and runs the
+//! SRBF / reference / median-cut comparison of Ren 2010 §8.
+//!
+//! Dependencies point one way: `tables` ← `precompute`, `runtime` ← this crate ← the CLI.
+
+pub mod compare;
+pub mod env_frame;
+pub mod environment;
+pub mod equal_time;
+pub mod fit_cache;
+pub mod hair_input;
+pub mod image_metrics;
+pub mod look;
+pub mod reference_cache;
+pub mod scene_tables;
+pub mod steps;
+pub mod summary;
+pub mod world_lights;

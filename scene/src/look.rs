@@ -1,0 +1,114 @@
+//! How an environment-lit frame looks besides its scene and lights: the view's transparency,
+//! the transmittance's box average, and where multiple scattering's shadow paths are marched.
+//! The `cli` feature lets the command line parse these settings directly.
+
+use anyhow::Context;
+use strandlight_runtime::env::{BoxAverage, ViewTransparency};
+
+/// What the view shows of each pixel's fibers (Ren §8).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum EnvTransparency {
+    /// The nearest fiber, weighted by its coverage.
+    Opaque,
+    /// Every fiber, weighted by coverage × its visibility through the occupancy map.
+    Occupancy,
+}
+
+/// Where the forward-scattering shadow paths are marched (Ren §6).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum ForwardDevice {
+    /// The GPU on a hardware adapter, rayon on a software one (lavapipe runs compute shaders on
+    /// the same CPU cores, where rayon measured 4–9% faster at the interactive grid:
+    /// docs/BENCHMARKS.md, "CPU vs GPU march").
+    Auto,
+    Cpu,
+    Gpu,
+}
+
+/// What the effective transmittance's box averages (the CLI's names for [`BoxAverage`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum BoxAverageArg {
+    /// Ren 2010: exp(−mean optical depth).
+    OpticalDepth,
+    /// The mean of exp(−optical depth).
+    Transmittance,
+}
+
+/// The renderer choices of the env-lit commands.
+#[derive(Debug, Clone, Copy)]
+#[cfg_attr(any(feature = "cli", test), derive(clap::Args))]
+pub struct LookArgs {
+    /// The nearest fiber of each pixel (opaque), or every fiber weighted by its visibility
+    /// through an occupancy map (Ren §8; order-independent transparency; costs about as many
+    /// times the view pass as the hair has fragments per pixel).
+    #[cfg_attr(any(feature = "cli", test), arg(long, value_enum, default_value = "opaque"))]
+    pub transparency: EnvTransparency,
+    #[cfg_attr(any(feature = "cli", test), command(flatten))]
+    pub view: ViewArgs,
+}
+
+/// The env-lit renderer's choices besides the transparency (which `render` names its own way,
+/// sharing `--transparency` with the point-light renderer).
+#[derive(Debug, Clone, Copy)]
+#[cfg_attr(any(feature = "cli", test), derive(clap::Args))]
+pub struct ViewArgs {
+    /// With occupancy: fragments seen less than this fraction are not shaded (early termination).
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = ViewTransparency::DEFAULT_CUTOFF))]
+    pub visibility_cutoff: f32,
+    /// What the SRBF transmittance's box averages over the convolution optical depth map.
+    #[cfg_attr(any(feature = "cli", test), arg(long, value_enum, default_value = "optical-depth"))]
+    pub box_average: BoxAverageArg,
+    /// Where multiple scattering's shadow paths are marched (the brute-force reference's dense
+    /// grid always uses the CPU light sweep).
+    #[cfg_attr(any(feature = "cli", test), arg(long, value_enum, default_value = "auto"))]
+    pub forward_scattering: ForwardDevice,
+}
+
+impl Default for ViewArgs {
+    fn default() -> Self {
+        Self { visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF, box_average: BoxAverageArg::OpticalDepth, forward_scattering: ForwardDevice::Auto }
+    }
+}
+
+impl Default for LookArgs {
+    fn default() -> Self {
+        Self { transparency: EnvTransparency::Opaque, view: ViewArgs::default() }
+    }
+}
+
+impl LookArgs {
+    /// The look these arguments ask for (`shadowed` and no fragment counts).
+    pub fn look(&self) -> anyhow::Result<EnvLook> {
+        let view = &self.view;
+        let transparency = match self.transparency {
+            EnvTransparency::Opaque => ViewTransparency::Opaque,
+            EnvTransparency::Occupancy => ViewTransparency::Occupancy { visibility_cutoff: view.visibility_cutoff },
+        };
+        transparency.check().with_context(|| format!("--visibility-cutoff {}", view.visibility_cutoff))?;
+        let box_average = match view.box_average {
+            BoxAverageArg::OpticalDepth => BoxAverage::OpticalDepth,
+            BoxAverageArg::Transmittance => BoxAverage::Transmittance,
+        };
+        Ok(EnvLook { shadowed: true, transparency, box_average, count_fragments: false, forward_scattering: view.forward_scattering })
+    }
+}
+
+/// How a frame is rendered besides its scene and lights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnvLook {
+    /// False sets every single-scattering transmittance to 1 (a diagnostic: what is left is
+    /// the lighting and table error alone).
+    pub shadowed: bool,
+    pub transparency: ViewTransparency,
+    pub box_average: BoxAverage,
+    /// Count the fragments rasterized and shaded (two extra passes, outside the frame time).
+    pub count_fragments: bool,
+    pub forward_scattering: ForwardDevice,
+}
+

@@ -1,0 +1,189 @@
+//! The tables a scene's frames read: which ones each fiber model and scattering mode needs, and
+//! their bake (cached by content) for the λ range a fit actually uses.
+
+use anyhow::{Context, bail};
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::path::Path;
+use strandlight_precompute::bake::{BakedTable, bake_job};
+use strandlight_precompute::bake_plan::{DEFAULT_MULTIPLE_THRESHOLD, FiberDescription, Model, PlanOptions, plan, BakeResolution};
+use strandlight_precompute::srbf_set::SrbfSet;
+use strandlight_tables::asset::{Storage, TableAsset, expect_parameters, read_asset};
+
+/// The fiber model whose tables shade the hair.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum EnvShading {
+    Marschner,
+    Artist,
+}
+
+/// Single scattering only, or with multiple scattering (Ren §3.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum ScatteringMode {
+    Single,
+    Full,
+}
+
+impl ScatteringMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            ScatteringMode::Single => "single",
+            ScatteringMode::Full => "full",
+        }
+    }
+}
+
+impl EnvShading {
+    fn model(self) -> Model {
+        match self {
+            EnvShading::Marschner => Model::Marschner,
+            EnvShading::Artist => Model::Artist,
+        }
+    }
+
+    /// The convolution table of SRBF lights in `mode` (the artist model has no d_b·S_back
+    /// variant: its full mode adds only I_G).
+    pub fn srbf_table(self, mode: ScatteringMode) -> &'static str {
+        match (self, mode) {
+            (EnvShading::Marschner, ScatteringMode::Single) => "marschner",
+            (EnvShading::Marschner, ScatteringMode::Full) => "marschner_full",
+            (EnvShading::Artist, _) => "artist",
+        }
+    }
+
+    /// The direct table of directional lights in `mode`.
+    pub fn direct_table(self, mode: ScatteringMode) -> &'static str {
+        match (self, mode) {
+            (EnvShading::Marschner, ScatteringMode::Single) => "marschner_direct",
+            (EnvShading::Marschner, ScatteringMode::Full) => "marschner_full_direct",
+            (EnvShading::Artist, _) => "artist_direct",
+        }
+    }
+}
+
+/// The tables multiple scattering reads (the first is absent for hair too dark to need it).
+pub const MULTIPLE_TABLES: [&str; 4] = ["multiple", "fiber_averages", "attenuation_ratio", "srbf_spread"];
+
+/// The tables a frame in any of `modes` may read: the multiple-scattering tables, the SRBF
+/// tables and, with `directional` lights (baselines, references, a fit's compact sources), the
+/// direct tables.
+pub fn wanted_tables(shading: EnvShading, modes: &[ScatteringMode], srbf: bool, directional: bool) -> Vec<&'static str> {
+    let mut wanted: Vec<&str> = MULTIPLE_TABLES.to_vec();
+    for &mode in modes {
+        if srbf {
+            wanted.push(shading.srbf_table(mode));
+        }
+        if directional {
+            wanted.push(shading.direct_table(mode));
+        }
+    }
+    wanted.dedup();
+    wanted
+}
+
+/// Loaded tables by name, each checked against the fiber parameters it was asked for.
+pub struct SceneTables {
+    pub assets: BTreeMap<String, TableAsset>,
+    pub baked: Vec<BakedTable>,
+    /// Tables the plan skipped, with the reason (e.g. `multiple` for dark hair).
+    pub skipped: Vec<(String, String)>,
+}
+
+impl SceneTables {
+    pub fn get(&self, name: &str) -> anyhow::Result<&TableAsset> {
+        self.assets.get(name).with_context(|| format!("table `{name}` was not baked (known: {:?})", self.assets.keys().collect::<Vec<_>>()))
+    }
+}
+
+/// Bakes (or finds in `dir`'s cache) the tables named in `wanted` for `shading`, with the 1/λ
+/// axis spanning only `lambda_range`, and loads them with a parameter check. `report` sees
+/// each table as it is done.
+pub fn bake_scene_tables(
+    fiber: &FiberDescription,
+    shading: EnvShading,
+    resolution: BakeResolution,
+    lambda_range: (f64, f64),
+    wanted: &[&str],
+    dir: &Path,
+    report: &mut dyn FnMut(&BakedTable),
+) -> anyhow::Result<SceneTables> {
+    let options = PlanOptions {
+        models: vec![shading.model()],
+        resolution: resolution.with_lambda_range(lambda_range.0, lambda_range.1),
+        force_multiple: false,
+        multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD,
+    };
+    let plan = plan(fiber, &options)?;
+    let skipped = plan.skipped.iter().map(|s| (s.name.clone(), s.reason.clone())).collect();
+    let mut expected: BTreeMap<String, Value> = BTreeMap::new();
+    let mut baked = Vec::new();
+    for job in plan.jobs.into_iter().filter(|j| wanted.contains(&j.name)) {
+        expected.insert(job.name.to_string(), job.fiber_parameters.clone());
+        let t = bake_job(job, dir, Storage::F32)?;
+        report(&t);
+        baked.push(t);
+    }
+    let mut assets = BTreeMap::new();
+    for t in &baked {
+        let asset = read_asset(&t.path)?;
+        expect_parameters(&asset, &expected[&t.name])?;
+        assets.insert(t.name.clone(), asset);
+    }
+    Ok(SceneTables { assets, baked, skipped })
+}
+
+
+/// λ range of an SRBF set with a 10% margin (the bake's 1/λ axis spans only this). A set of
+/// compact sources alone (a sun on black: no lobes) gets the fit's default range, which no
+/// table uses (`wanted_tables` then asks for no SRBF table).
+pub fn lambda_range_of_set(set: &SrbfSet) -> anyhow::Result<(f64, f64)> {
+    let lambdas = set.lobes.iter().map(|l| l.lambda);
+    let (lo, hi) = lambdas.fold((f64::INFINITY, 0.0f64), |(lo, hi), l| (lo.min(l), hi.max(l)));
+    if !(lo.is_finite() && hi > 0.0) {
+        if set.sources.is_empty() {
+            bail!("the SRBF set holds no lobes and no compact sources (a black map?)");
+        }
+        let defaults = strandlight_precompute::FitOptions::default();
+        return Ok((defaults.lambda_min, defaults.lambda_max));
+    }
+    let (lo, hi) = (lo / 1.1, hi * 1.1);
+    if hi > 1e4 {
+        bail!("λ up to {hi:.0} (directional lights?); bake tables for SRBF sets, not directional baselines");
+    }
+    Ok((lo, if hi > lo * 1.01 { hi } else { lo * 1.01 }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tables_for_each_mode_exist_in_the_plan() {
+        let dir = std::env::temp_dir().join(format!("strandlight-scene-tables-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let fiber = FiberDescription::preset("blonde").unwrap();
+        for shading in [EnvShading::Marschner, EnvShading::Artist] {
+            let mut wanted: Vec<&str> = MULTIPLE_TABLES.to_vec();
+            for mode in [ScatteringMode::Single, ScatteringMode::Full] {
+                wanted.push(shading.srbf_table(mode));
+                wanted.push(shading.direct_table(mode));
+            }
+            let tables = bake_scene_tables(&fiber, shading, BakeResolution::reduced(4), (20.0, 40.0), &wanted, &dir.join(format!("{shading:?}")), &mut |_| {}).unwrap();
+            for name in &wanted {
+                let t = tables.get(name).unwrap();
+                if !["fiber_averages", "attenuation_ratio", "srbf_spread"].contains(name) {
+                    assert_eq!(t.table.axes().len(), 4, "{name}: the renderer's 4-axis lookup");
+                }
+            }
+            // The 1/λ axis spans the requested range, not the global bounds.
+            let conv = tables.get(shading.srbf_table(ScatteringMode::Single)).unwrap();
+            let inv = &conv.table.axes()[3];
+            assert!((inv.min - 1.0 / 40.0).abs() < 1e-12 && (inv.max - 1.0 / 20.0).abs() < 1e-12, "{inv:?}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
