@@ -8,7 +8,7 @@ mod fit;
 mod image_error;
 mod render;
 mod summary;
-mod sweep;
+mod sweep_cmd;
 mod tables_cmd;
 
 use clap::{Parser, Subcommand};
@@ -31,7 +31,7 @@ enum Command {
     /// Fit SRBF lights to an environment map (Ren 2010 §3.1), or the median-cut baseline.
     Fit(fit::FitArgs),
     /// Hard-case sweep of every fiber model (NaN/Inf/negative counts), in parallel.
-    Sweep(sweep::SweepArgs),
+    Sweep(sweep_cmd::SweepArgs),
     /// Bake the convolution tables and point-light lookup textures for a fiber.
     Bake(tables_cmd::BakeArgs),
     /// Check baked tables against direct f64 integration at random off-grid points.
@@ -57,7 +57,7 @@ fn main() -> anyhow::Result<()> {
     match cli.command.unwrap_or(default) {
         Command::Summary(args) => summary::run(args),
         Command::Fit(args) => fit::run(args),
-        Command::Sweep(args) => sweep::run(args),
+        Command::Sweep(args) => sweep_cmd::run(args),
         Command::Bake(args) => tables_cmd::bake(args),
         Command::CheckTables(args) => tables_cmd::check(args),
         Command::Inspect(args) => tables_cmd::inspect(args),

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandlight_precompute::bake::{bake_job, BakedTable, TABLE_EXTENSION};
 use strandlight_precompute::bake_plan::{plan, BakeResolution, FiberDescription, Model, PlanOptions, DEFAULT_MULTIPLE_THRESHOLD};
-use strandlight_precompute::check_tables::check_asset;
+use strandlight_precompute::baked_tables_check::check_asset;
 use strandlight_precompute::srbf_set::SrbfSet;
 use strandlight_tables::asset::{read_asset, Storage};
 use strandlight_tables::slices::{write_slices, PngTonemap, SliceLayout};

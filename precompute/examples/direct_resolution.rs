@@ -7,7 +7,7 @@
 use std::time::Instant;
 use strandlight_precompute::bake::bake_job;
 use strandlight_precompute::bake_plan::{plan, BakeResolution, FiberDescription, Model, PlanOptions};
-use strandlight_precompute::check_tables::check_asset;
+use strandlight_precompute::baked_tables_check::check_asset;
 use strandlight_tables::asset::{read_asset, Storage};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

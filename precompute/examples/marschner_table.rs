@@ -3,7 +3,7 @@
 use std::time::Instant;
 use strandlight_precompute::convolution::ConvolutionSettings;
 use strandlight_precompute::convolution_table::{bake_convolution_table, ConvolutionResolution};
-use strandlight_precompute::table_check::{check_table, stratified_points};
+use strandlight_precompute::table_accuracy::{check_table, stratified_points};
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 use strandlight_tables::ScatteringFunction;
 

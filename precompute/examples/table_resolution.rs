@@ -5,7 +5,7 @@ use rayon::prelude::*;
 use std::time::Instant;
 use strandlight_precompute::convolution::{convolve_reference, ConvolutionSettings};
 use strandlight_precompute::convolution_table::{bake_convolution_table, ConvolutionResolution, DirectionAxes};
-use strandlight_precompute::table_check::{is_axial, stratified_points};
+use strandlight_precompute::table_accuracy::{is_axial, stratified_points};
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 use strandlight_tables::table::Table;
 use strandlight_tables::{FiberAngles, ScatteringFunction};

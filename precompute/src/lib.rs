@@ -11,12 +11,12 @@
 //! directional lights, on the same axes), [`multiple_scattering_table`] (I_G),
 //! [`attenuation_ratio`], [`srbf_spread`], [`point_light_luts`] (Hunz Algorithm 2),
 //! [`bake_plan`] (which tables a fiber needs), [`bake`] (assets and the cache),
-//! [`table_check`] and [`check_tables`] (accuracy against f64 references).
+//! [`table_accuracy`] (the accuracy measure: stratified off-grid points against f64 integration) and [`baked_tables_check`] (every baked asset against its f64 reference).
 
 pub mod attenuation_ratio;
 pub mod bake;
 pub mod bake_plan;
-pub mod check_tables;
+pub mod baked_tables_check;
 pub mod compact_sources;
 pub mod convolution;
 pub mod convolution_table;
@@ -37,7 +37,7 @@ pub mod srbf_fit;
 pub mod srbf_objective;
 pub mod srbf_set;
 pub mod srbf_spread;
-pub mod table_check;
+pub mod table_accuracy;
 
 pub use envmap::EnvMap;
 pub use envmap_error::EnvMapError;

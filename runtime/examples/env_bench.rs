@@ -18,7 +18,7 @@ use strandlight_runtime::env::{
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
-use strandlight_tables::sweep::SweepRng;
+use strandlight_tables::hard_case_sweep::SweepRng;
 use strandlight_tables::table::{Axis, Table};
 
 type BoxError = Box<dyn std::error::Error>;

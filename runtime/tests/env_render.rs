@@ -29,7 +29,7 @@ use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 use strandlight_tables::scattering::ScatteringFunction;
 use strandlight_tables::srbf::sample_cos_gamma;
-use strandlight_tables::sweep::SweepRng;
+use strandlight_tables::hard_case_sweep::SweepRng;
 use strandlight_tables::table::{Axis, AxisMapping, Table};
 
 /// Writes `texels` (RGBA, row-major) into layer 0 of the batch's optical-depth texture.

@@ -10,11 +10,11 @@ use std::time::Instant;
 use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::artist::{self, ArtistModel, ArtistParams, Normalization};
 use strandlight_tables::dual_scattering::{
-    self, DualScatteringAverages, DualScatteringConfig, fiber_averages_direct,
+    DualScatteringAverages, DualScatteringConfig, fiber_averages_direct,
 };
 use strandlight_tables::kajiya_kay::{self, KajiyaKay, KajiyaKayParams};
 use strandlight_tables::scattering::ScatteringFunction;
-use strandlight_tables::sweep::SweepRng;
+use strandlight_tables::hard_case_sweep::SweepRng;
 
 /// Median wall time in seconds of `runs` calls of `f`.
 fn median_seconds(runs: usize, mut f: impl FnMut()) -> f64 {
@@ -128,7 +128,7 @@ fn main() {
             kajiya_kay::hard_case_sweep as fn(u64, u64) -> _,
         ),
         ("artist", artist::hard_case_sweep),
-        ("dual-scattering", dual_scattering::hard_case_sweep),
+        ("dual-scattering", strandlight_tables::dual_scattering_hard_cases::hard_case_sweep),
     ] {
         let start = Instant::now();
         let report = run(sweep_samples, 2026);

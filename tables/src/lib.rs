@@ -14,7 +14,9 @@ pub mod asset;
 pub mod atomic_write;
 pub mod checksum;
 pub mod dual_scattering;
+pub mod dual_scattering_hard_cases;
 pub mod error;
+pub mod hard_case_sweep;
 pub mod kajiya_kay;
 pub mod longitudinal;
 pub mod marschner;
@@ -25,7 +27,6 @@ pub mod slices;
 pub mod special;
 pub mod split_mix;
 pub mod srbf;
-pub mod sweep;
 pub mod table;
 
 pub use angles::FiberAngles;

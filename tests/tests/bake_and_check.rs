@@ -3,7 +3,7 @@
 
 use strandlight_precompute::bake::bake_job;
 use strandlight_precompute::bake_plan::{plan, BakeResolution, FiberDescription, Model, PlanOptions};
-use strandlight_precompute::check_tables::check_asset;
+use strandlight_precompute::baked_tables_check::check_asset;
 use strandlight_tables::asset::{read_asset, Storage};
 
 fn temp_dir(tag: &str) -> std::path::PathBuf {

@@ -9,7 +9,7 @@
 //! Output: [`DodmBatch`] (textures + the lights' cameras), read by `summed_area` and the view pass.
 
 use glam::Vec3;
-use strandlight_tables::sweep::SweepRng;
+use strandlight_tables::hard_case_sweep::SweepRng;
 use wgpu::util::DeviceExt;
 
 use super::attachments::{cleared_color, cleared_depth};

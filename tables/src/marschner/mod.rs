@@ -24,12 +24,12 @@
 
 pub mod azimuth;
 pub mod params;
-mod sweep;
+mod hard_cases;
 #[cfg(test)]
 mod tests;
 
 pub use params::{MarschnerParams, elliptical_index, elliptical_indices};
-pub use sweep::{SweepReport, hard_case_sweep};
+pub use hard_cases::{SweepReport, hard_case_sweep};
 
 use crate::angles::FiberAngles;
 use crate::dual_scattering::LobeDecomposition;

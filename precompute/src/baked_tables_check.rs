@@ -8,7 +8,7 @@ use crate::convolution::convolve_reference;
 use crate::direct_table::direct_value;
 use crate::multiple_scattering_table::multiple_scattering_reference;
 use crate::srbf_spread::srbf_longitudinal_variance;
-use crate::table_check::{stratified_points, summarize, TableAccuracy};
+use crate::table_accuracy::{stratified_points, summarize, TableAccuracy};
 use rayon::prelude::*;
 use serde_json::Value;
 use std::sync::Arc;
@@ -129,7 +129,7 @@ pub fn check_asset(asset: &TableAsset, samples: usize, seed: u64) -> Result<Tabl
 /// Points uniform over every continuous axis; integer-labelled axes (`quantity`, `lobe`) get a
 /// random node.
 fn random_points(table: &strandlight_tables::table::Table, count: usize, seed: u64) -> Vec<Vec<f64>> {
-    let mut rng = strandlight_tables::sweep::SweepRng::new(seed);
+    let mut rng = strandlight_tables::hard_case_sweep::SweepRng::new(seed);
     let mut unit = move || rng.uniform();
     (0..count)
         .map(|_| {

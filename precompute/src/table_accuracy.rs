@@ -8,7 +8,7 @@ use serde::Serialize;
 use std::f64::consts::PI;
 use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::scattering::Rgb;
-use strandlight_tables::sweep::SweepRng;
+use strandlight_tables::hard_case_sweep::SweepRng;
 use strandlight_tables::table::{Table, TableError};
 
 /// What `check-tables --json` reports per table.

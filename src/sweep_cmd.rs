@@ -5,8 +5,8 @@
 use serde::Serialize;
 use std::io::IsTerminal;
 use std::time::Instant;
-use strandlight_tables::sweep::{SweepReport, chunked_sweep};
-use strandlight_tables::{artist, dual_scattering, kajiya_kay, marschner};
+use strandlight_tables::hard_case_sweep::{SweepReport, chunked_sweep};
+use strandlight_tables::{artist, dual_scattering_hard_cases, kajiya_kay, marschner};
 
 #[derive(clap::Args)]
 pub struct SweepArgs {
@@ -54,7 +54,7 @@ const SWEEPS: [ModelSweep; 4] = [
         name: "dual-scattering",
         unit: "scalar value",
         chunk: 1 << 20,
-        run: dual_scattering::hard_case_sweep,
+        run: dual_scattering_hard_cases::hard_case_sweep,
     },
 ];
 

@@ -6,7 +6,7 @@
 //!
 //! Public so that a benchmark mode can run it with 10⁸ samples; the unit test runs 10⁶.
 
-use crate::sweep::SweepRng;
+use crate::hard_case_sweep::SweepRng;
 use super::{Lobe, Marschner, MarschnerParams};
 use crate::angles::FiberAngles;
 use crate::longitudinal::LongitudinalModel;
