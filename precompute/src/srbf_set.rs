@@ -112,7 +112,12 @@ impl SrbfSet {
             path: path.into(),
             source,
         })?;
-        let set: SrbfSet = serde_json::from_slice(&bytes).map_err(|source| SrbfSetError::Json {
+        Self::from_json(path, &bytes)
+    }
+
+    /// Parses and checks a set already in memory; `path` only names it in errors.
+    pub fn from_json(path: &Path, bytes: &[u8]) -> Result<SrbfSet, SrbfSetError> {
+        let set: SrbfSet = serde_json::from_slice(bytes).map_err(|source| SrbfSetError::Json {
             path: path.into(),
             source,
         })?;

@@ -16,6 +16,7 @@ pub mod image_metrics;
 pub mod look;
 pub mod reference_cache;
 pub mod scene_tables;
+pub mod sealed_file;
 pub mod steps;
 pub mod summary;
 pub mod world_lights;
