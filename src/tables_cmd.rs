@@ -135,6 +135,9 @@ pub fn bake(args: BakeArgs) -> anyhow::Result<()> {
         bar.set_message(job.name);
         let t = bake_job(job, &args.out, storage)?;
         bar.inc(1);
+        if let Some(reason) = &t.replaced_damaged {
+            say(&bar, format!("warning: {} was damaged and has been rebaked ({reason})", t.path.display()));
+        }
         if !args.json {
             say(&bar, format!(
                 "{:<18} {:>10} bytes {:>7.2} s{}  {}",
@@ -150,7 +153,7 @@ pub fn bake(args: BakeArgs) -> anyhow::Result<()> {
     bar.finish_and_clear();
     let total = start.elapsed().as_secs_f64();
     if args.json {
-        let tables: Vec<_> = baked.iter().map(|t| json!({"name": t.name, "bytes": t.bytes, "seconds": t.seconds, "cached": t.cached, "path": t.path})).collect();
+        let tables: Vec<_> = baked.iter().map(|t| json!({"name": t.name, "bytes": t.bytes, "seconds": t.seconds, "cached": t.cached, "replaced_damaged": t.replaced_damaged, "path": t.path})).collect();
         println!("{}", json!({"tables": tables, "skipped": plan.skipped, "multiple_scattering_share": plan.multiple_scattering_share, "total_seconds": total, "total_bytes": baked.iter().map(|t| t.bytes).sum::<u64>()}));
     } else {
         println!("{} tables, {} bytes, {total:.1} s → {}", baked.len(), baked.iter().map(|t| t.bytes).sum::<u64>(), args.out.display());

@@ -2,14 +2,17 @@
 //!
 //! Each job names its table, the fiber parameters and the settings that determine its values;
 //! their SHA-256 is the job's `inputs_key`, stored in the asset. A re-bake whose key matches the
-//! file on disk is skipped (a content-addressed cache), and any change rebakes.
+//! file on disk is skipped (a content-addressed cache), and any change rebakes. A file is served
+//! from the cache only after its payload checksum is verified too: a truncated or bit-flipped
+//! asset is rebuilt (and reported), never kept. Writes are atomic, so two bakes of the same
+//! table at once, or a bake killed half way, leave either the old file or a complete new one.
 
 use serde::Serialize;
 use serde_json::{json, Value};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use strandlight_tables::asset::{read_asset_metadata, write_asset, AssetDescription, AssetError, CreationInfo, Generator, Storage};
+use strandlight_tables::asset::{read_asset, read_asset_metadata, write_asset, AssetDescription, AssetError, CreationInfo, Generator, Storage};
 use strandlight_tables::table::Table;
 use thiserror::Error;
 
@@ -54,6 +57,35 @@ pub struct BakedTable {
     /// True when an existing file with the same inputs was kept.
     pub cached: bool,
     pub max_value: f32,
+    /// Why the file that was there could not be served, when it was damaged (and so rebuilt).
+    pub replaced_damaged: Option<String>,
+}
+
+/// What is on disk where a job's asset belongs.
+enum ExistingAsset {
+    /// A complete asset baked from the same inputs: serve it.
+    Current,
+    /// No file, or a valid one from other inputs: bake.
+    AbsentOrStale,
+    /// A file that fails its own checks (truncated, bit-flipped, not an asset): rebake.
+    Damaged(AssetError),
+}
+
+/// Checks the asset at `path` against `key`: its metadata first (cheap, and enough to see other
+/// inputs), then, for a key match, the whole file with its payload checksum.
+fn existing_asset(path: &Path, key: &str, storage: Storage) -> ExistingAsset {
+    if !path.exists() {
+        return ExistingAsset::AbsentOrStale;
+    }
+    let same_inputs = |m: &strandlight_tables::asset::AssetMetadata| m.description.inputs_key.as_deref() == Some(key) && m.payload.storage == storage;
+    match read_asset_metadata(path) {
+        Err(e) => ExistingAsset::Damaged(e),
+        Ok(m) if !same_inputs(&m) => ExistingAsset::AbsentOrStale,
+        Ok(_) => match read_asset(path) {
+            Ok(_) => ExistingAsset::Current,
+            Err(e) => ExistingAsset::Damaged(e),
+        },
+    }
 }
 
 impl TableJob {
@@ -79,12 +111,14 @@ pub fn bake_job(job: TableJob, dir: &Path, storage: Storage) -> Result<BakedTabl
     let path = table_path(dir, job.name);
     let key = job.inputs_key();
     let start = Instant::now();
-    if let Ok(existing) = read_asset_metadata(&path) {
-        if existing.description.inputs_key.as_deref() == Some(key.as_str()) && existing.payload.storage == storage {
+    let replaced_damaged = match existing_asset(&path, &key, storage) {
+        ExistingAsset::Current => {
             let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
-            return Ok(BakedTable { name: job.name.into(), path, bytes, seconds: start.elapsed().as_secs_f64(), cached: true, max_value: f32::NAN });
+            return Ok(BakedTable { name: job.name.into(), path, bytes, seconds: start.elapsed().as_secs_f64(), cached: true, max_value: f32::NAN, replaced_damaged: None });
         }
-    }
+        ExistingAsset::AbsentOrStale => None,
+        ExistingAsset::Damaged(e) => Some(e.to_string()),
+    };
     let name = job.name;
     let description = AssetDescription {
         name: name.into(),
@@ -107,7 +141,7 @@ pub fn bake_job(job: TableJob, dir: &Path, storage: Storage) -> Result<BakedTabl
     }
     write_asset(&path, &table, &description, storage)?;
     let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
-    Ok(BakedTable { name: name.into(), path, bytes, seconds: start.elapsed().as_secs_f64(), cached: false, max_value: stats.max })
+    Ok(BakedTable { name: name.into(), path, bytes, seconds: start.elapsed().as_secs_f64(), cached: false, max_value: stats.max, replaced_damaged })
 }
 
 #[cfg(test)]
@@ -140,6 +174,69 @@ mod tests {
         assert_eq!(asset.table.lookup_scalar(&[1.0]).unwrap(), 3.0);
         let other_storage = bake_job(job(3.0), &dir, Storage::F16).unwrap();
         assert!(!other_storage.cached);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    fn temp_dir(tag: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("strandlight-bake-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        dir
+    }
+
+    /// Every byte of an asset matters: the magic, version, lengths, metadata, its digest,
+    /// padding and payload. A flip anywhere, or a cut anywhere, must be rebuilt, not served.
+    #[test]
+    fn damaged_assets_are_rebuilt_not_served() {
+        let dir = temp_dir("damaged");
+        let good = bake_job(job(2.0), &dir, Storage::F32).unwrap();
+        let original = std::fs::read(&good.path).unwrap();
+        let mut damages: Vec<(String, Vec<u8>)> = Vec::new();
+        for at in (0..original.len()).step_by(7).chain([original.len() - 1]) {
+            let mut bytes = original.clone();
+            bytes[at] ^= 0x10;
+            damages.push((format!("bit flip at byte {at}"), bytes));
+        }
+        for cut in [0, 8, 16, original.len() / 2, original.len() - 1] {
+            damages.push((format!("truncated to {cut} bytes"), original[..cut].to_vec()));
+        }
+        let mut rebuilt = 0;
+        for (what, bytes) in &damages {
+            std::fs::write(&good.path, bytes).unwrap();
+            let again = bake_job(job(2.0), &dir, Storage::F32).unwrap();
+            assert!(!again.cached, "{what}: a damaged asset was served from the cache");
+            assert!(again.replaced_damaged.is_some(), "{what}: the rebuild was not reported");
+            let asset = strandlight_tables::asset::read_asset(&good.path).unwrap_or_else(|e| panic!("{what}: rebuilt asset unreadable: {e}"));
+            assert_eq!(asset.table.lookup_scalar(&[1.0]).unwrap(), 2.0, "{what}");
+            rebuilt += 1;
+        }
+        assert_eq!(rebuilt, damages.len());
+        assert!(damages.len() > 50, "the asset is only {} bytes: the sweep is too thin", original.len());
+        // And an intact file is served again.
+        assert!(bake_job(job(2.0), &dir, Storage::F32).unwrap().cached);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// Two bakes of one table into one folder at the same moment: both succeed and the file
+    /// left behind is complete (atomic renames; the last writer wins with identical content).
+    #[test]
+    fn concurrent_bakes_of_one_table_leave_a_valid_asset() {
+        let dir = temp_dir("concurrent");
+        for round in 0..8 {
+            let _ = std::fs::remove_file(table_path(&dir, "test_table"));
+            let barrier = std::sync::Barrier::new(4);
+            std::thread::scope(|scope| {
+                for _ in 0..4 {
+                    scope.spawn(|| {
+                        barrier.wait();
+                        bake_job(job(2.0), &dir, Storage::F32).unwrap_or_else(|e| panic!("round {round}: {e}"))
+                    });
+                }
+            });
+            let asset = strandlight_tables::asset::read_asset(&table_path(&dir, "test_table")).unwrap();
+            assert_eq!(asset.table.lookup_scalar(&[0.5]).unwrap(), 1.0);
+        }
+        let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).filter(|n| n.to_string_lossy().contains(".tmp-")).collect();
+        assert!(leftovers.is_empty(), "temporary files left behind: {leftovers:?}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

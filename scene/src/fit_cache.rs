@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use strandlight_precompute::FitOptions;
 use strandlight_precompute::srbf_set::SrbfSet;
 use strandlight_tables::checksum::sha256_hex;
+use crate::sealed_file::{Unsealed, read_sealed, seal};
 
 /// A fitted set and whether it came from the cache.
 pub struct FitOutcome {
@@ -21,22 +22,35 @@ pub fn fit_key(env: &LoadedEnv, options: &FitOptions) -> String {
 }
 
 /// The SRBF fit of `env`, served from `cache_dir/fits/KEY.srbf.json` when the map and options
-/// are unchanged, else computed and stored there.
+/// are unchanged and the file still matches the digest sealed beside it, else computed and
+/// stored there (a damaged entry is reported and refitted).
 pub fn fit_cached(env: &LoadedEnv, options: &FitOptions, cache_dir: &Path) -> anyhow::Result<FitOutcome> {
     let dir = cache_dir.join("fits");
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create the cache folder {}", dir.display()))?;
     let path = dir.join(format!("{}.srbf.json", &fit_key(env, options)[..32]));
-    if let Ok(set) = SrbfSet::load(&path) {
-        let same_options = serde_json::to_value(&set.options).ok() == serde_json::to_value(options).ok();
-        if set.source_sha256 == env.sha256 && same_options {
-            return Ok(FitOutcome { set, cached: true, path });
-        }
+    if let Some(set) = cached_fit(&path, env, options) {
+        return Ok(FitOutcome { set, cached: true, path });
     }
     let set = SrbfSet::fit(&env.source(), options, &mut |_| {}).with_context(|| format!("fitting SRBFs to {}", env.name))?;
     set.save(&path)?;
+    seal(&path).with_context(|| format!("sealing the cache entry {}", path.display()))?;
     Ok(FitOutcome { set, cached: false, path })
 }
 
+/// The set stored at `path` if it is intact and was fitted to this map with these options.
+fn cached_fit(path: &Path, env: &LoadedEnv, options: &FitOptions) -> Option<SrbfSet> {
+    let bytes = match read_sealed(path) {
+        Ok(bytes) => bytes,
+        Err(Unsealed::Missing) => return None,
+        Err(Unsealed::Damaged) => {
+            eprintln!("warning: the cached fit {} does not match its checksum; fitting again", path.display());
+            return None;
+        }
+    };
+    let set = SrbfSet::from_json(path, &bytes).ok()?;
+    let same_options = serde_json::to_value(&set.options).ok() == serde_json::to_value(options).ok();
+    (set.source_sha256 == env.sha256 && same_options).then_some(set)
+}
 
 #[cfg(test)]
 mod tests {
@@ -66,6 +80,15 @@ mod tests {
         let map2 = EnvMap::from_pixels(env.map.width(), env.map.height(), pixels);
         let env2 = LoadedEnv { sha256: map_pixels_sha256(&map2), map: map2, name: "one-lobe".into(), sanitized: Default::default() };
         assert!(!fit_cached(&env2, &options, &dir).unwrap().cached, "a changed map must refit");
+        // A damaged entry (a flipped digit in a lobe) is refitted, not served.
+        let mut bytes = std::fs::read(&first.path).unwrap();
+        let digit = bytes.iter().rposition(|b| b.is_ascii_digit() && *b != b'9').unwrap();
+        bytes[digit] += 1;
+        std::fs::write(&first.path, &bytes).unwrap();
+        let refit = fit_cached(&env, &options, &dir).unwrap();
+        assert!(!refit.cached, "a damaged cache entry was served");
+        assert_eq!(refit.set.lobes, first.set.lobes, "the refit reproduces the first fit");
+        assert!(fit_cached(&env, &options, &dir).unwrap().cached, "the refit was sealed again");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -1,8 +1,10 @@
 //! The brute-force reference image, cached by everything it depends on (it may take minutes):
 //! `DIR/KEY.exr` (linear RGBA) beside `DIR/KEY.json` (the inputs and the measured time), both
-//! written atomically. A hit needs both files and the same inputs recorded in the JSON.
+//! written atomically and sealed by a SHA-256 sidecar. A hit needs both files intact and the
+//! same inputs recorded in the JSON; a damaged entry is reported and rendered again.
 
 use strandlight_tables::checksum::sha256_hex;
+use crate::sealed_file::{Unsealed, read_sealed, seal, write_sealed};
 use crate::image_metrics::Image;
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
@@ -39,13 +41,14 @@ impl ReferenceCache {
         (self.dir.join(format!("{key}.exr")), self.dir.join(format!("{key}.json")))
     }
 
-    /// The cached image for `inputs`, or None (absent, unreadable or recorded for other inputs).
+    /// The cached image for `inputs`, or None (absent, damaged or recorded for other inputs).
     pub fn load(&self, inputs: &Value) -> Option<(Image, ReferenceRecord)> {
         let (exr_path, json_path) = self.paths(inputs);
-        let record: ReferenceRecord = serde_json::from_slice(&std::fs::read(&json_path).ok()?).ok()?;
+        let record: ReferenceRecord = serde_json::from_slice(&intact(&json_path)?).ok()?;
         if &record.inputs != inputs {
             return None;
         }
+        intact(&exr_path)?;
         match read_rgba_exr(&exr_path) {
             Ok(image) => Some((image, record)),
             Err(e) => {
@@ -55,15 +58,27 @@ impl ReferenceCache {
         }
     }
 
-    /// Stores the image (EXR first, then the JSON that makes it a hit).
+    /// Stores the image (EXR first, then the JSON that makes it a hit), each sealed.
     pub fn store(&self, image: &Image, record: &ReferenceRecord) -> anyhow::Result<PathBuf> {
         std::fs::create_dir_all(&self.dir).with_context(|| format!("cannot create the cache folder {}", self.dir.display()))?;
         let (exr_path, json_path) = self.paths(&record.inputs);
         write_exr(&exr_path, image.width, image.height, &image.pixels, "strandlight brute-force reference")?;
+        seal(&exr_path).with_context(|| format!("sealing {}", exr_path.display()))?;
         let json = serde_json::to_vec_pretty(record)?;
-        strandlight_tables::atomic_write::write_atomically(&json_path, |out| std::io::Write::write_all(out, &json))
-            .with_context(|| json_path.display().to_string())?;
+        write_sealed(&json_path, &json).with_context(|| json_path.display().to_string())?;
         Ok(exr_path)
+    }
+}
+
+/// The bytes of a sealed cache file, None when absent or (with a warning) damaged.
+fn intact(path: &Path) -> Option<Vec<u8>> {
+    match read_sealed(path) {
+        Ok(bytes) => Some(bytes),
+        Err(Unsealed::Missing) => None,
+        Err(Unsealed::Damaged) => {
+            eprintln!("warning: the cached reference file {} does not match its checksum; rendering again", path.display());
+            None
+        }
     }
 }
 
@@ -100,8 +115,25 @@ mod tests {
         assert_eq!(back, image, "f32 EXR round trip is exact");
         assert_eq!(rec, record);
         assert!(cache.load(&json!({ "hair_sha256": "ab", "size": [3, 2], "lights": 96 })).is_none());
-        // A truncated image is a miss, not a crash.
-        let (exr_path, _) = cache.paths(&inputs);
+        // A damaged image or record is a miss, not a crash and not a wrong picture: every single
+        // byte flip of the EXR is refused, including those its own decoder would accept (flips
+        // in header attributes, offsets, padding).
+        let (exr_path, json_path) = cache.paths(&inputs);
+        let original = std::fs::read(&exr_path).unwrap();
+        let mut decoder_accepted = 0;
+        for at in 0..original.len() {
+            let mut flipped = original.clone();
+            flipped[at] ^= 0x01;
+            std::fs::write(&exr_path, &flipped).unwrap();
+            decoder_accepted += usize::from(read_rgba_exr(&exr_path).is_ok());
+            assert!(cache.load(&inputs).is_none(), "a reference image flipped at byte {at} was served");
+        }
+        assert!(decoder_accepted > 0, "no flip gets past the decoder alone: the seal is untested");
+        std::fs::write(&exr_path, &original).unwrap();
+        assert!(cache.load(&inputs).is_some());
+        let json = std::fs::read(&json_path).unwrap();
+        std::fs::write(&json_path, &json[..json.len() - 3]).unwrap();
+        assert!(cache.load(&inputs).is_none(), "a truncated record was served");
         std::fs::write(&exr_path, b"not an exr").unwrap();
         assert!(cache.load(&inputs).is_none());
         std::fs::remove_dir_all(&dir).unwrap();

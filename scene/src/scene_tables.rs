@@ -124,6 +124,9 @@ pub fn bake_scene_tables(
     for job in plan.jobs.into_iter().filter(|j| wanted.contains(&j.name)) {
         expected.insert(job.name.to_string(), job.fiber_parameters.clone());
         let t = bake_job(job, dir, Storage::F32)?;
+        if let Some(reason) = &t.replaced_damaged {
+            eprintln!("warning: the cached table {} was damaged and has been rebaked ({reason})", t.path.display());
+        }
         report(&t);
         baked.push(t);
     }
