@@ -170,17 +170,6 @@ struct VoxelSums {
 }
 
 impl VoxelSums {
-    fn add(&mut self, other: &Self) {
-        self.length += other.length;
-        self.cross_section += other.cross_section;
-        for k in 0..6 {
-            self.tensor[k] += other.tensor[k];
-        }
-        for k in 0..3 {
-            self.signed[k] += other.signed[k];
-        }
-    }
-
     fn deposit(&mut self, length: f64, diameter: f64, t: DVec3) {
         self.length += length;
         self.cross_section += length * diameter;
@@ -293,52 +282,63 @@ impl HairVolume {
     }
 }
 
-/// Per-strand deposits summed over rayon tasks.
+/// One piece of fiber (at most half a voxel long) to add to a voxel's sums.
+struct Deposit {
+    voxel: u32,
+    length: f64,
+    diameter: f64,
+    tangent: DVec3,
+}
+
+/// Strands whose deposits are computed in parallel and then summed, per block: bounds the
+/// deposits held at once (tens of MB) while keeping the threads busy.
+const STRANDS_PER_BLOCK: usize = 4096;
+
+/// Per-voxel sums of every strand's pieces. The pieces are cut in parallel but added in strand
+/// order on one thread, so the f64 sums (and the grid) are bit-identical for any thread count.
 fn accumulate(model: &HairModel, grid: &VoxelGrid, default_diameter: f32) -> Vec<VoxelSums> {
-    let n = grid.voxel_count();
+    let mut sums = vec![VoxelSums::default(); grid.voxel_count()];
     let strands = model.strand_count();
-    let tasks = rayon::current_num_threads().max(1);
-    let per_task = strands.div_ceil(tasks).max(1);
+    for block_start in (0..strands).step_by(STRANDS_PER_BLOCK) {
+        let block = block_start..(block_start + STRANDS_PER_BLOCK).min(strands);
+        let deposits: Vec<Vec<Deposit>> = block
+            .into_par_iter()
+            .map(|s| strand_deposits(model, s, grid, default_diameter))
+            .collect();
+        for d in deposits.iter().flatten() {
+            sums[d.voxel as usize].deposit(d.length, d.diameter, d.tangent);
+        }
+    }
+    sums
+}
+
+/// Strand `s` cut into pieces of at most half a voxel, each deposited in the voxel of its
+/// midpoint.
+fn strand_deposits(model: &HairModel, s: usize, grid: &VoxelGrid, default_diameter: f32) -> Vec<Deposit> {
     let max_piece = 0.5 * grid.voxel_size as f64;
     let offsets = model.strand_offsets();
     let points = model.points();
     let thickness = model.thickness();
-    (0..strands)
-        .into_par_iter()
-        .with_min_len(per_task)
-        .fold(
-            || vec![VoxelSums::default(); n],
-            |mut acc, s| {
-                let (start, end) = (offsets[s] as usize, offsets[s + 1] as usize);
-                for i in start..end.saturating_sub(1) {
-                    let (a, b) = (points[i].as_dvec3(), points[i + 1].as_dvec3());
-                    let length = (b - a).length();
-                    if !(length > 0.0) {
-                        continue; // zero-length segment: no fiber to shadow anything
-                    }
-                    let diameter = match thickness {
-                        Some(t) => 0.5 * (t.at(i) as f64 + t.at(i + 1) as f64),
-                        None => default_diameter as f64,
-                    };
-                    let tangent = (b - a) / length;
-                    let pieces = (length / max_piece).ceil().max(1.0) as usize;
-                    let piece = length / pieces as f64;
-                    for k in 0..pieces {
-                        let mid = a + (b - a) * ((k as f64 + 0.5) / pieces as f64);
-                        let v = grid.voxel_clamped(mid.as_vec3());
-                        acc[v].deposit(piece, diameter, tangent);
-                    }
-                }
-                acc
-            },
-        )
-        .reduce(
-            || vec![VoxelSums::default(); n],
-            |mut a, b| {
-                for (x, y) in a.iter_mut().zip(&b) {
-                    x.add(y);
-                }
-                a
-            },
-        )
+    let (start, end) = (offsets[s] as usize, offsets[s + 1] as usize);
+    let mut out = Vec::new();
+    for i in start..end.saturating_sub(1) {
+        let (a, b) = (points[i].as_dvec3(), points[i + 1].as_dvec3());
+        let length = (b - a).length();
+        if !(length > 0.0) {
+            continue; // zero-length segment: no fiber to shadow anything
+        }
+        let diameter = match thickness {
+            Some(t) => 0.5 * (t.at(i) as f64 + t.at(i + 1) as f64),
+            None => default_diameter as f64,
+        };
+        let tangent = (b - a) / length;
+        let pieces = (length / max_piece).ceil().max(1.0) as usize;
+        let piece = length / pieces as f64;
+        for k in 0..pieces {
+            let mid = a + (b - a) * ((k as f64 + 0.5) / pieces as f64);
+            let voxel = grid.voxel_clamped(mid.as_vec3()) as u32;
+            out.push(Deposit { voxel, length: piece, diameter, tangent });
+        }
+    }
+    out
 }
