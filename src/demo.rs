@@ -3,22 +3,19 @@
 //! on a fresh machine with no files of the user's. Writes `out/demo.png` and `out/demo.exr`
 //! and prints each step's time.
 
-use strandlight_runtime::env::EnvRenderOptions;
-use strandlight_scene::env_frame::{EnvFrame, FrameRole, fit_summary, light_summary, render_lights};
-use strandlight_scene::environment::{ensure_procedural_envmap, load_env};
-use strandlight_scene::fit_cache::fit_cached;
-use strandlight_scene::look::{EnvTransparency, LookArgs};
-use strandlight_scene::scene_tables::{EnvShading, ScatteringMode, bake_scene_tables, lambda_range_of_set, wanted_tables};
-use strandlight_scene::steps::Steps;
-use strandlight_scene::world_lights::to_env_lights;
 use anyhow::Context;
 use std::path::Path;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
-use strandlight_precompute::env_lights::srbf_set_lights;
-use strandlight_precompute::FitOptions;
 use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_runtime::hair::{generate_groom, GroomParams};
-use strandlight_runtime::image_out::{write_exr, write_png, PNG_TONEMAP};
+use strandlight_runtime::env::EnvRenderOptions;
+use strandlight_runtime::hair::{GroomParams, generate_groom};
+use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
+use strandlight_scene::env_frame::{EnvFrame, FrameRole, light_summary, render_lights};
+use strandlight_scene::env_scene::{EnvSceneRequest, prepare_env_scene};
+use strandlight_scene::environment::{ensure_procedural_envmap, load_env};
+use strandlight_scene::look::{EnvTransparency, LookArgs};
+use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
+use strandlight_scene::steps::Steps;
 
 /// The environment the demo renders under, and where it is written.
 pub const DEMO_ENVIRONMENT: &str = "sun_and_sky";
@@ -53,33 +50,28 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     )?
     .0;
     let hair = steps.run("groom", || Ok(generate_groom(&GroomParams::default())?), |h| format!("procedural groom, {} strands", h.strand_count()))?;
-    let cache = Path::new(CACHE_DIR);
-    let fit = steps.run("fit", || fit_cached(&env, &FitOptions::default(), cache), |f| {
-        format!("{}{}", fit_summary(&f.set), if f.cached { " (cached)" } else { "" })
-    })?;
     let fiber = FiberDescription::preset(DEMO_PRESET)?;
     let shading = EnvShading::Marschner;
-    let wanted = wanted_tables(shading, &[ScatteringMode::Single, ScatteringMode::Full], !fit.set.lobes.is_empty(), !fit.set.sources.is_empty());
-    let lambda_range = lambda_range_of_set(&fit.set)?;
-    let table_dir = cache.join("tables").join("demo");
-    let tables = steps.run(
-        "bake",
-        || bake_scene_tables(&fiber, shading, BakeResolution::reduced(DEMO_TABLE_NODES), lambda_range, &wanted, &table_dir, &mut |_| {}),
-        |t| format!("{} tables ({} cached), {DEMO_TABLE_NODES} nodes per direction axis → {}", t.baked.len(), t.baked.iter().filter(|b| b.cached).count(), table_dir.display()),
-    )?;
-    for (name, reason) in &tables.skipped {
-        steps.say(format!("skipped {name}: {reason}"));
-    }
     let up = UpAxis::detect(&hair);
+    let request = EnvSceneRequest {
+        env: &env,
+        fiber: &fiber,
+        shading,
+        scattering: ScatteringMode::Full,
+        resolution: BakeResolution::reduced(DEMO_TABLE_NODES),
+        cache_dir: Path::new(CACHE_DIR),
+        table_set: "demo",
+        up,
+    };
+    let scene = prepare_env_scene(&request, &mut steps)?;
+    let (lights, mode) = (&scene.lights, scene.mode);
     let (width, height) = DEMO_SIZE;
     let camera = Camera::framing_front(hair.bounds(), width as f32 / height as f32, false, up);
-    let lights = to_env_lights(&srbf_set_lights(&fit.set), up);
-    let mode = if tables.assets.contains_key("multiple") { ScatteringMode::Full } else { ScatteringMode::Single };
-    let frame = EnvFrame { hair: &hair, camera, width, height, lights: &lights, tables: &tables, shading, mode, role: FrameRole::Interactive { kappa: EnvRenderOptions::default().kappa }, look };
-    let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {}, {} scattering, {:?} view", r.milliseconds, light_summary(&lights), mode.name(), args.transparency))?;
+    let frame = EnvFrame { hair: &hair, camera, width, height, lights, tables: &scene.tables, shading, mode, role: FrameRole::Interactive { kappa: EnvRenderOptions::default().kappa }, look };
+    let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {}, {} scattering, {:?} view", r.milliseconds, light_summary(lights), mode.name(), args.transparency))?;
     let out = Path::new(OUT_DIR);
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let description = format!("strandlight demo: procedural groom under procedural:{DEMO_ENVIRONMENT}, {}, Marschner ({DEMO_PRESET}), {} scattering", light_summary(&lights), mode.name());
+    let description = format!("strandlight demo: procedural groom under procedural:{DEMO_ENVIRONMENT}, {}, Marschner ({DEMO_PRESET}), {} scattering", light_summary(lights), mode.name());
     let (exr, png) = (out.join("demo.exr"), out.join("demo.png"));
     let image = &rendered.image;
     write_exr(&exr, image.width, image.height, &image.pixels, &description)?;

@@ -1,30 +1,26 @@
 //! `strandlight render`: one headless frame of a hair model under point lights, written as a
 //! linear EXR and a tonemapped PNG, with timings and GPU memory on request.
 
-use strandlight_scene::hair_input::{load_hair, parse_size};
-use std::path::{Path, PathBuf};
-
 use anyhow::{Context, bail};
 use clap::{Args, ValueEnum};
-use strandlight_precompute::point_light_luts::{LutResolution, bake_lut_m, bake_lut_n};
-use strandlight_runtime::camera::{Camera, UpAxis};
+use std::path::{Path, PathBuf};
+use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
+use strandlight_runtime::camera::UpAxis;
 use strandlight_runtime::gpu::GpuContext;
-use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::DomSettings;
-use strandlight_runtime::passes::fiber_shading::{MarschnerLuts, ShadingModel};
 use strandlight_runtime::passes::strands::{FrameParams, KajiyaKay};
 use strandlight_runtime::render::{self, RenderOptions, render_frame_with_model};
-use strandlight_tables::artist::{ArtistModel, ArtistParams};
-use strandlight_tables::marschner::{Marschner, MarschnerParams};
-
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum Shading {
-    KajiyaKay,
-    Marschner,
-    Artist,
-}
+use strandlight_scene::camera_choice::{CameraChoice, CameraKind, UpChoice};
+use strandlight_scene::env_frame::{EnvFrame, FrameRole, light_summary, render_lights};
+use strandlight_scene::env_scene::{EnvSceneRequest, prepare_env_scene};
+use strandlight_scene::environment::load_env;
+use strandlight_scene::hair_input::{load_hair, parse_size};
+use strandlight_scene::look::{EnvLook, EnvTransparency, LookArgs};
+use strandlight_scene::point_shading::{PointShadingRequest, Shading, point_shading_model};
+use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
+use strandlight_scene::steps::Steps;
 
 #[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
 pub enum Shadows {
@@ -39,12 +35,6 @@ pub enum Transparency {
     Dbk,
     /// With --env only: every fiber weighted by its visibility through an occupancy map.
     Occupancy,
-}
-
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum CameraKind {
-    Perspective,
-    Orthographic,
 }
 
 /// The default light when none is given: from the upper right front.
@@ -68,7 +58,7 @@ pub struct RenderArgs {
     pub env: Option<String>,
     /// With --env: single scattering, or full (single + multiple; skipped for dark hair).
     #[arg(long, value_enum, default_value = "full")]
-    pub scattering: strandlight_scene::scene_tables::ScatteringMode,
+    pub scattering: ScatteringMode,
     /// With --env: fraction of the strands drawn into the light maps (Ren §7; 1 = all).
     #[arg(long, default_value_t = 0.1)]
     pub kappa: f32,
@@ -135,13 +125,6 @@ fn output_stem(out: &Path) -> PathBuf {
     }
 }
 
-#[derive(Clone, Copy, Debug, ValueEnum)]
-pub enum UpChoice {
-    Auto,
-    Y,
-    Z,
-}
-
 fn parse_vec3(flag: &str, text: &str) -> anyhow::Result<[f32; 3]> {
     let values = text
         .split(',')
@@ -154,76 +137,21 @@ fn parse_vec3(flag: &str, text: &str) -> anyhow::Result<[f32; 3]> {
 }
 
 /// The camera `--camera`, `--up` and `--eye` ask for.
-fn choose_camera(args: &RenderArgs, model: &HairModel, aspect: f32) -> anyhow::Result<Camera> {
-    let up = match args.up {
-        UpChoice::Auto => UpAxis::detect(model),
-        UpChoice::Y => UpAxis::Y,
-        UpChoice::Z => UpAxis::Z,
-    };
-    let orthographic = matches!(args.camera, CameraKind::Orthographic);
-    Ok(match &args.eye {
-        None => Camera::framing_front(model.bounds(), aspect, orthographic, up),
-        Some(text) => Camera::framing_from_eye(
-            model.bounds(),
-            aspect,
-            orthographic,
-            parse_vec3("--eye", text)?,
-            up.vector(),
-        )
-        .with_context(|| format!("--eye {text}"))?,
-    })
-}
-
-/// The fiber model, with its lookup tables baked now for Marschner (the runtime does not link
-/// the tabulation code), and a line describing it.
-fn shading_model(args: &RenderArgs) -> anyhow::Result<(ShadingModel, String)> {
-    match args.shading.unwrap_or(Shading::KajiyaKay) {
-        Shading::KajiyaKay => Ok((
-            ShadingModel::KajiyaKay,
-            format!("Kajiya-Kay {:?}", KajiyaKay::default()),
-        )),
-        Shading::Marschner => {
-            let params = MarschnerParams::with_preset(&args.preset)
-                .with_context(|| format!("--preset {:?}", args.preset))?;
-            let model = Marschner::new(params)?;
-            let resolution = LutResolution::square(args.lut_size);
-            let lut_m = bake_lut_m(&model, &resolution)
-                .with_context(|| format!("--lut-size {}", args.lut_size))?;
-            let lut_n = bake_lut_n(&model, &resolution)
-                .with_context(|| format!("--lut-size {}", args.lut_size))?;
-            Ok((
-                ShadingModel::MarschnerLut(MarschnerLuts::new(lut_m, lut_n)?),
-                format!(
-                    "Marschner (preset {}) through {}² lookup tables (Hunz 2016 Algorithm 2)",
-                    args.preset, args.lut_size
-                ),
-            ))
-        }
-        Shading::Artist => {
-            let (params, from) = match &args.artist_params {
-                None => (ArtistParams::default(), "default controls".to_string()),
-                Some(path) => {
-                    let text = std::fs::read_to_string(path)
-                        .with_context(|| format!("--artist-params {}", path.display()))?;
-                    let params: ArtistParams = serde_json::from_str(&text)
-                        .with_context(|| format!("--artist-params {}", path.display()))?;
-                    (params, path.display().to_string())
-                }
-            };
-            let model = ArtistModel::new(params).context("--artist-params")?;
-            Ok((
-                ShadingModel::Artist(model),
-                format!("artist-friendly (Sadeghi 2010), {from}"),
-            ))
-        }
-    }
+fn camera_choice(args: &RenderArgs) -> anyhow::Result<CameraChoice> {
+    let eye = args.eye.as_deref().map(|text| parse_vec3("--eye", text)).transpose()?;
+    Ok(CameraChoice { kind: args.camera, up: args.up, eye })
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if let Some(env) = args.env.clone() {
         return run_env(&args, &env);
     }
-    let (shading, shading_description) = shading_model(&args)?;
+    let (shading, shading_description) = point_shading_model(&PointShadingRequest {
+        shading: args.shading.unwrap_or(Shading::KajiyaKay),
+        preset: &args.preset,
+        lut_size: args.lut_size,
+        artist_params: args.artist_params.as_deref(),
+    })?;
     let transparency = match args.transparency {
         Transparency::None => render::Transparency::Opaque,
         Transparency::Abuffer => render::Transparency::ABuffer {
@@ -262,7 +190,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         other => other,
     };
     let gpu = GpuContext::new_headless()?;
-    let camera = choose_camera(&args, &model, width as f32 / height as f32)?;
+    let camera = camera_choice(&args)?.camera(&model, width as f32 / height as f32)?;
     let frame = FrameParams {
         camera,
         width,
@@ -351,64 +279,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use clap::Parser;
-
-    #[derive(Parser)]
-    struct Cli {
-        #[command(flatten)]
-        args: RenderArgs,
-    }
-
-    fn args(line: &[&str]) -> RenderArgs {
-        Cli::try_parse_from(std::iter::once("render").chain(line.iter().copied()))
-            .unwrap()
-            .args
-    }
-
-    #[test]
-    fn shading_choices_build_their_models_and_name_bad_parameters() {
-        let (model, text) =
-            shading_model(&args(&["--shading", "marschner", "--lut-size", "16"])).unwrap();
-        match model {
-            ShadingModel::MarschnerLut(luts) => {
-                assert_eq!(luts.lut_m().shape(), vec![16, 16, 4]);
-                assert_eq!(luts.lut_n().shape(), vec![16, 16, 3]);
-            }
-            other => panic!("{}", other.name()),
-        }
-        assert!(text.contains("brown") && text.contains("16²"), "{text}");
-        assert!(matches!(
-            shading_model(&args(&["--shading", "artist"])).unwrap().0,
-            ShadingModel::Artist(_)
-        ));
-        let e =
-            shading_model(&args(&["--shading", "marschner", "--preset", "purple"])).unwrap_err();
-        assert!(format!("{e:#}").contains("--preset \"purple\""), "{e:#}");
-        let e = shading_model(&args(&["--shading", "marschner", "--lut-size", "1"])).unwrap_err();
-        assert!(format!("{e:#}").contains("--lut-size 1"), "{e:#}");
-        let e = shading_model(&args(&[
-            "--shading",
-            "artist",
-            "--artist-params",
-            "/nonexistent/artist.json",
-        ]))
-        .unwrap_err();
-        assert!(format!("{e:#}").contains("artist.json"), "{e:#}");
-    }
-}
-
 /// `render --env MAP`: the SRBF path alone (fit and tables cached under out/cache).
 fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
-    use strandlight_scene::env_frame::{EnvFrame, FrameRole, fit_summary, light_summary, render_lights};
-    use strandlight_scene::environment::load_env;
-    use strandlight_scene::fit_cache::fit_cached;
-    use strandlight_scene::look::{EnvLook, EnvTransparency, LookArgs};
-    use strandlight_scene::scene_tables::{EnvShading, ScatteringMode, bake_scene_tables, lambda_range_of_set, wanted_tables};
-    use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
-    use strandlight_precompute::env_lights::srbf_set_lights;
     let shading = match args.shading.unwrap_or(Shading::Marschner) {
         Shading::Marschner => EnvShading::Marschner,
         Shading::Artist => EnvShading::Artist,
@@ -423,38 +295,29 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
     };
     let look = EnvLook { count_fragments: args.json, ..look_args.look()? };
     let (width, height) = parse_size(&args.size)?;
-    let mut steps = strandlight_scene::steps::Steps::new(args.json);
+    let mut steps = Steps::new(args.json);
     let (model, source) = steps.run("hair", || load_hair(args.hair.as_deref()), |(m, s)| format!("{s} ({} strands)", m.strand_count()))?;
     let env = steps.run("environment", || load_env(env_spec, false), |e| format!("{} {}x{}", e.name, e.map.width(), e.map.height()))?;
-    let cache = Path::new("out/cache");
-    let fit = steps.run("fit", || fit_cached(&env, &strandlight_precompute::FitOptions::default(), cache), |f| format!("{}{}", fit_summary(&f.set), if f.cached { " (cached)" } else { "" }))?;
     let fiber = FiberDescription::preset(&args.preset).with_context(|| format!("--preset {:?}", args.preset))?;
-    // Full asks for the single-scattering tables too: dark hair skips the multiple table and the
-    // frame falls back to single scattering (below).
-    let modes: &[ScatteringMode] = match args.scattering {
-        ScatteringMode::Single => &[ScatteringMode::Single],
-        ScatteringMode::Full => &[ScatteringMode::Single, ScatteringMode::Full],
+    let table_set = format!("{}-{:?}", args.preset, shading).to_lowercase();
+    let request = EnvSceneRequest {
+        env: &env,
+        fiber: &fiber,
+        shading,
+        scattering: args.scattering,
+        resolution: BakeResolution::default(),
+        cache_dir: Path::new("out/cache"),
+        table_set: &table_set,
+        up: UpAxis::detect(&model),
     };
-    let wanted = wanted_tables(shading, modes, !fit.set.lobes.is_empty(), !fit.set.sources.is_empty());
-    let lambda_range = lambda_range_of_set(&fit.set)?;
-    let dir = cache.join("tables").join(format!("{}-{:?}", args.preset, shading).to_lowercase());
-    let tables = steps.run("bake", || bake_scene_tables(&fiber, shading, BakeResolution::default(), lambda_range, &wanted, &dir, &mut |_| {}), |t| format!("{} tables ({} cached)", t.baked.len(), t.baked.iter().filter(|b| b.cached).count()))?;
-    let mode = if args.scattering == ScatteringMode::Full && !tables.assets.contains_key("multiple") {
-        for (name, reason) in &tables.skipped {
-            steps.say(format!("skipped {name}: {reason}"));
-        }
-        ScatteringMode::Single
-    } else {
-        args.scattering
-    };
-    let camera = choose_camera(args, &model, width as f32 / height as f32)?;
-    let up = UpAxis::detect(&model);
-    let lights = strandlight_scene::world_lights::to_env_lights(&srbf_set_lights(&fit.set), up);
-    let frame = EnvFrame { hair: &model, camera, width, height, lights: &lights, tables: &tables, shading, mode, role: FrameRole::Interactive { kappa: args.kappa }, look };
-    let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {}, {} scattering", r.milliseconds, light_summary(&lights), mode.name()))?;
+    let scene = prepare_env_scene(&request, &mut steps)?;
+    let (lights, mode) = (&scene.lights, scene.mode);
+    let camera = camera_choice(args)?.camera(&model, width as f32 / height as f32)?;
+    let frame = EnvFrame { hair: &model, camera, width, height, lights, tables: &scene.tables, shading, mode, role: FrameRole::Interactive { kappa: args.kappa }, look };
+    let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {}, {} scattering", r.milliseconds, light_summary(lights), mode.name()))?;
     let stem = output_stem(&args.out);
     let (exr_path, png_path) = (stem.with_extension("exr"), stem.with_extension("png"));
-    let description = format!("{source}; {width}x{height}; env {env_spec}, {}; {shading:?} ({}), {} scattering", light_summary(&lights), args.preset, mode.name());
+    let description = format!("{source}; {width}x{height}; env {env_spec}, {}; {shading:?} ({}), {} scattering", light_summary(lights), args.preset, mode.name());
     let image = &rendered.image;
     write_exr(&exr_path, width, height, &image.pixels, &description)?;
     write_png(&png_path, width, height, &image.pixels, &description)?;

@@ -6,14 +6,17 @@
 //!
 //! Dependencies point one way: `tables` ← `precompute`, `runtime` ← this crate ← the CLI.
 
+pub mod camera_choice;
 pub mod compare;
 pub mod env_frame;
+pub mod env_scene;
 pub mod environment;
 pub mod equal_time;
 pub mod fit_cache;
 pub mod hair_input;
 pub mod image_metrics;
 pub mod look;
+pub mod point_shading;
 pub mod reference_cache;
 pub mod scene_tables;
 pub mod sealed_file;

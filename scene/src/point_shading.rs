@@ -1,0 +1,93 @@
+//! The fiber model of a point-lit frame, built from a user's choice: Kajiya-Kay, Marschner
+//! through its lookup textures (baked here: the runtime does not link the tabulation code), or
+//! the artist-friendly model with controls from a JSON file.
+
+use anyhow::Context;
+use std::path::Path;
+use strandlight_precompute::point_light_luts::{LutResolution, bake_lut_m, bake_lut_n};
+use strandlight_runtime::passes::fiber_shading::{MarschnerLuts, ShadingModel};
+use strandlight_runtime::passes::strands::KajiyaKay;
+use strandlight_tables::artist::{ArtistModel, ArtistParams};
+use strandlight_tables::marschner::{Marschner, MarschnerParams};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
+pub enum Shading {
+    KajiyaKay,
+    Marschner,
+    Artist,
+}
+
+/// What a point-lit frame's fiber model is made from.
+pub struct PointShadingRequest<'a> {
+    pub shading: Shading,
+    /// Melanin preset of the Marschner fiber.
+    pub preset: &'a str,
+    /// Nodes per axis of the Marschner lookup textures.
+    pub lut_size: usize,
+    /// JSON artist controls; None: the built-in defaults.
+    pub artist_params: Option<&'a Path>,
+}
+
+/// The model and a line describing it. Errors name the setting at fault (`--preset`,
+/// `--lut-size`, `--artist-params`).
+pub fn point_shading_model(request: &PointShadingRequest) -> anyhow::Result<(ShadingModel, String)> {
+    match request.shading {
+        Shading::KajiyaKay => Ok((ShadingModel::KajiyaKay, format!("Kajiya-Kay {:?}", KajiyaKay::default()))),
+        Shading::Marschner => marschner_luts(request.preset, request.lut_size),
+        Shading::Artist => artist(request.artist_params),
+    }
+}
+
+fn marschner_luts(preset: &str, lut_size: usize) -> anyhow::Result<(ShadingModel, String)> {
+    let params = MarschnerParams::with_preset(preset).with_context(|| format!("--preset {preset:?}"))?;
+    let model = Marschner::new(params)?;
+    let resolution = LutResolution::square(lut_size);
+    let lut_m = bake_lut_m(&model, &resolution).with_context(|| format!("--lut-size {lut_size}"))?;
+    let lut_n = bake_lut_n(&model, &resolution).with_context(|| format!("--lut-size {lut_size}"))?;
+    let description = format!("Marschner (preset {preset}) through {lut_size}² lookup tables (Hunz 2016 Algorithm 2)");
+    Ok((ShadingModel::MarschnerLut(MarschnerLuts::new(lut_m, lut_n)?), description))
+}
+
+fn artist(params_file: Option<&Path>) -> anyhow::Result<(ShadingModel, String)> {
+    let (params, from) = match params_file {
+        None => (ArtistParams::default(), "default controls".to_string()),
+        Some(path) => {
+            let text = std::fs::read_to_string(path).with_context(|| format!("--artist-params {}", path.display()))?;
+            let params: ArtistParams = serde_json::from_str(&text).with_context(|| format!("--artist-params {}", path.display()))?;
+            (params, path.display().to_string())
+        }
+    };
+    let model = ArtistModel::new(params).context("--artist-params")?;
+    Ok((ShadingModel::Artist(model), format!("artist-friendly (Sadeghi 2010), {from}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn request(shading: Shading) -> PointShadingRequest<'static> {
+        PointShadingRequest { shading, preset: "brown", lut_size: 16, artist_params: None }
+    }
+
+    #[test]
+    fn shading_choices_build_their_models_and_name_bad_parameters() {
+        let (model, text) = point_shading_model(&request(Shading::Marschner)).unwrap();
+        match model {
+            ShadingModel::MarschnerLut(luts) => {
+                assert_eq!(luts.lut_m().shape(), vec![16, 16, 4]);
+                assert_eq!(luts.lut_n().shape(), vec![16, 16, 3]);
+            }
+            other => panic!("{}", other.name()),
+        }
+        assert!(text.contains("brown") && text.contains("16²"), "{text}");
+        assert!(matches!(point_shading_model(&request(Shading::Artist)).unwrap().0, ShadingModel::Artist(_)));
+        let e = point_shading_model(&PointShadingRequest { preset: "purple", ..request(Shading::Marschner) }).unwrap_err();
+        assert!(format!("{e:#}").contains("--preset \"purple\""), "{e:#}");
+        let e = point_shading_model(&PointShadingRequest { lut_size: 1, ..request(Shading::Marschner) }).unwrap_err();
+        assert!(format!("{e:#}").contains("--lut-size 1"), "{e:#}");
+        let missing = Path::new("/nonexistent/artist.json");
+        let e = point_shading_model(&PointShadingRequest { artist_params: Some(missing), ..request(Shading::Artist) }).unwrap_err();
+        assert!(format!("{e:#}").contains("artist.json"), "{e:#}");
+    }
+}
