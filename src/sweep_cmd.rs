@@ -6,7 +6,7 @@ use serde::Serialize;
 use std::io::IsTerminal;
 use std::time::Instant;
 use strandlight_tables::hard_case_sweep::{SweepReport, chunked_sweep};
-use strandlight_tables::{artist, dual_scattering_hard_cases, kajiya_kay, marschner};
+use strandlight_tables::model_sweeps::{ModelSweep, SWEEPS};
 
 #[derive(clap::Args)]
 pub struct SweepArgs {
@@ -19,58 +19,6 @@ pub struct SweepArgs {
     /// Print one JSON object instead of the table.
     #[arg(long)]
     json: bool,
-}
-
-/// One model's sweep and the chunk size its work is split into. A chunk should be large next
-/// to the sweep's own per-parameter-set granularity (the sweeps round up to whole sets).
-struct ModelSweep {
-    name: &'static str,
-    /// What one requested sample is for this model.
-    unit: &'static str,
-    chunk: u64,
-    run: fn(u64, u64) -> SweepReport,
-}
-
-const SWEEPS: [ModelSweep; 4] = [
-    ModelSweep {
-        name: "marschner",
-        unit: "input (S, M_p and N_p of 3 lobes, oriented S)",
-        chunk: 1 << 18,
-        run: marschner_sweep,
-    },
-    ModelSweep {
-        name: "kajiya-kay",
-        unit: "scalar value",
-        chunk: 1 << 20,
-        run: kajiya_kay::hard_case_sweep,
-    },
-    ModelSweep {
-        name: "artist",
-        unit: "scalar value",
-        chunk: 1 << 20,
-        run: artist::hard_case_sweep,
-    },
-    ModelSweep {
-        name: "dual-scattering",
-        unit: "scalar value",
-        chunk: 1 << 20,
-        run: dual_scattering_hard_cases::hard_case_sweep,
-    },
-];
-
-/// The Marschner sweep reports in its own type (samples = inputs); recast it to the common
-/// report, whose `samples` counts scalar values. Its maximum is that of S only.
-fn marschner_sweep(samples: u64, seed: u64) -> SweepReport {
-    let r = marschner::hard_case_sweep(samples, seed);
-    SweepReport {
-        name: "marschner".into(),
-        samples: r.values_checked,
-        nan: r.nan,
-        infinite: r.inf,
-        negative: r.negative,
-        max_finite: r.max_s,
-        rejected: 0,
-    }
 }
 
 #[derive(Serialize)]

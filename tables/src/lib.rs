@@ -20,6 +20,7 @@ pub mod hard_case_sweep;
 pub mod kajiya_kay;
 pub mod longitudinal;
 pub mod marschner;
+pub mod model_sweeps;
 pub mod quadrature;
 pub mod scattering;
 pub mod shared_data;
