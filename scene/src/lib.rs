@@ -8,6 +8,7 @@
 
 pub mod camera_choice;
 pub mod compare;
+pub mod compare_table;
 pub mod env_frame;
 pub mod env_scene;
 pub mod environment;
