@@ -118,10 +118,10 @@ pub fn bake(args: BakeArgs) -> anyhow::Result<()> {
     let options = PlanOptions { models, resolution, force_multiple: args.force_multiple, multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD };
     let start = Instant::now();
     let plan = plan(&fiber, &options)?;
-    if let Some(share) = plan.multiple_scattering_share {
-        if !args.json {
-            println!("multiple-scattering share (direction-averaged single-event albedo): {:.1}%", 100.0 * share);
-        }
+    if let Some(share) = plan.multiple_scattering_share
+        && !args.json
+    {
+        println!("multiple-scattering share (direction-averaged single-event albedo): {:.1}%", 100.0 * share);
     }
     for s in &plan.skipped {
         if !args.json {

@@ -122,8 +122,7 @@ fn main() {
             swept
                 .history
                 .iter()
-                .filter(|r| r.lobes <= k)
-                .next_back()
+                .rfind(|r| r.lobes <= k)
                 .map(|r| {
                     let note = if r.lobes < k {
                         format!(" ({})", r.lobes)

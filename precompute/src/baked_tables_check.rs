@@ -148,11 +148,15 @@ fn random_points(table: &strandlight_tables::table::Table, count: usize, seed: u
         .collect()
 }
 
+/// One checked point: the looked-up values, their largest error, and the relative error
+/// where the reference is large enough to divide by.
+type CheckedPoint = (Vec<f64>, f64, Option<f64>);
+
 fn compare(asset: &TableAsset, name: &str, reference: &Reference, points: &[Vec<f64>]) -> Result<TableAccuracy, CheckError> {
     let table = &asset.table;
     let channels = table.channels();
     let table_max = table.stats().max.abs().max(table.stats().min.abs()) as f64;
-    let rows: Vec<Result<(Vec<f64>, f64, Option<f64>), CheckError>> = points
+    let rows: Vec<Result<CheckedPoint, CheckError>> = points
         .par_iter()
         .map(|p| {
             let mut looked = vec![0f32; channels];

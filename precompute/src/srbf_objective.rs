@@ -41,10 +41,10 @@ impl FitGrid {
             .map(|i| map.direction(i % width, i / width))
             .collect();
         let mut norm2 = 0.0;
-        for y in 0..height {
+        for (y, weight) in row_weight.iter().enumerate().take(height) {
             for x in 0..width {
                 let p = map.pixel(x, y);
-                norm2 += row_weight[y] * p.iter().map(|&v| (v as f64) * (v as f64)).sum::<f64>();
+                norm2 += weight * p.iter().map(|&v| (v as f64) * (v as f64)).sum::<f64>();
             }
         }
         let scale = if norm2 > 0.0 { norm2.sqrt() } else { 1.0 };
@@ -236,8 +236,8 @@ pub fn evaluate(grid: &FitGrid, centers: &[DVec3], lambdas: &[f64]) -> Evaluatio
         let b = DVector::from_fn(k, |r, _| projections[r].0[c]);
         let a = crate::nnls::solve(&gram, &b);
         relative_mse += a.dot(&(&gram * &a)) - 2.0 * a.dot(&b);
-        for r in 0..k {
-            amplitudes[r][c] = a[r];
+        for (amplitude, a_r) in amplitudes.iter_mut().zip(a.iter()) {
+            amplitude[c] = *a_r;
         }
     }
     let mut grad_center = vec![DVec3::ZERO; k];

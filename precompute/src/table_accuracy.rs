@@ -91,13 +91,17 @@ pub fn stratified_points(count: usize, lambda_min: f64, lambda_max: f64, seed: u
         .collect()
 }
 
+/// One checked point: the point, its largest error, and the relative error where the
+/// reference is large enough to divide by.
+type CheckedPoint = ([f64; 4], f64, Option<f64>);
+
 /// Compares `table` with the reference integral of `s` at `points`.
 pub fn check_table<F>(name: &str, table: &Table, s: &F, points: &[[f64; 4]], reference_panels: usize) -> Result<TableAccuracy, TableError>
 where
     F: Fn(&FiberAngles) -> Rgb + Sync,
 {
     let table_max = table.stats().max as f64;
-    let rows: Vec<Result<([f64; 4], f64, Option<f64>), TableError>> = points
+    let rows: Vec<Result<CheckedPoint, TableError>> = points
         .par_iter()
         .map(|p| {
             let looked = table.lookup_rgb(p)?;

@@ -137,13 +137,13 @@ fn independent_relative_mse(map: &EnvMap, lobes: &[SrbfLobe]) -> f64 {
                 -theta.sin() * phi.cos(),
             );
             let p = map.pixel(x, y);
-            for c in 0..3 {
+            for (c, &pixel) in p.iter().enumerate() {
                 let f: f64 = lobes
                     .iter()
                     .map(|l| l.amplitude[c] * srbf::kernel(dir.dot(l.center()), l.lambda))
                     .sum();
-                err += d_omega * (f - p[c] as f64).powi(2);
-                norm += d_omega * (p[c] as f64).powi(2);
+                err += d_omega * (f - pixel as f64).powi(2);
+                norm += d_omega * (pixel as f64).powi(2);
             }
         }
     }

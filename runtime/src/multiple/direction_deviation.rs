@@ -40,10 +40,10 @@ impl DirectionDeviation {
         for k in 0..n {
             let nu = nu_max * k as f64 / (n - 1) as f64;
             let v = mean_sin2_offset(nu);
-            if let Some(&last) = f.last() {
-                if v <= last {
-                    break;
-                }
+            if let Some(&last) = f.last()
+                && v <= last
+            {
+                break;
             }
             nus.push(nu);
             f.push(v);

@@ -50,15 +50,15 @@ impl VoxelSettings {
                 problem: "must be in 1..=1024".into(),
             });
         }
-        if let Some(d) = self.default_diameter {
-            if !(d.is_finite() && d >= 0.0) {
+        if let Some(d) = self.default_diameter
+            && !(d.is_finite() && d >= 0.0)
+        {
                 return Err(ForwardScatteringError::InvalidSetting {
                     parameter: "default_diameter",
                     value: d.to_string(),
                     problem: "must be finite and ≥ 0".into(),
                 });
             }
-        }
         Ok(())
     }
 }
