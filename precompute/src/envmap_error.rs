@@ -31,6 +31,22 @@ pub enum EnvMapError {
         problem: String,
     },
 
+    /// A header whose pixel count the file's bytes cannot hold even at the format's densest
+    /// encoding: refused before anything is allocated for the pixels.
+    #[error(
+        "{path}: the header claims {width} × {height} pixels, more than its {bytes} bytes can \
+         hold even at the densest {encoding} ({max_pixels} pixels at most); the file is corrupt \
+         or truncated"
+    )]
+    ImpossibleSize {
+        path: PathBuf,
+        width: u64,
+        height: u64,
+        bytes: u64,
+        encoding: &'static str,
+        max_pixels: u64,
+    },
+
     #[error("{path}: cannot decode OpenEXR: {message}")]
     Exr { path: PathBuf, message: String },
 

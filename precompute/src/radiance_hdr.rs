@@ -59,8 +59,9 @@ pub fn decode(path: &Path, bytes: &[u8]) -> Result<EnvMap, EnvMapError> {
 
     // Even the densest run-length code (127 pixels in 2 bytes per plane) needs about one byte
     // per 16 pixels: refuse a header that promises more than the file can hold before
-    // allocating for it.
-    if (layout.width * layout.height) as u128 > 16 * (bytes.len() - pos) as u128 + 1024 {
+    // allocating for it: the pixel data is truncated as the header counts. (Old-style runs can
+    // in principle compress further; files that rely on that are refused too.)
+    if (layout.width as u64) * (layout.height as u64) > max_pixels(bytes.len() - pos) {
         return Err(EnvMapError::Truncated {
             path: path.into(),
             scanline: 0,
@@ -78,6 +79,14 @@ pub fn decode(path: &Path, bytes: &[u8]) -> Result<EnvMap, EnvMapError> {
         }
     }
     Ok(EnvMap::from_pixels(layout.width, layout.height, pixels))
+}
+
+/// The most pixels `pixel_bytes` bytes of run-length coded scanlines can describe (with a
+/// little slack for tiny images): 16 per byte.
+pub const PIXELS_PER_BYTE: u64 = 16;
+
+fn max_pixels(pixel_bytes: usize) -> u64 {
+    PIXELS_PER_BYTE * pixel_bytes as u64 + 1024
 }
 
 /// Radiance `colr_color`: mantissa + ½ times 2^(e − 136); e = 0 is black.

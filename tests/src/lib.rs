@@ -1,1 +1,4 @@
-//! End-to-end tests across crates live in `tests/tests/`.
+//! End-to-end tests across crates live in `tests/tests/`; [`fuzz`] is the in-process fuzzer of
+//! every file reader that `tests/tests/fuzz_readers.rs` runs.
+
+pub mod fuzz;

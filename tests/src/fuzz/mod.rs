@@ -1,0 +1,554 @@
+//! An in-process, seeded mutation fuzzer for every file reader of the project (issue #15, "Bad
+//! input"). For each [`targets::Target`] it builds a seed corpus ([`seeds`]), runs
+//! `execs × STRANDLIGHT_FUZZ_EXECS` mutants ([`mutate`]) plus random junk behind the seeds'
+//! first bytes, and checks each execution:
+//!
+//! - it returns (a panic is a finding; it runs under `catch_unwind`),
+//! - no single allocation exceeds `(64 + bytes_out_per_byte_in) × input length + 64 MiB`
+//!   (measured by the [`alloc::CountingAlloc`] the test binary installs),
+//! - it takes less than [`EXEC_TIME_CAP`] (a watchdog ends the process, with the input saved,
+//!   if one runs for [`WATCHDOG`]),
+//! - a refusal names the file (its message contains the target's `file_name`).
+//!
+//! Strict prefixes of the seeds must be refused where the format fixes its own size (every
+//! prefix of the smallest generated seed, a sample of the others). Deterministic: the same
+//! multiplier gives the same mutants. A finding is saved under
+//! `target/strandlight-fuzz/<target>/` with the seed and edits that made it, so it can become
+//! a regression test beside the reader.
+//!
+//! The input being executed is also written to `target/strandlight-fuzz/<target>/current.bin`
+//! first: an abort (an allocation so large that the system refuses it) leaves it behind.
+
+pub mod alloc;
+pub mod mutate;
+pub mod seeds;
+pub mod targets;
+
+use std::collections::BTreeMap;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Mutex, Once, OnceLock};
+use std::time::{Duration, Instant};
+
+use strandlight_tables::split_mix::SplitMix64;
+
+use seeds::Seed;
+use targets::Target;
+
+/// Fixed allowance of the wild-allocation bound, beyond the per-byte part: decoders keep small
+/// tables and buffers whose size does not follow the input's.
+pub const ALLOCATION_SLACK: usize = 64 << 20;
+/// An execution slower than this is a finding (seeds are small; a normal one takes well under
+/// a millisecond to a few milliseconds).
+pub const EXEC_TIME_CAP: Duration = Duration::from_secs(3);
+/// An execution still running after this is a hang: the process ends with the input saved.
+pub const WATCHDOG: Duration = Duration::from_secs(60);
+/// Bytes of random junk behind a seed's first bytes, at most.
+const JUNK_MAX: usize = 512;
+/// One execution in this many is junk behind a seed's head instead of a mutant.
+const JUNK_EVERY: usize = 16;
+/// Random strict prefixes checked per seed (the smallest generated seed gets all of them).
+const SAMPLED_PREFIXES: usize = 48;
+
+/// The workspace's `target/` folder (`$CARGO_TARGET_DIR` when set).
+pub fn target_dir() -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| {
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .parent()
+                .expect("the tests crate lives in the workspace")
+                .join("target")
+        })
+}
+
+/// Where findings and the current input go: `target/strandlight-fuzz/`.
+pub fn fuzz_dir() -> PathBuf {
+    target_dir().join("strandlight-fuzz")
+}
+
+/// A scratch folder of this process (for readers that take a path), created on first use: in
+/// `/dev/shm` where there is one, since on ext4 closing a file truncated and rewritten in place
+/// forces it to disk (milliseconds per execution), else under `target/strandlight-fuzz/`.
+pub fn scratch_dir() -> &'static Path {
+    static DIR: OnceLock<PathBuf> = OnceLock::new();
+    DIR.get_or_init(|| {
+        let shm = Path::new("/dev/shm");
+        let parent = if shm.is_dir() {
+            shm.join("strandlight-fuzz")
+        } else {
+            fuzz_dir()
+        };
+        // Folders left by earlier runs whose process is gone.
+        if let Ok(entries) = std::fs::read_dir(&parent) {
+            for entry in entries.flatten() {
+                let name = entry.file_name().to_string_lossy().into_owned();
+                if let Some(pid) = name.strip_prefix("scratch-")
+                    && Path::new("/proc").is_dir()
+                    && !Path::new("/proc").join(pid).exists()
+                {
+                    let _ = std::fs::remove_dir_all(entry.path());
+                }
+            }
+        }
+        let dir = parent.join(format!("scratch-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("target/ is writable");
+        dir
+    })
+}
+
+/// `STRANDLIGHT_FUZZ_EXECS`: the multiplier of every target's CI execution count (default 1;
+/// fractions such as 0.1 allowed for a quick look).
+pub fn execs_multiplier() -> f64 {
+    match std::env::var("STRANDLIGHT_FUZZ_EXECS") {
+        Ok(v) => v
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|m| m.is_finite() && *m > 0.0)
+            .unwrap_or_else(|| panic!("STRANDLIGHT_FUZZ_EXECS={v:?} is not a positive number")),
+        Err(_) => 1.0,
+    }
+}
+
+/// What went wrong in one execution.
+#[derive(Clone, Debug)]
+pub enum Problem {
+    Panic(String),
+    WildAllocation {
+        bytes: usize,
+        bound: usize,
+    },
+    Slow(Duration),
+    /// The refusal's message does not contain the file's name.
+    UnnamedFile {
+        kind: String,
+        message: String,
+    },
+    /// A seed written by the project's own writer does not load.
+    SeedRefused,
+    /// A strict prefix of a valid file was accepted.
+    PrefixLoaded {
+        prefix: usize,
+        of: usize,
+    },
+}
+
+impl std::fmt::Display for Problem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Problem::Panic(m) => write!(f, "panic: {m}"),
+            Problem::WildAllocation { bytes, bound } => {
+                write!(
+                    f,
+                    "wild allocation: one request of {bytes} bytes (bound {bound})"
+                )
+            }
+            Problem::Slow(d) => write!(
+                f,
+                "slow: {:.2} s (cap {:?})",
+                d.as_secs_f64(),
+                EXEC_TIME_CAP
+            ),
+            Problem::UnnamedFile { kind, message } => {
+                write!(f, "error {kind} does not name the file: {message:?}")
+            }
+            Problem::SeedRefused => {
+                write!(f, "a seed written by the project's own writer is refused")
+            }
+            Problem::PrefixLoaded { prefix, of } => {
+                write!(f, "the first {prefix} of {of} bytes of a valid file loaded")
+            }
+        }
+    }
+}
+
+/// A finding with how to reproduce it.
+#[derive(Clone, Debug)]
+pub struct Finding {
+    pub problem: Problem,
+    /// The seed and the edits (or the prefix, or the junk) that made the input.
+    pub origin: String,
+    /// The input, saved under `target/strandlight-fuzz/<target>/`.
+    pub saved: PathBuf,
+}
+
+/// One target's figures.
+#[derive(Debug, Default)]
+pub struct Report {
+    pub target: String,
+    pub seeds: Vec<(String, usize)>,
+    pub executions: usize,
+    pub ok: usize,
+    /// Refusals by error variant.
+    pub refusals: BTreeMap<String, usize>,
+    /// One message per variant, for the log.
+    pub examples: BTreeMap<String, String>,
+    pub prefixes_checked: usize,
+    /// Largest single allocation seen, as a multiple of the input's length (inputs ≥ 1 kB).
+    pub largest_allocation_per_byte: f64,
+    pub findings: Vec<Finding>,
+    pub seconds: f64,
+}
+
+impl Report {
+    /// Prints the figures and each finding.
+    pub fn print(&self) {
+        eprintln!(
+            "fuzz {}: {} executions ({} mutants and junk, {} prefixes) in {:.1} s: {} Ok, {} refused, {} findings",
+            self.target,
+            self.executions,
+            self.executions - self.prefixes_checked,
+            self.prefixes_checked,
+            self.seconds,
+            self.ok,
+            self.refusals.values().sum::<usize>(),
+            self.findings.len()
+        );
+        for (name, len) in &self.seeds {
+            eprintln!("  seed {name}: {len} bytes");
+        }
+        for (kind, count) in &self.refusals {
+            eprintln!(
+                "  refused {count:>6} × {kind}: e.g. {}",
+                self.examples[kind]
+            );
+        }
+        eprintln!(
+            "  largest allocation: {:.1} bytes per input byte (inputs of 1 kB or more)",
+            self.largest_allocation_per_byte
+        );
+        for f in &self.findings {
+            eprintln!(
+                "  FINDING {}\n    from {}\n    saved {}",
+                f.problem,
+                f.origin,
+                f.saved.display()
+            );
+        }
+    }
+}
+
+/// The panic message of the execution in flight (the hook keeps it instead of printing).
+static FUZZING: AtomicBool = AtomicBool::new(false);
+static LAST_PANIC: Mutex<Option<String>> = Mutex::new(None);
+
+fn install_panic_hook() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        let previous = std::panic::take_hook();
+        std::panic::set_hook(Box::new(move |info| {
+            if FUZZING.load(Ordering::SeqCst) {
+                let message = info
+                    .payload()
+                    .downcast_ref::<&str>()
+                    .map(|s| s.to_string())
+                    .or_else(|| info.payload().downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "(non-string payload)".into());
+                let at = info
+                    .location()
+                    .map(|l| format!(" at {}:{}", l.file(), l.line()))
+                    .unwrap_or_default();
+                *LAST_PANIC.lock().unwrap_or_else(|e| e.into_inner()) =
+                    Some(format!("{message}{at}"));
+            } else {
+                previous(info);
+            }
+        }));
+    });
+}
+
+/// Milliseconds since [`epoch`] at which the execution in flight started (0: none), and the
+/// path of its saved input, read by the watchdog thread.
+static STARTED_MS: AtomicU64 = AtomicU64::new(0);
+static CURRENT_INPUT: Mutex<Option<PathBuf>> = Mutex::new(None);
+
+fn epoch() -> Instant {
+    static EPOCH: OnceLock<Instant> = OnceLock::new();
+    *EPOCH.get_or_init(Instant::now)
+}
+
+fn start_watchdog() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        epoch();
+        std::thread::spawn(|| {
+            loop {
+                std::thread::sleep(Duration::from_millis(500));
+                let started = STARTED_MS.load(Ordering::SeqCst);
+                if started == 0 {
+                    continue;
+                }
+                let now = epoch().elapsed().as_millis() as u64;
+                if now.saturating_sub(started) > WATCHDOG.as_millis() as u64 {
+                    let input = CURRENT_INPUT.lock().unwrap_or_else(|e| e.into_inner()).clone();
+                    eprintln!(
+                        "FINDING hang: an execution has run for more than {WATCHDOG:?}; its input is {}",
+                        input.map(|p| p.display().to_string()).unwrap_or_default()
+                    );
+                    std::process::exit(101);
+                }
+            }
+        });
+    });
+}
+
+/// The result of one execution.
+enum Outcome {
+    Ok,
+    Refused(targets::Refusal),
+    Problem(Problem),
+}
+
+/// The largest single allocation `target` may make for an input of `len` bytes.
+pub fn allocation_bound(target: &Target, len: usize) -> usize {
+    (64 + target.bytes_out_per_byte_in as usize)
+        .saturating_mul(len)
+        .saturating_add(ALLOCATION_SLACK)
+}
+
+/// Runs one input through `target` with every check.
+fn execute(target: &Target, data: &[u8], current: &mut std::fs::File) -> (Outcome, usize) {
+    // Kept on disk first: an abort inside the reader leaves the input behind. (One open file,
+    // rewritten in place: cheaper than creating a file per execution.)
+    {
+        use std::io::{Seek, Write};
+        current.set_len(0).expect("target/ is writable");
+        current.rewind().expect("target/ is writable");
+        current.write_all(data).expect("target/ is writable");
+    }
+    *LAST_PANIC.lock().unwrap_or_else(|e| e.into_inner()) = None;
+    FUZZING.store(true, Ordering::SeqCst);
+    STARTED_MS.store(epoch().elapsed().as_millis() as u64 + 1, Ordering::SeqCst);
+    let start = Instant::now();
+    let (result, largest) =
+        alloc::measure(|| catch_unwind(AssertUnwindSafe(|| (target.run)(data))));
+    let elapsed = start.elapsed();
+    STARTED_MS.store(0, Ordering::SeqCst);
+    FUZZING.store(false, Ordering::SeqCst);
+    let bound = allocation_bound(target, data.len());
+    let outcome = match result {
+        Err(_) => {
+            let message = LAST_PANIC
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .take()
+                .unwrap_or_else(|| "(no message)".into());
+            Outcome::Problem(Problem::Panic(message))
+        }
+        Ok(_) if largest > bound => Outcome::Problem(Problem::WildAllocation {
+            bytes: largest,
+            bound,
+        }),
+        Ok(_) if elapsed > EXEC_TIME_CAP => Outcome::Problem(Problem::Slow(elapsed)),
+        Ok(Ok(())) => Outcome::Ok,
+        Ok(Err(refusal)) if !refusal.message.contains(target.file_name) => {
+            Outcome::Problem(Problem::UnnamedFile {
+                kind: refusal.kind,
+                message: refusal.message,
+            })
+        }
+        Ok(Err(refusal)) => Outcome::Refused(refusal),
+    };
+    (outcome, largest)
+}
+
+/// A stable seed for a target's random stream.
+fn stream_seed(name: &str) -> u64 {
+    name.bytes()
+        .fold(0xF0CC_5EED_u64, |h, b| h.rotate_left(8) ^ b as u64)
+}
+
+/// Fuzzes one target: seeds, prefixes, mutants and junk. The caller holds
+/// [`alloc::MEASURING`] and has checked [`alloc::is_installed`].
+pub fn run(target: &Target) -> Report {
+    install_panic_hook();
+    start_watchdog();
+    let started = Instant::now();
+    let seeds: Vec<Seed> = seeds::seeds(target.name);
+    assert!(!seeds.is_empty(), "{}: no seeds", target.name);
+    let out_dir = fuzz_dir().join(target.name);
+    std::fs::create_dir_all(&out_dir).expect("target/ is writable");
+    let current = out_dir.join("current.bin");
+    *CURRENT_INPUT.lock().unwrap_or_else(|e| e.into_inner()) = Some(current.clone());
+    let mut report = Report {
+        target: target.name.into(),
+        seeds: seeds
+            .iter()
+            .map(|s| (s.name.clone(), s.bytes.len()))
+            .collect(),
+        ..Report::default()
+    };
+    let mut rng = SplitMix64::new(stream_seed(target.name));
+
+    let mut current_file = std::fs::File::create(&current).expect("target/ is writable");
+    let mut record = |report: &mut Report, data: &[u8], origin: String| {
+        let (outcome, largest) = execute(target, data, &mut current_file);
+        report.executions += 1;
+        if data.len() >= 1024 {
+            report.largest_allocation_per_byte = report
+                .largest_allocation_per_byte
+                .max(largest as f64 / data.len() as f64);
+        }
+        let problem = match outcome {
+            Outcome::Ok => {
+                report.ok += 1;
+                return true;
+            }
+            Outcome::Refused(r) => {
+                report.examples.entry(r.kind.clone()).or_insert(r.message);
+                *report.refusals.entry(r.kind).or_default() += 1;
+                return false;
+            }
+            Outcome::Problem(p) => p,
+        };
+        save_finding(report, &out_dir, data, problem, origin);
+        false
+    };
+
+    // Every seed loads (the generated ones must; a shared one that does not is reported).
+    for seed in &seeds {
+        let loaded = record(&mut report, &seed.bytes, format!("seed {}", seed.name));
+        if !loaded && seed.generated && report.findings.is_empty() {
+            save_finding(
+                &mut report,
+                &out_dir,
+                &seed.bytes,
+                Problem::SeedRefused,
+                format!("seed {}", seed.name),
+            );
+        }
+    }
+
+    // Strict prefixes: all of the smallest generated seed's, a sample of every other seed's.
+    if target.prefixes_fail {
+        let smallest = seeds
+            .iter()
+            .filter(|s| s.generated)
+            .min_by_key(|s| s.bytes.len())
+            .map(|s| s.name.clone());
+        for seed in &seeds {
+            let cuts: Vec<usize> = if Some(&seed.name) == smallest.as_ref() {
+                (0..seed.bytes.len()).collect()
+            } else {
+                (0..SAMPLED_PREFIXES)
+                    .map(|_| rng.below(seed.bytes.len()))
+                    .collect()
+            };
+            for cut in cuts {
+                let prefix = &seed.bytes[..cut];
+                let before = report.findings.len();
+                let loaded = record(
+                    &mut report,
+                    prefix,
+                    format!("seed {}, first {cut} bytes", seed.name),
+                );
+                report.prefixes_checked += 1;
+                if loaded && report.findings.len() == before {
+                    save_finding(
+                        &mut report,
+                        &out_dir,
+                        prefix,
+                        Problem::PrefixLoaded {
+                            prefix: cut,
+                            of: seed.bytes.len(),
+                        },
+                        format!("seed {}, first {cut} bytes", seed.name),
+                    );
+                }
+            }
+        }
+    }
+
+    // Mutants, and now and then junk behind a seed's first bytes (its magic and header start).
+    let executions = (target.execs as f64 * execs_multiplier()).round() as usize;
+    for i in 0..executions {
+        let seed = &seeds[rng.below(seeds.len())];
+        if i % JUNK_EVERY == JUNK_EVERY - 1 {
+            let head = rng.below(seed.bytes.len().min(64) + 1);
+            let mut junk = seed.bytes[..head].to_vec();
+            let len = rng.below(JUNK_MAX + 1);
+            junk.extend((0..len).map(|_| rng.next_u64() as u8));
+            let origin = format!(
+                "junk: the first {head} bytes of seed {} and {len} random bytes",
+                seed.name
+            );
+            record(&mut report, &junk, origin);
+            continue;
+        }
+        let other = &seeds[rng.below(seeds.len())];
+        let (mut data, edits) = mutate::mutate(&seed.bytes, &other.bytes, &mut rng);
+        let resealed = match target.reseal {
+            Some(reseal) if rng.below(2) == 0 => {
+                reseal(&mut data);
+                true
+            }
+            _ => false,
+        };
+        let origin = format!(
+            "seed {}, edits {edits:?}{}{} (mutant {i} of stream {:#x}, STRANDLIGHT_FUZZ_EXECS={})",
+            seed.name,
+            if edits.contains(&mutate::Edit::Splice) {
+                format!(" (splice partner {})", other.name)
+            } else {
+                String::new()
+            },
+            if resealed { ", resealed" } else { "" },
+            stream_seed(target.name),
+            execs_multiplier(),
+        );
+        record(&mut report, &data, origin);
+    }
+    drop(record);
+    let _ = std::fs::remove_file(&current);
+    report.seconds = started.elapsed().as_secs_f64();
+    report
+}
+
+fn save_finding(report: &mut Report, dir: &Path, data: &[u8], problem: Problem, origin: String) {
+    let n = report.findings.len();
+    let saved = dir.join(format!("finding-{n}.bin"));
+    std::fs::write(&saved, data).expect("target/ is writable");
+    let note = format!("{problem}\nfrom {origin}\n{} bytes\n", data.len());
+    std::fs::write(saved.with_extension("txt"), note).expect("target/ is writable");
+    report.findings.push(Finding {
+        problem,
+        origin,
+        saved,
+    });
+}
+
+/// Runs the target named `name` as a test: takes [`alloc::MEASURING`], checks the counting
+/// allocator is installed, fuzzes, prints, and fails on any finding.
+pub fn fuzz_target(name: &str) -> Report {
+    let _measuring = alloc::MEASURING.lock().unwrap_or_else(|e| e.into_inner());
+    assert!(
+        alloc::is_installed(),
+        "the test binary must install fuzz::alloc::CountingAlloc as its #[global_allocator]"
+    );
+    let target = targets::all()
+        .into_iter()
+        .find(|t| t.name == name)
+        .unwrap_or_else(|| panic!("no fuzz target {name}"));
+    let report = run(&target);
+    report.print();
+    assert!(
+        report.findings.is_empty(),
+        "fuzz {name}: {} findings (inputs saved under {}):\n{}",
+        report.findings.len(),
+        fuzz_dir().join(name).display(),
+        report
+            .findings
+            .iter()
+            .map(|f| format!(
+                "  {}\n    from {}\n    saved {}",
+                f.problem,
+                f.origin,
+                f.saved.display()
+            ))
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+    report
+}

@@ -1,0 +1,179 @@
+//! The readers under test, each as a function from bytes to Ok or a classified error. Each
+//! decodes as a user's file would be loaded: the hair parsers with cleaning, the environment
+//! maps through `envmap_io::load_bytes` (2:1 and bad-pixel checks, sanitizing), the table asset
+//! and SRBF set through their public loaders.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, OnceLock};
+
+use strandlight_precompute::SrbfSet;
+use strandlight_precompute::envmap_io::{LoadOptions, load_bytes};
+use strandlight_runtime::hair;
+use strandlight_tables::asset;
+
+/// A reader's failure: the error's variant (for the tally) and its message.
+#[derive(Clone, Debug)]
+pub struct Refusal {
+    pub kind: String,
+    pub message: String,
+}
+
+/// One reader.
+pub struct Target {
+    /// Short name, also the extension of the seed files (`hair`, `sltab`, …).
+    pub name: &'static str,
+    /// The name errors must mention (the path handed to the reader ends with it).
+    pub file_name: &'static str,
+    pub run: fn(&[u8]) -> Result<(), Refusal>,
+    /// Every strict prefix of a valid file is refused (the format fixes its own size).
+    pub prefixes_fail: bool,
+    /// Pixels (or values) a byte of this format can legitimately decode to at most: the
+    /// allowance of the wild-allocation check beyond 64 bytes per input byte.
+    pub bytes_out_per_byte_in: u64,
+    /// Executions in CI (times `STRANDLIGHT_FUZZ_EXECS`).
+    pub execs: usize,
+    /// Fixes up a mutant so that it gets past an integrity check to the parser behind it.
+    pub reseal: Option<fn(&mut Vec<u8>)>,
+}
+
+fn refusal<E: std::fmt::Debug + std::fmt::Display>(e: E) -> Refusal {
+    let debug = format!("{e:?}");
+    let kind = debug
+        .split([' ', '{', '('])
+        .next()
+        .unwrap_or_default()
+        .to_string();
+    Refusal {
+        kind,
+        message: e.to_string(),
+    }
+}
+
+fn hair_with(
+    parse: fn(&[u8], &Path) -> Result<hair::LoadedHair, hair::HairError>,
+    file: &str,
+    bytes: &[u8],
+) -> Result<(), Refusal> {
+    parse(bytes, Path::new(file)).map(drop).map_err(refusal)
+}
+
+fn run_hair(bytes: &[u8]) -> Result<(), Refusal> {
+    hair_with(hair::yuksel::parse_hair, "fuzz-input.hair", bytes)
+}
+
+fn run_tfx(bytes: &[u8]) -> Result<(), Refusal> {
+    hair_with(hair::tfx::parse_tfx, "fuzz-input.tfx", bytes)
+}
+
+fn run_data(bytes: &[u8]) -> Result<(), Refusal> {
+    hair_with(hair::usc::parse_usc, "fuzz-input.data", bytes)
+}
+
+fn run_ply(bytes: &[u8]) -> Result<(), Refusal> {
+    hair_with(hair::ply::parse_ply, "fuzz-input.ply", bytes)
+}
+
+/// Environment maps are loaded with sanitizing on, so that decoded maps with bad pixels go on
+/// through the cleaning code instead of stopping at the refusal.
+fn run_envmap(file: &str, bytes: &[u8]) -> Result<(), Refusal> {
+    let loaded = load_bytes(Path::new(file), bytes, LoadOptions { sanitize: true });
+    loaded.map(drop).map_err(refusal)
+}
+
+fn run_hdr(bytes: &[u8]) -> Result<(), Refusal> {
+    run_envmap("fuzz-input.hdr", bytes)
+}
+
+fn run_exr(bytes: &[u8]) -> Result<(), Refusal> {
+    run_envmap("fuzz-input.exr", bytes)
+}
+
+/// The table asset reader takes a path, so each input goes through one scratch file, kept
+/// open and rewritten in place (creating a file per execution costs milliseconds here).
+fn run_sltab(bytes: &[u8]) -> Result<(), Refusal> {
+    use std::io::{Seek, Write};
+    static FILE: OnceLock<(PathBuf, Mutex<File>)> = OnceLock::new();
+    let (path, file) = FILE.get_or_init(|| {
+        let path = super::scratch_dir().join("fuzz-input.sltab");
+        let file = File::create(&path).expect("the scratch folder is writable");
+        (path, Mutex::new(file))
+    });
+    {
+        let mut file = file.lock().unwrap_or_else(|e| e.into_inner());
+        file.set_len(0).expect("the scratch file is writable");
+        file.rewind().expect("the scratch file is writable");
+        file.write_all(bytes).expect("the scratch file is writable");
+    }
+    asset::read_asset(path).map(drop).map_err(refusal)
+}
+
+fn run_srbf(bytes: &[u8]) -> Result<(), Refusal> {
+    SrbfSet::from_json(Path::new("fuzz-input.srbf.json"), bytes)
+        .map(drop)
+        .map_err(refusal)
+}
+
+/// The metadata of a table asset is guarded by its own SHA-256, so a mutated JSON block would
+/// only ever reach the checksum test. Half the asset mutants get a digest that matches again.
+fn reseal_asset(data: &mut Vec<u8>) {
+    if data.len() < 16 || data[..8] != asset::MAGIC {
+        return;
+    }
+    let len = u32::from_le_bytes(data[12..16].try_into().unwrap()) as usize;
+    let Some(digest_end) = (16 + len).checked_add(32) else {
+        return;
+    };
+    if digest_end > data.len() {
+        return;
+    }
+    let hex = strandlight_tables::checksum::sha256_hex(&data[16..16 + len]);
+    for (i, byte) in data[16 + len..digest_end].iter_mut().enumerate() {
+        *byte = u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap();
+    }
+}
+
+/// Every reader, with its CI execution count.
+pub fn all() -> Vec<Target> {
+    let target = |name, file_name, run, execs| Target {
+        name,
+        file_name,
+        run,
+        prefixes_fail: true,
+        bytes_out_per_byte_in: 64,
+        execs,
+        reseal: None,
+    };
+    vec![
+        target(
+            "hair",
+            "fuzz-input.hair",
+            run_hair as fn(&[u8]) -> _,
+            200000,
+        ),
+        Target {
+            // Offsets may leave gaps and trailing bytes (TressFX files have them), so a file
+            // cut after its last array still loads.
+            prefixes_fail: false,
+            ..target("tfx", "fuzz-input.tfx", run_tfx, 100000)
+        },
+        target("data", "fuzz-input.data", run_data, 150000),
+        target("ply", "fuzz-input.ply", run_ply, 150000),
+        Target {
+            // A byte of run-length code holds up to 16 pixels of 12 bytes (f32 RGB) each.
+            bytes_out_per_byte_in: 16 * 12,
+            ..target("hdr", "fuzz-input.hdr", run_hdr, 150000)
+        },
+        Target {
+            // Up to 1376 bytes of samples per byte (PXR24's deflate), 6 of them (half RGB) per
+            // pixel of 12 bytes (f32 RGB) in memory.
+            bytes_out_per_byte_in: 1376 * 12 / 6,
+            ..target("exr", "fuzz-input.exr", run_exr, 60000)
+        },
+        Target {
+            reseal: Some(reseal_asset),
+            ..target("sltab", "fuzz-input.sltab", run_sltab, 40000)
+        },
+        target("srbf", "fuzz-input.srbf.json", run_srbf, 150000),
+    ]
+}
