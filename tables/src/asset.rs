@@ -407,6 +407,20 @@ impl OpenedAsset {
         if Sha256::digest(&json).as_slice() != digest {
             return Err(AssetError::MetadataChecksumMismatch { path: path_buf });
         }
+        // The padding is covered by no checksum, so it must be what the writer wrote: zeros. A
+        // flipped bit there is harmless to the values but says the file is not the one written.
+        let padding_len = payload_offset(metadata_len as u64).saturating_sub(digest_end).min(16);
+        if file_len < digest_end + padding_len {
+            return Err(truncated("padding", digest_end + padding_len));
+        }
+        let mut padding = vec![0u8; padding_len as usize];
+        file.read_exact(&mut padding).map_err(io_error)?;
+        if padding.iter().any(|&b| b != 0) {
+            return Err(AssetError::Inconsistent {
+                path: path_buf,
+                problem: "the padding before the payload is not zero: the file is corrupt".into(),
+            });
+        }
         let metadata: AssetMetadata =
             serde_json::from_slice(&json).map_err(|source| AssetError::BadMetadata {
                 path: path_buf.clone(),
