@@ -346,3 +346,59 @@ fn float_to_rgbe(c: Rgb32) -> [u8; 4] {
     let q = |v: f32| ((v as f64 * scale).floor().clamp(0.0, 255.0)) as u8;
     [q(c[0]), q(c[1]), q(c[2]), (e + 128) as u8]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::{Duration, Instant};
+
+    fn decode_named(bytes: &[u8]) -> Result<EnvMap, EnvMapError> {
+        decode(Path::new("crafted.hdr"), bytes)
+    }
+
+    /// A header claiming 10⁶ × 10⁶ pixels (or the largest resolution the reader accepts) in a
+    /// file of a few bytes is refused before the pixel buffer is allocated, naming the file.
+    #[test]
+    fn absurd_resolutions_are_refused_before_allocation() {
+        for resolution in [
+            "-Y 1000000 +X 1000000",
+            "-Y 1048576 +X 1048576",
+            "+X 1000000 -Y 500000",
+        ] {
+            let mut bytes =
+                format!("#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n{resolution}\n").into_bytes();
+            bytes.extend_from_slice(&[2, 2, 0x40, 0, 0x80 + 127, 0]);
+            let start = Instant::now();
+            let e = decode_named(&bytes).unwrap_err();
+            assert!(start.elapsed() < Duration::from_secs(1), "{e}");
+            assert!(
+                matches!(e, EnvMapError::Truncated { scanline: 0, .. }),
+                "{e}"
+            );
+            assert!(e.to_string().contains("crafted.hdr"), "{e}");
+        }
+        // Past the reader's 2²⁰ limit per axis the resolution line itself is refused.
+        let e = decode_named(b"#?RADIANCE\n\n-Y 1000000000000 +X 2\n").unwrap_err();
+        assert!(matches!(e, EnvMapError::RadianceHeader { .. }), "{e}");
+    }
+
+    /// The bound is honest: a map of one colour, which new-style RLE packs at 127 pixels per
+    /// 2 bytes per channel, is still accepted.
+    #[test]
+    fn a_maximally_compressed_map_still_loads() {
+        let (w, h) = (2032, 1016);
+        let map = EnvMap::from_pixels(w, h, vec![[0.5, 0.25, 0.125]; w * h]);
+        let bytes = encode_for_tests(&map, &format!("-Y {h} +X {w}"), true);
+        assert!(
+            ((w * h) as u64) > 15 * bytes.len() as u64,
+            "{} bytes",
+            bytes.len()
+        );
+        let decoded = decode_named(&bytes).unwrap();
+        let (got, want) = (decoded.pixel(w - 1, h - 1), map.pixel(w - 1, h - 1));
+        for c in 0..3 {
+            // RGBE keeps 8 bits of mantissa.
+            assert!((got[c] - want[c]).abs() <= want[c] / 64.0, "{got:?} vs {want:?}");
+        }
+    }
+}

@@ -905,6 +905,54 @@ mod tests {
         assert!(err.to_string().contains("missing.sltab"));
     }
 
+    /// Axes claiming 10¹⁰ entries are refused from the metadata alone; a shape under the
+    /// table size limit but bigger than the file is refused against the file's length (the
+    /// honest bound). Neither allocates for the payload, and both answer at once.
+    #[test]
+    fn absurd_shapes_are_refused_before_allocation() {
+        let dir = scratch_dir("asset-absurd");
+        let (good, json_start, payload_start) = valid_bytes();
+        let json = &good[json_start
+            ..json_start + u32::from_le_bytes(good[12..16].try_into().unwrap()) as usize];
+        let payload = &good[payload_start..];
+        let metadata: Value = serde_json::from_slice(json).unwrap();
+        let with_counts = |counts: [u64; 3]| {
+            let mut m = metadata.clone();
+            for (i, c) in counts.iter().enumerate() {
+                m["payload"]["axes"][i]["count"] = json!(c);
+            }
+            let values: u64 = counts.iter().product();
+            m["payload"]["payload_bytes"] = json!(4 * values);
+            assemble(FORMAT_VERSION, &serde_json::to_vec(&m).unwrap(), payload)
+        };
+
+        let start = std::time::Instant::now();
+        let err = load(&dir, "ten-billion.sltab", &with_counts([100_000, 10_000, 10]));
+        assert!(
+            matches!(
+                &err,
+                AssetError::InvalidShape {
+                    source: TableError::TooLarge { shape, .. },
+                    ..
+                } if shape.iter().product::<usize>() == 10_000_000_000
+            ),
+            "{err}"
+        );
+        let err = load(&dir, "under-the-limit.sltab", &with_counts([512, 512, 256]));
+        assert!(
+            matches!(
+                err,
+                AssetError::Truncated {
+                    section: "payload",
+                    needed,
+                    ..
+                } if needed > 1 << 28
+            ),
+            "{err}"
+        );
+        assert!(start.elapsed() < std::time::Duration::from_secs(2));
+    }
+
     #[test]
     fn parameters_must_match_and_the_first_difference_is_named() {
         let dir = scratch_dir("asset-params");

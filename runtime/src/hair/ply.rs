@@ -265,10 +265,14 @@ fn skip_with_lists(
         for p in &element.properties {
             let what = || format!("{} {} property {}", element.name, i, p.name);
             match p.list_count {
-                None => offset += p.kind.size(),
+                None => offset = offset.saturating_add(p.kind.size()),
                 Some(count_kind) => {
                     let n = count_kind.read(bytes.slice(offset, count_kind.size(), what)?);
-                    offset += count_kind.size() + (n.max(0.0) as u64).saturating_mul(p.kind.size());
+                    // A float list count can be 1e308: saturate, and the check below refuses
+                    // it as truncated (a plain `+` overflowed here).
+                    offset = offset
+                        .saturating_add(count_kind.size())
+                        .saturating_add((n.max(0.0) as u64).saturating_mul(p.kind.size()));
                 }
             }
         }
@@ -435,5 +439,108 @@ mod tests {
             parse(absurd.as_bytes()),
             Err(HairError::AbsurdCount { .. })
         ));
+    }
+
+    /// Swaps the header line `from` for `to` and keeps the body.
+    fn with_header_line(file: &[u8], from: &str, to: &str) -> Vec<u8> {
+        let end = file.windows(11).position(|w| w == b"end_header\n").unwrap() + 11;
+        let header = String::from_utf8(file[..end].to_vec()).unwrap();
+        assert!(header.contains(from), "{header}");
+        let mut out = header.replace(from, to).into_bytes();
+        out.extend_from_slice(&file[end..]);
+        out
+    }
+
+    /// Counts of 10¹² vertices, strands or other elements are refused from the header against
+    /// the bytes that follow it, before anything is allocated (and at once).
+    #[test]
+    fn absurd_element_counts_are_refused_before_allocation() {
+        let pts = [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let good = file(&pts, &[1], true);
+        for (from, to) in [
+            ("element vertex 2", "element vertex 1000000000000"),
+            ("element strand 1", "element strand 1000000000000"),
+            ("element edge 1", "element edge 1000000000000"),
+            ("element vertex 2", "element vertex 18446744073709551615"),
+        ] {
+            let start = std::time::Instant::now();
+            let e = parse(&with_header_line(&good, from, to)).unwrap_err();
+            assert!(start.elapsed() < std::time::Duration::from_secs(1));
+            assert!(
+                matches!(e, HairError::AbsurdCount { count, .. } if count >= 1_000_000_000_000),
+                "{to}: {e}"
+            );
+            assert!(e.to_string().contains("crafted.ply"), "{e}");
+        }
+        // Beyond u64: not a count at all.
+        let e = parse(&with_header_line(
+            &good,
+            "element vertex 2",
+            "element vertex 99999999999999999999999",
+        ))
+        .unwrap_err();
+        assert!(matches!(e, HairError::Unsupported { .. }), "{e}");
+    }
+
+    /// Review finding: a list property whose length prefix is a `double` read as 1e308
+    /// overflowed the running offset (a panic in debug builds, a wrapped offset in release).
+    /// It is now refused as truncated.
+    #[test]
+    fn a_huge_float_list_length_is_refused() {
+        let pts = [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        let mut f = with_header_line(
+            &file(&pts, &[1], false),
+            "end_header",
+            "element face 1\nproperty list double int vertex_indices\nend_header",
+        );
+        f.extend_from_slice(&1e308f64.to_le_bytes());
+        f.extend_from_slice(&[0; 8]);
+        let e = parse(&f).unwrap_err();
+        assert!(matches!(e, HairError::Truncated { .. }), "{e}");
+        assert!(e.to_string().contains("crafted.ply"), "{e}");
+    }
+
+    /// NaN and ±Inf coordinates (and doubles too large for f32) are refused naming the file,
+    /// the strand and the point; NaN colours likewise.
+    #[test]
+    fn non_finite_points_are_refused_with_their_place() {
+        for bad in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+            let pts = [
+                [0.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, bad, 0.0],
+            ];
+            let e = parse(&file(&pts, &[1, 1], false)).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    HairError::NonFinite {
+                        strand: 1,
+                        point: 1,
+                        ..
+                    }
+                ),
+                "{bad}: {e}"
+            );
+            assert!(e.to_string().contains("crafted.ply"), "{e}");
+        }
+        let mut doubles = b"ply\nformat binary_little_endian 1.0\nelement vertex 2\nproperty double x\nproperty double y\nproperty double z\nelement strand 1\nproperty uchar nsegs\nend_header\n".to_vec();
+        for v in [0.0f64, 0.0, 0.0, 0.0, 1e300, 0.0] {
+            doubles.extend_from_slice(&v.to_le_bytes());
+        }
+        doubles.push(1);
+        let e = parse(&doubles).unwrap_err();
+        assert!(
+            matches!(
+                e,
+                HairError::NonFinite {
+                    strand: 0,
+                    point: 1,
+                    ..
+                }
+            ),
+            "{e}"
+        );
     }
 }

@@ -244,4 +244,26 @@ mod tests {
             Err(HairError::NonFinite { .. })
         ));
     }
+
+    /// 10⁶ strands of 10⁶ vertices (10¹² points), or the largest u32 counts, claimed by a file
+    /// of a few hundred bytes: refused against the file's length before any allocation.
+    #[test]
+    fn absurd_counts_are_refused_before_allocation() {
+        let good = file(&two_strands(), None, false);
+        for (strands, per_strand) in [
+            (1_000_000u32, 1_000_000u32),
+            (u32::MAX, 3),
+            (2, u32::MAX),
+            (u32::MAX, u32::MAX),
+        ] {
+            let mut f = good.clone();
+            f[4..8].copy_from_slice(&strands.to_le_bytes());
+            f[8..12].copy_from_slice(&per_strand.to_le_bytes());
+            let start = std::time::Instant::now();
+            let e = parse(&f).unwrap_err();
+            assert!(start.elapsed() < std::time::Duration::from_secs(1), "{e}");
+            assert!(matches!(e, HairError::AbsurdCount { .. }), "{e}");
+            assert!(e.to_string().contains("crafted.tfx"), "{e}");
+        }
+    }
 }

@@ -162,6 +162,18 @@ mod tests {
         let mut huge = good.clone();
         huge[4..8].copy_from_slice(&i32::MAX.to_le_bytes());
         assert!(matches!(parse(&huge), Err(HairError::Truncated { .. })));
+        let nan = file(&[
+            &[[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            &[[f32::NAN, 1.0, 0.0], [0.0; 3]],
+        ]);
+        assert!(matches!(
+            parse(&nan),
+            Err(HairError::NonFinite {
+                strand: 1,
+                point: 0,
+                ..
+            })
+        ));
         let inf = file(&[&[[0.0, 0.0, 0.0], [f32::INFINITY, 1.0, 0.0]]]);
         assert!(matches!(
             parse(&inf),
@@ -171,5 +183,29 @@ mod tests {
                 ..
             })
         ));
+    }
+
+    /// The counts are i32: a million strands (each able to claim 2³¹ points, 10¹⁵ in all) or
+    /// i32::MAX of them in a file of a few bytes are refused against its length, at once.
+    #[test]
+    fn absurd_counts_are_refused_before_allocation() {
+        for strands in [1_000_000i32, i32::MAX] {
+            let mut f = strands.to_le_bytes().to_vec();
+            f.extend_from_slice(&i32::MAX.to_le_bytes());
+            let start = std::time::Instant::now();
+            let e = parse(&f).unwrap_err();
+            assert!(start.elapsed() < std::time::Duration::from_secs(1), "{e}");
+            assert!(
+                matches!(e, HairError::AbsurdCount { what: "strand", .. }),
+                "{e}"
+            );
+            assert!(e.to_string().contains("crafted.data"), "{e}");
+        }
+        // One strand claiming i32::MAX points: its bytes are not there.
+        let mut f = 1i32.to_le_bytes().to_vec();
+        f.extend_from_slice(&i32::MAX.to_le_bytes());
+        let e = parse(&f).unwrap_err();
+        assert!(matches!(e, HairError::Truncated { .. }), "{e}");
+        assert!(e.to_string().contains("crafted.data"), "{e}");
     }
 }

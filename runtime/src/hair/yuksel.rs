@@ -581,6 +581,92 @@ mod tests {
         ));
     }
 
+    /// The header's counts are u32, so "10¹² strands" reads as the largest count it can hold
+    /// (and 10¹² mod 2³² where a writer truncated it): all are refused against the file's
+    /// length before anything is allocated, and at once.
+    #[test]
+    fn absurd_counts_are_refused_before_allocation() {
+        let truncated_10_12 = (1_000_000_000_000u64 % (1 << 32)) as u32;
+        let points = points_bytes(&[[0.0; 3], [0.0, 1.0, 0.0]]);
+        for (strands, points_count, flag_bits, what) in [
+            (1, u32::MAX, flags::POINTS, "point"),
+            (1, truncated_10_12, flags::POINTS | flags::COLOR, "point"),
+            (u32::MAX, 2, flags::POINTS | flags::SEGMENTS, "strand"),
+            (
+                truncated_10_12,
+                2,
+                flags::POINTS | flags::SEGMENTS,
+                "strand",
+            ),
+        ] {
+            let mut f = header(strands, points_count, flag_bits, 1);
+            f.extend_from_slice(&points);
+            let start = std::time::Instant::now();
+            let e = parse(&f).unwrap_err();
+            assert!(start.elapsed() < std::time::Duration::from_secs(1), "{e}");
+            assert!(
+                matches!(e, HairError::AbsurdCount { what: w, .. } if w == what),
+                "{e}"
+            );
+            assert!(e.to_string().contains("crafted.hair"), "{e}");
+        }
+        // Without a segments array a strand costs no bytes of its own, but still at least a
+        // byte's worth of the file: a huge strand count is refused all the same.
+        let mut f = header(u32::MAX, 2, flags::POINTS, 1);
+        f.extend_from_slice(&points);
+        assert!(matches!(
+            parse(&f),
+            Err(HairError::AbsurdCount { what: "strand", .. })
+        ));
+    }
+
+    /// Inf points (and NaN per-point thickness and colour) are refused naming the file, strand
+    /// and point, like the NaN point of `crafted_bad_files_give_their_own_errors`.
+    #[test]
+    fn non_finite_points_and_attributes_are_refused() {
+        let pts = [[0.0; 3], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]];
+        for bad in [f32::INFINITY, f32::NEG_INFINITY] {
+            let mut p = pts;
+            p[2][0] = bad;
+            let mut f = header(2, 4, flags::POINTS, 1);
+            f.extend_from_slice(&points_bytes(&p));
+            let e = parse(&f).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    HairError::NonFinite {
+                        strand: 1,
+                        point: 0,
+                        ..
+                    }
+                ),
+                "{e}"
+            );
+            assert!(e.to_string().contains("crafted.hair"), "{e}");
+        }
+        for flag in [flags::THICKNESS, flags::COLOR] {
+            let mut f = header(2, 4, flags::POINTS | flag, 1);
+            f.extend_from_slice(&points_bytes(&pts));
+            let per_point = if flag == flags::COLOR { 3 } else { 1 };
+            let mut values = vec![0.5f32; 4 * per_point];
+            values[per_point] = f32::NAN;
+            f.extend(values.iter().flat_map(|v| v.to_le_bytes()));
+            let e = parse(&f).unwrap_err();
+            assert!(
+                matches!(
+                    e,
+                    HairError::NonFinite {
+                        strand: 0,
+                        point: 1,
+                        ..
+                    } | HairError::BadValue { .. }
+                ),
+                "{e}"
+            );
+            assert!(e.to_string().contains("crafted.hair"), "{e}");
+        }
+    }
+
     #[test]
     fn degenerate_segments_in_a_file_are_merged_and_counted() {
         // Strand 0 repeats its middle point twice; strand 1 is a single repeated point.
