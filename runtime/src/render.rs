@@ -3,19 +3,19 @@
 
 use std::time::Instant;
 
+use crate::camera::light_camera;
 use crate::gpu::readback::ReadbackError;
 use crate::gpu::{AdapterReport, GpuContext, read_texture_rgba};
 use crate::hair::HairModel;
 use crate::lights::Light;
 use crate::passes::abuffer::{ABufferError, ABufferPass, ListMode};
-use crate::passes::deep_opacity::{
-    DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError, light_camera,
-};
+use crate::passes::deep_opacity::{DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError};
 use crate::passes::fiber_shading::ShadingModel;
-use crate::passes::strands::{
-    FrameParams, MAX_SHADOWED_LIGHTS, RenderTarget, ShadowInput, StrandGeometry, StrandPass,
-    TooManyPoints, TooManyShadowMaps,
-};
+use crate::passes::frame_params::FrameParams;
+use crate::passes::render_target::RenderTarget;
+use crate::passes::shadow_slots::{MAX_SHADOWED_LIGHTS, ShadowInput, TooManyShadowMaps};
+use crate::passes::strand_geometry::{StrandGeometry, TooManyPoints};
+use crate::passes::strands::StrandPass;
 
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {

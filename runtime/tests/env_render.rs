@@ -20,7 +20,7 @@ use strandlight_runtime::passes::convolution_depth::{
     ConvolutionDepthPass, DodmBatch, DodmSettings, SimplifiedSegments,
 };
 use strandlight_runtime::passes::env_view::BatchBinding;
-use strandlight_runtime::passes::strands::StrandGeometry;
+use strandlight_runtime::passes::strand_geometry::StrandGeometry;
 use strandlight_runtime::passes::summed_area::{
     BoxAverage, MAX_BOX_HALF_SIZE, SummedAreaPass, SummedAreaTables, quantize_optical_depth,
 };

@@ -19,7 +19,8 @@ use crate::passes::convolution_depth::{
 use crate::passes::env_view::{
     BatchBinding, EnvViewPass, EnvViewTargets, FrameVisibility, TableBinding, ViewBinding,
 };
-use crate::passes::strands::{FrameParams, KajiyaKay, StrandGeometry, TooManyPoints};
+use crate::passes::frame_params::{FrameParams, KajiyaKay};
+use crate::passes::strand_geometry::{StrandGeometry, TooManyPoints};
 pub use crate::passes::summed_area::BoxAverage;
 use crate::passes::summed_area::{SatTooLarge, SummedAreaPass, SummedAreaTables};
 pub use crate::passes::transmittance_filter::TransmittanceFilter;

@@ -1,5 +1,6 @@
 //! GPU plumbing shared by the passes: the device, and reading textures back to the CPU.
 
+pub mod bind_layout;
 pub mod device;
 pub mod readback;
 

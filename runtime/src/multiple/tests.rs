@@ -135,7 +135,7 @@ fn parallel_block_voxelizes_to_the_closed_form() {
     assert!(worst_nu < 1e-3);
     // Without a thickness attribute the renderer's default diameter (10⁻³ × diagonal) is used.
     let model = parallel_block(None);
-    let default_d = crate::passes::strands::default_thickness(&model);
+    let default_d = crate::passes::strand_geometry::default_thickness(&model);
     let v = HairVolume::build(&model, &settings(8, 1, 0.5).voxels, 1.0).unwrap();
     println!("default diameter {default_d}: σ_t⊥ {}", v.sigma_perp[0]);
     assert!((v.sigma_perp[0] / default_d - 1.0).abs() < 1e-5);

@@ -4,7 +4,7 @@
 //! are counted and reported, never silent.
 //! Fragments are shaded exactly as the opaque strand pass shades them: the same WGSL (any
 //! [`ShadingModel`], group 2) and a deep opacity map for each of up to
-//! [`MAX_SHADOWED_LIGHTS`](crate::passes::strands::MAX_SHADOWED_LIGHTS) lights (group 1).
+//! [`MAX_SHADOWED_LIGHTS`](crate::passes::shadow_slots::MAX_SHADOWED_LIGHTS) lights (group 1).
 //! Inputs: [`StrandGeometry`], [`FrameParams`], the shadow maps, the node capacity.
 //! Output: [`ABufferFrame`].
 
@@ -12,13 +12,19 @@ use super::attachments::{cleared_color, cleared_depth};
 use wgpu::util::DeviceExt;
 
 use crate::gpu::GpuContext;
+use crate::gpu::bind_layout::{
+    depth_texture_entry, float_texture_entry, storage_entry, uniform_entry,
+};
 use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::passes::fiber_shading::{ModelBinding, ShadingModel};
-use crate::passes::strands::{
-    DEPTH_FORMAT, FrameParams, RenderTarget, ShadowInput, StrandGeometry, TooManyShadowMaps,
-    shading_source, shadow_bind_group_for, shadow_bind_group_layout, strand_bind_group,
-    strand_bind_group_layout,
+use crate::passes::frame_params::FrameParams;
+use crate::passes::render_target::{DEPTH_FORMAT, RenderTarget};
+use crate::passes::shadow_slots::{
+    ShadowInput, TooManyShadowMaps, shadow_bind_group_for, shadow_bind_group_layout,
 };
+use crate::passes::strand_geometry::StrandGeometry;
+use crate::passes::strand_quads::{strand_bind_group, strand_bind_group_layout};
+use crate::passes::strands::shading_source;
 
 #[derive(Debug, thiserror::Error)]
 pub enum ABufferError {
@@ -77,36 +83,6 @@ pub struct ABufferPass {
     /// Group 2: the fiber model's constants and tables (none for Kajiya-Kay), as in
     /// [`StrandPass`](crate::passes::strands::StrandPass).
     model: Option<ModelBinding>,
-}
-
-fn storage_entry(
-    binding: u32,
-    visibility: wgpu::ShaderStages,
-    read_only: bool,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
 }
 
 impl ABufferPass {
@@ -194,16 +170,7 @@ impl ABufferPass {
                 storage_entry(2, compute, false),
                 storage_entry(3, compute, false),
                 uniform_entry(4, compute),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: compute,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
+                float_texture_entry(5, compute),
             ],
         });
         let resolve_pipeline_layout =
@@ -227,16 +194,7 @@ impl ABufferPass {
                 list_entries[1],
                 list_entries[2],
                 list_entries[3],
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: frag,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
+                depth_texture_entry(4, frag),
                 uniform_entry(5, frag),
             ],
         });
@@ -386,7 +344,7 @@ impl ABufferPass {
     }
 
     /// [`Self::draw`] with a deep opacity map for each of up to
-    /// [`MAX_SHADOWED_LIGHTS`](crate::passes::strands::MAX_SHADOWED_LIGHTS) lights.
+    /// [`MAX_SHADOWED_LIGHTS`](crate::passes::shadow_slots::MAX_SHADOWED_LIGHTS) lights.
     pub fn draw_shadowed(
         &self,
         gpu: &GpuContext,

@@ -9,39 +9,21 @@
 //! map). Output: the sums buffer of [`EnvAccumulator`].
 
 use glam::Vec3;
-use strandlight_tables::srbf::support_angle;
 use strandlight_tables::table::{AxisGpu, Table};
 use wgpu::util::DeviceExt;
 
 use super::attachments::{cleared_color, prepassed_depth};
 use super::convolution_depth::DodmBatch;
-use super::strands::{
-    DEPTH_FORMAT, FrameParams, StrandGeometry, strand_bind_group, strand_bind_group_layout,
-};
+use super::frame_params::FrameParams;
+use super::render_target::DEPTH_FORMAT;
+use super::strand_geometry::StrandGeometry;
+use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
 use super::summed_area::{BoxAverage, MAX_BOX_HALF_SIZE, SummedAreaTables};
 use super::transmittance_filter::TransmittanceFilter;
 use super::view_visibility::{OccupancyMap, ViewTransparency, ViewVisibilityPass};
 use crate::env::{EnvLight, ForwardScatteringGrid};
 use crate::gpu::GpuContext;
-
-/// The largest tan α used for the averaging radius: SRBFs wider than ~89° (λ < ~7) are limited
-/// by the box size anyway.
-const MAX_TAN_SUPPORT: f32 = 64.0;
-
-/// tan α of light `light`'s support (G = 10⁻³), 0 for a directional light.
-pub fn tan_support(light: &EnvLight) -> f32 {
-    match light.lambda {
-        None => 0.0,
-        Some(lambda) => {
-            let alpha = support_angle(lambda as f64);
-            if alpha >= std::f64::consts::FRAC_PI_2 {
-                MAX_TAN_SUPPORT
-            } else {
-                (alpha.tan() as f32).min(MAX_TAN_SUPPORT)
-            }
-        }
-    }
-}
+use crate::gpu::bind_layout::{float_texture_entry, storage_entry, texture_entry, uniform_entry};
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -69,36 +51,6 @@ const FLAG_UNSHADOWED: u32 = 1;
 const FLAG_GRID: u32 = 2;
 const FLAG_SAT_TRANSMITTANCE: u32 = 4;
 
-fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn storage_entry(
-    binding: u32,
-    visibility: wgpu::ShaderStages,
-    read_only: bool,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 /// Group 1 of the view pass and the probe (`convolution_transmittance.wgsl`).
 pub fn transmittance_bind_group_layout(
     device: &wgpu::Device,
@@ -109,16 +61,12 @@ pub fn transmittance_bind_group_layout(
         entries: &[
             uniform_entry(0, visibility),
             storage_entry(1, visibility, true),
-            wgpu::BindGroupLayoutEntry {
-                binding: 2,
+            texture_entry(
+                2,
                 visibility,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Depth,
-                    view_dimension: wgpu::TextureViewDimension::D2Array,
-                    multisampled: false,
-                },
-                count: None,
-            },
+                wgpu::TextureSampleType::Depth,
+                wgpu::TextureViewDimension::D2Array,
+            ),
             storage_entry(3, visibility, true),
         ],
     })
@@ -589,16 +537,7 @@ impl EnvViewPass {
                 uniform_entry(0, fragment),
                 storage_entry(1, fragment, true),
                 storage_entry(2, fragment, false),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: fragment,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
+                float_texture_entry(3, fragment),
             ],
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -690,21 +629,11 @@ impl EnvViewPass {
             None,
         );
         let compute = wgpu::ShaderStages::COMPUTE;
-        let float_texture = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: compute,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
         let accumulate_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("env accumulate"),
             entries: &[
-                float_texture(0),
-                float_texture(1),
+                float_texture_entry(0, compute),
+                float_texture_entry(1, compute),
                 storage_entry(2, compute, false),
                 uniform_entry(3, compute),
             ],

@@ -15,6 +15,7 @@ use wgpu::util::DeviceExt;
 
 use super::convolution_depth::DodmBatch;
 use crate::gpu::GpuContext;
+use crate::gpu::bind_layout::{storage_entry, texture_entry, uniform_entry};
 
 pub const FIXED_POINT_SCALE: f32 = 256.0;
 pub const TRANSMITTANCE_SCALE: f32 = 4096.0;
@@ -140,39 +141,18 @@ impl SummedAreaPass {
             label: Some("summed_area.wgsl"),
             source: wgpu::ShaderSource::Wgsl(include_str!("summed_area.wgsl").into()),
         });
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty,
-            count: None,
-        };
+        let compute = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("summed area"),
             entries: &[
-                entry(
+                texture_entry(
                     0,
-                    wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
+                    compute,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    wgpu::TextureViewDimension::D2Array,
                 ),
-                entry(
-                    1,
-                    wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: false },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                ),
-                entry(
-                    2,
-                    wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                ),
+                storage_entry(1, compute, false),
+                uniform_entry(2, compute),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

@@ -15,7 +15,7 @@
 //! Outputs: the view's depth and coverage textures (opaque) or the occupancy map (occupancy).
 
 use super::attachments::{cleared_color, cleared_depth, prepassed_depth};
-use super::strands::{DEPTH_FORMAT, RenderTarget};
+use super::render_target::{DEPTH_FORMAT, RenderTarget};
 use crate::gpu::GpuContext;
 use crate::gpu::readback::{ReadbackError, read_texture_rgba};
 
