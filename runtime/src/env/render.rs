@@ -6,6 +6,9 @@
 use std::time::Instant;
 
 use strandlight_tables::table::Table;
+use strandlight_tables::table_axes::{
+    AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_SIGMA_F, AXIS_U_DOT_WO, AXIS_U_DOT_XI,
+};
 
 use super::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource};
 use crate::camera::Camera;
@@ -27,14 +30,6 @@ pub use crate::passes::transmittance_filter::TransmittanceFilter;
 use crate::passes::view_visibility::OccupancyMap;
 pub use crate::passes::view_visibility::{FragmentCounts, OccupancyError, ViewTransparency};
 use crate::render::PassTiming;
-
-/// Axis names of the env tables (`strandlight_precompute::convolution_table` and
-/// `multiple_scattering_table`; the runtime never links the precompute crate).
-pub const AXIS_U_DOT_XI: &str = "u_dot_xi";
-pub const AXIS_U_DOT_WO: &str = "u_dot_wo";
-pub const AXIS_COS_DPHI: &str = "cos_dphi";
-pub const AXIS_INV_LAMBDA: &str = "inv_lambda";
-pub const AXIS_SIGMA_F: &str = "sigma_f";
 
 /// The tables a frame shades with. Each is an RGB [`Table`] with axes (u·ξ, u·ω_o, cos Δφ, w):
 /// * `srbf`: the convolution table I (I_M, `marschner_full` or the artist I_A), w = 1/λ;

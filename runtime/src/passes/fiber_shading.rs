@@ -13,6 +13,10 @@
 
 use strandlight_tables::artist::ArtistModel;
 use strandlight_tables::table::{AxisGpu, Table};
+use strandlight_tables::table_axes::{
+    AXIS_COS_HALF_PHI, AXIS_COS_PHI, AXIS_COS_THETA_D, AXIS_LOBE, AXIS_QUANTITY, AXIS_SIN_THETA_I,
+    AXIS_SIN_THETA_O,
+};
 use wgpu::util::DeviceExt;
 
 use crate::gpu::GpuContext;
@@ -125,18 +129,22 @@ impl MarschnerLuts {
         check_layout(
             "lut_m",
             &lut_m,
-            [&["sin_theta_i"], &["sin_theta_o"], &["quantity"]],
+            [&[AXIS_SIN_THETA_I], &[AXIS_SIN_THETA_O], &[AXIS_QUANTITY]],
             4,
             1,
         )?;
         check_layout(
             "lut_n",
             &lut_n,
-            [&["cos_phi", "cos_half_phi"], &["cos_theta_d"], &["lobe"]],
+            [
+                &[AXIS_COS_PHI, AXIS_COS_HALF_PHI],
+                &[AXIS_COS_THETA_D],
+                &[AXIS_LOBE],
+            ],
             3,
             3,
         )?;
-        let half_phi = lut_n.axes()[0].name == "cos_half_phi";
+        let half_phi = lut_n.axes()[0].name == AXIS_COS_HALF_PHI;
         Ok(Self {
             lut_m,
             lut_n,
@@ -315,8 +323,8 @@ mod tests {
 
     #[test]
     fn lut_layout_is_checked_and_strides_are_row_major() {
-        let m = table(["sin_theta_i", "sin_theta_o", "quantity"], [5, 6, 4], 1);
-        let n = table(["cos_half_phi", "cos_theta_d", "lobe"], [7, 8, 3], 3);
+        let m = table([AXIS_SIN_THETA_I, AXIS_SIN_THETA_O, AXIS_QUANTITY], [5, 6, 4], 1);
+        let n = table([AXIS_COS_HALF_PHI, AXIS_COS_THETA_D, AXIS_LOBE], [7, 8, 3], 3);
         let luts = MarschnerLuts::new(m.clone(), n.clone()).unwrap();
         assert!(luts.half_phi);
         // The stride of each axis is the offset between neighbouring nodes.
@@ -332,7 +340,7 @@ mod tests {
         assert_eq!(strides(&m), [24, 4, 1, 0]);
         let e = MarschnerLuts::new(n.clone(), m.clone()).unwrap_err();
         assert!(e.to_string().contains("lut_m"), "{e}");
-        let wrong_lobes = table(["cos_phi", "cos_theta_d", "lobe"], [7, 8, 4], 3);
+        let wrong_lobes = table([AXIS_COS_PHI, AXIS_COS_THETA_D, AXIS_LOBE], [7, 8, 4], 3);
         let e = MarschnerLuts::new(m, wrong_lobes).unwrap_err();
         assert!(e.to_string().contains("4 nodes, expected 3"), "{e}");
     }
