@@ -789,7 +789,7 @@ fn bad_inputs_are_typed_errors() {
         ..options
     };
     let e = render(&many, &tables, &big);
-    assert!(matches!(e, EnvRenderError::GpuLimit(_)), "{e}");
+    assert!(matches!(e, EnvRenderError::Limit(_)), "{e}");
     println!("{e}");
 }
 

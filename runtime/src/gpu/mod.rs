@@ -2,7 +2,9 @@
 
 pub mod bind_layout;
 pub mod device;
+pub mod limits;
 pub mod readback;
 
 pub use device::{AdapterReport, DeviceError, GpuContext};
+pub use limits::{GpuLimits, LimitError};
 pub use readback::{read_buffer, read_texture_rgba};

@@ -669,13 +669,18 @@ impl EnvViewPass {
         }
     }
 
+    /// Bytes of the sums of a `width`×`height` frame: RGBA f32 per pixel, single then multiple.
+    pub fn accumulator_bytes(width: u32, height: u32) -> u64 {
+        2 * width as u64 * height as u64 * 16
+    }
+
     /// Zeroed sums for a `width`×`height` frame, bound to `targets`.
     pub fn accumulator(&self, gpu: &GpuContext, targets: &EnvViewTargets) -> EnvAccumulator {
         let device = &gpu.device;
         let (width, height) = (targets.single.width(), targets.single.height());
         let sums = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("env sums"),
-            size: 2 * width as u64 * height as u64 * 16,
+            size: Self::accumulator_bytes(width, height),
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
