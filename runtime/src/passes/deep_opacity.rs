@@ -300,7 +300,7 @@ impl DeepOpacityPass {
             .iter()
             .map(|t| t.create_view(&Default::default()))
             .collect();
-        let attachments: Vec<_> = views.iter().map(|view| cleared_color(view)).collect();
+        let attachments: Vec<_> = views.iter().map(cleared_color).collect();
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("dom layers"),
