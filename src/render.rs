@@ -10,7 +10,7 @@ use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::DomSettings;
-use strandlight_runtime::passes::strands::{FrameParams, KajiyaKay};
+use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
 use strandlight_runtime::render::{self, RenderOptions, render_frame_with_model};
 use strandlight_scene::camera_choice::{CameraChoice, CameraKind, UpChoice};
 use strandlight_scene::env_frame::{EnvFrame, FrameRole, light_summary, render_lights};

@@ -97,3 +97,26 @@ fn small_sweep_is_clean_and_reports_every_model() {
         assert!(m["rejected_parameter_sets"].is_u64() && m["seconds"].is_f64());
     }
 }
+
+/// A frame past the adapter's texture limit is refused before anything is rendered or written:
+/// a non-zero exit, the limit named with a size that fits, and no output file.
+#[test]
+fn render_past_the_texture_limit_fails_cleanly_without_output() {
+    let dir = std::env::temp_dir().join(format!("strandlight-cli-limit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary directory");
+    let stem = dir.join("huge");
+    let out = Command::new(env!("CARGO_BIN_EXE_strandlight"))
+        .args(["render", "--size", "100000x100000", "--out"])
+        .arg(&stem)
+        .output()
+        .expect("the strandlight binary runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "exit status {:?}; stderr:\n{stderr}", out.status);
+    assert!(stderr.contains("max_texture_dimension_2d"), "{stderr}");
+    assert!(stderr.contains("--size"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for ext in ["exr", "png"] {
+        assert!(!stem.with_extension(ext).exists(), "{ext} written");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

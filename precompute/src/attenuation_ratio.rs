@@ -11,9 +11,8 @@
 use std::f64::consts::PI;
 use strandlight_tables::quadrature::GaussLegendre;
 use strandlight_tables::table::{Axis, AxisMapping, Table, TableError};
+use strandlight_tables::table_axes::{AXIS_ABS_SIN_THETA, AXIS_NU};
 
-pub const AXIS_NU: &str = "nu";
-pub const AXIS_ABS_SIN_THETA: &str = "abs_sin_theta";
 
 /// α(ν, θ) by quadrature over the offset's polar radius r (Rayleigh density) and angle ψ.
 pub fn attenuation_ratio(nu: f64, sin_theta: f64) -> f64 {

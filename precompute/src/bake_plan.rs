@@ -20,6 +20,7 @@ use strandlight_tables::kajiya_kay::{KajiyaKay, KajiyaKayParams};
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 use strandlight_tables::scattering::{Rgb, ScatteringFunction};
 use strandlight_tables::table::{Axis, AxisMapping, Table};
+use strandlight_tables::table_axes::{AXIS_QUANTITY, AXIS_SIN_THETA};
 use strandlight_tables::FiberAngles;
 use thiserror::Error;
 
@@ -389,8 +390,8 @@ fn push_fiber_averages(jobs: &mut Vec<TableJob>, averages: DualScatteringAverage
         settings: json!({ "thetas": thetas }),
         build: Box::new(move || {
             let axes = vec![
-                Axis::with_mapping("sin_theta", -1.0, 1.0, thetas, AxisMapping::Arcsine),
-                Axis::uniform("quantity", 0.0, (FIBER_AVERAGE_QUANTITIES.len() - 1) as f64, FIBER_AVERAGE_QUANTITIES.len()),
+                Axis::with_mapping(AXIS_SIN_THETA, -1.0, 1.0, thetas, AxisMapping::Arcsine),
+                Axis::uniform(AXIS_QUANTITY, 0.0, (FIBER_AVERAGE_QUANTITIES.len() - 1) as f64, FIBER_AVERAGE_QUANTITIES.len()),
             ];
             Ok(Table::from_fn(axes, 3, |x, out| {
                 let theta = x[0].clamp(-1.0, 1.0).asin();

@@ -18,6 +18,7 @@ use strandlight_tables::dual_scattering::{backscatter_series, fiber_averages_dir
 use strandlight_tables::kajiya_kay::{KajiyaKay, KajiyaKayParams};
 use strandlight_tables::marschner::{Lobe, Marschner, MarschnerParams};
 use strandlight_tables::scattering::{Rgb, ScatteringFunction};
+use strandlight_tables::table_axes::{AXIS_LOBE, AXIS_QUANTITY};
 use strandlight_tables::FiberAngles;
 use thiserror::Error;
 
@@ -137,7 +138,7 @@ fn random_points(table: &strandlight_tables::table::Table, count: usize, seed: u
                 .axes()
                 .iter()
                 .map(|a| {
-                    if a.name == "quantity" || a.name == "lobe" {
+                    if a.name == AXIS_QUANTITY || a.name == AXIS_LOBE {
                         (unit() * a.count as f64).floor().min((a.count - 1) as f64)
                     } else {
                         a.min + (a.max - a.min) * unit()

@@ -6,11 +6,8 @@ use serde::{Deserialize, Serialize};
 use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::scattering::Rgb;
 use strandlight_tables::table::{Axis, AxisMapping, Table, TableError};
+use strandlight_tables::table_axes::{AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
 
-pub const AXIS_U_DOT_XI: &str = "u_dot_xi";
-pub const AXIS_U_DOT_WO: &str = "u_dot_wo";
-pub const AXIS_COS_DPHI: &str = "cos_dphi";
-pub const AXIS_INV_LAMBDA: &str = "inv_lambda";
 
 /// Node counts and ranges of a 4D convolution table.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

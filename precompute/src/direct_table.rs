@@ -5,7 +5,8 @@
 //! the brute-force reference and the median-cut baseline (Ren 2010 §8) as
 //! `L_o = D · irradiance · table(u·ω_i, u·ω_o, cos Δφ, 0)`.
 
-use crate::convolution_table::{DirectionAxes, AXIS_INV_LAMBDA};
+use crate::convolution_table::DirectionAxes;
+use strandlight_tables::table_axes::AXIS_INV_LAMBDA;
 use serde::{Deserialize, Serialize};
 use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::scattering::Rgb;
@@ -67,7 +68,8 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::convolution_table::{ConvolutionResolution, AXIS_COS_DPHI, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
+    use crate::convolution_table::ConvolutionResolution;
+    use strandlight_tables::table_axes::{AXIS_COS_DPHI, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
 
     /// A smooth stand-in model: a Gaussian in θ_h times (1 + cos φ).
     fn model(a: &FiberAngles) -> Rgb {

@@ -21,8 +21,7 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::scattering::Rgb;
 use strandlight_tables::table::{Axis, Table, TableError};
-
-pub const AXIS_SIGMA_F: &str = "sigma_f";
+use strandlight_tables::table_axes::AXIS_SIGMA_F;
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MultipleScatteringResolution {

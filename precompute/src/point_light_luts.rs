@@ -47,6 +47,7 @@ use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::marschner::{Lobe, MIN_COS2_THETA_D, Marschner};
 use strandlight_tables::scattering::{Rgb, ScatteringFunction};
 use strandlight_tables::table::{Axis, Table, TableError};
+use strandlight_tables::table_axes::{AXIS_COS_HALF_PHI, AXIS_COS_PHI, AXIS_COS_THETA_D, AXIS_LOBE, AXIS_QUANTITY, AXIS_SIN_THETA_I, AXIS_SIN_THETA_O};
 use thiserror::Error;
 
 /// Index of cos θ_d on the `quantity` axis of the M table (after M_R, M_TT, M_TRT).
@@ -92,8 +93,8 @@ impl AzimuthAxis {
     /// The axis name the N table carries.
     pub fn name(self) -> &'static str {
         match self {
-            AzimuthAxis::CosPhi => "cos_phi",
-            AzimuthAxis::CosHalfPhi => "cos_half_phi",
+            AzimuthAxis::CosPhi => AXIS_COS_PHI,
+            AzimuthAxis::CosHalfPhi => AXIS_COS_HALF_PHI,
         }
     }
 
@@ -236,9 +237,9 @@ fn lobe_axis_value(lobe: Lobe) -> f64 {
 pub fn bake_lut_m(model: &Marschner, resolution: &LutResolution) -> Result<Table, LutError> {
     resolution.validate()?;
     let axes = vec![
-        Axis::uniform("sin_theta_i", -1.0, 1.0, resolution.sin_theta_i),
-        Axis::uniform("sin_theta_o", -1.0, 1.0, resolution.sin_theta_o),
-        Axis::uniform("quantity", 0.0, COS_THETA_D_QUANTITY as f64, 4),
+        Axis::uniform(AXIS_SIN_THETA_I, -1.0, 1.0, resolution.sin_theta_i),
+        Axis::uniform(AXIS_SIN_THETA_O, -1.0, 1.0, resolution.sin_theta_o),
+        Axis::uniform(AXIS_QUANTITY, 0.0, COS_THETA_D_QUANTITY as f64, 4),
     ];
     let table = Table::from_fn(axes, 1, |x, out| {
         let theta_i = x[0].clamp(-1.0, 1.0).asin();
@@ -257,8 +258,8 @@ pub fn bake_lut_n(model: &Marschner, resolution: &LutResolution) -> Result<Table
     resolution.validate()?;
     let axes = vec![
         resolution.azimuth_axis.axis(resolution.azimuth),
-        Axis::uniform("cos_theta_d", 0.0, 1.0, resolution.cos_theta_d),
-        Axis::uniform("lobe", 0.0, 2.0, 3),
+        Axis::uniform(AXIS_COS_THETA_D, 0.0, 1.0, resolution.cos_theta_d),
+        Axis::uniform(AXIS_LOBE, 0.0, 2.0, 3),
     ];
     let table = Table::from_fn(axes, 3, |x, out| {
         let phi = resolution.azimuth_axis.phi(x[0]);

@@ -12,9 +12,8 @@ use strandlight_tables::angles::{direction, inclination};
 use strandlight_tables::quadrature::GaussLegendre;
 use strandlight_tables::srbf::kernel;
 use strandlight_tables::table::{Axis, AxisMapping, Table, TableError};
+use strandlight_tables::table_axes::{AXIS_ABS_U_DOT_XI, AXIS_LAMBDA};
 
-pub const AXIS_ABS_U_DOT_XI: &str = "abs_u_dot_xi";
-pub const AXIS_LAMBDA: &str = "lambda";
 
 /// σ² by quadrature in a frame centred on ξ (polar angle γ within G's 1e-12 support).
 pub fn srbf_longitudinal_variance(sin_theta_xi: f64, lambda: f64) -> f64 {

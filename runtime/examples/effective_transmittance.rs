@@ -30,6 +30,7 @@ use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::hair::{self, HairModel};
 use strandlight_runtime::image_out::write_png;
+use strandlight_tables::table_axes::{AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
 use strandlight_tables::srbf::{integral, sample_cos_gamma};
 use strandlight_tables::table::{Axis, Table};
 
@@ -112,14 +113,14 @@ const INV_LAMBDA_NODES: usize = 49;
 fn constant_tables() -> Result<EnvTables, BoxError> {
     let directions = || {
         vec![
-            Axis::uniform("u_dot_xi", -1.0, 1.0, 2),
-            Axis::uniform("u_dot_wo", -1.0, 1.0, 2),
-            Axis::uniform("cos_dphi", -1.0, 1.0, 2),
+            Axis::uniform(AXIS_U_DOT_XI, -1.0, 1.0, 2),
+            Axis::uniform(AXIS_U_DOT_WO, -1.0, 1.0, 2),
+            Axis::uniform(AXIS_COS_DPHI, -1.0, 1.0, 2),
         ]
     };
     let mut srbf_axes = directions();
     srbf_axes.push(Axis::uniform(
-        "inv_lambda",
+        AXIS_INV_LAMBDA,
         1.0 / 64.0,
         1.0 / 16.0,
         INV_LAMBDA_NODES,

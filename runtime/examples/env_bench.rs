@@ -18,6 +18,7 @@ use strandlight_runtime::env::{
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
+use strandlight_tables::table_axes::{AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
 use strandlight_tables::hard_case_sweep::SweepRng;
 use strandlight_tables::table::{Axis, Table};
 
@@ -35,10 +36,10 @@ fn median(values: &mut [f64]) -> f64 {
 
 fn table() -> Result<Table, BoxError> {
     let axes = vec![
-        Axis::uniform("u_dot_xi", -1.0, 1.0, 32),
-        Axis::uniform("u_dot_wo", -1.0, 1.0, 32),
-        Axis::uniform("cos_dphi", -1.0, 1.0, 32),
-        Axis::uniform("inv_lambda", 1.0 / 64.0, 1.0 / 16.0, 64),
+        Axis::uniform(AXIS_U_DOT_XI, -1.0, 1.0, 32),
+        Axis::uniform(AXIS_U_DOT_WO, -1.0, 1.0, 32),
+        Axis::uniform(AXIS_COS_DPHI, -1.0, 1.0, 32),
+        Axis::uniform(AXIS_INV_LAMBDA, 1.0 / 64.0, 1.0 / 16.0, 64),
     ];
     Ok(Table::from_fn(axes, 3, |x, out| {
         let v = (1.0 + x[0] * x[1]).abs() * (1.5 + x[2]) * (1.0 + 10.0 * x[3]);

@@ -20,6 +20,7 @@ use strandlight_runtime::multiple::{
     CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering, HairVolume,
     VoxelSettings, interpolate_grid,
 };
+use strandlight_tables::table_axes::{AXIS_QUANTITY, AXIS_SIN_THETA};
 use strandlight_tables::dual_scattering::{DualScatteringAverages, DualScatteringConfig, LobeDecomposition};
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 use strandlight_tables::table::{Axis, AxisMapping, Table};
@@ -31,8 +32,8 @@ fn fiber_averages_table(thetas: usize) -> Table {
     let averages = DualScatteringAverages::new(&m as &dyn LobeDecomposition, DualScatteringConfig::default())
         .expect("default dual-scattering configuration is valid");
     let axes = vec![
-        Axis::with_mapping("sin_theta", -1.0, 1.0, thetas, AxisMapping::Arcsine),
-        Axis::uniform("quantity", 0.0, 8.0, 9),
+        Axis::with_mapping(AXIS_SIN_THETA, -1.0, 1.0, thetas, AxisMapping::Arcsine),
+        Axis::uniform(AXIS_QUANTITY, 0.0, 8.0, 9),
     ];
     Table::from_fn(axes, 3, |x, out| {
         let theta = x[0].clamp(-1.0, 1.0).asin();

@@ -17,7 +17,7 @@ use strandlight_runtime::hair::{self, HairModel};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::abuffer::NODE_BYTES;
 use strandlight_runtime::passes::deep_opacity::DomSettings;
-use strandlight_runtime::passes::strands::{FrameParams, KajiyaKay};
+use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
 use strandlight_runtime::render::{Frame, RenderOptions, Transparency, render_frame};
 
 const WIDTH: u32 = 656;

@@ -236,6 +236,25 @@ impl Camera {
     }
 }
 
+/// The orthographic camera of a directional light (`toward_light` points at the light) that
+/// just covers `bounds`.
+pub fn light_camera(toward_light: Vec3, bounds: Aabb) -> Camera {
+    let center = bounds.center();
+    let radius = (bounds.diagonal() * 0.5).max(1e-6);
+    let dir = toward_light.normalize();
+    let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    Camera {
+        eye: center + dir * (2.0 * radius),
+        target: center,
+        up,
+        projection: Projection::Orthographic {
+            half_height: radius,
+        },
+        near: radius * 0.5,
+        far: radius * 3.5,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

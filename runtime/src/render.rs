@@ -3,26 +3,24 @@
 
 use std::time::Instant;
 
+use crate::camera::light_camera;
 use crate::gpu::readback::ReadbackError;
-use crate::gpu::{AdapterReport, GpuContext, read_texture_rgba};
+use crate::gpu::{AdapterReport, GpuContext, GpuLimits, LimitError, read_texture_rgba};
 use crate::hair::HairModel;
 use crate::lights::Light;
 use crate::passes::abuffer::{ABufferError, ABufferPass, ListMode};
-use crate::passes::deep_opacity::{
-    DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError, light_camera,
-};
+use crate::passes::deep_opacity::{DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError};
 use crate::passes::fiber_shading::ShadingModel;
-use crate::passes::strands::{
-    FrameParams, MAX_SHADOWED_LIGHTS, RenderTarget, ShadowInput, StrandGeometry, StrandPass,
-    TooManyPoints, TooManyShadowMaps,
-};
+use crate::passes::frame_params::FrameParams;
+use crate::passes::render_target::RenderTarget;
+use crate::passes::shadow_slots::{MAX_SHADOWED_LIGHTS, ShadowInput, TooManyShadowMaps};
+use crate::passes::strand_geometry::{StrandGeometry, TooManyPoints};
+use crate::passes::strands::StrandPass;
 
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
-    #[error(
-        "image size {width}×{height} must be between 1 and {max} on each side (the adapter's limit)"
-    )]
-    BadSize { width: u32, height: u32, max: u32 },
+    #[error(transparent)]
+    Limit(#[from] LimitError),
     #[error(transparent)]
     TooManyPoints(#[from] TooManyPoints),
     #[error(transparent)]
@@ -59,9 +57,45 @@ pub struct RenderStats {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FragmentCounts {
     pub stored: u64,
+    /// Fragments that found the node pool full (overflow): missing from the image.
     pub dropped: u64,
     pub truncated: u64,
+    /// Nodes in the pool: the requested count clamped to the adapter's storage limits.
     pub capacity: u64,
+    /// Nodes asked for (`nodes_per_pixel` × pixels).
+    pub requested_capacity: u64,
+}
+
+impl From<ABufferError> for RenderError {
+    fn from(e: ABufferError) -> Self {
+        match e {
+            ABufferError::TooManyShadowMaps(e) => Self::TooManyShadowMaps(e),
+            ABufferError::Readback(e) => Self::Readback(e),
+            ABufferError::Limit(e) => Self::Limit(e),
+            ABufferError::SizeMismatch { .. } => Self::Gpu(e.to_string()),
+        }
+    }
+}
+
+/// The image and the deep opacity maps against the adapter's limits, before anything is
+/// created (the A-buffer checks its own buffers: [`ABufferResources`]).
+///
+/// [`ABufferResources`]: crate::passes::abuffer::ABufferResources
+fn check_frame_limits(
+    gpu: &GpuContext,
+    frame: &FrameParams,
+    shadowed_lights: &[(DomSettings, u32, glam::Vec3)],
+) -> Result<(), LimitError> {
+    let limits = GpuLimits::of(gpu);
+    limits.check_image(frame.width, frame.height)?;
+    // Every light's map has the same settings.
+    if let Some((settings, _, _)) = shadowed_lights.first() {
+        let res = settings.resolution;
+        limits.check_texture_2d("deep opacity map", res, res, |max| {
+            format!("use a deep opacity map resolution of at most {max}")
+        })?;
+    }
+    Ok(())
 }
 
 /// How overlapping fibers combine.
@@ -156,14 +190,7 @@ pub fn render_frame_with_model(
             directional
         }
     };
-    let max = gpu.device.limits().max_texture_dimension_2d;
-    if frame.width == 0 || frame.height == 0 || frame.width > max || frame.height > max {
-        return Err(RenderError::BadSize {
-            width: frame.width,
-            height: frame.height,
-            max,
-        });
-    }
+    check_frame_limits(gpu, frame, &shadowed_lights)?;
     let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
     let mut timings = Vec::new();
     let geometry = timed(&mut timings, gpu, "upload", || {
@@ -227,16 +254,14 @@ pub fn render_frame_with_model(
                 "abuffer build + resolve + readback",
                 || abuffer.draw_shadowed(gpu, &geometry, frame, &shadows, capacity, list_mode),
             )
-            .map_err(|e| match e {
-                ABufferError::TooManyShadowMaps(e) => RenderError::TooManyShadowMaps(e),
-                ABufferError::Readback(e) => RenderError::Readback(e),
-            })?;
+            .map_err(RenderError::from)?;
             memory_bytes.extend(out.memory_bytes);
             fragments = Some(FragmentCounts {
                 stored: out.fragments_stored,
                 dropped: out.fragments_dropped,
                 truncated: out.fragments_truncated,
                 capacity: capacity as u64,
+                requested_capacity: wanted,
             });
             out.pixels
         }

@@ -17,9 +17,11 @@ use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::abuffer::{ABufferPass, ListMode};
 use strandlight_runtime::passes::deep_opacity::{DeepOpacityMap, DeepOpacityPass, DomSettings};
 use strandlight_runtime::passes::fiber_shading::{MarschnerLuts, ShadingModel};
-use strandlight_runtime::passes::strands::{
-    FrameParams, KajiyaKay, RenderTarget, ShadowInput, StrandGeometry, StrandPass,
-};
+use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
+use strandlight_runtime::passes::render_target::RenderTarget;
+use strandlight_runtime::passes::shadow_slots::ShadowInput;
+use strandlight_runtime::passes::strand_geometry::StrandGeometry;
+use strandlight_runtime::passes::strands::StrandPass;
 use strandlight_tables::artist::{ArtistModel, ArtistParams};
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 

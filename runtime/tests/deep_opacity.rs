@@ -14,9 +14,11 @@ use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::{
     DeepOpacityMap, DeepOpacityPass, DomSettings, transmittance_before_layer,
 };
-use strandlight_runtime::passes::strands::{
-    FrameParams, KajiyaKay, RenderTarget, ShadowInput, StrandGeometry, StrandPass,
-};
+use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
+use strandlight_runtime::passes::render_target::RenderTarget;
+use strandlight_runtime::passes::shadow_slots::ShadowInput;
+use strandlight_runtime::passes::strand_geometry::StrandGeometry;
+use strandlight_runtime::passes::strands::StrandPass;
 
 
 #[test]

@@ -20,11 +20,12 @@ use strandlight_runtime::passes::convolution_depth::{
     ConvolutionDepthPass, DodmBatch, DodmSettings, SimplifiedSegments,
 };
 use strandlight_runtime::passes::env_view::BatchBinding;
-use strandlight_runtime::passes::strands::StrandGeometry;
+use strandlight_runtime::passes::strand_geometry::StrandGeometry;
 use strandlight_runtime::passes::summed_area::{
     BoxAverage, MAX_BOX_HALF_SIZE, SummedAreaPass, SummedAreaTables, quantize_optical_depth,
 };
 use strandlight_runtime::passes::transmittance_probe::{ProbeBox, TransmittanceProbe};
+use strandlight_tables::table_axes::{AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_SIGMA_F, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
 use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 use strandlight_tables::scattering::ScatteringFunction;
@@ -383,9 +384,9 @@ const TOLERANCE: f64 = 0.15;
 /// function so interpolation weights and strides all matter.
 fn synthetic_table(fourth: Axis) -> Table {
     let axes = vec![
-        Axis::with_mapping("u_dot_xi", -1.0, 1.0, 9, AxisMapping::Arcsine),
-        Axis::uniform("u_dot_wo", -1.0, 1.0, 7),
-        Axis::with_mapping("cos_dphi", -1.0, 1.0, 6, AxisMapping::Arccosine),
+        Axis::with_mapping(AXIS_U_DOT_XI, -1.0, 1.0, 9, AxisMapping::Arcsine),
+        Axis::uniform(AXIS_U_DOT_WO, -1.0, 1.0, 7),
+        Axis::with_mapping(AXIS_COS_DPHI, -1.0, 1.0, 6, AxisMapping::Arccosine),
         fourth,
     ];
     Table::from_fn(axes, 3, |x, out| {
@@ -526,7 +527,7 @@ fn compare_at(
 #[test]
 fn unshadowed_srbf_image_is_the_sum_of_table_lookups() {
     let (model, probes) = three_strands();
-    let table = synthetic_table(Axis::uniform("inv_lambda", 1.0 / 64.0, 1.0 / 8.0, 5));
+    let table = synthetic_table(Axis::uniform(AXIS_INV_LAMBDA, 1.0 / 64.0, 1.0 / 8.0, 5));
     let lights = [
         EnvLight::srbf(Vec3::new(0.3, 0.8, 0.5), 20.0, [1.0, 0.5, 0.25]),
         EnvLight::srbf(Vec3::new(-0.7, 0.1, 0.7), 40.0, [0.2, 0.9, 0.4]),
@@ -557,10 +558,10 @@ fn directional_light_image_is_s_cos_theta_times_irradiance() {
     let (model, probes) = three_strands();
     let marschner = Marschner::new(MarschnerParams::default()).unwrap();
     let axes = vec![
-        Axis::uniform("u_dot_xi", -1.0, 1.0, 48),
-        Axis::uniform("u_dot_wo", -1.0, 1.0, 48),
-        Axis::uniform("cos_dphi", -1.0, 1.0, 24),
-        Axis::uniform("inv_lambda", 0.0, 0.0, 1),
+        Axis::uniform(AXIS_U_DOT_XI, -1.0, 1.0, 48),
+        Axis::uniform(AXIS_U_DOT_WO, -1.0, 1.0, 48),
+        Axis::uniform(AXIS_COS_DPHI, -1.0, 1.0, 24),
+        Axis::uniform(AXIS_INV_LAMBDA, 0.0, 0.0, 1),
     ];
     let direct = Table::from_fn(axes, 3, |x, out| {
         let angles = FiberAngles::new(
@@ -664,8 +665,8 @@ fn multiple_scattering_is_power_times_attenuation_times_the_spread_table() {
         DVec3::new(0.5, 0.5, 0.0),
         DVec3::new(0.0, -0.5, 0.0),
     ];
-    let single = synthetic_table(Axis::uniform("inv_lambda", 1.0 / 64.0, 1.0 / 8.0, 3));
-    let multiple = synthetic_table(Axis::uniform("sigma_f", 0.0, 0.6, 7));
+    let single = synthetic_table(Axis::uniform(AXIS_INV_LAMBDA, 1.0 / 64.0, 1.0 / 8.0, 3));
+    let multiple = synthetic_table(Axis::uniform(AXIS_SIGMA_F, 0.0, 0.6, 7));
     let lights = [
         EnvLight::srbf(Vec3::new(0.3, 0.8, 0.5), 20.0, [1.0, 0.5, 0.25]),
         EnvLight::srbf(Vec3::new(-0.7, 0.1, 0.7), 40.0, [0.2, 0.9, 0.4]),
@@ -700,7 +701,7 @@ fn bad_inputs_are_typed_errors() {
     let gpu = gpu();
     let (model, _) = three_strands();
     let camera = ortho_camera();
-    let srbf = synthetic_table(Axis::uniform("inv_lambda", 1.0 / 64.0, 1.0 / 8.0, 3));
+    let srbf = synthetic_table(Axis::uniform(AXIS_INV_LAMBDA, 1.0 / 64.0, 1.0 / 8.0, 3));
     let tables = EnvTables {
         srbf: Some(srbf.clone()),
         ..Default::default()
@@ -734,7 +735,7 @@ fn bad_inputs_are_typed_errors() {
     );
     assert!(e.to_string().contains("κ = 0"), "{e}");
     // A direct table (one-node fourth axis named otherwise) where the SRBF table belongs.
-    let wrong = synthetic_table(Axis::uniform("sigma_f", 0.0, 1.0, 3));
+    let wrong = synthetic_table(Axis::uniform(AXIS_SIGMA_F, 0.0, 1.0, 3));
     let e = render(
         &light,
         &EnvTables {
@@ -788,7 +789,7 @@ fn bad_inputs_are_typed_errors() {
         ..options
     };
     let e = render(&many, &tables, &big);
-    assert!(matches!(e, EnvRenderError::GpuLimit(_)), "{e}");
+    assert!(matches!(e, EnvRenderError::Limit(_)), "{e}");
     println!("{e}");
 }
 
@@ -1200,7 +1201,7 @@ fn srbf_and_directional_lights_in_one_frame_add_and_directional_ignores_kappa() 
     let camera = Camera::framing(model.bounds(), 1.0, false);
     let tables = EnvTables {
         srbf: Some(synthetic_table(Axis::uniform(
-            "inv_lambda",
+            AXIS_INV_LAMBDA,
             1.0 / 64.0,
             1.0 / 8.0,
             5,

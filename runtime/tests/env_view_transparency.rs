@@ -12,6 +12,7 @@ use strandlight_runtime::env::{
 };
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
+use strandlight_tables::table_axes::{AXIS_COS_DPHI, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
 use strandlight_tables::table::{Axis, Table};
 
 /// The light: directional, toward +x (in the image plane), unit irradiance per channel.
@@ -25,9 +26,9 @@ const CENTRE: Vec3 = Vec3::new(1.0 / 64.0, 1.0 / 64.0, 0.0);
 /// the light have different colours and the compositing order shows.
 fn direct_table() -> Table {
     let axes = vec![
-        Axis::uniform("u_dot_xi", -1.0, 1.0, 33),
-        Axis::uniform("u_dot_wo", -1.0, 1.0, 3),
-        Axis::uniform("cos_dphi", -1.0, 1.0, 3),
+        Axis::uniform(AXIS_U_DOT_XI, -1.0, 1.0, 33),
+        Axis::uniform(AXIS_U_DOT_WO, -1.0, 1.0, 3),
+        Axis::uniform(AXIS_COS_DPHI, -1.0, 1.0, 3),
         Axis::uniform("w", 0.0, 0.0, 1),
     ];
     Table::from_fn(axes, 3, |x, out| {

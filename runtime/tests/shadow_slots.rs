@@ -10,10 +10,13 @@ use strandlight_runtime::gpu::{GpuContext, read_texture_rgba};
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::{DeepOpacityMap, DeepOpacityPass, DomSettings};
-use strandlight_runtime::passes::strands::{
-    FrameParams, KajiyaKay, MAX_SHADOWED_LIGHTS, RenderTarget, ShadowInput, StrandGeometry,
-    StrandPass, TooManyShadowMaps,
+use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
+use strandlight_runtime::passes::render_target::RenderTarget;
+use strandlight_runtime::passes::shadow_slots::{
+    MAX_SHADOWED_LIGHTS, ShadowInput, TooManyShadowMaps,
 };
+use strandlight_runtime::passes::strand_geometry::StrandGeometry;
+use strandlight_runtime::passes::strands::StrandPass;
 
 
 fn map_of_slab(gpu: &GpuContext, rows: usize, thickness: f32) -> DeepOpacityMap {

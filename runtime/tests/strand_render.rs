@@ -9,7 +9,7 @@ use glam::Vec3;
 use strandlight_runtime::camera::{Camera, Projection};
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::lights::Light;
-use strandlight_runtime::passes::strands::{FrameParams, KajiyaKay};
+use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
 use strandlight_runtime::render::{RenderOptions, render_frame};
 
 const SIZE: u32 = 64;

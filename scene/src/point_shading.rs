@@ -6,7 +6,7 @@ use anyhow::Context;
 use std::path::Path;
 use strandlight_precompute::point_light_luts::{LutResolution, bake_lut_m, bake_lut_n};
 use strandlight_runtime::passes::fiber_shading::{MarschnerLuts, ShadingModel};
-use strandlight_runtime::passes::strands::KajiyaKay;
+use strandlight_runtime::passes::frame_params::KajiyaKay;
 use strandlight_tables::artist::{ArtistModel, ArtistParams};
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 

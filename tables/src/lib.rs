@@ -29,6 +29,7 @@ pub mod special;
 pub mod split_mix;
 pub mod srbf;
 pub mod table;
+pub mod table_axes;
 
 pub use angles::FiberAngles;
 pub use error::ParamError;

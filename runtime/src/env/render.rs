@@ -6,34 +6,32 @@
 use std::time::Instant;
 
 use strandlight_tables::table::Table;
+use strandlight_tables::table_axes::{
+    AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_SIGMA_F, AXIS_U_DOT_WO, AXIS_U_DOT_XI,
+};
 
 use super::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource};
 use crate::camera::Camera;
+use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels, fit_within};
 use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::gpu::{AdapterReport, GpuContext};
-use crate::hair::HairModel;
+use crate::hair::{Aabb, HairModel};
 use crate::passes::convolution_depth::{
     ConvolutionDepthPass, DodmBatch, DodmSettings, DodmSettingsError, SimplifiedSegments,
     check_kappa,
 };
 use crate::passes::env_view::{
-    BatchBinding, EnvViewPass, EnvViewTargets, FrameVisibility, TableBinding, ViewBinding,
+    BatchBinding, EnvAccumulator, EnvViewPass, EnvViewTargets, FrameVisibility, TableBinding,
+    ViewBinding,
 };
-use crate::passes::strands::{FrameParams, KajiyaKay, StrandGeometry, TooManyPoints};
+use crate::passes::frame_params::{FrameParams, KajiyaKay};
+use crate::passes::strand_geometry::{StrandGeometry, TooManyPoints};
 pub use crate::passes::summed_area::BoxAverage;
-use crate::passes::summed_area::{SatTooLarge, SummedAreaPass, SummedAreaTables};
+use crate::passes::summed_area::{SummedAreaPass, SummedAreaTables};
 pub use crate::passes::transmittance_filter::TransmittanceFilter;
 use crate::passes::view_visibility::OccupancyMap;
 pub use crate::passes::view_visibility::{FragmentCounts, OccupancyError, ViewTransparency};
 use crate::render::PassTiming;
-
-/// Axis names of the env tables (`strandlight_precompute::convolution_table` and
-/// `multiple_scattering_table`; the runtime never links the precompute crate).
-pub const AXIS_U_DOT_XI: &str = "u_dot_xi";
-pub const AXIS_U_DOT_WO: &str = "u_dot_wo";
-pub const AXIS_COS_DPHI: &str = "cos_dphi";
-pub const AXIS_INV_LAMBDA: &str = "inv_lambda";
-pub const AXIS_SIGMA_F: &str = "sigma_f";
 
 /// The tables a frame shades with. Each is an RGB [`Table`] with axes (u·ξ, u·ω_o, cos Δφ, w):
 /// * `srbf`: the convolution table I (I_M, `marschner_full` or the artist I_A), w = 1/λ;
@@ -166,16 +164,12 @@ pub enum EnvRenderError {
     NoLights,
     #[error("light {index}: {problem}")]
     BadLight { index: usize, problem: String },
-    #[error(
-        "image size {width}×{height} must be between 1 and {max} on each side (the adapter's limit)"
-    )]
-    BadSize { width: u32, height: u32, max: u32 },
     #[error(transparent)]
     Settings(#[from] DodmSettingsError),
     #[error(transparent)]
     Table(#[from] EnvTableError),
     #[error(transparent)]
-    GpuLimit(#[from] SatTooLarge),
+    Limit(#[from] LimitError),
     #[error("forward-scattering grid: {0}")]
     Grid(String),
     #[error(transparent)]
@@ -293,6 +287,191 @@ pub struct EnvRenderer {
     view: EnvViewPass,
 }
 
+/// A frame's lights split by kind: each kind is shaded with its own table and batched apart.
+struct LightKinds {
+    srbf: Vec<EnvLight>,
+    directional: Vec<EnvLight>,
+}
+
+impl LightKinds {
+    fn of(lights: &[EnvLight]) -> Self {
+        let (srbf, directional) = lights.iter().partition(|l| l.lambda.is_some());
+        Self { srbf, directional }
+    }
+}
+
+/// The table a kind of light needs, checked for its layout.
+fn required_table<'t>(
+    table: &'t Option<Table>,
+    name: &'static str,
+    needed_by: &'static str,
+    fourth_axis: Option<&str>,
+) -> Result<&'t Table, EnvTableError> {
+    let t = table.as_ref().ok_or(EnvTableError::Missing {
+        table: name,
+        needed_by,
+    })?;
+    check_env_table(name, t, fourth_axis)?;
+    Ok(t)
+}
+
+/// Everything the inputs must satisfy before anything is created on the GPU.
+fn check_inputs(
+    lights: &[EnvLight],
+    kinds: &LightKinds,
+    tables: &EnvTables,
+    options: &EnvRenderOptions,
+    with_multiple: bool,
+) -> Result<(), EnvRenderError> {
+    if lights.is_empty() {
+        return Err(EnvRenderError::NoLights);
+    }
+    for (i, l) in lights.iter().enumerate() {
+        check_light(i, l)?;
+    }
+    options.dodm.check()?;
+    check_kappa(options.kappa)?;
+    options.transparency.check()?;
+    if !kinds.srbf.is_empty() {
+        required_table(&tables.srbf, "srbf", "SRBF lights", Some(AXIS_INV_LAMBDA))?;
+    }
+    if !kinds.directional.is_empty() {
+        required_table(&tables.direct, "direct", "directional lights", None)?;
+    }
+    if with_multiple {
+        required_table(
+            &tables.multiple,
+            "multiple",
+            "multiple scattering",
+            Some(AXIS_SIGMA_F),
+        )?;
+    }
+    Ok(())
+}
+
+/// The image and the DODM batch (one array layer per light slot) against the adapter's limits;
+/// the SAT, the occupancy map and the sums are checked when created.
+fn check_frame_limits(
+    gpu: &GpuContext,
+    (width, height): (u32, u32),
+    resolution: u32,
+    slots: u32,
+) -> Result<(), LimitError> {
+    let limits = GpuLimits::of(gpu);
+    limits.check_image(width, height)?;
+    limits.check_texture_2d("DODM", resolution, resolution, |max| {
+        format!("use a DODM resolution of at most {max}")
+    })?;
+    limits.check_texture_layers("DODM light batch", slots, |max| {
+        format!("use a light batch size of at most {max}")
+    })
+}
+
+/// The frame's running sums (two RGBA f32 images) and the pass that adds into them.
+fn check_sums_limits(gpu: &GpuContext, width: u32, height: u32) -> Result<(), LimitError> {
+    let limits = GpuLimits::of(gpu);
+    let pixels_fitting = |bytes_per_pixel: u64| {
+        move |max: u64| {
+            let (w, h) = fit_pixels(width, height, max / bytes_per_pixel);
+            format!("render at {w}x{h} or smaller")
+        }
+    };
+    let sums = EnvViewPass::accumulator_bytes(width, height);
+    limits.check_storage_buffer(
+        "env sums",
+        sums,
+        pixels_fitting(sums / (width as u64 * height as u64)),
+    )?;
+    limits.check_workgroups(
+        "env accumulate",
+        [width.div_ceil(8), height.div_ceil(8), 1],
+        |max| {
+            let (w, h) = fit_within(width, height, max as u64 * 8);
+            format!("render at {w}x{h} or smaller")
+        },
+    )
+}
+
+/// What one frame renders into, created once before its passes: the hair (all of it for the
+/// view and directional lights, the κ-simplified order for SRBF light passes), the DODM batch
+/// (DODM: the convolution optical depth map of Ren 2010 §5, one layer per light) and its
+/// summed-area tables, the view's visibility, targets and running sums, and the tables bound
+/// per light kind.
+struct FrameResources {
+    geometry: StrandGeometry,
+    light_geometry: StrandGeometry,
+    bounds: Aabb,
+    dodm: DodmBatch,
+    sat: SummedAreaTables,
+    occupancy: OccupancyMap,
+    targets: EnvViewTargets,
+    sums: EnvAccumulator,
+    /// Group 0 of every view and visibility pass.
+    strands: wgpu::BindGroup,
+    coverage_view: wgpu::TextureView,
+    depth_view: wgpu::TextureView,
+    /// The single-scattering tables of the SRBF and the directional lights (None: no such
+    /// lights), each bound with the multiple-scattering table.
+    srbf_tables: Option<TableBinding>,
+    directional_tables: Option<TableBinding>,
+}
+
+impl FrameResources {
+    /// The visibility input of group 3 for this frame.
+    fn visibility(&self, options: &EnvRenderOptions) -> FrameVisibility<'_> {
+        FrameVisibility {
+            map: &self.occupancy,
+            coverage: &self.coverage_view,
+            transparency: options.transparency,
+            width: self.sums.width,
+            height: self.sums.height,
+        }
+    }
+
+    /// GPU memory held while one batch renders, per resource (tables and grid added later).
+    fn memory(&self) -> Vec<(String, u64)> {
+        let mut memory = self.geometry.memory();
+        memory.extend(self.dodm.memory());
+        memory.extend(self.sat.memory());
+        memory.extend(self.targets.memory());
+        memory.push(self.occupancy.memory());
+        memory.push(("env sums".into(), self.sums.sums.size()));
+        memory
+    }
+}
+
+/// The geometry the SRBF light passes draw: the first κ of the shuffled strands, or all.
+fn light_pass_geometry(
+    gpu: &GpuContext,
+    model: &HairModel,
+    geometry: &StrandGeometry,
+    options: &EnvRenderOptions,
+) -> StrandGeometry {
+    if options.kappa < 1.0 {
+        SimplifiedSegments::new(gpu, model, options.simplification_seed)
+            .geometry(geometry, options.kappa)
+    } else {
+        StrandGeometry {
+            points: geometry.points.clone(),
+            segments: geometry.segments.clone(),
+            attributes: geometry.attributes.clone(),
+            segment_count: geometry.segment_count,
+            default_thickness: geometry.default_thickness,
+        }
+    }
+}
+
+/// What one frame is asked for.
+struct FrameRequest<'a> {
+    model: &'a HairModel,
+    camera: &'a Camera,
+    width: u32,
+    height: u32,
+    tables: &'a EnvTables,
+    options: &'a EnvRenderOptions,
+    multiple: Option<&'a dyn ForwardScatteringSource>,
+}
+
 impl EnvRenderer {
     pub fn new(gpu: &GpuContext) -> Self {
         Self {
@@ -318,251 +497,50 @@ impl EnvRenderer {
         options: &EnvRenderOptions,
         multiple: Option<&dyn ForwardScatteringSource>,
     ) -> Result<EnvFrame, EnvRenderError> {
+        let request = FrameRequest {
+            model,
+            camera,
+            width,
+            height,
+            tables,
+            options,
+            multiple,
+        };
         let mut timings = Timings(Vec::new());
-        if lights.is_empty() {
-            return Err(EnvRenderError::NoLights);
-        }
-        for (i, l) in lights.iter().enumerate() {
-            check_light(i, l)?;
-        }
-        options.dodm.check()?;
-        check_kappa(options.kappa)?;
-        options.transparency.check()?;
-        let max = gpu.device.limits().max_texture_dimension_2d;
-        if width == 0 || height == 0 || width > max || height > max {
-            return Err(EnvRenderError::BadSize { width, height, max });
-        }
-        let srbf_lights: Vec<EnvLight> = lights
-            .iter()
-            .copied()
-            .filter(|l| l.lambda.is_some())
-            .collect();
-        let directional: Vec<EnvLight> = lights
-            .iter()
-            .copied()
-            .filter(|l| l.lambda.is_none())
-            .collect();
-        if !srbf_lights.is_empty() {
-            let t = tables.srbf.as_ref().ok_or(EnvTableError::Missing {
-                table: "srbf",
-                needed_by: "SRBF lights",
-            })?;
-            check_env_table("srbf", t, Some(AXIS_INV_LAMBDA))?;
-        }
-        if !directional.is_empty() {
-            let t = tables.direct.as_ref().ok_or(EnvTableError::Missing {
-                table: "direct",
-                needed_by: "directional lights",
-            })?;
-            check_env_table("direct", t, None)?;
-        }
-        if multiple.is_some() {
-            let t = tables.multiple.as_ref().ok_or(EnvTableError::Missing {
-                table: "multiple",
-                needed_by: "multiple scattering",
-            })?;
-            check_env_table("multiple", t, Some(AXIS_SIGMA_F))?;
-        }
-        let batch_size = options.dodm.batch_size as usize;
-        let slots = batch_size.min(srbf_lights.len().max(directional.len())) as u32;
-        let resolution = options.dodm.resolution;
-        // Checked before anything is allocated.
-        let mut sat = SummedAreaTables::new(gpu, resolution, slots)?;
-        let occupancy = OccupancyMap::new(gpu, options.transparency, width, height)?;
-
+        let kinds = LightKinds::of(lights);
+        check_inputs(lights, &kinds, tables, options, multiple.is_some())?;
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;
-        let simplified = (options.kappa < 1.0)
-            .then(|| SimplifiedSegments::new(gpu, model, options.simplification_seed));
-        let light_geometry = match &simplified {
-            Some(s) => s.geometry(&geometry, options.kappa),
-            None => StrandGeometry {
-                points: geometry.points.clone(),
-                segments: geometry.segments.clone(),
-                attributes: geometry.attributes.clone(),
-                segment_count: geometry.segment_count,
-                default_thickness: geometry.default_thickness,
-            },
+        let mut frame = self.frame_resources(gpu, &request, &kinds, &mut timings)?;
+        let mut memory = frame.memory();
+        self.encode_visibility(gpu, &frame, options, &mut timings);
+        let fragments = match options.count_fragments {
+            true => Some(self.count_fragments(gpu, &frame, options)?),
+            false => None,
         };
-        let bounds = model.bounds();
-        let mut dodm = DodmBatch::new(gpu, resolution, slots, options.dodm.first_layer_for(bounds));
-        let targets = EnvViewTargets::new(gpu, width, height, options.transparency);
-        let sums = self.view.accumulator(gpu, &targets);
-        let frame = FrameParams {
-            camera: *camera,
-            width,
-            height,
-            lights: Vec::new(),
-            shading: KajiyaKay::default(),
-            width_override_px: options.width_override_px,
-        };
-        let table_bindings = timings.time(gpu, "table upload", || {
-            let multiple_table = multiple.and(tables.multiple.as_ref());
-            let bind = |t: &Option<Table>| {
-                t.as_ref()
-                    .map(|t| TableBinding::new(gpu, &self.view.table_layout, t, multiple_table))
-            };
-            (
-                if srbf_lights.is_empty() {
-                    None
-                } else {
-                    bind(&tables.srbf)
-                },
-                if directional.is_empty() {
-                    None
-                } else {
-                    bind(&tables.direct)
-                },
-            )
-        });
-        let mut memory: Vec<(String, u64)> = geometry.memory();
-        memory.extend(dodm.memory());
-        memory.extend(sat.memory());
-        memory.extend(targets.memory());
-        memory.push(occupancy.memory());
-        memory.push(("env sums".into(), sums.sums.size()));
-        let strands = self.view.strands(gpu, &geometry, &frame);
-        let coverage_view = targets.coverage.create_view(&Default::default());
-        let visibility = FrameVisibility {
-            map: &occupancy,
-            coverage: &coverage_view,
-            transparency: options.transparency,
-            width,
-            height,
-        };
-        let depth_view = targets.depth.create_view(&Default::default());
-        timings.time(gpu, "view visibility", || {
-            let view = ViewBinding::new(gpu, &self.view.view_layout, None, &visibility);
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            self.view.visibility.encode(
-                &mut encoder,
-                options.transparency,
-                &strands,
-                &view.group,
-                &depth_view,
-                &coverage_view,
-                &occupancy,
-                geometry.segment_count,
-            );
-            gpu.queue.submit([encoder.finish()]);
-        });
-        let fragments = if options.count_fragments {
-            let view = ViewBinding::new(gpu, &self.view.view_layout, None, &visibility);
-            Some(self.view.visibility.count_fragments(
-                gpu,
-                options.transparency,
-                &strands,
-                &view.group,
-                &depth_view,
-                (width, height),
-                geometry.segment_count,
-            )?)
-        } else {
-            None
-        };
-        let mut table_bytes = 0;
-        let mut grid_bytes = 0u64;
-        let mut batches = 0u32;
-        for (kind_lights, binding) in [
-            (&srbf_lights, &table_bindings.0),
-            (&directional, &table_bindings.1),
-        ] {
+        let mut usage = BatchUsage::default();
+        let kind_tables = [
+            (&kinds.srbf, frame.srbf_tables.take()),
+            (&kinds.directional, frame.directional_tables.take()),
+        ];
+        for (kind_lights, binding) in &kind_tables {
             let Some(binding) = binding else { continue };
-            table_bytes += binding.bytes;
-            let srbf_kind = kind_lights.first().is_some_and(|l| l.lambda.is_some());
-            sat.average = if srbf_kind {
-                options.box_average
-            } else {
-                BoxAverage::OpticalDepth
-            };
-            let (kind_geometry, enlargement) = if srbf_kind {
-                (&light_geometry, 1.0 / options.kappa)
-            } else {
-                (&geometry, 1.0)
-            };
-            for chunk in kind_lights.chunks(batch_size) {
-                batches += 1;
-                let grid = match multiple {
-                    Some(source) => {
-                        let pass = format!("multiple grid ({})", source.device());
-                        let grid = timings
-                            .time(gpu, &pass, || source.grid(chunk))
-                            .map_err(|e| EnvRenderError::Grid(e.to_string()))?;
-                        check_grid(&grid, chunk.len())?;
-                        Some(grid)
-                    }
-                    None => None,
+            usage.table_bytes += binding.bytes;
+            for chunk in kind_lights.chunks(options.dodm.batch_size as usize) {
+                let batch = LightBatch {
+                    lights: chunk,
+                    tables: binding,
                 };
-                let directions: Vec<_> = chunk.iter().map(|l| l.direction).collect();
-                timings.time(gpu, "light pass", || {
-                    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                    self.depth.encode(
-                        gpu,
-                        &mut encoder,
-                        kind_geometry,
-                        &directions,
-                        bounds,
-                        enlargement,
-                        enlargement,
-                        &mut dodm,
-                    );
-                    gpu.queue.submit([encoder.finish()]);
-                });
-                timings.time(gpu, "summed-area tables", || {
-                    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                    self.sat
-                        .encode(gpu, &mut encoder, &dodm.optical_depth, &sat);
-                    gpu.queue.submit([encoder.finish()]);
-                });
-                timings.time(gpu, "view", || {
-                    let batch = BatchBinding::with_filter(
-                        gpu,
-                        &self.view.batch_layout,
-                        chunk,
-                        &dodm,
-                        &sat,
-                        options.shadowed,
-                        grid.is_some(),
-                        options.transmittance_filter,
-                    );
-                    let view =
-                        ViewBinding::new(gpu, &self.view.view_layout, grid.as_ref(), &visibility);
-                    grid_bytes = grid_bytes.max(view.bytes);
-                    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-                    self.view.encode(
-                        &mut encoder,
-                        &geometry,
-                        &strands,
-                        options.transparency,
-                        &batch,
-                        binding,
-                        &view,
-                        &targets,
-                        &sums,
-                    );
-                    gpu.queue.submit([encoder.finish()]);
-                });
+                self.render_batch(gpu, &mut frame, &batch, &request, &mut timings, &mut usage)?;
             }
         }
-        memory.push(("env tables".into(), table_bytes));
-        memory.push(("forward-scattering grid".into(), grid_bytes));
-        let bytes = timings.time(gpu, "readback", || read_buffer(gpu, &sums.sums))?;
-
+        memory.push(("env tables".into(), usage.table_bytes));
+        memory.push(("forward-scattering grid".into(), usage.grid_bytes));
+        let bytes = timings.time(gpu, "readback", || read_buffer(gpu, &frame.sums.sums))?;
         if let Some(error) = pollster::block_on(scope.pop()) {
             return Err(EnvRenderError::Gpu(error.to_string()));
         }
-        let all: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
-        let n = width as usize * height as usize;
-        let single_pixels = all[..n].to_vec();
-        let multiple_pixels = multiple.map(|_| all[n..2 * n].to_vec());
-        let pixels = match &multiple_pixels {
-            None => single_pixels.clone(),
-            Some(m) => single_pixels
-                .iter()
-                .zip(m)
-                .map(|(s, m)| [s[0] + m[0], s[1] + m[1], s[2] + m[2], s[3]])
-                .collect(),
-        };
+        let (pixels, single_pixels, multiple_pixels) =
+            split_sums(&bytes, width, height, multiple.is_some());
         Ok(EnvFrame {
             width,
             height,
@@ -573,15 +551,259 @@ impl EnvRenderer {
                 adapter: gpu.report.clone(),
                 timings: timings.0,
                 memory_per_batch: memory,
-                batches,
+                batches: usage.batches,
                 lights: lights.len() as u32,
-                segments: geometry.segment_count,
-                light_pass_segments: light_geometry.segment_count,
+                segments: frame.geometry.segment_count,
+                light_pass_segments: frame.light_geometry.segment_count,
                 timing_method: "CPU wall clock around submit + wait for idle, summed over batches",
                 fragments,
             },
         })
     }
+
+    /// Creates the frame's resources, after checking them against the adapter's limits.
+    fn frame_resources(
+        &self,
+        gpu: &GpuContext,
+        request: &FrameRequest<'_>,
+        kinds: &LightKinds,
+        timings: &mut Timings,
+    ) -> Result<FrameResources, EnvRenderError> {
+        let FrameRequest {
+            model,
+            camera,
+            width,
+            height,
+            tables,
+            options,
+            multiple,
+        } = *request;
+        let batch_size = options.dodm.batch_size as usize;
+        let slots = batch_size.min(kinds.srbf.len().max(kinds.directional.len())) as u32;
+        let resolution = options.dodm.resolution;
+        check_frame_limits(gpu, (width, height), resolution, slots)?;
+        let sat = SummedAreaTables::new(gpu, resolution, slots)?;
+        let occupancy = OccupancyMap::new(gpu, options.transparency, width, height)?;
+        check_sums_limits(gpu, width, height)?;
+        let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;
+        let light_geometry = light_pass_geometry(gpu, model, &geometry, options);
+        let bounds = model.bounds();
+        let first_layer = options.dodm.first_layer_for(bounds);
+        let dodm = DodmBatch::new(gpu, resolution, slots, first_layer);
+        let targets = EnvViewTargets::new(gpu, width, height, options.transparency);
+        let sums = self.view.accumulator(gpu, &targets);
+        let view_params = FrameParams {
+            camera: *camera,
+            width,
+            height,
+            lights: Vec::new(),
+            shading: KajiyaKay::default(),
+            width_override_px: options.width_override_px,
+        };
+        let (srbf_tables, directional_tables) = timings.time(gpu, "table upload", || {
+            let multiple_table = multiple.and(tables.multiple.as_ref());
+            let bind = |needed: bool, t: &Option<Table>| {
+                t.as_ref()
+                    .filter(|_| needed)
+                    .map(|t| TableBinding::new(gpu, &self.view.table_layout, t, multiple_table))
+            };
+            (
+                bind(!kinds.srbf.is_empty(), &tables.srbf),
+                bind(!kinds.directional.is_empty(), &tables.direct),
+            )
+        });
+        Ok(FrameResources {
+            strands: self.view.strands(gpu, &geometry, &view_params),
+            coverage_view: targets.coverage.create_view(&Default::default()),
+            depth_view: targets.depth.create_view(&Default::default()),
+            geometry,
+            light_geometry,
+            bounds,
+            dodm,
+            sat,
+            occupancy,
+            targets,
+            sums,
+            srbf_tables,
+            directional_tables,
+        })
+    }
+
+    /// The frame's visibility (depth prepass and coverage, or the occupancy map), once.
+    fn encode_visibility(
+        &self,
+        gpu: &GpuContext,
+        frame: &FrameResources,
+        options: &EnvRenderOptions,
+        timings: &mut Timings,
+    ) {
+        timings.time(gpu, "view visibility", || {
+            let visibility = frame.visibility(options);
+            let view = ViewBinding::new(gpu, &self.view.view_layout, None, &visibility);
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            self.view.visibility.encode(
+                &mut encoder,
+                options.transparency,
+                &frame.strands,
+                &view.group,
+                &frame.depth_view,
+                &frame.coverage_view,
+                &frame.occupancy,
+                frame.geometry.segment_count,
+            );
+            gpu.queue.submit([encoder.finish()]);
+        });
+    }
+
+    /// The fragments one batch's view pass rasterizes and shades (benchmarks).
+    fn count_fragments(
+        &self,
+        gpu: &GpuContext,
+        frame: &FrameResources,
+        options: &EnvRenderOptions,
+    ) -> Result<FragmentCounts, ReadbackError> {
+        let visibility = frame.visibility(options);
+        let view = ViewBinding::new(gpu, &self.view.view_layout, None, &visibility);
+        self.view.visibility.count_fragments(
+            gpu,
+            options.transparency,
+            &frame.strands,
+            &view.group,
+            &frame.depth_view,
+            (frame.sums.width, frame.sums.height),
+            frame.geometry.segment_count,
+        )
+    }
+
+    /// One batch of lights of one kind: its forward-scattering grid, the light pass into the
+    /// DODM, the SATs, then the view pass added into the frame's sums.
+    fn render_batch(
+        &self,
+        gpu: &GpuContext,
+        frame: &mut FrameResources,
+        batch: &LightBatch<'_>,
+        request: &FrameRequest<'_>,
+        timings: &mut Timings,
+        usage: &mut BatchUsage,
+    ) -> Result<(), EnvRenderError> {
+        let options = request.options;
+        usage.batches += 1;
+        let srbf_kind = batch.lights.first().is_some_and(|l| l.lambda.is_some());
+        let grid = match request.multiple {
+            Some(source) => Some(batch_grid(gpu, source, batch.lights, timings)?),
+            None => None,
+        };
+        timings.time(gpu, "light pass", || {
+            let (geometry, enlargement) = match srbf_kind {
+                true => (&frame.light_geometry, 1.0 / options.kappa),
+                false => (&frame.geometry, 1.0),
+            };
+            let directions: Vec<_> = batch.lights.iter().map(|l| l.direction).collect();
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            self.depth.encode(
+                gpu,
+                &mut encoder,
+                geometry,
+                &directions,
+                frame.bounds,
+                enlargement,
+                enlargement,
+                &mut frame.dodm,
+            );
+            gpu.queue.submit([encoder.finish()]);
+        });
+        frame.sat.average = match srbf_kind {
+            true => options.box_average,
+            false => BoxAverage::OpticalDepth,
+        };
+        timings.time(gpu, "summed-area tables", || {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            self.sat
+                .encode(gpu, &mut encoder, &frame.dodm.optical_depth, &frame.sat);
+            gpu.queue.submit([encoder.finish()]);
+        });
+        timings.time(gpu, "view", || {
+            let lights = BatchBinding::with_filter(
+                gpu,
+                &self.view.batch_layout,
+                batch.lights,
+                &frame.dodm,
+                &frame.sat,
+                options.shadowed,
+                grid.is_some(),
+                options.transmittance_filter,
+            );
+            let visibility = frame.visibility(options);
+            let view = ViewBinding::new(gpu, &self.view.view_layout, grid.as_ref(), &visibility);
+            usage.grid_bytes = usage.grid_bytes.max(view.bytes);
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            self.view.encode(
+                &mut encoder,
+                &frame.geometry,
+                &frame.strands,
+                options.transparency,
+                &lights,
+                batch.tables,
+                &view,
+                &frame.targets,
+                &frame.sums,
+            );
+            gpu.queue.submit([encoder.finish()]);
+        });
+        Ok(())
+    }
+}
+
+/// One batch: lights of one kind (at most the batch size) and their kind's tables.
+struct LightBatch<'a> {
+    lights: &'a [EnvLight],
+    tables: &'a TableBinding,
+}
+
+/// Counts over the batches, for the stats.
+#[derive(Default)]
+struct BatchUsage {
+    batches: u32,
+    table_bytes: u64,
+    grid_bytes: u64,
+}
+
+/// The forward-scattering grid of one batch, checked.
+fn batch_grid(
+    gpu: &GpuContext,
+    source: &dyn ForwardScatteringSource,
+    lights: &[EnvLight],
+    timings: &mut Timings,
+) -> Result<ForwardScatteringGrid, EnvRenderError> {
+    let pass = format!("multiple grid ({})", source.device());
+    let grid = timings
+        .time(gpu, &pass, || source.grid(lights))
+        .map_err(|e| EnvRenderError::Grid(e.to_string()))?;
+    check_grid(&grid, lights.len())?;
+    Ok(grid)
+}
+
+/// The readback of the sums split into (single + multiple, single, multiple).
+#[allow(clippy::type_complexity)]
+fn split_sums(
+    bytes: &[u8],
+    width: u32,
+    height: u32,
+    with_multiple: bool,
+) -> (Vec<[f32; 4]>, Vec<[f32; 4]>, Option<Vec<[f32; 4]>>) {
+    let all: &[[f32; 4]] = bytemuck::cast_slice(bytes);
+    let n = width as usize * height as usize;
+    let single_pixels = all[..n].to_vec();
+    let multiple_pixels = with_multiple.then(|| all[n..2 * n].to_vec());
+    let pixels = match &multiple_pixels {
+        None => single_pixels.clone(),
+        Some(m) => single_pixels
+            .iter()
+            .zip(m)
+            .map(|(s, m)| [s[0] + m[0], s[1] + m[1], s[2] + m[2], s[3]])
+            .collect(),
+    };
+    (pixels, single_pixels, multiple_pixels)
 }
 
 /// [`EnvRenderer::render`] with pipelines built for this one frame.

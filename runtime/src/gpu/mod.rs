@@ -1,7 +1,10 @@
 //! GPU plumbing shared by the passes: the device, and reading textures back to the CPU.
 
+pub mod bind_layout;
 pub mod device;
+pub mod limits;
 pub mod readback;
 
 pub use device::{AdapterReport, DeviceError, GpuContext};
+pub use limits::{GpuLimits, LimitError};
 pub use readback::{read_buffer, read_texture_rgba};

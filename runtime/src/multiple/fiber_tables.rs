@@ -13,6 +13,7 @@
 
 use std::f64::consts::FRAC_PI_2;
 
+use strandlight_tables::table_axes::{AXIS_ABS_SIN_THETA, AXIS_ABS_U_DOT_XI, AXIS_LAMBDA, AXIS_NU, AXIS_QUANTITY, AXIS_SIN_THETA};
 use strandlight_tables::table::Table;
 use thiserror::Error;
 
@@ -120,7 +121,7 @@ pub struct ForwardEvent {
 
 impl ForwardFiberAverages {
     pub fn from_table(table: &Table) -> Result<Self, ForwardScatteringError> {
-        check_shape(table, "fiber_averages", &["sin_theta", "quantity"], 3)?;
+        check_shape(table, "fiber_averages", &[AXIS_SIN_THETA, AXIS_QUANTITY], 3)?;
         let q = &table.axes()[1];
         if q.count != FIBER_AVERAGE_QUANTITY_COUNT {
             return Err(ForwardScatteringError::TableShape {
@@ -169,7 +170,7 @@ pub struct AttenuationRatio {
 
 impl AttenuationRatio {
     pub fn from_table(table: &Table) -> Result<Self, ForwardScatteringError> {
-        check_shape(table, "attenuation_ratio", &["nu", "abs_sin_theta"], 1)?;
+        check_shape(table, "attenuation_ratio", &[AXIS_NU, AXIS_ABS_SIN_THETA], 1)?;
         let (nu_min, nu_max) = (table.axes()[0].min, table.axes()[0].max);
         let rows = (0..NU_NODES)
             .map(|r| {
@@ -206,7 +207,7 @@ pub struct SrbfSpread {
 
 impl SrbfSpread {
     pub fn from_table(table: &Table) -> Result<Self, ForwardScatteringError> {
-        check_shape(table, "srbf_spread", &["abs_u_dot_xi", "lambda"], 1)?;
+        check_shape(table, "srbf_spread", &[AXIS_ABS_U_DOT_XI, AXIS_LAMBDA], 1)?;
         Ok(Self { table: table.clone() })
     }
 
@@ -271,8 +272,8 @@ mod tests {
 
     fn fiber_table(quantities: usize) -> Table {
         let axes = vec![
-            Axis::with_mapping("sin_theta", -1.0, 1.0, 17, AxisMapping::Arcsine),
-            Axis::uniform("quantity", 0.0, (quantities - 1) as f64, quantities),
+            Axis::with_mapping(AXIS_SIN_THETA, -1.0, 1.0, 17, AxisMapping::Arcsine),
+            Axis::uniform(AXIS_QUANTITY, 0.0, (quantities - 1) as f64, quantities),
         ];
         // Node q holds q + (0.1, 0.2, 0.3) scaled by cos θ: a_f = 0.1..0.3 cos θ, β² = 4.1.. cos θ.
         Table::from_fn(axes, 3, |x, out| {
@@ -304,8 +305,8 @@ mod tests {
         // interpolation far below one table cell's error.
         let fiber = Table::from_fn(
             vec![
-                Axis::with_mapping("sin_theta", -1.0, 1.0, 64, AxisMapping::Arcsine),
-                Axis::uniform("quantity", 0.0, 8.0, 9),
+                Axis::with_mapping(AXIS_SIN_THETA, -1.0, 1.0, 64, AxisMapping::Arcsine),
+                Axis::uniform(AXIS_QUANTITY, 0.0, 8.0, 9),
             ],
             3,
             |x, out| {
@@ -317,7 +318,7 @@ mod tests {
         )
         .unwrap();
         let ratio = Table::from_fn(
-            vec![Axis::uniform("nu", 0.0, 1.0, 16), Axis::with_mapping("abs_sin_theta", 0.0, 1.0, 32, AxisMapping::Arcsine)],
+            vec![Axis::uniform(AXIS_NU, 0.0, 1.0, 16), Axis::with_mapping(AXIS_ABS_SIN_THETA, 0.0, 1.0, 32, AxisMapping::Arcsine)],
             1,
             |x, o| o[0] = ((1.0 - x[1] * x[1]).sqrt() * (1.0 - 0.3 * x[0]) + 0.4 * x[0] * x[0]) as f32,
         )
@@ -344,7 +345,7 @@ mod tests {
         println!("{err}");
         assert!(matches!(err, ForwardScatteringError::TableShape { table: "fiber_averages", .. }));
         let wrong_axes = Table::from_fn(
-            vec![Axis::uniform("lambda", 1.0, 2.0, 3), Axis::uniform("nu", 0.0, 1.0, 3)],
+            vec![Axis::uniform(AXIS_LAMBDA, 1.0, 2.0, 3), Axis::uniform(AXIS_NU, 0.0, 1.0, 3)],
             1,
             |_, o| o[0] = 1.0,
         )

@@ -16,6 +16,7 @@ use super::forward_scattering::CpuForwardScattering;
 use super::shadow_paths::{LightMedium, light_direction};
 use crate::env::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource};
 use crate::gpu::{GpuContext, read_buffer};
+use crate::gpu::bind_layout::{storage_entry, uniform_entry};
 
 const WORKGROUP_SIZE: u32 = 64;
 /// Two vec4 per voxel per light (see the shader's layout).
@@ -198,21 +199,15 @@ fn build_pipeline(gpu: &GpuContext) -> (wgpu::ComputePipeline, wgpu::BindGroupLa
         label: Some("gpu_shadow_paths.wgsl"),
         source: wgpu::ShaderSource::Wgsl(include_str!("gpu_shadow_paths.wgsl").into()),
     });
-    let buffer = |binding, ty| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-        count: None,
-    };
-    let read_only = wgpu::BufferBindingType::Storage { read_only: true };
+    let compute = wgpu::ShaderStages::COMPUTE;
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("shadow paths"),
         entries: &[
-            buffer(0, wgpu::BufferBindingType::Uniform),
-            buffer(1, read_only),
-            buffer(2, read_only),
-            buffer(3, read_only),
-            buffer(4, wgpu::BufferBindingType::Storage { read_only: false }),
+            uniform_entry(0, compute),
+            storage_entry(1, compute, true),
+            storage_entry(2, compute, true),
+            storage_entry(3, compute, true),
+            storage_entry(4, compute, false),
         ],
     });
     let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

@@ -31,7 +31,7 @@ pub struct VoxelSettings {
     /// uses 74–90 on the longest side; 64 by default.
     pub voxels_longest_side: u32,
     /// Fiber diameter where the model has no thickness attribute (model units); `None` uses
-    /// the renderer's default (`passes::strands::default_thickness`: 10⁻³ × bounds diagonal).
+    /// the renderer's default (`passes::strand_geometry::default_thickness`: 10⁻³ × bounds diagonal).
     pub default_diameter: Option<f32>,
 }
 
@@ -227,7 +227,7 @@ impl HairVolume {
         settings.validate()?;
         let default_diameter = settings
             .default_diameter
-            .unwrap_or_else(|| crate::passes::strands::default_thickness(model));
+            .unwrap_or_else(|| crate::passes::strand_geometry::default_thickness(model));
         let grid = VoxelGrid::around(model.bounds(), settings.voxels_longest_side, default_diameter);
         let sums = accumulate(model, &grid, default_diameter);
         Ok(Self::from_sums(grid, &sums, nu_max))

@@ -1,6 +1,7 @@
 //! Voxelization and shadow paths against closed forms on synthetic hair, with hand-made tables
 //! (constant ā_f, β̄_f², SRBF variance; α(0, θ) = cos θ), independent of the bake.
 
+use strandlight_tables::table_axes::{AXIS_ABS_SIN_THETA, AXIS_ABS_U_DOT_XI, AXIS_LAMBDA, AXIS_NU, AXIS_QUANTITY, AXIS_SIN_THETA};
 use glam::Vec3;
 use strandlight_tables::table::{Axis, AxisMapping, Table};
 
@@ -15,8 +16,8 @@ const SRBF_VARIANCE: f64 = 0.02;
 fn tables() -> ForwardScatteringTables {
     let fiber = Table::from_fn(
         vec![
-            Axis::with_mapping("sin_theta", -1.0, 1.0, 33, AxisMapping::Arcsine),
-            Axis::uniform("quantity", 0.0, 8.0, 9),
+            Axis::with_mapping(AXIS_SIN_THETA, -1.0, 1.0, 33, AxisMapping::Arcsine),
+            Axis::uniform(AXIS_QUANTITY, 0.0, 8.0, 9),
         ],
         3,
         |x, out| {
@@ -33,8 +34,8 @@ fn tables() -> ForwardScatteringTables {
     // α(ν, θ) = cos θ: exact for aligned fibers, used for ν ≈ 0 layouts only.
     let ratio = Table::from_fn(
         vec![
-            Axis::uniform("nu", 0.0, 1.0, 5),
-            Axis::with_mapping("abs_sin_theta", 0.0, 1.0, 65, AxisMapping::Arcsine),
+            Axis::uniform(AXIS_NU, 0.0, 1.0, 5),
+            Axis::with_mapping(AXIS_ABS_SIN_THETA, 0.0, 1.0, 65, AxisMapping::Arcsine),
         ],
         1,
         |x, out| out[0] = (1.0 - x[1] * x[1]).max(0.0).sqrt() as f32,
@@ -42,8 +43,8 @@ fn tables() -> ForwardScatteringTables {
     .unwrap();
     let spread = Table::from_fn(
         vec![
-            Axis::with_mapping("abs_u_dot_xi", 0.0, 1.0, 9, AxisMapping::Arcsine),
-            Axis::uniform("lambda", 4.0, 400.0, 9),
+            Axis::with_mapping(AXIS_ABS_U_DOT_XI, 0.0, 1.0, 9, AxisMapping::Arcsine),
+            Axis::uniform(AXIS_LAMBDA, 4.0, 400.0, 9),
         ],
         1,
         |_, out| out[0] = SRBF_VARIANCE as f32,
@@ -135,7 +136,7 @@ fn parallel_block_voxelizes_to_the_closed_form() {
     assert!(worst_nu < 1e-3);
     // Without a thickness attribute the renderer's default diameter (10⁻³ × diagonal) is used.
     let model = parallel_block(None);
-    let default_d = crate::passes::strands::default_thickness(&model);
+    let default_d = crate::passes::strand_geometry::default_thickness(&model);
     let v = HairVolume::build(&model, &settings(8, 1, 0.5).voxels, 1.0).unwrap();
     println!("default diameter {default_d}: σ_t⊥ {}", v.sigma_perp[0]);
     assert!((v.sigma_perp[0] / default_d - 1.0).abs() < 1e-5);

@@ -1,10 +1,13 @@
 //! Order-independent transparency with an A-buffer: per-pixel linked lists of shaded fragments
 //! built with storage-buffer atomics (`abuffer.wgsl`), then sorted and composited front to back
 //! by a compute resolve (`abuffer_resolve.wgsl`). Node-buffer overflow and resolve truncation
-//! are counted and reported, never silent.
+//! are counted and reported ([`ABufferFrame`]), never silent.
+//! The DBK-buffer (depth-based K-buffer, Hunz 2016 §5.3) is the cheaper variant: a depth
+//! prepass finds each pixel's nearest fiber, only fragments within a depth bucket of width Δ
+//! behind it go into the lists, and the rest fall back to an opaque depth-tested target.
 //! Fragments are shaded exactly as the opaque strand pass shades them: the same WGSL (any
 //! [`ShadingModel`], group 2) and a deep opacity map for each of up to
-//! [`MAX_SHADOWED_LIGHTS`](crate::passes::strands::MAX_SHADOWED_LIGHTS) lights (group 1).
+//! [`MAX_SHADOWED_LIGHTS`](crate::passes::shadow_slots::MAX_SHADOWED_LIGHTS) lights (group 1).
 //! Inputs: [`StrandGeometry`], [`FrameParams`], the shadow maps, the node capacity.
 //! Output: [`ABufferFrame`].
 
@@ -12,13 +15,20 @@ use super::attachments::{cleared_color, cleared_depth};
 use wgpu::util::DeviceExt;
 
 use crate::gpu::GpuContext;
+use crate::gpu::bind_layout::{
+    bind_group, depth_texture_entry, float_texture_entry, storage_entry, uniform_entry,
+};
+use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels, fit_within};
 use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::passes::fiber_shading::{ModelBinding, ShadingModel};
-use crate::passes::strands::{
-    DEPTH_FORMAT, FrameParams, RenderTarget, ShadowInput, StrandGeometry, TooManyShadowMaps,
-    shading_source, shadow_bind_group_for, shadow_bind_group_layout, strand_bind_group,
-    strand_bind_group_layout,
+use crate::passes::frame_params::FrameParams;
+use crate::passes::render_target::{DEPTH_FORMAT, RenderTarget};
+use crate::passes::shadow_slots::{
+    ShadowInput, TooManyShadowMaps, shadow_bind_group_for, shadow_bind_group_layout,
 };
+use crate::passes::strand_geometry::StrandGeometry;
+use crate::passes::strand_quads::{strand_bind_group, strand_bind_group_layout};
+use crate::passes::strands::shading_source;
 
 #[derive(Debug, thiserror::Error)]
 pub enum ABufferError {
@@ -26,6 +36,18 @@ pub enum ABufferError {
     TooManyShadowMaps(#[from] TooManyShadowMaps),
     #[error(transparent)]
     Readback(#[from] ReadbackError),
+    #[error(transparent)]
+    Limit(#[from] LimitError),
+    #[error(
+        "the frame is {frame_width}×{frame_height} but the A-buffer resources were made for \
+         {width}×{height}"
+    )]
+    SizeMismatch {
+        frame_width: u32,
+        frame_height: u32,
+        width: u32,
+        height: u32,
+    },
 }
 
 /// Bytes per list node (colour, depth, next, padding).
@@ -58,55 +80,423 @@ struct Params {
 pub enum ListMode {
     /// Every fragment (A-buffer).
     All,
-    /// DBK-buffer: fragments within `delta` (view depth, world units) of the pixel's nearest
-    /// fiber; the rest fall back to an opaque depth-tested target composited underneath.
+    /// DBK-buffer (depth-based K-buffer, Hunz 2016 §5.3): fragments within `delta` (view depth,
+    /// world units) of the pixel's nearest fiber; the rest fall back to an opaque depth-tested
+    /// target composited underneath.
     Dbk { delta: f32 },
 }
 
+/// The pipelines, built once per shading model.
 pub struct ABufferPass {
     build: wgpu::RenderPipeline,
     dbk_build: wgpu::RenderPipeline,
     depth_prepass: wgpu::RenderPipeline,
     resolve: wgpu::ComputePipeline,
-    strand_layout: wgpu::BindGroupLayout,
-    shadow_layout: wgpu::BindGroupLayout,
-    /// Group 3 of the A-buffer build: heads, nodes, counters, parameters.
-    lists_layout: wgpu::BindGroupLayout,
-    /// Group 3 of the DBK build: the lists' bindings, then the nearest depth and DBK parameters.
-    dbk_lists_layout: wgpu::BindGroupLayout,
+    layouts: ABufferLayouts,
     /// Group 2: the fiber model's constants and tables (none for Kajiya-Kay), as in
     /// [`StrandPass`](crate::passes::strands::StrandPass).
     model: Option<ModelBinding>,
 }
 
-fn storage_entry(
-    binding: u32,
-    visibility: wgpu::ShaderStages,
-    read_only: bool,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
+/// The bind group layouts of the build and resolve passes.
+struct ABufferLayouts {
+    strand: wgpu::BindGroupLayout,
+    shadow: wgpu::BindGroupLayout,
+    /// Group 3 of the A-buffer build: heads, nodes, counters, parameters.
+    lists: wgpu::BindGroupLayout,
+    /// Group 3 of the DBK build: the lists' bindings, then the nearest depth and DBK parameters.
+    dbk_lists: wgpu::BindGroupLayout,
+    /// The resolve: heads, nodes, resolved colours, truncation counter, parameters, fallback.
+    resolve: wgpu::BindGroupLayout,
+}
+
+impl ABufferLayouts {
+    fn new(device: &wgpu::Device) -> Self {
+        let frag = wgpu::ShaderStages::FRAGMENT;
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let list_entries = [
+            storage_entry(0, frag, false),
+            storage_entry(1, frag, false),
+            storage_entry(2, frag, false),
+            uniform_entry(3, frag),
+        ];
+        let mut dbk_entries = list_entries.to_vec();
+        dbk_entries.extend([depth_texture_entry(4, frag), uniform_entry(5, frag)]);
+        let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            })
+        };
+        Self {
+            strand: strand_bind_group_layout(device),
+            shadow: shadow_bind_group_layout(device),
+            lists: layout("abuffer lists", &list_entries),
+            dbk_lists: layout("dbk lists", &dbk_entries),
+            resolve: layout(
+                "abuffer resolve",
+                &[
+                    storage_entry(0, compute, true),
+                    storage_entry(1, compute, true),
+                    storage_entry(2, compute, false),
+                    storage_entry(3, compute, false),
+                    uniform_entry(4, compute),
+                    float_texture_entry(5, compute),
+                ],
+            ),
+        }
     }
 }
 
-fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
+fn pipeline_layout(
+    device: &wgpu::Device,
+    label: &str,
+    groups: &[Option<&wgpu::BindGroupLayout>],
+) -> wgpu::PipelineLayout {
+    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: groups,
+        immediate_size: 0,
+    })
+}
+
+/// Depth-tested and written: the DBK prepass and its opaque fallback.
+fn depth_tested() -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::Less),
+        stencil: Default::default(),
+        bias: Default::default(),
     }
+}
+
+/// A depth attachment only to give the A-buffer build a size; every fragment passes.
+fn every_fragment() -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(false),
+        depth_compare: Some(wgpu::CompareFunction::Always),
+        stencil: Default::default(),
+        bias: Default::default(),
+    }
+}
+
+/// A pipeline drawing strand quads (`vs_main`), with fragment entry point `fragment` and its
+/// colour targets, or depth only.
+fn strand_quad_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    fragment: Option<(&str, &[Option<wgpu::ColorTargetState>])>,
+    depth: wgpu::DepthStencilState,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        fragment: fragment.map(|(entry, targets)| wgpu::FragmentState {
+            module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            targets,
+        }),
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            cull_mode: None,
+            ..Default::default()
+        },
+        depth_stencil: Some(depth),
+        multisample: Default::default(),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+fn resolve_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+) -> wgpu::ComputePipeline {
+    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("abuffer_resolve.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(include_str!("abuffer_resolve.wgsl").into()),
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("abuffer resolve"),
+        layout: Some(&pipeline_layout(device, "abuffer resolve", &[Some(layout)])),
+        module: &shader,
+        entry_point: Some("resolve"),
+        compilation_options: Default::default(),
+        cache: None,
+    })
+}
+
+/// Bytes of the per-pixel list heads, resolved colours and nodes of a `width`×`height` frame
+/// with `capacity` nodes: `(heads, resolved, nodes)`.
+fn list_bytes(width: u32, height: u32, capacity: u32) -> (u64, u64, u64) {
+    let pixels = width as u64 * height as u64;
+    (pixels * 4, pixels * 16, capacity.max(1) as u64 * NODE_BYTES)
+}
+
+/// Everything one A-buffer or DBK frame of a given size, node capacity and list mode draws
+/// into, created once and reused by every [`ABufferPass::draw_into`].
+pub struct ABufferResources {
+    width: u32,
+    height: u32,
+    capacity: u32,
+    mode: ListMode,
+    /// Per pixel, the index of its list's first node (`u32::MAX`: empty).
+    heads: wgpu::Buffer,
+    nodes: wgpu::Buffer,
+    /// Fragments that asked for a node, fragments dropped for a full node buffer.
+    counters: wgpu::Buffer,
+    /// Fragments left out at resolve (beyond [`MAX_SORTED_PER_PIXEL`] in a pixel).
+    truncated: wgpu::Buffer,
+    /// The composited colour per pixel.
+    resolved: wgpu::Buffer,
+    /// The camera's near and far planes, Δ and the projection kind, rewritten per draw.
+    dbk_params: wgpu::Buffer,
+    /// The build's depth attachment; for DBK also the opaque fallback's colour.
+    target: RenderTarget,
+    /// DBK only: each pixel's nearest fiber depth.
+    nearest_depth: Option<wgpu::Texture>,
+    lists: wgpu::BindGroup,
+    resolve: wgpu::BindGroup,
+}
+
+impl ABufferResources {
+    /// Resources for `width`×`height` frames with `capacity` nodes (see
+    /// [`ABufferPass::max_capacity`]), checked against the adapter's limits first.
+    pub fn new(
+        gpu: &GpuContext,
+        pass: &ABufferPass,
+        (width, height): (u32, u32),
+        capacity: u32,
+        mode: ListMode,
+    ) -> Result<Self, LimitError> {
+        check_abuffer_limits(gpu, width, height, capacity)?;
+        let device = &gpu.device;
+        let (heads_bytes, resolved_bytes, node_bytes) = list_bytes(width, height, capacity);
+        let storage = |label, size| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::COPY_SRC
+                    | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        };
+        let uniform = |label, contents: &[u8]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            })
+        };
+        let is_dbk = matches!(mode, ListMode::Dbk { .. });
+        let heads = storage("abuffer heads", heads_bytes);
+        let nodes = storage("abuffer nodes", node_bytes);
+        let counters = storage("abuffer counters", 8);
+        let truncated = storage("abuffer truncated", 4);
+        let resolved = storage("abuffer resolved", resolved_bytes);
+        let build_params = uniform(
+            "abuffer params",
+            bytemuck::bytes_of(&Params {
+                a: width,
+                b: capacity,
+                _pad: [0; 2],
+            }),
+        );
+        let resolve_params = uniform(
+            "abuffer resolve params",
+            bytemuck::bytes_of(&Params {
+                a: width,
+                b: height,
+                _pad: [is_dbk as u32, 0],
+            }),
+        );
+        let dbk_params = uniform("dbk params", &[0u8; 16]);
+        let target = RenderTarget::new(gpu, width, height);
+        let nearest_depth = is_dbk.then(|| nearest_depth_texture(gpu, target.depth.size()));
+        let nearest_view = nearest_depth
+            .as_ref()
+            .map(|t| t.create_view(&Default::default()));
+        let mut list_resources = vec![
+            heads.as_entire_binding(),
+            nodes.as_entire_binding(),
+            counters.as_entire_binding(),
+            build_params.as_entire_binding(),
+        ];
+        let lists_layout = match &nearest_view {
+            Some(view) => {
+                list_resources.push(wgpu::BindingResource::TextureView(view));
+                list_resources.push(dbk_params.as_entire_binding());
+                &pass.layouts.dbk_lists
+            }
+            None => &pass.layouts.lists,
+        };
+        let lists = bind_group(device, "abuffer lists", lists_layout, &list_resources);
+        // The A-buffer binds a 1×1 fallback it never reads.
+        let placeholder = (!is_dbk).then(|| RenderTarget::new(gpu, 1, 1));
+        let fallback = placeholder.as_ref().unwrap_or(&target);
+        let fallback_view = fallback.color.create_view(&Default::default());
+        let resolve = bind_group(
+            device,
+            "abuffer resolve",
+            &pass.layouts.resolve,
+            &[
+                heads.as_entire_binding(),
+                nodes.as_entire_binding(),
+                resolved.as_entire_binding(),
+                truncated.as_entire_binding(),
+                resolve_params.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&fallback_view),
+            ],
+        );
+        Ok(Self {
+            width,
+            height,
+            capacity,
+            mode,
+            heads,
+            nodes,
+            counters,
+            truncated,
+            resolved,
+            dbk_params,
+            target,
+            nearest_depth,
+            lists,
+            resolve,
+        })
+    }
+
+    pub fn capacity(&self) -> u32 {
+        self.capacity
+    }
+
+    /// Bytes held per resource, for reports.
+    pub fn memory(&self) -> Vec<(String, u64)> {
+        let pixels = self.width as u64 * self.height as u64;
+        let mut memory = vec![
+            ("abuffer heads".to_string(), self.heads.size()),
+            ("abuffer nodes".to_string(), self.nodes.size()),
+            ("abuffer resolved".to_string(), self.resolved.size()),
+            ("depth".to_string(), pixels * 4),
+        ];
+        if self.nearest_depth.is_some() {
+            let texel = self
+                .target
+                .color
+                .format()
+                .block_copy_size(None)
+                .unwrap_or(16) as u64;
+            memory.push(("dbk nearest depth".to_string(), pixels * 4));
+            memory.push(("dbk fallback colour".to_string(), pixels * texel));
+        }
+        memory
+    }
+
+    /// Empties the lists and counters and sets the camera's DBK parameters for the next draw.
+    fn reset(&self, gpu: &GpuContext, encoder: &mut wgpu::CommandEncoder, frame: &FrameParams) {
+        let empty_heads = vec![0xffu8; self.heads.size() as usize];
+        gpu.queue.write_buffer(&self.heads, 0, &empty_heads);
+        let camera = &frame.camera;
+        let delta = match self.mode {
+            ListMode::Dbk { delta } => delta,
+            ListMode::All => 0.0,
+        };
+        let dbk = [
+            camera.near,
+            camera.far,
+            delta,
+            f32::from_bits(camera.is_perspective() as u32),
+        ];
+        gpu.queue
+            .write_buffer(&self.dbk_params, 0, bytemuck::cast_slice(&dbk));
+        encoder.clear_buffer(&self.counters, 0, None);
+        encoder.clear_buffer(&self.truncated, 0, None);
+        encoder.clear_buffer(&self.resolved, 0, None);
+    }
+
+    /// The resolved image and the fragment counts.
+    fn read(&self, gpu: &GpuContext) -> Result<ABufferFrame, ReadbackError> {
+        let colour_bytes = read_buffer(gpu, &self.resolved)?;
+        let counter_bytes = read_buffer(gpu, &self.counters)?;
+        let truncated_bytes = read_buffer(gpu, &self.truncated)?;
+        let floats: &[f32] = bytemuck::cast_slice(&colour_bytes);
+        let counts: &[u32] = bytemuck::cast_slice(&counter_bytes);
+        let truncated: &[u32] = bytemuck::cast_slice(&truncated_bytes);
+        let (requested, dropped) = (counts[0] as u64, counts[1] as u64);
+        Ok(ABufferFrame {
+            pixels: floats
+                .chunks_exact(4)
+                .map(|c| [c[0], c[1], c[2], c[3]])
+                .collect(),
+            fragments_stored: requested.saturating_sub(dropped),
+            fragments_dropped: dropped,
+            fragments_truncated: truncated[0] as u64,
+            memory_bytes: self.memory(),
+        })
+    }
+}
+
+fn nearest_depth_texture(gpu: &GpuContext, size: wgpu::Extent3d) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("dbk nearest depth"),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: DEPTH_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    })
+}
+
+/// The image's textures, the three per-pixel/per-node storage buffers and the resolve's
+/// 8×8 workgroups, against the adapter's limits.
+fn check_abuffer_limits(
+    gpu: &GpuContext,
+    width: u32,
+    height: u32,
+    capacity: u32,
+) -> Result<(), LimitError> {
+    let limits = GpuLimits::of(gpu);
+    limits.check_image(width, height)?;
+    let (heads, resolved, nodes) = list_bytes(width, height, capacity);
+    let smaller_image = |bytes_per_pixel: u64| {
+        move |max: u64| {
+            let (w, h) = fit_pixels(width, height, max / bytes_per_pixel);
+            format!("render at {w}x{h} or smaller")
+        }
+    };
+    limits.check_storage_buffer("A-buffer list heads", heads, smaller_image(4))?;
+    limits.check_storage_buffer("A-buffer resolved colours", resolved, smaller_image(16))?;
+    let pixels = width as u64 * height as u64;
+    limits.check_storage_buffer("A-buffer node pool", nodes, |max| {
+        let fits = max / NODE_BYTES;
+        format!(
+            "use at most {fits} nodes ({} per pixel at this size; ABufferPass::max_capacity \
+             gives the largest pool that fits)",
+            fits / pixels.max(1)
+        )
+    })?;
+    limits.check_workgroups(
+        "A-buffer resolve",
+        [width.div_ceil(8), height.div_ceil(8), 1],
+        |max| {
+            let (w, h) = fit_within(width, height, max as u64 * 8);
+            format!("render at {w}x{h} or smaller")
+        },
+    )
 }
 
 impl ABufferPass {
@@ -118,252 +508,63 @@ impl ABufferPass {
     /// Fragments shaded with `model`; its tables and constants are uploaded once, here.
     pub fn with_model(gpu: &GpuContext, shading: &ShadingModel) -> Self {
         let device = &gpu.device;
-        let build_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("abuffer.wgsl"),
             source: wgpu::ShaderSource::Wgsl(
                 shading_source(shading, include_str!("abuffer.wgsl")).into(),
             ),
         });
         let model = ModelBinding::new(gpu, shading);
-        let resolve_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("abuffer_resolve.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("abuffer_resolve.wgsl").into()),
-        });
-        let strand_layout = strand_bind_group_layout(device);
-        let shadow_layout = shadow_bind_group_layout(device);
-        let frag = wgpu::ShaderStages::FRAGMENT;
-        let list_entries = [
-            storage_entry(0, frag, false),
-            storage_entry(1, frag, false),
-            storage_entry(2, frag, false),
-            uniform_entry(3, frag),
-        ];
-        let lists_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("abuffer lists"),
-            entries: &list_entries,
-        });
+        let layouts = ABufferLayouts::new(device);
         let model_layout = model.as_ref().map(|m| &m.layout);
-        let build_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("abuffer build"),
-            bind_group_layouts: &[
-                Some(&strand_layout),
-                Some(&shadow_layout),
+        let shading_groups = |lists| {
+            [
+                Some(&layouts.strand),
+                Some(&layouts.shadow),
                 model_layout,
-                Some(&lists_layout),
-            ],
-            immediate_size: 0,
-        });
-        let build = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("abuffer build"),
-            layout: Some(&build_layout),
-            vertex: wgpu::VertexState {
-                module: &build_shader,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &build_shader,
-                entry_point: Some("fs_abuffer"),
-                compilation_options: Default::default(),
-                targets: &[],
-            }),
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            // A depth attachment only to give the pass a size; every fragment passes.
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(false),
-                depth_compare: Some(wgpu::CompareFunction::Always),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        });
-        let compute = wgpu::ShaderStages::COMPUTE;
-        let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("abuffer resolve"),
-            entries: &[
-                storage_entry(0, compute, true),
-                storage_entry(1, compute, true),
-                storage_entry(2, compute, false),
-                storage_entry(3, compute, false),
-                uniform_entry(4, compute),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: compute,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let resolve_pipeline_layout =
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("abuffer resolve"),
-                bind_group_layouts: &[Some(&resolve_layout)],
-                immediate_size: 0,
-            });
-        let resolve = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("abuffer resolve"),
-            layout: Some(&resolve_pipeline_layout),
-            module: &resolve_shader,
-            entry_point: Some("resolve"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        let dbk_lists_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("dbk lists"),
-            entries: &[
-                list_entries[0],
-                list_entries[1],
-                list_entries[2],
-                list_entries[3],
-                wgpu::BindGroupLayoutEntry {
-                    binding: 4,
-                    visibility: frag,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                uniform_entry(5, frag),
-            ],
-        });
-        let depth_tested = wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
-            stencil: Default::default(),
-            bias: Default::default(),
+                Some(lists),
+            ]
         };
-        let primitive = wgpu::PrimitiveState {
-            topology: wgpu::PrimitiveTopology::TriangleList,
-            cull_mode: None,
-            ..Default::default()
+        let build_layout =
+            pipeline_layout(device, "abuffer build", &shading_groups(&layouts.lists));
+        let dbk_layout = pipeline_layout(device, "dbk build", &shading_groups(&layouts.dbk_lists));
+        let prepass_layout = pipeline_layout(device, "dbk depth prepass", &[Some(&layouts.strand)]);
+        let fallback_target = [Some(wgpu::ColorTargetState {
+            format: gpu.hdr_format(),
+            blend: None,
+            write_mask: wgpu::ColorWrites::ALL,
+        })];
+        let quads = |label, layout, fragment, depth| {
+            strand_quad_pipeline(device, label, layout, &shader, fragment, depth)
         };
-        let vertex = wgpu::VertexState {
-            module: &build_shader,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        };
-        let prepass_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("dbk depth prepass"),
-            bind_group_layouts: &[Some(&strand_layout)],
-            immediate_size: 0,
-        });
-        let depth_prepass = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("dbk depth prepass"),
-            layout: Some(&prepass_layout),
-            vertex: vertex.clone(),
-            fragment: None,
-            primitive,
-            depth_stencil: Some(depth_tested.clone()),
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        });
-        let dbk_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("dbk build"),
-            bind_group_layouts: &[
-                Some(&strand_layout),
-                Some(&shadow_layout),
-                model_layout,
-                Some(&dbk_lists_layout),
-            ],
-            immediate_size: 0,
-        });
-        let dbk_build = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("dbk build"),
-            layout: Some(&dbk_pipeline_layout),
-            vertex,
-            fragment: Some(wgpu::FragmentState {
-                module: &build_shader,
-                entry_point: Some("fs_dbk"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: gpu.hdr_format(),
-                    blend: None,
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            primitive,
-            depth_stencil: Some(depth_tested),
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        });
         Self {
-            build,
-            dbk_build,
-            depth_prepass,
-            resolve,
-            strand_layout,
-            shadow_layout,
-            lists_layout,
-            dbk_lists_layout,
+            build: quads(
+                "abuffer build",
+                &build_layout,
+                Some(("fs_abuffer", &[])),
+                every_fragment(),
+            ),
+            dbk_build: quads(
+                "dbk build",
+                &dbk_layout,
+                Some(("fs_dbk", &fallback_target)),
+                depth_tested(),
+            ),
+            depth_prepass: quads("dbk depth prepass", &prepass_layout, None, depth_tested()),
+            resolve: resolve_pipeline(device, &layouts.resolve),
+            layouts,
             model,
         }
     }
 
-    /// DBK: the nearest-depth prepass, then the build that sorts fragments into the lists or
-    /// the depth-tested fallback.
-    fn encode_dbk(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        geometry: &StrandGeometry,
-        nearest_view: &wgpu::TextureView,
-        target: &RenderTarget,
-        [strands, shadows, lists]: [&wgpu::BindGroup; 3],
-    ) {
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("dbk depth prepass"),
-                color_attachments: &[],
-                depth_stencil_attachment: cleared_depth(&nearest_view, true),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.depth_prepass);
-            pass.set_bind_group(0, strands, &[]);
-            pass.draw(0..6, 0..geometry.segment_count);
-        }
-        let color_view = target.color.create_view(&Default::default());
-        let depth_view = target.depth.create_view(&Default::default());
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("dbk build"),
-            color_attachments: &[cleared_color(&color_view)],
-            depth_stencil_attachment: cleared_depth(&depth_view, false),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        pass.set_pipeline(&self.dbk_build);
-        pass.set_bind_group(0, strands, &[]);
-        pass.set_bind_group(1, shadows, &[]);
-        if let Some(model) = &self.model {
-            pass.set_bind_group(2, &model.group, &[]);
-        }
-        pass.set_bind_group(3, lists, &[]);
-        pass.draw(0..6, 0..geometry.segment_count);
-    }
-
-    /// The node capacity the adapter's storage-binding limit allows, at most `wanted`.
+    /// The node capacity the adapter's storage-binding and buffer-size limits allow, at most
+    /// `wanted`.
     pub fn max_capacity(gpu: &GpuContext, wanted: u64) -> u32 {
-        let limit = gpu.device.limits().max_storage_buffer_binding_size / NODE_BYTES;
-        wanted.min(limit).min(u32::MAX as u64 - 1) as u32
+        let limits = gpu.device.limits();
+        let bytes = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        wanted.min(bytes / NODE_BYTES).min(u32::MAX as u64 - 1) as u32
     }
 
     /// Builds the lists and resolves them; `capacity` nodes (see [`Self::max_capacity`]).
@@ -375,18 +576,13 @@ impl ABufferPass {
         shadow: Option<ShadowInput<'_>>,
         capacity: u32,
         mode: ListMode,
-    ) -> Result<ABufferFrame, ReadbackError> {
-        match self.draw_shadowed(gpu, geometry, frame, shadow.as_slice(), capacity, mode) {
-            Ok(out) => Ok(out),
-            Err(ABufferError::Readback(e)) => Err(e),
-            Err(ABufferError::TooManyShadowMaps(_)) => {
-                unreachable!("one shadow map is within the limit")
-            }
-        }
+    ) -> Result<ABufferFrame, ABufferError> {
+        self.draw_shadowed(gpu, geometry, frame, shadow.as_slice(), capacity, mode)
     }
 
     /// [`Self::draw`] with a deep opacity map for each of up to
-    /// [`MAX_SHADOWED_LIGHTS`](crate::passes::strands::MAX_SHADOWED_LIGHTS) lights.
+    /// [`MAX_SHADOWED_LIGHTS`](crate::passes::shadow_slots::MAX_SHADOWED_LIGHTS) lights, into
+    /// resources made for this one frame.
     pub fn draw_shadowed(
         &self,
         gpu: &GpuContext,
@@ -396,238 +592,122 @@ impl ABufferPass {
         capacity: u32,
         mode: ListMode,
     ) -> Result<ABufferFrame, ABufferError> {
-        let shadow_group = shadow_bind_group_for(gpu, &self.shadow_layout, frame, shadows)?;
-        let device = &gpu.device;
-        let (width, height) = (frame.width, frame.height);
-        let pixels = width as u64 * height as u64;
-        let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-        let heads = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("abuffer heads"),
-            contents: bytemuck::cast_slice(&vec![u32::MAX; pixels as usize]),
-            usage: storage,
+        let resources =
+            ABufferResources::new(gpu, self, (frame.width, frame.height), capacity, mode)?;
+        self.draw_into(gpu, &resources, geometry, frame, shadows)
+    }
+
+    /// Builds and resolves one frame in `resources` (whose size must be the frame's).
+    pub fn draw_into(
+        &self,
+        gpu: &GpuContext,
+        resources: &ABufferResources,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        shadows: &[ShadowInput<'_>],
+    ) -> Result<ABufferFrame, ABufferError> {
+        if (frame.width, frame.height) != (resources.width, resources.height) {
+            return Err(ABufferError::SizeMismatch {
+                frame_width: frame.width,
+                frame_height: frame.height,
+                width: resources.width,
+                height: resources.height,
+            });
+        }
+        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows)?;
+        let strands = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
+        let groups = [&strands, &shadow_group, &resources.lists];
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        resources.reset(gpu, &mut encoder, frame);
+        match &resources.nearest_depth {
+            Some(nearest) => self.encode_dbk(&mut encoder, geometry, nearest, resources, groups),
+            None => self.encode_abuffer(&mut encoder, geometry, resources, groups),
+        }
+        self.encode_resolve(&mut encoder, resources);
+        gpu.queue.submit([encoder.finish()]);
+        Ok(resources.read(gpu)?)
+    }
+
+    /// Groups 0–3 of the build passes.
+    fn bind_shading_groups(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        [strands, shadows, lists]: [&wgpu::BindGroup; 3],
+    ) {
+        pass.set_bind_group(0, strands, &[]);
+        pass.set_bind_group(1, shadows, &[]);
+        if let Some(model) = &self.model {
+            pass.set_bind_group(2, &model.group, &[]);
+        }
+        pass.set_bind_group(3, lists, &[]);
+    }
+
+    /// A-buffer: every fragment into the lists.
+    fn encode_abuffer(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &StrandGeometry,
+        resources: &ABufferResources,
+        groups: [&wgpu::BindGroup; 3],
+    ) {
+        let depth_view = resources.target.depth.create_view(&Default::default());
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("abuffer build"),
+            color_attachments: &[],
+            depth_stencil_attachment: cleared_depth(&depth_view, false),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
         });
-        let nodes = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("abuffer nodes"),
-            size: capacity.max(1) as u64 * NODE_BYTES,
-            usage: storage,
-            mapped_at_creation: false,
-        });
-        let counters = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("abuffer counters"),
-            contents: bytemuck::cast_slice(&[0u32; 2]),
-            usage: storage,
-        });
-        let truncated = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("abuffer truncated"),
-            contents: bytemuck::cast_slice(&[0u32; 1]),
-            usage: storage,
-        });
-        let resolved = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("abuffer resolved"),
-            size: pixels * 16,
-            usage: storage,
-            mapped_at_creation: false,
-        });
-        let uniform = |label, params: Params| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: bytemuck::bytes_of(&params),
-                usage: wgpu::BufferUsages::UNIFORM,
-            })
-        };
-        let build_params = uniform(
-            "abuffer params",
-            Params {
-                a: width,
-                b: capacity,
-                _pad: [0; 2],
-            },
-        );
-        let is_dbk = matches!(mode, ListMode::Dbk { .. });
-        let resolve_params = uniform(
-            "abuffer resolve params",
-            Params {
-                a: width,
-                b: height,
-                _pad: [is_dbk as u32, 0],
-            },
-        );
-        let target = RenderTarget::new(gpu, width, height);
-        let nearest = RenderTarget::new(gpu, 1, 1);
-        let nearest_depth = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("dbk nearest depth"),
-            size: target.depth.size(),
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: DEPTH_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        // The A-buffer binds a 1×1 fallback it never reads.
-        let fallback = if is_dbk {
-            &target.color
-        } else {
-            &nearest.color
-        };
-        let fallback_view = fallback.create_view(&Default::default());
-        let strands = strand_bind_group(gpu, &self.strand_layout, geometry, frame);
+        pass.set_pipeline(&self.build);
+        self.bind_shading_groups(&mut pass, groups);
+        pass.draw(0..6, 0..geometry.segment_count);
+    }
+
+    /// DBK: the nearest-depth prepass, then the build that sorts fragments into the lists or
+    /// the depth-tested fallback.
+    fn encode_dbk(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &StrandGeometry,
+        nearest_depth: &wgpu::Texture,
+        resources: &ABufferResources,
+        groups: [&wgpu::BindGroup; 3],
+    ) {
         let nearest_view = nearest_depth.create_view(&Default::default());
-        let camera = &frame.camera;
-        let delta = match mode {
-            ListMode::Dbk { delta } => delta,
-            ListMode::All => 0.0,
-        };
-        let dbk_params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("dbk params"),
-            contents: bytemuck::cast_slice(&[
-                camera.near,
-                camera.far,
-                delta,
-                f32::from_bits(camera.is_perspective() as u32),
-            ]),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let mut list_entries = vec![
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: heads.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: nodes.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: counters.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: build_params.as_entire_binding(),
-            },
-        ];
-        let lists_layout = if is_dbk {
-            list_entries.push(wgpu::BindGroupEntry {
-                binding: 4,
-                resource: wgpu::BindingResource::TextureView(&nearest_view),
-            });
-            list_entries.push(wgpu::BindGroupEntry {
-                binding: 5,
-                resource: dbk_params.as_entire_binding(),
-            });
-            &self.dbk_lists_layout
-        } else {
-            &self.lists_layout
-        };
-        let lists = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("abuffer lists"),
-            layout: lists_layout,
-            entries: &list_entries,
-        });
-        let resolve_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("abuffer resolve"),
-            layout: &self.resolve.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: heads.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: nodes.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: resolved.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: truncated.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: resolve_params.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::TextureView(&fallback_view),
-                },
-            ],
-        });
-        let depth_view = target.depth.create_view(&Default::default());
-        let mut encoder = device.create_command_encoder(&Default::default());
-        if is_dbk {
-            self.encode_dbk(
-                &mut encoder,
-                geometry,
-                &nearest_view,
-                &target,
-                [&strands, &shadow_group, &lists],
-            );
-        } else {
+        {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("abuffer build"),
+                label: Some("dbk depth prepass"),
                 color_attachments: &[],
-                depth_stencil_attachment: cleared_depth(&depth_view, false),
+                depth_stencil_attachment: cleared_depth(&nearest_view, true),
                 timestamp_writes: None,
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.build);
-            pass.set_bind_group(0, &strands, &[]);
-            pass.set_bind_group(1, &shadow_group, &[]);
-            if let Some(model) = &self.model {
-                pass.set_bind_group(2, &model.group, &[]);
-            }
-            pass.set_bind_group(3, &lists, &[]);
+            pass.set_pipeline(&self.depth_prepass);
+            pass.set_bind_group(0, groups[0], &[]);
             pass.draw(0..6, 0..geometry.segment_count);
         }
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            pass.set_pipeline(&self.resolve);
-            pass.set_bind_group(0, &resolve_group, &[]);
-            pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
-        }
-        gpu.queue.submit([encoder.finish()]);
-        let colour_bytes = read_buffer(gpu, &resolved)?;
-        let counter_bytes = read_buffer(gpu, &counters)?;
-        let truncated_bytes = read_buffer(gpu, &truncated)?;
-        let floats: &[f32] = bytemuck::cast_slice(&colour_bytes);
-        let counts: &[u32] = bytemuck::cast_slice(&counter_bytes);
-        let requested = counts[0] as u64;
-        let dropped = counts[1] as u64;
-        Ok(ABufferFrame {
-            pixels: floats
-                .chunks_exact(4)
-                .map(|c| [c[0], c[1], c[2], c[3]])
-                .collect(),
-            fragments_stored: requested - dropped,
-            fragments_dropped: dropped,
-            fragments_truncated: bytemuck::cast_slice::<u8, u32>(&truncated_bytes)[0] as u64,
-            memory_bytes: vec![
-                ("abuffer heads".into(), heads.size()),
-                ("abuffer nodes".into(), nodes.size()),
-                ("abuffer resolved".into(), resolved.size()),
-                ("depth".into(), pixels * 4),
-            ]
-            .into_iter()
-            .chain(
-                is_dbk
-                    .then(|| {
-                        vec![
-                            ("dbk nearest depth".to_string(), pixels * 4),
-                            (
-                                "dbk fallback colour".to_string(),
-                                pixels
-                                    * target.color.format().block_copy_size(None).unwrap_or(16)
-                                        as u64,
-                            ),
-                        ]
-                    })
-                    .into_iter()
-                    .flatten(),
-            )
-            .collect(),
-        })
+        let color_view = resources.target.color.create_view(&Default::default());
+        let depth_view = resources.target.depth.create_view(&Default::default());
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("dbk build"),
+            color_attachments: &[cleared_color(&color_view)],
+            depth_stencil_attachment: cleared_depth(&depth_view, false),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.dbk_build);
+        self.bind_shading_groups(&mut pass, groups);
+        pass.draw(0..6, 0..geometry.segment_count);
+    }
+
+    /// Sorts and composites every pixel's list (8×8 pixels a workgroup).
+    fn encode_resolve(&self, encoder: &mut wgpu::CommandEncoder, resources: &ABufferResources) {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&self.resolve);
+        pass.set_bind_group(0, &resources.resolve, &[]);
+        pass.dispatch_workgroups(resources.width.div_ceil(8), resources.height.div_ceil(8), 1);
     }
 }

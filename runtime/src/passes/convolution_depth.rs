@@ -13,13 +13,13 @@ use strandlight_tables::hard_case_sweep::SweepRng;
 use wgpu::util::DeviceExt;
 
 use super::attachments::{cleared_color, cleared_depth};
-use super::deep_opacity::light_camera;
-use super::strands::{
-    DEPTH_FORMAT, FrameParams, KajiyaKay, StrandGeometry, segment_table, strand_bind_group_layout,
-    strand_bind_group_scaled,
-};
-use crate::camera::{Camera, Projection};
+use super::frame_params::{FrameParams, KajiyaKay};
+use super::render_target::DEPTH_FORMAT;
+use super::strand_geometry::{StrandGeometry, segment_table};
+use super::strand_quads::{strand_bind_group_layout, strand_bind_group_scaled};
+use crate::camera::{Camera, Projection, light_camera};
 use crate::gpu::GpuContext;
+use crate::gpu::bind_layout::{depth_texture_entry, uniform_entry};
 use crate::hair::{Aabb, HairModel};
 
 /// The largest DODM side the SAT's u32 fixed point is specified for (see `summed_area`).
@@ -298,26 +298,8 @@ impl ConvolutionDepthPass {
         let dodm_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dodm"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                depth_texture_entry(0, wgpu::ShaderStages::FRAGMENT),
+                uniform_entry(1, wgpu::ShaderStages::FRAGMENT),
             ],
         });
         let layout = |label, groups: &[Option<&wgpu::BindGroupLayout>]| {

@@ -6,18 +6,17 @@
 //! The pipelines are built once and the per-light targets can be reused, so the pass repeats
 //! cheaply for many lights.
 
-use super::attachments::{cleared_color, cleared_depth};
-use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-use crate::camera::{Camera, Projection};
+use super::attachments::{cleared_color, cleared_depth};
+use super::frame_params::{FrameParams, KajiyaKay};
+use super::render_target::DEPTH_FORMAT;
+use super::strand_geometry::StrandGeometry;
+use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
+use crate::camera::Camera;
 use crate::gpu::GpuContext;
+use crate::gpu::bind_layout::{depth_texture_entry, uniform_entry};
 use crate::gpu::readback::{ReadbackError, read_texture_rgba};
-use crate::hair::Aabb;
-use crate::passes::strands::{
-    DEPTH_FORMAT, FrameParams, KajiyaKay, StrandGeometry, strand_bind_group,
-    strand_bind_group_layout,
-};
 
 /// At most this many layers (two RGBA targets).
 pub const MAX_LAYERS: u32 = 8;
@@ -62,25 +61,6 @@ struct DomUniform {
     far: f32,
     spacing: f32,
     layers: u32,
-}
-
-/// The orthographic camera of a directional light (`toward_light` points at the light) that
-/// just covers `bounds`.
-pub fn light_camera(toward_light: Vec3, bounds: Aabb) -> Camera {
-    let center = bounds.center();
-    let radius = (bounds.diagonal() * 0.5).max(1e-6);
-    let dir = toward_light.normalize();
-    let up = if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
-    Camera {
-        eye: center + dir * (2.0 * radius),
-        target: center,
-        up,
-        projection: Projection::Orthographic {
-            half_height: radius,
-        },
-        near: radius * 0.5,
-        far: radius * 3.5,
-    }
 }
 
 /// One light's maps.
@@ -184,26 +164,8 @@ impl DeepOpacityPass {
         let dom_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dom"),
             entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Depth,
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
+                depth_texture_entry(0, wgpu::ShaderStages::FRAGMENT),
+                uniform_entry(1, wgpu::ShaderStages::FRAGMENT),
             ],
         });
         let depth_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -338,12 +300,7 @@ impl DeepOpacityPass {
             .iter()
             .map(|t| t.create_view(&Default::default()))
             .collect();
-        let attachments: Vec<_> = views
-            .iter()
-            .map(|view| {
-                cleared_color(view)
-            })
-            .collect();
+        let attachments: Vec<_> = views.iter().map(cleared_color).collect();
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("dom layers"),

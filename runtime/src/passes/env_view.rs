@@ -9,39 +9,21 @@
 //! map). Output: the sums buffer of [`EnvAccumulator`].
 
 use glam::Vec3;
-use strandlight_tables::srbf::support_angle;
 use strandlight_tables::table::{AxisGpu, Table};
 use wgpu::util::DeviceExt;
 
 use super::attachments::{cleared_color, prepassed_depth};
 use super::convolution_depth::DodmBatch;
-use super::strands::{
-    DEPTH_FORMAT, FrameParams, StrandGeometry, strand_bind_group, strand_bind_group_layout,
-};
+use super::frame_params::FrameParams;
+use super::render_target::DEPTH_FORMAT;
+use super::strand_geometry::StrandGeometry;
+use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
 use super::summed_area::{BoxAverage, MAX_BOX_HALF_SIZE, SummedAreaTables};
 use super::transmittance_filter::TransmittanceFilter;
 use super::view_visibility::{OccupancyMap, ViewTransparency, ViewVisibilityPass};
 use crate::env::{EnvLight, ForwardScatteringGrid};
 use crate::gpu::GpuContext;
-
-/// The largest tan α used for the averaging radius: SRBFs wider than ~89° (λ < ~7) are limited
-/// by the box size anyway.
-const MAX_TAN_SUPPORT: f32 = 64.0;
-
-/// tan α of light `light`'s support (G = 10⁻³), 0 for a directional light.
-pub fn tan_support(light: &EnvLight) -> f32 {
-    match light.lambda {
-        None => 0.0,
-        Some(lambda) => {
-            let alpha = support_angle(lambda as f64);
-            if alpha >= std::f64::consts::FRAC_PI_2 {
-                MAX_TAN_SUPPORT
-            } else {
-                (alpha.tan() as f32).min(MAX_TAN_SUPPORT)
-            }
-        }
-    }
-}
+use crate::gpu::bind_layout::{float_texture_entry, storage_entry, texture_entry, uniform_entry};
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -69,36 +51,6 @@ const FLAG_UNSHADOWED: u32 = 1;
 const FLAG_GRID: u32 = 2;
 const FLAG_SAT_TRANSMITTANCE: u32 = 4;
 
-fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn storage_entry(
-    binding: u32,
-    visibility: wgpu::ShaderStages,
-    read_only: bool,
-) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 /// Group 1 of the view pass and the probe (`convolution_transmittance.wgsl`).
 pub fn transmittance_bind_group_layout(
     device: &wgpu::Device,
@@ -109,16 +61,12 @@ pub fn transmittance_bind_group_layout(
         entries: &[
             uniform_entry(0, visibility),
             storage_entry(1, visibility, true),
-            wgpu::BindGroupLayoutEntry {
-                binding: 2,
+            texture_entry(
+                2,
                 visibility,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Depth,
-                    view_dimension: wgpu::TextureViewDimension::D2Array,
-                    multisampled: false,
-                },
-                count: None,
-            },
+                wgpu::TextureSampleType::Depth,
+                wgpu::TextureViewDimension::D2Array,
+            ),
             storage_entry(3, visibility, true),
         ],
     })
@@ -555,73 +503,170 @@ pub struct EnvViewPass {
     pub view_layout: wgpu::BindGroupLayout,
 }
 
+/// The bind group layouts of the view pass: strands (0), the batch's lights, DODM and SATs (1),
+/// the tables (2), the grid and the frame's visibility (3).
+struct EnvViewLayouts {
+    strand: wgpu::BindGroupLayout,
+    batch: wgpu::BindGroupLayout,
+    table: wgpu::BindGroupLayout,
+    view: wgpu::BindGroupLayout,
+}
+
+impl EnvViewLayouts {
+    fn new(device: &wgpu::Device) -> Self {
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let layout = |label, entries: &[wgpu::BindGroupLayoutEntry]| {
+            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some(label),
+                entries,
+            })
+        };
+        Self {
+            strand: strand_bind_group_layout(device),
+            batch: transmittance_bind_group_layout(device, fragment),
+            table: layout(
+                "env tables",
+                &[
+                    uniform_entry(0, fragment),
+                    storage_entry(1, fragment, true),
+                    uniform_entry(2, fragment),
+                    storage_entry(3, fragment, true),
+                ],
+            ),
+            view: layout(
+                "env view",
+                &[
+                    uniform_entry(0, fragment),
+                    storage_entry(1, fragment, true),
+                    storage_entry(2, fragment, false),
+                    float_texture_entry(3, fragment),
+                ],
+            ),
+        }
+    }
+}
+
+fn pipeline_layout(
+    device: &wgpu::Device,
+    label: &str,
+    groups: &[Option<&wgpu::BindGroupLayout>],
+) -> wgpu::PipelineLayout {
+    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: groups,
+        immediate_size: 0,
+    })
+}
+
+/// The view and visibility passes share one module, so that both rasterize bit-identical
+/// depths (the opaque view's Equal depth test relies on it).
+fn env_view_shader(device: &wgpu::Device) -> wgpu::ShaderModule {
+    let source = [
+        include_str!("strand_quads.wgsl"),
+        include_str!("fiber_frame.wgsl"),
+        include_str!("convolution_transmittance.wgsl"),
+        include_str!("occupancy_map.wgsl"),
+        include_str!("env_view.wgsl"),
+        include_str!("view_visibility.wgsl"),
+    ]
+    .concat();
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("env_view.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    })
+}
+
+/// A view pipeline writing the single and multiple targets from fragment entry `entry`.
+fn view_pipeline(
+    gpu: &GpuContext,
+    layout: &wgpu::PipelineLayout,
+    shader: &wgpu::ShaderModule,
+    (label, entry): (&str, &str),
+    blend: Option<wgpu::BlendComponent>,
+    depth: Option<wgpu::DepthStencilState>,
+) -> wgpu::RenderPipeline {
+    let target = Some(wgpu::ColorTargetState {
+        format: gpu.hdr_format(),
+        blend: blend.map(|b| wgpu::BlendState { color: b, alpha: b }),
+        write_mask: wgpu::ColorWrites::ALL,
+    });
+    gpu.device
+        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some(label),
+            layout: Some(layout),
+            vertex: wgpu::VertexState {
+                module: shader,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: shader,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                targets: &[target.clone(), target],
+            }),
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: depth,
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        })
+}
+
+/// The compute pass adding a batch's two images into the sums, and its layout.
+fn accumulate_pipeline(device: &wgpu::Device) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
+    let compute = wgpu::ShaderStages::COMPUTE;
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("env accumulate"),
+        entries: &[
+            float_texture_entry(0, compute),
+            float_texture_entry(1, compute),
+            storage_entry(2, compute, false),
+            uniform_entry(3, compute),
+        ],
+    });
+    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("env_accumulate.wgsl"),
+        source: wgpu::ShaderSource::Wgsl(include_str!("env_accumulate.wgsl").into()),
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("env accumulate"),
+        layout: Some(&pipeline_layout(device, "env accumulate", &[Some(&layout)])),
+        module: &shader,
+        entry_point: Some("accumulate"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    (pipeline, layout)
+}
+
 impl EnvViewPass {
     pub fn new(gpu: &GpuContext) -> Self {
         let device = &gpu.device;
-        let source = [
-            include_str!("strand_quads.wgsl"),
-            include_str!("fiber_frame.wgsl"),
-            include_str!("convolution_transmittance.wgsl"),
-            include_str!("occupancy_map.wgsl"),
-            include_str!("env_view.wgsl"),
-            include_str!("view_visibility.wgsl"),
-        ]
-        .concat();
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("env_view.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-        let strand_layout = strand_bind_group_layout(device);
-        let fragment = wgpu::ShaderStages::FRAGMENT;
-        let batch_layout = transmittance_bind_group_layout(device, fragment);
-        let table_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("env tables"),
-            entries: &[
-                uniform_entry(0, fragment),
-                storage_entry(1, fragment, true),
-                uniform_entry(2, fragment),
-                storage_entry(3, fragment, true),
+        let shader = env_view_shader(device);
+        let layouts = EnvViewLayouts::new(device);
+        let layout = pipeline_layout(
+            device,
+            "env view",
+            &[
+                Some(&layouts.strand),
+                Some(&layouts.batch),
+                Some(&layouts.table),
+                Some(&layouts.view),
             ],
-        });
-        let view_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("env view"),
-            entries: &[
-                uniform_entry(0, fragment),
-                storage_entry(1, fragment, true),
-                storage_entry(2, fragment, false),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 3,
-                    visibility: fragment,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-            ],
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("env view"),
-            bind_group_layouts: &[
-                Some(&strand_layout),
-                Some(&batch_layout),
-                Some(&table_layout),
-                Some(&view_layout),
-            ],
-            immediate_size: 0,
-        });
-        let visibility_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("view visibility"),
-            bind_group_layouts: &[Some(&strand_layout), None, None, Some(&view_layout)],
-            immediate_size: 0,
-        });
+        );
+        let visibility_layout = pipeline_layout(
+            device,
+            "view visibility",
+            &[Some(&layouts.strand), None, None, Some(&layouts.view)],
+        );
         // The coverage pass writes the texture group 3 reads: it binds the strands alone.
-        let strands_only = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("view coverage"),
-            bind_group_layouts: &[Some(&strand_layout)],
-            immediate_size: 0,
-        });
+        let strands_only = pipeline_layout(device, "view coverage", &[Some(&layouts.strand)]);
         let visibility = ViewVisibilityPass::new(
             device,
             &shader,
@@ -629,44 +674,6 @@ impl EnvViewPass {
             &strands_only,
             gpu.hdr_format(),
         );
-        let additive = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let view_pipeline =
-            |label: &str, entry: &str, blend: Option<wgpu::BlendComponent>, depth| {
-                let target = Some(wgpu::ColorTargetState {
-                    format: gpu.hdr_format(),
-                    blend: blend.map(|b| wgpu::BlendState { color: b, alpha: b }),
-                    write_mask: wgpu::ColorWrites::ALL,
-                });
-                device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                    label: Some(label),
-                    layout: Some(&layout),
-                    vertex: wgpu::VertexState {
-                        module: &shader,
-                        entry_point: Some("vs_main"),
-                        compilation_options: Default::default(),
-                        buffers: &[],
-                    },
-                    fragment: Some(wgpu::FragmentState {
-                        module: &shader,
-                        entry_point: Some(entry),
-                        compilation_options: Default::default(),
-                        targets: &[target.clone(), target],
-                    }),
-                    primitive: wgpu::PrimitiveState {
-                        topology: wgpu::PrimitiveTopology::TriangleList,
-                        cull_mode: None,
-                        ..Default::default()
-                    },
-                    depth_stencil: depth,
-                    multisample: Default::default(),
-                    multiview_mask: None,
-                    cache: None,
-                })
-            };
         // After the depth prepass only the nearest fragments are at an Equal depth; nothing
         // writes depth, so early depth testing rejects the rest before the fragment shader.
         let nearest_only = wgpu::DepthStencilState {
@@ -676,68 +683,45 @@ impl EnvViewPass {
             stencil: Default::default(),
             bias: Default::default(),
         };
+        let additive = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
         // Fragments tied at the nearest depth (segment joints) replace, not add to, each other.
         let opaque = view_pipeline(
-            "env view (opaque)",
-            "fs_env_opaque",
+            gpu,
+            &layout,
+            &shader,
+            ("env view (opaque)", "fs_env_opaque"),
             None,
             Some(nearest_only),
         );
         let transparent = view_pipeline(
-            "env view (occupancy)",
-            "fs_env_transparent",
+            gpu,
+            &layout,
+            &shader,
+            ("env view (occupancy)", "fs_env_transparent"),
             Some(additive),
             None,
         );
-        let compute = wgpu::ShaderStages::COMPUTE;
-        let float_texture = |binding| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: compute,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                view_dimension: wgpu::TextureViewDimension::D2,
-                multisampled: false,
-            },
-            count: None,
-        };
-        let accumulate_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("env accumulate"),
-            entries: &[
-                float_texture(0),
-                float_texture(1),
-                storage_entry(2, compute, false),
-                uniform_entry(3, compute),
-            ],
-        });
-        let accumulate_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("env_accumulate.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("env_accumulate.wgsl").into()),
-        });
-        let accumulate_pipeline_layout =
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some("env accumulate"),
-                bind_group_layouts: &[Some(&accumulate_layout)],
-                immediate_size: 0,
-            });
-        let accumulate = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("env accumulate"),
-            layout: Some(&accumulate_pipeline_layout),
-            module: &accumulate_shader,
-            entry_point: Some("accumulate"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let (accumulate, accumulate_layout) = accumulate_pipeline(device);
         Self {
             opaque,
             transparent,
             visibility,
             accumulate,
             accumulate_layout,
-            strand_layout,
-            batch_layout,
-            table_layout,
-            view_layout,
+            strand_layout: layouts.strand,
+            batch_layout: layouts.batch,
+            table_layout: layouts.table,
+            view_layout: layouts.view,
         }
+    }
+
+    /// Bytes of the sums of a `width`×`height` frame: RGBA f32 per pixel, single then multiple.
+    pub fn accumulator_bytes(width: u32, height: u32) -> u64 {
+        2 * width as u64 * height as u64 * 16
     }
 
     /// Zeroed sums for a `width`×`height` frame, bound to `targets`.
@@ -746,7 +730,7 @@ impl EnvViewPass {
         let (width, height) = (targets.single.width(), targets.single.height());
         let sums = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("env sums"),
-            size: 2 * width as u64 * height as u64 * 16,
+            size: Self::accumulator_bytes(width, height),
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });

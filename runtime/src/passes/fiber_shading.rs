@@ -1,7 +1,7 @@
 //! The fiber scattering model the strand pass shades with, and its GPU resources (bind group 2 of
 //! the strand pipeline).
 //!
-//! * [`ShadingModel::KajiyaKay`] — the constants of [`FrameParams::shading`](super::strands::FrameParams).
+//! * [`ShadingModel::KajiyaKay`] — the constants of [`FrameParams::shading`](super::frame_params::FrameParams).
 //! * [`ShadingModel::MarschnerLut`] — Marschner through the two point-light lookup tables of
 //!   Hunz 2016 Algorithm 2, baked elsewhere (`strandlight_precompute::point_light_luts`; the
 //!   runtime never links tabulation code) and uploaded as-is.
@@ -13,9 +13,14 @@
 
 use strandlight_tables::artist::ArtistModel;
 use strandlight_tables::table::{AxisGpu, Table};
+use strandlight_tables::table_axes::{
+    AXIS_COS_HALF_PHI, AXIS_COS_PHI, AXIS_COS_THETA_D, AXIS_LOBE, AXIS_QUANTITY, AXIS_SIN_THETA_I,
+    AXIS_SIN_THETA_O,
+};
 use wgpu::util::DeviceExt;
 
 use crate::gpu::GpuContext;
+use crate::gpu::bind_layout::{bind_group, storage_entry, uniform_entry};
 
 /// `cos²θ_d` floor of the Marschner division (`strandlight_tables::marschner::MIN_COS2_THETA_D`).
 pub const MIN_COS2_THETA_D: f32 = 1e-8;
@@ -124,18 +129,22 @@ impl MarschnerLuts {
         check_layout(
             "lut_m",
             &lut_m,
-            [&["sin_theta_i"], &["sin_theta_o"], &["quantity"]],
+            [&[AXIS_SIN_THETA_I], &[AXIS_SIN_THETA_O], &[AXIS_QUANTITY]],
             4,
             1,
         )?;
         check_layout(
             "lut_n",
             &lut_n,
-            [&["cos_phi", "cos_half_phi"], &["cos_theta_d"], &["lobe"]],
+            [
+                &[AXIS_COS_PHI, AXIS_COS_HALF_PHI],
+                &[AXIS_COS_THETA_D],
+                &[AXIS_LOBE],
+            ],
             3,
             3,
         )?;
-        let half_phi = lut_n.axes()[0].name == "cos_half_phi";
+        let half_phi = lut_n.axes()[0].name == AXIS_COS_HALF_PHI;
         Ok(Self {
             lut_m,
             lut_n,
@@ -242,35 +251,10 @@ pub(crate) struct ModelBinding {
     pub group: wgpu::BindGroup,
 }
 
-fn uniform_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Uniform,
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
-fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
-    wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::FRAGMENT,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    }
-}
-
 impl ModelBinding {
     pub(crate) fn new(gpu: &GpuContext, model: &ShadingModel) -> Option<Self> {
         let device = &gpu.device;
+        let fragment = wgpu::ShaderStages::FRAGMENT;
         let buffer = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
@@ -281,7 +265,11 @@ impl ModelBinding {
         let (entries, buffers): (Vec<_>, Vec<wgpu::Buffer>) = match model {
             ShadingModel::KajiyaKay => return None,
             ShadingModel::MarschnerLut(luts) => (
-                vec![uniform_entry(0), storage_entry(1), storage_entry(2)],
+                vec![
+                    uniform_entry(0, fragment),
+                    storage_entry(1, fragment, true),
+                    storage_entry(2, fragment, true),
+                ],
                 vec![
                     buffer(
                         "marschner lut params",
@@ -301,7 +289,7 @@ impl ModelBinding {
                 ],
             ),
             ShadingModel::Artist(model) => (
-                vec![uniform_entry(0)],
+                vec![uniform_entry(0, fragment)],
                 vec![buffer(
                     "artist lobes",
                     bytemuck::bytes_of(&artist_uniform(model)),
@@ -313,19 +301,8 @@ impl ModelBinding {
             label: Some("fiber model"),
             entries: &entries,
         });
-        let bind_entries: Vec<_> = buffers
-            .iter()
-            .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
-                binding: i as u32,
-                resource: b.as_entire_binding(),
-            })
-            .collect();
-        let group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("fiber model"),
-            layout: &layout,
-            entries: &bind_entries,
-        });
+        let resources: Vec<_> = buffers.iter().map(|b| b.as_entire_binding()).collect();
+        let group = bind_group(device, "fiber model", &layout, &resources);
         Some(Self { layout, group })
     }
 }
@@ -346,8 +323,8 @@ mod tests {
 
     #[test]
     fn lut_layout_is_checked_and_strides_are_row_major() {
-        let m = table(["sin_theta_i", "sin_theta_o", "quantity"], [5, 6, 4], 1);
-        let n = table(["cos_half_phi", "cos_theta_d", "lobe"], [7, 8, 3], 3);
+        let m = table([AXIS_SIN_THETA_I, AXIS_SIN_THETA_O, AXIS_QUANTITY], [5, 6, 4], 1);
+        let n = table([AXIS_COS_HALF_PHI, AXIS_COS_THETA_D, AXIS_LOBE], [7, 8, 3], 3);
         let luts = MarschnerLuts::new(m.clone(), n.clone()).unwrap();
         assert!(luts.half_phi);
         // The stride of each axis is the offset between neighbouring nodes.
@@ -363,7 +340,7 @@ mod tests {
         assert_eq!(strides(&m), [24, 4, 1, 0]);
         let e = MarschnerLuts::new(n.clone(), m.clone()).unwrap_err();
         assert!(e.to_string().contains("lut_m"), "{e}");
-        let wrong_lobes = table(["cos_phi", "cos_theta_d", "lobe"], [7, 8, 4], 3);
+        let wrong_lobes = table([AXIS_COS_PHI, AXIS_COS_THETA_D, AXIS_LOBE], [7, 8, 4], 3);
         let e = MarschnerLuts::new(m, wrong_lobes).unwrap_err();
         assert!(e.to_string().contains("4 nodes, expected 3"), "{e}");
     }

@@ -15,6 +15,8 @@ use wgpu::util::DeviceExt;
 
 use super::convolution_depth::DodmBatch;
 use crate::gpu::GpuContext;
+use crate::gpu::bind_layout::{storage_entry, texture_entry, uniform_entry};
+use crate::gpu::limits::{GpuLimits, LimitError};
 
 pub const FIXED_POINT_SCALE: f32 = 256.0;
 pub const TRANSMITTANCE_SCALE: f32 = 4096.0;
@@ -30,35 +32,27 @@ pub fn quantize_optical_depth(tau: f32) -> u32 {
     (tau.clamp(0.0, MAX_TEXEL_TAU) * FIXED_POINT_SCALE).round_ties_even() as u32
 }
 
-#[derive(Debug, thiserror::Error, PartialEq)]
-#[error(
-    "GPU limit exceeded: summed-area tables of {slots} lights at {resolution}² texels need \
-     {bytes} bytes in one storage buffer; this adapter binds at most {limit} \
-     (lower the batch size or the DODM resolution)"
-)]
-pub struct SatTooLarge {
-    pub slots: u32,
-    pub resolution: u32,
-    pub bytes: u64,
-    pub limit: u64,
-}
-
 /// Bytes of the SAT buffer for `slots` maps of `resolution`², checked against the adapter's
-/// storage-binding and buffer-size limits.
-pub fn sat_bytes(gpu: &GpuContext, resolution: u32, slots: u32) -> Result<u64, SatTooLarge> {
-    let bytes = resolution as u64 * resolution as u64 * slots.max(1) as u64 * SAT_TEXEL_BYTES;
-    let limits = gpu.device.limits();
-    let limit = limits
-        .max_storage_buffer_binding_size
-        .min(limits.max_buffer_size);
-    if bytes > limit {
-        return Err(SatTooLarge {
-            slots,
-            resolution,
-            bytes,
-            limit,
-        });
-    }
+/// storage-binding and buffer-size limits (the fix names the largest batch that fits).
+pub fn sat_bytes(gpu: &GpuContext, resolution: u32, slots: u32) -> Result<u64, LimitError> {
+    let per_slot = resolution as u64 * resolution as u64 * SAT_TEXEL_BYTES;
+    let bytes = per_slot * slots.max(1) as u64;
+    let limits = GpuLimits::of(gpu);
+    limits.check_storage_buffer("DODM summed-area tables", bytes, |max| {
+        match max / per_slot {
+            0 => format!(
+                "use a DODM resolution of at most {}",
+                ((max / SAT_TEXEL_BYTES) as f64).sqrt().floor() as u64
+            ),
+            fit => format!("use a light batch size of at most {fit} at this DODM resolution"),
+        }
+    })?;
+    // One workgroup of 64 texels per row or column, one row of workgroups per slot.
+    limits.check_workgroups(
+        "DODM summed-area scan",
+        [resolution.div_ceil(64), slots.max(1), 1],
+        |max| format!("use a light batch size of at most {max}"),
+    )?;
     Ok(bytes)
 }
 
@@ -96,7 +90,7 @@ pub struct SummedAreaTables {
 }
 
 impl SummedAreaTables {
-    pub fn new(gpu: &GpuContext, resolution: u32, slots: u32) -> Result<Self, SatTooLarge> {
+    pub fn new(gpu: &GpuContext, resolution: u32, slots: u32) -> Result<Self, LimitError> {
         let size = sat_bytes(gpu, resolution, slots)?;
         let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("dodm summed-area tables"),
@@ -140,39 +134,18 @@ impl SummedAreaPass {
             label: Some("summed_area.wgsl"),
             source: wgpu::ShaderSource::Wgsl(include_str!("summed_area.wgsl").into()),
         });
-        let entry = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty,
-            count: None,
-        };
+        let compute = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("summed area"),
             entries: &[
-                entry(
+                texture_entry(
                     0,
-                    wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                        view_dimension: wgpu::TextureViewDimension::D2Array,
-                        multisampled: false,
-                    },
+                    compute,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    wgpu::TextureViewDimension::D2Array,
                 ),
-                entry(
-                    1,
-                    wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Storage { read_only: false },
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                ),
-                entry(
-                    2,
-                    wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                ),
+                storage_entry(1, compute, false),
+                uniform_entry(2, compute),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

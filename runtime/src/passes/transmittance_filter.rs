@@ -4,10 +4,12 @@
 //! The box is continuous in R: the view pass interpolates between the two nearest texel boxes
 //! (`convolution_transmittance.wgsl`).
 
-use super::env_view::tan_support;
+use strandlight_tables::srbf::support_angle;
+
 use crate::env::EnvLight;
 
-/// The largest slope used (an SRBF wider than ~89° is limited by the box size anyway).
+/// The largest slope used, for every filter (an SRBF wider than ~89°, λ < ~7, is limited by the
+/// box size anyway).
 const MAX_SLOPE: f32 = 64.0;
 
 /// How wide the averaging box of an SRBF light is.
@@ -47,6 +49,22 @@ impl TransmittanceFilter {
             Self::PaperSupport => "paper support (G = 1e-3)",
             Self::MatchedVariance => "matched variance",
             Self::Centre => "centre texel",
+        }
+    }
+}
+
+/// tan α of light `light`'s support (G = 10⁻³), 0 for a directional light: the slope of
+/// [`TransmittanceFilter::PaperSupport`].
+pub fn tan_support(light: &EnvLight) -> f32 {
+    match light.lambda {
+        None => 0.0,
+        Some(lambda) => {
+            let alpha = support_angle(lambda as f64);
+            if alpha >= std::f64::consts::FRAC_PI_2 {
+                MAX_SLOPE
+            } else {
+                (alpha.tan() as f32).min(MAX_SLOPE)
+            }
         }
     }
 }

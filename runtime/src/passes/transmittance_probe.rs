@@ -7,6 +7,7 @@ use wgpu::util::DeviceExt;
 
 use super::env_view::{BatchBinding, transmittance_bind_group_layout};
 use crate::gpu::GpuContext;
+use crate::gpu::bind_layout::storage_entry;
 use crate::gpu::readback::{ReadbackError, read_buffer};
 
 #[repr(C)]
@@ -55,23 +56,13 @@ impl TransmittanceProbe {
             source: wgpu::ShaderSource::Wgsl(source.into()),
         });
         let compute = wgpu::ShaderStages::COMPUTE;
-        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: compute,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
         let probe_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe"),
             entries: &[
-                storage(0, true),
-                storage(1, false),
-                storage(2, true),
-                storage(3, false),
+                storage_entry(0, compute, true),
+                storage_entry(1, compute, false),
+                storage_entry(2, compute, true),
+                storage_entry(3, compute, false),
             ],
         });
         let batch_layout = transmittance_bind_group_layout(device, compute);

@@ -15,8 +15,9 @@
 //! Outputs: the view's depth and coverage textures (opaque) or the occupancy map (occupancy).
 
 use super::attachments::{cleared_color, cleared_depth, prepassed_depth};
-use super::strands::{DEPTH_FORMAT, RenderTarget};
+use super::render_target::{DEPTH_FORMAT, RenderTarget};
 use crate::gpu::GpuContext;
+use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels};
 use crate::gpu::readback::{ReadbackError, read_texture_rgba};
 
 /// How the env view pass weighs the fragments of a pixel.
@@ -67,15 +68,8 @@ pub const RECORD_WORDS: u64 = 10;
 pub enum OccupancyError {
     #[error("transparency visibility cutoff {0}: must be in [0, 1)")]
     Cutoff(f32),
-    #[error(
-        "the occupancy map of a {width}×{height} image needs {bytes} bytes, over the adapter's storage-binding limit of {limit} bytes; render a smaller image or use opaque"
-    )]
-    TooLarge {
-        width: u32,
-        height: u32,
-        bytes: u64,
-        limit: u64,
-    },
+    #[error(transparent)]
+    TooLarge(#[from] LimitError),
 }
 
 /// Fragment counts of one batch's view pass (every batch draws the same fragments).
@@ -109,16 +103,11 @@ impl OccupancyMap {
     ) -> Result<Self, OccupancyError> {
         transparency.check()?;
         let bytes = Self::bytes(transparency, width, height);
-        let limits = gpu.device.limits();
-        let limit = (limits.max_storage_buffer_binding_size as u64).min(limits.max_buffer_size);
-        if bytes > limit {
-            return Err(OccupancyError::TooLarge {
-                width,
-                height,
-                bytes,
-                limit,
-            });
-        }
+        GpuLimits::of(gpu).check_storage_buffer("occupancy map", bytes, |max| {
+            let per_pixel = RECORD_WORDS * 4;
+            let (w, h) = fit_pixels(width, height, max / per_pixel);
+            format!("render at {w}x{h} or smaller, or use the opaque view")
+        })?;
         let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("occupancy map"),
             size: bytes,

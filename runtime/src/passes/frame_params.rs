@@ -1,0 +1,87 @@
+//! What a strand-quad pass needs besides the geometry: the camera and image size, the lights,
+//! the Kajiya-Kay constants and the fiber width override, and their uniform as
+//! `strand_quads.wgsl` reads it.
+
+use glam::Mat4;
+
+use crate::camera::Camera;
+use crate::lights::Light;
+
+/// Kajiya-Kay constants: `L = E·(kd·color·sin(t,l) + ks·max(0, sin(t,l)sin(t,e) − (t·l)(t·e))^p)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KajiyaKay {
+    pub kd: f32,
+    pub ks: f32,
+    pub shininess: f32,
+}
+
+impl Default for KajiyaKay {
+    fn default() -> Self {
+        Self {
+            kd: 0.6,
+            ks: 0.25,
+            shininess: 40.0,
+        }
+    }
+}
+
+/// What the pass needs besides the geometry.
+#[derive(Clone, Debug)]
+pub struct FrameParams {
+    pub camera: Camera,
+    pub width: u32,
+    pub height: u32,
+    pub lights: Vec<Light>,
+    pub shading: KajiyaKay,
+    /// Every fiber this many pixels wide instead of its projected thickness.
+    pub width_override_px: Option<f32>,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct FrameUniform {
+    view_proj: [[f32; 4]; 4],
+    eye: [f32; 4],
+    toward_eye: [f32; 4],
+    viewport: [f32; 2],
+    focal_px: f32,
+    width_override_px: f32,
+    kd: f32,
+    ks: f32,
+    shininess: f32,
+    light_count: u32,
+    /// Fiber width multiplier (the light pass's stochastic simplification enlarges fibers by
+    /// 1/κ); 1 elsewhere.
+    width_scale: f32,
+    _pad: [f32; 3],
+}
+
+impl FrameParams {
+    pub(crate) fn uniform(&self, width_scale: f32) -> FrameUniform {
+        let aspect = self.width as f32 / self.height as f32;
+        let proj = self.camera.projection_matrix(aspect);
+        let view_proj: Mat4 = proj * self.camera.view();
+        FrameUniform {
+            view_proj: view_proj.to_cols_array_2d(),
+            eye: self
+                .camera
+                .eye
+                .extend(if self.camera.is_perspective() {
+                    1.0
+                } else {
+                    0.0
+                })
+                .into(),
+            toward_eye: self.camera.toward_eye().extend(0.0).into(),
+            viewport: [self.width as f32, self.height as f32],
+            focal_px: proj.y_axis.y * self.height as f32 * 0.5,
+            width_override_px: self.width_override_px.unwrap_or(0.0),
+            kd: self.shading.kd,
+            ks: self.shading.ks,
+            shininess: self.shading.shininess,
+            light_count: self.lights.len() as u32,
+            width_scale,
+            _pad: [0.0; 3],
+        }
+    }
+}

@@ -1,0 +1,77 @@
+//! Group 0 of every pass that draws strand quads (`strand_quads.wgsl`): the frame uniform, the
+//! hair's points, segments and point attributes ([`StrandGeometry`]) and the lights
+//! ([`FrameParams`]).
+
+use wgpu::util::DeviceExt;
+
+use super::frame_params::FrameParams;
+use super::strand_geometry::StrandGeometry;
+use crate::gpu::GpuContext;
+use crate::gpu::bind_layout::{bind_group, storage_entry, uniform_entry};
+use crate::lights::{GpuLight, Light};
+
+/// Group 0 of every pass that draws strand quads (`strand_quads.wgsl`): frame uniform, points,
+/// segments, point attributes, lights.
+pub fn strand_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("strands"),
+        entries: &[
+            uniform_entry(0, stages),
+            storage_entry(1, stages, true),
+            storage_entry(2, stages, true),
+            storage_entry(3, stages, true),
+            storage_entry(4, stages, true),
+        ],
+    })
+}
+
+/// Group 0's resources for `geometry` seen through `frame`.
+pub fn strand_bind_group(
+    gpu: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    geometry: &StrandGeometry,
+    frame: &FrameParams,
+) -> wgpu::BindGroup {
+    strand_bind_group_scaled(gpu, layout, geometry, frame, 1.0)
+}
+
+/// [`strand_bind_group`] with every fiber `width_scale` times wider, its optical depth summed
+/// across kept (`strand_quads.wgsl`): the light pass's enlargement by 1/κ (Ren 2010 §7).
+pub fn strand_bind_group_scaled(
+    gpu: &GpuContext,
+    layout: &wgpu::BindGroupLayout,
+    geometry: &StrandGeometry,
+    frame: &FrameParams,
+    width_scale: f32,
+) -> wgpu::BindGroup {
+    let device = &gpu.device;
+    let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("strand frame"),
+        contents: bytemuck::bytes_of(&frame.uniform(width_scale)),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    // A storage binding may not be empty: pad with one unused light.
+    let mut lights: Vec<GpuLight> = frame.lights.iter().map(Light::to_gpu).collect();
+    if lights.is_empty() {
+        lights.push(bytemuck::Zeroable::zeroed());
+    }
+    let lights = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("lights"),
+        contents: bytemuck::cast_slice(&lights),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+
+    bind_group(
+        device,
+        "strands",
+        layout,
+        &[
+            uniform.as_entire_binding(),
+            geometry.points.as_entire_binding(),
+            geometry.segments.as_entire_binding(),
+            geometry.attributes.as_entire_binding(),
+            lights.as_entire_binding(),
+        ],
+    )
+}
