@@ -72,3 +72,97 @@ fn sltab() {
 fn srbf() {
     fuzz::fuzz_target("srbf");
 }
+
+/// One header per format claiming an absurd size (10¹² strands or points, 10⁶ × 10⁶ pixels, a
+/// 10⁶ × 10⁶ EXR data window, table axes of 10¹⁰ entries): each is refused with an error naming
+/// the file, and no allocation made while reading it reaches 1 MiB.
+#[test]
+fn absurd_sizes_are_refused_before_any_allocation() {
+    use fuzz::seeds;
+    let _measuring = alloc::MEASURING.lock().unwrap_or_else(|e| e.into_inner());
+    assert!(alloc::is_installed());
+
+    let le = |values: &[u32]| -> Vec<u8> { values.iter().flat_map(|v| v.to_le_bytes()).collect() };
+    let mut cases: Vec<(&str, &str, Vec<u8>)> = Vec::new();
+
+    // .hair: u32 counts, so the largest they hold (4.3 × 10⁹), and 10¹² truncated to 32 bits.
+    for (strands, points, flags) in [
+        (1, u32::MAX, 2),
+        (u32::MAX, 2, 3),
+        (1, (1_000_000_000_000u64 % (1 << 32)) as u32, 2),
+    ] {
+        let mut f = b"HAIR".to_vec();
+        f.extend(le(&[strands, points, flags, 1]));
+        f.resize(128 + 24, 0);
+        cases.push(("hair", "strand or point count", f));
+    }
+    // .tfx: 10⁶ strands of 10⁶ vertices.
+    let mut f = 4.0f32.to_le_bytes().to_vec();
+    f.extend(le(&[1_000_000, 1_000_000, 160]));
+    f.resize(160 + 64, 0);
+    cases.push(("tfx", "10⁶ × 10⁶ vertices", f));
+    // .data: 10⁶ strands, the first claiming i32::MAX points.
+    cases.push((
+        "data",
+        "10⁶ strands",
+        le(&[1_000_000, i32::MAX as u32, 0, 0]),
+    ));
+    // .ply: 10¹² vertices.
+    let ply = "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000\nproperty float x\n\
+               property float y\nproperty float z\nelement strand 1\nproperty uchar nsegs\nend_header\n";
+    let mut f = ply.as_bytes().to_vec();
+    f.extend_from_slice(&[0; 13]);
+    cases.push(("ply", "10¹² vertices", f));
+    // .hdr: 10⁶ × 10⁶ pixels.
+    let mut f = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1000000 +X 1000000\n".to_vec();
+    f.extend_from_slice(&[2, 2, 0x40, 0, 0xFF, 0]);
+    cases.push(("hdr", "10⁶ × 10⁶ pixels", f));
+    // .exr: a 10⁶ × 10⁶ data window in a file of a few hundred bytes.
+    let map = strandlight_precompute::EnvMap::from_pixels(8, 4, vec![[0.5; 3]; 32]);
+    let mut f = seeds::exr_bytes(&map, exr::prelude::Encoding::UNCOMPRESSED, true);
+    let key = b"dataWindow\0box2i\0";
+    let at = f.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+    f[at + 8..at + 16].copy_from_slice(&le(&[999_999, 999_999]));
+    cases.push(("exr", "10⁶ × 10⁶ data window", f));
+    // .sltab: axes of 10¹⁰ entries (metadata resealed so the claim reaches the shape check).
+    let good = seeds::sltab_bytes(strandlight_tables::asset::Storage::F32);
+    let len = u32::from_le_bytes(good[12..16].try_into().unwrap()) as usize;
+    let mut meta: serde_json::Value = serde_json::from_slice(&good[16..16 + len]).unwrap();
+    meta["payload"]["axes"][0]["count"] = serde_json::json!(100_000);
+    meta["payload"]["axes"][1]["count"] = serde_json::json!(100_000);
+    meta["payload"]["payload_bytes"] = serde_json::json!(4u64 * 3 * 10_000_000_000);
+    let json = serde_json::to_vec(&meta).unwrap();
+    let mut f = good[..12].to_vec();
+    f.extend((json.len() as u32).to_le_bytes());
+    f.extend(&json);
+    f.extend([0u8; 32]);
+    f.resize((16 + json.len() + 32).div_ceil(16) * 16, 0);
+    f.extend(&good[good.len() - 3 * 2 * 3 * 4..]);
+    fuzz::targets::reseal_asset(&mut f);
+    cases.push(("sltab", "axes of 10¹⁰ entries", f));
+
+    let targets = fuzz::targets::all();
+    for (name, what, bytes) in cases {
+        let target = targets.iter().find(|t| t.name == name).unwrap();
+        let start = std::time::Instant::now();
+        let (result, largest) = alloc::measure(|| (target.run)(&bytes));
+        let refusal = match result {
+            Err(r) => r,
+            Ok(()) => panic!("{name}: {what} loaded"),
+        };
+        eprintln!(
+            "{name} ({what}): {} in {:.1} ms, largest allocation {largest} bytes",
+            refusal.message,
+            start.elapsed().as_secs_f64() * 1e3
+        );
+        assert!(
+            refusal.message.contains(target.file_name),
+            "{}",
+            refusal.message
+        );
+        assert!(
+            largest < 1 << 20,
+            "{name}: {what}: an allocation of {largest} bytes"
+        );
+    }
+}

@@ -48,6 +48,21 @@ pub const WATCHDOG: Duration = Duration::from_secs(60);
 const JUNK_MAX: usize = 512;
 /// One execution in this many is junk behind a seed's head instead of a mutant.
 const JUNK_EVERY: usize = 16;
+/// The first bytes of every format read here (junk goes behind them): `.hair`, a TressFX 4
+/// version, a PLY header, a `.data` strand count, Radiance, OpenEXR, the table asset, JSON.
+const SIGNATURES: [&[u8]; 8] = [
+    b"HAIR",
+    &[0, 0, 0x80, 0x40],
+    b"ply\nformat binary_little_endian 1.0\nelement vertex 3\n",
+    &[2, 0, 0, 0],
+    b"#?RADIANCE\n",
+    &[0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0],
+    b"STRNDLUT\x02\0\0\0",
+    b"{\"format\":\"strandlight-srbf-set\",",
+];
+/// Each target must reach at least this many kinds of refusal, and some mutants must load:
+/// otherwise the mutations are not getting past the first check.
+pub const MIN_REFUSAL_KINDS: usize = 3;
 /// Random strict prefixes checked per seed (the smallest generated seed gets all of them).
 const SAMPLED_PREFIXES: usize = 48;
 
@@ -219,12 +234,18 @@ impl Report {
             "  largest allocation: {:.1} bytes per input byte (inputs of 1 kB or more)",
             self.largest_allocation_per_byte
         );
-        for f in &self.findings {
+        for f in self.findings.iter().take(SAVED_FINDINGS) {
             eprintln!(
                 "  FINDING {}\n    from {}\n    saved {}",
                 f.problem,
                 f.origin,
                 f.saved.display()
+            );
+        }
+        if self.findings.len() > SAVED_FINDINGS {
+            eprintln!(
+                "  … and {} more findings (not saved)",
+                self.findings.len() - SAVED_FINDINGS
             );
         }
     }
@@ -466,14 +487,25 @@ pub fn run(target: &Target) -> Report {
     for i in 0..executions {
         let seed = &seeds[rng.below(seeds.len())];
         if i % JUNK_EVERY == JUNK_EVERY - 1 {
-            let head = rng.below(seed.bytes.len().min(64) + 1);
-            let mut junk = seed.bytes[..head].to_vec();
+            // Mostly behind this format's own head; one time in four behind another format's
+            // signature, so that every reader also meets its neighbours' files.
+            let (head_bytes, head_name): (&[u8], String) = if rng.below(4) > 0 {
+                let head = rng.below(seed.bytes.len().min(64) + 1);
+                (
+                    &seed.bytes[..head],
+                    format!("the first {head} bytes of seed {}", seed.name),
+                )
+            } else {
+                let magic = SIGNATURES[rng.below(SIGNATURES.len())];
+                (
+                    magic,
+                    format!("the signature {:?}", magic.escape_ascii().to_string()),
+                )
+            };
+            let mut junk = head_bytes.to_vec();
             let len = rng.below(JUNK_MAX + 1);
             junk.extend((0..len).map(|_| rng.next_u64() as u8));
-            let origin = format!(
-                "junk: the first {head} bytes of seed {} and {len} random bytes",
-                seed.name
-            );
+            let origin = format!("junk: {head_name} and {len} random bytes");
             record(&mut report, &junk, origin);
             continue;
         }
@@ -506,12 +538,17 @@ pub fn run(target: &Target) -> Report {
     report
 }
 
+/// Findings of one target saved to disk at most (a bug hit by many mutants is still counted).
+const SAVED_FINDINGS: usize = 20;
+
 fn save_finding(report: &mut Report, dir: &Path, data: &[u8], problem: Problem, origin: String) {
     let n = report.findings.len();
     let saved = dir.join(format!("finding-{n}.bin"));
-    std::fs::write(&saved, data).expect("target/ is writable");
-    let note = format!("{problem}\nfrom {origin}\n{} bytes\n", data.len());
-    std::fs::write(saved.with_extension("txt"), note).expect("target/ is writable");
+    if n < SAVED_FINDINGS {
+        std::fs::write(&saved, data).expect("target/ is writable");
+        let note = format!("{problem}\nfrom {origin}\n{} bytes\n", data.len());
+        std::fs::write(saved.with_extension("txt"), note).expect("target/ is writable");
+    }
     report.findings.push(Finding {
         problem,
         origin,
@@ -534,6 +571,12 @@ pub fn fuzz_target(name: &str) -> Report {
     let report = run(&target);
     report.print();
     assert!(
+        report.refusals.len() >= MIN_REFUSAL_KINDS && report.ok > 0,
+        "fuzz {name}: the mutants reach only {:?} and {} loads; the fuzzing is shallow",
+        report.refusals.keys().collect::<Vec<_>>(),
+        report.ok
+    );
+    assert!(
         report.findings.is_empty(),
         "fuzz {name}: {} findings (inputs saved under {}):\n{}",
         report.findings.len(),
@@ -541,6 +584,7 @@ pub fn fuzz_target(name: &str) -> Report {
         report
             .findings
             .iter()
+            .take(SAVED_FINDINGS)
             .map(|f| format!(
                 "  {}\n    from {}\n    saved {}",
                 f.problem,

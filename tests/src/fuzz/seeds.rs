@@ -50,8 +50,15 @@ pub fn seeds(name: &str) -> Vec<Seed> {
             hair::usc::encode_usc(&small_groom(6, 5)),
         )],
         "ply" => vec![
-            generated("3 strands, uchar colours, list element", ply_file(true)),
-            generated("3 strands", ply_file(false)),
+            generated(
+                "3 strands, uchar colours, list element",
+                ply_file(Some("uchar")),
+            ),
+            generated(
+                "3 strands, list with double lengths",
+                ply_file(Some("double")),
+            ),
+            generated("3 strands", ply_file(None)),
         ],
         "hdr" => hdr_seeds(),
         "exr" => exr_seeds(),
@@ -143,8 +150,8 @@ fn tfx_file(attributes: bool) -> Vec<u8> {
 }
 
 /// A binary PLY of three strands (hapPLY layout); with `lists`, a trailing `face` element
-/// with a list property, which the reader must step over.
-fn ply_file(lists: bool) -> Vec<u8> {
+/// with a list property whose lengths have that type, which the reader must step over.
+fn ply_file(lists: Option<&str>) -> Vec<u8> {
     let strands: [&[[f32; 3]]; 3] = [
         &[[0.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
         &[[1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [1.0, 2.0, 0.5]],
@@ -160,10 +167,9 @@ fn ply_file(lists: bool) -> Vec<u8> {
         "ply\nformat binary_little_endian 1.0\ncomment fuzz seed\nelement vertex {points}\n\
          property float x\nproperty float y\nproperty float z\nproperty uchar red\n\
          property uchar green\nproperty uchar blue\nelement strand 3\nproperty ushort nsegs\n{}end_header\n",
-        if lists {
-            "element face 2\nproperty list uchar int vertex_indices\n"
-        } else {
-            ""
+        match lists {
+            Some(kind) => format!("element face 2\nproperty list {kind} int vertex_indices\n"),
+            None => String::new(),
         }
     )
     .into_bytes();
@@ -174,9 +180,12 @@ fn ply_file(lists: bool) -> Vec<u8> {
     for s in strands {
         out.extend_from_slice(&(s.len() as u16 - 1).to_le_bytes());
     }
-    if lists {
+    if let Some(kind) = lists {
         for face in [[0i32, 1, 2].as_slice(), &[3, 4]] {
-            out.push(face.len() as u8);
+            match kind {
+                "double" => out.extend_from_slice(&(face.len() as f64).to_le_bytes()),
+                _ => out.push(face.len() as u8),
+            }
             out.extend(face.iter().flat_map(|v| v.to_le_bytes()));
         }
     }
