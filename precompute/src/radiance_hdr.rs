@@ -59,13 +59,17 @@ pub fn decode(path: &Path, bytes: &[u8]) -> Result<EnvMap, EnvMapError> {
 
     // Even the densest run-length code (127 pixels in 2 bytes per plane) needs about one byte
     // per 16 pixels: refuse a header that promises more than the file can hold before
-    // allocating for it: the pixel data is truncated as the header counts. (Old-style runs can
+    // allocating for it. (Old-style runs can
     // in principle compress further; files that rely on that are refused too.)
-    if (layout.width as u64) * (layout.height as u64) > max_pixels(bytes.len() - pos) {
-        return Err(EnvMapError::Truncated {
+    let max_pixels = max_pixels(bytes.len() - pos);
+    if (layout.width as u64) * (layout.height as u64) > max_pixels {
+        return Err(EnvMapError::ImpossibleSize {
             path: path.into(),
-            scanline: 0,
-            scanlines: layout.scanlines,
+            width: layout.width as u64,
+            height: layout.height as u64,
+            bytes: bytes.len() as u64,
+            encoding: "Radiance run-length code",
+            max_pixels,
         });
     }
     let mut reader = ScanlineReader { bytes, pos, path };
@@ -371,10 +375,7 @@ mod tests {
             let start = Instant::now();
             let e = decode_named(&bytes).unwrap_err();
             assert!(start.elapsed() < Duration::from_secs(1), "{e}");
-            assert!(
-                matches!(e, EnvMapError::Truncated { scanline: 0, .. }),
-                "{e}"
-            );
+            assert!(matches!(e, EnvMapError::ImpossibleSize { .. }), "{e}");
             assert!(e.to_string().contains("crafted.hdr"), "{e}");
         }
         // Past the reader's 2²⁰ limit per axis the resolution line itself is refused.
