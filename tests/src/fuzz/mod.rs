@@ -532,7 +532,7 @@ pub fn run(target: &Target) -> Report {
         );
         record(&mut report, &data, origin);
     }
-    drop(record);
+    drop(current_file); // closed before it is removed
     let _ = std::fs::remove_file(&current);
     report.seconds = started.elapsed().as_secs_f64();
     report

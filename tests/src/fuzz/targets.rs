@@ -35,7 +35,7 @@ pub struct Target {
     /// about 100 s in the test profile on 2 cores.
     pub execs: usize,
     /// Fixes up a mutant so that it gets past an integrity check to the parser behind it.
-    pub reseal: Option<fn(&mut Vec<u8>)>,
+    pub reseal: Option<fn(&mut [u8])>,
 }
 
 fn refusal<E: std::fmt::Debug + std::fmt::Display>(e: E) -> Refusal {
@@ -117,7 +117,7 @@ fn run_srbf(bytes: &[u8]) -> Result<(), Refusal> {
 
 /// The metadata of a table asset is guarded by its own SHA-256, so a mutated JSON block would
 /// only ever reach the checksum test. Half the asset mutants get a digest that matches again.
-pub fn reseal_asset(data: &mut Vec<u8>) {
+pub fn reseal_asset(data: &mut [u8]) {
     if data.len() < 16 || data[..8] != asset::MAGIC {
         return;
     }
