@@ -12,6 +12,9 @@ pub struct CompareTableArgs {
 }
 
 pub fn run(args: CompareTableArgs) -> anyhow::Result<()> {
-    println!("{}", strandlight_scene::compare_table::markdown_table(&args.reports)?);
+    println!(
+        "{}",
+        strandlight_scene::compare_table::markdown_table(&args.reports)?
+    );
     Ok(())
 }

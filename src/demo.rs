@@ -38,18 +38,38 @@ pub struct DemoArgs {
 }
 
 pub fn run(args: DemoArgs) -> anyhow::Result<()> {
-    let look = LookArgs { transparency: args.transparency, ..Default::default() }.look()?;
+    let look = LookArgs {
+        transparency: args.transparency,
+        ..Default::default()
+    }
+    .look()?;
     let mut steps = Steps::new(false);
-    let env = steps.run(
-        "environment",
-        || {
-            let (path, written) = ensure_procedural_envmap(Path::new(ENVMAP_DIR), DEMO_ENVIRONMENT)?;
-            Ok((load_env(&path.to_string_lossy(), false)?, path, written))
-        },
-        |(_, p, w)| format!("{} ({}, read back)", p.display(), if *w { "generated now by procedural_env" } else { "already there" }),
-    )?
-    .0;
-    let hair = steps.run("groom", || Ok(generate_groom(&GroomParams::default())?), |h| format!("procedural groom, {} strands", h.strand_count()))?;
+    let env = steps
+        .run(
+            "environment",
+            || {
+                let (path, written) =
+                    ensure_procedural_envmap(Path::new(ENVMAP_DIR), DEMO_ENVIRONMENT)?;
+                Ok((load_env(&path.to_string_lossy(), false)?, path, written))
+            },
+            |(_, p, w)| {
+                format!(
+                    "{} ({}, read back)",
+                    p.display(),
+                    if *w {
+                        "generated now by procedural_env"
+                    } else {
+                        "already there"
+                    }
+                )
+            },
+        )?
+        .0;
+    let hair = steps.run(
+        "groom",
+        || Ok(generate_groom(&GroomParams::default())?),
+        |h| format!("procedural groom, {} strands", h.strand_count()),
+    )?;
     let fiber = FiberDescription::preset(DEMO_PRESET)?;
     let shading = EnvShading::Marschner;
     let up = UpAxis::detect(&hair);
@@ -67,15 +87,49 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let (lights, mode) = (&scene.lights, scene.mode);
     let (width, height) = DEMO_SIZE;
     let camera = Camera::framing_front(hair.bounds(), width as f32 / height as f32, false, up);
-    let frame = EnvFrame { hair: &hair, camera, width, height, lights, tables: &scene.tables, shading, mode, role: FrameRole::Interactive { kappa: EnvRenderOptions::default().kappa }, look };
-    let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {}, {} scattering, {:?} view", r.milliseconds, light_summary(lights), mode.name(), args.transparency))?;
+    let frame = EnvFrame {
+        hair: &hair,
+        camera,
+        width,
+        height,
+        lights,
+        tables: &scene.tables,
+        shading,
+        mode,
+        role: FrameRole::Interactive {
+            kappa: EnvRenderOptions::default().kappa,
+        },
+        look,
+    };
+    let rendered = steps.run(
+        "render",
+        || render_lights(&frame),
+        |r| {
+            format!(
+                "{:.1} ms/frame, {}, {} scattering, {:?} view",
+                r.milliseconds,
+                light_summary(lights),
+                mode.name(),
+                args.transparency
+            )
+        },
+    )?;
     let out = Path::new(OUT_DIR);
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
-    let description = format!("strandlight demo: procedural groom under procedural:{DEMO_ENVIRONMENT}, {}, Marschner ({DEMO_PRESET}), {} scattering", light_summary(lights), mode.name());
+    let description = format!(
+        "strandlight demo: procedural groom under procedural:{DEMO_ENVIRONMENT}, {}, Marschner ({DEMO_PRESET}), {} scattering",
+        light_summary(lights),
+        mode.name()
+    );
     let (exr, png) = (out.join("demo.exr"), out.join("demo.png"));
     let image = &rendered.image;
     write_exr(&exr, image.width, image.height, &image.pixels, &description)?;
     write_png(&png, image.width, image.height, &image.pixels, &description)?;
-    steps.say(format!("wrote {} (linear) and {} ({PNG_TONEMAP}); total {:.1} s", exr.display(), png.display(), steps.total_seconds()));
+    steps.say(format!(
+        "wrote {} (linear) and {} ({PNG_TONEMAP}); total {:.1} s",
+        exr.display(),
+        png.display(),
+        steps.total_seconds()
+    ));
     Ok(())
 }

@@ -97,7 +97,11 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
         grid_width: args.grid_width,
         rotate_degrees: args.rotate,
         sources: strandlight_precompute::compact_sources::SourceOptions {
-            max_sources: if args.directional.is_some() { 0 } else { args.sources },
+            max_sources: if args.directional.is_some() {
+                0
+            } else {
+                args.sources
+            },
             radius_degrees: args.source_radius,
             min_norm_share: args.source_min_share,
         },
@@ -146,7 +150,13 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
     for s in &set.sources {
         eprintln!(
             "compact source toward ({:.4}, {:.4}, {:.4}): power {:.4e} {:.4e} {:.4e} ({:.1}% of the map's), a directional light",
-            s.direction[0], s.direction[1], s.direction[2], s.power[0], s.power[1], s.power[2], 100.0 * s.power_share
+            s.direction[0],
+            s.direction[1],
+            s.direction[2],
+            s.power[0],
+            s.power[1],
+            s.power[2],
+            100.0 * s.power_share
         );
     }
     eprintln!(

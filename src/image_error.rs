@@ -19,9 +19,21 @@ pub struct ImageErrorArgs {
 }
 
 pub fn run(args: ImageErrorArgs) -> anyhow::Result<()> {
-    let test = read_rgba_exr(&args.test).with_context(|| format!("reading {}", args.test.display()))?;
-    let reference = read_rgba_exr(&args.reference).with_context(|| format!("reading {}", args.reference.display()))?;
-    let error = relative_rmse(&test, &reference).with_context(|| format!("{} against {}", args.test.display(), args.reference.display()))?;
-    println!("relative RMSE {error:.4}  ({} against {}, over the reference's hair pixels)", args.test.display(), args.reference.display());
+    let test =
+        read_rgba_exr(&args.test).with_context(|| format!("reading {}", args.test.display()))?;
+    let reference = read_rgba_exr(&args.reference)
+        .with_context(|| format!("reading {}", args.reference.display()))?;
+    let error = relative_rmse(&test, &reference).with_context(|| {
+        format!(
+            "{} against {}",
+            args.test.display(),
+            args.reference.display()
+        )
+    })?;
+    println!(
+        "relative RMSE {error:.4}  ({} against {}, over the reference's hair pixels)",
+        args.test.display(),
+        args.reference.display()
+    );
     Ok(())
 }

@@ -138,8 +138,16 @@ fn parse_vec3(flag: &str, text: &str) -> anyhow::Result<[f32; 3]> {
 
 /// The camera `--camera`, `--up` and `--eye` ask for.
 fn camera_choice(args: &RenderArgs) -> anyhow::Result<CameraChoice> {
-    let eye = args.eye.as_deref().map(|text| parse_vec3("--eye", text)).transpose()?;
-    Ok(CameraChoice { kind: args.camera, up: args.up, eye })
+    let eye = args
+        .eye
+        .as_deref()
+        .map(|text| parse_vec3("--eye", text))
+        .transpose()?;
+    Ok(CameraChoice {
+        kind: args.camera,
+        up: args.up,
+        eye,
+    })
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
@@ -161,7 +169,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             nodes_per_pixel: args.abuffer_nodes_per_pixel,
             delta: args.dbk_delta.unwrap_or(0.0),
         },
-        Transparency::Occupancy => bail!("--transparency occupancy is the view of --env (environment lighting); with point lights use none, abuffer or dbk"),
+        Transparency::Occupancy => bail!(
+            "--transparency occupancy is the view of --env (environment lighting); with point lights use none, abuffer or dbk"
+        ),
     };
     let (width, height) = parse_size(&args.size)?;
     if let Some(w) = args.fiber_width_px
@@ -284,21 +294,43 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
     let shading = match args.shading.unwrap_or(Shading::Marschner) {
         Shading::Marschner => EnvShading::Marschner,
         Shading::Artist => EnvShading::Artist,
-        Shading::KajiyaKay => bail!("--shading kajiya-kay with --env: the env renderer reads one RGB 4D table (Marschner I_M or the artist I_A); use --shading marschner or artist"),
+        Shading::KajiyaKay => bail!(
+            "--shading kajiya-kay with --env: the env renderer reads one RGB 4D table (Marschner I_M or the artist I_A); use --shading marschner or artist"
+        ),
     };
-    if matches!(args.transparency, Transparency::Abuffer | Transparency::Dbk) || args.shadows != Shadows::None {
-        bail!("--env shadows every SRBF light with its convolution optical depth map and renders opaque (none) or through an occupancy map (occupancy); --shadows, --transparency abuffer/dbk apply to point lights only");
+    if matches!(args.transparency, Transparency::Abuffer | Transparency::Dbk)
+        || args.shadows != Shadows::None
+    {
+        bail!(
+            "--env shadows every SRBF light with its convolution optical depth map and renders opaque (none) or through an occupancy map (occupancy); --shadows, --transparency abuffer/dbk apply to point lights only"
+        );
     }
     let look_args = LookArgs {
-        transparency: if args.transparency == Transparency::Occupancy { EnvTransparency::Occupancy } else { EnvTransparency::Opaque },
+        transparency: if args.transparency == Transparency::Occupancy {
+            EnvTransparency::Occupancy
+        } else {
+            EnvTransparency::Opaque
+        },
         view: args.env_view,
     };
-    let look = EnvLook { count_fragments: args.json, ..look_args.look()? };
+    let look = EnvLook {
+        count_fragments: args.json,
+        ..look_args.look()?
+    };
     let (width, height) = parse_size(&args.size)?;
     let mut steps = Steps::new(args.json);
-    let (model, source) = steps.run("hair", || load_hair(args.hair.as_deref()), |(m, s)| format!("{s} ({} strands)", m.strand_count()))?;
-    let env = steps.run("environment", || load_env(env_spec, false), |e| format!("{} {}x{}", e.name, e.map.width(), e.map.height()))?;
-    let fiber = FiberDescription::preset(&args.preset).with_context(|| format!("--preset {:?}", args.preset))?;
+    let (model, source) = steps.run(
+        "hair",
+        || load_hair(args.hair.as_deref()),
+        |(m, s)| format!("{s} ({} strands)", m.strand_count()),
+    )?;
+    let env = steps.run(
+        "environment",
+        || load_env(env_spec, false),
+        |e| format!("{} {}x{}", e.name, e.map.width(), e.map.height()),
+    )?;
+    let fiber = FiberDescription::preset(&args.preset)
+        .with_context(|| format!("--preset {:?}", args.preset))?;
     let table_set = format!("{}-{:?}", args.preset, shading).to_lowercase();
     let request = EnvSceneRequest {
         env: &env,
@@ -313,11 +345,38 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
     let scene = prepare_env_scene(&request, &mut steps)?;
     let (lights, mode) = (&scene.lights, scene.mode);
     let camera = camera_choice(args)?.camera(&model, width as f32 / height as f32)?;
-    let frame = EnvFrame { hair: &model, camera, width, height, lights, tables: &scene.tables, shading, mode, role: FrameRole::Interactive { kappa: args.kappa }, look };
-    let rendered = steps.run("render", || render_lights(&frame), |r| format!("{:.1} ms/frame, {}, {} scattering", r.milliseconds, light_summary(lights), mode.name()))?;
+    let frame = EnvFrame {
+        hair: &model,
+        camera,
+        width,
+        height,
+        lights,
+        tables: &scene.tables,
+        shading,
+        mode,
+        role: FrameRole::Interactive { kappa: args.kappa },
+        look,
+    };
+    let rendered = steps.run(
+        "render",
+        || render_lights(&frame),
+        |r| {
+            format!(
+                "{:.1} ms/frame, {}, {} scattering",
+                r.milliseconds,
+                light_summary(lights),
+                mode.name()
+            )
+        },
+    )?;
     let stem = output_stem(&args.out);
     let (exr_path, png_path) = (stem.with_extension("exr"), stem.with_extension("png"));
-    let description = format!("{source}; {width}x{height}; env {env_spec}, {}; {shading:?} ({}), {} scattering", light_summary(lights), args.preset, mode.name());
+    let description = format!(
+        "{source}; {width}x{height}; env {env_spec}, {}; {shading:?} ({}), {} scattering",
+        light_summary(lights),
+        args.preset,
+        mode.name()
+    );
     let image = &rendered.image;
     write_exr(&exr_path, width, height, &image.pixels, &description)?;
     write_png(&png_path, width, height, &image.pixels, &description)?;
@@ -345,8 +404,16 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
         let memory: u64 = rendered.memory_per_batch.iter().map(|(_, b)| b).sum();
-        steps.say(format!("GPU memory per batch of {} lights: {:.1} MB (--json lists it per resource)", strandlight_runtime::passes::convolution_depth::DodmSettings::default().batch_size, memory as f64 / 1e6));
-        steps.say(format!("wrote {} and {}", exr_path.display(), png_path.display()));
+        steps.say(format!(
+            "GPU memory per batch of {} lights: {:.1} MB (--json lists it per resource)",
+            strandlight_runtime::passes::convolution_depth::DodmSettings::default().batch_size,
+            memory as f64 / 1e6
+        ));
+        steps.say(format!(
+            "wrote {} and {}",
+            exr_path.display(),
+            png_path.display()
+        ));
     }
     Ok(())
 }

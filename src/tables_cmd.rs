@@ -1,18 +1,20 @@
 //! `strandlight bake`, `check-tables` and `inspect`: the convolution tables of Ren 2010 §4/§6
 //! and the point-light lookup textures, baked, checked against f64 integration, and pictured.
 
-use strandlight_scene::scene_tables::lambda_range_of_set;
-use anyhow::{bail, Context};
+use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde_json::json;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use strandlight_precompute::bake::{bake_job, BakedTable, TABLE_EXTENSION};
-use strandlight_precompute::bake_plan::{plan, BakeResolution, FiberDescription, Model, PlanOptions, DEFAULT_MULTIPLE_THRESHOLD};
+use strandlight_precompute::bake::{BakedTable, TABLE_EXTENSION, bake_job};
+use strandlight_precompute::bake_plan::{
+    BakeResolution, DEFAULT_MULTIPLE_THRESHOLD, FiberDescription, Model, PlanOptions, plan,
+};
 use strandlight_precompute::baked_tables_check::check_asset;
 use strandlight_precompute::srbf_set::SrbfSet;
-use strandlight_tables::asset::{read_asset, Storage};
-use strandlight_tables::slices::{write_slices, PngTonemap, SliceLayout};
+use strandlight_scene::scene_tables::lambda_range_of_set;
+use strandlight_tables::asset::{Storage, read_asset};
+use strandlight_tables::slices::{PngTonemap, SliceLayout, write_slices};
 
 #[derive(Clone, Copy, clap::ValueEnum)]
 pub enum ModelArg {
@@ -85,7 +87,10 @@ fn progress(len: u64, hidden: bool) -> ProgressBar {
         return ProgressBar::hidden();
     }
     let bar = ProgressBar::new(len);
-    bar.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}").unwrap());
+    bar.set_style(
+        ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg}")
+            .unwrap(),
+    );
     bar
 }
 
@@ -107,7 +112,9 @@ pub fn bake(args: BakeArgs) -> anyhow::Result<()> {
         ModelArg::All => vec![Model::Marschner, Model::KajiyaKay, Model::Artist],
     };
     let mut resolution = match args.resolution {
-        Some(n) if !(2..=256).contains(&n) => bail!("--resolution {n}: use 2 to 256 nodes per direction axis"),
+        Some(n) if !(2..=256).contains(&n) => {
+            bail!("--resolution {n}: use 2 to 256 nodes per direction axis")
+        }
         Some(n) => BakeResolution::reduced(n),
         None => BakeResolution::default(),
     };
@@ -115,20 +122,32 @@ pub fn bake(args: BakeArgs) -> anyhow::Result<()> {
         let (lo, hi) = lambda_range_of(srbf)?;
         resolution = resolution.with_lambda_range(lo, hi);
     }
-    let options = PlanOptions { models, resolution, force_multiple: args.force_multiple, multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD };
+    let options = PlanOptions {
+        models,
+        resolution,
+        force_multiple: args.force_multiple,
+        multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD,
+    };
     let start = Instant::now();
     let plan = plan(&fiber, &options)?;
     if let Some(share) = plan.multiple_scattering_share
         && !args.json
     {
-        println!("multiple-scattering share (direction-averaged single-event albedo): {:.1}%", 100.0 * share);
+        println!(
+            "multiple-scattering share (direction-averaged single-event albedo): {:.1}%",
+            100.0 * share
+        );
     }
     for s in &plan.skipped {
         if !args.json {
             println!("skipped {}: {}", s.name, s.reason);
         }
     }
-    let storage = if args.half { Storage::F16 } else { Storage::F32 };
+    let storage = if args.half {
+        Storage::F16
+    } else {
+        Storage::F32
+    };
     let bar = progress(plan.jobs.len() as u64, args.json);
     let mut baked: Vec<BakedTable> = Vec::new();
     for job in plan.jobs {
@@ -136,17 +155,26 @@ pub fn bake(args: BakeArgs) -> anyhow::Result<()> {
         let t = bake_job(job, &args.out, storage)?;
         bar.inc(1);
         if let Some(reason) = &t.replaced_damaged {
-            say(&bar, format!("warning: {} was damaged and has been rebaked ({reason})", t.path.display()));
+            say(
+                &bar,
+                format!(
+                    "warning: {} was damaged and has been rebaked ({reason})",
+                    t.path.display()
+                ),
+            );
         }
         if !args.json {
-            say(&bar, format!(
-                "{:<18} {:>10} bytes {:>7.2} s{}  {}",
-                t.name,
-                t.bytes,
-                t.seconds,
-                if t.cached { " (cached)" } else { "" },
-                t.path.display()
-            ));
+            say(
+                &bar,
+                format!(
+                    "{:<18} {:>10} bytes {:>7.2} s{}  {}",
+                    t.name,
+                    t.bytes,
+                    t.seconds,
+                    if t.cached { " (cached)" } else { "" },
+                    t.path.display()
+                ),
+            );
         }
         baked.push(t);
     }
@@ -154,9 +182,17 @@ pub fn bake(args: BakeArgs) -> anyhow::Result<()> {
     let total = start.elapsed().as_secs_f64();
     if args.json {
         let tables: Vec<_> = baked.iter().map(|t| json!({"name": t.name, "bytes": t.bytes, "seconds": t.seconds, "cached": t.cached, "replaced_damaged": t.replaced_damaged, "path": t.path})).collect();
-        println!("{}", json!({"tables": tables, "skipped": plan.skipped, "multiple_scattering_share": plan.multiple_scattering_share, "total_seconds": total, "total_bytes": baked.iter().map(|t| t.bytes).sum::<u64>()}));
+        println!(
+            "{}",
+            json!({"tables": tables, "skipped": plan.skipped, "multiple_scattering_share": plan.multiple_scattering_share, "total_seconds": total, "total_bytes": baked.iter().map(|t| t.bytes).sum::<u64>()})
+        );
     } else {
-        println!("{} tables, {} bytes, {total:.1} s → {}", baked.len(), baked.iter().map(|t| t.bytes).sum::<u64>(), args.out.display());
+        println!(
+            "{} tables, {} bytes, {total:.1} s → {}",
+            baked.len(),
+            baked.iter().map(|t| t.bytes).sum::<u64>(),
+            args.out.display()
+        );
     }
     Ok(())
 }
@@ -172,7 +208,11 @@ fn table_files(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
         .collect();
     files.sort();
     if files.is_empty() {
-        bail!("{}: no .{TABLE_EXTENSION} tables here (run `strandlight bake --out {}` first)", dir.display(), dir.display());
+        bail!(
+            "{}: no .{TABLE_EXTENSION} tables here (run `strandlight bake --out {}` first)",
+            dir.display(),
+            dir.display()
+        );
     }
     Ok(files)
 }
@@ -182,24 +222,31 @@ pub fn check(args: CheckArgs) -> anyhow::Result<()> {
     let bar = progress(files.len() as u64, args.json);
     let mut results = Vec::new();
     for path in files {
-        bar.set_message(path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default());
+        bar.set_message(
+            path.file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+        );
         let asset = read_asset(&path)?;
         let t = Instant::now();
         let acc = check_asset(&asset, args.samples, args.seed)?;
         if !args.json {
-            say(&bar, format!(
-                "{:<18} max {:>9.3e}  rms {:>9.3e}  max rel (>1% of max) {:>9.3e} | off-axis: max {:>9.3e} rms {:>9.3e} | vs p99.9: max {:>9.3e} rms {:>9.3e}  {} samples  {:.1} s",
-                acc.name,
-                acc.max_abs_error,
-                acc.rms_abs_error,
-                acc.max_rel_error,
-                acc.off_axis_max_abs_error,
-                acc.off_axis_rms_abs_error,
-                acc.max_abs_error_p999,
-                acc.rms_abs_error_p999,
-                acc.samples,
-                t.elapsed().as_secs_f64()
-            ));
+            say(
+                &bar,
+                format!(
+                    "{:<18} max {:>9.3e}  rms {:>9.3e}  max rel (>1% of max) {:>9.3e} | off-axis: max {:>9.3e} rms {:>9.3e} | vs p99.9: max {:>9.3e} rms {:>9.3e}  {} samples  {:.1} s",
+                    acc.name,
+                    acc.max_abs_error,
+                    acc.rms_abs_error,
+                    acc.max_rel_error,
+                    acc.off_axis_max_abs_error,
+                    acc.off_axis_rms_abs_error,
+                    acc.max_abs_error_p999,
+                    acc.rms_abs_error_p999,
+                    acc.samples,
+                    t.elapsed().as_secs_f64()
+                ),
+            );
         }
         results.push(acc);
         bar.inc(1);
@@ -208,7 +255,9 @@ pub fn check(args: CheckArgs) -> anyhow::Result<()> {
     if args.json {
         println!("{}", serde_json::to_string(&results)?);
     } else {
-        println!("errors are relative to each table's maximum (and, after |, to its 99.9th percentile of |value|); references: direct f64 integration (see docs/BENCHMARKS.md)");
+        println!(
+            "errors are relative to each table's maximum (and, after |, to its 99.9th percentile of |value|); references: direct f64 integration (see docs/BENCHMARKS.md)"
+        );
     }
     Ok(())
 }
@@ -218,15 +267,31 @@ pub fn inspect(args: InspectArgs) -> anyhow::Result<()> {
     let meta = &asset.metadata;
     println!("{} — {}", meta.description.name, meta.description.quantity);
     for a in asset.table.axes() {
-        println!("  axis {:<14} [{}, {}] × {} ({:?})", a.name, a.min, a.max, a.count, a.mapping);
+        println!(
+            "  axis {:<14} [{}, {}] × {} ({:?})",
+            a.name, a.min, a.max, a.count, a.mapping
+        );
     }
     let s = asset.table.stats();
-    println!("  {} channel(s), {:?} storage, min {:.4e} max {:.4e} mean {:.4e}", asset.table.channels(), meta.payload.storage, s.min, s.max, s.mean);
+    println!(
+        "  {} channel(s), {:?} storage, min {:.4e} max {:.4e} mean {:.4e}",
+        asset.table.channels(),
+        meta.payload.storage,
+        s.min,
+        s.max,
+        s.mean
+    );
     println!("  parameters: {}", meta.description.fiber_parameters);
     if let Some(png) = &args.slices {
         let layout = SliceLayout::default_for(&asset.table);
         let exr = png.with_extension("exr");
-        let (_, note) = write_slices(&asset.table, &layout, &exr, png, PngTonemap::Log10 { decades: 4.0 })?;
+        let (_, note) = write_slices(
+            &asset.table,
+            &layout,
+            &exr,
+            png,
+            PngTonemap::Log10 { decades: 4.0 },
+        )?;
         println!("wrote {} and {} ({note})", png.display(), exr.display());
     }
     Ok(())

@@ -12,7 +12,15 @@ use strandlight_tables::asset::read_asset;
 fn bake_command(dir: &Path) -> Command {
     let mut command = Command::new(env!("CARGO_BIN_EXE_strandlight"));
     command
-        .args(["bake", "--model", "all", "--resolution", "8", "--json", "--out"])
+        .args([
+            "bake",
+            "--model",
+            "all",
+            "--resolution",
+            "8",
+            "--json",
+            "--out",
+        ])
         .arg(dir)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
@@ -59,7 +67,10 @@ fn two_bakes_at_once_leave_valid_tables() {
     let tables = valid_tables(&dir);
     let reported = reports[0]["tables"].as_array().unwrap().len();
     assert_eq!(tables.len(), reported, "{tables:?}");
-    assert!(reported >= 10, "a bake of every model writes at least ten tables");
+    assert!(
+        reported >= 10,
+        "a bake of every model writes at least ten tables"
+    );
     // The temporary files of both writers were renamed or removed.
     let leftovers: Vec<_> = std::fs::read_dir(&dir)
         .unwrap()
@@ -85,16 +96,30 @@ fn a_killed_bake_leaves_a_valid_cache() {
         let finished_early = child.try_wait().unwrap().is_some();
         child.kill().unwrap();
         child.wait().unwrap();
-        let survivors = if dir.exists() { valid_tables(&dir) } else { Vec::new() };
-        println!("killed after {millis} ms: {} complete tables", survivors.len());
+        let survivors = if dir.exists() {
+            valid_tables(&dir)
+        } else {
+            Vec::new()
+        };
+        println!(
+            "killed after {millis} ms: {} complete tables",
+            survivors.len()
+        );
         seen_partial |= !finished_early;
         // The next bake completes the folder and keeps what was complete.
         let report = bake_json(bake_command(&dir).output().unwrap());
         let tables = report["tables"].as_array().unwrap();
         let cached = tables.iter().filter(|t| t["cached"] == true).count();
-        assert_eq!(cached, survivors.len(), "every complete survivor is reused: {report}");
+        assert_eq!(
+            cached,
+            survivors.len(),
+            "every complete survivor is reused: {report}"
+        );
         assert_eq!(valid_tables(&dir).len(), tables.len());
     }
-    assert!(seen_partial, "every bake finished before it could be killed");
+    assert!(
+        seen_partial,
+        "every bake finished before it could be killed"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }

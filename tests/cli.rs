@@ -111,7 +111,11 @@ fn render_past_the_texture_limit_fails_cleanly_without_output() {
         .output()
         .expect("the strandlight binary runs");
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success(), "exit status {:?}; stderr:\n{stderr}", out.status);
+    assert!(
+        !out.status.success(),
+        "exit status {:?}; stderr:\n{stderr}",
+        out.status
+    );
     assert!(stderr.contains("max_texture_dimension_2d"), "{stderr}");
     assert!(stderr.contains("--size"), "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");

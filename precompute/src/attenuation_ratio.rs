@@ -13,7 +13,6 @@ use strandlight_tables::quadrature::GaussLegendre;
 use strandlight_tables::table::{Axis, AxisMapping, Table, TableError};
 use strandlight_tables::table_axes::{AXIS_ABS_SIN_THETA, AXIS_NU};
 
-
 /// α(ν, θ) by quadrature over the offset's polar radius r (Rayleigh density) and angle ψ.
 pub fn attenuation_ratio(nu: f64, sin_theta: f64) -> f64 {
     let s = sin_theta.clamp(-1.0, 1.0);
@@ -40,10 +39,25 @@ pub fn attenuation_ratio(nu: f64, sin_theta: f64) -> f64 {
 }
 
 /// The 2D table over (ν ∈ [0, ν_max], |sin θ| ∈ [0, 1]); α is even in θ.
-pub fn attenuation_ratio_table(nu_count: usize, sin_count: usize, nu_max: f64) -> Result<Table, TableError> {
+pub fn attenuation_ratio_table(
+    nu_count: usize,
+    sin_count: usize,
+    nu_max: f64,
+) -> Result<Table, TableError> {
     // Uniform in θ: α = cos θ for aligned fibers has an infinite slope in sin θ at the pole.
-    let axes = vec![Axis::uniform(AXIS_NU, 0.0, nu_max, nu_count), Axis::with_mapping(AXIS_ABS_SIN_THETA, 0.0, 1.0, sin_count, AxisMapping::Arcsine)];
-    Table::from_fn(axes, 1, |x, out| out[0] = attenuation_ratio(x[0], x[1]) as f32)
+    let axes = vec![
+        Axis::uniform(AXIS_NU, 0.0, nu_max, nu_count),
+        Axis::with_mapping(
+            AXIS_ABS_SIN_THETA,
+            0.0,
+            1.0,
+            sin_count,
+            AxisMapping::Arcsine,
+        ),
+    ];
+    Table::from_fn(axes, 1, |x, out| {
+        out[0] = attenuation_ratio(x[0], x[1]) as f32
+    })
 }
 
 #[cfg(test)]
@@ -76,10 +90,17 @@ mod tests {
             for _ in 0..n {
                 let (u1, u2): (f64, f64) = (unit().max(1e-300), unit());
                 let rad = (-2.0 * u1.ln()).sqrt();
-                let (x, y) = (nu * rad * (2.0 * PI * u2).cos(), nu * rad * (2.0 * PI * u2).sin());
+                let (x, y) = (
+                    nu * rad * (2.0 * PI * u2).cos(),
+                    nu * rad * (2.0 * PI * u2).sin(),
+                );
                 let r = (x * x + y * y).sqrt();
                 let (sr, cr) = r.sin_cos();
-                let t = if r > 0.0 { [sr * x / r, sr * y / r, cr] } else { [0.0, 0.0, 1.0] };
+                let t = if r > 0.0 {
+                    [sr * x / r, sr * y / r, cr]
+                } else {
+                    [0.0, 0.0, 1.0]
+                };
                 let d = t[0] * c + t[2] * s;
                 sum += (1.0 - d * d).max(0.0).sqrt();
             }

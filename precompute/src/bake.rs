@@ -8,11 +8,14 @@
 //! table at once, or a bake killed half way, leave either the old file or a complete new one.
 
 use serde::Serialize;
-use serde_json::{json, Value};
+use serde_json::{Value, json};
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-use strandlight_tables::asset::{read_asset, read_asset_metadata, write_asset, AssetDescription, AssetError, CreationInfo, Generator, Storage};
+use strandlight_tables::asset::{
+    AssetDescription, AssetError, CreationInfo, Generator, Storage, read_asset,
+    read_asset_metadata, write_asset,
+};
 use strandlight_tables::table::Table;
 use thiserror::Error;
 
@@ -22,13 +25,26 @@ pub const TABLE_EXTENSION: &str = "sltab";
 #[derive(Debug, Error)]
 pub enum BakeError {
     #[error("{table}: {source}")]
-    Build { table: String, source: Box<dyn std::error::Error + Send + Sync> },
+    Build {
+        table: String,
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
     #[error(transparent)]
     Asset(#[from] AssetError),
-    #[error("{table}: the computed table holds {nan} NaN and {inf} infinite values (first at node {first:?}); refusing to write it")]
-    NonFinite { table: String, nan: usize, inf: usize, first: Option<Vec<usize>> },
+    #[error(
+        "{table}: the computed table holds {nan} NaN and {inf} infinite values (first at node {first:?}); refusing to write it"
+    )]
+    NonFinite {
+        table: String,
+        nan: usize,
+        inf: usize,
+        first: Option<Vec<usize>>,
+    },
     #[error("cannot create the output folder {}: {source}", .path.display())]
-    OutputDir { path: PathBuf, source: std::io::Error },
+    OutputDir {
+        path: PathBuf,
+        source: std::io::Error,
+    },
 }
 
 /// Whatever a table's builder can fail with.
@@ -77,7 +93,9 @@ fn existing_asset(path: &Path, key: &str, storage: Storage) -> ExistingAsset {
     if !path.exists() {
         return ExistingAsset::AbsentOrStale;
     }
-    let same_inputs = |m: &strandlight_tables::asset::AssetMetadata| m.description.inputs_key.as_deref() == Some(key) && m.payload.storage == storage;
+    let same_inputs = |m: &strandlight_tables::asset::AssetMetadata| {
+        m.description.inputs_key.as_deref() == Some(key) && m.payload.storage == storage
+    };
     match read_asset_metadata(path) {
         Err(e) => ExistingAsset::Damaged(e),
         Ok(m) if !same_inputs(&m) => ExistingAsset::AbsentOrStale,
@@ -97,7 +115,10 @@ impl TableJob {
             "settings": self.settings,
             "generator": env!("CARGO_PKG_VERSION"),
         });
-        Sha256::digest(inputs.to_string().as_bytes()).iter().map(|b| format!("{b:02x}")).collect()
+        Sha256::digest(inputs.to_string().as_bytes())
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect()
     }
 }
 
@@ -107,14 +128,25 @@ pub fn table_path(dir: &Path, name: &str) -> PathBuf {
 
 /// Bakes `job` into `dir` unless a file with the same inputs is already there.
 pub fn bake_job(job: TableJob, dir: &Path, storage: Storage) -> Result<BakedTable, BakeError> {
-    std::fs::create_dir_all(dir).map_err(|source| BakeError::OutputDir { path: dir.to_path_buf(), source })?;
+    std::fs::create_dir_all(dir).map_err(|source| BakeError::OutputDir {
+        path: dir.to_path_buf(),
+        source,
+    })?;
     let path = table_path(dir, job.name);
     let key = job.inputs_key();
     let start = Instant::now();
     let replaced_damaged = match existing_asset(&path, &key, storage) {
         ExistingAsset::Current => {
             let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
-            return Ok(BakedTable { name: job.name.into(), path, bytes, seconds: start.elapsed().as_secs_f64(), cached: true, max_value: f32::NAN, replaced_damaged: None });
+            return Ok(BakedTable {
+                name: job.name.into(),
+                path,
+                bytes,
+                seconds: start.elapsed().as_secs_f64(),
+                cached: true,
+                max_value: f32::NAN,
+                replaced_damaged: None,
+            });
         }
         ExistingAsset::AbsentOrStale => None,
         ExistingAsset::Damaged(e) => Some(e.to_string()),
@@ -125,11 +157,17 @@ pub fn bake_job(job: TableJob, dir: &Path, storage: Storage) -> Result<BakedTabl
         quantity: job.quantity.clone(),
         scattering_function: job.scattering_function.clone(),
         fiber_parameters: job.fiber_parameters.clone(),
-        generator: Generator { name: "strandlight bake".into(), version: env!("CARGO_PKG_VERSION").into() },
+        generator: Generator {
+            name: "strandlight bake".into(),
+            version: env!("CARGO_PKG_VERSION").into(),
+        },
         created: CreationInfo::now(),
         inputs_key: Some(key),
     };
-    let table = (job.build)().map_err(|source| BakeError::Build { table: name.into(), source })?;
+    let table = (job.build)().map_err(|source| BakeError::Build {
+        table: name.into(),
+        source,
+    })?;
     let stats = table.stats();
     if stats.nan_count + stats.infinite_count > 0 {
         return Err(BakeError::NonFinite {
@@ -141,7 +179,15 @@ pub fn bake_job(job: TableJob, dir: &Path, storage: Storage) -> Result<BakedTabl
     }
     write_asset(&path, &table, &description, storage)?;
     let bytes = std::fs::metadata(&path).map(|m| m.len()).unwrap_or(0);
-    Ok(BakedTable { name: name.into(), path, bytes, seconds: start.elapsed().as_secs_f64(), cached: false, max_value: stats.max, replaced_damaged })
+    Ok(BakedTable {
+        name: name.into(),
+        path,
+        bytes,
+        seconds: start.elapsed().as_secs_f64(),
+        cached: false,
+        max_value: stats.max,
+        replaced_damaged,
+    })
 }
 
 #[cfg(test)]
@@ -156,13 +202,20 @@ mod tests {
             scattering_function: "none".into(),
             fiber_parameters: json!({ "scale": scale }),
             settings: json!({ "n": 5 }),
-            build: Box::new(move || Ok(Table::from_fn(vec![Axis::uniform("x", 0.0, 1.0, 5)], 1, move |x, out| out[0] = x[0] as f32 * scale)?)),
+            build: Box::new(move || {
+                Ok(Table::from_fn(
+                    vec![Axis::uniform("x", 0.0, 1.0, 5)],
+                    1,
+                    move |x, out| out[0] = x[0] as f32 * scale,
+                )?)
+            }),
         }
     }
 
     #[test]
     fn unchanged_inputs_are_cached_and_changed_ones_rebake() {
-        let dir = std::env::temp_dir().join(format!("strandlight-bake-test-{}", std::process::id()));
+        let dir =
+            std::env::temp_dir().join(format!("strandlight-bake-test-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         let first = bake_job(job(2.0), &dir, Storage::F32).unwrap();
         assert!(!first.cached);
@@ -178,7 +231,8 @@ mod tests {
     }
 
     fn temp_dir(tag: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("strandlight-bake-{tag}-{}", std::process::id()));
+        let dir =
+            std::env::temp_dir().join(format!("strandlight-bake-{tag}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         dir
     }
@@ -197,21 +251,38 @@ mod tests {
             damages.push((format!("bit flip at byte {at}"), bytes));
         }
         for cut in [0, 8, 16, original.len() / 2, original.len() - 1] {
-            damages.push((format!("truncated to {cut} bytes"), original[..cut].to_vec()));
+            damages.push((
+                format!("truncated to {cut} bytes"),
+                original[..cut].to_vec(),
+            ));
         }
         let mut rebuilt = 0;
         for (what, bytes) in &damages {
             std::fs::write(&good.path, bytes).unwrap();
             let again = bake_job(job(2.0), &dir, Storage::F32).unwrap();
-            assert!(!again.cached, "{what}: a damaged asset was served from the cache");
-            assert!(again.replaced_damaged.is_some(), "{what}: the rebuild was not reported");
-            let asset = strandlight_tables::asset::read_asset(&good.path).unwrap_or_else(|e| panic!("{what}: rebuilt asset unreadable: {e}"));
+            assert!(
+                !again.cached,
+                "{what}: a damaged asset was served from the cache"
+            );
+            assert!(
+                again.replaced_damaged.is_some(),
+                "{what}: the rebuild was not reported"
+            );
+            let asset = strandlight_tables::asset::read_asset(&good.path)
+                .unwrap_or_else(|e| panic!("{what}: rebuilt asset unreadable: {e}"));
             assert_eq!(asset.table.lookup_scalar(&[1.0]).unwrap(), 2.0, "{what}");
             rebuilt += 1;
         }
         assert_eq!(rebuilt, damages.len());
-        println!("{rebuilt} damaged copies of a {}-byte asset, every one rebuilt", original.len());
-        assert!(damages.len() > 50, "the asset is only {} bytes: the sweep is too thin", original.len());
+        println!(
+            "{rebuilt} damaged copies of a {}-byte asset, every one rebuilt",
+            original.len()
+        );
+        assert!(
+            damages.len() > 50,
+            "the asset is only {} bytes: the sweep is too thin",
+            original.len()
+        );
         // And an intact file is served again.
         assert!(bake_job(job(2.0), &dir, Storage::F32).unwrap().cached);
         std::fs::remove_dir_all(&dir).unwrap();
@@ -229,15 +300,24 @@ mod tests {
                 for _ in 0..4 {
                     scope.spawn(|| {
                         barrier.wait();
-                        bake_job(job(2.0), &dir, Storage::F32).unwrap_or_else(|e| panic!("round {round}: {e}"))
+                        bake_job(job(2.0), &dir, Storage::F32)
+                            .unwrap_or_else(|e| panic!("round {round}: {e}"))
                     });
                 }
             });
-            let asset = strandlight_tables::asset::read_asset(&table_path(&dir, "test_table")).unwrap();
+            let asset =
+                strandlight_tables::asset::read_asset(&table_path(&dir, "test_table")).unwrap();
             assert_eq!(asset.table.lookup_scalar(&[0.5]).unwrap(), 1.0);
         }
-        let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).filter(|n| n.to_string_lossy().contains(".tmp-")).collect();
-        assert!(leftovers.is_empty(), "temporary files left behind: {leftovers:?}");
+        let leftovers: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .filter(|n| n.to_string_lossy().contains(".tmp-"))
+            .collect();
+        assert!(
+            leftovers.is_empty(),
+            "temporary files left behind: {leftovers:?}"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -246,7 +326,13 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("strandlight-bake-nan-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         let bad = TableJob {
-            build: Box::new(|| Ok(Table::from_fn(vec![Axis::uniform("x", 0.0, 1.0, 3)], 1, |x, out| out[0] = if x[0] > 0.7 { f32::NAN } else { 1.0 })?)),
+            build: Box::new(|| {
+                Ok(Table::from_fn(
+                    vec![Axis::uniform("x", 0.0, 1.0, 3)],
+                    1,
+                    |x, out| out[0] = if x[0] > 0.7 { f32::NAN } else { 1.0 },
+                )?)
+            }),
             ..job(1.0)
         };
         let err = bake_job(bad, &dir, Storage::F32).unwrap_err();

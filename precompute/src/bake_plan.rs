@@ -3,25 +3,29 @@
 
 use crate::attenuation_ratio::attenuation_ratio_table;
 use crate::bake::{BuildError, TableJob};
-use crate::convolution::{convolve_grid, ConvolutionGrid, ConvolutionSettings};
-use crate::convolution_table::{bake_convolution_table, ConvolutionResolution};
-use crate::direct_table::{bake_direct_table, DirectResolution};
-use crate::multiple_scattering_table::{bake_multiple_scattering_table, MultipleScatteringResolution};
-use crate::point_light_luts::{bake_lut_m, bake_lut_n, LutResolution};
+use crate::convolution::{ConvolutionGrid, ConvolutionSettings, convolve_grid};
+use crate::convolution_table::{ConvolutionResolution, bake_convolution_table};
+use crate::direct_table::{DirectResolution, bake_direct_table};
+use crate::multiple_scattering_table::{
+    MultipleScatteringResolution, bake_multiple_scattering_table,
+};
+use crate::point_light_luts::{LutResolution, bake_lut_m, bake_lut_n};
 use crate::srbf_spread::srbf_spread_table;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::path::Path;
 use std::sync::Arc;
+use strandlight_tables::FiberAngles;
 use strandlight_tables::artist::{ArtistModel, ArtistParams, Normalization};
-use strandlight_tables::dual_scattering::{DualScatteringAverages, DualScatteringBcsdf, DualScatteringConfig, LobeDecomposition};
+use strandlight_tables::dual_scattering::{
+    DualScatteringAverages, DualScatteringBcsdf, DualScatteringConfig, LobeDecomposition,
+};
 use strandlight_tables::error::ParamError;
 use strandlight_tables::kajiya_kay::{KajiyaKay, KajiyaKayParams};
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 use strandlight_tables::scattering::{Rgb, ScatteringFunction};
 use strandlight_tables::table::{Axis, AxisMapping, Table};
 use strandlight_tables::table_axes::{AXIS_QUANTITY, AXIS_SIN_THETA};
-use strandlight_tables::FiberAngles;
 use thiserror::Error;
 
 /// Everything about a fiber that any table depends on. A TOML file with any subset of these
@@ -38,9 +42,15 @@ pub struct FiberDescription {
 #[derive(Debug, Error)]
 pub enum FiberError {
     #[error("{}: {source}", .path.display())]
-    Read { path: std::path::PathBuf, source: std::io::Error },
+    Read {
+        path: std::path::PathBuf,
+        source: std::io::Error,
+    },
     #[error("{}: not a valid fiber description: {message}", .path.display())]
-    Parse { path: std::path::PathBuf, message: String },
+    Parse {
+        path: std::path::PathBuf,
+        message: String,
+    },
     #[error("{context}: {source}")]
     Param { context: String, source: ParamError },
 }
@@ -48,25 +58,46 @@ pub enum FiberError {
 impl FiberDescription {
     /// The defaults with the Marschner absorption of a named melanin preset.
     pub fn preset(name: &str) -> Result<Self, FiberError> {
-        let marschner = MarschnerParams::with_preset(name).map_err(|source| FiberError::Param { context: "--preset".into(), source })?;
-        Ok(Self { marschner, ..Self::default() })
+        let marschner = MarschnerParams::with_preset(name).map_err(|source| FiberError::Param {
+            context: "--preset".into(),
+            source,
+        })?;
+        Ok(Self {
+            marschner,
+            ..Self::default()
+        })
     }
 
     pub fn from_toml_file(path: &Path) -> Result<Self, FiberError> {
-        let text = std::fs::read_to_string(path).map_err(|source| FiberError::Read { path: path.into(), source })?;
-        let fiber: Self = toml::from_str(&text).map_err(|e| FiberError::Parse { path: path.into(), message: e.to_string() })?;
+        let text = std::fs::read_to_string(path).map_err(|source| FiberError::Read {
+            path: path.into(),
+            source,
+        })?;
+        let fiber: Self = toml::from_str(&text).map_err(|e| FiberError::Parse {
+            path: path.into(),
+            message: e.to_string(),
+        })?;
         fiber.validate().map_err(|e| match e {
-            FiberError::Param { context, source } => FiberError::Param { context: format!("{}: {context}", path.display()), source },
+            FiberError::Param { context, source } => FiberError::Param {
+                context: format!("{}: {context}", path.display()),
+                source,
+            },
             other => other,
         })?;
         Ok(fiber)
     }
 
     pub fn validate(&self) -> Result<(), FiberError> {
-        self.marschner.validate().map_err(param_error("[marschner]"))?;
-        self.kajiya_kay.validate().map_err(param_error("[kajiya_kay]"))?;
+        self.marschner
+            .validate()
+            .map_err(param_error("[marschner]"))?;
+        self.kajiya_kay
+            .validate()
+            .map_err(param_error("[kajiya_kay]"))?;
         self.artist.validate().map_err(param_error("[artist]"))?;
-        self.dual_scattering.validate().map_err(param_error("[dual_scattering]"))?;
+        self.dual_scattering
+            .validate()
+            .map_err(param_error("[dual_scattering]"))?;
         Ok(())
     }
 }
@@ -108,19 +139,32 @@ pub struct ConvolutionSettingsSerde {
 
 impl From<ConvolutionSettingsSerde> for ConvolutionSettings {
     fn from(s: ConvolutionSettingsSerde) -> Self {
-        Self { theta_panels: s.theta_panels, phi_panels: s.phi_panels, max_harmonic: None }
+        Self {
+            theta_panels: s.theta_panels,
+            phi_panels: s.phi_panels,
+            max_harmonic: None,
+        }
     }
 }
 
 impl Default for BakeResolution {
     /// The paper's sample counts (32 per direction axis, 64 for λ and σ̄_f) on angular axes.
     fn default() -> Self {
-        let convolution = ConvolutionResolution { axes: crate::convolution_table::DirectionAxes::Angular, ..Default::default() };
+        let convolution = ConvolutionResolution {
+            axes: crate::convolution_table::DirectionAxes::Angular,
+            ..Default::default()
+        };
         let d = ConvolutionSettings::default();
         Self {
             convolution,
-            settings: ConvolutionSettingsSerde { theta_panels: d.theta_panels, phi_panels: d.phi_panels },
-            multiple: MultipleScatteringResolution { axes: crate::convolution_table::DirectionAxes::Angular, ..Default::default() },
+            settings: ConvolutionSettingsSerde {
+                theta_panels: d.theta_panels,
+                phi_panels: d.phi_panels,
+            },
+            multiple: MultipleScatteringResolution {
+                axes: crate::convolution_table::DirectionAxes::Angular,
+                ..Default::default()
+            },
             luts: LutResolution::default(),
             attenuation_ratio: [32, 32],
             attenuation_nu_max: 1.0,
@@ -144,8 +188,21 @@ impl BakeResolution {
     /// Every direction axis with `n` nodes, λ and σ̄_f with `2n`: for quick runs and CI.
     pub fn reduced(n: usize) -> Self {
         let mut r = Self::default();
-        r.convolution = ConvolutionResolution { u_dot_xi: n, u_dot_wo: n, cos_dphi: n, inv_lambda: 2 * n, ..r.convolution };
-        r.multiple = MultipleScatteringResolution { u_dot_xi: n, u_dot_wo: n, cos_dphi: n, sigma_f: 2 * n, theta_nodes: 513, ..r.multiple };
+        r.convolution = ConvolutionResolution {
+            u_dot_xi: n,
+            u_dot_wo: n,
+            cos_dphi: n,
+            inv_lambda: 2 * n,
+            ..r.convolution
+        };
+        r.multiple = MultipleScatteringResolution {
+            u_dot_xi: n,
+            u_dot_wo: n,
+            cos_dphi: n,
+            sigma_f: 2 * n,
+            theta_nodes: 513,
+            ..r.multiple
+        };
         r.luts = LutResolution::square(4 * n);
         r.attenuation_ratio = [n, n];
         r.srbf_spread = [n, 2 * n];
@@ -153,7 +210,10 @@ impl BakeResolution {
         r.kajiya_kay_direction_nodes = 3 * n;
         // 3D and cheap, so 4n, but never above the full-resolution count (1024³ would be 13 GB).
         r.direct_direction_nodes = (4 * n).min(DEFAULT_DIRECT_NODES);
-        r.settings = ConvolutionSettingsSerde { theta_panels: 48, phi_panels: 16 };
+        r.settings = ConvolutionSettingsSerde {
+            theta_panels: 48,
+            phi_panels: 16,
+        };
         r
     }
 
@@ -195,7 +255,12 @@ pub struct PlanOptions {
 
 impl Default for PlanOptions {
     fn default() -> Self {
-        Self { models: vec![Model::Marschner, Model::KajiyaKay, Model::Artist], resolution: BakeResolution::default(), force_multiple: false, multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD }
+        Self {
+            models: vec![Model::Marschner, Model::KajiyaKay, Model::Artist],
+            resolution: BakeResolution::default(),
+            force_multiple: false,
+            multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD,
+        }
     }
 }
 
@@ -204,7 +269,10 @@ fn boxed<E: std::error::Error + Send + Sync + 'static>(e: E) -> BuildError {
 }
 
 fn param_error(context: &'static str) -> impl Fn(ParamError) -> FiberError {
-    move |source| FiberError::Param { context: context.into(), source }
+    move |source| FiberError::Param {
+        context: context.into(),
+        source,
+    }
 }
 
 /// Builds the list of jobs. Cheap: every table is computed only when its job runs.
@@ -219,10 +287,16 @@ pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan,
 
     // The physical model whose BCSDF multiple scattering uses: Marschner if baked, else the
     // artist model's normalized copy (Sadeghi eq. 13).
-    let mut multiple_source: Option<(Arc<dyn ScatteringFunction>, DualScatteringAverages, serde_json::Value, &'static str)> = None;
+    let mut multiple_source: Option<(
+        Arc<dyn ScatteringFunction>,
+        DualScatteringAverages,
+        serde_json::Value,
+        &'static str,
+    )> = None;
 
     if options.models.contains(&Model::Marschner) {
-        let m = Arc::new(Marschner::new(fiber.marschner.clone()).map_err(param_error("[marschner]"))?);
+        let m =
+            Arc::new(Marschner::new(fiber.marschner.clone()).map_err(param_error("[marschner]"))?);
         let params = json!({ "marschner": fiber.marschner });
         let s = m.clone();
         jobs.push(TableJob {
@@ -233,9 +307,17 @@ pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan,
             settings: conv_settings.clone(),
             build: Box::new(move || Ok(bake_convolution_table(&|a: &FiberAngles| s.eval(a), &res.convolution, &settings)?)),
         });
-        let averages = DualScatteringAverages::new(m.as_ref() as &dyn LobeDecomposition, fiber.dual_scattering).map_err(param_error("[marschner] dual-scattering averages"))?;
-        let full_params = json!({ "marschner": fiber.marschner, "dual_scattering": fiber.dual_scattering });
-        let bcsdf = Arc::new(DualScatteringBcsdf { single: (*m).clone(), averages: averages.clone() });
+        let averages = DualScatteringAverages::new(
+            m.as_ref() as &dyn LobeDecomposition,
+            fiber.dual_scattering,
+        )
+        .map_err(param_error("[marschner] dual-scattering averages"))?;
+        let full_params =
+            json!({ "marschner": fiber.marschner, "dual_scattering": fiber.dual_scattering });
+        let bcsdf = Arc::new(DualScatteringBcsdf {
+            single: (*m).clone(),
+            averages: averages.clone(),
+        });
         let b = bcsdf.clone();
         let r2 = options.resolution.clone();
         jobs.push(TableJob {
@@ -244,16 +326,44 @@ pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan,
             scattering_function: "marschner+dual-scattering-back".into(),
             fiber_parameters: full_params.clone(),
             settings: conv_settings.clone(),
-            build: Box::new(move || Ok(bake_convolution_table(&|a: &FiberAngles| b.eval(a), &r2.convolution, &settings)?)),
+            build: Box::new(move || {
+                Ok(bake_convolution_table(
+                    &|a: &FiberAngles| b.eval(a),
+                    &r2.convolution,
+                    &settings,
+                )?)
+            }),
         });
-        push_direct(&mut jobs, "marschner_direct", "S(ω_i, ω_o)·cos θ_i of Marschner for a directional light, RGB", "marschner", params.clone(), &options.resolution, m.clone());
-        push_direct(&mut jobs, "marschner_full_direct", "(S + d_b S_back)·cos θ_i for a directional light (Ren §7), RGB", "marschner+dual-scattering-back", full_params.clone(), &options.resolution, bcsdf.clone());
-        push_fiber_averages(&mut jobs, averages.clone(), full_params.clone(), options.resolution.fiber_average_thetas);
+        push_direct(
+            &mut jobs,
+            "marschner_direct",
+            "S(ω_i, ω_o)·cos θ_i of Marschner for a directional light, RGB",
+            "marschner",
+            params.clone(),
+            &options.resolution,
+            m.clone(),
+        );
+        push_direct(
+            &mut jobs,
+            "marschner_full_direct",
+            "(S + d_b S_back)·cos θ_i for a directional light (Ren §7), RGB",
+            "marschner+dual-scattering-back",
+            full_params.clone(),
+            &options.resolution,
+            bcsdf.clone(),
+        );
+        push_fiber_averages(
+            &mut jobs,
+            averages.clone(),
+            full_params.clone(),
+            options.resolution.fiber_average_thetas,
+        );
         let (mm, mn) = (m.clone(), m.clone());
         let (luts_m, luts_n) = (options.resolution.luts, options.resolution.luts);
         jobs.push(TableJob {
             name: "lut_m",
-            quantity: "Hunz Alg. 2 M texture: M_R, M_TT, M_TRT, cos θ_d over (sin θ_i, sin θ_o)".into(),
+            quantity: "Hunz Alg. 2 M texture: M_R, M_TT, M_TRT, cos θ_d over (sin θ_i, sin θ_o)"
+                .into(),
             scattering_function: "marschner".into(),
             fiber_parameters: params.clone(),
             settings: json!({ "luts": luts_m }),
@@ -267,7 +377,12 @@ pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan,
             settings: json!({ "luts": luts_n }),
             build: Box::new(move || bake_lut_n(&mn, &luts_n).map_err(boxed)),
         });
-        multiple_source = Some((m as Arc<dyn ScatteringFunction>, averages, full_params, "marschner"));
+        multiple_source = Some((
+            m as Arc<dyn ScatteringFunction>,
+            averages,
+            full_params,
+            "marschner",
+        ));
     }
 
     if options.models.contains(&Model::KajiyaKay) {
@@ -286,13 +401,35 @@ pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan,
             settings: conv_settings.clone(),
             build: Box::new(move || Ok(bake_convolution_table(&|x: &FiberAngles| s.eval(x), &r.convolution, &settings)?)),
         });
-        push_direct(&mut jobs, "artist_direct", "f'_s(ω_i, ω_o)·cos θ_i of the artist-friendly model for a directional light, RGB", "artist", json!({ "artist": fiber.artist }), &options.resolution, a.clone());
+        push_direct(
+            &mut jobs,
+            "artist_direct",
+            "f'_s(ω_i, ω_o)·cos θ_i of the artist-friendly model for a directional light, RGB",
+            "artist",
+            json!({ "artist": fiber.artist }),
+            &options.resolution,
+            a.clone(),
+        );
         if multiple_source.is_none() {
             let normalized = a.normalized(Normalization::PeakPerChannel);
-            let averages = DualScatteringAverages::new(&normalized as &dyn LobeDecomposition, fiber.dual_scattering).map_err(param_error("[artist] dual-scattering averages"))?;
+            let averages = DualScatteringAverages::new(
+                &normalized as &dyn LobeDecomposition,
+                fiber.dual_scattering,
+            )
+            .map_err(param_error("[artist] dual-scattering averages"))?;
             let params = json!({ "artist": fiber.artist, "dual_scattering": fiber.dual_scattering, "normalization": "peak-per-channel" });
-            push_fiber_averages(&mut jobs, averages.clone(), params.clone(), options.resolution.fiber_average_thetas);
-            multiple_source = Some((Arc::new(normalized) as Arc<dyn ScatteringFunction>, averages, params, "artist-normalized"));
+            push_fiber_averages(
+                &mut jobs,
+                averages.clone(),
+                params.clone(),
+                options.resolution.fiber_average_thetas,
+            );
+            multiple_source = Some((
+                Arc::new(normalized) as Arc<dyn ScatteringFunction>,
+                averages,
+                params,
+                "artist-normalized",
+            ));
         }
     }
 
@@ -346,12 +483,24 @@ pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan,
             build: Box::new(move || Ok(srbf_spread_table(r.srbf_spread[0], r.srbf_spread[1], r.convolution.lambda_min, r.convolution.lambda_max)?)),
         });
     }
-    Ok(BakePlan { jobs, skipped, multiple_scattering_share: share })
+    Ok(BakePlan {
+        jobs,
+        skipped,
+        multiple_scattering_share: share,
+    })
 }
 
 /// A direct table of `model` (see [`crate::direct_table`]): same fiber parameters as the
 /// convolution table it stands beside, so one parameter check serves both.
-fn push_direct(jobs: &mut Vec<TableJob>, name: &'static str, quantity: &str, scattering_function: &str, fiber_parameters: serde_json::Value, res: &BakeResolution, model: Arc<dyn ScatteringFunction>) {
+fn push_direct(
+    jobs: &mut Vec<TableJob>,
+    name: &'static str,
+    quantity: &str,
+    scattering_function: &str,
+    fiber_parameters: serde_json::Value,
+    res: &BakeResolution,
+    model: Arc<dyn ScatteringFunction>,
+) {
     let direct = res.direct();
     jobs.push(TableJob {
         name,
@@ -359,7 +508,12 @@ fn push_direct(jobs: &mut Vec<TableJob>, name: &'static str, quantity: &str, sca
         scattering_function: scattering_function.into(),
         fiber_parameters,
         settings: json!({ "direct": direct }),
-        build: Box::new(move || Ok(bake_direct_table(&|a: &FiberAngles| model.eval(a), &direct)?)),
+        build: Box::new(move || {
+            Ok(bake_direct_table(
+                &|a: &FiberAngles| model.eval(a),
+                &direct,
+            )?)
+        }),
     });
 }
 
@@ -367,7 +521,12 @@ fn push_direct(jobs: &mut Vec<TableJob>, name: &'static str, quantity: &str, sca
 /// inclinations, as light arrives isotropically in a dense volume), for the brightest channel.
 /// In a dense medium of albedo a the multiply scattered share of the scattered light is a.
 pub fn single_event_albedo(averages: &DualScatteringAverages) -> f64 {
-    let rule = strandlight_tables::quadrature::GaussLegendre::composite(8, 16, -std::f64::consts::FRAC_PI_2, std::f64::consts::FRAC_PI_2);
+    let rule = strandlight_tables::quadrature::GaussLegendre::composite(
+        8,
+        16,
+        -std::f64::consts::FRAC_PI_2,
+        std::f64::consts::FRAC_PI_2,
+    );
     (0..3)
         .map(|c| {
             0.5 * rule.integrate(|theta| {
@@ -379,9 +538,16 @@ pub fn single_event_albedo(averages: &DualScatteringAverages) -> f64 {
 }
 
 /// Names of the quantities on the `quantity` axis of `fiber_averages`, in node order.
-pub const FIBER_AVERAGE_QUANTITIES: [&str; 9] = ["a_f", "a_b", "alpha_f", "alpha_b", "beta2_f", "beta2_b", "A_b", "Delta_b", "sigma2_b"];
+pub const FIBER_AVERAGE_QUANTITIES: [&str; 9] = [
+    "a_f", "a_b", "alpha_f", "alpha_b", "beta2_f", "beta2_b", "A_b", "Delta_b", "sigma2_b",
+];
 
-fn push_fiber_averages(jobs: &mut Vec<TableJob>, averages: DualScatteringAverages, params: serde_json::Value, thetas: usize) {
+fn push_fiber_averages(
+    jobs: &mut Vec<TableJob>,
+    averages: DualScatteringAverages,
+    params: serde_json::Value,
+    thetas: usize,
+) {
     jobs.push(TableJob {
         name: "fiber_averages",
         quantity: format!("dual-scattering fiber averages per inclination (Zinke 2008), quantity axis = {FIBER_AVERAGE_QUANTITIES:?}, angles in radians of θ_h, RGB"),
@@ -416,12 +582,24 @@ fn push_fiber_averages(jobs: &mut Vec<TableJob>, averages: DualScatteringAverage
     });
 }
 
-fn push_kajiya_kay(jobs: &mut Vec<TableJob>, fiber: &FiberDescription, res: &BakeResolution, settings: ConvolutionSettings) -> Result<(), FiberError> {
+fn push_kajiya_kay(
+    jobs: &mut Vec<TableJob>,
+    fiber: &FiberDescription,
+    res: &BakeResolution,
+    settings: ConvolutionSettings,
+) -> Result<(), FiberError> {
     // Neither integrand depends on φ: only the zeroth harmonic is non-zero, exactly.
-    let settings = ConvolutionSettings { max_harmonic: Some(0), ..settings };
+    let settings = ConvolutionSettings {
+        max_harmonic: Some(0),
+        ..settings
+    };
     let kk = Arc::new(KajiyaKay::new(fiber.kajiya_kay).map_err(param_error("[kajiya_kay]"))?);
     let n = res.kajiya_kay_direction_nodes;
-    let conv = ConvolutionResolution { u_dot_xi: n, u_dot_wo: n, ..res.convolution };
+    let conv = ConvolutionResolution {
+        u_dot_xi: n,
+        u_dot_wo: n,
+        ..res.convolution
+    };
     let grid_2d = {
         let axes = conv.axes();
         ConvolutionGrid {
@@ -437,13 +615,18 @@ fn push_kajiya_kay(jobs: &mut Vec<TableJob>, fiber: &FiberDescription, res: &Bak
     };
     jobs.push(TableJob {
         name: "kk_diffuse",
-        quantity: "I_d: ∫ G(ω_i; ξ, λ) cos θ_i dω_i (Ren §4; times K_d at run time), monochrome".into(),
+        quantity: "I_d: ∫ G(ω_i; ξ, λ) cos θ_i dω_i (Ren §4; times K_d at run time), monochrome"
+            .into(),
         scattering_function: "kajiya-kay".into(),
         fiber_parameters: json!({}),
         settings: json!({ "resolution": conv, "settings": res.settings }),
         build: Box::new(move || {
             let v = convolve_grid(&|_: &FiberAngles| [1.0, 1.0, 1.0], &grid_2d, &settings);
-            Ok(Table::new(diffuse_axes, 1, v.iter().map(|x| x[0] as f32).collect())?)
+            Ok(Table::new(
+                diffuse_axes,
+                1,
+                v.iter().map(|x| x[0] as f32).collect(),
+            )?)
         }),
     });
     let exponent = fiber.kajiya_kay.exponent;
@@ -462,7 +645,9 @@ fn push_kajiya_kay(jobs: &mut Vec<TableJob>, fiber: &FiberDescription, res: &Bak
     };
     jobs.push(TableJob {
         name: "kk_specular",
-        quantity: "I_s: ∫ G(ω_i; ξ, λ) cos^p(θ_i + θ_o) dω_i (Ren §4; times K_s at run time), monochrome".into(),
+        quantity:
+            "I_s: ∫ G(ω_i; ξ, λ) cos^p(θ_i + θ_o) dω_i (Ren §4; times K_s at run time), monochrome"
+                .into(),
         scattering_function: "kajiya-kay".into(),
         fiber_parameters: json!({ "exponent": exponent }),
         settings: json!({ "resolution": conv, "settings": res.settings }),
@@ -474,7 +659,11 @@ fn push_kajiya_kay(jobs: &mut Vec<TableJob>, fiber: &FiberDescription, res: &Bak
                 [v, v, v]
             };
             let v = convolve_grid(&s, &grid_3d, &settings);
-            Ok(Table::new(spec_axes, 1, v.iter().map(|x| x[0] as f32).collect())?)
+            Ok(Table::new(
+                spec_axes,
+                1,
+                v.iter().map(|x| x[0] as f32).collect(),
+            )?)
         }),
     });
     Ok(())
@@ -486,19 +675,33 @@ mod tests {
 
     #[test]
     fn dark_hair_skips_multiple_scattering_and_blonde_keeps_it() {
-        let options = PlanOptions { models: vec![Model::Marschner], resolution: BakeResolution::reduced(4), ..Default::default() };
+        let options = PlanOptions {
+            models: vec![Model::Marschner],
+            resolution: BakeResolution::reduced(4),
+            ..Default::default()
+        };
         let dark = plan(&FiberDescription::preset("dark").unwrap(), &options).unwrap();
         let blonde = plan(&FiberDescription::preset("blonde").unwrap(), &options).unwrap();
         for preset in ["dark", "brown", "red", "blonde", "white"] {
             let p = plan(&FiberDescription::preset(preset).unwrap(), &options).unwrap();
-            println!("multiple-scattering share {preset}: {:.4}", p.multiple_scattering_share.unwrap());
+            println!(
+                "multiple-scattering share {preset}: {:.4}",
+                p.multiple_scattering_share.unwrap()
+            );
         }
         assert!(dark.skipped.iter().any(|s| s.name == "multiple"));
         assert!(blonde.jobs.iter().any(|j| j.name == "multiple"));
         // The share is an albedo: above the ~4.6% Fresnel reflectance of R alone, below 1.
         let d = dark.multiple_scattering_share.unwrap();
         assert!(d > 0.046 && d < DEFAULT_MULTIPLE_THRESHOLD, "{d}");
-        let forced = plan(&FiberDescription::preset("dark").unwrap(), &PlanOptions { force_multiple: true, ..options }).unwrap();
+        let forced = plan(
+            &FiberDescription::preset("dark").unwrap(),
+            &PlanOptions {
+                force_multiple: true,
+                ..options
+            },
+        )
+        .unwrap();
         assert!(forced.jobs.iter().any(|j| j.name == "multiple"));
     }
 
@@ -508,12 +711,20 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("bad.toml");
         std::fs::write(&path, "[marschner]\neta = 0.9\n").unwrap();
-        let err = FiberDescription::from_toml_file(&path).unwrap_err().to_string();
+        let err = FiberDescription::from_toml_file(&path)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("bad.toml") && err.contains("eta"), "{err}");
         std::fs::write(&path, "[marschner]\netta = 1.5\n").unwrap();
-        let err = FiberDescription::from_toml_file(&path).unwrap_err().to_string();
+        let err = FiberDescription::from_toml_file(&path)
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("bad.toml") && err.contains("etta"), "{err}");
-        std::fs::write(&path, "[marschner]\neta = 1.6\n[dual_scattering]\ndensity_backward = 0.6\n").unwrap();
+        std::fs::write(
+            &path,
+            "[marschner]\neta = 1.6\n[dual_scattering]\ndensity_backward = 0.6\n",
+        )
+        .unwrap();
         let ok = FiberDescription::from_toml_file(&path).unwrap();
         assert_eq!(ok.marschner.eta, 1.6);
         std::fs::remove_dir_all(&dir).unwrap();

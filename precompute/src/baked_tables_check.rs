@@ -8,28 +8,40 @@ use crate::convolution::convolve_reference;
 use crate::direct_table::direct_value;
 use crate::multiple_scattering_table::multiple_scattering_reference;
 use crate::srbf_spread::srbf_longitudinal_variance;
-use crate::table_accuracy::{stratified_points, summarize, TableAccuracy};
+use crate::table_accuracy::{TableAccuracy, stratified_points, summarize};
 use rayon::prelude::*;
 use serde_json::Value;
 use std::sync::Arc;
+use strandlight_tables::FiberAngles;
 use strandlight_tables::artist::{ArtistModel, ArtistParams, Normalization};
 use strandlight_tables::asset::TableAsset;
-use strandlight_tables::dual_scattering::{backscatter_series, fiber_averages_direct, DualScatteringAverages, DualScatteringConfig, LobeDecomposition};
+use strandlight_tables::dual_scattering::{
+    DualScatteringAverages, DualScatteringConfig, LobeDecomposition, backscatter_series,
+    fiber_averages_direct,
+};
 use strandlight_tables::kajiya_kay::{KajiyaKay, KajiyaKayParams};
 use strandlight_tables::marschner::{Lobe, Marschner, MarschnerParams};
 use strandlight_tables::scattering::{Rgb, ScatteringFunction};
 use strandlight_tables::table_axes::{AXIS_LOBE, AXIS_QUANTITY};
-use strandlight_tables::FiberAngles;
 use thiserror::Error;
 
 #[derive(Debug, Error)]
 pub enum CheckError {
     #[error("{}: table `{name}` is not one strandlight knows how to check", .path.display())]
-    UnknownTable { path: std::path::PathBuf, name: String },
+    UnknownTable {
+        path: std::path::PathBuf,
+        name: String,
+    },
     #[error("{}: its fiber parameters cannot be read back: {message}", .path.display())]
-    Parameters { path: std::path::PathBuf, message: String },
+    Parameters {
+        path: std::path::PathBuf,
+        message: String,
+    },
     #[error("{}: lookup failed: {source}", .path.display())]
-    Lookup { path: std::path::PathBuf, source: strandlight_tables::table::TableError },
+    Lookup {
+        path: std::path::PathBuf,
+        source: strandlight_tables::table::TableError,
+    },
 }
 
 /// Panels of the reference quadratures: converged well below the tables' errors (the harmonic
@@ -39,20 +51,37 @@ const REFERENCE_PANELS: usize = 32;
 type Reference = Arc<dyn Fn(&[f64]) -> Vec<f64> + Send + Sync>;
 
 /// Checks one table at `samples` points.
-pub fn check_asset(asset: &TableAsset, samples: usize, seed: u64) -> Result<TableAccuracy, CheckError> {
+pub fn check_asset(
+    asset: &TableAsset,
+    samples: usize,
+    seed: u64,
+) -> Result<TableAccuracy, CheckError> {
     let name = asset.metadata.description.name.clone();
     let params = &asset.metadata.description.fiber_parameters;
     let path = asset.path.clone();
-    let bad = |message: String| CheckError::Parameters { path: path.clone(), message };
+    let bad = |message: String| CheckError::Parameters {
+        path: path.clone(),
+        message,
+    };
     let table = &asset.table;
     let axes = table.axes();
     let (reference, points): (Reference, Vec<Vec<f64>>) = match name.as_str() {
         "marschner" | "marschner_full" | "artist" => {
             let s = scattering_from(&name, params).map_err(bad)?;
             let (lmin, lmax) = (1.0 / axes[3].max, 1.0 / axes[3].min);
-            let pts = stratified_points(samples, lmin, lmax, seed).into_iter().map(|p| p.to_vec()).collect();
+            let pts = stratified_points(samples, lmin, lmax, seed)
+                .into_iter()
+                .map(|p| p.to_vec())
+                .collect();
             let r: Reference = Arc::new(move |x: &[f64]| {
-                let v = convolve_reference(&|a: &FiberAngles| s.eval(a), x[0].asin(), x[1].asin(), x[2].clamp(-1.0, 1.0).acos(), 1.0 / x[3], REFERENCE_PANELS);
+                let v = convolve_reference(
+                    &|a: &FiberAngles| s.eval(a),
+                    x[0].asin(),
+                    x[1].asin(),
+                    x[2].clamp(-1.0, 1.0).acos(),
+                    1.0 / x[3],
+                    REFERENCE_PANELS,
+                );
                 v.to_vec()
             });
             (r, pts)
@@ -62,18 +91,37 @@ pub fn check_asset(asset: &TableAsset, samples: usize, seed: u64) -> Result<Tabl
             // The convolution tables' stratification (grazing ends, Δφ strata), at the one
             // 1/λ node; the reference evaluates the model itself in f64.
             let inv = axes[3].min;
-            let pts = stratified_points(samples, 16.0, 64.0, seed).into_iter().map(|p| vec![p[0], p[1], p[2], inv]).collect();
-            let r: Reference = Arc::new(move |x: &[f64]| direct_value(&|a: &FiberAngles| s.eval(a), x).to_vec());
+            let pts = stratified_points(samples, 16.0, 64.0, seed)
+                .into_iter()
+                .map(|p| vec![p[0], p[1], p[2], inv])
+                .collect();
+            let r: Reference =
+                Arc::new(move |x: &[f64]| direct_value(&|a: &FiberAngles| s.eval(a), x).to_vec());
             (r, pts)
         }
         "kk_diffuse" | "kk_specular" => {
-            let exponent = params.get("exponent").and_then(Value::as_f64).unwrap_or(KajiyaKayParams::default().exponent);
-            let kk = KajiyaKay::new(KajiyaKayParams { exponent, ..Default::default() }).map_err(|e| bad(e.to_string()))?;
+            let exponent = params
+                .get("exponent")
+                .and_then(Value::as_f64)
+                .unwrap_or(KajiyaKayParams::default().exponent);
+            let kk = KajiyaKay::new(KajiyaKayParams {
+                exponent,
+                ..Default::default()
+            })
+            .map_err(|e| bad(e.to_string()))?;
             let diffuse = name == "kk_diffuse";
             let r: Reference = Arc::new(move |x: &[f64]| {
-                let (theta_xi, theta_o, inv) = if diffuse { (x[0].asin(), 0.0, x[1]) } else { (x[0].asin(), x[1].asin(), x[2]) };
+                let (theta_xi, theta_o, inv) = if diffuse {
+                    (x[0].asin(), 0.0, x[1])
+                } else {
+                    (x[0].asin(), x[1].asin(), x[2])
+                };
                 let s = |a: &FiberAngles| {
-                    let v = if diffuse { 1.0 } else { kk.specular_lobe(a) / a.theta_i.cos() };
+                    let v = if diffuse {
+                        1.0
+                    } else {
+                        kk.specular_lobe(a) / a.theta_i.cos()
+                    };
                     [v, v, v]
                 };
                 vec![convolve_reference(&s, theta_xi, theta_o, 0.0, 1.0 / inv, REFERENCE_PANELS)[0]]
@@ -83,12 +131,26 @@ pub fn check_asset(asset: &TableAsset, samples: usize, seed: u64) -> Result<Tabl
         "multiple" => {
             let s_d = bcsdf_from(params).map_err(bad)?;
             let r: Reference = Arc::new(move |x: &[f64]| {
-                multiple_scattering_reference(&|a: &FiberAngles| s_d.eval(a), x[0].asin(), x[1].asin(), x[2].clamp(-1.0, 1.0).acos(), x[3].max(1e-4), 24).to_vec()
+                multiple_scattering_reference(
+                    &|a: &FiberAngles| s_d.eval(a),
+                    x[0].asin(),
+                    x[1].asin(),
+                    x[2].clamp(-1.0, 1.0).acos(),
+                    x[3].max(1e-4),
+                    24,
+                )
+                .to_vec()
             });
             (r, random_points(table, samples, seed))
         }
-        "attenuation_ratio" => (Arc::new(|x: &[f64]| vec![attenuation_ratio(x[0], x[1])]), random_points(table, samples, seed)),
-        "srbf_spread" => (Arc::new(|x: &[f64]| vec![srbf_longitudinal_variance(x[0], x[1])]), random_points(table, samples, seed)),
+        "attenuation_ratio" => (
+            Arc::new(|x: &[f64]| vec![attenuation_ratio(x[0], x[1])]),
+            random_points(table, samples, seed),
+        ),
+        "srbf_spread" => (
+            Arc::new(|x: &[f64]| vec![srbf_longitudinal_variance(x[0], x[1])]),
+            random_points(table, samples, seed),
+        ),
         "fiber_averages" => {
             let model = lobes_from(params).map_err(bad)?;
             let r: Reference = Arc::new(move |x: &[f64]| {
@@ -97,8 +159,25 @@ pub fn check_asset(asset: &TableAsset, samples: usize, seed: u64) -> Result<Tabl
                 let q = x[1].round() as usize;
                 (0..3)
                     .map(|c| {
-                        let (ab, db, sb) = backscatter_series(a.a_f[c], a.a_b[c], a.alpha_f[c], a.alpha_b[c], a.beta2_f[c], a.beta2_b[c]);
-                        [a.a_f[c], a.a_b[c], a.alpha_f[c], a.alpha_b[c], a.beta2_f[c], a.beta2_b[c], ab, db, sb][q]
+                        let (ab, db, sb) = backscatter_series(
+                            a.a_f[c],
+                            a.a_b[c],
+                            a.alpha_f[c],
+                            a.alpha_b[c],
+                            a.beta2_f[c],
+                            a.beta2_b[c],
+                        );
+                        [
+                            a.a_f[c],
+                            a.a_b[c],
+                            a.alpha_f[c],
+                            a.alpha_b[c],
+                            a.beta2_f[c],
+                            a.beta2_b[c],
+                            ab,
+                            db,
+                            sb,
+                        ][q]
                     })
                     .collect()
             });
@@ -117,19 +196,33 @@ pub fn check_asset(asset: &TableAsset, samples: usize, seed: u64) -> Result<Tabl
                         vec![m.longitudinal(lobe(x[2]), ti, to)]
                     }
                 } else {
-                    m.azimuthal(lobe(x[2]), x[1].clamp(0.0, 1.0).acos(), x[0].clamp(-1.0, 1.0).acos()).to_vec()
+                    m.azimuthal(
+                        lobe(x[2]),
+                        x[1].clamp(0.0, 1.0).acos(),
+                        x[0].clamp(-1.0, 1.0).acos(),
+                    )
+                    .to_vec()
                 }
             });
             (r, random_points(table, samples, seed))
         }
-        _ => return Err(CheckError::UnknownTable { path: asset.path.clone(), name }),
+        _ => {
+            return Err(CheckError::UnknownTable {
+                path: asset.path.clone(),
+                name,
+            });
+        }
     };
     compare(asset, &name, &reference, &points)
 }
 
 /// Points uniform over every continuous axis; integer-labelled axes (`quantity`, `lobe`) get a
 /// random node.
-fn random_points(table: &strandlight_tables::table::Table, count: usize, seed: u64) -> Vec<Vec<f64>> {
+fn random_points(
+    table: &strandlight_tables::table::Table,
+    count: usize,
+    seed: u64,
+) -> Vec<Vec<f64>> {
     let mut rng = strandlight_tables::hard_case_sweep::SweepRng::new(seed);
     let mut unit = move || rng.uniform();
     (0..count)
@@ -153,7 +246,12 @@ fn random_points(table: &strandlight_tables::table::Table, count: usize, seed: u
 /// where the reference is large enough to divide by.
 type CheckedPoint = (Vec<f64>, f64, Option<f64>);
 
-fn compare(asset: &TableAsset, name: &str, reference: &Reference, points: &[Vec<f64>]) -> Result<TableAccuracy, CheckError> {
+fn compare(
+    asset: &TableAsset,
+    name: &str,
+    reference: &Reference,
+    points: &[Vec<f64>],
+) -> Result<TableAccuracy, CheckError> {
     let table = &asset.table;
     let channels = table.channels();
     let table_max = table.stats().max.abs().max(table.stats().min.abs()) as f64;
@@ -161,7 +259,12 @@ fn compare(asset: &TableAsset, name: &str, reference: &Reference, points: &[Vec<
         .par_iter()
         .map(|p| {
             let mut looked = vec![0f32; channels];
-            table.lookup_into(p, &mut looked).map_err(|source| CheckError::Lookup { path: asset.path.clone(), source })?;
+            table
+                .lookup_into(p, &mut looked)
+                .map_err(|source| CheckError::Lookup {
+                    path: asset.path.clone(),
+                    source,
+                })?;
             let want = reference(p);
             let mut abs: f64 = 0.0;
             let mut rel: Option<f64> = None;
@@ -176,11 +279,24 @@ fn compare(asset: &TableAsset, name: &str, reference: &Reference, points: &[Vec<
         })
         .collect();
     let rows = rows.into_iter().collect::<Result<Vec<_>, _>>()?;
-    let directional = matches!(name, "marschner" | "marschner_full" | "artist" | "multiple" | "kk_specular" | "marschner_direct" | "marschner_full_direct" | "artist_direct");
+    let directional = matches!(
+        name,
+        "marschner"
+            | "marschner_full"
+            | "artist"
+            | "multiple"
+            | "kk_specular"
+            | "marschner_direct"
+            | "marschner_full_direct"
+            | "artist_direct"
+    );
     Ok(summarize(name, table, table_max, &rows, directional))
 }
 
-fn section<T: serde::de::DeserializeOwned + Default>(params: &Value, key: &str) -> Result<T, String> {
+fn section<T: serde::de::DeserializeOwned + Default>(
+    params: &Value,
+    key: &str,
+) -> Result<T, String> {
     match params.get(key) {
         Some(v) => serde_json::from_value(v.clone()).map_err(|e| format!("[{key}]: {e}")),
         None => Ok(T::default()),
@@ -209,7 +325,9 @@ fn lobes_from(params: &Value) -> Result<Arc<dyn LobesAndScattering>, String> {
     if params.get("marschner").is_some() {
         Ok(Arc::new(marschner_from(params)?))
     } else {
-        Ok(Arc::new(artist_from(params)?.normalized(Normalization::PeakPerChannel)))
+        Ok(Arc::new(
+            artist_from(params)?.normalized(Normalization::PeakPerChannel),
+        ))
     }
 }
 
@@ -243,6 +361,7 @@ impl ScatteringFunction for Bcsdf {
 fn bcsdf_from(params: &Value) -> Result<Arc<dyn ScatteringFunction>, String> {
     let single = lobes_from(params)?;
     let config = section::<DualScatteringConfig>(params, "dual_scattering")?;
-    let averages = DualScatteringAverages::new(single.as_lobes(), config).map_err(|e| e.to_string())?;
+    let averages =
+        DualScatteringAverages::new(single.as_lobes(), config).map_err(|e| e.to_string())?;
     Ok(Arc::new(Bcsdf { single, averages }))
 }

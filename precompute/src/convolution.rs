@@ -32,7 +32,11 @@ pub struct ConvolutionSettings {
 
 impl Default for ConvolutionSettings {
     fn default() -> Self {
-        Self { theta_panels: 96, phi_panels: 32, max_harmonic: None }
+        Self {
+            theta_panels: 96,
+            phi_panels: 32,
+            max_harmonic: None,
+        }
     }
 }
 
@@ -51,7 +55,10 @@ pub struct ConvolutionGrid {
 
 impl ConvolutionGrid {
     pub fn len(&self) -> usize {
-        self.sin_theta_xi.len() * self.sin_theta_o.len() * self.cos_delta_phi.len() * self.lambda.len()
+        self.sin_theta_xi.len()
+            * self.sin_theta_o.len()
+            * self.cos_delta_phi.len()
+            * self.lambda.len()
     }
 
     pub fn is_empty(&self) -> bool {
@@ -109,7 +116,13 @@ pub fn cosine_coefficients(f: impl Fn(f64) -> f64, phi_panels: usize, n_max: usi
 }
 
 /// Cosine series of S(θ_i, θ_o, ·) per channel (symmetrized in φ, as [`convolve_grid`] does).
-pub fn cosine_coefficients_many<F>(s: &F, theta_i: f64, theta_o: f64, phi_panels: usize, n_max: usize) -> Vec<Rgb>
+pub fn cosine_coefficients_many<F>(
+    s: &F,
+    theta_i: f64,
+    theta_o: f64,
+    phi_panels: usize,
+    n_max: usize,
+) -> Vec<Rgb>
 where
     F: Fn(&FiberAngles) -> Rgb,
 {
@@ -133,21 +146,34 @@ impl CosineBasis {
                 table.push(2.0 / PI * w * (n as f64 * p).cos());
             }
         }
-        Self { nodes: rule.nodes, table }
+        Self {
+            nodes: rule.nodes,
+            table,
+        }
     }
 
     /// The cosine series of `s` at (θ_i, θ_o), per channel: `[n][c]`.
     fn spectrum<F: Fn(&FiberAngles) -> Rgb>(&self, s: &F, theta_i: f64, theta_o: f64) -> Vec<Rgb> {
         let mut channels = vec![vec![0.0; self.nodes.len()]; 3];
         for (k, &phi) in self.nodes.iter().enumerate() {
-            let plus = s(&FiberAngles { theta_i, theta_o, phi });
-            let minus = s(&FiberAngles { theta_i, theta_o, phi: -phi });
+            let plus = s(&FiberAngles {
+                theta_i,
+                theta_o,
+                phi,
+            });
+            let minus = s(&FiberAngles {
+                theta_i,
+                theta_o,
+                phi: -phi,
+            });
             for c in 0..3 {
                 channels[c][k] = 0.5 * (plus[c] + minus[c]);
             }
         }
         let per_channel: Vec<Vec<f64>> = channels.iter().map(|ch| self.coefficients(ch)).collect();
-        (0..per_channel[0].len()).map(|n| [per_channel[0][n], per_channel[1][n], per_channel[2][n]]).collect()
+        (0..per_channel[0].len())
+            .map(|n| [per_channel[0][n], per_channel[1][n], per_channel[2][n]])
+            .collect()
     }
 
     fn coefficients(&self, samples: &[f64]) -> Vec<f64> {
@@ -176,7 +202,13 @@ where
         .unwrap_or_else(|| harmonics_for(lambda_max))
         .min(8 * settings.phi_panels / 2);
     let theta_rule = GaussLegendre::composite(8, settings.theta_panels, -FRAC_PI_2, FRAC_PI_2);
-    let spectra = azimuthal_spectra(s, &theta_rule.nodes, &grid.sin_theta_o, settings.phi_panels, n_max);
+    let spectra = azimuthal_spectra(
+        s,
+        &theta_rule.nodes,
+        &grid.sin_theta_o,
+        settings.phi_panels,
+        n_max,
+    );
 
     let n_o = grid.sin_theta_o.len();
     let delta_cosines: Vec<Vec<f64>> = grid
@@ -189,28 +221,36 @@ where
         .collect();
     let mut out = vec![[0.0; 3]; grid.len()];
     let block = n_o * grid.cos_delta_phi.len() * grid.lambda.len();
-    out.par_chunks_mut(block).enumerate().for_each(|(xi_index, chunk)| {
-        let theta_xi = grid.sin_theta_xi[xi_index].clamp(-1.0, 1.0).asin();
-        for (l, &lambda) in grid.lambda.iter().enumerate() {
-            // κ ≤ λ cos θ_ξ: lobes near the fiber's poles need few harmonics.
-            let n_used = n_max.min(harmonics_for(lambda * theta_xi.cos()));
-            let kernel = ThetaKernel::new(&theta_rule, theta_xi, lambda, n_used);
-            for o in 0..n_o {
-                let harmonics = kernel.harmonic_sums(&spectra[o], n_used);
-                for (d, cosines) in delta_cosines.iter().enumerate() {
-                    let value = cosine_series(&harmonics, cosines).map(|v| 2.0 * PI * v);
-                    chunk[(o * grid.cos_delta_phi.len() + d) * grid.lambda.len() + l] = value;
+    out.par_chunks_mut(block)
+        .enumerate()
+        .for_each(|(xi_index, chunk)| {
+            let theta_xi = grid.sin_theta_xi[xi_index].clamp(-1.0, 1.0).asin();
+            for (l, &lambda) in grid.lambda.iter().enumerate() {
+                // κ ≤ λ cos θ_ξ: lobes near the fiber's poles need few harmonics.
+                let n_used = n_max.min(harmonics_for(lambda * theta_xi.cos()));
+                let kernel = ThetaKernel::new(&theta_rule, theta_xi, lambda, n_used);
+                for o in 0..n_o {
+                    let harmonics = kernel.harmonic_sums(&spectra[o], n_used);
+                    for (d, cosines) in delta_cosines.iter().enumerate() {
+                        let value = cosine_series(&harmonics, cosines).map(|v| 2.0 * PI * v);
+                        chunk[(o * grid.cos_delta_phi.len() + d) * grid.lambda.len() + l] = value;
+                    }
                 }
             }
-        }
-    });
+        });
     out
 }
 
 /// aₙ(θ_i, θ_o) per channel: `spectra[o][i][n]`. S is symmetrized in φ (exact for round
 /// fibers; for eccentric ones the table holds the orientation average of ±φ, which is what a
 /// table indexed by cos Δφ can hold).
-fn azimuthal_spectra<F>(s: &F, theta_i: &[f64], sin_theta_o: &[f64], phi_panels: usize, n_max: usize) -> Vec<Vec<Vec<Rgb>>>
+fn azimuthal_spectra<F>(
+    s: &F,
+    theta_i: &[f64],
+    sin_theta_o: &[f64],
+    phi_panels: usize,
+    n_max: usize,
+) -> Vec<Vec<Vec<Rgb>>>
 where
     F: Fn(&FiberAngles) -> Rgb + Sync,
 {
@@ -219,7 +259,10 @@ where
         .par_iter()
         .map(|&so| {
             let theta_o = so.clamp(-1.0, 1.0).asin();
-            theta_i.iter().map(|&ti| basis.spectrum(s, ti, theta_o)).collect()
+            theta_i
+                .iter()
+                .map(|&ti| basis.spectrum(s, ti, theta_o))
+                .collect()
         })
         .collect()
 }
@@ -286,7 +329,14 @@ fn cosine_series(harmonics: &[Rgb], cosines: &[f64]) -> Rgb {
 /// the azimuths where it does. Independent of every shortcut above (no series, no separation),
 /// and the fiber frame keeps the poles θ_i = ±π/2 at the ends of the θ_i range, where the
 /// integrand's cos θ_i factor is smooth.
-pub fn convolve_reference<F>(s: &F, theta_xi: f64, theta_o: f64, delta_phi: f64, lambda: f64, panels: usize) -> Rgb
+pub fn convolve_reference<F>(
+    s: &F,
+    theta_xi: f64,
+    theta_o: f64,
+    delta_phi: f64,
+    lambda: f64,
+    panels: usize,
+) -> Rgb
 where
     F: Fn(&FiberAngles) -> Rgb,
 {
@@ -305,7 +355,9 @@ where
         let half_width = if denom <= 1e-300 {
             PI
         } else {
-            ((cos_gamma_min - st * s_xi) / denom).clamp(-1.0, 1.0).acos()
+            ((cos_gamma_min - st * s_xi) / denom)
+                .clamp(-1.0, 1.0)
+                .acos()
         };
         if half_width <= 0.0 {
             continue;
@@ -353,7 +405,11 @@ mod tests {
                     q += w * (kappa * (t.cos() - 1.0)).exp() * (n as f64 * t).cos();
                 }
                 q /= m as f64;
-                assert!((seq[n] - q).abs() < 1e-13 + 1e-10 * q.abs(), "κ={kappa} n={n}: {} vs {q}", seq[n]);
+                assert!(
+                    (seq[n] - q).abs() < 1e-13 + 1e-10 * q.abs(),
+                    "κ={kappa} n={n}: {} vs {q}",
+                    seq[n]
+                );
             }
             assert!((seq[0] - strandlight_tables::special::scaled_bessel_i0(kappa)).abs() < 1e-13);
         }
@@ -384,7 +440,11 @@ mod tests {
             cos_delta_phi: vec![-1.0, -0.2, 0.5, 1.0],
             lambda: vec![16.0, 40.0, 64.0],
         };
-        let settings = ConvolutionSettings { theta_panels: 48, phi_panels: 16, max_harmonic: None };
+        let settings = ConvolutionSettings {
+            theta_panels: 48,
+            phi_panels: 16,
+            max_harmonic: None,
+        };
         let fast = convolve_grid(&smooth_s, &grid, &settings);
         let mut worst: f64 = 0.0;
         let mut peak: f64 = 0.0;
@@ -392,7 +452,14 @@ mod tests {
             for (o, &so) in grid.sin_theta_o.iter().enumerate() {
                 for (d, &cd) in grid.cos_delta_phi.iter().enumerate() {
                     for (l, &lambda) in grid.lambda.iter().enumerate() {
-                        let r = convolve_reference(&smooth_s, sx.asin(), so.asin(), cd.acos(), lambda, 48);
+                        let r = convolve_reference(
+                            &smooth_s,
+                            sx.asin(),
+                            so.asin(),
+                            cd.acos(),
+                            lambda,
+                            48,
+                        );
                         let f = fast[grid.index(xi, o, d, l)];
                         for c in 0..3 {
                             worst = worst.max((f[c] - r[c]).abs());
@@ -402,7 +469,9 @@ mod tests {
                 }
             }
         }
-        println!("harmonic convolution vs brute force: max |Δ| = {worst:.3e} (peak value {peak:.3e})");
+        println!(
+            "harmonic convolution vs brute force: max |Δ| = {worst:.3e} (peak value {peak:.3e})"
+        );
         // Two independent quadratures of a smooth integrand: both converge spectrally.
         assert!(worst < 1e-10 * peak, "max deviation {worst} of peak {peak}");
     }
@@ -422,7 +491,14 @@ mod tests {
         let v = convolve_grid(&one, &grid, &ConvolutionSettings::default());
         for xi in 0..2 {
             for l in 0..2 {
-                let r = convolve_reference(&one, grid.sin_theta_xi[xi].asin(), 0.0, 0.0, grid.lambda[l], 64)[0];
+                let r = convolve_reference(
+                    &one,
+                    grid.sin_theta_xi[xi].asin(),
+                    0.0,
+                    0.0,
+                    grid.lambda[l],
+                    64,
+                )[0];
                 for o in 0..2 {
                     for d in 0..2 {
                         let f = v[grid.index(xi, o, d, l)][0];
@@ -434,8 +510,14 @@ mod tests {
         let at_pole = convolve_reference(&one, FRAC_PI_2, 0.0, 0.0, 64.0, 64)[0];
         let flat = convolve_reference(&one, 0.0, 0.0, 0.0, 64.0, 64)[0];
         // With ξ along the fiber, cos θ_i = sin γ: a 1D integral 2π ∫ e^{λ(cos γ−1)} sin²γ dγ.
-        let pole_1d = 2.0 * PI * GaussLegendre::composite(8, 64, 0.0, PI).integrate(|g| (64.0 * (g.cos() - 1.0)).exp() * g.sin().powi(2));
-        assert!((at_pole - pole_1d).abs() < 1e-7 * pole_1d, "{at_pole} vs {pole_1d}");
+        let pole_1d = 2.0
+            * PI
+            * GaussLegendre::composite(8, 64, 0.0, PI)
+                .integrate(|g| (64.0 * (g.cos() - 1.0)).exp() * g.sin().powi(2));
+        assert!(
+            (at_pole - pole_1d).abs() < 1e-7 * pole_1d,
+            "{at_pole} vs {pole_1d}"
+        );
         let integral = strandlight_tables::srbf::integral(64.0);
         assert!((flat - integral).abs() < 0.02 * integral);
     }

@@ -1,13 +1,14 @@
 //! Convolution tables I(u·ξ, u·ω_o, cos(φ_ξ − φ_o), 1/λ) (Ren 2010 §4) as [`Table`]s: the axis
 //! layout the runtime indexes, and the filling of every node by [`convolve_grid`].
 
-use crate::convolution::{convolve_grid, ConvolutionGrid, ConvolutionSettings};
+use crate::convolution::{ConvolutionGrid, ConvolutionSettings, convolve_grid};
 use serde::{Deserialize, Serialize};
 use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::scattering::Rgb;
 use strandlight_tables::table::{Axis, AxisMapping, Table, TableError};
-use strandlight_tables::table_axes::{AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
-
+use strandlight_tables::table_axes::{
+    AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_U_DOT_WO, AXIS_U_DOT_XI,
+};
 
 /// Node counts and ranges of a 4D convolution table.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -72,7 +73,12 @@ impl ConvolutionResolution {
             xi,
             wo,
             cos_dphi,
-            Axis::uniform(AXIS_INV_LAMBDA, 1.0 / self.lambda_max, 1.0 / self.lambda_min, self.inv_lambda),
+            Axis::uniform(
+                AXIS_INV_LAMBDA,
+                1.0 / self.lambda_max,
+                1.0 / self.lambda_min,
+                self.inv_lambda,
+            ),
         ]
     }
 

@@ -6,11 +6,11 @@
 //! `L_o = D · irradiance · table(u·ω_i, u·ω_o, cos Δφ, 0)`.
 
 use crate::convolution_table::DirectionAxes;
-use strandlight_tables::table_axes::AXIS_INV_LAMBDA;
 use serde::{Deserialize, Serialize};
 use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::scattering::Rgb;
 use strandlight_tables::table::{Axis, Table, TableError};
+use strandlight_tables::table_axes::AXIS_INV_LAMBDA;
 
 /// Node counts of a direct table (the 1/λ axis always has one node).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -23,7 +23,12 @@ pub struct DirectResolution {
 
 impl DirectResolution {
     pub fn cube(n: usize, axes: DirectionAxes) -> Self {
-        Self { u_dot_xi: n, u_dot_wo: n, cos_dphi: n, axes }
+        Self {
+            u_dot_xi: n,
+            u_dot_wo: n,
+            cos_dphi: n,
+            axes,
+        }
     }
 
     /// The three direction axes of [`DirectionAxes::build`] and a one-node `inv_lambda` at 0.
@@ -81,18 +86,39 @@ mod tests {
     fn axes_match_the_convolution_tables_and_the_lambda_axis_has_one_node() {
         for axes in [DirectionAxes::Uniform, DirectionAxes::Angular] {
             let d = DirectResolution::cube(7, axes).axes();
-            let c = ConvolutionResolution { u_dot_xi: 7, u_dot_wo: 7, cos_dphi: 7, axes, ..Default::default() }.axes();
+            let c = ConvolutionResolution {
+                u_dot_xi: 7,
+                u_dot_wo: 7,
+                cos_dphi: 7,
+                axes,
+                ..Default::default()
+            }
+            .axes();
             for k in 0..3 {
                 assert_eq!(d[k], c[k]);
             }
-            assert_eq!([d[0].name.as_str(), d[1].name.as_str(), d[2].name.as_str(), d[3].name.as_str()], [AXIS_U_DOT_XI, AXIS_U_DOT_WO, AXIS_COS_DPHI, c[3].name.as_str()]);
+            assert_eq!(
+                [
+                    d[0].name.as_str(),
+                    d[1].name.as_str(),
+                    d[2].name.as_str(),
+                    d[3].name.as_str()
+                ],
+                [
+                    AXIS_U_DOT_XI,
+                    AXIS_U_DOT_WO,
+                    AXIS_COS_DPHI,
+                    c[3].name.as_str()
+                ]
+            );
             assert_eq!(d[3].count, 1);
         }
     }
 
     #[test]
     fn a_four_axis_lookup_at_any_inv_lambda_reads_the_three_axis_interpolation() {
-        let table = bake_direct_table(&model, &DirectResolution::cube(9, DirectionAxes::Angular)).unwrap();
+        let table =
+            bake_direct_table(&model, &DirectResolution::cube(9, DirectionAxes::Angular)).unwrap();
         let axes = table.axes().to_vec();
         // At a node the table is the model·cos θ_i computed independently here.
         let (i, j, k) = (3, 5, 2);
@@ -101,7 +127,10 @@ mod tests {
         let want = model(&FiberAngles::new(x[0].asin(), x[1].asin(), x[2].acos()))[0] * cos_ti;
         for inv in [0.0, 0.03, 1.0] {
             let got = table.lookup_rgb(&[x[0], x[1], x[2], inv]).unwrap()[0] as f64;
-            assert!((got - want).abs() < 1e-6 * want.abs().max(1.0), "{got} vs {want}");
+            assert!(
+                (got - want).abs() < 1e-6 * want.abs().max(1.0),
+                "{got} vs {want}"
+            );
         }
         // Halfway between two nodes of the first axis: the mean of the two node values.
         let mid = 0.5 * (axes[0].node(i) + axes[0].node(i + 1));

@@ -7,9 +7,9 @@
 //! turned by `rotate_degrees` about +Y exactly as [`crate::srbf_set::SrbfSet`] stores its
 //! lobes, so all three sets of one map agree.
 
-use crate::cube_lights::{cube_face_lights, CubeLightsError};
-use crate::envmap::{rotate_about_up, EnvMap};
-use crate::median_cut::{median_cut, DirectionalLight};
+use crate::cube_lights::{CubeLightsError, cube_face_lights};
+use crate::envmap::{EnvMap, rotate_about_up};
+use crate::median_cut::{DirectionalLight, median_cut};
 use crate::srbf_set::{LightKind, SrbfSet};
 use glam::DVec3;
 use strandlight_tables::srbf;
@@ -50,24 +50,47 @@ pub fn total_power(lights: &[LightSpec]) -> [f64; 3] {
 /// The set's compact sources follow as directional lights carrying their power.
 pub fn srbf_set_lights(set: &SrbfSet) -> Vec<LightSpec> {
     let lobes = set.lobes.iter().map(|l| match set.kind {
-        LightKind::Srbf => LightSpec { direction: l.center().normalize(), lambda: Some(l.lambda), rgb: l.amplitude },
-        LightKind::Directional => LightSpec { direction: l.center().normalize(), lambda: None, rgb: crate::srbf_set::power(l) },
+        LightKind::Srbf => LightSpec {
+            direction: l.center().normalize(),
+            lambda: Some(l.lambda),
+            rgb: l.amplitude,
+        },
+        LightKind::Directional => LightSpec {
+            direction: l.center().normalize(),
+            lambda: None,
+            rgb: crate::srbf_set::power(l),
+        },
     });
-    let sources = set.sources.iter().map(|s| LightSpec { direction: DVec3::from(s.direction).normalize(), lambda: None, rgb: s.power });
+    let sources = set.sources.iter().map(|s| LightSpec {
+        direction: DVec3::from(s.direction).normalize(),
+        lambda: None,
+        rgb: s.power,
+    });
     lobes.chain(sources).collect()
 }
 
 fn directional(lights: Vec<DirectionalLight>, rotate_degrees: f64) -> Vec<LightSpec> {
     lights
         .into_iter()
-        .map(|l| LightSpec { direction: rotate_about_up(l.direction, rotate_degrees).normalize(), lambda: None, rgb: l.power })
+        .map(|l| LightSpec {
+            direction: rotate_about_up(l.direction, rotate_degrees).normalize(),
+            lambda: None,
+            rgb: l.power,
+        })
         .collect()
 }
 
 /// The brute-force reference: `6 · face_resolution²` directional lights, one per cube texel
 /// (32 → the paper's 6144), each carrying its texels' ∫ L dω ([`cube_face_lights`]).
-pub fn reference_lights(map: &EnvMap, face_resolution: usize, rotate_degrees: f64) -> Result<Vec<LightSpec>, CubeLightsError> {
-    Ok(directional(cube_face_lights(map, face_resolution)?, rotate_degrees))
+pub fn reference_lights(
+    map: &EnvMap,
+    face_resolution: usize,
+    rotate_degrees: f64,
+) -> Result<Vec<LightSpec>, CubeLightsError> {
+    Ok(directional(
+        cube_face_lights(map, face_resolution)?,
+        rotate_degrees,
+    ))
 }
 
 /// The equal-cost baseline: `count` median-cut directional lights (Debevec 2005).
@@ -90,7 +113,7 @@ mod tests {
     use super::*;
     use crate::procedural_env;
     use crate::srbf_fit::FitOptions;
-    use crate::srbf_set::{Source, FORMAT, FORMAT_VERSION};
+    use crate::srbf_set::{FORMAT, FORMAT_VERSION, Source};
     use std::f64::consts::PI;
     use strandlight_tables::srbf::SrbfLobe;
 
@@ -113,7 +136,9 @@ mod tests {
     }
 
     fn relative_gap(a: [f64; 3], b: [f64; 3]) -> f64 {
-        (0..3).map(|c| ((a[c] - b[c]) / b[c]).abs()).fold(0.0, f64::max)
+        (0..3)
+            .map(|c| ((a[c] - b[c]) / b[c]).abs())
+            .fold(0.0, f64::max)
     }
 
     #[test]
@@ -126,7 +151,10 @@ mod tests {
             let lights = reference_lights(&map, n, 30.0).unwrap();
             assert_eq!(lights.len(), 6 * n * n);
             let gap = relative_gap(total_power(&lights), truth);
-            println!("cube reference n = {n}: {} lights, relative power gap {gap:.2e}", lights.len());
+            println!(
+                "cube reference n = {n}: {} lights, relative power gap {gap:.2e}",
+                lights.len()
+            );
             assert!(gap < 1e-9, "{gap}");
         }
         for count in [1, 17, 64] {
@@ -135,7 +163,11 @@ mod tests {
             let gap = relative_gap(total_power(&lights), truth);
             println!("median cut {count}: relative power gap {gap:.2e}");
             assert!(gap < 1e-9, "{gap}");
-            assert!(lights.iter().all(|l| (l.direction.length() - 1.0).abs() < 1e-12 && l.lambda.is_none()));
+            assert!(
+                lights
+                    .iter()
+                    .all(|l| (l.direction.length() - 1.0).abs() < 1e-12 && l.lambda.is_none())
+            );
         }
     }
 
@@ -154,7 +186,16 @@ mod tests {
     }
 
     fn set_of(kind: LightKind, lobes: Vec<SrbfLobe>, map: &EnvMap) -> SrbfSet {
-        let mut set = SrbfSet::directional(&Source { map, name: "test".into(), sha256: String::new(), sanitized: Default::default() }, 1, &FitOptions::default());
+        let mut set = SrbfSet::directional(
+            &Source {
+                map,
+                name: "test".into(),
+                sha256: String::new(),
+                sanitized: Default::default(),
+            },
+            1,
+            &FitOptions::default(),
+        );
         set.format = FORMAT.into();
         set.version = FORMAT_VERSION;
         set.kind = kind;
@@ -170,9 +211,21 @@ mod tests {
         // over a smooth lobe); measured 1.9e-6, bound 1e-4. A wrong λ, a missing 2π or a lost
         // lobe is off by far more.
         let lobes = vec![
-            SrbfLobe { center: DVec3::new(0.3, 0.8, -0.5).normalize().to_array(), lambda: 64.0, amplitude: [2.0, 1.5, 1.0] },
-            SrbfLobe { center: DVec3::new(-0.9, 0.1, 0.2).normalize().to_array(), lambda: 16.0, amplitude: [0.2, 0.3, 0.5] },
-            SrbfLobe { center: DVec3::new(0.0, -1.0, 0.0).to_array(), lambda: 30.0, amplitude: [0.1, 0.1, 0.05] },
+            SrbfLobe {
+                center: DVec3::new(0.3, 0.8, -0.5).normalize().to_array(),
+                lambda: 64.0,
+                amplitude: [2.0, 1.5, 1.0],
+            },
+            SrbfLobe {
+                center: DVec3::new(-0.9, 0.1, 0.2).normalize().to_array(),
+                lambda: 16.0,
+                amplitude: [0.2, 0.3, 0.5],
+            },
+            SrbfLobe {
+                center: DVec3::new(0.0, -1.0, 0.0).to_array(),
+                lambda: 30.0,
+                amplitude: [0.1, 0.1, 0.05],
+            },
         ];
         let map = procedural_env::from_srbf_lobes(1024, &lobes);
         let set = set_of(LightKind::Srbf, lobes.clone(), &map);
@@ -186,7 +239,15 @@ mod tests {
             assert!((l.direction - lobe.center()).length() < 1e-12);
         }
         // A directional set (narrow stand-in lobes) becomes directional lights of equal power.
-        let dir = set_of(LightKind::Directional, vec![SrbfLobe { center: [0.0, 1.0, 0.0], lambda: 1e4, amplitude: [3.0, 2.0, 1.0] }], &map);
+        let dir = set_of(
+            LightKind::Directional,
+            vec![SrbfLobe {
+                center: [0.0, 1.0, 0.0],
+                lambda: 1e4,
+                amplitude: [3.0, 2.0, 1.0],
+            }],
+            &map,
+        );
         let d = srbf_set_lights(&dir);
         let want = 2.0 * PI / 1e4 * (1.0 - (-2e4f64).exp());
         assert!(d[0].lambda.is_none() && (d[0].rgb[0] - 3.0 * want).abs() < 1e-15);

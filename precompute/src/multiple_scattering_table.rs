@@ -114,13 +114,21 @@ fn gaussian_weights(nodes: &[f64], mu: f64, sigma: f64) -> Vec<f64> {
 }
 
 /// Tabulates I_G for the BCSDF `s_d` (S + d_b·S_back, per RGB channel).
-pub fn bake_multiple_scattering_table<F>(s_d: &F, res: &MultipleScatteringResolution) -> Result<Table, TableError>
+pub fn bake_multiple_scattering_table<F>(
+    s_d: &F,
+    res: &MultipleScatteringResolution,
+) -> Result<Table, TableError>
 where
     F: Fn(&FiberAngles) -> Rgb + Sync,
 {
     let axes = res.axes();
     let nodes = |a: &Axis| (0..a.count).map(|i| a.node(i)).collect::<Vec<f64>>();
-    let (xis, wos, cds, sigmas) = (nodes(&axes[0]), nodes(&axes[1]), nodes(&axes[2]), nodes(&axes[3]));
+    let (xis, wos, cds, sigmas) = (
+        nodes(&axes[0]),
+        nodes(&axes[1]),
+        nodes(&axes[2]),
+        nodes(&axes[3]),
+    );
     let theta: Vec<f64> = (0..res.theta_nodes)
         .map(|j| -FRAC_PI_2 + PI * j as f64 / (res.theta_nodes - 1) as f64)
         .collect();
@@ -142,7 +150,9 @@ where
             let theta_o = so.clamp(-1.0, 1.0).asin();
             let spectra: Vec<Vec<Rgb>> = theta
                 .iter()
-                .map(|&ti| cosine_coefficients_many(s_d, ti, theta_o, res.phi_panels, res.harmonics))
+                .map(|&ti| {
+                    cosine_coefficients_many(s_d, ti, theta_o, res.phi_panels, res.harmonics)
+                })
                 .collect();
             cos_n_delta
                 .iter()
@@ -177,39 +187,53 @@ where
         h[od / n_d][od % n_d][j][c]
     });
     let mut values = vec![0f32; xis.len() * n_o * n_d * n_s * 3];
-    values.par_chunks_mut(n_o * n_d * n_s * 3).zip(&xis).for_each(|(chunk, &sx)| {
-        let theta_xi = sx.clamp(-1.0, 1.0).asin();
-        let mut w = nalgebra::DMatrix::<f64>::zeros(n_s, n_j);
-        let mut inv_norm = vec![0.0; n_s];
-        for (k, &sigma) in sigmas.iter().enumerate() {
-            let weights = gaussian_weights(&theta, theta_xi, sigma);
-            let norm: f64 = weights.iter().zip(&theta).map(|(w, t)| w * t.cos()).sum();
-            // Exactly along the fiber with σ̄_f = 0 no light reaches the fiber's cross-section.
-            inv_norm[k] = if norm > 1e-12 { 1.0 / norm } else { 0.0 };
-            for (j, wj) in weights.into_iter().enumerate() {
-                w[(k, j)] = wj;
-            }
-        }
-        let product = w * &h_matrix; // n_s × (o, d, c)
-        for k in 0..n_s {
-            for od in 0..n_o * n_d {
-                for c in 0..3 {
-                    chunk[(od * n_s + k) * 3 + c] = (product[(k, od * 3 + c)] * inv_norm[k]) as f32;
+    values
+        .par_chunks_mut(n_o * n_d * n_s * 3)
+        .zip(&xis)
+        .for_each(|(chunk, &sx)| {
+            let theta_xi = sx.clamp(-1.0, 1.0).asin();
+            let mut w = nalgebra::DMatrix::<f64>::zeros(n_s, n_j);
+            let mut inv_norm = vec![0.0; n_s];
+            for (k, &sigma) in sigmas.iter().enumerate() {
+                let weights = gaussian_weights(&theta, theta_xi, sigma);
+                let norm: f64 = weights.iter().zip(&theta).map(|(w, t)| w * t.cos()).sum();
+                // Exactly along the fiber with σ̄_f = 0 no light reaches the fiber's cross-section.
+                inv_norm[k] = if norm > 1e-12 { 1.0 / norm } else { 0.0 };
+                for (j, wj) in weights.into_iter().enumerate() {
+                    w[(k, j)] = wj;
                 }
             }
-        }
-    });
+            let product = w * &h_matrix; // n_s × (o, d, c)
+            for k in 0..n_s {
+                for od in 0..n_o * n_d {
+                    for c in 0..3 {
+                        chunk[(od * n_s + k) * 3 + c] =
+                            (product[(k, od * 3 + c)] * inv_norm[k]) as f32;
+                    }
+                }
+            }
+        });
     Table::new(axes, 3, values)
 }
 
 /// Brute-force reference of eq. 11: 2D quadrature over θ_i (fine composite Gauss–Legendre
 /// around θ_ξ) and φ_i over the forward half only, with the same normalization N.
-pub fn multiple_scattering_reference<F>(s_d: &F, theta_xi: f64, theta_o: f64, delta: f64, sigma: f64, panels: usize) -> Rgb
+pub fn multiple_scattering_reference<F>(
+    s_d: &F,
+    theta_xi: f64,
+    theta_o: f64,
+    delta: f64,
+    sigma: f64,
+    panels: usize,
+) -> Rgb
 where
     F: Fn(&FiberAngles) -> Rgb,
 {
     use strandlight_tables::quadrature::GaussLegendre;
-    let (lo, hi) = ((theta_xi - 9.0 * sigma).max(-FRAC_PI_2), (theta_xi + 9.0 * sigma).min(FRAC_PI_2));
+    let (lo, hi) = (
+        (theta_xi - 9.0 * sigma).max(-FRAC_PI_2),
+        (theta_xi + 9.0 * sigma).min(FRAC_PI_2),
+    );
     let rule_t = GaussLegendre::composite(8, panels, lo, hi);
     let rule_p = GaussLegendre::composite(8, panels, -FRAC_PI_2, FRAC_PI_2);
     let g = |x: f64| (-(x * x) / (2.0 * sigma * sigma)).exp() / ((2.0 * PI).sqrt() * sigma);
@@ -247,7 +271,10 @@ mod tests {
             let w = gaussian_weights(&nodes, mu, sigma);
             // ∫ g (2 + 3θ) dθ over ℝ = 2 + 3μ; the mass beyond ±1 is < 1e-10 here (≥ 6σ away).
             let got: f64 = w.iter().zip(&nodes).map(|(w, t)| w * (2.0 + 3.0 * t)).sum();
-            assert!((got - (2.0 + 3.0 * mu)).abs() < 1e-9, "μ={mu} σ={sigma}: {got}");
+            assert!(
+                (got - (2.0 + 3.0 * mu)).abs() < 1e-9,
+                "μ={mu} σ={sigma}: {got}"
+            );
         }
     }
 
@@ -269,8 +296,20 @@ mod tests {
             for o in [0usize, 2] {
                 for d in [0usize, 2, 4] {
                     for k in [1usize, 3] {
-                        let x = [axes[0].node(i), axes[1].node(o), axes[2].node(d), axes[3].node(k)];
-                        let r = multiple_scattering_reference(&bcsdf, x[0].asin(), x[1].asin(), x[2].acos(), x[3], 24);
+                        let x = [
+                            axes[0].node(i),
+                            axes[1].node(o),
+                            axes[2].node(d),
+                            axes[3].node(k),
+                        ];
+                        let r = multiple_scattering_reference(
+                            &bcsdf,
+                            x[0].asin(),
+                            x[1].asin(),
+                            x[2].acos(),
+                            x[3],
+                            24,
+                        );
                         let t = table.lookup_rgb(&x).unwrap();
                         for c in 0..3 {
                             worst = worst.max((t[c] as f64 - r[c]).abs());
@@ -279,7 +318,10 @@ mod tests {
                 }
             }
         }
-        println!("I_G at nodes vs brute force: max |Δ| = {:.3e} of the table maximum", worst / peak);
+        println!(
+            "I_G at nodes vs brute force: max |Δ| = {:.3e} of the table maximum",
+            worst / peak
+        );
         // Residual (measured 2e-7): the piecewise-linear H (h = π/2048) and the 127 box
         // harmonics of a function with a kink at φ = π (aₙ ~ 1/n², Kₙ ~ 1/n).
         assert!(worst < 1e-5 * peak, "{worst} of {peak}");
@@ -287,7 +329,14 @@ mod tests {
 
     #[test]
     fn vanishing_spread_is_finite_and_continuous() {
-        let res = MultipleScatteringResolution { u_dot_xi: 9, u_dot_wo: 3, cos_dphi: 3, sigma_f: 9, sigma_f_max: 0.08, ..Default::default() };
+        let res = MultipleScatteringResolution {
+            u_dot_xi: 9,
+            u_dot_wo: 3,
+            cos_dphi: 3,
+            sigma_f: 9,
+            sigma_f_max: 0.08,
+            ..Default::default()
+        };
         let table = bake_multiple_scattering_table(&bcsdf, &res).unwrap();
         let s = table.stats();
         assert_eq!(s.nan_count + s.infinite_count, 0);
@@ -295,7 +344,10 @@ mod tests {
         let x0 = table.lookup_rgb(&[0.3, 0.0, -1.0, 0.0]).unwrap();
         let x1 = table.lookup_rgb(&[0.3, 0.0, -1.0, 0.01]).unwrap();
         for c in 0..3 {
-            assert!((x0[c] - x1[c]).abs() < 0.02 * x0[c].abs().max(1e-3), "{x0:?} vs {x1:?}");
+            assert!(
+                (x0[c] - x1[c]).abs() < 0.02 * x0[c].abs().max(1e-3),
+                "{x0:?} vs {x1:?}"
+            );
         }
     }
 }

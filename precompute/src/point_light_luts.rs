@@ -47,7 +47,10 @@ use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::marschner::{Lobe, MIN_COS2_THETA_D, Marschner};
 use strandlight_tables::scattering::{Rgb, ScatteringFunction};
 use strandlight_tables::table::{Axis, Table, TableError};
-use strandlight_tables::table_axes::{AXIS_COS_HALF_PHI, AXIS_COS_PHI, AXIS_COS_THETA_D, AXIS_LOBE, AXIS_QUANTITY, AXIS_SIN_THETA_I, AXIS_SIN_THETA_O};
+use strandlight_tables::table_axes::{
+    AXIS_COS_HALF_PHI, AXIS_COS_PHI, AXIS_COS_THETA_D, AXIS_LOBE, AXIS_QUANTITY, AXIS_SIN_THETA_I,
+    AXIS_SIN_THETA_O,
+};
 use thiserror::Error;
 
 /// Index of cos θ_d on the `quantity` axis of the M table (after M_R, M_TT, M_TRT).

@@ -5,9 +5,9 @@
 //! per channel, then the sRGB transfer curve. The error panel shows |fit − original| with the
 //! same exposure, so equal brightness means equal radiance in all three panels.
 
-use strandlight_tables::atomic_write::write_atomically;
 use crate::envmap::EnvMap;
 use std::path::Path;
+use strandlight_tables::atomic_write::write_atomically;
 use strandlight_tables::srbf::SrbfLobe;
 
 pub const TONEMAP: &str = "exposure to mean luminance 0.18, Reinhard x/(1+x), sRGB";

@@ -399,7 +399,10 @@ mod tests {
         let (got, want) = (decoded.pixel(w - 1, h - 1), map.pixel(w - 1, h - 1));
         for c in 0..3 {
             // RGBE keeps 8 bits of mantissa.
-            assert!((got[c] - want[c]).abs() <= want[c] / 64.0, "{got:?} vs {want:?}");
+            assert!(
+                (got[c] - want[c]).abs() <= want[c] / 64.0,
+                "{got:?} vs {want:?}"
+            );
         }
     }
 }

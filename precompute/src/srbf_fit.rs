@@ -292,8 +292,14 @@ pub fn fit(
     let mut ev = evaluate(&grid, &centers(&best_lobes), &lambdas(&best_lobes));
     if options.preserve_power {
         let power = grid_map.integral().map(|p| p / grid.scale);
-        ev.amplitudes = power_matched_amplitudes(&grid, &centers(&best_lobes), &lambdas(&best_lobes), power);
-        ev.relative_mse = relative_mse_of(&grid, &centers(&best_lobes), &lambdas(&best_lobes), &ev.amplitudes);
+        ev.amplitudes =
+            power_matched_amplitudes(&grid, &centers(&best_lobes), &lambdas(&best_lobes), power);
+        ev.relative_mse = relative_mse_of(
+            &grid,
+            &centers(&best_lobes),
+            &lambdas(&best_lobes),
+            &ev.amplitudes,
+        );
     }
     let lobes = best_lobes
         .iter()

@@ -172,9 +172,17 @@ fn gram_entry(xi_k: DVec3, l_k: f64, xi_j: DVec3, l_j: f64) -> GramEntry {
 /// (measured: 1.2–1.6× the power of the quarry map), and hair, whose shading integrates the
 /// light, comes out that much too bright. The constraint enters the non-negative solve as a
 /// heavily weighted extra residual row w·(cᵀa − P), so it holds to about 1/w relative.
-pub fn power_matched_amplitudes(grid: &FitGrid, centers: &[DVec3], lambdas: &[f64], power: [f64; 3]) -> Vec<[f64; 3]> {
+pub fn power_matched_amplitudes(
+    grid: &FitGrid,
+    centers: &[DVec3],
+    lambdas: &[f64],
+    power: [f64; 3],
+) -> Vec<[f64; 3]> {
     let k = centers.len();
-    let projections: Vec<_> = (0..k).into_par_iter().map(|i| grid.project(centers[i], lambdas[i]).0).collect();
+    let projections: Vec<_> = (0..k)
+        .into_par_iter()
+        .map(|i| grid.project(centers[i], lambdas[i]).0)
+        .collect();
     let integrals: Vec<f64> = lambdas.iter().map(|&l| srbf::integral(l)).collect();
     let c = DVector::from_column_slice(&integrals);
     let gram = DMatrix::from_fn(k, k, |r, col| {
@@ -200,17 +208,32 @@ pub fn power_matched_amplitudes(grid: &FitGrid, centers: &[DVec3], lambdas: &[f6
 
 /// The relative MSE of given amplitudes (grid units): 1 + Σ_c (aᵀ G a − 2 aᵀ b), the grid being
 /// normalized so that Σ w‖L‖² = 1.
-pub fn relative_mse_of(grid: &FitGrid, centers: &[DVec3], lambdas: &[f64], amplitudes: &[[f64; 3]]) -> f64 {
+pub fn relative_mse_of(
+    grid: &FitGrid,
+    centers: &[DVec3],
+    lambdas: &[f64],
+    amplitudes: &[[f64; 3]],
+) -> f64 {
     let k = centers.len();
-    let projections: Vec<_> = (0..k).into_par_iter().map(|i| grid.project(centers[i], lambdas[i]).0).collect();
+    let projections: Vec<_> = (0..k)
+        .into_par_iter()
+        .map(|i| grid.project(centers[i], lambdas[i]).0)
+        .collect();
     let mut e = 1.0;
     for r in 0..k {
         for ch in 0..3 {
             e -= 2.0 * amplitudes[r][ch] * projections[r][ch];
         }
         for col in 0..k {
-            let g = if r == col { srbf::squared_norm(lambdas[r]) } else { srbf::inner_product(centers[r], lambdas[r], centers[col], lambdas[col]) };
-            e += g * (0..3).map(|ch| amplitudes[r][ch] * amplitudes[col][ch]).sum::<f64>();
+            let g = if r == col {
+                srbf::squared_norm(lambdas[r])
+            } else {
+                srbf::inner_product(centers[r], lambdas[r], centers[col], lambdas[col])
+            };
+            e += g
+                * (0..3)
+                    .map(|ch| amplitudes[r][ch] * amplitudes[col][ch])
+                    .sum::<f64>();
         }
     }
     e.max(0.0)

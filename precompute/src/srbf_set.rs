@@ -7,12 +7,12 @@
 //! light's power (∫ L dω of its region), so one format serves both; a renderer that wants delta
 //! lights uses `power()` and the center.
 
-use strandlight_tables::atomic_write::write_atomically;
 use crate::compact_sources::CompactSource;
 use crate::envmap::BadPixelCounts;
 use crate::srbf_fit::{FitOptions, RoundRecord};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+use strandlight_tables::atomic_write::write_atomically;
 use strandlight_tables::srbf::{self, SrbfLobe};
 
 pub const FORMAT: &str = "strandlight-srbf-set";
@@ -101,9 +101,11 @@ pub enum SrbfSetError {
 impl SrbfSet {
     pub fn save(&self, path: &Path) -> Result<(), SrbfSetError> {
         let json = serde_json::to_vec_pretty(self).expect("an SrbfSet always serializes");
-        write_atomically(path, |out| std::io::Write::write_all(out, &json)).map_err(|source| SrbfSetError::Io {
-            path: path.into(),
-            source,
+        write_atomically(path, |out| std::io::Write::write_all(out, &json)).map_err(|source| {
+            SrbfSetError::Io {
+                path: path.into(),
+                source,
+            }
         })
     }
 
@@ -184,7 +186,11 @@ pub fn power(lobe: &SrbfLobe) -> [f64; 3] {
 }
 
 /// (Σ lobe power + Σ source power) / ∫ map dω per channel.
-fn power_ratio(map: &crate::envmap::EnvMap, lobes: &[SrbfLobe], sources: &[CompactSource]) -> [f64; 3] {
+fn power_ratio(
+    map: &crate::envmap::EnvMap,
+    lobes: &[SrbfLobe],
+    sources: &[CompactSource],
+) -> [f64; 3] {
     let map_power = map.integral();
     std::array::from_fn(|c| {
         let fit: f64 = lobes.iter().map(|l| power(l)[c]).sum::<f64>()
@@ -244,8 +250,11 @@ impl SrbfSet {
         let rotated = sources
             .iter()
             .map(|s| CompactSource {
-                direction: crate::envmap::rotate_about_up(s.direction.into(), options.rotate_degrees)
-                    .to_array(),
+                direction: crate::envmap::rotate_about_up(
+                    s.direction.into(),
+                    options.rotate_degrees,
+                )
+                .to_array(),
                 ..*s
             })
             .collect();

@@ -14,7 +14,6 @@ use strandlight_tables::srbf::kernel;
 use strandlight_tables::table::{Axis, AxisMapping, Table, TableError};
 use strandlight_tables::table_axes::{AXIS_ABS_U_DOT_XI, AXIS_LAMBDA};
 
-
 /// σ² by quadrature in a frame centred on ξ (polar angle γ within G's 1e-12 support).
 pub fn srbf_longitudinal_variance(sin_theta_xi: f64, lambda: f64) -> f64 {
     let theta_xi = sin_theta_xi.clamp(-1.0, 1.0).asin();
@@ -40,13 +39,20 @@ pub fn srbf_longitudinal_variance(sin_theta_xi: f64, lambda: f64) -> f64 {
 }
 
 /// The 2D table over (|u·ξ| ∈ [0, 1], λ ∈ [λ_min, λ_max]); the variance is even in u·ξ.
-pub fn srbf_spread_table(xi_count: usize, lambda_count: usize, lambda_min: f64, lambda_max: f64) -> Result<Table, TableError> {
+pub fn srbf_spread_table(
+    xi_count: usize,
+    lambda_count: usize,
+    lambda_min: f64,
+    lambda_max: f64,
+) -> Result<Table, TableError> {
     let axes = vec![
         // Uniform in θ_ξ: the variance changes fastest near the pole (|u·ξ| → 1).
         Axis::with_mapping(AXIS_ABS_U_DOT_XI, 0.0, 1.0, xi_count, AxisMapping::Arcsine),
         Axis::uniform(AXIS_LAMBDA, lambda_min, lambda_max, lambda_count),
     ];
-    Table::from_fn(axes, 1, |x, out| out[0] = srbf_longitudinal_variance(x[0], x[1]) as f32)
+    Table::from_fn(axes, 1, |x, out| {
+        out[0] = srbf_longitudinal_variance(x[0], x[1]) as f32
+    })
 }
 
 #[cfg(test)]
@@ -88,7 +94,10 @@ mod tests {
             let w = |g: f64| (lambda * (g.cos() - 1.0)).exp() * g.sin();
             let want = rule.integrate(|g| w(g) * g * g) / rule.integrate(w);
             let got = srbf_longitudinal_variance(1.0, lambda);
-            assert!((got - want).abs() < 1e-9 * want, "λ={lambda}: {got} vs {want}");
+            assert!(
+                (got - want).abs() < 1e-9 * want,
+                "λ={lambda}: {got} vs {want}"
+            );
         }
         let t = srbf_spread_table(8, 8, 16.0, 64.0).unwrap();
         assert_eq!(t.stats().nan_count, 0);

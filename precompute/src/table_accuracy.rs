@@ -7,8 +7,8 @@ use rayon::prelude::*;
 use serde::Serialize;
 use std::f64::consts::PI;
 use strandlight_tables::angles::FiberAngles;
-use strandlight_tables::scattering::Rgb;
 use strandlight_tables::hard_case_sweep::SweepRng;
+use strandlight_tables::scattering::Rgb;
 use strandlight_tables::table::{Table, TableError};
 
 /// What `check-tables --json` reports per table.
@@ -54,7 +54,11 @@ impl TableAccuracy {
     /// Fills the percentile-relative fields from the max-relative ones.
     pub fn with_percentile(mut self, table: &Table) -> Self {
         self.table_p999 = percentile_999(table.values());
-        let ratio = if self.table_p999 > 0.0 { self.table_max / self.table_p999 } else { 1.0 };
+        let ratio = if self.table_p999 > 0.0 {
+            self.table_max / self.table_p999
+        } else {
+            1.0
+        };
         self.max_abs_error_p999 = self.max_abs_error * ratio;
         self.rms_abs_error_p999 = self.rms_abs_error * ratio;
         self
@@ -65,7 +69,12 @@ impl TableAccuracy {
 /// hard edges (u·ξ or u·ω_o = ±1, λ at a bound): u·ξ and u·ω_o stratified in
 /// the sine (so grazing ±1 ends get their share), Δφ stratified in angle (so the TT region near
 /// π is sampled as densely as the rest), 1/λ uniform. `lambda` spans [λ_min, λ_max].
-pub fn stratified_points(count: usize, lambda_min: f64, lambda_max: f64, seed: u64) -> Vec<[f64; 4]> {
+pub fn stratified_points(
+    count: usize,
+    lambda_min: f64,
+    lambda_max: f64,
+    seed: u64,
+) -> Vec<[f64; 4]> {
     // A fixed generator: the points must not change with thread count or a crate's version.
     let mut rng = SweepRng::new(seed);
     (0..count)
@@ -96,7 +105,13 @@ pub fn stratified_points(count: usize, lambda_min: f64, lambda_max: f64, seed: u
 type CheckedPoint = ([f64; 4], f64, Option<f64>);
 
 /// Compares `table` with the reference integral of `s` at `points`.
-pub fn check_table<F>(name: &str, table: &Table, s: &F, points: &[[f64; 4]], reference_panels: usize) -> Result<TableAccuracy, TableError>
+pub fn check_table<F>(
+    name: &str,
+    table: &Table,
+    s: &F,
+    points: &[[f64; 4]],
+    reference_panels: usize,
+) -> Result<TableAccuracy, TableError>
 where
     F: Fn(&FiberAngles) -> Rgb + Sync,
 {
@@ -106,7 +121,14 @@ where
         .map(|p| {
             let looked = table.lookup_rgb(p)?;
             let (theta_xi, theta_o) = (p[0].clamp(-1.0, 1.0).asin(), p[1].clamp(-1.0, 1.0).asin());
-            let reference = convolve_reference(s, theta_xi, theta_o, p[2].clamp(-1.0, 1.0).acos(), 1.0 / p[3], reference_panels);
+            let reference = convolve_reference(
+                s,
+                theta_xi,
+                theta_o,
+                p[2].clamp(-1.0, 1.0).acos(),
+                1.0 / p[3],
+                reference_panels,
+            );
             let mut abs: f64 = 0.0;
             let mut rel: Option<f64> = None;
             for c in 0..3 {
@@ -119,7 +141,10 @@ where
             Ok((*p, abs, rel))
         })
         .collect();
-    let rows = rows.into_iter().map(|r| r.map(|(p, abs, rel)| (p.to_vec(), abs, rel))).collect::<Result<Vec<_>, _>>()?;
+    let rows = rows
+        .into_iter()
+        .map(|r| r.map(|(p, abs, rel)| (p.to_vec(), abs, rel)))
+        .collect::<Result<Vec<_>, _>>()?;
     Ok(summarize(name, table, table_max, &rows, true))
 }
 
@@ -135,7 +160,13 @@ const AXIAL: f64 = 0.999;
 
 /// Folds per-point errors (point, max |Δ| over channels, max relative |Δ|) into the report;
 /// `directional` says the first two axes are u·ξ and u·ω_o (so axial points can be told apart).
-pub fn summarize(name: &str, table: &Table, table_max: f64, rows: &[(Vec<f64>, f64, Option<f64>)], directional: bool) -> TableAccuracy {
+pub fn summarize(
+    name: &str,
+    table: &Table,
+    table_max: f64,
+    rows: &[(Vec<f64>, f64, Option<f64>)],
+    directional: bool,
+) -> TableAccuracy {
     let scale = if table_max > 0.0 { table_max } else { 1.0 };
     let (mut max_abs, mut sum_sq, mut max_rel) = (0.0f64, 0.0, 0.0f64);
     let (mut inner_max, mut inner_sq, mut inner_n) = (0.0f64, 0.0, 0usize);
@@ -172,12 +203,11 @@ pub fn summarize(name: &str, table: &Table, table_max: f64, rows: &[(Vec<f64>, f
     .with_percentile(table)
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::convolution::ConvolutionSettings;
-    use crate::convolution_table::{bake_convolution_table, ConvolutionResolution};
+    use crate::convolution_table::{ConvolutionResolution, bake_convolution_table};
 
     /// A lobe model with Marschner's shape: a Gaussian in θ_h and a peaked azimuthal term.
     /// Its 1/cos²θ_d is softened: the true one makes eq. 8 diverge logarithmically at
@@ -192,15 +222,31 @@ mod tests {
 
     #[test]
     fn error_shrinks_with_resolution_and_is_measured_against_the_reference() {
-        let settings = ConvolutionSettings { theta_panels: 48, phi_panels: 16, max_harmonic: None };
+        let settings = ConvolutionSettings {
+            theta_panels: 48,
+            phi_panels: 16,
+            max_harmonic: None,
+        };
         let points = stratified_points(60, 16.0, 64.0, 7);
         let mut previous = f64::INFINITY;
         for n in [8usize, 16] {
-            let res = ConvolutionResolution { u_dot_xi: n, u_dot_wo: n, cos_dphi: n, inv_lambda: n, ..Default::default() };
+            let res = ConvolutionResolution {
+                u_dot_xi: n,
+                u_dot_wo: n,
+                cos_dphi: n,
+                inv_lambda: n,
+                ..Default::default()
+            };
             let table = bake_convolution_table(&lobe, &res, &settings).unwrap();
             let acc = check_table("lobe", &table, &lobe, &points, 24).unwrap();
-            println!("{n}^4 nodes: max {:.3e}, rms {:.3e}, max rel {:.3e}", acc.max_abs_error, acc.rms_abs_error, acc.max_rel_error);
-            assert!(acc.rms_abs_error < previous, "error must fall as the table grows");
+            println!(
+                "{n}^4 nodes: max {:.3e}, rms {:.3e}, max rel {:.3e}",
+                acc.max_abs_error, acc.rms_abs_error, acc.max_rel_error
+            );
+            assert!(
+                acc.rms_abs_error < previous,
+                "error must fall as the table grows"
+            );
             previous = acc.rms_abs_error;
         }
         // Interpolation error of a smooth 4D function falls ~4× per doubling; demand at least 2×
@@ -210,17 +256,45 @@ mod tests {
 
     #[test]
     fn at_nodes_the_table_is_the_reference() {
-        let settings = ConvolutionSettings { theta_panels: 48, phi_panels: 16, max_harmonic: None };
-        let res = ConvolutionResolution { u_dot_xi: 5, u_dot_wo: 4, cos_dphi: 6, inv_lambda: 3, ..Default::default() };
+        let settings = ConvolutionSettings {
+            theta_panels: 48,
+            phi_panels: 16,
+            max_harmonic: None,
+        };
+        let res = ConvolutionResolution {
+            u_dot_xi: 5,
+            u_dot_wo: 4,
+            cos_dphi: 6,
+            inv_lambda: 3,
+            ..Default::default()
+        };
         let table = bake_convolution_table(&lobe, &res, &settings).unwrap();
         let axes = res.axes();
         let points: Vec<[f64; 4]> = vec![
-            [axes[0].node(1), axes[1].node(2), axes[2].node(0), axes[3].node(2)],
-            [axes[0].node(4), axes[1].node(0), axes[2].node(5), axes[3].node(0)],
-            [axes[0].node(2), axes[1].node(3), axes[2].node(3), axes[3].node(1)],
+            [
+                axes[0].node(1),
+                axes[1].node(2),
+                axes[2].node(0),
+                axes[3].node(2),
+            ],
+            [
+                axes[0].node(4),
+                axes[1].node(0),
+                axes[2].node(5),
+                axes[3].node(0),
+            ],
+            [
+                axes[0].node(2),
+                axes[1].node(3),
+                axes[2].node(3),
+                axes[3].node(1),
+            ],
         ];
         let acc = check_table("lobe", &table, &lobe, &points, 48).unwrap();
-        println!("at nodes: max {:.3e} of the table maximum", acc.max_abs_error);
+        println!(
+            "at nodes: max {:.3e} of the table maximum",
+            acc.max_abs_error
+        );
         // Only f32 storage and the reference's own ~1e-8 error remain.
         assert!(acc.max_abs_error < 1e-6);
     }

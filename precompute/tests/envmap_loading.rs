@@ -207,7 +207,14 @@ fn each_bad_file_gives_its_own_error() {
     // A header that promises a million-pixel-square image in a few bytes.
     let e = err(b"#?RADIANCE\n\n-Y 1000000 +X 1000000\n\x02\x02");
     assert!(
-        matches!(e, EnvMapError::ImpossibleSize { width: 1_000_000, height: 1_000_000, .. }),
+        matches!(
+            e,
+            EnvMapError::ImpossibleSize {
+                width: 1_000_000,
+                height: 1_000_000,
+                ..
+            }
+        ),
         "{e}"
     );
     // A run longer than the scanline.

@@ -362,7 +362,11 @@ fn by_default_a_sun_is_taken_out_as_a_directional_light_with_its_power() {
     assert_eq!(set.sources.len(), 1, "{:?}", set.sources);
     for c in 0..3 {
         assert!((set.sources[0].power[c] - expected).abs() < 1e-9 * expected);
-        assert!((set.power_ratio[c] - 1.0).abs() < 1e-9, "{:?}", set.power_ratio);
+        assert!(
+            (set.power_ratio[c] - 1.0).abs() < 1e-9,
+            "{:?}",
+            set.power_ratio
+        );
     }
     // The sources round-trip through the set file, and a corrupted one is refused by index.
     let dir = std::env::temp_dir().join(format!("strandlight-set-sources-{}", std::process::id()));

@@ -30,9 +30,11 @@ use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::hair::{self, HairModel};
 use strandlight_runtime::image_out::write_png;
-use strandlight_tables::table_axes::{AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
 use strandlight_tables::srbf::{integral, sample_cos_gamma};
 use strandlight_tables::table::{Axis, Table};
+use strandlight_tables::table_axes::{
+    AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_U_DOT_WO, AXIS_U_DOT_XI,
+};
 
 type BoxError = Box<dyn std::error::Error>;
 
@@ -64,12 +66,10 @@ fn parse_args() -> Result<Args, BoxError> {
             "--procedural" => args.procedural = true,
             "--strands" => {
                 let v = value("--strands")?;
-                args.strands = Some(
-                    v.parse()
-                        .ok()
-                        .filter(|&n| n > 0)
-                        .ok_or_else(|| format!("--strands {v:?}: expected a positive whole number"))?,
-                );
+                args.strands =
+                    Some(v.parse().ok().filter(|&n| n > 0).ok_or_else(|| {
+                        format!("--strands {v:?}: expected a positive whole number")
+                    })?);
                 args.procedural = true;
             }
             "--size" => {
@@ -82,11 +82,10 @@ fn parse_args() -> Result<Args, BoxError> {
             }
             "--samples" => {
                 let v = value("--samples")?;
-                args.samples = v
-                    .parse()
-                    .ok()
-                    .filter(|&n| n > 0)
-                    .ok_or_else(|| format!("--samples {v:?}: expected a positive whole number"))?;
+                args.samples =
+                    v.parse().ok().filter(|&n| n > 0).ok_or_else(|| {
+                        format!("--samples {v:?}: expected a positive whole number")
+                    })?;
             }
             "--lambdas" => {
                 let v = value("--lambdas")?;
@@ -218,7 +217,11 @@ fn main() -> Result<(), BoxError> {
     let right = (camera.target - camera.eye).cross(camera.up).normalize();
     let screen_up = right.cross(camera.target - camera.eye).normalize();
     let directions = [
-        ("upper front, 45° elevation", "upper", (toward_eye + screen_up).normalize()),
+        (
+            "upper front, 45° elevation",
+            "upper",
+            (toward_eye + screen_up).normalize(),
+        ),
         (
             "back rim (behind, 30° up, 15° right)",
             "rim",
@@ -226,10 +229,26 @@ fn main() -> Result<(), BoxError> {
         ),
     ];
     let filters = [
-        (TransmittanceFilter::PaperSupport, BoxAverage::OpticalDepth, "paper"),
-        (TransmittanceFilter::MatchedVariance, BoxAverage::OpticalDepth, "matched"),
-        (TransmittanceFilter::Centre, BoxAverage::OpticalDepth, "centre"),
-        (TransmittanceFilter::MatchedVariance, BoxAverage::Transmittance, "matched_t"),
+        (
+            TransmittanceFilter::PaperSupport,
+            BoxAverage::OpticalDepth,
+            "paper",
+        ),
+        (
+            TransmittanceFilter::MatchedVariance,
+            BoxAverage::OpticalDepth,
+            "matched",
+        ),
+        (
+            TransmittanceFilter::Centre,
+            BoxAverage::OpticalDepth,
+            "centre",
+        ),
+        (
+            TransmittanceFilter::MatchedVariance,
+            BoxAverage::Transmittance,
+            "matched_t",
+        ),
     ];
     println!(
         "{hair_name}: {} strands, {} segments; {width}×{height}; DODM {}²; reference: {} directional lights from G; {}",
@@ -267,11 +286,12 @@ fn main() -> Result<(), BoxError> {
                 &reference,
                 &format!("{} directional lights from G", lights.len()),
             )?;
-            let mut row = format!(
-                "| {dir_label} | {lambda} | {:.0} |",
-                reference_ms
-            );
-            let srbf = [EnvLight::srbf(xi, lambda, [(1.0 / integral(lambda as f64)) as f32; 3])];
+            let mut row = format!("| {dir_label} | {lambda} | {:.0} |", reference_ms);
+            let srbf = [EnvLight::srbf(
+                xi,
+                lambda,
+                [(1.0 / integral(lambda as f64)) as f32; 3],
+            )];
             for kappa in [1.0f32, 0.1] {
                 for &(filter, box_average, tag) in &filters {
                     let options = EnvRenderOptions {
@@ -286,7 +306,11 @@ fn main() -> Result<(), BoxError> {
                     let rmse = relative_rmse(&estimate.pixels, &reference.pixels);
                     row += &format!(" {rmse:.4} ({:.0} ms) |", frame_ms(&estimate));
                     if kappa == 1.0 {
-                        write(tag, &estimate, &format!("{}, averaging {}", filter.name(), box_average.name()))?;
+                        write(
+                            tag,
+                            &estimate,
+                            &format!("{}, averaging {}", filter.name(), box_average.name()),
+                        )?;
                     }
                 }
             }

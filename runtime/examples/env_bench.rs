@@ -18,9 +18,11 @@ use strandlight_runtime::env::{
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
-use strandlight_tables::table_axes::{AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
 use strandlight_tables::hard_case_sweep::SweepRng;
 use strandlight_tables::table::{Axis, Table};
+use strandlight_tables::table_axes::{
+    AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_U_DOT_WO, AXIS_U_DOT_XI,
+};
 
 type BoxError = Box<dyn std::error::Error>;
 

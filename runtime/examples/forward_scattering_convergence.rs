@@ -17,20 +17,26 @@ use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::multiple::shadow_paths::LightMedium;
 use strandlight_runtime::multiple::{
-    CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering, HairVolume,
-    VoxelSettings, interpolate_grid,
+    CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering,
+    HairVolume, VoxelSettings, interpolate_grid,
 };
-use strandlight_tables::table_axes::{AXIS_QUANTITY, AXIS_SIN_THETA};
-use strandlight_tables::dual_scattering::{DualScatteringAverages, DualScatteringConfig, LobeDecomposition};
+use strandlight_tables::dual_scattering::{
+    DualScatteringAverages, DualScatteringConfig, LobeDecomposition,
+};
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 use strandlight_tables::table::{Axis, AxisMapping, Table};
+use strandlight_tables::table_axes::{AXIS_QUANTITY, AXIS_SIN_THETA};
 
 /// The `fiber_averages` table as `bake_plan::push_fiber_averages` writes it (same axes, same
 /// quantity order), from Marschner's default fiber.
 fn fiber_averages_table(thetas: usize) -> Table {
-    let m = Marschner::new(MarschnerParams::default()).expect("default Marschner parameters are valid");
-    let averages = DualScatteringAverages::new(&m as &dyn LobeDecomposition, DualScatteringConfig::default())
-        .expect("default dual-scattering configuration is valid");
+    let m =
+        Marschner::new(MarschnerParams::default()).expect("default Marschner parameters are valid");
+    let averages = DualScatteringAverages::new(
+        &m as &dyn LobeDecomposition,
+        DualScatteringConfig::default(),
+    )
+    .expect("default dual-scattering configuration is valid");
     let axes = vec![
         Axis::with_mapping(AXIS_SIN_THETA, -1.0, 1.0, thetas, AxisMapping::Arcsine),
         Axis::uniform(AXIS_QUANTITY, 0.0, 8.0, 9),
@@ -78,7 +84,13 @@ fn sphere_directions(n: usize) -> Vec<Vec3> {
 /// Every `stride`-th hair point: where shading happens.
 fn probe_points(model: &HairModel, count: usize) -> Vec<Vec3> {
     let stride = (model.point_count() / count).max(1);
-    model.points().iter().step_by(stride).take(count).copied().collect()
+    model
+        .points()
+        .iter()
+        .step_by(stride)
+        .take(count)
+        .copied()
+        .collect()
 }
 
 /// RMS and max of |ΔT| (channel mean) and of |Δσ̄| between two probe sets.
@@ -99,7 +111,10 @@ fn differences(a: &[[f32; 4]], b: &[[f32; 4]]) -> (f64, f64, f64, f64) {
 fn mean_t(v: &[[f32; 4]]) -> (f64, f64) {
     let n = v.len().max(1) as f64;
     (
-        v.iter().map(|x| (x[0] + x[1] + x[2]) as f64 / 3.0).sum::<f64>() / n,
+        v.iter()
+            .map(|x| (x[0] + x[1] + x[2]) as f64 / 3.0)
+            .sum::<f64>()
+            / n,
         v.iter().map(|x| x[3] as f64).sum::<f64>() / n,
     )
 }
@@ -111,15 +126,28 @@ fn compare_devices(model: &HairModel, tables: &ForwardScatteringTables) {
         Ok(gpu) => gpu,
         Err(e) => return println!("\n## CPU vs GPU march: skipped ({e})"),
     };
-    println!("\n## CPU vs GPU march (grid() for a batch of SRBF lights λ=32; median of 5 after a warm-up)");
-    println!("GPU: {}; CPU: rayon, {} threads. Both include the per-light table lookups on the CPU.", gpu.report, rayon::current_num_threads());
-    println!("Differences: f32 vs f64 recursions, and positions that round into the neighbouring voxel (nearest-voxel");
+    println!(
+        "\n## CPU vs GPU march (grid() for a batch of SRBF lights λ=32; median of 5 after a warm-up)"
+    );
+    println!(
+        "GPU: {}; CPU: rayon, {} threads. Both include the per-light table lookups on the CPU.",
+        gpu.report,
+        rayon::current_num_threads()
+    );
+    println!(
+        "Differences: f32 vs f64 recursions, and positions that round into the neighbouring voxel (nearest-voxel"
+    );
     println!("lookups are discontinuous; the shader's division need not round as the CPU's does).");
-    println!("| voxels | coarse factor | taps | sample vertices | lights | CPU ms | GPU ms | GPU / CPU | RMS |ΔT_f| | max |ΔT_f| | values with |ΔT_f| > 10⁻³ | max |Δσ̄_f| |");
+    println!(
+        "| voxels | coarse factor | taps | sample vertices | lights | CPU ms | GPU ms | GPU / CPU | RMS |ΔT_f| | max |ΔT_f| | values with |ΔT_f| > 10⁻³ | max |Δσ̄_f| |"
+    );
     println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     for &(voxels, coarse, taps) in &[(64u32, 4u32, 2u32), (90, 4, 2), (64, 2, 2), (64, 1, 1)] {
         let settings = ForwardScatteringSettings {
-            voxels: VoxelSettings { voxels_longest_side: voxels, default_diameter: None },
+            voxels: VoxelSettings {
+                voxels_longest_side: voxels,
+                default_diameter: None,
+            },
             coarse_factor: coarse,
             filter_taps: taps,
             ..Default::default()
@@ -128,8 +156,10 @@ fn compare_devices(model: &HairModel, tables: &ForwardScatteringTables) {
         let vertices = cpu.sample_grid().vertex_count();
         let on_gpu = GpuForwardScattering::new(&gpu, cpu.clone()).expect("GPU source");
         for &count in &[16usize, 50] {
-            let lights: Vec<EnvLight> =
-                sphere_directions(count).into_iter().map(|d| EnvLight::srbf(d, 32.0, [1.0; 3])).collect();
+            let lights: Vec<EnvLight> = sphere_directions(count)
+                .into_iter()
+                .map(|d| EnvLight::srbf(d, 32.0, [1.0; 3]))
+                .collect();
             let time = |source: &dyn ForwardScatteringSource| {
                 let mut last = source.grid(&lights).expect("grid");
                 let times = (0..5)
@@ -165,7 +195,9 @@ fn main() {
     let Some(path) = strandlight_tables::shared_data::shared_file("hair/straight.hair") else {
         return;
     };
-    let model = strandlight_runtime::hair::load(&path).expect("straight.hair loads").model;
+    let model = strandlight_runtime::hair::load(&path)
+        .expect("straight.hair loads")
+        .model;
     println!(
         "straight.hair: {} strands, {} points, bounds {:?}..{:?}, thickness {:?}; rayon threads {}",
         model.strand_count(),
@@ -179,8 +211,12 @@ fn main() {
     let fiber = fiber_averages_table(128);
     let ratio = attenuation_ratio_table(32, 32, 1.0).expect("attenuation ratio table");
     let spread = srbf_spread_table(32, 64, 16.0, 64.0).expect("srbf spread table");
-    let tables = ForwardScatteringTables::from_tables(&fiber, &ratio, &spread).expect("table shapes");
-    println!("tables built in {:.2} s (bake-time work, not part of the runtime)", t0.elapsed().as_secs_f64());
+    let tables =
+        ForwardScatteringTables::from_tables(&fiber, &ratio, &spread).expect("table shapes");
+    println!(
+        "tables built in {:.2} s (bake-time work, not part of the runtime)",
+        t0.elapsed().as_secs_f64()
+    );
 
     // Optional section names on the command line (voxels, paths, gpu, medium, convergence).
     let only: Vec<String> = std::env::args().skip(1).collect();
@@ -188,87 +224,109 @@ fn main() {
 
     // --- Voxelization time (dynamic hair rebuilds it every frame).
     if want("voxels") {
-    println!("\n## Voxelization (median of 5)");
-    println!("| voxels (longest side) | grid | occupied | voxel side | max σ_t⊥·h | mean σ_t⊥·h (occupied) | median ms |");
-    println!("|---|---|---|---|---|---|---|");
-    for &n in &[32u32, 64, 90, 128] {
-        let settings = VoxelSettings { voxels_longest_side: n, default_diameter: None };
-        let mut times = Vec::new();
-        let mut volume = None;
-        for _ in 0..5 {
-            let t = Instant::now();
-            volume = Some(HairVolume::build(&model, &settings, 1.0).expect("voxelization"));
-            times.push(t.elapsed().as_secs_f64() * 1e3);
-        }
-        let v = volume.unwrap();
-        let h = v.grid.voxel_size;
-        let occ: Vec<f32> = v.sigma_perp.iter().copied().filter(|&s| s > 0.0).collect();
-        let max = occ.iter().cloned().fold(0.0, f32::max) * h;
-        let mean = occ.iter().map(|&s| s as f64).sum::<f64>() / occ.len().max(1) as f64 * h as f64;
+        println!("\n## Voxelization (median of 5)");
         println!(
-            "| {n} | {:?} | {} | {h:.4} | {max:.3} | {mean:.3} | {:.1} |",
-            v.grid.dims,
-            occ.len(),
-            median(times)
+            "| voxels (longest side) | grid | occupied | voxel side | max σ_t⊥·h | mean σ_t⊥·h (occupied) | median ms |"
         );
-    }
-
+        println!("|---|---|---|---|---|---|---|");
+        for &n in &[32u32, 64, 90, 128] {
+            let settings = VoxelSettings {
+                voxels_longest_side: n,
+                default_diameter: None,
+            };
+            let mut times = Vec::new();
+            let mut volume = None;
+            for _ in 0..5 {
+                let t = Instant::now();
+                volume = Some(HairVolume::build(&model, &settings, 1.0).expect("voxelization"));
+                times.push(t.elapsed().as_secs_f64() * 1e3);
+            }
+            let v = volume.unwrap();
+            let h = v.grid.voxel_size;
+            let occ: Vec<f32> = v.sigma_perp.iter().copied().filter(|&s| s > 0.0).collect();
+            let max = occ.iter().cloned().fold(0.0, f32::max) * h;
+            let mean =
+                occ.iter().map(|&s| s as f64).sum::<f64>() / occ.len().max(1) as f64 * h as f64;
+            println!(
+                "| {n} | {:?} | {} | {h:.4} | {max:.3} | {mean:.3} | {:.1} |",
+                v.grid.dims,
+                occ.len(),
+                median(times)
+            );
+        }
     }
 
     // --- Shadow-path time per light batch.
     if want("paths") {
-    println!("\n## Shadow paths (grid() for a batch; median of 3, one run for the slow per-vertex dense case)");
-    println!("| voxels | coarse factor | method | step | lights | kind | sample vertices | batch ms | ms / light |");
-    println!("|---|---|---|---|---|---|---|---|---|");
-    let timing_cases = [
-        (64u32, 4u32, 2u32, 0.5f32, false),
-        (64, 4, 1, 0.5, false),
-        (64, 4, 1, 0.5, true),
-        (90, 4, 2, 0.5, false),
-        (90, 4, 1, 0.5, true),
-        (64, 1, 1, 0.25, true),
-        (90, 1, 1, 0.25, true),
-        (64, 1, 2, 0.25, false),
-    ];
-    for &(voxels, coarse, taps, step, sweep) in &timing_cases {
-        let settings = ForwardScatteringSettings {
-            voxels: VoxelSettings { voxels_longest_side: voxels, default_diameter: None },
-            coarse_factor: coarse,
-            step_fraction: step,
-            filter_taps: taps,
-            light_sweep: sweep,
-            ..Default::default()
-        };
-        let source = CpuForwardScattering::new(&model, tables.clone(), settings).expect("source");
-        for &count in &[16usize, 50] {
-            if coarse == 1 && !sweep && count == 50 {
-                continue; // per-vertex marching of the dense grid is timed with 16 lights only
-            }
-            for srbf in [true, false] {
-                let lights: Vec<EnvLight> = sphere_directions(count)
-                    .into_iter()
-                    .map(|d| if srbf { EnvLight::srbf(d, 32.0, [1.0; 3]) } else { EnvLight::directional(d, [1.0; 3]) })
-                    .collect();
-                let mut times = Vec::new();
-                let reps = if coarse == 1 && !sweep { 1 } else { 3 };
-                for _ in 0..reps {
-                    let t = Instant::now();
-                    let grid = source.grid(&lights).expect("grid");
-                    times.push(t.elapsed().as_secs_f64() * 1e3);
-                    assert!(grid.values.iter().all(|v| v.iter().all(|x| x.is_finite())));
+        println!(
+            "\n## Shadow paths (grid() for a batch; median of 3, one run for the slow per-vertex dense case)"
+        );
+        println!(
+            "| voxels | coarse factor | method | step | lights | kind | sample vertices | batch ms | ms / light |"
+        );
+        println!("|---|---|---|---|---|---|---|---|---|");
+        let timing_cases = [
+            (64u32, 4u32, 2u32, 0.5f32, false),
+            (64, 4, 1, 0.5, false),
+            (64, 4, 1, 0.5, true),
+            (90, 4, 2, 0.5, false),
+            (90, 4, 1, 0.5, true),
+            (64, 1, 1, 0.25, true),
+            (90, 1, 1, 0.25, true),
+            (64, 1, 2, 0.25, false),
+        ];
+        for &(voxels, coarse, taps, step, sweep) in &timing_cases {
+            let settings = ForwardScatteringSettings {
+                voxels: VoxelSettings {
+                    voxels_longest_side: voxels,
+                    default_diameter: None,
+                },
+                coarse_factor: coarse,
+                step_fraction: step,
+                filter_taps: taps,
+                light_sweep: sweep,
+                ..Default::default()
+            };
+            let source =
+                CpuForwardScattering::new(&model, tables.clone(), settings).expect("source");
+            for &count in &[16usize, 50] {
+                if coarse == 1 && !sweep && count == 50 {
+                    continue; // per-vertex marching of the dense grid is timed with 16 lights only
                 }
-                let ms = median(times);
-                let method = if sweep { "light sweep".to_string() } else { format!("march, {taps}³ taps") };
-                println!(
-                    "| {voxels} | {coarse} | {method} | {step} | {count} | {} | {} | {ms:.1} | {:.2} |",
-                    if srbf { "SRBF λ=32" } else { "directional" },
-                    source.sample_grid().vertex_count(),
-                    ms / count as f64
-                );
+                for srbf in [true, false] {
+                    let lights: Vec<EnvLight> = sphere_directions(count)
+                        .into_iter()
+                        .map(|d| {
+                            if srbf {
+                                EnvLight::srbf(d, 32.0, [1.0; 3])
+                            } else {
+                                EnvLight::directional(d, [1.0; 3])
+                            }
+                        })
+                        .collect();
+                    let mut times = Vec::new();
+                    let reps = if coarse == 1 && !sweep { 1 } else { 3 };
+                    for _ in 0..reps {
+                        let t = Instant::now();
+                        let grid = source.grid(&lights).expect("grid");
+                        times.push(t.elapsed().as_secs_f64() * 1e3);
+                        assert!(grid.values.iter().all(|v| v.iter().all(|x| x.is_finite())));
+                    }
+                    let ms = median(times);
+                    let method = if sweep {
+                        "light sweep".to_string()
+                    } else {
+                        format!("march, {taps}³ taps")
+                    };
+                    println!(
+                        "| {voxels} | {coarse} | {method} | {step} | {count} | {} | {} | {ms:.1} | {:.2} |",
+                        if srbf { "SRBF λ=32" } else { "directional" },
+                        source.sample_grid().vertex_count(),
+                        ms / count as f64
+                    );
+                }
             }
         }
-    }
-
     }
 
     // --- The same march on the GPU (compute shader) vs rayon: which source the device wants.
@@ -278,24 +336,30 @@ fn main() {
 
     // --- Where a light's time goes: the per-voxel table lookups (LightMedium) vs the paths.
     if want("medium") {
-    println!("\n## Per-light table lookups (LightMedium::new, median of 5)");
-    println!("| voxels | occupied | ms |");
-    println!("|---|---|---|");
-    for &voxels in &[64u32, 90] {
-        let settings = VoxelSettings { voxels_longest_side: voxels, default_diameter: None };
-        let volume = HairVolume::build(&model, &settings, 1.0).expect("voxelization");
-        let light = EnvLight::srbf(Vec3::new(0.3, 0.5, 0.8), 32.0, [1.0; 3]);
-        let times: Vec<f64> = (0..5)
-            .map(|_| {
-                let t = Instant::now();
-                let m = LightMedium::new(&volume, &tables, &light);
-                std::hint::black_box(&m);
-                t.elapsed().as_secs_f64() * 1e3
-            })
-            .collect();
-        println!("| {voxels} | {} | {:.1} |", volume.occupied_voxels(), median(times));
-    }
-
+        println!("\n## Per-light table lookups (LightMedium::new, median of 5)");
+        println!("| voxels | occupied | ms |");
+        println!("|---|---|---|");
+        for &voxels in &[64u32, 90] {
+            let settings = VoxelSettings {
+                voxels_longest_side: voxels,
+                default_diameter: None,
+            };
+            let volume = HairVolume::build(&model, &settings, 1.0).expect("voxelization");
+            let light = EnvLight::srbf(Vec3::new(0.3, 0.5, 0.8), 32.0, [1.0; 3]);
+            let times: Vec<f64> = (0..5)
+                .map(|_| {
+                    let t = Instant::now();
+                    let m = LightMedium::new(&volume, &tables, &light);
+                    std::hint::black_box(&m);
+                    t.elapsed().as_secs_f64() * 1e3
+                })
+                .collect();
+            println!(
+                "| {voxels} | {} | {:.1} |",
+                volume.occupied_voxels(),
+                median(times)
+            );
+        }
     }
 
     // --- Convergence at fixed points on the hair.
@@ -303,78 +367,131 @@ fn main() {
         return;
     }
     let probes = probe_points(&model, 1000);
-    let lights: Vec<EnvLight> = sphere_directions(8).into_iter().map(|d| EnvLight::directional(d, [1.0; 3])).collect();
+    let lights: Vec<EnvLight> = sphere_directions(8)
+        .into_iter()
+        .map(|d| EnvLight::directional(d, [1.0; 3]))
+        .collect();
     let base = ForwardScatteringSettings::default();
     let with = |voxels: u32, coarse: u32, step: f32, taps: u32| ForwardScatteringSettings {
-        voxels: VoxelSettings { voxels_longest_side: voxels, default_diameter: None },
+        voxels: VoxelSettings {
+            voxels_longest_side: voxels,
+            default_diameter: None,
+        },
         coarse_factor: coarse,
         step_fraction: step,
         filter_taps: taps,
         light_sweep: false,
         ..base
     };
-    let swept = |voxels: u32, coarse: u32, step: f32| ForwardScatteringSettings { light_sweep: true, ..with(voxels, coarse, step, 1) };
+    let swept = |voxels: u32, coarse: u32, step: f32| ForwardScatteringSettings {
+        light_sweep: true,
+        ..with(voxels, coarse, step, 1)
+    };
     let probe_values = |source: &CpuForwardScattering| -> Vec<[f32; 4]> {
-        lights.iter().flat_map(|l| source.values_at(l, &probes)).collect()
+        lights
+            .iter()
+            .flat_map(|l| source.values_at(l, &probes))
+            .collect()
     };
     let grid_values = |source: &CpuForwardScattering| -> Vec<[f32; 4]> {
         let grid = source.grid(&lights).expect("grid");
-        (0..lights.len()).flat_map(|l| probes.iter().map(move |&p| (l, p))).map(|(l, p)| interpolate_grid(&grid, l, p).expect("light index within the batch")).collect()
+        (0..lights.len())
+            .flat_map(|l| probes.iter().map(move |&p| (l, p)))
+            .map(|(l, p)| interpolate_grid(&grid, l, p).expect("light index within the batch"))
+            .collect()
     };
 
-    println!("\n## Convergence vs sample-grid density ({} hair points × {} directional lights, 64 voxels, step 0.5, taps 2)", probes.len(), lights.len());
-    println!("Reference: the march evaluated at each point itself (an infinitely dense sample grid).");
-    let source = CpuForwardScattering::new(&model, tables.clone(), with(64, 4, 0.5, 2)).expect("source");
+    println!(
+        "\n## Convergence vs sample-grid density ({} hair points × {} directional lights, 64 voxels, step 0.5, taps 2)",
+        probes.len(),
+        lights.len()
+    );
+    println!(
+        "Reference: the march evaluated at each point itself (an infinitely dense sample grid)."
+    );
+    let source =
+        CpuForwardScattering::new(&model, tables.clone(), with(64, 4, 0.5, 2)).expect("source");
     let exact = probe_values(&source);
     let (mt, ms) = mean_t(&exact);
     println!("mean T_f at the probes {mt:.4}, mean σ̄_f {ms:.4} rad");
     println!("| coarse factor | vertices | RMS ΔT_f | max ΔT_f | RMS Δσ̄_f | max Δσ̄_f |");
     println!("|---|---|---|---|---|---|");
     for &coarse in &[8u32, 4, 2, 1] {
-        let s = CpuForwardScattering::new(&model, tables.clone(), with(64, coarse, 0.5, 2)).expect("source");
+        let s = CpuForwardScattering::new(&model, tables.clone(), with(64, coarse, 0.5, 2))
+            .expect("source");
         let (a, b, c, d) = differences(&grid_values(&s), &exact);
-        println!("| {coarse} | {} | {a:.4} | {b:.4} | {c:.4} | {d:.4} |", s.sample_grid().vertex_count());
+        println!(
+            "| {coarse} | {} | {a:.4} | {b:.4} | {c:.4} | {d:.4} |",
+            s.sample_grid().vertex_count()
+        );
     }
 
     println!("\n## Light-sweep grids vs the same per-point reference (64 voxels, step 0.5)");
     println!("| coarse factor | vertices | RMS ΔT_f | max ΔT_f | RMS Δσ̄_f | max Δσ̄_f |");
     println!("|---|---|---|---|---|---|");
     for &coarse in &[4u32, 2, 1] {
-        let s = CpuForwardScattering::new(&model, tables.clone(), swept(64, coarse, 0.5)).expect("source");
+        let s = CpuForwardScattering::new(&model, tables.clone(), swept(64, coarse, 0.5))
+            .expect("source");
         let (a, b, c, d) = differences(&grid_values(&s), &exact);
-        println!("| {coarse} | {} | {a:.4} | {b:.4} | {c:.4} | {d:.4} |", s.sample_grid().vertex_count());
+        println!(
+            "| {coarse} | {} | {a:.4} | {b:.4} | {c:.4} | {d:.4} |",
+            s.sample_grid().vertex_count()
+        );
     }
     println!("light sweep evaluated at the probes themselves (no grid):");
     let s = CpuForwardScattering::new(&model, tables.clone(), swept(64, 4, 0.5)).expect("source");
     let (a, b, c, d) = differences(&probe_values(&s), &exact);
     println!("| at probes | - | {a:.4} | {b:.4} | {c:.4} | {d:.4} |");
 
-    println!("\n## Convergence vs step size (values at the probes, 64 voxels, taps 2; reference step 1/16 voxel)");
-    let reference = probe_values(&CpuForwardScattering::new(&model, tables.clone(), with(64, 4, 1.0 / 16.0, 2)).expect("source"));
+    println!(
+        "\n## Convergence vs step size (values at the probes, 64 voxels, taps 2; reference step 1/16 voxel)"
+    );
+    let reference = probe_values(
+        &CpuForwardScattering::new(&model, tables.clone(), with(64, 4, 1.0 / 16.0, 2))
+            .expect("source"),
+    );
     println!("| step (voxels) | RMS ΔT_f | max ΔT_f | RMS Δσ̄_f | max Δσ̄_f |");
     println!("|---|---|---|---|---|");
     for &step in &[1.0f32, 0.5, 0.25, 0.125] {
-        let v = probe_values(&CpuForwardScattering::new(&model, tables.clone(), with(64, 4, step, 2)).expect("source"));
+        let v = probe_values(
+            &CpuForwardScattering::new(&model, tables.clone(), with(64, 4, step, 2))
+                .expect("source"),
+        );
         let (a, b, c, d) = differences(&v, &reference);
         println!("| {step} | {a:.4} | {b:.4} | {c:.4} | {d:.4} |");
     }
 
-    println!("\n## Convergence vs voxel resolution (values at the probes, step 0.25, taps 2; reference 128 voxels)");
-    let reference = probe_values(&CpuForwardScattering::new(&model, tables.clone(), with(128, 4, 0.25, 2)).expect("source"));
+    println!(
+        "\n## Convergence vs voxel resolution (values at the probes, step 0.25, taps 2; reference 128 voxels)"
+    );
+    let reference = probe_values(
+        &CpuForwardScattering::new(&model, tables.clone(), with(128, 4, 0.25, 2)).expect("source"),
+    );
     println!("| voxels | RMS ΔT_f | max ΔT_f | RMS Δσ̄_f | max Δσ̄_f | mean T_f |");
     println!("|---|---|---|---|---|---|");
     for &voxels in &[32u32, 64, 90] {
-        let v = probe_values(&CpuForwardScattering::new(&model, tables.clone(), with(voxels, 4, 0.25, 2)).expect("source"));
+        let v = probe_values(
+            &CpuForwardScattering::new(&model, tables.clone(), with(voxels, 4, 0.25, 2))
+                .expect("source"),
+        );
         let (a, b, c, d) = differences(&v, &reference);
-        println!("| {voxels} | {a:.4} | {b:.4} | {c:.4} | {d:.4} | {:.4} |", mean_t(&v).0);
+        println!(
+            "| {voxels} | {a:.4} | {b:.4} | {c:.4} | {d:.4} | {:.4} |",
+            mean_t(&v).0
+        );
     }
 
     println!("\n## Box filter (values at the probes, 64 voxels, step 0.25): taps vs taps 4");
-    let reference = probe_values(&CpuForwardScattering::new(&model, tables.clone(), with(64, 4, 0.25, 4)).expect("source"));
+    let reference = probe_values(
+        &CpuForwardScattering::new(&model, tables.clone(), with(64, 4, 0.25, 4)).expect("source"),
+    );
     println!("| taps per axis | RMS ΔT_f | max ΔT_f | RMS Δσ̄_f | max Δσ̄_f |");
     println!("|---|---|---|---|---|");
     for &taps in &[1u32, 2, 3] {
-        let v = probe_values(&CpuForwardScattering::new(&model, tables.clone(), with(64, 4, 0.25, taps)).expect("source"));
+        let v = probe_values(
+            &CpuForwardScattering::new(&model, tables.clone(), with(64, 4, 0.25, taps))
+                .expect("source"),
+        );
         let (a, b, c, d) = differences(&v, &reference);
         println!("| {taps} | {a:.4} | {b:.4} | {c:.4} | {d:.4} |");
     }

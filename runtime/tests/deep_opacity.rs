@@ -20,7 +20,6 @@ use strandlight_runtime::passes::shadow_slots::ShadowInput;
 use strandlight_runtime::passes::strand_geometry::StrandGeometry;
 use strandlight_runtime::passes::strands::StrandPass;
 
-
 #[test]
 fn slab_of_parallel_strands_matches_the_closed_form() {
     let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
@@ -223,7 +222,13 @@ fn a_reused_map_equals_a_fresh_one_for_each_light() {
     pass.draw(&gpu, &geometry, &reused);
     let fresh = DeepOpacityMap::new(&gpu, tilted, settings);
     pass.draw(&gpu, &geometry, &fresh);
-    let (a, b) = (reused.read_layers(&gpu).unwrap(), fresh.read_layers(&gpu).unwrap());
-    assert_eq!(a, b, "a re-aimed map must hold exactly what a fresh one holds");
+    let (a, b) = (
+        reused.read_layers(&gpu).unwrap(),
+        fresh.read_layers(&gpu).unwrap(),
+    );
+    assert_eq!(
+        a, b,
+        "a re-aimed map must hold exactly what a fresh one holds"
+    );
     assert_ne!(a, first, "the two lights must see different optical depths");
 }

@@ -13,9 +13,9 @@ use strandlight_runtime::env::{
     render_env_frame,
 };
 use strandlight_runtime::gpu::GpuContext;
-use strandlight_runtime::multiple::ForwardScatteringError;
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::hair::{Attribute, HairModel};
+use strandlight_runtime::multiple::ForwardScatteringError;
 use strandlight_runtime::passes::convolution_depth::{
     ConvolutionDepthPass, DodmBatch, DodmSettings, SimplifiedSegments,
 };
@@ -25,13 +25,15 @@ use strandlight_runtime::passes::summed_area::{
     BoxAverage, MAX_BOX_HALF_SIZE, SummedAreaPass, SummedAreaTables, quantize_optical_depth,
 };
 use strandlight_runtime::passes::transmittance_probe::{ProbeBox, TransmittanceProbe};
-use strandlight_tables::table_axes::{AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_SIGMA_F, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
 use strandlight_tables::angles::FiberAngles;
+use strandlight_tables::hard_case_sweep::SweepRng;
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 use strandlight_tables::scattering::ScatteringFunction;
 use strandlight_tables::srbf::sample_cos_gamma;
-use strandlight_tables::hard_case_sweep::SweepRng;
 use strandlight_tables::table::{Axis, AxisMapping, Table};
+use strandlight_tables::table_axes::{
+    AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_SIGMA_F, AXIS_U_DOT_WO, AXIS_U_DOT_XI,
+};
 
 /// Writes `texels` (RGBA, row-major) into layer 0 of the batch's optical-depth texture.
 fn upload_optical_depth(gpu: &GpuContext, batch: &DodmBatch, texels: &[[f32; 4]]) {

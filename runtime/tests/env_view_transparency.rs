@@ -12,8 +12,8 @@ use strandlight_runtime::env::{
 };
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
-use strandlight_tables::table_axes::{AXIS_COS_DPHI, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
 use strandlight_tables::table::{Axis, Table};
+use strandlight_tables::table_axes::{AXIS_COS_DPHI, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
 
 /// The light: directional, toward +x (in the image plane), unit irradiance per channel.
 const LIGHT: Vec3 = Vec3::X;

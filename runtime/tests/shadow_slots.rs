@@ -18,7 +18,6 @@ use strandlight_runtime::passes::shadow_slots::{
 use strandlight_runtime::passes::strand_geometry::StrandGeometry;
 use strandlight_runtime::passes::strands::StrandPass;
 
-
 fn map_of_slab(gpu: &GpuContext, rows: usize, thickness: f32) -> DeepOpacityMap {
     let geometry = StrandGeometry::upload(gpu, &slab(rows, thickness)).unwrap();
     let map = DeepOpacityMap::new(

@@ -48,8 +48,10 @@ impl CameraChoice {
         let orthographic = self.kind == CameraKind::Orthographic;
         Ok(match self.eye {
             None => Camera::framing_front(model.bounds(), aspect, orthographic, up),
-            Some(eye) => Camera::framing_from_eye(model.bounds(), aspect, orthographic, eye, up.vector())
-                .with_context(|| format!("--eye {},{},{}", eye[0], eye[1], eye[2]))?,
+            Some(eye) => {
+                Camera::framing_from_eye(model.bounds(), aspect, orthographic, eye, up.vector())
+                    .with_context(|| format!("--eye {},{},{}", eye[0], eye[1], eye[2]))?
+            }
         })
     }
 }

@@ -11,20 +11,24 @@ use crate::hair_input::{load_hair, parse_size};
 use crate::image_metrics::{Image, error_legend, relative_rmse, write_side_by_side};
 use crate::look::{EnvLook, LookArgs};
 use crate::reference_cache::{ReferenceCache, ReferenceRecord};
-use crate::scene_tables::{EnvShading, ScatteringMode, SceneTables, bake_scene_tables, lambda_range_of_set, wanted_tables};
+use crate::scene_tables::{
+    EnvShading, ScatteringMode, SceneTables, bake_scene_tables, lambda_range_of_set, wanted_tables,
+};
 use crate::steps::Steps;
 use crate::world_lights::to_env_lights;
-use strandlight_tables::checksum::sha256_hex;
-use anyhow::{bail, Context};
-use serde_json::{json, Value};
+use anyhow::{Context, bail};
+use serde_json::{Value, json};
 use std::path::PathBuf;
-use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
-use strandlight_precompute::env_lights::{face_resolution_for, median_cut_lights, reference_lights, srbf_set_lights};
 use strandlight_precompute::FitOptions;
+use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
+use strandlight_precompute::env_lights::{
+    face_resolution_for, median_cut_lights, reference_lights, srbf_set_lights,
+};
 use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::{EnvLight, EnvRenderOptions};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::image_out::{write_exr, write_png};
+use strandlight_tables::checksum::sha256_hex;
 
 #[derive(Debug)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::Args))]
@@ -52,7 +56,10 @@ pub struct CompareArgs {
     /// paper's 32×32×6; 1536, 384, 96 for quick runs).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 6144))]
     pub reference_lights: usize,
-    #[cfg_attr(any(feature = "cli", test), arg(long, value_enum, default_value = "marschner"))]
+    #[cfg_attr(
+        any(feature = "cli", test),
+        arg(long, value_enum, default_value = "marschner")
+    )]
     pub shading: EnvShading,
     /// Melanin preset of the fiber: white, blonde, red, auburn, brown, dark.
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value = "brown"))]
@@ -64,7 +71,10 @@ pub struct CompareArgs {
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value = "out/cache"))]
     pub cache: PathBuf,
     /// Rotate the environment about its up axis by this many degrees.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0.0, allow_negative_numbers = true))]
+    #[cfg_attr(
+        any(feature = "cli", test),
+        arg(long, default_value_t = 0.0, allow_negative_numbers = true)
+    )]
     pub rotate: f64,
     /// Replace NaN/negative map values by 0 and +Inf by the largest finite value.
     #[cfg_attr(any(feature = "cli", test), arg(long))]
@@ -73,7 +83,10 @@ pub struct CompareArgs {
     #[cfg_attr(any(feature = "cli", test), arg(long, value_name = "N"))]
     pub table_resolution: Option<usize>,
     /// Which modes to compare: single scattering, full (single + multiple), or both.
-    #[cfg_attr(any(feature = "cli", test), arg(long, value_enum, value_delimiter = ',', default_value = "single,full"))]
+    #[cfg_attr(
+        any(feature = "cli", test),
+        arg(long, value_enum, value_delimiter = ',', default_value = "single,full")
+    )]
     pub modes: Vec<ScatteringMode>,
     /// Stochastic simplification of the SRBF light pass (Ren §7): the fraction of strands drawn
     /// into the light maps (1 = all). The reference and the baseline always draw all.
@@ -141,45 +154,125 @@ pub fn prepare(args: &CompareArgs, steps: &mut Steps) -> anyhow::Result<CompareS
     let (hair, hair_sha256) = steps.run(
         "hair",
         || {
-            let bytes = std::fs::read(&args.hair).with_context(|| format!("--hair {}", args.hair.display()))?;
+            let bytes = std::fs::read(&args.hair)
+                .with_context(|| format!("--hair {}", args.hair.display()))?;
             let (model, _) = load_hair(Some(&args.hair))?;
             Ok((model, sha256_hex(&bytes)))
         },
-        |(m, _): &(HairModel, String)| format!("{} ({} strands)", args.hair.display(), m.strand_count()),
+        |(m, _): &(HairModel, String)| {
+            format!("{} ({} strands)", args.hair.display(), m.strand_count())
+        },
     )?;
     prepare_with_hair(args, hair, hair_sha256, steps)
 }
 
 /// [`prepare`] for a hair already loaded (`hair_sha256` identifies it in the reference cache).
-pub fn prepare_with_hair(args: &CompareArgs, hair: HairModel, hair_sha256: String, steps: &mut Steps) -> anyhow::Result<CompareScene> {
+pub fn prepare_with_hair(
+    args: &CompareArgs,
+    hair: HairModel,
+    hair_sha256: String,
+    steps: &mut Steps,
+) -> anyhow::Result<CompareScene> {
     let face_resolution = validate(args)?;
     let (width, height) = parse_size(&args.size)?;
-    let fiber = FiberDescription::preset(&args.preset).with_context(|| format!("--preset {:?}", args.preset))?;
-    let env = steps.run("environment", || load_env(&args.env, args.sanitize), |e| format!("{} {}x{}", e.name, e.map.width(), e.map.height()))?;
-    let sources = strandlight_precompute::compact_sources::SourceOptions { max_sources: args.sources, ..Default::default() };
-    let options = FitOptions { max_lobes: args.lobes, initial_lobes: args.lobes.min(FitOptions::default().initial_lobes), rotate_degrees: args.rotate, sources, ..FitOptions::default() };
-    let fit = steps.run("fit", || fit_cached(&env, &options, &args.cache), |f| {
-        format!("{}{} → {}", fit_summary(&f.set), if f.cached { " (cached)" } else { "" }, f.path.display())
-    })?;
+    let fiber = FiberDescription::preset(&args.preset)
+        .with_context(|| format!("--preset {:?}", args.preset))?;
+    let env = steps.run(
+        "environment",
+        || load_env(&args.env, args.sanitize),
+        |e| format!("{} {}x{}", e.name, e.map.width(), e.map.height()),
+    )?;
+    let sources = strandlight_precompute::compact_sources::SourceOptions {
+        max_sources: args.sources,
+        ..Default::default()
+    };
+    let options = FitOptions {
+        max_lobes: args.lobes,
+        initial_lobes: args.lobes.min(FitOptions::default().initial_lobes),
+        rotate_degrees: args.rotate,
+        sources,
+        ..FitOptions::default()
+    };
+    let fit = steps.run(
+        "fit",
+        || fit_cached(&env, &options, &args.cache),
+        |f| {
+            format!(
+                "{}{} → {}",
+                fit_summary(&f.set),
+                if f.cached { " (cached)" } else { "" },
+                f.path.display()
+            )
+        },
+    )?;
     let lambda_range = lambda_range_of_set(&fit.set)?;
-    let resolution = args.table_resolution.map(BakeResolution::reduced).unwrap_or_default();
+    let resolution = args
+        .table_resolution
+        .map(BakeResolution::reduced)
+        .unwrap_or_default();
     let wanted = wanted_tables(args.shading, &args.modes, !fit.set.lobes.is_empty(), true);
-    let table_dir = args.cache.join("tables").join(format!("{}-{:?}", args.preset, args.shading).to_lowercase());
+    let table_dir = args
+        .cache
+        .join("tables")
+        .join(format!("{}-{:?}", args.preset, args.shading).to_lowercase());
     let tables = steps.run(
         "bake",
-        || bake_scene_tables(&fiber, args.shading, resolution, lambda_range, &wanted, &table_dir, &mut |_| {}),
-        |t| format!("{} tables ({} cached), λ ∈ [{:.1}, {:.1}] → {}", t.baked.len(), t.baked.iter().filter(|b| b.cached).count(), lambda_range.0, lambda_range.1, table_dir.display()),
+        || {
+            bake_scene_tables(
+                &fiber,
+                args.shading,
+                resolution,
+                lambda_range,
+                &wanted,
+                &table_dir,
+                &mut |_| {},
+            )
+        },
+        |t| {
+            format!(
+                "{} tables ({} cached), λ ∈ [{:.1}, {:.1}] → {}",
+                t.baked.len(),
+                t.baked.iter().filter(|b| b.cached).count(),
+                lambda_range.0,
+                lambda_range.1,
+                table_dir.display()
+            )
+        },
     )?;
     let up = UpAxis::detect(&hair);
     let camera = Camera::framing_front(hair.bounds(), width as f32 / height as f32, false, up);
     let srbf = to_env_lights(&srbf_set_lights(&fit.set), up);
     let reference = steps.run(
         "reference set",
-        || Ok(to_env_lights(&reference_lights(&env.map, face_resolution, args.rotate)?, up)),
-        |r: &Vec<EnvLight>| format!("{} cube-texel directional lights ({face_resolution}×{face_resolution}×6)", r.len()),
+        || {
+            Ok(to_env_lights(
+                &reference_lights(&env.map, face_resolution, args.rotate)?,
+                up,
+            ))
+        },
+        |r: &Vec<EnvLight>| {
+            format!(
+                "{} cube-texel directional lights ({face_resolution}×{face_resolution}×6)",
+                r.len()
+            )
+        },
     )?;
     let fit_relative_l2_error = fit.set.relative_l2_error;
-    Ok(CompareScene { hair, hair_sha256, camera, up, size: (width, height), tables, srbf, reference, map: env.map, map_sha256: env.sha256, fiber, fit_relative_l2_error, compact_sources: fit.set.sources.clone() })
+    Ok(CompareScene {
+        hair,
+        hair_sha256,
+        camera,
+        up,
+        size: (width, height),
+        tables,
+        srbf,
+        reference,
+        map: env.map,
+        map_sha256: env.sha256,
+        fiber,
+        fit_relative_l2_error,
+        compact_sources: fit.set.sources.clone(),
+    })
 }
 
 /// The function that renders a frame: [`render_lights`] in the program, a stand-in in tests.
@@ -219,39 +312,97 @@ struct EqualErrorResult {
 
 impl EqualErrorResult {
     fn chosen(&self) -> (usize, f64, f64) {
-        *self.renders.iter().find(|r| r.0 == self.lights).expect("the chosen count was rendered")
+        *self
+            .renders
+            .iter()
+            .find(|r| r.0 == self.lights)
+            .expect("the chosen count was rendered")
     }
 }
 
 /// The median-cut baseline with `lights` directional lights.
-fn render_baseline(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: ScatteringMode, lights: usize) -> anyhow::Result<RenderedEnv> {
-    let lights = to_env_lights(&median_cut_lights(&scene.map, lights, args.rotate), scene.up);
+fn render_baseline(
+    render: Renderer,
+    scene: &CompareScene,
+    args: &CompareArgs,
+    mode: ScatteringMode,
+    lights: usize,
+) -> anyhow::Result<RenderedEnv> {
+    let lights = to_env_lights(
+        &median_cut_lights(&scene.map, lights, args.rotate),
+        scene.up,
+    );
     timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)
 }
 
 /// Median-cut baselines of growing size until one is as accurate as `target_error`.
-fn equal_error_baseline(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: ScatteringMode, reference: &Image, target_error: f64, start: usize) -> anyhow::Result<EqualErrorResult> {
+fn equal_error_baseline(
+    render: Renderer,
+    scene: &CompareScene,
+    args: &CompareArgs,
+    mode: ScatteringMode,
+    reference: &Image,
+    target_error: f64,
+    start: usize,
+) -> anyhow::Result<EqualErrorResult> {
     let mut renders = Vec::new();
-    let found = equal_error_lights(target_error, start, scene.reference.len().max(16), 0.1, 10, |n| {
-        let r = render_baseline(render, scene, args, mode, n)?;
-        let error = relative_rmse(&r.image, reference)?;
-        renders.push((n, r.milliseconds, error));
-        Ok::<f64, anyhow::Error>(error)
-    })?;
-    Ok(EqualErrorResult { lights: found.lights, at_bound: found.at_bound, renders })
+    let found = equal_error_lights(
+        target_error,
+        start,
+        scene.reference.len().max(16),
+        0.1,
+        10,
+        |n| {
+            let r = render_baseline(render, scene, args, mode, n)?;
+            let error = relative_rmse(&r.image, reference)?;
+            renders.push((n, r.milliseconds, error));
+            Ok::<f64, anyhow::Error>(error)
+        },
+    )?;
+    Ok(EqualErrorResult {
+        lights: found.lights,
+        at_bound: found.at_bound,
+        renders,
+    })
 }
 
-fn frame<'a>(scene: &'a CompareScene, args: &CompareArgs, lights: &'a [EnvLight], mode: ScatteringMode) -> EnvFrame<'a> {
-    EnvFrame { hair: &scene.hair, camera: scene.camera, width: scene.size.0, height: scene.size.1, lights, tables: &scene.tables, shading: args.shading, mode, role: FrameRole::Interactive { kappa: args.kappa }, look: look(args) }
+fn frame<'a>(
+    scene: &'a CompareScene,
+    args: &CompareArgs,
+    lights: &'a [EnvLight],
+    mode: ScatteringMode,
+) -> EnvFrame<'a> {
+    EnvFrame {
+        hair: &scene.hair,
+        camera: scene.camera,
+        width: scene.size.0,
+        height: scene.size.1,
+        lights,
+        tables: &scene.tables,
+        shading: args.shading,
+        mode,
+        role: FrameRole::Interactive { kappa: args.kappa },
+        look: look(args),
+    }
 }
 
 /// The renderer choices of every frame (checked by `validate`).
 fn look(args: &CompareArgs) -> EnvLook {
-    EnvLook { shadowed: !args.unshadowed, ..args.look.look().expect("checked by validate") }
+    EnvLook {
+        shadowed: !args.unshadowed,
+        ..args.look.look().expect("checked by validate")
+    }
 }
 
-fn reference_frame<'a>(scene: &'a CompareScene, args: &CompareArgs, mode: ScatteringMode) -> EnvFrame<'a> {
-    EnvFrame { role: FrameRole::Reference, ..frame(scene, args, &scene.reference, mode) }
+fn reference_frame<'a>(
+    scene: &'a CompareScene,
+    args: &CompareArgs,
+    mode: ScatteringMode,
+) -> EnvFrame<'a> {
+    EnvFrame {
+        role: FrameRole::Reference,
+        ..frame(scene, args, &scene.reference, mode)
+    }
 }
 
 /// The multiple-scattering tables a directional reference reads (`srbf_spread` serves SRBF
@@ -259,7 +410,11 @@ fn reference_frame<'a>(scene: &'a CompareScene, args: &CompareArgs, mode: Scatte
 const REFERENCE_MULTIPLE_TABLES: [&str; 3] = ["multiple", "fiber_averages", "attenuation_ratio"];
 
 /// What identifies a reference image: everything its render reads, nothing else.
-fn reference_inputs(scene: &CompareScene, args: &CompareArgs, mode: ScatteringMode) -> anyhow::Result<Value> {
+fn reference_inputs(
+    scene: &CompareScene,
+    args: &CompareArgs,
+    mode: ScatteringMode,
+) -> anyhow::Result<Value> {
     let direct = scene.tables.get(args.shading.direct_table(mode))?;
     Ok(json!({
         "hair_sha256": scene.hair_sha256,
@@ -278,9 +433,31 @@ fn reference_inputs(scene: &CompareScene, args: &CompareArgs, mode: ScatteringMo
     }))
 }
 
-fn run_mode(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: ScatteringMode, steps: &mut Steps) -> anyhow::Result<ModeResult> {
+fn run_mode(
+    render: Renderer,
+    scene: &CompareScene,
+    args: &CompareArgs,
+    mode: ScatteringMode,
+    steps: &mut Steps,
+) -> anyhow::Result<ModeResult> {
     let m = mode.name();
-    let srbf = steps.run(&format!("{m}: SRBF"), || timed_render(render, &frame(scene, args, &scene.srbf, mode), args.timing_runs), |r| format!("{:.2} ms/frame, {} lights", r.milliseconds, scene.srbf.len()))?;
+    let srbf = steps.run(
+        &format!("{m}: SRBF"),
+        || {
+            timed_render(
+                render,
+                &frame(scene, args, &scene.srbf, mode),
+                args.timing_runs,
+            )
+        },
+        |r| {
+            format!(
+                "{:.2} ms/frame, {} lights",
+                r.milliseconds,
+                scene.srbf.len()
+            )
+        },
+    )?;
     let cache = ReferenceCache::new(args.cache.join("reference"));
     let inputs = reference_inputs(scene, args, mode)?;
     let reference = steps.run(
@@ -289,16 +466,31 @@ fn run_mode(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: Sc
             Some((image, record)) => Ok((image, record, true)),
             None => {
                 let r = render(&reference_frame(scene, args, mode))?;
-                let record = ReferenceRecord { inputs: inputs.clone(), lights: scene.reference.len(), milliseconds: r.milliseconds };
+                let record = ReferenceRecord {
+                    inputs: inputs.clone(),
+                    lights: scene.reference.len(),
+                    milliseconds: r.milliseconds,
+                };
                 cache.store(&r.image, &record)?;
                 Ok((r.image, record, false))
             }
         },
-        |(_, rec, cached): &(Image, ReferenceRecord, bool)| format!("{:.1} ms/frame, {} lights{}", rec.milliseconds, rec.lights, if *cached { " (cached)" } else { "" }),
+        |(_, rec, cached): &(Image, ReferenceRecord, bool)| {
+            format!(
+                "{:.1} ms/frame, {} lights{}",
+                rec.milliseconds,
+                rec.lights,
+                if *cached { " (cached)" } else { "" }
+            )
+        },
     )?;
-    let search = EqualTimeSearch { max_lights: scene.reference.len().max(16), ..EqualTimeSearch::new(srbf.milliseconds) };
+    let search = EqualTimeSearch {
+        max_lights: scene.reference.len().max(16),
+        ..EqualTimeSearch::new(srbf.milliseconds)
+    };
     // Every image the search renders is kept, so the chosen count need not be rendered again.
-    let mut searched: std::collections::HashMap<usize, RenderedEnv> = std::collections::HashMap::new();
+    let mut searched: std::collections::HashMap<usize, RenderedEnv> =
+        std::collections::HashMap::new();
     let found = steps.run(
         &format!("{m}: baseline"),
         || {
@@ -309,7 +501,19 @@ fn run_mode(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: Sc
                 Ok::<f64, anyhow::Error>(ms)
             })
         },
-        |f| format!("{} median-cut lights at {:.2} ms/frame ({} searches{})", f.lights, f.milliseconds, f.measurements.len(), if f.at_bound { ", at the search bound" } else { "" }),
+        |f| {
+            format!(
+                "{} median-cut lights at {:.2} ms/frame ({} searches{})",
+                f.lights,
+                f.milliseconds,
+                f.measurements.len(),
+                if f.at_bound {
+                    ", at the search bound"
+                } else {
+                    ""
+                }
+            )
+        },
     )?;
     let baseline = match searched.remove(&found.lights) {
         Some(r) => r,
@@ -328,32 +532,82 @@ fn run_mode(render: Renderer, scene: &CompareScene, args: &CompareArgs, mode: Sc
     } else {
         None
     };
-    Ok(ModeResult { srbf, reference, baseline, baseline_lights: found.lights, baseline_search: found.measurements, equal_error })
+    Ok(ModeResult {
+        srbf,
+        reference,
+        baseline,
+        baseline_lights: found.lights,
+        baseline_search: found.measurements,
+        equal_error,
+    })
 }
 
-fn write_mode_images(args: &CompareArgs, mode: ScatteringMode, r: &ModeResult, description: &str) -> anyhow::Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+fn write_mode_images(
+    args: &CompareArgs,
+    mode: ScatteringMode,
+    r: &ModeResult,
+    description: &str,
+) -> anyhow::Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
     let mut written = Vec::new();
-    for (name, image) in [("srbf", &r.srbf.image), ("reference", &r.reference.0), ("baseline", &r.baseline.image)] {
+    for (name, image) in [
+        ("srbf", &r.srbf.image),
+        ("reference", &r.reference.0),
+        ("baseline", &r.baseline.image),
+    ] {
         let stem = args.out.join(format!("{}-{name}", mode.name()));
-        write_exr(&stem.with_extension("exr"), image.width, image.height, &image.pixels, description)?;
-        write_png(&stem.with_extension("png"), image.width, image.height, &image.pixels, description)?;
+        write_exr(
+            &stem.with_extension("exr"),
+            image.width,
+            image.height,
+            &image.pixels,
+            description,
+        )?;
+        write_png(
+            &stem.with_extension("png"),
+            image.width,
+            image.height,
+            &image.pixels,
+            description,
+        )?;
         written.push(stem.with_extension("png"));
     }
     let side = args.out.join(format!("{}-compare.png", mode.name()));
-    write_side_by_side(&side, &r.srbf.image, &r.reference.0, &r.baseline.image, description)?;
+    write_side_by_side(
+        &side,
+        &r.srbf.image,
+        &r.reference.0,
+        &r.baseline.image,
+        description,
+    )?;
     written.push(side);
     Ok(written)
 }
 
 /// Renders both modes three ways with `render`, writes the images and returns the report
 /// (`{"single": {...}, "full": {...}, "steps": [...]}`; the shape of the issue's JSON).
-pub fn execute(args: &CompareArgs, scene: &CompareScene, steps: &mut Steps, render: Renderer) -> anyhow::Result<Value> {
+pub fn execute(
+    args: &CompareArgs,
+    scene: &CompareScene,
+    steps: &mut Steps,
+    render: Renderer,
+) -> anyhow::Result<Value> {
     let mut report = serde_json::Map::new();
-    let description = format!("strandlight compare: {} under {} ({:?}, preset {})", args.hair.display(), args.env, args.shading, args.preset);
+    let description = format!(
+        "strandlight compare: {} under {} ({:?}, preset {})",
+        args.hair.display(),
+        args.env,
+        args.shading,
+        args.preset
+    );
     if let Some(&first) = args.modes.first() {
         // Drivers compile shader variants at their first draw (lavapipe: seconds): not a frame's cost.
-        steps.run("warm-up", || render(&frame(scene, args, &scene.srbf, first)), |r| format!("{:.0} ms, untimed", r.milliseconds))?;
+        steps.run(
+            "warm-up",
+            || render(&frame(scene, args, &scene.srbf, first)),
+            |r| format!("{:.0} ms, untimed", r.milliseconds),
+        )?;
     }
     for &mode in &args.modes {
         let r = run_mode(render, scene, args, mode, steps)?;
@@ -390,7 +644,16 @@ pub fn execute(args: &CompareArgs, scene: &CompareScene, steps: &mut Steps, rend
             "compact_sources": scene.compact_sources,
         }),
     );
-    report.insert("steps".into(), json!(steps.done.iter().map(|(n, s, note)| json!({"step": n, "seconds": s, "note": note})).collect::<Vec<_>>()));
+    report.insert(
+        "steps".into(),
+        json!(
+            steps
+                .done
+                .iter()
+                .map(|(n, s, note)| json!({"step": n, "seconds": s, "note": note}))
+                .collect::<Vec<_>>()
+        ),
+    );
     Ok(Value::Object(report))
 }
 
@@ -412,22 +675,55 @@ mod tests {
     #[test]
     fn arguments_parse_with_the_issue_defaults_and_bad_values_are_named() {
         let a = args(&["--hair", "h.hair", "--env", "procedural:studio"]).unwrap();
-        assert_eq!((a.lobes, a.size.as_str(), a.reference_lights, a.shading), (64, "640x480", 6144, EnvShading::Marschner));
+        assert_eq!(
+            (a.lobes, a.size.as_str(), a.reference_lights, a.shading),
+            (64, "640x480", 6144, EnvShading::Marschner)
+        );
         assert_eq!(validate(&a).unwrap(), 32);
         assert!(args(&["--env", "x.hdr"]).is_err(), "--hair is required");
         let a = args(&["--hair", "h", "--env", "e", "--reference-lights", "100"]).unwrap();
         let e = validate(&a).unwrap_err().to_string();
-        assert!(e.contains("--reference-lights 100") && e.contains("6n²"), "{e}");
-        let a = args(&["--hair", "h", "--env", "e", "--shading", "artist", "--reference-lights", "96", "--size", "64x48", "--json"]).unwrap();
-        assert_eq!((a.shading, validate(&a).unwrap(), a.json), (EnvShading::Artist, 4, true));
+        assert!(
+            e.contains("--reference-lights 100") && e.contains("6n²"),
+            "{e}"
+        );
+        let a = args(&[
+            "--hair",
+            "h",
+            "--env",
+            "e",
+            "--shading",
+            "artist",
+            "--reference-lights",
+            "96",
+            "--size",
+            "64x48",
+            "--json",
+        ])
+        .unwrap();
+        assert_eq!(
+            (a.shading, validate(&a).unwrap(), a.json),
+            (EnvShading::Artist, 4, true)
+        );
         assert!(args(&["--hair", "h", "--env", "e", "--shading", "kajiya-kay"]).is_err());
     }
 
     #[test]
     fn a_missing_hair_file_is_named_before_any_work() {
-        let a = args(&["--hair", "/nonexistent/straight.hair", "--env", "procedural:studio", "--reference-lights", "96"]).unwrap();
+        let a = args(&[
+            "--hair",
+            "/nonexistent/straight.hair",
+            "--env",
+            "procedural:studio",
+            "--reference-lights",
+            "96",
+        ])
+        .unwrap();
         let e = prepare(&a, &mut Steps::new(true)).err().expect("must fail");
-        assert!(format!("{e:#}").contains("/nonexistent/straight.hair"), "{e:#}");
+        assert!(
+            format!("{e:#}").contains("/nonexistent/straight.hair"),
+            "{e:#}"
+        );
     }
 
     /// A stand-in renderer whose picture is known without a GPU: every pixel of a central
@@ -442,48 +738,113 @@ mod tests {
         let pixels = (0..w * h)
             .map(|i| {
                 let (x, y) = (i % w, i / w);
-                if (w / 4..3 * w / 4).contains(&x) && (h / 4..3 * h / 4).contains(&y) { [total[0], total[1], total[2], 1.0] } else { [0.0; 4] }
+                if (w / 4..3 * w / 4).contains(&x) && (h / 4..3 * h / 4).contains(&y) {
+                    [total[0], total[1], total[2], 1.0]
+                } else {
+                    [0.0; 4]
+                }
             })
             .collect();
-        Ok(RenderedEnv { image: Image::new(w, h, pixels), milliseconds: 1.0 + 0.01 * frame.lights.len() as f64, passes: Vec::new(), fragments: None, memory_per_batch: Vec::new() })
+        Ok(RenderedEnv {
+            image: Image::new(w, h, pixels),
+            milliseconds: 1.0 + 0.01 * frame.lights.len() as f64,
+            passes: Vec::new(),
+            fragments: None,
+            memory_per_batch: Vec::new(),
+        })
     }
 
     #[test]
     fn the_whole_comparison_runs_with_a_stand_in_renderer() {
-        let dir = std::env::temp_dir().join(format!("strandlight-compare-e2e-{}", std::process::id()));
+        let dir =
+            std::env::temp_dir().join(format!("strandlight-compare-e2e-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
-        let (out, cache) = (dir.join("out").display().to_string(), dir.join("cache").display().to_string());
+        let (out, cache) = (
+            dir.join("out").display().to_string(),
+            dir.join("cache").display().to_string(),
+        );
         let a = args(&[
-            "--hair", "groom", "--env", "procedural:studio", "--lobes", "8", "--size", "32x24", "--reference-lights", "96",
-            "--table-resolution", "4", "--timing-runs", "1", "--out", &out, "--cache", &cache, "--json",
+            "--hair",
+            "groom",
+            "--env",
+            "procedural:studio",
+            "--lobes",
+            "8",
+            "--size",
+            "32x24",
+            "--reference-lights",
+            "96",
+            "--table-resolution",
+            "4",
+            "--timing-runs",
+            "1",
+            "--out",
+            &out,
+            "--cache",
+            &cache,
+            "--json",
         ])
         .unwrap();
-        let groom = strandlight_runtime::hair::generate_groom(&strandlight_runtime::hair::GroomParams { strand_count: 40, clump_count: 8, ..Default::default() }).unwrap();
+        let groom =
+            strandlight_runtime::hair::generate_groom(&strandlight_runtime::hair::GroomParams {
+                strand_count: 40,
+                clump_count: 8,
+                ..Default::default()
+            })
+            .unwrap();
         let mut steps = Steps::new(true);
         let scene = prepare_with_hair(&a, groom.clone(), "groom".into(), &mut steps).unwrap();
         let report = execute(&a, &scene, &mut steps, &power_renderer).unwrap();
         println!("{}", serde_json::to_string_pretty(&report).unwrap());
         // Independent expectations: the reference and the median cut both carry the map's
         // integral exactly, the SRBFs carry it times the fit's own measured power ratio.
-        let fit = fit_cached(&load_env("procedural:studio", false).unwrap(), &FitOptions { max_lobes: 8, initial_lobes: 8, ..FitOptions::default() }, &dir.join("cache")).unwrap();
+        let fit = fit_cached(
+            &load_env("procedural:studio", false).unwrap(),
+            &FitOptions {
+                max_lobes: 8,
+                initial_lobes: 8,
+                ..FitOptions::default()
+            },
+            &dir.join("cache"),
+        )
+        .unwrap();
         assert!(fit.cached, "compare stored its fit in the cache");
         let integral = scene.map.integral();
-        let num: f64 = (0..3).map(|c| ((fit.set.power_ratio[c] - 1.0) * integral[c]).powi(2)).sum();
+        let num: f64 = (0..3)
+            .map(|c| ((fit.set.power_ratio[c] - 1.0) * integral[c]).powi(2))
+            .sum();
         let den: f64 = integral.iter().map(|v| v * v).sum();
         let want_srbf = (num / den).sqrt();
         let n_srbf = scene.srbf.len();
         for mode in ["single", "full"] {
             let m = &report[mode];
             let srbf = m["srbf"]["relative_rmse"].as_f64().unwrap();
-            assert!((srbf - want_srbf).abs() < 1e-5, "{mode}: {srbf} vs {want_srbf}");
-            assert!(m["baseline"]["relative_rmse"].as_f64().unwrap() < 1e-5, "{mode}: median cut carries the whole map");
+            assert!(
+                (srbf - want_srbf).abs() < 1e-5,
+                "{mode}: {srbf} vs {want_srbf}"
+            );
+            assert!(
+                m["baseline"]["relative_rmse"].as_f64().unwrap() < 1e-5,
+                "{mode}: median cut carries the whole map"
+            );
             let lights = m["baseline"]["lights"].as_u64().unwrap() as usize;
-            assert!(lights.abs_diff(n_srbf) <= 1, "{mode}: equal time ⇔ equal light count here ({lights} vs {n_srbf})");
+            assert!(
+                lights.abs_diff(n_srbf) <= 1,
+                "{mode}: equal time ⇔ equal light count here ({lights} vs {n_srbf})"
+            );
             assert_eq!(m["reference"]["lights"], 96);
-            assert!((m["speedup_vs_reference"].as_f64().unwrap() - (1.96 / (1.0 + 0.01 * n_srbf as f64))).abs() < 1e-9);
+            assert!(
+                (m["speedup_vs_reference"].as_f64().unwrap()
+                    - (1.96 / (1.0 + 0.01 * n_srbf as f64)))
+                    .abs()
+                    < 1e-9
+            );
             assert_eq!(m["reference"]["cached"], false);
             for image in m["images"].as_array().unwrap() {
-                assert!(std::path::Path::new(image.as_str().unwrap()).is_file(), "{image}");
+                assert!(
+                    std::path::Path::new(image.as_str().unwrap()).is_file(),
+                    "{image}"
+                );
             }
         }
         // Again: the reference comes from its cache.

@@ -11,21 +11,34 @@ const HEADER: &str = "| map | fit L2 err (map without its sources) | mode | SRBF
 fn number(v: &Value, path: &[&str], file: &Path) -> anyhow::Result<f64> {
     let mut at = v;
     for key in path {
-        at = at.get(key).with_context(|| format!("{}: no \"{}\"", file.display(), path.join(".")))?;
+        at = at
+            .get(key)
+            .with_context(|| format!("{}: no \"{}\"", file.display(), path.join(".")))?;
     }
-    at.as_f64().with_context(|| format!("{}: \"{}\" is not a number", file.display(), path.join(".")))
+    at.as_f64()
+        .with_context(|| format!("{}: \"{}\" is not a number", file.display(), path.join(".")))
 }
 
 /// The map's name: the report's `scene.env` file stem, else the report's own file stem.
 fn map_name(report: &Value, file: &Path) -> String {
-    let from_scene = report["scene"]["env"].as_str().and_then(|e| Path::new(e).file_stem().map(|s| s.to_string_lossy().into_owned()));
-    from_scene.unwrap_or_else(|| file.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default())
+    let from_scene = report["scene"]["env"].as_str().and_then(|e| {
+        Path::new(e)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+    });
+    from_scene.unwrap_or_else(|| {
+        file.file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default()
+    })
 }
 
 /// The rows of one report (`single` then `full`, whichever it holds).
 pub fn rows(report: &Value, file: &Path) -> anyhow::Result<Vec<String>> {
     let name = map_name(report, file);
-    let fit_error = report["scene"]["fit_relative_l2_error"].as_f64().map_or("–".to_string(), |e| format!("{e:.3}"));
+    let fit_error = report["scene"]["fit_relative_l2_error"]
+        .as_f64()
+        .map_or("–".to_string(), |e| format!("{e:.3}"));
     let mut out = Vec::new();
     for mode in ["single", "full"] {
         let Some(m) = report.get(mode) else { continue };
@@ -36,20 +49,28 @@ pub fn rows(report: &Value, file: &Path) -> anyhow::Result<Vec<String>> {
                 let lights = number(e, &["lights"], file)?;
                 let speedup = n(&["speedup_at_equal_error"])?;
                 if e["at_bound"].as_bool() == Some(true) {
-                    (format!("> {lights:.0} (not reached)"), format!("> {speedup:.1}×"))
+                    (
+                        format!("> {lights:.0} (not reached)"),
+                        format!("> {speedup:.1}×"),
+                    )
                 } else {
                     (format!("{lights:.0}"), format!("{speedup:.1}×"))
                 }
             }
         };
         // "N + k sun": N SRBFs and k compact sources rendered as directional lights.
-        let sources = report["scene"]["compact_sources"].as_array().map_or(0, |s| s.len());
+        let sources = report["scene"]["compact_sources"]
+            .as_array()
+            .map_or(0, |s| s.len());
         let srbf_lights = n(&["srbf", "lights"])? as usize;
         let srbf_lights = match sources {
             0 => srbf_lights.to_string(),
             k => match srbf_lights.checked_sub(k) {
                 Some(lobes) => format!("{lobes} + {k} src"),
-                None => bail!("{}: {mode}: {srbf_lights} lights cannot hold {k} compact sources", file.display()),
+                None => bail!(
+                    "{}: {mode}: {srbf_lights} lights cannot hold {k} compact sources",
+                    file.display()
+                ),
             },
         };
         out.push(format!(
@@ -65,7 +86,10 @@ pub fn rows(report: &Value, file: &Path) -> anyhow::Result<Vec<String>> {
         ));
     }
     if out.is_empty() {
-        bail!("{}: neither \"single\" nor \"full\" — is it a `compare --json` report?", file.display());
+        bail!(
+            "{}: neither \"single\" nor \"full\" — is it a `compare --json` report?",
+            file.display()
+        );
     }
     Ok(out)
 }
@@ -74,8 +98,10 @@ pub fn rows(report: &Value, file: &Path) -> anyhow::Result<Vec<String>> {
 pub fn markdown_table(files: &[PathBuf]) -> anyhow::Result<String> {
     let mut lines = vec![HEADER.to_string()];
     for file in files {
-        let text = std::fs::read_to_string(file).with_context(|| format!("cannot read {}", file.display()))?;
-        let report: Value = serde_json::from_str(&text).with_context(|| format!("{}: not JSON", file.display()))?;
+        let text = std::fs::read_to_string(file)
+            .with_context(|| format!("cannot read {}", file.display()))?;
+        let report: Value =
+            serde_json::from_str(&text).with_context(|| format!("{}: not JSON", file.display()))?;
         lines.extend(rows(&report, file)?);
     }
     Ok(lines.join("\n"))
@@ -101,16 +127,22 @@ mod tests {
         assert!(r[1].contains("| full |") && r[1].contains("0.0700"));
 
         let mut with_equal = report.clone();
-        with_equal["single"]["baseline_equal_error"] = json!({"lights": 450, "ms": 1500.0, "relative_rmse": 0.039, "at_bound": false});
+        with_equal["single"]["baseline_equal_error"] =
+            json!({"lights": 450, "ms": 1500.0, "relative_rmse": 0.039, "at_bound": false});
         with_equal["single"]["speedup_at_equal_error"] = json!(15.0);
         let r = rows(&with_equal, Path::new("x.json")).unwrap();
         assert!(r[0].ends_with("| 450 | 15.0× |"), "{}", r[0]);
 
         let mut broken = report.clone();
-        broken["full"]["baseline"].as_object_mut().unwrap().remove("ms");
+        broken["full"]["baseline"]
+            .as_object_mut()
+            .unwrap()
+            .remove("ms");
         let e = rows(&broken, Path::new("b.json")).unwrap_err().to_string();
         assert!(e.contains("b.json") && e.contains("baseline.ms"), "{e}");
-        let e = rows(&json!({"steps": []}), Path::new("c.json")).unwrap_err().to_string();
+        let e = rows(&json!({"steps": []}), Path::new("c.json"))
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("c.json"), "{e}");
     }
 }

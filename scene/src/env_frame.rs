@@ -3,15 +3,20 @@
 
 use crate::image_metrics::Image;
 use crate::look::{EnvLook, ForwardDevice};
-use crate::scene_tables::{EnvShading, SceneTables, ScatteringMode};
+use crate::scene_tables::{EnvShading, ScatteringMode, SceneTables};
 use anyhow::Context;
 use std::sync::OnceLock;
 use strandlight_precompute::srbf_set::SrbfSet;
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env::{EnvLight, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables, ForwardScatteringSource, FragmentCounts};
+use strandlight_runtime::env::{
+    EnvLight, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables, ForwardScatteringSource,
+    FragmentCounts,
+};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
-use strandlight_runtime::multiple::{CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering};
+use strandlight_runtime::multiple::{
+    CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering,
+};
 
 /// "N SRBF lights" or "N SRBF lights + k directional" for a frame's lights.
 pub fn light_summary(lights: &[EnvLight]) -> String {
@@ -33,8 +38,16 @@ pub fn fit_summary(set: &SrbfSet) -> String {
             100.0 * set.sources.iter().map(|s| s.power_share).sum::<f64>()
         ),
     };
-    let without = if set.sources.is_empty() { "" } else { " (of the rest)" };
-    format!("{} SRBFs{sources}, relative L2 error {:.3}{without}", set.lobes.len(), set.relative_l2_error)
+    let without = if set.sources.is_empty() {
+        ""
+    } else {
+        " (of the rest)"
+    };
+    format!(
+        "{} SRBFs{sources}, relative L2 error {:.3}{without}",
+        set.lobes.len(),
+        set.relative_l2_error
+    )
 }
 
 /// One frame for the environment-lit renderer: a hair, a camera and one set of lights (all
@@ -89,7 +102,12 @@ const SETUP_PASSES: [&str; 3] = ["pipelines", "upload", "table upload"];
 
 /// Milliseconds of one frame: the renderer's passes without the one-time setup.
 pub fn frame_milliseconds(stats: &EnvRenderStats) -> f64 {
-    stats.timings.iter().filter(|t| !SETUP_PASSES.contains(&t.pass.as_str())).map(|t| t.milliseconds).sum()
+    stats
+        .timings
+        .iter()
+        .filter(|t| !SETUP_PASSES.contains(&t.pass.as_str()))
+        .map(|t| t.milliseconds)
+        .sum()
 }
 
 /// Which renderer settings a frame uses.
@@ -111,7 +129,14 @@ fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
         _ => 1.0,
     };
     let look = frame.look;
-    EnvRenderOptions { kappa, shadowed: look.shadowed, transparency: look.transparency, box_average: look.box_average, count_fragments: look.count_fragments, ..EnvRenderOptions::default() }
+    EnvRenderOptions {
+        kappa,
+        shadowed: look.shadowed,
+        transparency: look.transparency,
+        box_average: look.box_average,
+        count_fragments: look.count_fragments,
+        ..EnvRenderOptions::default()
+    }
 }
 
 /// Forward-scattering settings of `role`.
@@ -125,13 +150,22 @@ pub fn forward_settings(role: FrameRole) -> ForwardScatteringSettings {
 /// The forward-scattering source of Ren §6 for `frame` on the device its look asks for
 /// (voxelization included: a static hair pays it once, outside the frame time; dynamic hair per
 /// frame — see docs/BENCHMARKS.md). The reference's light sweep runs on the CPU only.
-fn forward_scattering<'g>(frame: &EnvFrame, gpu: &'g GpuContext) -> anyhow::Result<Box<dyn ForwardScatteringSource + 'g>> {
-    let tables = ForwardScatteringTables::from_tables(&frame.tables.get("fiber_averages")?.table, &frame.tables.get("attenuation_ratio")?.table, &frame.tables.get("srbf_spread")?.table)?;
+fn forward_scattering<'g>(
+    frame: &EnvFrame,
+    gpu: &'g GpuContext,
+) -> anyhow::Result<Box<dyn ForwardScatteringSource + 'g>> {
+    let tables = ForwardScatteringTables::from_tables(
+        &frame.tables.get("fiber_averages")?.table,
+        &frame.tables.get("attenuation_ratio")?.table,
+        &frame.tables.get("srbf_spread")?.table,
+    )?;
     let cpu = CpuForwardScattering::new(frame.hair, tables, forward_settings(frame.role))?;
     Ok(match frame.look.forward_scattering {
         _ if frame.role == FrameRole::Reference => Box::new(cpu),
         ForwardDevice::Cpu => Box::new(cpu),
-        ForwardDevice::Gpu => Box::new(GpuForwardScattering::new(gpu, cpu).context("--forward-scattering gpu")?),
+        ForwardDevice::Gpu => {
+            Box::new(GpuForwardScattering::new(gpu, cpu).context("--forward-scattering gpu")?)
+        }
         ForwardDevice::Auto if gpu.report.is_software => Box::new(cpu),
         // A volume beyond the adapter's limits is still rendered, by rayon.
         ForwardDevice::Auto => match GpuForwardScattering::new(gpu, cpu.clone()) {
@@ -147,10 +181,22 @@ fn forward_scattering<'g>(frame: &EnvFrame, gpu: &'g GpuContext) -> anyhow::Resu
 fn env_tables(frame: &EnvFrame) -> anyhow::Result<EnvTables> {
     let mut tables = EnvTables::default();
     if frame.lights.iter().any(|l| l.lambda.is_some()) {
-        tables.srbf = Some(frame.tables.get(frame.shading.srbf_table(frame.mode))?.table.clone());
+        tables.srbf = Some(
+            frame
+                .tables
+                .get(frame.shading.srbf_table(frame.mode))?
+                .table
+                .clone(),
+        );
     }
     if frame.lights.iter().any(|l| l.lambda.is_none()) {
-        tables.direct = Some(frame.tables.get(frame.shading.direct_table(frame.mode))?.table.clone());
+        tables.direct = Some(
+            frame
+                .tables
+                .get(frame.shading.direct_table(frame.mode))?
+                .table
+                .clone(),
+        );
     }
     if frame.mode == ScatteringMode::Full {
         tables.multiple = Some(frame.tables.get("multiple")?.table.clone());
@@ -171,14 +217,38 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
     let multiple = source.as_deref();
     let out = r
         .renderer
-        .render(&r.gpu, frame.hair, &frame.camera, frame.width, frame.height, frame.lights, &tables, &render_options(frame), multiple)
-        .with_context(|| format!("rendering {} lights ({} scattering)", frame.lights.len(), frame.mode.name()))?;
+        .render(
+            &r.gpu,
+            frame.hair,
+            &frame.camera,
+            frame.width,
+            frame.height,
+            frame.lights,
+            &tables,
+            &render_options(frame),
+            multiple,
+        )
+        .with_context(|| {
+            format!(
+                "rendering {} lights ({} scattering)",
+                frame.lights.len(),
+                frame.mode.name()
+            )
+        })?;
     Ok(RenderedEnv {
         milliseconds: frame_milliseconds(&out.stats),
-        passes: out.stats.timings.iter().map(|t| (t.pass.clone(), t.milliseconds)).collect(),
+        passes: out
+            .stats
+            .timings
+            .iter()
+            .map(|t| (t.pass.clone(), t.milliseconds))
+            .collect(),
         fragments: out.stats.fragments,
         memory_per_batch: out.stats.memory_per_batch.clone(),
-        image: Image { width: out.width, height: out.height, pixels: out.pixels },
+        image: Image {
+            width: out.width,
+            height: out.height,
+            pixels: out.pixels,
+        },
     })
 }
-

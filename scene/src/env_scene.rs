@@ -5,7 +5,9 @@
 use crate::env_frame::fit_summary;
 use crate::environment::LoadedEnv;
 use crate::fit_cache::{FitOutcome, fit_cached};
-use crate::scene_tables::{EnvShading, ScatteringMode, SceneTables, bake_scene_tables, lambda_range_of_set, wanted_tables};
+use crate::scene_tables::{
+    EnvShading, ScatteringMode, SceneTables, bake_scene_tables, lambda_range_of_set, wanted_tables,
+};
 use crate::steps::Steps;
 use crate::world_lights::to_env_lights;
 use std::path::Path;
@@ -41,31 +43,67 @@ pub struct EnvScene {
 
 /// Fits (cached), bakes (cached) and places the lights, reporting each as a step.
 pub fn prepare_env_scene(request: &EnvSceneRequest, steps: &mut Steps) -> anyhow::Result<EnvScene> {
-    let fit = steps.run("fit", || fit_cached(request.env, &FitOptions::default(), request.cache_dir), |f| {
-        format!("{}{}", fit_summary(&f.set), if f.cached { " (cached)" } else { "" })
-    })?;
+    let fit = steps.run(
+        "fit",
+        || fit_cached(request.env, &FitOptions::default(), request.cache_dir),
+        |f| {
+            format!(
+                "{}{}",
+                fit_summary(&f.set),
+                if f.cached { " (cached)" } else { "" }
+            )
+        },
+    )?;
     // Full asks for the single-scattering tables too: dark hair skips the multiple table and
     // the frame falls back to single scattering.
     let modes: &[ScatteringMode] = match request.scattering {
         ScatteringMode::Single => &[ScatteringMode::Single],
         ScatteringMode::Full => &[ScatteringMode::Single, ScatteringMode::Full],
     };
-    let wanted = wanted_tables(request.shading, modes, !fit.set.lobes.is_empty(), !fit.set.sources.is_empty());
+    let wanted = wanted_tables(
+        request.shading,
+        modes,
+        !fit.set.lobes.is_empty(),
+        !fit.set.sources.is_empty(),
+    );
     let lambda_range = lambda_range_of_set(&fit.set)?;
     let dir = request.cache_dir.join("tables").join(request.table_set);
     let tables = steps.run(
         "bake",
-        || bake_scene_tables(request.fiber, request.shading, request.resolution.clone(), lambda_range, &wanted, &dir, &mut |_| {}),
-        |t| format!("{} tables ({} cached) → {}", t.baked.len(), t.baked.iter().filter(|b| b.cached).count(), dir.display()),
+        || {
+            bake_scene_tables(
+                request.fiber,
+                request.shading,
+                request.resolution.clone(),
+                lambda_range,
+                &wanted,
+                &dir,
+                &mut |_| {},
+            )
+        },
+        |t| {
+            format!(
+                "{} tables ({} cached) → {}",
+                t.baked.len(),
+                t.baked.iter().filter(|b| b.cached).count(),
+                dir.display()
+            )
+        },
     )?;
-    let mode = if request.scattering == ScatteringMode::Full && !tables.assets.contains_key("multiple") {
-        for (name, reason) in &tables.skipped {
-            steps.say(format!("skipped {name}: {reason}"));
-        }
-        ScatteringMode::Single
-    } else {
-        request.scattering
-    };
+    let mode =
+        if request.scattering == ScatteringMode::Full && !tables.assets.contains_key("multiple") {
+            for (name, reason) in &tables.skipped {
+                steps.say(format!("skipped {name}: {reason}"));
+            }
+            ScatteringMode::Single
+        } else {
+            request.scattering
+        };
     let lights = to_env_lights(&srbf_set_lights(&fit.set), request.up);
-    Ok(EnvScene { fit, tables, lights, mode })
+    Ok(EnvScene {
+        fit,
+        tables,
+        lights,
+        mode,
+    })
 }

@@ -31,13 +31,22 @@ pub struct EqualTimeSearch {
 
 impl EqualTimeSearch {
     pub fn new(target_ms: f64) -> Self {
-        Self { target_ms, start: 16, max_lights: 8192, relative_width: 0.1, max_measurements: 10 }
+        Self {
+            target_ms,
+            start: 16,
+            max_lights: 8192,
+            relative_width: 0.1,
+            max_measurements: 10,
+        }
     }
 }
 
 /// Finds the light count whose `time_ms(count)` (the caller's median of a few renders) is
 /// closest to `search.target_ms`, assuming time grows with the count.
-pub fn equal_time_lights<E>(search: &EqualTimeSearch, mut time_ms: impl FnMut(usize) -> Result<f64, E>) -> Result<EqualTime, E> {
+pub fn equal_time_lights<E>(
+    search: &EqualTimeSearch,
+    mut time_ms: impl FnMut(usize) -> Result<f64, E>,
+) -> Result<EqualTime, E> {
     let max = search.max_lights.max(1);
     let budget = search.max_measurements.max(2);
     let mut measurements: Vec<(usize, f64)> = Vec::new();
@@ -70,7 +79,9 @@ pub fn equal_time_lights<E>(search: &EqualTimeSearch, mut time_ms: impl FnMut(us
         }
     }
     if let (Some(mut l), Some(mut h)) = (lo, hi) {
-        while measurements.len() < budget && h - l > ((search.relative_width * l as f64) as usize).max(1) {
+        while measurements.len() < budget
+            && h - l > ((search.relative_width * l as f64) as usize).max(1)
+        {
             let mid = l + (h - l) / 2;
             if measure(mid, &mut measurements)? < search.target_ms {
                 l = mid;
@@ -81,10 +92,20 @@ pub fn equal_time_lights<E>(search: &EqualTimeSearch, mut time_ms: impl FnMut(us
     }
     let &(lights, milliseconds) = measurements
         .iter()
-        .min_by(|a, b| (a.1 - search.target_ms).abs().total_cmp(&(b.1 - search.target_ms).abs()))
+        .min_by(|a, b| {
+            (a.1 - search.target_ms)
+                .abs()
+                .total_cmp(&(b.1 - search.target_ms).abs())
+        })
         .expect("at least one measurement");
-    let at_bound = (lights == max && milliseconds < search.target_ms) || (lights == 1 && milliseconds > search.target_ms);
-    Ok(EqualTime { lights, milliseconds, measurements, at_bound })
+    let at_bound = (lights == max && milliseconds < search.target_ms)
+        || (lights == 1 && milliseconds > search.target_ms);
+    Ok(EqualTime {
+        lights,
+        milliseconds,
+        measurements,
+        at_bound,
+    })
 }
 
 /// The equal-error baseline (Ren 2010 Fig. 6: 450 directional lights to match 50 SRBFs): the
@@ -135,15 +156,25 @@ pub fn equal_error_lights<E>(
         }
     }
     if let (Some(mut lo), Some(mut hi)) = (below, reached) {
-        while measurements.len() < max_measurements && hi - lo > ((relative_width * lo as f64) as usize).max(1) {
+        while measurements.len() < max_measurements
+            && hi - lo > ((relative_width * lo as f64) as usize).max(1)
+        {
             let mid = lo + (hi - lo) / 2;
             let e = error(mid)?;
             measurements.push((mid, e));
             if e <= target { hi = mid } else { lo = mid }
         }
     }
-    let best = measurements.iter().filter(|(_, e)| *e <= target).map(|(n, _)| *n).min();
-    Ok(EqualError { lights: best.unwrap_or(max), at_bound: best.is_none(), measurements })
+    let best = measurements
+        .iter()
+        .filter(|(_, e)| *e <= target)
+        .map(|(n, _)| *n)
+        .min();
+    Ok(EqualError {
+        lights: best.unwrap_or(max),
+        at_bound: best.is_none(),
+        measurements,
+    })
 }
 
 #[cfg(test)]
@@ -161,13 +192,24 @@ mod tests {
         // 15 ms ⇔ 130 lights exactly.
         let r = equal_time_lights(&EqualTimeSearch::new(15.0), linear).unwrap();
         println!("{r:?}");
-        assert!((r.lights as f64 - 130.0).abs() <= 0.1 * 130.0, "{}", r.lights);
+        assert!(
+            (r.lights as f64 - 130.0).abs() <= 0.1 * 130.0,
+            "{}",
+            r.lights
+        );
         assert!(r.measurements.len() <= 10);
         assert!(!r.at_bound);
         // Every reported time is the cost function's at that count.
         assert!(r.measurements.iter().all(|&(n, t)| t == linear(n).unwrap()));
         // Starting above the target halves down.
-        let r = equal_time_lights(&EqualTimeSearch { start: 4096, ..EqualTimeSearch::new(4.5) }, linear).unwrap();
+        let r = equal_time_lights(
+            &EqualTimeSearch {
+                start: 4096,
+                ..EqualTimeSearch::new(4.5)
+            },
+            linear,
+        )
+        .unwrap();
         assert!((r.lights as f64 - 25.0).abs() <= 3.0, "{}", r.lights);
     }
 
@@ -183,20 +225,34 @@ mod tests {
         let r = equal_time_lights(&EqualTimeSearch::new(40.0), cost).unwrap();
         // Noise-free answer: 0.05 n + 1e-5 n² = 35 → n = (−0.05 + √0.0039)/2e-5 ≈ 622.
         println!("{r:?}");
-        assert!((r.lights as f64 - 622.0).abs() < 0.15 * 622.0, "{}", r.lights);
+        assert!(
+            (r.lights as f64 - 622.0).abs() < 0.15 * 622.0,
+            "{}",
+            r.lights
+        );
         assert!((r.milliseconds - 40.0).abs() < 0.1 * 40.0);
     }
 
     #[test]
     fn bounds_and_errors() {
-        let r = equal_time_lights(&EqualTimeSearch { max_lights: 64, ..EqualTimeSearch::new(1000.0) }, linear).unwrap();
+        let r = equal_time_lights(
+            &EqualTimeSearch {
+                max_lights: 64,
+                ..EqualTimeSearch::new(1000.0)
+            },
+            linear,
+        )
+        .unwrap();
         assert_eq!(r.lights, 64);
         assert!(r.at_bound);
         let r = equal_time_lights(&EqualTimeSearch::new(0.5), linear).unwrap();
         assert_eq!(r.lights, 1);
         assert!(r.at_bound);
         let failing = |_: usize| -> Result<f64, String> { Err("device lost".into()) };
-        assert_eq!(equal_time_lights(&EqualTimeSearch::new(1.0), failing).unwrap_err(), "device lost");
+        assert_eq!(
+            equal_time_lights(&EqualTimeSearch::new(1.0), failing).unwrap_err(),
+            "device lost"
+        );
     }
     #[test]
     fn equal_error_finds_the_fewest_lights_reaching_the_target() {

@@ -3,7 +3,7 @@
 //! PNG `compare` writes (SRBF | reference | baseline | error).
 
 use std::path::{Path, PathBuf};
-use strandlight_runtime::image_out::{tonemap_channel, PNG_TONEMAP};
+use strandlight_runtime::image_out::{PNG_TONEMAP, tonemap_channel};
 use strandlight_tables::atomic_write::write_atomically;
 use thiserror::Error;
 
@@ -43,35 +43,70 @@ const LEGEND_ROWS: u32 = 12;
 #[derive(Debug, Error)]
 pub enum CompareError {
     #[error("{what} is {w}x{h} but the reference is {rw}x{rh}")]
-    SizeMismatch { what: String, w: u32, h: u32, rw: u32, rh: u32 },
+    SizeMismatch {
+        what: String,
+        w: u32,
+        h: u32,
+        rw: u32,
+        rh: u32,
+    },
     #[error("{what}: {count} pixel value(s) are NaN or infinite (first at pixel {first})")]
-    NotFinite { what: String, count: usize, first: usize },
+    NotFinite {
+        what: String,
+        count: usize,
+        first: usize,
+    },
     #[error("the reference covers no hair pixels (alpha > {HAIR_ALPHA}): nothing to compare")]
     NoHair,
     #[error("the reference is black over the hair (Σ|r|² = 0): relative error undefined")]
     BlackReference,
     #[error("{}: {source}", .path.display())]
-    Write { path: PathBuf, source: std::io::Error },
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
 }
 
 impl Image {
     pub fn new(width: u32, height: u32, pixels: Vec<[f32; 4]>) -> Self {
-        assert_eq!(pixels.len(), width as usize * height as usize, "pixel count must equal width × height");
-        Self { width, height, pixels }
+        assert_eq!(
+            pixels.len(),
+            width as usize * height as usize,
+            "pixel count must equal width × height"
+        );
+        Self {
+            width,
+            height,
+            pixels,
+        }
     }
 
     fn check_against(&self, what: &str, reference: &Image) -> Result<(), CompareError> {
         if (self.width, self.height) != (reference.width, reference.height) {
-            return Err(CompareError::SizeMismatch { what: what.into(), w: self.width, h: self.height, rw: reference.width, rh: reference.height });
+            return Err(CompareError::SizeMismatch {
+                what: what.into(),
+                w: self.width,
+                h: self.height,
+                rw: reference.width,
+                rh: reference.height,
+            });
         }
         check_finite(what, self)
     }
 }
 
 fn check_finite(what: &str, image: &Image) -> Result<(), CompareError> {
-    let mut bad = image.pixels.iter().enumerate().filter(|(_, p)| p.iter().any(|c| !c.is_finite()));
+    let mut bad = image
+        .pixels
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.iter().any(|c| !c.is_finite()));
     if let Some((first, _)) = bad.next() {
-        return Err(CompareError::NotFinite { what: what.into(), count: 1 + bad.count(), first });
+        return Err(CompareError::NotFinite {
+            what: what.into(),
+            count: 1 + bad.count(),
+            first,
+        });
     }
     Ok(())
 }
@@ -107,11 +142,17 @@ pub fn relative_rmse(approx: &Image, reference: &Image) -> Result<f64, CompareEr
 
 /// [`VIRIDIS`] at t ∈ [0, 1] (clamped), linearly interpolated between its samples.
 pub fn colormap(t: f64) -> [u8; 3] {
-    let t = if t.is_finite() { t.clamp(0.0, 1.0) } else { 1.0 };
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        1.0
+    };
     let x = t * (VIRIDIS.len() - 1) as f64;
     let i = (x.floor() as usize).min(VIRIDIS.len() - 2);
     let f = x - i as f64;
-    std::array::from_fn(|c| ((1.0 - f) * VIRIDIS[i][c] as f64 + f * VIRIDIS[i + 1][c] as f64).round() as u8)
+    std::array::from_fn(|c| {
+        ((1.0 - f) * VIRIDIS[i][c] as f64 + f * VIRIDIS[i + 1][c] as f64).round() as u8
+    })
 }
 
 /// The false-colour error panel (sRGB bytes, row-major): hair pixels coloured by
@@ -120,7 +161,12 @@ pub fn colormap(t: f64) -> [u8; 3] {
 pub fn error_panel(approx: &Image, reference: &Image) -> Result<(Vec<[u8; 3]>, f64), CompareError> {
     check_finite("the reference", reference)?;
     approx.check_against("the image", reference)?;
-    let peak = reference.pixels.iter().filter(|p| is_hair(p)).flat_map(|p| p[..3].iter().map(|c| *c as f64)).fold(0.0f64, f64::max);
+    let peak = reference
+        .pixels
+        .iter()
+        .filter(|p| is_hair(p))
+        .flat_map(|p| p[..3].iter().map(|c| *c as f64))
+        .fold(0.0f64, f64::max);
     if reference.pixels.iter().all(|p| !is_hair(p)) {
         return Err(CompareError::NoHair);
     }
@@ -136,7 +182,10 @@ pub fn error_panel(approx: &Image, reference: &Image) -> Result<(Vec<[u8; 3]>, f
             if !is_hair(r) {
                 return [0, 0, 0];
             }
-            let e = (0..3).map(|c| (a[c] as f64 - r[c] as f64).abs()).fold(0.0, f64::max) / peak;
+            let e = (0..3)
+                .map(|c| (a[c] as f64 - r[c] as f64).abs())
+                .fold(0.0, f64::max)
+                / peak;
             worst = worst.max(e);
             colormap(e / ERROR_SCALE)
         })
@@ -153,16 +202,37 @@ pub fn error_legend() -> String {
 
 /// One tonemapped panel ([`PNG_TONEMAP`]).
 fn tonemapped(image: &Image) -> Vec<[u8; 3]> {
-    image.pixels.iter().map(|p| [tonemap_channel(p[0]), tonemap_channel(p[1]), tonemap_channel(p[2])]).collect()
+    image
+        .pixels
+        .iter()
+        .map(|p| {
+            [
+                tonemap_channel(p[0]),
+                tonemap_channel(p[1]),
+                tonemap_channel(p[2]),
+            ]
+        })
+        .collect()
 }
 
 /// Writes `srbf | reference | baseline | error` side by side as one 8-bit PNG, atomically, with
 /// a legend strip under the error panel (the colormap from 0 to [`ERROR_SCALE`]).
-pub fn write_side_by_side(path: &Path, srbf: &Image, reference: &Image, baseline: &Image, description: &str) -> Result<(), CompareError> {
+pub fn write_side_by_side(
+    path: &Path,
+    srbf: &Image,
+    reference: &Image,
+    baseline: &Image,
+    description: &str,
+) -> Result<(), CompareError> {
     srbf.check_against("the SRBF image", reference)?;
     baseline.check_against("the baseline image", reference)?;
     let (error, _) = error_panel(srbf, reference)?;
-    let panels = [tonemapped(srbf), tonemapped(reference), tonemapped(baseline), error];
+    let panels = [
+        tonemapped(srbf),
+        tonemapped(reference),
+        tonemapped(baseline),
+        error,
+    ];
     let (w, h) = (reference.width as usize, reference.height as usize);
     let total_w = 4 * w;
     let total_h = h + LEGEND_ROWS as usize;
@@ -182,7 +252,10 @@ pub fn write_side_by_side(path: &Path, srbf: &Image, reference: &Image, baseline
             bytes[o..o + 3].copy_from_slice(&c);
         }
     }
-    let legend = format!("{description}; panels: SRBF | reference | baseline | error; images: {PNG_TONEMAP}; {}", error_legend());
+    let legend = format!(
+        "{description}; panels: SRBF | reference | baseline | error; images: {PNG_TONEMAP}; {}",
+        error_legend()
+    );
     let encode = |out: &mut std::io::BufWriter<std::fs::File>| -> Result<(), png::EncodingError> {
         let mut encoder = png::Encoder::new(out, total_w as u32, total_h as u32);
         encoder.set_color(png::ColorType::Rgb);
@@ -192,7 +265,12 @@ pub fn write_side_by_side(path: &Path, srbf: &Image, reference: &Image, baseline
         writer.write_image_data(&bytes)?;
         writer.finish()
     };
-    write_atomically(path, |out| encode(out).map_err(std::io::Error::other)).map_err(|source| CompareError::Write { path: path.into(), source })
+    write_atomically(path, |out| encode(out).map_err(std::io::Error::other)).map_err(|source| {
+        CompareError::Write {
+            path: path.into(),
+            source,
+        }
+    })
 }
 
 #[cfg(test)]
@@ -208,8 +286,16 @@ mod tests {
         // Hair pixels r = (1,0,0), (0,2,0); errors 0.1 and 0.2 → Σ|a−r|² = 0.01 + 0.04 = 0.05,
         // Σ|r|² = 1 + 4 = 5, √(0.05/5) = 0.1. The third pixel has no hair in the reference and
         // a huge difference that must not count.
-        let reference = image(vec![[1.0, 0.0, 0.0, 1.0], [0.0, 2.0, 0.0, 0.5], [0.0, 0.0, 0.0, 0.0]]);
-        let approx = image(vec![[1.1, 0.0, 0.0, 1.0], [0.0, 2.0, 0.2, 0.5], [50.0, 50.0, 50.0, 1.0]]);
+        let reference = image(vec![
+            [1.0, 0.0, 0.0, 1.0],
+            [0.0, 2.0, 0.0, 0.5],
+            [0.0, 0.0, 0.0, 0.0],
+        ]);
+        let approx = image(vec![
+            [1.1, 0.0, 0.0, 1.0],
+            [0.0, 2.0, 0.2, 0.5],
+            [50.0, 50.0, 50.0, 1.0],
+        ]);
         let e = relative_rmse(&approx, &reference).unwrap();
         assert!((e - 0.1).abs() < 1e-7, "{e}");
         assert_eq!(relative_rmse(&reference, &reference).unwrap(), 0.0);
@@ -219,14 +305,33 @@ mod tests {
     fn bad_inputs_are_named() {
         let reference = image(vec![[1.0, 0.0, 0.0, 1.0], [0.0; 4]]);
         let short = image(vec![[1.0, 0.0, 0.0, 1.0]]);
-        assert!(matches!(relative_rmse(&short, &reference), Err(CompareError::SizeMismatch { w: 1, rw: 2, .. })));
+        assert!(matches!(
+            relative_rmse(&short, &reference),
+            Err(CompareError::SizeMismatch { w: 1, rw: 2, .. })
+        ));
         let nan = image(vec![[1.0, 0.0, 0.0, 1.0], [f32::NAN, 0.0, 0.0, 0.0]]);
         let e = relative_rmse(&nan, &reference).unwrap_err();
-        assert!(matches!(e, CompareError::NotFinite { count: 1, first: 1, .. }), "{e}");
+        assert!(
+            matches!(
+                e,
+                CompareError::NotFinite {
+                    count: 1,
+                    first: 1,
+                    ..
+                }
+            ),
+            "{e}"
+        );
         let empty = image(vec![[1.0, 0.0, 0.0, 0.0], [0.0; 4]]);
-        assert!(matches!(relative_rmse(&reference, &empty), Err(CompareError::NoHair)));
+        assert!(matches!(
+            relative_rmse(&reference, &empty),
+            Err(CompareError::NoHair)
+        ));
         let black = image(vec![[0.0, 0.0, 0.0, 1.0], [0.0; 4]]);
-        assert!(matches!(relative_rmse(&reference, &black), Err(CompareError::BlackReference)));
+        assert!(matches!(
+            relative_rmse(&reference, &black),
+            Err(CompareError::BlackReference)
+        ));
     }
 
     #[test]
@@ -244,8 +349,16 @@ mod tests {
     fn error_panel_by_hand() {
         // Peak reference value over the hair = 2 (pixel 1's green). Pixel 0: max|Δ| = 0.1 →
         // 0.05 → t = 0.5 at scale 0.1; pixel 1: exact → t = 0; pixel 2: not hair → black.
-        let reference = image(vec![[1.0, 0.0, 0.0, 1.0], [0.0, 2.0, 0.0, 1.0], [9.0, 9.0, 9.0, 0.0]]);
-        let approx = image(vec![[1.1, 0.05, 0.0, 1.0], [0.0, 2.0, 0.0, 1.0], [0.0, 0.0, 0.0, 1.0]]);
+        let reference = image(vec![
+            [1.0, 0.0, 0.0, 1.0],
+            [0.0, 2.0, 0.0, 1.0],
+            [9.0, 9.0, 9.0, 0.0],
+        ]);
+        let approx = image(vec![
+            [1.1, 0.05, 0.0, 1.0],
+            [0.0, 2.0, 0.0, 1.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ]);
         let (panel, worst) = error_panel(&approx, &reference).unwrap();
         assert!((worst - 0.05).abs() < 1e-6, "{worst}");
         assert_eq!(panel, vec![colormap(0.5), colormap(0.0), [0, 0, 0]]);
@@ -260,12 +373,19 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("side.png");
         write_side_by_side(&path, &srbf, &reference, &baseline, "test").unwrap();
-        let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
+        let decoder =
+            png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&path).unwrap()));
         let mut reader = decoder.read_info().unwrap();
         let mut buf = vec![0; reader.output_buffer_size().unwrap()];
         let info = reader.next_frame(&mut buf).unwrap();
         assert_eq!((info.width, info.height), (8, 1 + LEGEND_ROWS));
-        let px = |x: usize, y: usize| [buf[(y * 8 + x) * 3], buf[(y * 8 + x) * 3 + 1], buf[(y * 8 + x) * 3 + 2]];
+        let px = |x: usize, y: usize| {
+            [
+                buf[(y * 8 + x) * 3],
+                buf[(y * 8 + x) * 3 + 1],
+                buf[(y * 8 + x) * 3 + 2],
+            ]
+        };
         // Reinhard 1.0 → 0.5 → sRGB 0.7354 → 188; 3.0 → 0.75 → 225 (by hand from the sRGB curve).
         assert_eq!(px(2, 0), [188, 0, 0]);
         assert_eq!(px(4, 0), [225, 0, 0]);
@@ -275,7 +395,10 @@ mod tests {
         // Legend strip: the colormap's two ends under the error panel.
         assert_eq!(px(6, 5), colormap(0.0));
         assert_eq!(px(7, 5), colormap(1.0));
-        assert!(std::fs::read_dir(&dir).unwrap().count() == 1, "no temporary file left behind");
+        assert!(
+            std::fs::read_dir(&dir).unwrap().count() == 1,
+            "no temporary file left behind"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -47,7 +47,10 @@ pub struct LookArgs {
     /// The nearest fiber of each pixel (opaque), or every fiber weighted by its visibility
     /// through an occupancy map (Ren §8; order-independent transparency; costs about as many
     /// times the view pass as the hair has fragments per pixel).
-    #[cfg_attr(any(feature = "cli", test), arg(long, value_enum, default_value = "opaque"))]
+    #[cfg_attr(
+        any(feature = "cli", test),
+        arg(long, value_enum, default_value = "opaque")
+    )]
     pub transparency: EnvTransparency,
     #[cfg_attr(any(feature = "cli", test), command(flatten))]
     pub view: ViewArgs,
@@ -62,23 +65,36 @@ pub struct ViewArgs {
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = ViewTransparency::DEFAULT_CUTOFF))]
     pub visibility_cutoff: f32,
     /// What the SRBF transmittance's box averages over the convolution optical depth map.
-    #[cfg_attr(any(feature = "cli", test), arg(long, value_enum, default_value = "optical-depth"))]
+    #[cfg_attr(
+        any(feature = "cli", test),
+        arg(long, value_enum, default_value = "optical-depth")
+    )]
     pub box_average: BoxAverageArg,
     /// Where multiple scattering's shadow paths are marched (the brute-force reference's dense
     /// grid always uses the CPU light sweep).
-    #[cfg_attr(any(feature = "cli", test), arg(long, value_enum, default_value = "auto"))]
+    #[cfg_attr(
+        any(feature = "cli", test),
+        arg(long, value_enum, default_value = "auto")
+    )]
     pub forward_scattering: ForwardDevice,
 }
 
 impl Default for ViewArgs {
     fn default() -> Self {
-        Self { visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF, box_average: BoxAverageArg::OpticalDepth, forward_scattering: ForwardDevice::Auto }
+        Self {
+            visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF,
+            box_average: BoxAverageArg::OpticalDepth,
+            forward_scattering: ForwardDevice::Auto,
+        }
     }
 }
 
 impl Default for LookArgs {
     fn default() -> Self {
-        Self { transparency: EnvTransparency::Opaque, view: ViewArgs::default() }
+        Self {
+            transparency: EnvTransparency::Opaque,
+            view: ViewArgs::default(),
+        }
     }
 }
 
@@ -88,14 +104,24 @@ impl LookArgs {
         let view = &self.view;
         let transparency = match self.transparency {
             EnvTransparency::Opaque => ViewTransparency::Opaque,
-            EnvTransparency::Occupancy => ViewTransparency::Occupancy { visibility_cutoff: view.visibility_cutoff },
+            EnvTransparency::Occupancy => ViewTransparency::Occupancy {
+                visibility_cutoff: view.visibility_cutoff,
+            },
         };
-        transparency.check().with_context(|| format!("--visibility-cutoff {}", view.visibility_cutoff))?;
+        transparency
+            .check()
+            .with_context(|| format!("--visibility-cutoff {}", view.visibility_cutoff))?;
         let box_average = match view.box_average {
             BoxAverageArg::OpticalDepth => BoxAverage::OpticalDepth,
             BoxAverageArg::Transmittance => BoxAverage::Transmittance,
         };
-        Ok(EnvLook { shadowed: true, transparency, box_average, count_fragments: false, forward_scattering: view.forward_scattering })
+        Ok(EnvLook {
+            shadowed: true,
+            transparency,
+            box_average,
+            count_fragments: false,
+            forward_scattering: view.forward_scattering,
+        })
     }
 }
 
@@ -111,4 +137,3 @@ pub struct EnvLook {
     pub count_fragments: bool,
     pub forward_scattering: ForwardDevice,
 }
-

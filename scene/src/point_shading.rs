@@ -31,35 +31,53 @@ pub struct PointShadingRequest<'a> {
 
 /// The model and a line describing it. Errors name the setting at fault (`--preset`,
 /// `--lut-size`, `--artist-params`).
-pub fn point_shading_model(request: &PointShadingRequest) -> anyhow::Result<(ShadingModel, String)> {
+pub fn point_shading_model(
+    request: &PointShadingRequest,
+) -> anyhow::Result<(ShadingModel, String)> {
     match request.shading {
-        Shading::KajiyaKay => Ok((ShadingModel::KajiyaKay, format!("Kajiya-Kay {:?}", KajiyaKay::default()))),
+        Shading::KajiyaKay => Ok((
+            ShadingModel::KajiyaKay,
+            format!("Kajiya-Kay {:?}", KajiyaKay::default()),
+        )),
         Shading::Marschner => marschner_luts(request.preset, request.lut_size),
         Shading::Artist => artist(request.artist_params),
     }
 }
 
 fn marschner_luts(preset: &str, lut_size: usize) -> anyhow::Result<(ShadingModel, String)> {
-    let params = MarschnerParams::with_preset(preset).with_context(|| format!("--preset {preset:?}"))?;
+    let params =
+        MarschnerParams::with_preset(preset).with_context(|| format!("--preset {preset:?}"))?;
     let model = Marschner::new(params)?;
     let resolution = LutResolution::square(lut_size);
-    let lut_m = bake_lut_m(&model, &resolution).with_context(|| format!("--lut-size {lut_size}"))?;
-    let lut_n = bake_lut_n(&model, &resolution).with_context(|| format!("--lut-size {lut_size}"))?;
-    let description = format!("Marschner (preset {preset}) through {lut_size}² lookup tables (Hunz 2016 Algorithm 2)");
-    Ok((ShadingModel::MarschnerLut(MarschnerLuts::new(lut_m, lut_n)?), description))
+    let lut_m =
+        bake_lut_m(&model, &resolution).with_context(|| format!("--lut-size {lut_size}"))?;
+    let lut_n =
+        bake_lut_n(&model, &resolution).with_context(|| format!("--lut-size {lut_size}"))?;
+    let description = format!(
+        "Marschner (preset {preset}) through {lut_size}² lookup tables (Hunz 2016 Algorithm 2)"
+    );
+    Ok((
+        ShadingModel::MarschnerLut(MarschnerLuts::new(lut_m, lut_n)?),
+        description,
+    ))
 }
 
 fn artist(params_file: Option<&Path>) -> anyhow::Result<(ShadingModel, String)> {
     let (params, from) = match params_file {
         None => (ArtistParams::default(), "default controls".to_string()),
         Some(path) => {
-            let text = std::fs::read_to_string(path).with_context(|| format!("--artist-params {}", path.display()))?;
-            let params: ArtistParams = serde_json::from_str(&text).with_context(|| format!("--artist-params {}", path.display()))?;
+            let text = std::fs::read_to_string(path)
+                .with_context(|| format!("--artist-params {}", path.display()))?;
+            let params: ArtistParams = serde_json::from_str(&text)
+                .with_context(|| format!("--artist-params {}", path.display()))?;
             (params, path.display().to_string())
         }
     };
     let model = ArtistModel::new(params).context("--artist-params")?;
-    Ok((ShadingModel::Artist(model), format!("artist-friendly (Sadeghi 2010), {from}")))
+    Ok((
+        ShadingModel::Artist(model),
+        format!("artist-friendly (Sadeghi 2010), {from}"),
+    ))
 }
 
 #[cfg(test)]
@@ -67,7 +85,12 @@ mod tests {
     use super::*;
 
     fn request(shading: Shading) -> PointShadingRequest<'static> {
-        PointShadingRequest { shading, preset: "brown", lut_size: 16, artist_params: None }
+        PointShadingRequest {
+            shading,
+            preset: "brown",
+            lut_size: 16,
+            artist_params: None,
+        }
     }
 
     #[test]
@@ -81,13 +104,28 @@ mod tests {
             other => panic!("{}", other.name()),
         }
         assert!(text.contains("brown") && text.contains("16²"), "{text}");
-        assert!(matches!(point_shading_model(&request(Shading::Artist)).unwrap().0, ShadingModel::Artist(_)));
-        let e = point_shading_model(&PointShadingRequest { preset: "purple", ..request(Shading::Marschner) }).unwrap_err();
+        assert!(matches!(
+            point_shading_model(&request(Shading::Artist)).unwrap().0,
+            ShadingModel::Artist(_)
+        ));
+        let e = point_shading_model(&PointShadingRequest {
+            preset: "purple",
+            ..request(Shading::Marschner)
+        })
+        .unwrap_err();
         assert!(format!("{e:#}").contains("--preset \"purple\""), "{e:#}");
-        let e = point_shading_model(&PointShadingRequest { lut_size: 1, ..request(Shading::Marschner) }).unwrap_err();
+        let e = point_shading_model(&PointShadingRequest {
+            lut_size: 1,
+            ..request(Shading::Marschner)
+        })
+        .unwrap_err();
         assert!(format!("{e:#}").contains("--lut-size 1"), "{e:#}");
         let missing = Path::new("/nonexistent/artist.json");
-        let e = point_shading_model(&PointShadingRequest { artist_params: Some(missing), ..request(Shading::Artist) }).unwrap_err();
+        let e = point_shading_model(&PointShadingRequest {
+            artist_params: Some(missing),
+            ..request(Shading::Artist)
+        })
+        .unwrap_err();
         assert!(format!("{e:#}").contains("artist.json"), "{e:#}");
     }
 }

@@ -3,14 +3,14 @@
 //! written atomically and sealed by a SHA-256 sidecar. A hit needs both files intact and the
 //! same inputs recorded in the JSON; a damaged entry is reported and rendered again.
 
-use strandlight_tables::checksum::sha256_hex;
-use crate::sealed_file::{Unsealed, read_sealed, seal, write_sealed};
 use crate::image_metrics::Image;
+use crate::sealed_file::{Unsealed, read_sealed, seal, write_sealed};
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use strandlight_runtime::image_out::write_exr;
+use strandlight_tables::checksum::sha256_hex;
 
 /// What is stored beside the image.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -38,7 +38,10 @@ impl ReferenceCache {
 
     fn paths(&self, inputs: &Value) -> (PathBuf, PathBuf) {
         let key = Self::key(inputs);
-        (self.dir.join(format!("{key}.exr")), self.dir.join(format!("{key}.json")))
+        (
+            self.dir.join(format!("{key}.exr")),
+            self.dir.join(format!("{key}.json")),
+        )
     }
 
     /// The cached image for `inputs`, or None (absent, damaged or recorded for other inputs).
@@ -60,9 +63,16 @@ impl ReferenceCache {
 
     /// Stores the image (EXR first, then the JSON that makes it a hit), each sealed.
     pub fn store(&self, image: &Image, record: &ReferenceRecord) -> anyhow::Result<PathBuf> {
-        std::fs::create_dir_all(&self.dir).with_context(|| format!("cannot create the cache folder {}", self.dir.display()))?;
+        std::fs::create_dir_all(&self.dir)
+            .with_context(|| format!("cannot create the cache folder {}", self.dir.display()))?;
         let (exr_path, json_path) = self.paths(&record.inputs);
-        write_exr(&exr_path, image.width, image.height, &image.pixels, "strandlight brute-force reference")?;
+        write_exr(
+            &exr_path,
+            image.width,
+            image.height,
+            &image.pixels,
+            "strandlight brute-force reference",
+        )?;
         seal(&exr_path).with_context(|| format!("sealing {}", exr_path.display()))?;
         let json = serde_json::to_vec_pretty(record)?;
         write_sealed(&json_path, &json).with_context(|| json_path.display().to_string())?;
@@ -76,7 +86,10 @@ fn intact(path: &Path) -> Option<Vec<u8>> {
         Ok(bytes) => Some(bytes),
         Err(Unsealed::Missing) => None,
         Err(Unsealed::Damaged) => {
-            eprintln!("warning: the cached reference file {} does not match its checksum; rendering again", path.display());
+            eprintln!(
+                "warning: the cached reference file {} does not match its checksum; rendering again",
+                path.display()
+            );
             None
         }
     }
@@ -87,13 +100,24 @@ pub fn read_rgba_exr(path: &Path) -> anyhow::Result<crate::image_metrics::Image>
     use exr::prelude::*;
     let image = read_first_rgba_layer_from_file(
         path,
-        |resolution, _| (resolution.width(), vec![[0f32; 4]; resolution.width() * resolution.height()]),
-        |(w, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| pixels[position.y() * *w + position.x()] = [r, g, b, a],
+        |resolution, _| {
+            (
+                resolution.width(),
+                vec![[0f32; 4]; resolution.width() * resolution.height()],
+            )
+        },
+        |(w, pixels), position, (r, g, b, a): (f32, f32, f32, f32)| {
+            pixels[position.y() * *w + position.x()] = [r, g, b, a]
+        },
     )
     .with_context(|| format!("{}: not a readable RGBA EXR", path.display()))?;
     let size = image.layer_data.size;
     let (_, pixels) = image.layer_data.channel_data.pixels;
-    Ok(crate::image_metrics::Image::new(size.width() as u32, size.height() as u32, pixels))
+    Ok(crate::image_metrics::Image::new(
+        size.width() as u32,
+        size.height() as u32,
+        pixels,
+    ))
 }
 
 #[cfg(test)]
@@ -107,14 +131,28 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
         let cache = ReferenceCache::new(&dir);
         let inputs = json!({ "hair_sha256": "ab", "size": [3, 2], "lights": 6144 });
-        let image = Image::new(3, 2, (0..6).map(|i| [i as f32, 0.5, -1.0, 0.25 * i as f32]).collect());
+        let image = Image::new(
+            3,
+            2,
+            (0..6)
+                .map(|i| [i as f32, 0.5, -1.0, 0.25 * i as f32])
+                .collect(),
+        );
         assert!(cache.load(&inputs).is_none());
-        let record = ReferenceRecord { inputs: inputs.clone(), lights: 6144, milliseconds: 1234.5 };
+        let record = ReferenceRecord {
+            inputs: inputs.clone(),
+            lights: 6144,
+            milliseconds: 1234.5,
+        };
         cache.store(&image, &record).unwrap();
         let (back, rec) = cache.load(&inputs).unwrap();
         assert_eq!(back, image, "f32 EXR round trip is exact");
         assert_eq!(rec, record);
-        assert!(cache.load(&json!({ "hair_sha256": "ab", "size": [3, 2], "lights": 96 })).is_none());
+        assert!(
+            cache
+                .load(&json!({ "hair_sha256": "ab", "size": [3, 2], "lights": 96 }))
+                .is_none()
+        );
         // A damaged image or record is a miss, not a crash and not a wrong picture: every single
         // byte flip of the EXR is refused, including those its own decoder would accept (flips
         // in header attributes, offsets, padding).
@@ -126,15 +164,28 @@ mod tests {
             flipped[at] ^= 0x01;
             std::fs::write(&exr_path, &flipped).unwrap();
             decoder_accepted += usize::from(read_rgba_exr(&exr_path).is_ok());
-            assert!(cache.load(&inputs).is_none(), "a reference image flipped at byte {at} was served");
+            assert!(
+                cache.load(&inputs).is_none(),
+                "a reference image flipped at byte {at} was served"
+            );
         }
-        println!("{} flips of a {}-byte EXR refused; the decoder alone accepted {decoder_accepted}", original.len(), original.len());
-        assert!(decoder_accepted > 0, "no flip gets past the decoder alone: the seal is untested");
+        println!(
+            "{} flips of a {}-byte EXR refused; the decoder alone accepted {decoder_accepted}",
+            original.len(),
+            original.len()
+        );
+        assert!(
+            decoder_accepted > 0,
+            "no flip gets past the decoder alone: the seal is untested"
+        );
         std::fs::write(&exr_path, &original).unwrap();
         assert!(cache.load(&inputs).is_some());
         let json = std::fs::read(&json_path).unwrap();
         std::fs::write(&json_path, &json[..json.len() - 3]).unwrap();
-        assert!(cache.load(&inputs).is_none(), "a truncated record was served");
+        assert!(
+            cache.load(&inputs).is_none(),
+            "a truncated record was served"
+        );
         std::fs::write(&exr_path, b"not an exr").unwrap();
         assert!(cache.load(&inputs).is_none());
         std::fs::remove_dir_all(&dir).unwrap();

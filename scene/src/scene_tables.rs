@@ -6,7 +6,9 @@ use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::Path;
 use strandlight_precompute::bake::{BakedTable, bake_job};
-use strandlight_precompute::bake_plan::{DEFAULT_MULTIPLE_THRESHOLD, FiberDescription, Model, PlanOptions, plan, BakeResolution};
+use strandlight_precompute::bake_plan::{
+    BakeResolution, DEFAULT_MULTIPLE_THRESHOLD, FiberDescription, Model, PlanOptions, plan,
+};
 use strandlight_precompute::srbf_set::SrbfSet;
 use strandlight_tables::asset::{Storage, TableAsset, expect_parameters, read_asset};
 
@@ -66,12 +68,22 @@ impl EnvShading {
 }
 
 /// The tables multiple scattering reads (the first is absent for hair too dark to need it).
-pub const MULTIPLE_TABLES: [&str; 4] = ["multiple", "fiber_averages", "attenuation_ratio", "srbf_spread"];
+pub const MULTIPLE_TABLES: [&str; 4] = [
+    "multiple",
+    "fiber_averages",
+    "attenuation_ratio",
+    "srbf_spread",
+];
 
 /// The tables a frame in any of `modes` may read: the multiple-scattering tables, the SRBF
 /// tables and, with `directional` lights (baselines, references, a fit's compact sources), the
 /// direct tables.
-pub fn wanted_tables(shading: EnvShading, modes: &[ScatteringMode], srbf: bool, directional: bool) -> Vec<&'static str> {
+pub fn wanted_tables(
+    shading: EnvShading,
+    modes: &[ScatteringMode],
+    srbf: bool,
+    directional: bool,
+) -> Vec<&'static str> {
     let mut wanted: Vec<&str> = MULTIPLE_TABLES.to_vec();
     for &mode in modes {
         if srbf {
@@ -95,7 +107,12 @@ pub struct SceneTables {
 
 impl SceneTables {
     pub fn get(&self, name: &str) -> anyhow::Result<&TableAsset> {
-        self.assets.get(name).with_context(|| format!("table `{name}` was not baked (known: {:?})", self.assets.keys().collect::<Vec<_>>()))
+        self.assets.get(name).with_context(|| {
+            format!(
+                "table `{name}` was not baked (known: {:?})",
+                self.assets.keys().collect::<Vec<_>>()
+            )
+        })
     }
 }
 
@@ -118,14 +135,21 @@ pub fn bake_scene_tables(
         multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD,
     };
     let plan = plan(fiber, &options)?;
-    let skipped = plan.skipped.iter().map(|s| (s.name.clone(), s.reason.clone())).collect();
+    let skipped = plan
+        .skipped
+        .iter()
+        .map(|s| (s.name.clone(), s.reason.clone()))
+        .collect();
     let mut expected: BTreeMap<String, Value> = BTreeMap::new();
     let mut baked = Vec::new();
     for job in plan.jobs.into_iter().filter(|j| wanted.contains(&j.name)) {
         expected.insert(job.name.to_string(), job.fiber_parameters.clone());
         let t = bake_job(job, dir, Storage::F32)?;
         if let Some(reason) = &t.replaced_damaged {
-            eprintln!("warning: the cached table {} was damaged and has been rebaked ({reason})", t.path.display());
+            eprintln!(
+                "warning: the cached table {} was damaged and has been rebaked ({reason})",
+                t.path.display()
+            );
         }
         report(&t);
         baked.push(t);
@@ -136,16 +160,21 @@ pub fn bake_scene_tables(
         expect_parameters(&asset, &expected[&t.name])?;
         assets.insert(t.name.clone(), asset);
     }
-    Ok(SceneTables { assets, baked, skipped })
+    Ok(SceneTables {
+        assets,
+        baked,
+        skipped,
+    })
 }
-
 
 /// λ range of an SRBF set with a 10% margin (the bake's 1/λ axis spans only this). A set of
 /// compact sources alone (a sun on black: no lobes) gets the fit's default range, which no
 /// table uses (`wanted_tables` then asks for no SRBF table).
 pub fn lambda_range_of_set(set: &SrbfSet) -> anyhow::Result<(f64, f64)> {
     let lambdas = set.lobes.iter().map(|l| l.lambda);
-    let (lo, hi) = lambdas.fold((f64::INFINITY, 0.0f64), |(lo, hi), l| (lo.min(l), hi.max(l)));
+    let (lo, hi) = lambdas.fold((f64::INFINITY, 0.0f64), |(lo, hi), l| {
+        (lo.min(l), hi.max(l))
+    });
     if !(lo.is_finite() && hi > 0.0) {
         if set.sources.is_empty() {
             bail!("the SRBF set holds no lobes and no compact sources (a black map?)");
@@ -155,7 +184,9 @@ pub fn lambda_range_of_set(set: &SrbfSet) -> anyhow::Result<(f64, f64)> {
     }
     let (lo, hi) = (lo / 1.1, hi * 1.1);
     if hi > 1e4 {
-        bail!("λ up to {hi:.0} (directional lights?); bake tables for SRBF sets, not directional baselines");
+        bail!(
+            "λ up to {hi:.0} (directional lights?); bake tables for SRBF sets, not directional baselines"
+        );
     }
     Ok((lo, if hi > lo * 1.01 { hi } else { lo * 1.01 }))
 }
@@ -166,7 +197,8 @@ mod tests {
 
     #[test]
     fn tables_for_each_mode_exist_in_the_plan() {
-        let dir = std::env::temp_dir().join(format!("strandlight-scene-tables-{}", std::process::id()));
+        let dir =
+            std::env::temp_dir().join(format!("strandlight-scene-tables-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         let fiber = FiberDescription::preset("blonde").unwrap();
         for shading in [EnvShading::Marschner, EnvShading::Artist] {
@@ -175,17 +207,35 @@ mod tests {
                 wanted.push(shading.srbf_table(mode));
                 wanted.push(shading.direct_table(mode));
             }
-            let tables = bake_scene_tables(&fiber, shading, BakeResolution::reduced(4), (20.0, 40.0), &wanted, &dir.join(format!("{shading:?}")), &mut |_| {}).unwrap();
+            let tables = bake_scene_tables(
+                &fiber,
+                shading,
+                BakeResolution::reduced(4),
+                (20.0, 40.0),
+                &wanted,
+                &dir.join(format!("{shading:?}")),
+                &mut |_| {},
+            )
+            .unwrap();
             for name in &wanted {
                 let t = tables.get(name).unwrap();
                 if !["fiber_averages", "attenuation_ratio", "srbf_spread"].contains(name) {
-                    assert_eq!(t.table.axes().len(), 4, "{name}: the renderer's 4-axis lookup");
+                    assert_eq!(
+                        t.table.axes().len(),
+                        4,
+                        "{name}: the renderer's 4-axis lookup"
+                    );
                 }
             }
             // The 1/λ axis spans the requested range, not the global bounds.
-            let conv = tables.get(shading.srbf_table(ScatteringMode::Single)).unwrap();
+            let conv = tables
+                .get(shading.srbf_table(ScatteringMode::Single))
+                .unwrap();
             let inv = &conv.table.axes()[3];
-            assert!((inv.min - 1.0 / 40.0).abs() < 1e-12 && (inv.max - 1.0 / 20.0).abs() < 1e-12, "{inv:?}");
+            assert!(
+                (inv.min - 1.0 / 40.0).abs() < 1e-12 && (inv.max - 1.0 / 20.0).abs() < 1e-12,
+                "{inv:?}"
+            );
         }
         std::fs::remove_dir_all(&dir).unwrap();
     }

@@ -64,15 +64,27 @@ mod tests {
                 let mut bytes = original.clone();
                 bytes[at] ^= bit;
                 std::fs::write(&path, &bytes).unwrap();
-                assert_eq!(read_sealed(&path), Err(Unsealed::Damaged), "flip {bit:#x} at {at}");
+                assert_eq!(
+                    read_sealed(&path),
+                    Err(Unsealed::Damaged),
+                    "flip {bit:#x} at {at}"
+                );
             }
             std::fs::write(&path, &original[..at]).unwrap();
-            assert_eq!(read_sealed(&path), Err(Unsealed::Damaged), "truncated to {at}");
+            assert_eq!(
+                read_sealed(&path),
+                Err(Unsealed::Damaged),
+                "truncated to {at}"
+            );
         }
         std::fs::write(&path, &original).unwrap();
         assert_eq!(read_sealed(&path).unwrap(), original);
         std::fs::remove_file(sidecar(&path)).unwrap();
-        assert_eq!(read_sealed(&path), Err(Unsealed::Missing), "no digest, no hit");
+        assert_eq!(
+            read_sealed(&path),
+            Err(Unsealed::Missing),
+            "no digest, no hit"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -12,11 +12,20 @@ pub struct Steps {
 
 impl Steps {
     pub fn new(quiet_stdout: bool) -> Self {
-        Self { done: Vec::new(), start: Instant::now(), quiet_stdout }
+        Self {
+            done: Vec::new(),
+            start: Instant::now(),
+            quiet_stdout,
+        }
     }
 
     /// Runs `f` as step `name`; `note` describes its result (e.g. "cached").
-    pub fn run<T>(&mut self, name: &str, f: impl FnOnce() -> anyhow::Result<T>, note: impl FnOnce(&T) -> String) -> anyhow::Result<T> {
+    pub fn run<T>(
+        &mut self,
+        name: &str,
+        f: impl FnOnce() -> anyhow::Result<T>,
+        note: impl FnOnce(&T) -> String,
+    ) -> anyhow::Result<T> {
         let t = Instant::now();
         let value = f().map_err(|e| e.context(format!("step `{name}`")))?;
         let seconds = t.elapsed().as_secs_f64();

@@ -15,7 +15,6 @@ use strandlight_tables::marschner::{Lobe, Marschner, MarschnerParams};
 use strandlight_tables::quadrature::integrate_sphere;
 use strandlight_tables::{FiberAngles, Rgb, ScatteringFunction, srbf};
 
-
 /// Named (θ_i, θ_o, φ) in degrees where each model is sampled.
 pub const CONFIGURATIONS: [(&str, f64, f64, f64); 4] = [
     ("specular cone, front (R)", 30.0, -30.0, 0.0),
@@ -89,14 +88,15 @@ pub struct Summary {
     pub srbf_integral: Vec<SrbfRow>,
 }
 
-
 /// Every figure of the summary, computed now.
 pub fn compute() -> anyhow::Result<Summary> {
     Ok(Summary {
         version: env!("CARGO_PKG_VERSION"),
         models: models()?,
         presets: presets()?,
-        furnace_rule: format!("integrate_sphere({FURNACE_PANELS:?}) (8-point Gauss–Legendre panels)"),
+        furnace_rule: format!(
+            "integrate_sphere({FURNACE_PANELS:?}) (8-point Gauss–Legendre panels)"
+        ),
         white_furnace_marschner: white_furnace()?,
         single_event_albedo_marschner: single_event_albedo()?,
         srbf_rule: format!("integrate_sphere({SRBF_PANELS:?}) (8-point Gauss–Legendre panels)"),

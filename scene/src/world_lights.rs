@@ -51,10 +51,22 @@ mod tests {
             // The default camera looks from `front` toward the hair; its right is forward × up.
             let right = (-front).cross(world_up);
             assert_eq!(w(DVec3::Y), world_up, "{up:?}");
-            assert_eq!(w(DVec3::NEG_Z), -front, "{up:?}: image center behind the hair");
-            assert_eq!(w(DVec3::X), right, "{up:?}: the image's right (u = ¾, +X) to the camera's right");
+            assert_eq!(
+                w(DVec3::NEG_Z),
+                -front,
+                "{up:?}: image center behind the hair"
+            );
+            assert_eq!(
+                w(DVec3::X),
+                right,
+                "{up:?}: the image's right (u = ¾, +X) to the camera's right"
+            );
             // A proper rotation: right-handed basis stays right-handed.
-            let (x, y, z) = (env_to_world(DVec3::X, up), env_to_world(DVec3::Y, up), env_to_world(DVec3::Z, up));
+            let (x, y, z) = (
+                env_to_world(DVec3::X, up),
+                env_to_world(DVec3::Y, up),
+                env_to_world(DVec3::Z, up),
+            );
             assert!((x.cross(y).dot(z) - 1.0).abs() < 1e-12);
         }
     }
@@ -73,11 +85,18 @@ mod tests {
             });
             for c in 0..3 {
                 // f32 rounding of each light's value: ≤ 2⁻²⁴ relative, summed.
-                assert!((got[c] - want[c]).abs() <= 1e-6 * want[c], "{name}: {got:?} vs {want:?}");
+                assert!(
+                    (got[c] - want[c]).abs() <= 1e-6 * want[c],
+                    "{name}: {got:?} vs {want:?}"
+                );
             }
             assert!(lights.iter().all(|l| l.lambda.is_none()));
         }
-        let srbf = [LightSpec { direction: DVec3::new(0.0, 0.6, 0.8), lambda: Some(32.0), rgb: [1.0, 2.0, 3.0] }];
+        let srbf = [LightSpec {
+            direction: DVec3::new(0.0, 0.6, 0.8),
+            lambda: Some(32.0),
+            rgb: [1.0, 2.0, 3.0],
+        }];
         let l = to_env_lights(&srbf, UpAxis::Y)[0];
         assert_eq!(l.lambda, Some(32.0));
         assert_eq!(l.rgb, [1.0, 2.0, 3.0]);

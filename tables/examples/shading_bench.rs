@@ -12,9 +12,9 @@ use strandlight_tables::artist::{self, ArtistModel, ArtistParams, Normalization}
 use strandlight_tables::dual_scattering::{
     DualScatteringAverages, DualScatteringConfig, fiber_averages_direct,
 };
+use strandlight_tables::hard_case_sweep::SweepRng;
 use strandlight_tables::kajiya_kay::{self, KajiyaKay, KajiyaKayParams};
 use strandlight_tables::scattering::ScatteringFunction;
-use strandlight_tables::hard_case_sweep::SweepRng;
 
 /// Median wall time in seconds of `runs` calls of `f`.
 fn median_seconds(runs: usize, mut f: impl FnMut()) -> f64 {
@@ -71,7 +71,10 @@ fn main() {
     let t = median_seconds(5, || {
         black_box(art.peak_total_attenuation());
     });
-    println!("artist peak ā_f+ā_b over inclinations (PeakPerChannel): {:.3} ms", t * 1e3);
+    println!(
+        "artist peak ā_f+ā_b over inclinations (PeakPerChannel): {:.3} ms",
+        t * 1e3
+    );
     let norm = art.normalized(Normalization::PerChannel);
 
     for (theta_samples, theta_d_samples) in [(257, 181), (513, 361), (1025, 721)] {
@@ -128,7 +131,10 @@ fn main() {
             kajiya_kay::hard_case_sweep as fn(u64, u64) -> _,
         ),
         ("artist", artist::hard_case_sweep),
-        ("dual-scattering", strandlight_tables::dual_scattering_hard_cases::hard_case_sweep),
+        (
+            "dual-scattering",
+            strandlight_tables::dual_scattering_hard_cases::hard_case_sweep,
+        ),
     ] {
         let start = Instant::now();
         let report = run(sweep_samples, 2026);

@@ -41,8 +41,8 @@
 use crate::angles::FiberAngles;
 use crate::dual_scattering::{LobeDecomposition, inverse_cos2_guarded, peaked_rule};
 use crate::error::{ParamError, check, check_non_negative};
-use crate::scattering::{Rgb, ScatteringFunction};
 use crate::hard_case_sweep::{SweepReport, SweepRng};
+use crate::scattering::{Rgb, ScatteringFunction};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI};
 

@@ -20,11 +20,11 @@
 //! wrong on load is its own [`AssetError`] variant naming the file.
 
 use crate::atomic_write::write_atomically;
+use crate::checksum::sha256_hex;
 use crate::table::{Axis, Table, TableError, checked_value_count};
 use half::f16;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
-use crate::checksum::sha256_hex;
 use sha2::{Digest, Sha256};
 use std::fs::File;
 use std::io::{self, Read, Seek, SeekFrom, Write};
@@ -262,7 +262,8 @@ fn encode_asset(
 }
 
 fn payload_offset(metadata_len: u64) -> u64 {
-    (HEADER_BYTES + metadata_len + METADATA_DIGEST_BYTES).div_ceil(PAYLOAD_ALIGNMENT) * PAYLOAD_ALIGNMENT
+    (HEADER_BYTES + metadata_len + METADATA_DIGEST_BYTES).div_ceil(PAYLOAD_ALIGNMENT)
+        * PAYLOAD_ALIGNMENT
 }
 
 fn encode_payload(path: &Path, table: &Table, storage: Storage) -> Result<Vec<u8>, AssetError> {
@@ -409,7 +410,9 @@ impl OpenedAsset {
         }
         // The padding is covered by no checksum, so it must be what the writer wrote: zeros. A
         // flipped bit there is harmless to the values but says the file is not the one written.
-        let padding_len = payload_offset(metadata_len as u64).saturating_sub(digest_end).min(16);
+        let padding_len = payload_offset(metadata_len as u64)
+            .saturating_sub(digest_end)
+            .min(16);
         if file_len < digest_end + padding_len {
             return Err(truncated("padding", digest_end + padding_len));
         }
@@ -839,7 +842,11 @@ mod tests {
         ));
         // JSON that is not an asset's metadata, with a valid digest.
         assert!(matches!(
-            load(&dir, "notjson.sltab", &assemble(FORMAT_VERSION, b"[1, 2", payload)),
+            load(
+                &dir,
+                "notjson.sltab",
+                &assemble(FORMAT_VERSION, b"[1, 2", payload)
+            ),
             AssetError::BadMetadata { .. }
         ));
 
@@ -927,7 +934,11 @@ mod tests {
         };
 
         let start = std::time::Instant::now();
-        let err = load(&dir, "ten-billion.sltab", &with_counts([100_000, 10_000, 10]));
+        let err = load(
+            &dir,
+            "ten-billion.sltab",
+            &with_counts([100_000, 10_000, 10]),
+        );
         assert!(
             matches!(
                 &err,

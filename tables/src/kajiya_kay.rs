@@ -20,8 +20,8 @@
 
 use crate::angles::FiberAngles;
 use crate::error::{ParamError, check, check_non_negative};
-use crate::scattering::{Rgb, ScatteringFunction};
 use crate::hard_case_sweep::{SweepReport, SweepRng};
+use crate::scattering::{Rgb, ScatteringFunction};
 use serde::{Deserialize, Serialize};
 
 /// Below this `cos θ_i` the specular term divides by this value instead (see module docs).

@@ -55,4 +55,3 @@ fn marschner_sweep(samples: u64, seed: u64) -> SweepReport {
         rejected: 0,
     }
 }
-

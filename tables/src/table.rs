@@ -173,7 +173,13 @@ impl Axis {
         }
     }
 
-    pub fn with_mapping(name: impl Into<String>, min: f64, max: f64, count: usize, mapping: AxisMapping) -> Self {
+    pub fn with_mapping(
+        name: impl Into<String>,
+        min: f64,
+        max: f64,
+        count: usize,
+        mapping: AxisMapping,
+    ) -> Self {
         Self {
             name: name.into(),
             min,
@@ -210,13 +216,15 @@ impl Axis {
             ));
         }
         match self.mapping {
-            AxisMapping::Power { exponent } if !(exponent.is_finite() && exponent > 0.0) => fail(format!(
-                "power mapping exponent {exponent} must be finite and > 0"
-            )),
-            AxisMapping::Arcsine | AxisMapping::Arccosine if self.min < -1.0 || self.max > 1.0 => fail(format!(
-                "range [{}, {}] must lie in [−1, 1] for an arcsine/arccosine mapping",
-                self.min, self.max
-            )),
+            AxisMapping::Power { exponent } if !(exponent.is_finite() && exponent > 0.0) => fail(
+                format!("power mapping exponent {exponent} must be finite and > 0"),
+            ),
+            AxisMapping::Arcsine | AxisMapping::Arccosine if self.min < -1.0 || self.max > 1.0 => {
+                fail(format!(
+                    "range [{}, {}] must lie in [−1, 1] for an arcsine/arccosine mapping",
+                    self.min, self.max
+                ))
+            }
             _ => Ok(()),
         }
     }
@@ -247,7 +255,9 @@ impl Axis {
         }
         let m = self.mapping;
         let (w0, w1) = (m.warp(self.min), m.warp(self.max));
-        let t = ((m.warp(x) - w0) / (w1 - w0)).clamp(0.0, 1.0).powf(1.0 / m.exponent());
+        let t = ((m.warp(x) - w0) / (w1 - w0))
+            .clamp(0.0, 1.0)
+            .powf(1.0 / m.exponent());
         let f = t * (self.count - 1) as f64;
         let nearest = f.round();
         Ok(if (f - nearest).abs() <= NODE_SNAP {
@@ -903,10 +913,18 @@ mod tests {
                     _ => x as f32,
                 };
                 let f = ((w - g.min) * g.inv_range).clamp(0.0, 1.0) * g.last_index;
-                assert!((f as f64 - axis.position(x).unwrap()).abs() < 1e-5, "{} x={x}", axis.name);
+                assert!(
+                    (f as f64 - axis.position(x).unwrap()).abs() < 1e-5,
+                    "{} x={x}",
+                    axis.name
+                );
             }
         }
-        assert!(Axis::with_mapping("bad", -2.0, 1.0, 3, AxisMapping::Arcsine).validate().is_err());
+        assert!(
+            Axis::with_mapping("bad", -2.0, 1.0, 3, AxisMapping::Arcsine)
+                .validate()
+                .is_err()
+        );
     }
 
     #[test]

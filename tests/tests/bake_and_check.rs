@@ -2,9 +2,11 @@
 //! against direct f64 integration (the full-resolution check is a benchmark: docs/BENCHMARKS.md).
 
 use strandlight_precompute::bake::bake_job;
-use strandlight_precompute::bake_plan::{plan, BakeResolution, FiberDescription, Model, PlanOptions};
+use strandlight_precompute::bake_plan::{
+    BakeResolution, FiberDescription, Model, PlanOptions, plan,
+};
 use strandlight_precompute::baked_tables_check::check_asset;
-use strandlight_tables::asset::{read_asset, Storage};
+use strandlight_tables::asset::{Storage, read_asset};
 
 fn temp_dir(tag: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("strandlight-e2e-{tag}-{}", std::process::id()));
@@ -14,7 +16,11 @@ fn temp_dir(tag: &str) -> std::path::PathBuf {
 
 /// Bakes `fiber` at 8 nodes per direction axis and checks every table at 40 points.
 /// Returns (name, max, rms) per table.
-fn bake_and_check(fiber: &FiberDescription, tag: &str, force_multiple: bool) -> Vec<(String, f64, f64)> {
+fn bake_and_check(
+    fiber: &FiberDescription,
+    tag: &str,
+    force_multiple: bool,
+) -> Vec<(String, f64, f64)> {
     let dir = temp_dir(tag);
     let options = PlanOptions {
         models: vec![Model::Marschner, Model::KajiyaKay, Model::Artist],
@@ -30,7 +36,10 @@ fn bake_and_check(fiber: &FiberDescription, tag: &str, force_multiple: bool) -> 
         let stats = asset.table.stats();
         assert_eq!(stats.nan_count + stats.infinite_count, 0, "{}", baked.name);
         let acc = check_asset(&asset, 40, 3).unwrap();
-        println!("{tag:>8} {:<18} max {:.3e} rms {:.3e} max rel {:.3e}", acc.name, acc.max_abs_error, acc.rms_abs_error, acc.max_rel_error);
+        println!(
+            "{tag:>8} {:<18} max {:.3e} rms {:.3e} max rel {:.3e}",
+            acc.name, acc.max_abs_error, acc.rms_abs_error, acc.max_rel_error
+        );
         out.push((acc.name, acc.max_abs_error, acc.rms_abs_error));
     }
     std::fs::remove_dir_all(&dir).unwrap();
@@ -45,7 +54,11 @@ fn assert_within(results: &[(String, f64, f64)], max_bound: f64, rms_bound: f64)
         // The point-light textures and the KK specular lobe (p = 40, ~9° wide) are the
         // narrowest functions on the coarsest grids here.
         let loose = matches!(name.as_str(), "lut_n" | "lut_m" | "kk_specular");
-        let (mb, rb) = if loose { (0.6, 0.15) } else { (max_bound, rms_bound) };
+        let (mb, rb) = if loose {
+            (0.6, 0.15)
+        } else {
+            (max_bound, rms_bound)
+        };
         assert!(*max < mb && *rms < rb, "{name}: max {max}, rms {rms}");
     }
 }
@@ -76,9 +89,17 @@ fn hard_fibers_bake_finite_checked_tables() {
 
 #[test]
 fn dark_hair_skips_the_multiple_scattering_table_and_says_why() {
-    let options = PlanOptions { models: vec![Model::Marschner], resolution: BakeResolution::reduced(4), ..Default::default() };
+    let options = PlanOptions {
+        models: vec![Model::Marschner],
+        resolution: BakeResolution::reduced(4),
+        ..Default::default()
+    };
     let p = plan(&FiberDescription::preset("dark").unwrap(), &options).unwrap();
-    let skipped = p.skipped.iter().find(|s| s.name == "multiple").expect("dark hair skips I_G");
+    let skipped = p
+        .skipped
+        .iter()
+        .find(|s| s.name == "multiple")
+        .expect("dark hair skips I_G");
     println!("{}", skipped.reason);
     assert!(skipped.reason.contains("threshold"));
 }

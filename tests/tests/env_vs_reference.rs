@@ -16,18 +16,27 @@ use glam::DVec3;
 use std::collections::BTreeMap;
 use std::sync::OnceLock;
 use std::time::Instant;
-use strandlight_precompute::compact_sources::SourceOptions;
 use strandlight_precompute::bake::bake_job;
-use strandlight_precompute::bake_plan::{plan, BakeResolution, FiberDescription, Model, PlanOptions, DEFAULT_MULTIPLE_THRESHOLD};
-use strandlight_precompute::env_lights::{reference_lights, srbf_set_lights, total_power, LightSpec};
+use strandlight_precompute::bake_plan::{
+    BakeResolution, DEFAULT_MULTIPLE_THRESHOLD, FiberDescription, Model, PlanOptions, plan,
+};
+use strandlight_precompute::compact_sources::SourceOptions;
+use strandlight_precompute::env_lights::{
+    LightSpec, reference_lights, srbf_set_lights, total_power,
+};
 use strandlight_precompute::srbf_set::{Source, SrbfSet};
-use strandlight_precompute::{procedural_env, FitOptions};
+use strandlight_precompute::{FitOptions, procedural_env};
 use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_runtime::env::{EnvLight, EnvRenderOptions, EnvRenderer, EnvTables, ForwardScatteringSource};
+use strandlight_runtime::env::{
+    EnvLight, EnvRenderOptions, EnvRenderer, EnvTables, ForwardScatteringSource,
+};
 use strandlight_runtime::gpu::GpuContext;
-use strandlight_runtime::hair::{generate_groom, GroomParams, HairModel};
-use strandlight_runtime::multiple::{CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering, VoxelSettings};
-use strandlight_tables::asset::{read_asset, Storage};
+use strandlight_runtime::hair::{GroomParams, HairModel, generate_groom};
+use strandlight_runtime::multiple::{
+    CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering,
+    VoxelSettings,
+};
+use strandlight_tables::asset::{Storage, read_asset};
 use strandlight_tables::table::Table;
 
 const WIDTH: u32 = 128;
@@ -41,8 +50,18 @@ const REFERENCE_FACE: usize = 8;
 const SINGLE_TABLE_NODES: usize = 24;
 /// Nodes of the multiple-scattering tables (I_G and the fiber averages are smooth).
 const MULTIPLE_TABLE_NODES: usize = 8;
-const SINGLE_TABLES: [&str; 4] = ["marschner", "marschner_direct", "marschner_full", "marschner_full_direct"];
-const MULTIPLE_TABLES: [&str; 4] = ["multiple", "fiber_averages", "attenuation_ratio", "srbf_spread"];
+const SINGLE_TABLES: [&str; 4] = [
+    "marschner",
+    "marschner_direct",
+    "marschner_full",
+    "marschner_full_direct",
+];
+const MULTIPLE_TABLES: [&str; 4] = [
+    "multiple",
+    "fiber_averages",
+    "attenuation_ratio",
+    "srbf_spread",
+];
 /// Light-pass map resolution for every light of both paths (half the default: the groom spans
 /// ~100 pixels, and the light pass dominates the reference's 384 lights).
 const DODM_RESOLUTION: u32 = 256;
@@ -91,26 +110,48 @@ fn to_env_lights(specs: &[LightSpec], up: UpAxis) -> Vec<EnvLight> {
 /// The scene, or the reason there is none (no GPU device).
 fn scene() -> Result<&'static Scene, String> {
     static SCENE: OnceLock<Result<Scene, String>> = OnceLock::new();
-    SCENE.get_or_init(build_scene).as_ref().map_err(Clone::clone)
+    SCENE
+        .get_or_init(build_scene)
+        .as_ref()
+        .map_err(Clone::clone)
 }
 
 fn build_scene() -> Result<Scene, String> {
     let t0 = Instant::now();
     let gpu = GpuContext::new_headless().map_err(|e| e.to_string())?;
     let renderer = EnvRenderer::new(&gpu);
-    eprintln!("device + pipelines: {:.2} s ({})", t0.elapsed().as_secs_f64(), gpu.report.name);
+    eprintln!(
+        "device + pipelines: {:.2} s ({})",
+        t0.elapsed().as_secs_f64(),
+        gpu.report.name
+    );
 
     let t = Instant::now();
     let map = procedural_env::by_name("studio", 256).expect("studio is a procedural map");
     // The paper's pure SRBF fit (no compact source taken out): this test measures its method.
-    let options = FitOptions { initial_lobes: 8, max_lobes: 24, target_relative_mse: 0.03, grid_width: 64, iterations_per_round: 10, final_iterations: 40, sources: SourceOptions::none(), ..FitOptions::default() };
-    let source = Source { map: &map, name: "procedural:studio".into(), sha256: String::new(), sanitized: Default::default() };
+    let options = FitOptions {
+        initial_lobes: 8,
+        max_lobes: 24,
+        target_relative_mse: 0.03,
+        grid_width: 64,
+        iterations_per_round: 10,
+        final_iterations: 40,
+        sources: SourceOptions::none(),
+        ..FitOptions::default()
+    };
+    let source = Source {
+        map: &map,
+        name: "procedural:studio".into(),
+        sha256: String::new(),
+        sanitized: Default::default(),
+    };
     let set = SrbfSet::fit(&source, &options, &mut |_| {}).expect("fit");
     let srbf_specs = srbf_set_lights(&set);
     let reference_specs = reference_lights(&map, REFERENCE_FACE, 0.0).expect("reference lights");
     // The reference of the fitted lobes themselves: separates the fit's error from the method's.
     let fitted_map = procedural_env::from_srbf_lobes(256, &set.lobes);
-    let fitted_reference_specs = reference_lights(&fitted_map, REFERENCE_FACE, 0.0).expect("reference lights");
+    let fitted_reference_specs =
+        reference_lights(&fitted_map, REFERENCE_FACE, 0.0).expect("reference lights");
     eprintln!(
         "fit: {} lobes in {:.2} s (relative MSE {:.4} on the fit grid, {:.4} at full resolution); reference: {} lights",
         srbf_specs.len(),
@@ -121,32 +162,63 @@ fn build_scene() -> Result<Scene, String> {
     );
 
     let t = Instant::now();
-    let (lo, hi) = srbf_specs.iter().filter_map(|s| s.lambda).fold((f64::INFINITY, 0.0f64), |(lo, hi), l| (lo.min(l), hi.max(l)));
+    let (lo, hi) = srbf_specs
+        .iter()
+        .filter_map(|s| s.lambda)
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), l| {
+            (lo.min(l), hi.max(l))
+        });
     let (lo, hi) = (lo / 1.1, (hi * 1.1).max(lo * 1.01 / 1.1));
     // Blonde: light enough that the plan bakes `multiple` (dark hair skips it).
     let fiber = FiberDescription::preset("blonde").expect("preset");
-    let dir = std::env::temp_dir().join(format!("strandlight-env-vs-reference-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!(
+        "strandlight-env-vs-reference-{}",
+        std::process::id()
+    ));
     let mut tables = BTreeMap::new();
-    for (nodes, wanted) in [(SINGLE_TABLE_NODES, &SINGLE_TABLES[..]), (MULTIPLE_TABLE_NODES, &MULTIPLE_TABLES[..])] {
+    for (nodes, wanted) in [
+        (SINGLE_TABLE_NODES, &SINGLE_TABLES[..]),
+        (MULTIPLE_TABLE_NODES, &MULTIPLE_TABLES[..]),
+    ] {
         let plan_options = PlanOptions {
             models: vec![Model::Marschner],
             resolution: BakeResolution::reduced(nodes).with_lambda_range(lo, hi),
             force_multiple: false,
             multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD,
         };
-        for job in plan(&fiber, &plan_options).expect("plan").jobs.into_iter().filter(|j| wanted.contains(&j.name)) {
+        for job in plan(&fiber, &plan_options)
+            .expect("plan")
+            .jobs
+            .into_iter()
+            .filter(|j| wanted.contains(&j.name))
+        {
             let baked = bake_job(job, &dir.join(nodes.to_string()), Storage::F32).expect("bake");
-            eprintln!("  baked {:<22} at {nodes:>2} nodes: {:.2} s", baked.name, baked.seconds);
-            tables.insert(baked.name.clone(), read_asset(&baked.path).expect("read table").table);
+            eprintln!(
+                "  baked {:<22} at {nodes:>2} nodes: {:.2} s",
+                baked.name, baked.seconds
+            );
+            tables.insert(
+                baked.name.clone(),
+                read_asset(&baked.path).expect("read table").table,
+            );
         }
         for name in wanted {
             assert!(tables.contains_key(*name), "table {name} was not baked");
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
-    eprintln!("bake (λ ∈ [{lo:.1}, {hi:.1}]): {:.2} s", t.elapsed().as_secs_f64());
+    eprintln!(
+        "bake (λ ∈ [{lo:.1}, {hi:.1}]): {:.2} s",
+        t.elapsed().as_secs_f64()
+    );
 
-    let hair = generate_groom(&GroomParams { strand_count: 800, points_per_strand: 12, clump_count: 40, ..GroomParams::default() }).expect("groom");
+    let hair = generate_groom(&GroomParams {
+        strand_count: 800,
+        points_per_strand: 12,
+        clump_count: 40,
+        ..GroomParams::default()
+    })
+    .expect("groom");
     let up = UpAxis::detect(&hair);
     let camera = Camera::framing_front(hair.bounds(), WIDTH as f32 / HEIGHT as f32, false, up);
     Ok(Scene {
@@ -166,13 +238,45 @@ fn build_scene() -> Result<Scene, String> {
 
 /// Renders `lights` (all of one kind) with κ = 1; `full` adds multiple scattering from
 /// `forward`. Returns the pixels and the seconds taken.
-fn render(scene: &Scene, lights: &[EnvLight], tables: EnvTables, shadowed: bool, forward: Option<&dyn ForwardScatteringSource>) -> (Vec<[f32; 4]>, f64) {
+fn render(
+    scene: &Scene,
+    lights: &[EnvLight],
+    tables: EnvTables,
+    shadowed: bool,
+    forward: Option<&dyn ForwardScatteringSource>,
+) -> (Vec<[f32; 4]>, f64) {
     let t = Instant::now();
-    let mut options = EnvRenderOptions { kappa: 1.0, shadowed, ..EnvRenderOptions::default() };
+    let mut options = EnvRenderOptions {
+        kappa: 1.0,
+        shadowed,
+        ..EnvRenderOptions::default()
+    };
     options.dodm.resolution = DODM_RESOLUTION;
-    let frame = scene.renderer.render(&scene.gpu, &scene.hair, &scene.camera, WIDTH, HEIGHT, lights, &tables, &options, forward).expect("render");
+    let frame = scene
+        .renderer
+        .render(
+            &scene.gpu,
+            &scene.hair,
+            &scene.camera,
+            WIDTH,
+            HEIGHT,
+            lights,
+            &tables,
+            &options,
+            forward,
+        )
+        .expect("render");
     if std::env::var_os("STRANDLIGHT_TIMINGS").is_some() {
-        eprintln!("    {} lights: {:?}", lights.len(), frame.stats.timings.iter().map(|t| format!("{} {:.0} ms", t.pass, t.milliseconds)).collect::<Vec<_>>());
+        eprintln!(
+            "    {} lights: {:?}",
+            lights.len(),
+            frame
+                .stats
+                .timings
+                .iter()
+                .map(|t| format!("{} {:.0} ms", t.pass, t.milliseconds))
+                .collect::<Vec<_>>()
+        );
     }
     (frame.pixels, t.elapsed().as_secs_f64())
 }
@@ -192,7 +296,10 @@ fn relative_rmse(a: &[[f32; 4]], r: &[[f32; 4]]) -> f64 {
 }
 
 fn assert_finite(what: &str, pixels: &[[f32; 4]]) {
-    let bad = pixels.iter().filter(|p| p.iter().any(|c| !c.is_finite())).count();
+    let bad = pixels
+        .iter()
+        .filter(|p| p.iter().any(|c| !c.is_finite()))
+        .count();
     assert_eq!(bad, 0, "{what}: {bad} pixels not finite");
 }
 
@@ -203,13 +310,22 @@ fn coverage(pixels: &[[f32; 4]]) -> usize {
 /// Mean of ‖rgb‖ over hair pixels (a scale for the printout).
 fn mean_hair(pixels: &[[f32; 4]]) -> f64 {
     let hair: Vec<_> = pixels.iter().filter(|p| p[3] > HAIR_ALPHA).collect();
-    hair.iter().map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0).sum::<f64>() / hair.len().max(1) as f64
+    hair.iter()
+        .map(|p| (p[0] + p[1] + p[2]) as f64 / 3.0)
+        .sum::<f64>()
+        / hair.len().max(1) as f64
 }
 
 /// `lights` turned by `degrees` about the world's up.
 fn rotated(lights: &[EnvLight], up: UpAxis, degrees: f32) -> Vec<EnvLight> {
     let q = glam::Quat::from_axis_angle(up.vector(), degrees.to_radians());
-    lights.iter().map(|l| EnvLight { direction: (q * l.direction).normalize(), ..*l }).collect()
+    lights
+        .iter()
+        .map(|l| EnvLight {
+            direction: (q * l.direction).normalize(),
+            ..*l
+        })
+        .collect()
 }
 
 fn table(scene: &Scene, name: &str) -> Table {
@@ -226,49 +342,119 @@ fn srbf_single_scattering_matches_the_directional_reference() {
             return;
         }
     };
-    eprintln!("scene ready after {:.2} s; groom up axis {:?}, {} SRBF lights, {} reference lights", start.elapsed().as_secs_f64(), scene.up, scene.srbf.len(), scene.reference.len());
+    eprintln!(
+        "scene ready after {:.2} s; groom up axis {:?}, {} SRBF lights, {} reference lights",
+        start.elapsed().as_secs_f64(),
+        scene.up,
+        scene.srbf.len(),
+        scene.reference.len()
+    );
 
     // The fit preserves the map's power; the cube texels integrate the same map.
-    let (ps, pr) = (total_power(&scene.srbf_specs), total_power(&scene.reference_specs));
+    let (ps, pr) = (
+        total_power(&scene.srbf_specs),
+        total_power(&scene.reference_specs),
+    );
     for c in 0..3 {
         let rel = (ps[c] - pr[c]).abs() / pr[c];
-        eprintln!("power channel {c}: SRBF {:.5} reference {:.5} (relative difference {rel:.2e})", ps[c], pr[c]);
-        assert!(rel < 1e-3, "channel {c}: SRBF power {} vs reference {}", ps[c], pr[c]);
+        eprintln!(
+            "power channel {c}: SRBF {:.5} reference {:.5} (relative difference {rel:.2e})",
+            ps[c], pr[c]
+        );
+        assert!(
+            rel < 1e-3,
+            "channel {c}: SRBF power {} vs reference {}",
+            ps[c],
+            pr[c]
+        );
     }
 
-    let srbf_tables = EnvTables { srbf: Some(table(scene, "marschner")), ..EnvTables::default() };
-    let direct_tables = EnvTables { direct: Some(table(scene, "marschner_direct")), ..EnvTables::default() };
+    let srbf_tables = EnvTables {
+        srbf: Some(table(scene, "marschner")),
+        ..EnvTables::default()
+    };
+    let direct_tables = EnvTables {
+        direct: Some(table(scene, "marschner_direct")),
+        ..EnvTables::default()
+    };
     let mut errors = Vec::new();
     for shadowed in [false, true] {
         let (a, ta) = render(scene, &scene.srbf, srbf_tables.clone(), shadowed, None);
-        let (r, tr) = render(scene, &scene.reference, direct_tables.clone(), shadowed, None);
+        let (r, tr) = render(
+            scene,
+            &scene.reference,
+            direct_tables.clone(),
+            shadowed,
+            None,
+        );
         assert_finite("SRBF image", &a);
         assert_finite("reference image", &r);
-        assert_eq!(coverage(&a), coverage(&r), "both paths rasterize the same hair");
-        assert!(coverage(&r) > 500, "the groom covers {} pixels", coverage(&r));
+        assert_eq!(
+            coverage(&a),
+            coverage(&r),
+            "both paths rasterize the same hair"
+        );
+        assert!(
+            coverage(&r) > 500,
+            "the groom covers {} pixels",
+            coverage(&r)
+        );
         let e = relative_rmse(&a, &r);
-        let (f, tf) = render(scene, &scene.fitted_reference, direct_tables.clone(), shadowed, None);
+        let (f, tf) = render(
+            scene,
+            &scene.fitted_reference,
+            direct_tables.clone(),
+            shadowed,
+            None,
+        );
         let e_method = relative_rmse(&a, &f);
         let e_fit = relative_rmse(&f, &r);
-        eprintln!("shadowed {shadowed:5}: SRBF vs reference of the fitted lobes {e_method:.4}; fitted-lobe reference vs map reference {e_fit:.4} ({tf:.2} s)");
+        eprintln!(
+            "shadowed {shadowed:5}: SRBF vs reference of the fitted lobes {e_method:.4}; fitted-lobe reference vs map reference {e_fit:.4} ({tf:.2} s)"
+        );
         eprintln!(
             "shadowed {shadowed:5}: relative RMSE {e:.4} over {} hair pixels; mean SRBF {:.4e}, reference {:.4e}; SRBF {ta:.2} s, reference {tr:.2} s",
             coverage(&r),
             mean_hair(&a),
             mean_hair(&r)
         );
-        let (turned, _) = render(scene, &rotated(&scene.srbf, scene.up, 90.0), srbf_tables.clone(), shadowed, None);
+        let (turned, _) = render(
+            scene,
+            &rotated(&scene.srbf, scene.up, 90.0),
+            srbf_tables.clone(),
+            shadowed,
+            None,
+        );
         let e_turned = relative_rmse(&turned, &r);
-        eprintln!("shadowed {shadowed:5}: SRBF lights turned 90° about up: relative RMSE {e_turned:.4}");
+        eprintln!(
+            "shadowed {shadowed:5}: SRBF lights turned 90° about up: relative RMSE {e_turned:.4}"
+        );
         errors.push((shadowed, e, e_turned, e_method));
     }
     eprintln!("total {:.2} s", start.elapsed().as_secs_f64());
     for (shadowed, e, e_turned, e_method) in errors {
-        let method_bound = if shadowed { METHOD_SHADOWED_BOUND } else { METHOD_UNSHADOWED_BOUND };
-        assert!(e_method < method_bound, "shadowed {shadowed}: SRBF vs the directional reference of the same lobes {e_method} ≥ {method_bound}");
-        let bound = if shadowed { SHADOWED_BOUND } else { UNSHADOWED_BOUND };
-        assert!(e < bound, "shadowed {shadowed}: relative RMSE {e} ≥ {bound}");
-        assert!(e_turned > bound, "shadowed {shadowed}: a 90°-turned environment gives {e_turned}, not above {bound}: the test cannot see a wrong light set");
+        let method_bound = if shadowed {
+            METHOD_SHADOWED_BOUND
+        } else {
+            METHOD_UNSHADOWED_BOUND
+        };
+        assert!(
+            e_method < method_bound,
+            "shadowed {shadowed}: SRBF vs the directional reference of the same lobes {e_method} ≥ {method_bound}"
+        );
+        let bound = if shadowed {
+            SHADOWED_BOUND
+        } else {
+            UNSHADOWED_BOUND
+        };
+        assert!(
+            e < bound,
+            "shadowed {shadowed}: relative RMSE {e} ≥ {bound}"
+        );
+        assert!(
+            e_turned > bound,
+            "shadowed {shadowed}: a 90°-turned environment gives {e_turned}, not above {bound}: the test cannot see a wrong light set"
+        );
     }
 }
 
@@ -304,32 +490,93 @@ fn srbf_full_scattering_matches_the_directional_reference() {
             return;
         }
     };
-    let forward_tables = || ForwardScatteringTables::from_tables(&scene.tables["fiber_averages"], &scene.tables["attenuation_ratio"], &scene.tables["srbf_spread"]).expect("forward-scattering tables");
+    let forward_tables = || {
+        ForwardScatteringTables::from_tables(
+            &scene.tables["fiber_averages"],
+            &scene.tables["attenuation_ratio"],
+            &scene.tables["srbf_spread"],
+        )
+        .expect("forward-scattering tables")
+    };
     let t = Instant::now();
-    let voxels = VoxelSettings { voxels_longest_side: FORWARD_VOXELS, ..VoxelSettings::default() };
-    let interactive = CpuForwardScattering::new(&scene.hair, forward_tables(), ForwardScatteringSettings { voxels, ..ForwardScatteringSettings::default() }).expect("voxelize");
-    let dense = CpuForwardScattering::new(&scene.hair, forward_tables(), ForwardScatteringSettings { voxels, ..ForwardScatteringSettings::dense_reference() }).expect("voxelize");
+    let voxels = VoxelSettings {
+        voxels_longest_side: FORWARD_VOXELS,
+        ..VoxelSettings::default()
+    };
+    let interactive = CpuForwardScattering::new(
+        &scene.hair,
+        forward_tables(),
+        ForwardScatteringSettings {
+            voxels,
+            ..ForwardScatteringSettings::default()
+        },
+    )
+    .expect("voxelize");
+    let dense = CpuForwardScattering::new(
+        &scene.hair,
+        forward_tables(),
+        ForwardScatteringSettings {
+            voxels,
+            ..ForwardScatteringSettings::dense_reference()
+        },
+    )
+    .expect("voxelize");
     eprintln!("voxelization (both): {:.2} s", t.elapsed().as_secs_f64());
-    let srbf_tables = EnvTables { srbf: Some(table(scene, "marschner_full")), multiple: Some(table(scene, "multiple")), ..EnvTables::default() };
-    let direct_tables = EnvTables { direct: Some(table(scene, "marschner_full_direct")), multiple: Some(table(scene, "multiple")), ..EnvTables::default() };
-    let (a, ta) = render(scene, &scene.srbf, srbf_tables.clone(), true, Some(&interactive));
+    let srbf_tables = EnvTables {
+        srbf: Some(table(scene, "marschner_full")),
+        multiple: Some(table(scene, "multiple")),
+        ..EnvTables::default()
+    };
+    let direct_tables = EnvTables {
+        direct: Some(table(scene, "marschner_full_direct")),
+        multiple: Some(table(scene, "multiple")),
+        ..EnvTables::default()
+    };
+    let (a, ta) = render(
+        scene,
+        &scene.srbf,
+        srbf_tables.clone(),
+        true,
+        Some(&interactive),
+    );
     let (r, tr) = render(scene, &scene.reference, direct_tables, true, Some(&dense));
     assert_finite("SRBF image", &a);
     assert_finite("reference image", &r);
     assert_eq!(coverage(&a), coverage(&r));
     let e = relative_rmse(&a, &r);
-    eprintln!("full: relative RMSE {e:.4}; mean SRBF {:.4e}, reference {:.4e}; SRBF {ta:.2} s, reference {tr:.2} s", mean_hair(&a), mean_hair(&r));
+    eprintln!(
+        "full: relative RMSE {e:.4}; mean SRBF {:.4e}, reference {:.4e}; SRBF {ta:.2} s, reference {tr:.2} s",
+        mean_hair(&a),
+        mean_hair(&r)
+    );
     // The same frame with the shadow paths marched by the compute shader: the same image.
     let on_gpu = GpuForwardScattering::new(&scene.gpu, interactive.clone()).expect("GPU march");
     let (g, tg) = render(scene, &scene.srbf, srbf_tables.clone(), true, Some(&on_gpu));
     let e_devices = relative_rmse(&g, &a);
-    eprintln!("full: GPU-marched grid vs CPU-marched grid: relative RMSE {e_devices:.2e} ({tg:.2} s vs {ta:.2} s)");
-    assert!(e_devices < 1e-4, "GPU and CPU forward scattering differ: {e_devices}");
-    let (turned, _) = render(scene, &rotated(&scene.srbf, scene.up, 90.0), srbf_tables, true, Some(&interactive));
+    eprintln!(
+        "full: GPU-marched grid vs CPU-marched grid: relative RMSE {e_devices:.2e} ({tg:.2} s vs {ta:.2} s)"
+    );
+    assert!(
+        e_devices < 1e-4,
+        "GPU and CPU forward scattering differ: {e_devices}"
+    );
+    let (turned, _) = render(
+        scene,
+        &rotated(&scene.srbf, scene.up, 90.0),
+        srbf_tables,
+        true,
+        Some(&interactive),
+    );
     let e_turned = relative_rmse(&turned, &r);
-    eprintln!("full: SRBF lights turned 90° about up: relative RMSE {e_turned:.4}; total {:.2} s", start.elapsed().as_secs_f64());
+    eprintln!(
+        "full: SRBF lights turned 90° about up: relative RMSE {e_turned:.4}; total {:.2} s",
+        start.elapsed().as_secs_f64()
+    );
     assert!(e < FULL_BOUND, "full: relative RMSE {e} ≥ {FULL_BOUND}");
-    assert!(e_turned > FULL_BOUND, "full: a 90°-turned environment gives {e_turned}, not above {FULL_BOUND}");
+    assert!(
+        e_turned > FULL_BOUND,
+        "full: a 90°-turned environment gives {e_turned}, not above {FULL_BOUND}"
+    );
 }
 
 /// Full scattering (single + I_G·T_f): the single-scattering bound plus the paper's allowance

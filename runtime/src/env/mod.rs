@@ -82,7 +82,7 @@ use crate::multiple::ForwardScatteringError;
 
 pub mod render;
 pub use render::{
-    EnvFrame, EnvRenderError, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTableError,
-    BoxAverage, EnvTables, FragmentCounts, OccupancyError, TransmittanceFilter, ViewTransparency,
-    render_env_frame,
+    BoxAverage, EnvFrame, EnvRenderError, EnvRenderOptions, EnvRenderStats, EnvRenderer,
+    EnvTableError, EnvTables, FragmentCounts, OccupancyError, TransmittanceFilter,
+    ViewTransparency, render_env_frame,
 };

@@ -33,7 +33,11 @@ pub struct DirectionDeviation {
 impl DirectionDeviation {
     /// Tabulates f on `nodes` points of [0, ν_max] (ν_max > 0), cut at f's first maximum.
     pub fn new(nu_max: f64, nodes: usize) -> Self {
-        let nu_max = if nu_max.is_finite() && nu_max > 0.0 { nu_max } else { 1.0 };
+        let nu_max = if nu_max.is_finite() && nu_max > 0.0 {
+            nu_max
+        } else {
+            1.0
+        };
         let n = nodes.max(3);
         let mut nus = Vec::with_capacity(n);
         let mut f: Vec<f64> = Vec::with_capacity(n);

@@ -13,8 +13,10 @@
 
 use std::f64::consts::FRAC_PI_2;
 
-use strandlight_tables::table_axes::{AXIS_ABS_SIN_THETA, AXIS_ABS_U_DOT_XI, AXIS_LAMBDA, AXIS_NU, AXIS_QUANTITY, AXIS_SIN_THETA};
 use strandlight_tables::table::Table;
+use strandlight_tables::table_axes::{
+    AXIS_ABS_SIN_THETA, AXIS_ABS_U_DOT_XI, AXIS_LAMBDA, AXIS_NU, AXIS_QUANTITY, AXIS_SIN_THETA,
+};
 use thiserror::Error;
 
 /// Node of `beta2_f` and `a_f` on the `quantity` axis of `fiber_averages` (bake_plan's order).
@@ -26,14 +28,25 @@ const FIBER_AVERAGE_QUANTITY_COUNT: usize = 9;
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum ForwardScatteringError {
     #[error("table `{table}`: {problem}")]
-    TableShape { table: &'static str, problem: String },
+    TableShape {
+        table: &'static str,
+        problem: String,
+    },
     #[error("forward-scattering setting `{parameter}` = {value}: {problem}")]
-    InvalidSetting { parameter: &'static str, value: String, problem: String },
+    InvalidSetting {
+        parameter: &'static str,
+        value: String,
+        problem: String,
+    },
     #[error(
         "GPU limit exceeded: {what} needs {bytes} (bytes or workgroups); this adapter allows at \
          most {limit} (lower voxels_longest_side or raise coarse_factor)"
     )]
-    GpuLimit { what: &'static str, bytes: u64, limit: u64 },
+    GpuLimit {
+        what: &'static str,
+        bytes: u64,
+        limit: u64,
+    },
     #[error("the GPU march failed: {0}")]
     Gpu(String),
 }
@@ -45,16 +58,27 @@ fn check_shape(
     axes: &[&str],
     channels: usize,
 ) -> Result<(), ForwardScatteringError> {
-    let fail = |problem: String| Err(ForwardScatteringError::TableShape { table: name, problem });
+    let fail = |problem: String| {
+        Err(ForwardScatteringError::TableShape {
+            table: name,
+            problem,
+        })
+    };
     let found: Vec<&str> = table.axes().iter().map(|a| a.name.as_str()).collect();
     if found != axes {
         return fail(format!("axes are {found:?}, expected {axes:?}"));
     }
     if table.channels() != channels {
-        return fail(format!("{} channels, expected {channels}", table.channels()));
+        return fail(format!(
+            "{} channels, expected {channels}",
+            table.channels()
+        ));
     }
     if let Some(a) = table.axes().iter().find(|a| a.count < 2) {
-        return fail(format!("axis `{}` has {} node(s), at least 2 are needed", a.name, a.count));
+        return fail(format!(
+            "axis `{}` has {} node(s), at least 2 are needed",
+            a.name, a.count
+        ));
     }
     let stats = table.stats();
     if stats.nan_count + stats.infinite_count > 0 {
@@ -90,7 +114,11 @@ impl<const C: usize> ThetaCurve<C> {
     fn sample(theta_min: f64, theta_max: f64, nodes: usize, f: impl Fn(f64) -> [f32; C]) -> Self {
         let step = (theta_max - theta_min) / (nodes - 1) as f64;
         let values = (0..nodes).map(|k| f(theta_min + step * k as f64)).collect();
-        Self { theta_min, step, values }
+        Self {
+            theta_min,
+            step,
+            values,
+        }
     }
 
     fn at(&self, theta: f64) -> [f32; C] {
@@ -153,7 +181,10 @@ impl ForwardFiberAverages {
     pub fn at(&self, sin_theta: f64) -> ForwardEvent {
         let theta = finite_or(sin_theta, 0.0).clamp(-1.0, 1.0).asin();
         let v = self.curve.at(theta);
-        ForwardEvent { attenuation: [v[0], v[1], v[2]], variance: [v[3], v[4], v[5]] }
+        ForwardEvent {
+            attenuation: [v[0], v[1], v[2]],
+            variance: [v[3], v[4], v[5]],
+        }
     }
 }
 
@@ -170,13 +201,21 @@ pub struct AttenuationRatio {
 
 impl AttenuationRatio {
     pub fn from_table(table: &Table) -> Result<Self, ForwardScatteringError> {
-        check_shape(table, "attenuation_ratio", &[AXIS_NU, AXIS_ABS_SIN_THETA], 1)?;
+        check_shape(
+            table,
+            "attenuation_ratio",
+            &[AXIS_NU, AXIS_ABS_SIN_THETA],
+            1,
+        )?;
         let (nu_min, nu_max) = (table.axes()[0].min, table.axes()[0].max);
         let rows = (0..NU_NODES)
             .map(|r| {
                 let nu = nu_min + (nu_max - nu_min) * r as f64 / (NU_NODES - 1) as f64;
                 ThetaCurve::sample(0.0, FRAC_PI_2, THETA_NODES / 2 + 1, |theta| {
-                    [table.lookup_scalar(&[nu, theta.sin()]).unwrap_or(0.0).max(0.0)]
+                    [table
+                        .lookup_scalar(&[nu, theta.sin()])
+                        .unwrap_or(0.0)
+                        .max(0.0)]
                 })
             })
             .collect();
@@ -208,7 +247,9 @@ pub struct SrbfSpread {
 impl SrbfSpread {
     pub fn from_table(table: &Table) -> Result<Self, ForwardScatteringError> {
         check_shape(table, "srbf_spread", &[AXIS_ABS_U_DOT_XI, AXIS_LAMBDA], 1)?;
-        Ok(Self { table: table.clone() })
+        Ok(Self {
+            table: table.clone(),
+        })
     }
 
     /// Variance (rad², incident inclination) of an SRBF of bandwidth λ seen by a fiber with
@@ -238,7 +279,8 @@ pub struct SrbfSpreadCurve {
 
 impl SrbfSpreadCurve {
     pub fn variance(&self, u_dot_xi: f64) -> f32 {
-        self.curve.at(finite_or(u_dot_xi, 0.0).abs().min(1.0).asin())[0]
+        self.curve
+            .at(finite_or(u_dot_xi, 0.0).abs().min(1.0).asin())[0]
     }
 }
 
@@ -318,12 +360,20 @@ mod tests {
         )
         .unwrap();
         let ratio = Table::from_fn(
-            vec![Axis::uniform(AXIS_NU, 0.0, 1.0, 16), Axis::with_mapping(AXIS_ABS_SIN_THETA, 0.0, 1.0, 32, AxisMapping::Arcsine)],
+            vec![
+                Axis::uniform(AXIS_NU, 0.0, 1.0, 16),
+                Axis::with_mapping(AXIS_ABS_SIN_THETA, 0.0, 1.0, 32, AxisMapping::Arcsine),
+            ],
             1,
-            |x, o| o[0] = ((1.0 - x[1] * x[1]).sqrt() * (1.0 - 0.3 * x[0]) + 0.4 * x[0] * x[0]) as f32,
+            |x, o| {
+                o[0] = ((1.0 - x[1] * x[1]).sqrt() * (1.0 - 0.3 * x[0]) + 0.4 * x[0] * x[0]) as f32
+            },
         )
         .unwrap();
-        let (f, r) = (ForwardFiberAverages::from_table(&fiber).unwrap(), AttenuationRatio::from_table(&ratio).unwrap());
+        let (f, r) = (
+            ForwardFiberAverages::from_table(&fiber).unwrap(),
+            AttenuationRatio::from_table(&ratio).unwrap(),
+        );
         let (mut worst_f, mut worst_r) = (0.0f32, 0.0f32);
         for k in 0..=2000 {
             let s = -1.0 + 2.0 * k as f64 / 2000.0;
@@ -333,9 +383,12 @@ mod tests {
                 worst_f = worst_f.max((got[c] - want[c].clamp(0.0, 1.0)).abs());
             }
             let nu = (k % 97) as f64 / 96.0;
-            worst_r = worst_r.max((r.at(nu, s) - ratio.lookup_scalar(&[nu, s.abs()]).unwrap()).abs());
+            worst_r =
+                worst_r.max((r.at(nu, s) - ratio.lookup_scalar(&[nu, s.abs()]).unwrap()).abs());
         }
-        println!("resampled vs table: fiber averages {worst_f:.2e}, attenuation ratio {worst_r:.2e}");
+        println!(
+            "resampled vs table: fiber averages {worst_f:.2e}, attenuation ratio {worst_r:.2e}"
+        );
         assert!(worst_f < 2e-4 && worst_r < 2e-3);
     }
 
@@ -343,9 +396,18 @@ mod tests {
     fn wrong_shapes_are_typed_errors() {
         let err = ForwardFiberAverages::from_table(&fiber_table(6)).unwrap_err();
         println!("{err}");
-        assert!(matches!(err, ForwardScatteringError::TableShape { table: "fiber_averages", .. }));
+        assert!(matches!(
+            err,
+            ForwardScatteringError::TableShape {
+                table: "fiber_averages",
+                ..
+            }
+        ));
         let wrong_axes = Table::from_fn(
-            vec![Axis::uniform(AXIS_LAMBDA, 1.0, 2.0, 3), Axis::uniform(AXIS_NU, 0.0, 1.0, 3)],
+            vec![
+                Axis::uniform(AXIS_LAMBDA, 1.0, 2.0, 3),
+                Axis::uniform(AXIS_NU, 0.0, 1.0, 3),
+            ],
             1,
             |_, o| o[0] = 1.0,
         )

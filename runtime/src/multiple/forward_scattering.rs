@@ -60,25 +60,50 @@ impl ForwardScatteringSettings {
     /// The reference renderer's setting: samples at every voxel corner, quarter-voxel steps,
     /// computed by light sweeps (see the convergence study in the example).
     pub fn dense_reference() -> Self {
-        Self { coarse_factor: 1, step_fraction: 0.25, light_sweep: true, ..Self::default() }
+        Self {
+            coarse_factor: 1,
+            step_fraction: 0.25,
+            light_sweep: true,
+            ..Self::default()
+        }
     }
 
     pub fn validate(&self) -> Result<(), ForwardScatteringError> {
         self.voxels.validate()?;
         let bad = |parameter: &'static str, value: String, problem: &str| {
-            Err(ForwardScatteringError::InvalidSetting { parameter, value, problem: problem.into() })
+            Err(ForwardScatteringError::InvalidSetting {
+                parameter,
+                value,
+                problem: problem.into(),
+            })
         };
         if !(1..=64).contains(&self.coarse_factor) {
-            return bad("coarse_factor", self.coarse_factor.to_string(), "must be in 1..=64");
+            return bad(
+                "coarse_factor",
+                self.coarse_factor.to_string(),
+                "must be in 1..=64",
+            );
         }
         if !(self.step_fraction > 0.0 && self.step_fraction <= 1.0) {
-            return bad("step_fraction", self.step_fraction.to_string(), "must be in (0, 1]");
+            return bad(
+                "step_fraction",
+                self.step_fraction.to_string(),
+                "must be in (0, 1]",
+            );
         }
         if !(1..=8).contains(&self.filter_taps) {
-            return bad("filter_taps", self.filter_taps.to_string(), "must be in 1..=8");
+            return bad(
+                "filter_taps",
+                self.filter_taps.to_string(),
+                "must be in 1..=8",
+            );
         }
         if !(self.density_forward.is_finite() && (0.0..=1.0).contains(&self.density_forward)) {
-            return bad("density_forward", self.density_forward.to_string(), "must be in [0, 1]");
+            return bad(
+                "density_forward",
+                self.density_forward.to_string(),
+                "must be in [0, 1]",
+            );
         }
         Ok(())
     }
@@ -113,7 +138,11 @@ impl SampleGrid {
             extent.y / (dims[1] - 1) as f32,
             extent.z / (dims[2] - 1) as f32,
         );
-        Self { origin: g.origin, spacing, dims }
+        Self {
+            origin: g.origin,
+            spacing,
+            dims,
+        }
     }
 
     pub fn vertex_count(&self) -> usize {
@@ -165,7 +194,13 @@ impl CpuForwardScattering {
     ) -> Self {
         let sample_grid = SampleGrid::over(&volume, settings.coarse_factor);
         let positions = sample_grid.positions();
-        Self { volume, tables, settings, sample_grid, positions }
+        Self {
+            volume,
+            tables,
+            settings,
+            sample_grid,
+            positions,
+        }
     }
 
     pub fn volume(&self) -> &HairVolume {
@@ -207,7 +242,12 @@ impl CpuForwardScattering {
                 .map(|&p| {
                     let mut acc = SampleAccumulator::default();
                     let direct = medium.srbf_variance[self.volume.grid.voxel_clamped(p)] as f64;
-                    acc.add(&sweep.path_at(p), march.density_forward, direct, march.include_direct);
+                    acc.add(
+                        &sweep.path_at(p),
+                        march.density_forward,
+                        direct,
+                        march.include_direct,
+                    );
                     acc.value()
                 })
                 .collect();
@@ -253,7 +293,11 @@ pub fn interpolate_grid(grid: &ForwardScatteringGrid, light: usize, p: Vec3) -> 
     let values = grid.values.get(light * block..(light + 1) * block)?;
     let q = (p - grid.origin) / grid.spacing;
     let cell = |k: usize, n: usize| -> (usize, f32) {
-        let v = if q[k].is_finite() { q[k].clamp(0.0, (n - 1) as f32) } else { 0.0 };
+        let v = if q[k].is_finite() {
+            q[k].clamp(0.0, (n - 1) as f32)
+        } else {
+            0.0
+        };
         let i = (v.floor() as usize).min(n.saturating_sub(2));
         (i, if n > 1 { v - i as f32 } else { 0.0 })
     };
@@ -267,7 +311,11 @@ pub fn interpolate_grid(grid: &ForwardScatteringGrid, light: usize, p: Vec3) -> 
         if w == 0.0 {
             continue;
         }
-        let (ix, iy, iz) = ((x + dx).min(nx - 1), (y + dy).min(ny - 1), (z + dz).min(nz - 1));
+        let (ix, iy, iz) = (
+            (x + dx).min(nx - 1),
+            (y + dy).min(ny - 1),
+            (z + dz).min(nz - 1),
+        );
         let v = values[(iz * ny + iy) * nx + ix];
         for c in 0..4 {
             out[c] += w * v[c];

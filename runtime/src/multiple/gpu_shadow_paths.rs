@@ -15,8 +15,8 @@ use super::fiber_tables::ForwardScatteringError;
 use super::forward_scattering::CpuForwardScattering;
 use super::shadow_paths::{LightMedium, light_direction};
 use crate::env::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource};
-use crate::gpu::{GpuContext, read_buffer};
 use crate::gpu::bind_layout::{storage_entry, uniform_entry};
+use crate::gpu::{GpuContext, read_buffer};
 
 const WORKGROUP_SIZE: u32 = 64;
 /// Two vec4 per voxel per light (see the shader's layout).
@@ -52,23 +52,33 @@ pub struct GpuForwardScattering<'g> {
 impl<'g> GpuForwardScattering<'g> {
     /// Builds the pipeline and uploads the sample points; checks the adapter's limits against
     /// the volume (one light's medium must fit one storage binding) and the sample count.
-    pub fn new(gpu: &'g GpuContext, cpu: CpuForwardScattering) -> Result<Self, ForwardScatteringError> {
+    pub fn new(
+        gpu: &'g GpuContext,
+        cpu: CpuForwardScattering,
+    ) -> Result<Self, ForwardScatteringError> {
         if cpu.settings().light_sweep {
             return Err(ForwardScatteringError::InvalidSetting {
                 parameter: "light_sweep",
                 value: "true".into(),
-                problem: "the light sweep runs on the CPU only; the GPU marches from every sample".into(),
+                problem: "the light sweep runs on the CPU only; the GPU marches from every sample"
+                    .into(),
             });
         }
         let limits = gpu.device.limits();
-        let binding_limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+        let binding_limit = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
         let voxels = cpu.volume().grid.voxel_count() as u64;
         let per_light = voxels * MEDIUM_BYTES_PER_VOXEL;
         let samples = cpu.sample_grid().vertex_count() as u64;
         let output_per_light = samples * 16;
         if per_light > binding_limit || output_per_light > binding_limit {
             return Err(ForwardScatteringError::GpuLimit {
-                what: if per_light > binding_limit { "one light's voxel medium" } else { "one light's sample values" },
+                what: if per_light > binding_limit {
+                    "one light's voxel medium"
+                } else {
+                    "one light's sample values"
+                },
                 bytes: per_light.max(output_per_light),
                 limit: binding_limit,
             });
@@ -81,19 +91,32 @@ impl<'g> GpuForwardScattering<'g> {
                 limit: limits.max_compute_workgroups_per_dimension as u64,
             });
         }
-        let fit = (binding_limit / per_light.max(output_per_light)).min(MAX_LIGHTS_PER_DISPATCH as u64);
+        let fit =
+            (binding_limit / per_light.max(output_per_light)).min(MAX_LIGHTS_PER_DISPATCH as u64);
         let lights_per_dispatch = (fit as u32)
             .min(limits.max_compute_workgroups_per_dimension)
             .max(1);
-        let points: Vec<[f32; 4]> =
-            cpu.sample_points().iter().map(|p| [p.x, p.y, p.z, 1.0]).collect();
-        let sample_points = gpu.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("forward-scattering sample points"),
-            contents: bytemuck::cast_slice(&points),
-            usage: wgpu::BufferUsages::STORAGE,
-        });
+        let points: Vec<[f32; 4]> = cpu
+            .sample_points()
+            .iter()
+            .map(|p| [p.x, p.y, p.z, 1.0])
+            .collect();
+        let sample_points = gpu
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("forward-scattering sample points"),
+                contents: bytemuck::cast_slice(&points),
+                usage: wgpu::BufferUsages::STORAGE,
+            });
         let (pipeline, layout) = build_pipeline(gpu);
-        Ok(Self { gpu, cpu, pipeline, layout, sample_points, lights_per_dispatch })
+        Ok(Self {
+            gpu,
+            cpu,
+            pipeline,
+            layout,
+            sample_points,
+            lights_per_dispatch,
+        })
     }
 
     pub fn cpu(&self) -> &CpuForwardScattering {
@@ -128,12 +151,24 @@ impl<'g> GpuForwardScattering<'g> {
             _pad: [0; 3],
         };
         let init = |label, contents: &[u8], usage| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage,
+            })
         };
         let storage = wgpu::BufferUsages::STORAGE;
-        let params = init("march params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
+        let params = init(
+            "march params",
+            bytemuck::bytes_of(&params),
+            wgpu::BufferUsages::UNIFORM,
+        );
         let medium = init("voxel medium", bytemuck::cast_slice(&medium), storage);
-        let directions = init("light directions", bytemuck::cast_slice(&directions), storage);
+        let directions = init(
+            "light directions",
+            bytemuck::cast_slice(&directions),
+            storage,
+        );
         let values = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("forward-scattering values"),
             size: samples as u64 * lights.len() as u64 * 16,
@@ -144,11 +179,26 @@ impl<'g> GpuForwardScattering<'g> {
             label: Some("shadow paths"),
             layout: &self.layout,
             entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: params.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: medium.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: self.sample_points.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: directions.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: values.as_entire_binding() },
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: medium.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: self.sample_points.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: directions.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: values.as_entire_binding(),
+                },
             ],
         });
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -175,7 +225,12 @@ impl ForwardScatteringSource for GpuForwardScattering<'_> {
             values.extend(self.march_chunk(chunk)?);
         }
         let grid = self.cpu.sample_grid();
-        Ok(ForwardScatteringGrid { origin: grid.origin, spacing: grid.spacing, dims: grid.dims, values })
+        Ok(ForwardScatteringGrid {
+            origin: grid.origin,
+            spacing: grid.spacing,
+            dims: grid.dims,
+            values,
+        })
     }
 
     fn device(&self) -> &'static str {

@@ -37,7 +37,10 @@ pub struct VoxelSettings {
 
 impl Default for VoxelSettings {
     fn default() -> Self {
-        Self { voxels_longest_side: 64, default_diameter: None }
+        Self {
+            voxels_longest_side: 64,
+            default_diameter: None,
+        }
     }
 }
 
@@ -53,12 +56,12 @@ impl VoxelSettings {
         if let Some(d) = self.default_diameter
             && !(d.is_finite() && d >= 0.0)
         {
-                return Err(ForwardScatteringError::InvalidSetting {
-                    parameter: "default_diameter",
-                    value: d.to_string(),
-                    problem: "must be finite and ≥ 0".into(),
-                });
-            }
+            return Err(ForwardScatteringError::InvalidSetting {
+                parameter: "default_diameter",
+                value: d.to_string(),
+                problem: "must be finite and ≥ 0".into(),
+            });
+        }
         Ok(())
     }
 }
@@ -84,9 +87,15 @@ impl VoxelGrid {
         } else {
             fallback_size.max(1e-6)
         };
-        let dims = size.to_array().map(|s| ((s / voxel_size).ceil() as u32).max(1));
+        let dims = size
+            .to_array()
+            .map(|s| ((s / voxel_size).ceil() as u32).max(1));
         let extent = Vec3::new(dims[0] as f32, dims[1] as f32, dims[2] as f32) * voxel_size;
-        Self { origin: bounds.center() - 0.5 * extent, voxel_size, dims }
+        Self {
+            origin: bounds.center() - 0.5 * extent,
+            voxel_size,
+            dims,
+        }
     }
 
     pub fn voxel_count(&self) -> usize {
@@ -95,7 +104,11 @@ impl VoxelGrid {
 
     /// World extent of the grid.
     pub fn extent(&self) -> Vec3 {
-        Vec3::new(self.dims[0] as f32, self.dims[1] as f32, self.dims[2] as f32) * self.voxel_size
+        Vec3::new(
+            self.dims[0] as f32,
+            self.dims[1] as f32,
+            self.dims[2] as f32,
+        ) * self.voxel_size
     }
 
     pub fn linear_index(&self, [x, y, z]: [u32; 3]) -> usize {
@@ -197,7 +210,9 @@ fn principal_direction(m: &[f64; 6], start: DVec3) -> DVec3 {
         )
     };
     let diag = [m[0], m[1], m[2]];
-    let heaviest = (0..3).max_by(|&a, &b| diag[a].total_cmp(&diag[b])).unwrap_or(2);
+    let heaviest = (0..3)
+        .max_by(|&a, &b| diag[a].total_cmp(&diag[b]))
+        .unwrap_or(2);
     let axis = [DVec3::X, DVec3::Y, DVec3::Z][heaviest];
     // Start off any eigenvector-orthogonal plane by mixing in the heaviest axis.
     let mut v = (start.normalize_or_zero() + 0.5 * axis).normalize_or(axis);
@@ -228,7 +243,11 @@ impl HairVolume {
         let default_diameter = settings
             .default_diameter
             .unwrap_or_else(|| crate::passes::strand_geometry::default_thickness(model));
-        let grid = VoxelGrid::around(model.bounds(), settings.voxels_longest_side, default_diameter);
+        let grid = VoxelGrid::around(
+            model.bounds(),
+            settings.voxels_longest_side,
+            default_diameter,
+        );
         let sums = accumulate(model, &grid, default_diameter);
         Ok(Self::from_sums(grid, &sums, nu_max))
     }
@@ -314,7 +333,12 @@ fn accumulate(model: &HairModel, grid: &VoxelGrid, default_diameter: f32) -> Vec
 
 /// Strand `s` cut into pieces of at most half a voxel, each deposited in the voxel of its
 /// midpoint.
-fn strand_deposits(model: &HairModel, s: usize, grid: &VoxelGrid, default_diameter: f32) -> Vec<Deposit> {
+fn strand_deposits(
+    model: &HairModel,
+    s: usize,
+    grid: &VoxelGrid,
+    default_diameter: f32,
+) -> Vec<Deposit> {
     let max_piece = 0.5 * grid.voxel_size as f64;
     let offsets = model.strand_offsets();
     let points = model.points();
@@ -337,7 +361,12 @@ fn strand_deposits(model: &HairModel, s: usize, grid: &VoxelGrid, default_diamet
         for k in 0..pieces {
             let mid = a + (b - a) * ((k as f64 + 0.5) / pieces as f64);
             let voxel = grid.voxel_clamped(mid.as_vec3()) as u32;
-            out.push(Deposit { voxel, length: piece, diameter, tangent });
+            out.push(Deposit {
+                voxel,
+                length: piece,
+                diameter,
+                tangent,
+            });
         }
     }
     out

@@ -71,7 +71,13 @@ impl LightSweep {
     /// `substeps` steps (model units > 0, substeps ≥ 1). Storing every voxel rather than every
     /// step keeps the lattice at 40 bytes per voxel-sized cell: its size, not the marching,
     /// sets the cost (memory traffic).
-    pub fn new(volume: &HairVolume, medium: &LightMedium, xi: Vec3, lateral: f32, substeps: u32) -> Self {
+    pub fn new(
+        volume: &HairVolume,
+        medium: &LightMedium,
+        xi: Vec3,
+        lateral: f32,
+        substeps: u32,
+    ) -> Self {
         let substeps = substeps.max(1);
         let delta = lateral;
         let step = delta / substeps as f32;
@@ -98,25 +104,44 @@ impl LightSweep {
         let w_top = max.z + delta;
         let nw = ((w_top - (min.z - delta)) / delta).ceil() as usize + 1;
         let mut nodes = vec![StoredPath::default(); nu * nv * nw];
-        nodes.par_chunks_mut(nw).enumerate().for_each(|(ray, column)| {
-            let (i, j) = (ray % nu, ray / nu);
-            let base = e1 * (u0 + i as f32 * lateral) + e2 * (v0 + j as f32 * lateral);
-            let mut path = ExpectedShadowPath::default();
-            column[0] = StoredPath::from(&path);
-            for (k, node) in column.iter_mut().enumerate().skip(1) {
-                for sub in 0..substeps {
-                    let w_mid = w_top - (k - 1) as f32 * delta - (sub as f32 + 0.5) * step;
-                    if let Some(v) = g.voxel_of(base + xi * w_mid) {
-                        let ext = medium.extinction[v];
-                        if ext > 0.0 {
-                            path.step(ext as f64, step as f64, &medium.event[v], medium.srbf_variance[v] as f64);
+        nodes
+            .par_chunks_mut(nw)
+            .enumerate()
+            .for_each(|(ray, column)| {
+                let (i, j) = (ray % nu, ray / nu);
+                let base = e1 * (u0 + i as f32 * lateral) + e2 * (v0 + j as f32 * lateral);
+                let mut path = ExpectedShadowPath::default();
+                column[0] = StoredPath::from(&path);
+                for (k, node) in column.iter_mut().enumerate().skip(1) {
+                    for sub in 0..substeps {
+                        let w_mid = w_top - (k - 1) as f32 * delta - (sub as f32 + 0.5) * step;
+                        if let Some(v) = g.voxel_of(base + xi * w_mid) {
+                            let ext = medium.extinction[v];
+                            if ext > 0.0 {
+                                path.step(
+                                    ext as f64,
+                                    step as f64,
+                                    &medium.event[v],
+                                    medium.srbf_variance[v] as f64,
+                                );
+                            }
                         }
                     }
+                    *node = StoredPath::from(&path);
                 }
-                *node = StoredPath::from(&path);
-            }
-        });
-        Self { xi, e1, e2, u0, v0, w_top, lateral, delta, dims: [nu, nv, nw], nodes }
+            });
+        Self {
+            xi,
+            e1,
+            e2,
+            u0,
+            v0,
+            w_top,
+            lateral,
+            delta,
+            dims: [nu, nv, nw],
+            nodes,
+        }
     }
 
     /// Rays × steps marched.
@@ -134,7 +159,11 @@ impl LightSweep {
         ];
         let n = [nu, nv, nw];
         let cell: [(usize, f64); 3] = std::array::from_fn(|a| {
-            let x = if coords[a].is_finite() { coords[a] } else { 0.0 };
+            let x = if coords[a].is_finite() {
+                coords[a]
+            } else {
+                0.0
+            };
             let x = x.clamp(0.0, (n[a] - 1) as f32) as f64;
             let i = (x.floor() as usize).min(n[a] - 2);
             (i, x - i as f64)
@@ -151,7 +180,11 @@ impl LightSweep {
             let d = [corner & 1, corner >> 1 & 1, corner >> 2 & 1];
             let mut w = 1.0;
             for a in 0..3 {
-                w *= if d[a] == 1 { cell[a].1 } else { 1.0 - cell[a].1 };
+                w *= if d[a] == 1 {
+                    cell[a].1
+                } else {
+                    1.0 - cell[a].1
+                };
             }
             if w == 0.0 {
                 continue;

@@ -49,7 +49,9 @@ impl LightMedium {
     /// Table lookups for every occupied voxel under `light` (parallel over voxels).
     pub fn new(volume: &HairVolume, tables: &ForwardScatteringTables, light: &EnvLight) -> Self {
         let xi = light_direction(light);
-        let srbf = light.lambda.map(|l| tables.srbf_spread.for_bandwidth(l as f64));
+        let srbf = light
+            .lambda
+            .map(|l| tables.srbf_spread.for_bandwidth(l as f64));
         let srbf_at = |s: f64| srbf.as_ref().map_or(0.0, |c| c.variance(s));
         let empty_srbf = srbf_at(0.0);
         let per_voxel: Vec<(f32, ForwardEvent, f32)> = (0..volume.sigma_perp.len())
@@ -58,7 +60,10 @@ impl LightMedium {
             .map(|v| {
                 let sigma = volume.sigma_perp[v];
                 if !(sigma > 0.0) {
-                    let none = ForwardEvent { attenuation: [1.0; 3], variance: [0.0; 3] };
+                    let none = ForwardEvent {
+                        attenuation: [1.0; 3],
+                        variance: [0.0; 3],
+                    };
                     return (0.0, none, empty_srbf);
                 }
                 let s = volume.mean_direction[v].dot(xi).clamp(-1.0, 1.0) as f64;
@@ -83,7 +88,11 @@ impl LightMedium {
 /// Unit direction toward the light; a degenerate direction falls back to +z (no NaN).
 pub fn light_direction(light: &EnvLight) -> Vec3 {
     let d = light.direction;
-    if d.is_finite() { d.normalize_or(Vec3::Z) } else { Vec3::Z }
+    if d.is_finite() {
+        d.normalize_or(Vec3::Z)
+    } else {
+        Vec3::Z
+    }
 }
 
 /// The expectations of one shadow path (see the module notes), per channel.
@@ -147,7 +156,8 @@ impl ExpectedShadowPath {
 
     /// E[T_f] per channel: P₀ + d_f (E[∏ā_f] − P₀).
     pub fn transmittance(&self, density_forward: f64) -> [f64; 3] {
-        self.product.map(|m| self.no_hit + density_forward * (m - self.no_hit).max(0.0))
+        self.product
+            .map(|m| self.no_hit + density_forward * (m - self.no_hit).max(0.0))
     }
 
     /// The forward-SCATTERED part of E[T_f]: d_f (E[∏ā_f] − P₀), paths with at least one hit.
@@ -155,7 +165,8 @@ impl ExpectedShadowPath {
     /// single scattering's (shadowed by the DODM, with d_b·S_back in `marschner_full`, Ren §7),
     /// so counting it again in the multiple term would light every exposed fiber twice.
     pub fn scattered_transmittance(&self, density_forward: f64) -> [f64; 3] {
-        self.product.map(|m| density_forward * (m - self.no_hit).max(0.0))
+        self.product
+            .map(|m| density_forward * (m - self.no_hit).max(0.0))
     }
 
     /// Numerators of the energy-weighted variance of the incident inclination, per channel
@@ -195,7 +206,12 @@ pub fn march(
         };
         let ext = medium.extinction[v];
         if ext > 0.0 {
-            path.step(ext as f64, delta as f64, &medium.event[v], medium.srbf_variance[v] as f64);
+            path.step(
+                ext as f64,
+                delta as f64,
+                &medium.event[v],
+                medium.srbf_variance[v] as f64,
+            );
         }
     }
     path
@@ -230,11 +246,23 @@ impl SampleAccumulator {
     /// SRBF's own width seen by the fiber there, 0 for a directional light).
     /// With `include_direct` false only the scattered paths count (see
     /// [`ExpectedShadowPath::scattered_transmittance`]).
-    pub fn add(&mut self, path: &ExpectedShadowPath, density_forward: f64, direct_variance: f64, include_direct: bool) {
+    pub fn add(
+        &mut self,
+        path: &ExpectedShadowPath,
+        density_forward: f64,
+        direct_variance: f64,
+        include_direct: bool,
+    ) {
         let (t, num) = if include_direct {
-            (path.transmittance(density_forward), path.variance_numerator(density_forward, direct_variance))
+            (
+                path.transmittance(density_forward),
+                path.variance_numerator(density_forward, direct_variance),
+            )
         } else {
-            (path.scattered_transmittance(density_forward), path.variance_numerator(density_forward, 0.0))
+            (
+                path.scattered_transmittance(density_forward),
+                path.variance_numerator(density_forward, 0.0),
+            )
         };
         for c in 0..3 {
             self.transmittance[c] += t[c];
@@ -282,7 +310,12 @@ pub fn sample_value(
         let p = point + offset;
         let path = march(volume, medium, p, xi, step);
         let direct_variance = medium.srbf_variance[volume.grid.voxel_clamped(p)] as f64;
-        acc.add(&path, settings.density_forward, direct_variance, settings.include_direct);
+        acc.add(
+            &path,
+            settings.density_forward,
+            direct_variance,
+            settings.include_direct,
+        );
     }
     acc.value()
 }

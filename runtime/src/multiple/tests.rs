@@ -1,9 +1,11 @@
 //! Voxelization and shadow paths against closed forms on synthetic hair, with hand-made tables
 //! (constant ā_f, β̄_f², SRBF variance; α(0, θ) = cos θ), independent of the bake.
 
-use strandlight_tables::table_axes::{AXIS_ABS_SIN_THETA, AXIS_ABS_U_DOT_XI, AXIS_LAMBDA, AXIS_NU, AXIS_QUANTITY, AXIS_SIN_THETA};
 use glam::Vec3;
 use strandlight_tables::table::{Axis, AxisMapping, Table};
+use strandlight_tables::table_axes::{
+    AXIS_ABS_SIN_THETA, AXIS_ABS_U_DOT_XI, AXIS_LAMBDA, AXIS_NU, AXIS_QUANTITY, AXIS_SIN_THETA,
+};
 
 use super::*;
 use crate::env::{EnvLight, ForwardScatteringSource};
@@ -55,7 +57,13 @@ fn tables() -> ForwardScatteringTables {
 
 /// `strands` random walks of `points` points with isotropic steps of length `step`, starting
 /// uniformly in an 8-cube, fibers of diameter `diameter`.
-fn tangled_hair(rng: &mut Rng, strands: usize, points: usize, step: f32, diameter: f32) -> HairModel {
+fn tangled_hair(
+    rng: &mut Rng,
+    strands: usize,
+    points: usize,
+    step: f32,
+    diameter: f32,
+) -> HairModel {
     let mut positions = Vec::new();
     let mut offsets = vec![0u32];
     for _ in 0..strands {
@@ -69,7 +77,14 @@ fn tangled_hair(rng: &mut Rng, strands: usize, points: usize, step: f32, diamete
         }
         offsets.push(positions.len() as u32);
     }
-    HairModel::new(positions, offsets, Some(Attribute::Uniform(diameter)), None, None).unwrap()
+    HairModel::new(
+        positions,
+        offsets,
+        Some(Attribute::Uniform(diameter)),
+        None,
+        None,
+    )
+    .unwrap()
 }
 
 /// 16 × 16 strands along +y at x, z = 0.5, 1.5, …, 15.5 (spacing 1), y from 0 to 32 in unit
@@ -86,12 +101,22 @@ fn parallel_block(diameter: Option<f32>) -> HairModel {
             offsets.push(points.len() as u32);
         }
     }
-    HairModel::new(points, offsets, diameter.map(Attribute::Uniform), None, None).unwrap()
+    HairModel::new(
+        points,
+        offsets,
+        diameter.map(Attribute::Uniform),
+        None,
+        None,
+    )
+    .unwrap()
 }
 
 fn settings(voxels: u32, taps: u32, step: f32) -> ForwardScatteringSettings {
     ForwardScatteringSettings {
-        voxels: VoxelSettings { voxels_longest_side: voxels, default_diameter: None },
+        voxels: VoxelSettings {
+            voxels_longest_side: voxels,
+            default_diameter: None,
+        },
         coarse_factor: 4,
         step_fraction: step,
         filter_taps: taps,
@@ -119,8 +144,12 @@ impl Rng {
 #[test]
 fn parallel_block_voxelizes_to_the_closed_form() {
     let d = 0.15f32;
-    let volume = HairVolume::build(&parallel_block(Some(d)), &settings(8, 1, 0.5).voxels, 1.0).unwrap();
-    println!("grid {:?}, origin {}, voxel {}", volume.grid.dims, volume.grid.origin, volume.grid.voxel_size);
+    let volume =
+        HairVolume::build(&parallel_block(Some(d)), &settings(8, 1, 0.5).voxels, 1.0).unwrap();
+    println!(
+        "grid {:?}, origin {}, voxel {}",
+        volume.grid.dims, volume.grid.origin, volume.grid.voxel_size
+    );
     assert_eq!(volume.grid.dims, [4, 8, 4]);
     // n fibers × d per area: 16 fibers through a 4 × 4 face → σ_t⊥ = 16·d/16 = d.
     let want = 16.0 * d / 16.0;
@@ -130,7 +159,9 @@ fn parallel_block_voxelizes_to_the_closed_form() {
         worst_dir = worst_dir.max((volume.mean_direction[v] - Vec3::Y).length());
         worst_nu = worst_nu.max(volume.deviation[v]);
     }
-    println!("σ_t⊥ want {want}: worst relative error {worst_sigma:.2e}; |ω̄ − y| ≤ {worst_dir:.2e}; ν ≤ {worst_nu:.2e}");
+    println!(
+        "σ_t⊥ want {want}: worst relative error {worst_sigma:.2e}; |ω̄ − y| ≤ {worst_dir:.2e}; ν ≤ {worst_nu:.2e}"
+    );
     assert!(worst_sigma < 1e-5);
     assert!(worst_dir < 1e-5);
     assert!(worst_nu < 1e-3);
@@ -154,7 +185,11 @@ fn fibers_drawn_around_an_axis_give_back_their_deviation() {
             let (x, y) = (nu * rng.normal(), nu * rng.normal());
             let r = (x * x + y * y).sqrt();
             let t = if r > 0.0 {
-                Vec3::new((r.sin() * x / r) as f32, (r.sin() * y / r) as f32, r.cos() as f32)
+                Vec3::new(
+                    (r.sin() * x / r) as f32,
+                    (r.sin() * y / r) as f32,
+                    r.cos() as f32,
+                )
             } else {
                 Vec3::Z
             };
@@ -164,7 +199,8 @@ fn fibers_drawn_around_an_axis_give_back_their_deviation() {
             points.push(c + 0.01 * t);
             offsets.push(points.len() as u32);
         }
-        let model = HairModel::new(points, offsets, Some(Attribute::Uniform(0.001)), None, None).unwrap();
+        let model =
+            HairModel::new(points, offsets, Some(Attribute::Uniform(0.001)), None, None).unwrap();
         let volume = HairVolume::build(&model, &settings(1, 1, 0.5).voxels, 1.0).unwrap();
         assert_eq!(volume.grid.voxel_count(), 1);
         let (got, dir) = (volume.deviation[0] as f64, volume.mean_direction[0]);
@@ -185,7 +221,10 @@ fn random_directions_give_a_large_deviation() {
         .map(|v| volume.deviation[v])
         .collect();
     let min = occupied.iter().cloned().fold(f32::INFINITY, f32::min);
-    println!("{} well-filled voxels, smallest ν {min:.3} rad (table ν_max 1.0)", occupied.len());
+    println!(
+        "{} well-filled voxels, smallest ν {min:.3} rad (table ν_max 1.0)",
+        occupied.len()
+    );
     assert!(!occupied.is_empty());
     assert!(min > 0.7);
 }
@@ -222,7 +261,9 @@ fn slab_attenuation_matches_the_expected_value_closed_form() {
             let (want, sigma) = poisson_closed_form(mu, srbf_var, 0.7);
             println!(
                 "step {step} voxel, λ {:?}: T_f {:?} σ̄_f {:.6}; closed form {want:.6?} σ̄ {sigma:.6}; expected hits σαL = {mu:.3}",
-                l.lambda, &got[..3], got[3]
+                l.lambda,
+                &got[..3],
+                got[3]
             );
             for c in 0..3 {
                 assert!((got[c] as f64 - want[c]).abs() < 2e-6, "channel {c}");
@@ -232,14 +273,25 @@ fn slab_attenuation_matches_the_expected_value_closed_form() {
     }
     // The renderer's default: only paths with ≥ 1 hit, T = d_f (E[a^N] − P₀) (Zinke's global
     // term without the direct fraction), σ̄_f weighted by those paths alone.
-    let scattered = CpuForwardScattering::new(&model, tables(), ForwardScatteringSettings { include_direct: false, ..settings(8, 1, 0.5) }).unwrap();
+    let scattered = CpuForwardScattering::new(
+        &model,
+        tables(),
+        ForwardScatteringSettings {
+            include_direct: false,
+            ..settings(8, 1, 0.5)
+        },
+    )
+    .unwrap();
     let got = scattered.values_at(&srbf, &[point])[0];
     let p0 = (-mu).exp();
     let (mut num, mut den) = (0.0, 0.0);
     for c in 0..3 {
         let m = (-mu * (1.0 - A_F[c])).exp();
         let want = 0.7 * (m - p0);
-        println!("scattered only: channel {c} T_f {} closed form {want:.6}", got[c]);
+        println!(
+            "scattered only: channel {c} T_f {} closed form {want:.6}",
+            got[c]
+        );
         assert!((got[c] as f64 - want).abs() < 2e-6, "channel {c}");
         num += 0.7 * (4.0 * BETA2_F * mu * A_F[c] * m + SRBF_VARIANCE * (m - p0));
         den += want;
@@ -252,23 +304,37 @@ fn expected_hits_equal_sigma_alpha_length() {
     // Independent of the transmittance bookkeeping: the optical depth Σ kδ is k·L; at an
     // oblique angle θ to the fibers α = cos θ and the path is longer.
     let d = 0.15f32;
-    let source = CpuForwardScattering::new(&parallel_block(Some(d)), tables(), settings(8, 1, 0.05)).unwrap();
+    let source =
+        CpuForwardScattering::new(&parallel_block(Some(d)), tables(), settings(8, 1, 0.05))
+            .unwrap();
     let theta = 0.5f32;
     let xi = Vec3::new(theta.cos(), theta.sin(), 0.0);
-    let medium = shadow_paths::LightMedium::new(source.volume(), &tables(), &EnvLight::directional(xi, [1.0; 3]));
+    let medium = shadow_paths::LightMedium::new(
+        source.volume(),
+        &tables(),
+        &EnvLight::directional(xi, [1.0; 3]),
+    );
     let point = Vec3::new(4.0, 10.0, 6.0);
     let path = shadow_paths::march(source.volume(), &medium, point, xi, 0.2);
     let length = 12.0 / theta.cos(); // leaves through the x = 16 face (y stays below 32)
     let want = d as f64 * (theta as f64).cos() * length as f64;
-    println!("expected hits {:.5}, σ_t⊥ α L = {want:.5}", path.expected_hits);
+    println!(
+        "expected hits {:.5}, σ_t⊥ α L = {want:.5}",
+        path.expected_hits
+    );
     assert!((path.expected_hits / want - 1.0).abs() < 1e-4);
 }
 
 #[test]
 fn light_along_the_fibers_is_not_attenuated() {
     // α(0, 90°) = 0: aligned fibers show no cross-section to light along their axis.
-    let source = CpuForwardScattering::new(&parallel_block(Some(0.15)), tables(), settings(8, 2, 0.5)).unwrap();
-    let v = source.values_at(&EnvLight::directional(Vec3::Y, [1.0; 3]), &[Vec3::new(8.0, 3.0, 8.0)])[0];
+    let source =
+        CpuForwardScattering::new(&parallel_block(Some(0.15)), tables(), settings(8, 2, 0.5))
+            .unwrap();
+    let v = source.values_at(
+        &EnvLight::directional(Vec3::Y, [1.0; 3]),
+        &[Vec3::new(8.0, 3.0, 8.0)],
+    )[0];
     println!("light along the fibers: {v:?}");
     assert!(v.iter().all(|x| x.is_finite()));
     assert!(v[..3].iter().all(|&t| (t - 1.0).abs() < 1e-6));
@@ -294,16 +360,26 @@ fn empty_regions_and_outside_points_are_lit_directly() {
     let model = HairModel::new(points, offsets, Some(Attribute::Uniform(0.2)), None, None).unwrap();
     let source = CpuForwardScattering::new(&model, tables(), settings(16, 2, 0.5)).unwrap();
     let light = EnvLight::directional(Vec3::Z, [1.0; 3]);
-    let probes = [Vec3::new(8.0, 8.0, 8.0), Vec3::new(100.0, -50.0, 3.0), Vec3::new(2.0, 8.0, 8.0)];
+    let probes = [
+        Vec3::new(8.0, 8.0, 8.0),
+        Vec3::new(100.0, -50.0, 3.0),
+        Vec3::new(2.0, 8.0, 8.0),
+    ];
     let v = source.values_at(&light, &probes);
-    println!("gap {:?}, outside {:?}, inside a block (lit along z, α = 1) {:?}", v[0], v[1], v[2]);
+    println!(
+        "gap {:?}, outside {:?}, inside a block (lit along z, α = 1) {:?}",
+        v[0], v[1], v[2]
+    );
     for probe in &v[..2] {
         assert_eq!(probe[..3], [1.0; 3]);
         assert_eq!(probe[3], 0.0);
     }
     assert!(v[2][0] < 1.0 && v[2][2] < v[2][0]);
     // A light from the gap's side (+x from x = 8 reaches the second block) is attenuated.
-    let from_x = source.values_at(&EnvLight::directional(Vec3::X, [1.0; 3]), &[Vec3::new(8.0, 8.0, 8.0)])[0];
+    let from_x = source.values_at(
+        &EnvLight::directional(Vec3::X, [1.0; 3]),
+        &[Vec3::new(8.0, 8.0, 8.0)],
+    )[0];
     println!("gap lit from +x through the second block: {from_x:?}");
     assert!(from_x[0] < 1.0);
 }
@@ -312,20 +388,40 @@ fn empty_regions_and_outside_points_are_lit_directly() {
 fn degenerate_hair_gives_finite_values() {
     // Zero-length strands only (every point of a strand equal), and a single point overall.
     let cases = [
-        (vec![Vec3::ONE, Vec3::ONE, Vec3::new(2.0, 1.0, 1.0), Vec3::new(2.0, 1.0, 1.0)], vec![0u32, 2, 4]),
+        (
+            vec![
+                Vec3::ONE,
+                Vec3::ONE,
+                Vec3::new(2.0, 1.0, 1.0),
+                Vec3::new(2.0, 1.0, 1.0),
+            ],
+            vec![0u32, 2, 4],
+        ),
         (vec![Vec3::ZERO; 3], vec![0u32, 3]),
     ];
     for (points, offsets) in cases {
         let model = HairModel::new(points, offsets, None, None, None).unwrap();
-        let with_direct = ForwardScatteringSettings { include_direct: true, ..Default::default() };
+        let with_direct = ForwardScatteringSettings {
+            include_direct: true,
+            ..Default::default()
+        };
         let source = CpuForwardScattering::new(&model, tables(), with_direct).unwrap();
         let lights = [
             EnvLight::directional(Vec3::new(0.3, 0.4, 0.5), [1.0; 3]),
             EnvLight::srbf(Vec3::new(-1.0, 0.0, 0.0), 50.0, [1.0; 3]),
         ];
         // The renderer's default counts only forward-scattered light: none without fibers.
-        let scattered = CpuForwardScattering::new(&model, tables(), ForwardScatteringSettings::default()).unwrap().grid(&lights).unwrap();
-        assert!(scattered.values.iter().all(|v| v[..3] == [0.0; 3] && v[3].is_finite()));
+        let scattered =
+            CpuForwardScattering::new(&model, tables(), ForwardScatteringSettings::default())
+                .unwrap()
+                .grid(&lights)
+                .unwrap();
+        assert!(
+            scattered
+                .values
+                .iter()
+                .all(|v| v[..3] == [0.0; 3] && v[3].is_finite())
+        );
         let grid = source.grid(&lights).unwrap();
         let volume = source.volume();
         println!(
@@ -355,9 +451,18 @@ fn the_grid_covers_the_hair_and_holds_every_light() {
     ];
     let grid = source.grid(&lights).unwrap();
     let n = grid.dims.iter().product::<u32>() as usize;
-    println!("dims {:?} origin {} spacing {}", grid.dims, grid.origin, grid.spacing);
+    println!(
+        "dims {:?} origin {} spacing {}",
+        grid.dims, grid.origin, grid.spacing
+    );
     assert_eq!(grid.values.len(), n * lights.len());
-    let far = grid.origin + grid.spacing * Vec3::new(grid.dims[0] as f32 - 1.0, grid.dims[1] as f32 - 1.0, grid.dims[2] as f32 - 1.0);
+    let far = grid.origin
+        + grid.spacing
+            * Vec3::new(
+                grid.dims[0] as f32 - 1.0,
+                grid.dims[1] as f32 - 1.0,
+                grid.dims[2] as f32 - 1.0,
+            );
     let b = model.bounds();
     assert!(grid.origin.cmple(b.min + 1e-4).all() && far.cmpge(b.max - 1e-4).all());
     // Vertex values are what values_at gives at the vertex; interpolation reproduces them.
@@ -366,7 +471,10 @@ fn the_grid_covers_the_hair_and_holds_every_light() {
         let direct = source.values_at(light, &[p])[0];
         let interpolated = interpolate_grid(&grid, l, p).unwrap();
         for c in 0..4 {
-            assert!((direct[c] - interpolated[c]).abs() < 1e-5, "light {l}: {direct:?} vs {interpolated:?}");
+            assert!(
+                (direct[c] - interpolated[c]).abs() < 1e-5,
+                "light {l}: {direct:?} vs {interpolated:?}"
+            );
         }
     }
     assert_eq!(interpolate_grid(&grid, lights.len(), p), None);
@@ -376,10 +484,25 @@ fn the_grid_covers_the_hair_and_holds_every_light() {
 fn bad_settings_are_typed_errors() {
     let model = parallel_block(None);
     for s in [
-        ForwardScatteringSettings { coarse_factor: 0, ..Default::default() },
-        ForwardScatteringSettings { step_fraction: f32::NAN, ..Default::default() },
-        ForwardScatteringSettings { density_forward: 1.5, ..Default::default() },
-        ForwardScatteringSettings { voxels: VoxelSettings { voxels_longest_side: 0, default_diameter: None }, ..Default::default() },
+        ForwardScatteringSettings {
+            coarse_factor: 0,
+            ..Default::default()
+        },
+        ForwardScatteringSettings {
+            step_fraction: f32::NAN,
+            ..Default::default()
+        },
+        ForwardScatteringSettings {
+            density_forward: 1.5,
+            ..Default::default()
+        },
+        ForwardScatteringSettings {
+            voxels: VoxelSettings {
+                voxels_longest_side: 0,
+                default_diameter: None,
+            },
+            ..Default::default()
+        },
     ] {
         let err = CpuForwardScattering::new(&model, tables(), s).unwrap_err();
         println!("{err}");
@@ -392,7 +515,10 @@ fn light_sweep_matches_the_slab_closed_form() {
     let d = 0.15f32;
     let point = Vec3::new(4.0, 13.0, 6.0);
     let mu = d as f64 * 12.0;
-    let s = ForwardScatteringSettings { light_sweep: true, ..settings(8, 1, 0.05) };
+    let s = ForwardScatteringSettings {
+        light_sweep: true,
+        ..settings(8, 1, 0.05)
+    };
     let source = CpuForwardScattering::new(&parallel_block(Some(d)), tables(), s).unwrap();
     for (l, srbf_var) in [
         (EnvLight::directional(Vec3::X, [1.0; 3]), 0.0),
@@ -400,7 +526,11 @@ fn light_sweep_matches_the_slab_closed_form() {
     ] {
         let got = source.values_at(&l, &[point])[0];
         let (want, sigma) = poisson_closed_form(mu, srbf_var, 0.7);
-        println!("sweep: T_f {:?} σ̄_f {:.6}; closed form {want:.6?} σ̄ {sigma:.6}", &got[..3], got[3]);
+        println!(
+            "sweep: T_f {:?} σ̄_f {:.6}; closed form {want:.6?} σ̄ {sigma:.6}",
+            &got[..3],
+            got[3]
+        );
         for c in 0..3 {
             assert!((got[c] as f64 - want[c]).abs() < 1e-3, "channel {c}");
         }
@@ -411,7 +541,10 @@ fn light_sweep_matches_the_slab_closed_form() {
     let off_node = Vec3::new(5.3, 13.0, 6.0);
     let got = source.values_at(&EnvLight::directional(Vec3::X, [1.0; 3]), &[off_node])[0];
     let (want, _) = poisson_closed_form(d as f64 * (16.0 - 5.3), 0.0, 0.7);
-    println!("sweep between depth nodes: T_f {:?} vs closed form {want:.5?}", &got[..3]);
+    println!(
+        "sweep between depth nodes: T_f {:?} vs closed form {want:.5?}",
+        &got[..3]
+    );
     for c in 0..3 {
         assert!((got[c] as f64 - want[c]).abs() < 0.02, "channel {c}");
     }
@@ -426,8 +559,19 @@ fn light_sweep_agrees_with_per_point_marching_on_tangled_hair() {
     let light = EnvLight::directional(Vec3::new(0.3, -0.5, 0.8), [1.0; 3]);
     let probes: Vec<Vec3> = model.points().iter().step_by(97).copied().collect();
     let march = CpuForwardScattering::new(&model, tables(), settings(16, 4, 0.25)).unwrap();
-    let sweep = CpuForwardScattering::new(&model, tables(), ForwardScatteringSettings { light_sweep: true, ..settings(16, 4, 0.25) }).unwrap();
-    let (a, b) = (march.values_at(&light, &probes), sweep.values_at(&light, &probes));
+    let sweep = CpuForwardScattering::new(
+        &model,
+        tables(),
+        ForwardScatteringSettings {
+            light_sweep: true,
+            ..settings(16, 4, 0.25)
+        },
+    )
+    .unwrap();
+    let (a, b) = (
+        march.values_at(&light, &probes),
+        sweep.values_at(&light, &probes),
+    );
     let (mut sum, mut max, mut mean) = (0.0f64, 0.0f64, 0.0f64);
     for (x, y) in a.iter().zip(&b) {
         let dt = (x[0] - y[0]).abs() as f64;
@@ -436,7 +580,11 @@ fn light_sweep_agrees_with_per_point_marching_on_tangled_hair() {
         mean += x[0] as f64;
     }
     let rms = (sum / a.len() as f64).sqrt();
-    println!("{} probes: mean T_f(red) {:.4}, RMS |Δ| {rms:.4}, max {max:.4}", a.len(), mean / a.len() as f64);
+    println!(
+        "{} probes: mean T_f(red) {:.4}, RMS |Δ| {rms:.4}, max {max:.4}",
+        a.len(),
+        mean / a.len() as f64
+    );
     assert!(rms < 0.03 && max < 0.15);
 }
 
@@ -448,7 +596,10 @@ fn gpu_march_matches_the_cpu_march() {
     // recursion runs in f64 on the CPU and f32 on the GPU.
     let mut rng = Rng(4242);
     let model = tangled_hair(&mut rng, 200, 60, 0.2, 0.1);
-    let mut lights = vec![EnvLight::directional(Vec3::Z, [1.0; 3]), EnvLight::srbf(Vec3::X, 30.0, [1.0; 3])];
+    let mut lights = vec![
+        EnvLight::directional(Vec3::Z, [1.0; 3]),
+        EnvLight::srbf(Vec3::X, 30.0, [1.0; 3]),
+    ];
     while lights.len() < 18 {
         let d = Vec3::new(rng.unit() as f32, rng.unit() as f32, rng.unit() as f32) * 2.0 - 1.0;
         lights.push(match lights.len() % 2 {
@@ -458,10 +609,17 @@ fn gpu_march_matches_the_cpu_march() {
     }
     let gpu = crate::gpu::GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
     for include_direct in [true, false] {
-        let s = ForwardScatteringSettings { coarse_factor: 2, include_direct, ..settings(16, 2, 0.5) };
+        let s = ForwardScatteringSettings {
+            coarse_factor: 2,
+            include_direct,
+            ..settings(16, 2, 0.5)
+        };
         let cpu = CpuForwardScattering::new(&model, tables(), s).unwrap();
         let want = cpu.grid(&lights).unwrap();
-        let got = GpuForwardScattering::new(&gpu, cpu).unwrap().grid(&lights).unwrap();
+        let got = GpuForwardScattering::new(&gpu, cpu)
+            .unwrap()
+            .grid(&lights)
+            .unwrap();
         assert_eq!((got.dims, got.values.len()), (want.dims, want.values.len()));
         let (mut worst_t, mut worst_sigma, mut mean_t) = (0.0f32, 0.0f32, 0.0f32);
         for (g, w) in got.values.iter().zip(&want.values) {
@@ -476,7 +634,14 @@ fn gpu_march_matches_the_cpu_march() {
             want.values.len()
         );
         // The hair must matter: it takes light away from the direct paths and scatters some.
-        assert!(if include_direct { mean_t < 0.9 } else { mean_t > 0.05 }, "mean T_f {mean_t}");
+        assert!(
+            if include_direct {
+                mean_t < 0.9
+            } else {
+                mean_t > 0.05
+            },
+            "mean T_f {mean_t}"
+        );
         assert!(worst_t < 1e-4 && worst_sigma < 1e-4);
     }
 }
@@ -490,22 +655,50 @@ fn the_grid_and_its_paths_do_not_depend_on_the_thread_count() {
     let light = EnvLight::directional(Vec3::new(0.3, -0.5, 0.8), [1.0; 3]);
     let probes: Vec<Vec3> = model.points().iter().step_by(13).copied().collect();
     let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap().install(|| {
-            let volume = HairVolume::build(&model, &VoxelSettings { voxels_longest_side: 24, default_diameter: None }, 1.0).unwrap();
-            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            let mut out = bits(&volume.sigma_perp);
-            out.extend(bits(&volume.deviation));
-            out.extend(volume.mean_direction.iter().flat_map(|d| bits(&d.to_array())));
-            for light_sweep in [false, true] {
-                let grid = CpuForwardScattering::new(&model, tables(), ForwardScatteringSettings { light_sweep, ..settings(16, 4, 0.25) }).unwrap();
-                out.extend(grid.values_at(&light, &probes).iter().flat_map(|v| bits(v)));
-            }
-            out
-        })
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| {
+                let volume = HairVolume::build(
+                    &model,
+                    &VoxelSettings {
+                        voxels_longest_side: 24,
+                        default_diameter: None,
+                    },
+                    1.0,
+                )
+                .unwrap();
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                let mut out = bits(&volume.sigma_perp);
+                out.extend(bits(&volume.deviation));
+                out.extend(
+                    volume
+                        .mean_direction
+                        .iter()
+                        .flat_map(|d| bits(&d.to_array())),
+                );
+                for light_sweep in [false, true] {
+                    let grid = CpuForwardScattering::new(
+                        &model,
+                        tables(),
+                        ForwardScatteringSettings {
+                            light_sweep,
+                            ..settings(16, 4, 0.25)
+                        },
+                    )
+                    .unwrap();
+                    out.extend(grid.values_at(&light, &probes).iter().flat_map(|v| bits(v)));
+                }
+                out
+            })
     };
     let one = run(1);
     assert!(one.iter().any(|&b| b != 0), "the grid holds something");
     for threads in [2, 8] {
-        assert!(run(threads) == one, "{threads} threads give other bits than 1");
+        assert!(
+            run(threads) == one,
+            "{threads} threads give other bits than 1"
+        );
     }
 }

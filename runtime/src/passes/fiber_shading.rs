@@ -323,8 +323,16 @@ mod tests {
 
     #[test]
     fn lut_layout_is_checked_and_strides_are_row_major() {
-        let m = table([AXIS_SIN_THETA_I, AXIS_SIN_THETA_O, AXIS_QUANTITY], [5, 6, 4], 1);
-        let n = table([AXIS_COS_HALF_PHI, AXIS_COS_THETA_D, AXIS_LOBE], [7, 8, 3], 3);
+        let m = table(
+            [AXIS_SIN_THETA_I, AXIS_SIN_THETA_O, AXIS_QUANTITY],
+            [5, 6, 4],
+            1,
+        );
+        let n = table(
+            [AXIS_COS_HALF_PHI, AXIS_COS_THETA_D, AXIS_LOBE],
+            [7, 8, 3],
+            3,
+        );
         let luts = MarschnerLuts::new(m.clone(), n.clone()).unwrap();
         assert!(luts.half_phi);
         // The stride of each axis is the offset between neighbouring nodes.

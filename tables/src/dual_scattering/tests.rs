@@ -1,7 +1,7 @@
 #![allow(clippy::needless_range_loop)] // per-channel loops read best indexed in these checks
 use super::*;
-use crate::hard_case_sweep::SweepRng;
 use crate::artist::{ArtistModel, ArtistParams, Normalization, NormalizedArtist};
+use crate::hard_case_sweep::SweepRng;
 use crate::quadrature::{GaussLegendre, integrate_sphere};
 
 /// A toy fiber whose averages have closed forms: Gaussian M_p and

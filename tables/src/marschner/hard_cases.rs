@@ -6,9 +6,9 @@
 //!
 //! Public so that a benchmark mode can run it with 10⁸ samples; the unit test runs 10⁶.
 
-use crate::hard_case_sweep::SweepRng;
 use super::{Lobe, Marschner, MarschnerParams};
 use crate::angles::FiberAngles;
+use crate::hard_case_sweep::SweepRng;
 use crate::longitudinal::LongitudinalModel;
 use crate::scattering::ScatteringFunction;
 use std::f64::consts::{FRAC_PI_2, PI};

@@ -23,13 +23,13 @@
 //! a set of measure zero where the specular cone degenerates), so S stays finite everywhere.
 
 pub mod azimuth;
-pub mod params;
 mod hard_cases;
+pub mod params;
 #[cfg(test)]
 mod tests;
 
-pub use params::{MarschnerParams, elliptical_index, elliptical_indices};
 pub use hard_cases::{SweepReport, hard_case_sweep};
+pub use params::{MarschnerParams, elliptical_index, elliptical_indices};
 
 use crate::angles::FiberAngles;
 use crate::dual_scattering::LobeDecomposition;
@@ -123,7 +123,11 @@ impl Marschner {
 
     /// ½ for the energy-conserving normalization of M_p, 1 for Marschner's published one.
     pub fn energy_scale(&self) -> f64 {
-        if self.params.energy_conserving { 0.5 } else { 1.0 }
+        if self.params.energy_conserving {
+            0.5
+        } else {
+            1.0
+        }
     }
 
     /// N_p(θ_d, φ) per channel (units 1/rad), fibers of random orientation.
