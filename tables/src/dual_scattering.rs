@@ -467,7 +467,9 @@ pub fn backscatter_zinke_fit(
     (shift, (sigma * sigma).max(MIN_VARIANCE))
 }
 
-fn moments_from(avg: &FiberAverages, form: MomentsForm) -> BackscatterMoments {
+/// The backscatter moments of `avg` computed on demand (what the tabulated averages store),
+/// by the path series or Zinke's fit.
+pub fn moments_from(avg: &FiberAverages, form: MomentsForm) -> BackscatterMoments {
     let mut m = BackscatterMoments::default();
     for c in 0..3 {
         let args = (
@@ -767,6 +769,3 @@ pub fn forward_spread(theta_light: f64, theta_i: f64, phi: f64, forward_variance
         theta_i - theta_light,
     ) / (PI * theta_light.cos().max(MIN_COS_THETA_D))
 }
-
-#[cfg(test)]
-mod tests;

@@ -1,8 +1,15 @@
 #![allow(clippy::needless_range_loop)] // per-channel loops read best indexed in these checks
-use super::*;
-use crate::artist::{ArtistModel, ArtistParams, Normalization, NormalizedArtist};
-use crate::hard_case_sweep::SweepRng;
-use crate::quadrature::{GaussLegendre, integrate_sphere};
+//! Dual scattering's fiber averages, path series and BCSDF, checked on a toy fiber with closed
+//! forms and on the artist-friendly fiber (Sadeghi 2010) against brute-force integration. An
+//! integration test, so that `dual_scattering` itself depends on no fiber model.
+
+use std::f64::consts::{FRAC_PI_2, PI};
+use strandlight_tables::angles::FiberAngles;
+use strandlight_tables::artist::{ArtistModel, ArtistParams, Normalization, NormalizedArtist};
+use strandlight_tables::dual_scattering::*;
+use strandlight_tables::hard_case_sweep::SweepRng;
+use strandlight_tables::quadrature::{GaussLegendre, integrate_sphere};
+use strandlight_tables::scattering::{Rgb, ScatteringFunction};
 
 /// A toy fiber whose averages have closed forms: Gaussian M_p and
 /// N_p(θ_d, φ) = cos²θ_d · (front_p for |φ| > π/2, back_p otherwise), so S = Σ_p M_p(θ_h) ·
@@ -583,7 +590,7 @@ fn bcsdf_adds_density_weighted_backscattering() {
 fn peak_normalization_keeps_every_inclination_at_or_below_unit_attenuation() {
     let mut rng = SweepRng::new(77);
     let mut params = vec![ArtistParams::default()];
-    params.extend((0..2).map(|_| crate::artist::random_params(&mut rng)));
+    params.extend((0..2).map(|_| strandlight_tables::artist::random_params(&mut rng)));
     for p in params {
         let m = ArtistModel::new(p)
             .unwrap()
