@@ -2,11 +2,11 @@
 //! with `--directional N`). Parsing, progress and printing only; the work is in
 //! `strandlight_precompute`.
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use std::path::{Path, PathBuf};
-use strandlight_precompute::envmap_io::{self, LoadOptions};
-use strandlight_precompute::srbf_set::{Source, SrbfSet, unrotated};
-use strandlight_precompute::{FitOptions, preview, procedural_env};
+use strandlight_precompute::srbf_set::{SrbfSet, unrotated};
+use strandlight_precompute::{FitOptions, preview};
+use strandlight_scene::environment::load_env;
 
 #[derive(clap::Args)]
 pub struct FitArgs {
@@ -62,32 +62,8 @@ pub struct FitArgs {
 }
 
 pub fn run(args: FitArgs) -> anyhow::Result<()> {
-    let (map, name, sha256, sanitized) =
-        if let Some(proc_name) = args.envmap.strip_prefix("procedural:") {
-            let Some(map) = procedural_env::by_name(proc_name, 1024) else {
-                bail!(
-                    "unknown procedural environment {proc_name:?} (known: {})",
-                    procedural_env::NAMES.join(", ")
-                );
-            };
-            (map, args.envmap.clone(), String::new(), Default::default())
-        } else {
-            let path = Path::new(&args.envmap);
-            let loaded = envmap_io::load(
-                path,
-                LoadOptions {
-                    sanitize: args.sanitize,
-                },
-            )?;
-            if loaded.sanitized.total() > 0 {
-                eprintln!("{}: sanitized {}", path.display(), loaded.sanitized);
-            }
-            let name = path
-                .file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            (loaded.map, name, loaded.sha256, loaded.sanitized)
-        };
+    let env = load_env(&args.envmap, args.sanitize)?;
+    let (map, name) = (&env.map, env.name.clone());
     let options = FitOptions {
         initial_lobes: args.initial_lobes,
         max_lobes: args.max_lobes,
@@ -107,12 +83,7 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
         },
         ..FitOptions::default()
     };
-    let source = Source {
-        map: &map,
-        name: name.clone(),
-        sha256,
-        sanitized,
-    };
+    let source = env.source();
     let set = match args.directional {
         Some(n) => SrbfSet::directional(&source, n, &options),
         None => {
@@ -143,7 +114,7 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
     });
     set.save(&out)?;
     if let Some(png) = &args.preview {
-        preview::write_preview(&map, &unrotated(&set.lobes, args.rotate), 512, png)
+        preview::write_preview(map, &unrotated(&set.lobes, args.rotate), 512, png)
             .with_context(|| format!("writing {}", png.display()))?;
         eprintln!("preview: {} (tonemap: {})", png.display(), preview::TONEMAP);
     }
