@@ -301,16 +301,17 @@ impl HairVolume {
     }
 }
 
-/// One piece of fiber (at most half a voxel long) to add to a voxel's sums.
+/// The fiber length segment `segment` leaves in `voxel`: its pieces (at most half a voxel
+/// long) whose midpoints fall there, consecutive ones merged. 16 bytes: the segment's diameter
+/// and tangent are looked up again when the deposit is added.
 struct Deposit {
     voxel: u32,
+    segment: u32,
     length: f64,
-    diameter: f64,
-    tangent: DVec3,
 }
 
 /// Strands whose deposits are computed in parallel and then summed, per block: bounds the
-/// deposits held at once (tens of MB) while keeping the threads busy.
+/// deposits held at once (a few MB) while keeping the threads busy.
 const STRANDS_PER_BLOCK: usize = 4096;
 
 /// Per-voxel sums of every strand's pieces. The pieces are cut in parallel but added in strand
@@ -322,51 +323,58 @@ fn accumulate(model: &HairModel, grid: &VoxelGrid, default_diameter: f32) -> Vec
         let block = block_start..(block_start + STRANDS_PER_BLOCK).min(strands);
         let deposits: Vec<Vec<Deposit>> = block
             .into_par_iter()
-            .map(|s| strand_deposits(model, s, grid, default_diameter))
+            .map(|s| strand_deposits(model, s, grid))
             .collect();
         for d in deposits.iter().flatten() {
-            sums[d.voxel as usize].deposit(d.length, d.diameter, d.tangent);
+            let (diameter, tangent) = segment_fiber(model, d.segment as usize, default_diameter);
+            sums[d.voxel as usize].deposit(d.length, diameter, tangent);
         }
     }
     sums
 }
 
+/// Diameter and unit tangent of the segment from point `i` to `i + 1` (not of zero length).
+fn segment_fiber(model: &HairModel, i: usize, default_diameter: f32) -> (f64, DVec3) {
+    let points = model.points();
+    let diameter = match model.thickness() {
+        Some(t) => 0.5 * (t.at(i) as f64 + t.at(i + 1) as f64),
+        None => default_diameter as f64,
+    };
+    (
+        diameter,
+        (points[i + 1].as_dvec3() - points[i].as_dvec3()).normalize(),
+    )
+}
+
 /// Strand `s` cut into pieces of at most half a voxel, each deposited in the voxel of its
 /// midpoint.
-fn strand_deposits(
-    model: &HairModel,
-    s: usize,
-    grid: &VoxelGrid,
-    default_diameter: f32,
-) -> Vec<Deposit> {
+fn strand_deposits(model: &HairModel, s: usize, grid: &VoxelGrid) -> Vec<Deposit> {
     let max_piece = 0.5 * grid.voxel_size as f64;
     let offsets = model.strand_offsets();
     let points = model.points();
-    let thickness = model.thickness();
     let (start, end) = (offsets[s] as usize, offsets[s + 1] as usize);
-    let mut out = Vec::new();
+    let mut out: Vec<Deposit> = Vec::with_capacity(end - start);
     for i in start..end.saturating_sub(1) {
         let (a, b) = (points[i].as_dvec3(), points[i + 1].as_dvec3());
         let length = (b - a).length();
         if !(length > 0.0) {
             continue; // zero-length segment: no fiber to shadow anything
         }
-        let diameter = match thickness {
-            Some(t) => 0.5 * (t.at(i) as f64 + t.at(i + 1) as f64),
-            None => default_diameter as f64,
-        };
-        let tangent = (b - a) / length;
         let pieces = (length / max_piece).ceil().max(1.0) as usize;
         let piece = length / pieces as f64;
         for k in 0..pieces {
             let mid = a + (b - a) * ((k as f64 + 0.5) / pieces as f64);
             let voxel = grid.voxel_clamped(mid.as_vec3()) as u32;
-            out.push(Deposit {
-                voxel,
-                length: piece,
-                diameter,
-                tangent,
-            });
+            match out.last_mut() {
+                Some(last) if last.voxel == voxel && last.segment == i as u32 => {
+                    last.length += piece
+                }
+                _ => out.push(Deposit {
+                    voxel,
+                    segment: i as u32,
+                    length: piece,
+                }),
+            }
         }
     }
     out
