@@ -38,15 +38,8 @@ pub enum ForwardScatteringError {
         value: String,
         problem: String,
     },
-    #[error(
-        "GPU limit exceeded: {what} needs {bytes} (bytes or workgroups); this adapter allows at \
-         most {limit} (lower voxels_longest_side or raise coarse_factor)"
-    )]
-    GpuLimit {
-        what: &'static str,
-        bytes: u64,
-        limit: u64,
-    },
+    #[error(transparent)]
+    Limit(#[from] crate::gpu::LimitError),
     #[error("the GPU march failed: {0}")]
     Gpu(String),
 }

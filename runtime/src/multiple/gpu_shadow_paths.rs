@@ -16,7 +16,7 @@ use super::forward_scattering::CpuForwardScattering;
 use super::shadow_paths::{LightMedium, light_direction};
 use crate::env::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource};
 use crate::gpu::bind_layout::{storage_entry, uniform_entry};
-use crate::gpu::{GpuContext, read_buffer};
+use crate::gpu::{GpuContext, GpuLimits, read_buffer};
 
 const WORKGROUP_SIZE: u32 = 64;
 /// Two vec4 per voxel per light (see the shader's layout).
@@ -64,38 +64,38 @@ impl<'g> GpuForwardScattering<'g> {
                     .into(),
             });
         }
-        let limits = gpu.device.limits();
-        let binding_limit = limits
-            .max_storage_buffer_binding_size
-            .min(limits.max_buffer_size);
+        let limits = GpuLimits::of(gpu);
         let voxels = cpu.volume().grid.voxel_count() as u64;
         let per_light = voxels * MEDIUM_BYTES_PER_VOXEL;
+        limits.check_storage_buffer("one light's voxel medium", per_light, |max| {
+            format!(
+                "use at most {} voxels (a smaller voxels_longest_side)",
+                max / MEDIUM_BYTES_PER_VOXEL
+            )
+        })?;
         let samples = cpu.sample_grid().vertex_count() as u64;
         let output_per_light = samples * 16;
-        if per_light > binding_limit || output_per_light > binding_limit {
-            return Err(ForwardScatteringError::GpuLimit {
-                what: if per_light > binding_limit {
-                    "one light's voxel medium"
-                } else {
-                    "one light's sample values"
-                },
-                bytes: per_light.max(output_per_light),
-                limit: binding_limit,
-            });
-        }
+        limits.check_storage_buffer("one light's sample values", output_per_light, |max| {
+            format!(
+                "use at most {} sample-grid vertices (a larger coarse_factor)",
+                max / 16
+            )
+        })?;
         let groups = samples.div_ceil(WORKGROUP_SIZE as u64);
-        if groups > limits.max_compute_workgroups_per_dimension as u64 {
-            return Err(ForwardScatteringError::GpuLimit {
-                what: "workgroups for the sample grid",
-                bytes: groups,
-                limit: limits.max_compute_workgroups_per_dimension as u64,
-            });
-        }
-        let fit =
-            (binding_limit / per_light.max(output_per_light)).min(MAX_LIGHTS_PER_DISPATCH as u64);
-        let lights_per_dispatch = (fit as u32)
-            .min(limits.max_compute_workgroups_per_dimension)
-            .max(1);
+        let max_groups = limits.limits().max_compute_workgroups_per_dimension;
+        limits.check_workgroups(
+            "the sample grid's march",
+            [u32::try_from(groups).unwrap_or(u32::MAX), 1, 1],
+            |max| {
+                format!(
+                    "use at most {} sample-grid vertices (a larger coarse_factor)",
+                    max as u64 * WORKGROUP_SIZE as u64
+                )
+            },
+        )?;
+        let fit = (limits.max_storage_bytes() / per_light.max(output_per_light))
+            .min(MAX_LIGHTS_PER_DISPATCH as u64);
+        let lights_per_dispatch = (fit as u32).min(max_groups).max(1);
         let points: Vec<[f32; 4]> = cpu
             .sample_points()
             .iter()
