@@ -9,13 +9,13 @@
 
 use serde::Serialize;
 use serde_json::{Value, json};
-use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 use strandlight_tables::asset::{
     AssetDescription, AssetError, CreationInfo, Generator, Storage, read_asset,
     read_asset_metadata, write_asset,
 };
+use strandlight_tables::checksum::sha256_hex;
 use strandlight_tables::table::Table;
 use thiserror::Error;
 
@@ -115,10 +115,7 @@ impl TableJob {
             "settings": self.settings,
             "generator": env!("CARGO_PKG_VERSION"),
         });
-        Sha256::digest(inputs.to_string().as_bytes())
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect()
+        sha256_hex(inputs.to_string().as_bytes())
     }
 }
 
