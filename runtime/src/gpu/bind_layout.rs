@@ -105,3 +105,16 @@ pub fn bind_group(
         entries: &entries,
     })
 }
+
+/// A pipeline layout of bind groups `groups` (None: a group the pipeline does not use).
+pub fn pipeline_layout(
+    device: &wgpu::Device,
+    label: &str,
+    groups: &[Option<&wgpu::BindGroupLayout>],
+) -> wgpu::PipelineLayout {
+    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: groups,
+        immediate_size: 0,
+    })
+}

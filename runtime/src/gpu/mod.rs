@@ -4,6 +4,7 @@ pub mod bind_layout;
 pub mod device;
 pub mod limits;
 pub mod readback;
+pub mod texture;
 
 pub use device::{AdapterReport, DeviceError, GpuContext};
 pub use limits::{GpuLimits, LimitError};

@@ -12,11 +12,13 @@
 //! Output: [`ABufferFrame`].
 
 use super::attachments::{cleared_color, cleared_depth};
+use crate::gpu::texture::texture_2d;
 use wgpu::util::DeviceExt;
 
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{
-    bind_group, depth_texture_entry, float_texture_entry, storage_entry, uniform_entry,
+    bind_group, depth_texture_entry, float_texture_entry, pipeline_layout, storage_entry,
+    uniform_entry,
 };
 use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels, fit_within};
 use crate::gpu::readback::{ReadbackError, read_buffer};
@@ -146,18 +148,6 @@ impl ABufferLayouts {
             ),
         }
     }
-}
-
-fn pipeline_layout(
-    device: &wgpu::Device,
-    label: &str,
-    groups: &[Option<&wgpu::BindGroupLayout>],
-) -> wgpu::PipelineLayout {
-    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: groups,
-        immediate_size: 0,
-    })
 }
 
 /// Depth-tested and written: the DBK prepass and its opaque fallback.
@@ -449,16 +439,13 @@ impl ABufferResources {
 }
 
 fn nearest_depth_texture(gpu: &GpuContext, size: wgpu::Extent3d) -> wgpu::Texture {
-    gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("dbk nearest depth"),
+    texture_2d(
+        gpu,
+        "dbk nearest depth",
         size,
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: DEPTH_FORMAT,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        view_formats: &[],
-    })
+        DEPTH_FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+    )
 }
 
 /// The image's textures, the three per-pixel/per-node storage buffers and the resolve's

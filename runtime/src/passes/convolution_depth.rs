@@ -20,6 +20,7 @@ use super::strand_quads::{strand_bind_group_layout, strand_bind_group_scaled};
 use crate::camera::{Camera, Projection, light_camera};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{depth_texture_entry, uniform_entry};
+use crate::gpu::texture::texture_2d;
 use crate::hair::{Aabb, HairModel};
 
 /// The largest DODM side the SAT's u32 fixed point is specified for (see `summed_area`).
@@ -199,18 +200,7 @@ impl DodmBatch {
             height: resolution,
             depth_or_array_layers: slots.max(1),
         };
-        let texture = |label, format, usage| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let texture = |label, format, usage| texture_2d(gpu, label, size, format, usage);
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         Self {
             resolution,

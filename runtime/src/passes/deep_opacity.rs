@@ -17,6 +17,7 @@ use crate::camera::Camera;
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{depth_texture_entry, uniform_entry};
 use crate::gpu::readback::{ReadbackError, read_texture_rgba};
+use crate::gpu::texture::texture_2d;
 
 /// At most this many layers (two RGBA targets).
 pub const MAX_LAYERS: u32 = 8;
@@ -79,18 +80,7 @@ impl DeepOpacityMap {
             height: settings.resolution,
             depth_or_array_layers: 1,
         };
-        let texture = |label, format, usage| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let texture = |label, format, usage| texture_2d(gpu, label, size, format, usage);
         let layer_usage = wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;

@@ -23,7 +23,10 @@ use super::transmittance_filter::TransmittanceFilter;
 use super::view_visibility::{OccupancyMap, ViewTransparency, ViewVisibilityPass};
 use crate::env::{EnvLight, ForwardScatteringGrid};
 use crate::gpu::GpuContext;
-use crate::gpu::bind_layout::{float_texture_entry, storage_entry, texture_entry, uniform_entry};
+use crate::gpu::bind_layout::{
+    float_texture_entry, pipeline_layout, storage_entry, texture_entry, uniform_entry,
+};
+use crate::gpu::texture::texture_2d;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -415,18 +418,7 @@ impl EnvViewTargets {
             height,
             depth_or_array_layers: 1,
         };
-        let texture = |label, format, usage| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let texture = |label, format, usage| texture_2d(gpu, label, size, format, usage);
         let color = wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
@@ -438,9 +430,10 @@ impl EnvViewTargets {
                 DEPTH_FORMAT,
                 wgpu::TextureUsages::RENDER_ATTACHMENT,
             ),
-            coverage: gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("env coverage"),
-                size: match transparency {
+            coverage: texture_2d(
+                gpu,
+                "env coverage",
+                match transparency {
                     ViewTransparency::Opaque => size,
                     ViewTransparency::Occupancy { .. } => wgpu::Extent3d {
                         width: 1,
@@ -448,14 +441,9 @@ impl EnvViewTargets {
                         depth_or_array_layers: 1,
                     },
                 },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: gpu.hdr_format(),
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT
-                    | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            }),
+                gpu.hdr_format(),
+                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            ),
         }
     }
 
@@ -544,18 +532,6 @@ impl EnvViewLayouts {
             ),
         }
     }
-}
-
-fn pipeline_layout(
-    device: &wgpu::Device,
-    label: &str,
-    groups: &[Option<&wgpu::BindGroupLayout>],
-) -> wgpu::PipelineLayout {
-    device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: groups,
-        immediate_size: 0,
-    })
 }
 
 /// The view and visibility passes share one module, so that both rasterize bit-identical

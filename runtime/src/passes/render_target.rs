@@ -1,6 +1,7 @@
 //! The colour and depth textures a strand pass draws into.
 
 use crate::gpu::GpuContext;
+use crate::gpu::texture::texture_2d;
 
 /// An HDR colour texture and its depth buffer.
 pub struct RenderTarget {
@@ -17,18 +18,7 @@ impl RenderTarget {
             height,
             depth_or_array_layers: 1,
         };
-        let texture = |label, format, usage| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size,
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let texture = |label, format, usage| texture_2d(gpu, label, size, format, usage);
         Self {
             color: texture(
                 "hdr colour",
