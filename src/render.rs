@@ -1,44 +1,25 @@
 //! `strandlight render`: one headless frame of a hair model under point lights, written as a
 //! linear EXR and a tonemapped PNG, with timings and GPU memory on request.
 
-use anyhow::{Context, bail};
-use clap::{Args, ValueEnum};
+use anyhow::bail;
+use clap::Args;
 use std::path::{Path, PathBuf};
-use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
-use strandlight_runtime::camera::UpAxis;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
-use strandlight_runtime::lights::Light;
-use strandlight_runtime::passes::deep_opacity::DomSettings;
-use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{self, RenderOptions, render_frame_with_model};
 use strandlight_scene::camera_choice::{CameraChoice, CameraKind, UpChoice};
-use strandlight_scene::env_frame::{EnvFrame, FrameRole, light_summary, render_lights};
-use strandlight_scene::env_scene::{EnvSceneRequest, prepare_env_scene};
-use strandlight_scene::environment::load_env;
-use strandlight_scene::hair_input::{load_hair, parse_size};
-use strandlight_scene::look::{EnvLook, EnvTransparency, LookArgs};
-use strandlight_scene::point_shading::{PointShadingRequest, Shading, point_shading_model};
-use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
+use strandlight_scene::env_frame::{light_summary, render_lights};
+use strandlight_scene::frame_render::{
+    env_frame, env_look, frame_lights, load_settings_hair, prepare_env, prepare_point, render_point,
+};
+use strandlight_scene::frame_settings::{
+    CameraSettings, DEFAULT_LIGHT, EnvLighting, FrameSettings, Lighting, PointLighting, Shadows,
+    Transparency,
+};
+use strandlight_scene::hair_input::parse_size;
+use strandlight_scene::look::{EnvLook, EnvTransparency};
+use strandlight_scene::point_shading::{Shading, read_artist_params};
+use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
-
-#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
-pub enum Shadows {
-    None,
-    Dom,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, ValueEnum)]
-pub enum Transparency {
-    None,
-    Abuffer,
-    Dbk,
-    /// With --env only: every fiber weighted by its visibility through an occupancy map.
-    Occupancy,
-}
-
-/// The default light when none is given: from the upper right front.
-const DEFAULT_LIGHT: &str = "directional:0.5,0.7,1:2";
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -62,6 +43,16 @@ pub struct RenderArgs {
     /// With --env: fraction of the strands drawn into the light maps (Ren §7; 1 = all).
     #[arg(long, default_value_t = 0.1)]
     pub kappa: f32,
+    /// With --env: only the N most powerful SRBF lobes (a fit's compact sources are kept).
+    #[arg(long)]
+    lobes: Option<usize>,
+    /// With --env: the environment turned about the hair's up axis, degrees (the fitted lobes
+    /// are rotated exactly; nothing is refitted).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    env_rotation: f32,
+    /// With --env: convolution optical depth map resolution (square).
+    #[arg(long, default_value_t = 512)]
+    dodm_size: u32,
     /// Melanin preset of the Marschner fiber (--shading marschner): dark, brown, blonde, ...
     #[arg(long, default_value = "brown")]
     preset: String,
@@ -109,6 +100,10 @@ pub struct RenderArgs {
     /// Every fiber this many pixels wide (default: the file's thickness, projected).
     #[arg(long)]
     fiber_width_px: Option<f32>,
+    /// Render exactly the settings of this JSON file (the sidecar of a viewer screenshot)
+    /// instead of the flags above; --out and --json still apply.
+    #[arg(long, value_name = "SETTINGS_JSON")]
+    replay: Option<PathBuf>,
     /// Output stem: writes STEM.exr (linear) and STEM.png (tonemapped).
     #[arg(long, default_value = "render")]
     out: PathBuf,
@@ -150,90 +145,92 @@ fn camera_choice(args: &RenderArgs) -> anyhow::Result<CameraChoice> {
     })
 }
 
-pub fn run(args: RenderArgs) -> anyhow::Result<()> {
-    if let Some(env) = args.env.clone() {
-        return run_env(&args, &env);
-    }
-    let (shading, shading_description) = point_shading_model(&PointShadingRequest {
-        shading: args.shading.unwrap_or(Shading::KajiyaKay),
-        preset: &args.preset,
-        lut_size: args.lut_size,
-        artist_params: args.artist_params.as_deref(),
-    })?;
-    let transparency = match args.transparency {
-        Transparency::None => render::Transparency::Opaque,
-        Transparency::Abuffer => render::Transparency::ABuffer {
-            nodes_per_pixel: args.abuffer_nodes_per_pixel,
-        },
-        Transparency::Dbk => render::Transparency::Dbk {
-            nodes_per_pixel: args.abuffer_nodes_per_pixel,
-            delta: args.dbk_delta.unwrap_or(0.0),
-        },
-        Transparency::Occupancy => bail!(
-            "--transparency occupancy is the view of --env (environment lighting); with point lights use none, abuffer or dbk"
-        ),
-    };
+/// The frame the flags describe.
+fn settings_from_args(args: &RenderArgs) -> anyhow::Result<FrameSettings> {
     let (width, height) = parse_size(&args.size)?;
-    if let Some(w) = args.fiber_width_px
-        && !(w.is_finite() && w > 0.0)
-    {
-        bail!("--fiber-width-px {w}: must be a positive number of pixels");
-    }
-    let lights = args
-        .lights
-        .iter()
-        .map(|s| Light::parse(s))
-        .collect::<Result<Vec<_>, _>>()?;
-    if let Some(d) = args.dbk_delta
-        && !(d.is_finite() && d >= 0.0)
-    {
-        bail!("--dbk-delta {d}: must be a non-negative number of world units");
-    }
-    let (model, source) = load_hair(args.hair.as_deref())?;
-    let transparency = match transparency {
-        render::Transparency::Dbk {
-            nodes_per_pixel, ..
-        } => render::Transparency::Dbk {
-            nodes_per_pixel,
-            delta: args.dbk_delta.unwrap_or(model.bounds().diagonal() * 0.05),
-        },
-        other => other,
-    };
-    let gpu = GpuContext::new_headless()?;
-    let camera = camera_choice(&args)?.camera(&model, width as f32 / height as f32)?;
-    let frame = FrameParams {
-        camera,
-        width,
-        height,
-        lights,
-        shading: KajiyaKay::default(),
-        width_override_px: args.fiber_width_px,
-    };
-    let shadows = match args.shadows {
-        Shadows::None => None,
-        Shadows::Dom => Some(DomSettings {
-            resolution: args.dom_size,
-            layers: args.dom_layers,
-            spacing: args.dom_spacing.unwrap_or(model.bounds().diagonal() * 0.01),
+    let lighting = match &args.env {
+        Some(map) => {
+            if matches!(args.transparency, Transparency::Abuffer | Transparency::Dbk)
+                || args.shadows != Shadows::None
+            {
+                bail!(
+                    "--env shadows every SRBF light with its convolution optical depth map and renders opaque (none) or through an occupancy map (occupancy); --shadows, --transparency abuffer/dbk apply to point lights only"
+                );
+            }
+            Lighting::Environment(EnvLighting {
+                scattering: args.scattering,
+                kappa: args.kappa,
+                lobes: args.lobes,
+                rotation_deg: args.env_rotation,
+                dodm_size: args.dodm_size,
+                transparency: match args.transparency {
+                    Transparency::Occupancy => EnvTransparency::Occupancy,
+                    _ => EnvTransparency::Opaque,
+                },
+                view: args.env_view,
+                ..EnvLighting::new(map.clone())
+            })
+        }
+        None => Lighting::Lights(PointLighting {
+            lights: args.lights.clone(),
+            shadows: args.shadows,
+            transparency: args.transparency,
+            dom_layers: args.dom_layers,
+            dom_spacing: args.dom_spacing,
+            dom_size: args.dom_size,
+            abuffer_nodes_per_pixel: args.abuffer_nodes_per_pixel,
+            dbk_delta: args.dbk_delta,
+            lut_size: args.lut_size,
         }),
     };
-    let rendered = render_frame_with_model(
-        &gpu,
-        &model,
-        &frame,
-        &RenderOptions {
-            shadows,
-            transparency,
-        },
-        &shading,
-    )?;
+    Ok(FrameSettings {
+        hair: args.hair.clone(),
+        size: [width, height],
+        camera: CameraSettings::Framed(camera_choice(args)?),
+        shading: args.shading,
+        preset: args.preset.clone(),
+        artist: args
+            .artist_params
+            .as_deref()
+            .map(read_artist_params)
+            .transpose()?,
+        fiber_width_px: args.fiber_width_px,
+        lighting,
+    })
+}
+
+pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+    let settings = match &args.replay {
+        Some(path) => FrameSettings::read(path)?,
+        None => settings_from_args(&args)?,
+    };
+    settings.check()?;
+    match &settings.lighting {
+        Lighting::Lights(point) => run_point(&args, &settings, point),
+        Lighting::Environment(env) => run_env(&args, &settings, env),
+    }
+}
+
+fn run_point(
+    args: &RenderArgs,
+    settings: &FrameSettings,
+    point: &PointLighting,
+) -> anyhow::Result<()> {
+    let prepared = prepare_point(settings, point)?;
+    let hair = load_settings_hair(settings)?;
+    let (model, source) = (&hair.model, &hair.source);
+    let gpu = GpuContext::new_headless()?;
+    let rendered = render_point(&gpu, settings, point, model, &prepared, settings.size)?;
+    let [width, height] = settings.size;
+    let shading_description = &prepared.description;
     let stem = output_stem(&args.out);
     let exr_path = stem.with_extension("exr");
     let png_path = stem.with_extension("png");
     let description = format!(
-        "{source}; {width}x{height}; {shading_description}; shadows {shadows:?}; lights {}; camera {:?}",
-        args.lights.join(" "),
-        args.camera
+        "{source}; {width}x{height}; {shading_description}; shadows {:?}; lights {}; camera {:?}",
+        point.shadows,
+        point.lights.join(" "),
+        settings.camera
     );
     write_exr(&exr_path, width, height, &rendered.pixels, &description)?;
     write_png(&png_path, width, height, &rendered.pixels, &description)?;
@@ -290,73 +287,32 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
 }
 
 /// `render --env MAP`: the SRBF path alone (fit and tables cached under out/cache).
-fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
-    let shading = match args.shading.unwrap_or(Shading::Marschner) {
-        Shading::Marschner => EnvShading::Marschner,
-        Shading::Artist => EnvShading::Artist,
-        Shading::KajiyaKay => bail!(
-            "--shading kajiya-kay with --env: the env renderer reads one RGB 4D table (Marschner I_M or the artist I_A); use --shading marschner or artist"
-        ),
-    };
-    if matches!(args.transparency, Transparency::Abuffer | Transparency::Dbk)
-        || args.shadows != Shadows::None
-    {
-        bail!(
-            "--env shadows every SRBF light with its convolution optical depth map and renders opaque (none) or through an occupancy map (occupancy); --shadows, --transparency abuffer/dbk apply to point lights only"
-        );
-    }
-    let look_args = LookArgs {
-        transparency: if args.transparency == Transparency::Occupancy {
-            EnvTransparency::Occupancy
-        } else {
-            EnvTransparency::Opaque
-        },
-        view: args.env_view,
-    };
+fn run_env(args: &RenderArgs, settings: &FrameSettings, env: &EnvLighting) -> anyhow::Result<()> {
     let look = EnvLook {
         count_fragments: args.json,
-        ..look_args.look()?
+        ..env_look(env)?
     };
-    let (width, height) = parse_size(&args.size)?;
     let mut steps = Steps::new(args.json);
-    let (model, source) = steps.run(
+    let hair = steps.run(
         "hair",
-        || load_hair(args.hair.as_deref()),
-        |(m, s)| format!("{s} ({} strands)", m.strand_count()),
+        || load_settings_hair(settings),
+        |h| format!("{} ({} strands)", h.source, h.model.strand_count()),
     )?;
-    let env = steps.run(
-        "environment",
-        || load_env(env_spec, false),
-        |e| format!("{} {}x{}", e.name, e.map.width(), e.map.height()),
+    let (model, source) = (&hair.model, &hair.source);
+    let prepared = prepare_env(
+        settings,
+        env,
+        model,
+        Path::new("out/cache"),
+        &mut steps,
+        &mut |_| {},
     )?;
-    let fiber = FiberDescription::preset(&args.preset)
-        .with_context(|| format!("--preset {:?}", args.preset))?;
-    let table_set = format!("{}-{:?}", args.preset, shading).to_lowercase();
-    let request = EnvSceneRequest {
-        env: &env,
-        fiber: &fiber,
-        shading,
-        scattering: args.scattering,
-        resolution: BakeResolution::default(),
-        cache_dir: Path::new("out/cache"),
-        table_set: &table_set,
-        up: UpAxis::detect(&model),
-    };
-    let scene = prepare_env_scene(&request, &mut steps)?;
-    let (lights, mode) = (&scene.lights, scene.mode);
-    let camera = camera_choice(args)?.camera(&model, width as f32 / height as f32)?;
-    let frame = EnvFrame {
-        hair: &model,
-        camera,
-        width,
-        height,
-        lights,
-        tables: &scene.tables,
-        shading,
-        mode,
-        role: FrameRole::Interactive { kappa: args.kappa },
-        look,
-    };
+    let lights = &frame_lights(&prepared, env);
+    let mode = prepared.scene.mode;
+    let frame = env_frame(settings, env, model, &prepared, lights, settings.size, look)?;
+    let [width, height] = settings.size;
+    let (env_spec, shading) = (&env.map, prepared.shading);
+    let look_args = env.look_args();
     let rendered = steps.run(
         "render",
         || render_lights(&frame),
@@ -374,7 +330,7 @@ fn run_env(args: &RenderArgs, env_spec: &str) -> anyhow::Result<()> {
     let description = format!(
         "{source}; {width}x{height}; env {env_spec}, {}; {shading:?} ({}), {} scattering",
         light_summary(lights),
-        args.preset,
+        settings.preset,
         mode.name()
     );
     let image = &rendered.image;

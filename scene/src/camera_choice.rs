@@ -4,8 +4,9 @@ use anyhow::Context;
 use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::hair::HairModel;
 
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
 pub enum CameraKind {
     #[default]
     Perspective,
@@ -13,8 +14,9 @@ pub enum CameraKind {
 }
 
 /// The hair file's up axis.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
 pub enum UpChoice {
     /// Z when the strands hang along −z (Yuksel's .hair files), else Y.
     #[default]
@@ -33,7 +35,7 @@ impl UpChoice {
     }
 }
 
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CameraChoice {
     pub kind: CameraKind,
     pub up: UpChoice,

@@ -135,6 +135,7 @@ fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
         transparency: look.transparency,
         box_average: look.box_average,
         count_fragments: look.count_fragments,
+        dodm: look.dodm,
         ..EnvRenderOptions::default()
     }
 }

@@ -41,8 +41,30 @@ pub struct EnvScene {
     pub mode: ScatteringMode,
 }
 
+/// How far [`prepare_env_scene_reporting`] is, for a progress bar.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PrepareProgress {
+    Fitting,
+    /// `done` of `total` tables baked (or found in the cache); `table` the last one.
+    Baking {
+        done: usize,
+        total: usize,
+        table: String,
+    },
+}
+
 /// Fits (cached), bakes (cached) and places the lights, reporting each as a step.
 pub fn prepare_env_scene(request: &EnvSceneRequest, steps: &mut Steps) -> anyhow::Result<EnvScene> {
+    prepare_env_scene_reporting(request, steps, &mut |_| {})
+}
+
+/// [`prepare_env_scene`], telling `progress` about the fit and every table as it completes.
+pub fn prepare_env_scene_reporting(
+    request: &EnvSceneRequest,
+    steps: &mut Steps,
+    progress: &mut dyn FnMut(PrepareProgress),
+) -> anyhow::Result<EnvScene> {
+    progress(PrepareProgress::Fitting);
     let fit = steps.run(
         "fit",
         || fit_cached(request.env, &FitOptions::default(), request.cache_dir),
@@ -68,6 +90,8 @@ pub fn prepare_env_scene(request: &EnvSceneRequest, steps: &mut Steps) -> anyhow
     );
     let lambda_range = lambda_range_of_set(&fit.set)?;
     let dir = request.cache_dir.join("tables").join(request.table_set);
+    let total = wanted.len();
+    let mut done = 0;
     let tables = steps.run(
         "bake",
         || {
@@ -78,7 +102,14 @@ pub fn prepare_env_scene(request: &EnvSceneRequest, steps: &mut Steps) -> anyhow
                 lambda_range,
                 &wanted,
                 &dir,
-                &mut |_| {},
+                &mut |t| {
+                    done += 1;
+                    progress(PrepareProgress::Baking {
+                        done,
+                        total,
+                        table: t.name.clone(),
+                    })
+                },
             )
         },
         |t| {

@@ -14,6 +14,8 @@ pub mod env_scene;
 pub mod environment;
 pub mod equal_time;
 pub mod fit_cache;
+pub mod frame_render;
+pub mod frame_settings;
 pub mod hair_input;
 pub mod image_metrics;
 pub mod look;

@@ -4,9 +4,10 @@
 
 use anyhow::Context;
 use strandlight_runtime::env::{BoxAverage, ViewTransparency};
+use strandlight_runtime::passes::convolution_depth::DodmSettings;
 
 /// What the view shows of each pixel's fibers (Ren §8).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum EnvTransparency {
@@ -17,7 +18,7 @@ pub enum EnvTransparency {
 }
 
 /// Where the forward-scattering shadow paths are marched (Ren §6).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum ForwardDevice {
@@ -30,7 +31,7 @@ pub enum ForwardDevice {
 }
 
 /// What the effective transmittance's box averages (the CLI's names for [`BoxAverage`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum BoxAverageArg {
@@ -58,7 +59,7 @@ pub struct LookArgs {
 
 /// The env-lit renderer's choices besides the transparency (which `render` names its own way,
 /// sharing `--transparency` with the point-light renderer).
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::Args))]
 pub struct ViewArgs {
     /// With occupancy: fragments seen less than this fraction are not shaded (early termination).
@@ -121,6 +122,7 @@ impl LookArgs {
             box_average,
             count_fragments: false,
             forward_scattering: view.forward_scattering,
+            dodm: DodmSettings::default(),
         })
     }
 }
@@ -136,4 +138,6 @@ pub struct EnvLook {
     /// Count the fragments rasterized and shaded (two extra passes, outside the frame time).
     pub count_fragments: bool,
     pub forward_scattering: ForwardDevice,
+    /// Light-pass map resolution and lights per batch.
+    pub dodm: DodmSettings,
 }

@@ -10,8 +10,9 @@ use strandlight_runtime::passes::frame_params::KajiyaKay;
 use strandlight_tables::artist::{ArtistModel, ArtistParams};
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
 pub enum Shading {
     KajiyaKay,
     Marschner,
@@ -25,8 +26,8 @@ pub struct PointShadingRequest<'a> {
     pub preset: &'a str,
     /// Nodes per axis of the Marschner lookup textures.
     pub lut_size: usize,
-    /// JSON artist controls; None: the built-in defaults.
-    pub artist_params: Option<&'a Path>,
+    /// Artist controls; None: the built-in defaults.
+    pub artist: Option<ArtistParams>,
 }
 
 /// The model and a line describing it. Errors name the setting at fault (`--preset`,
@@ -40,7 +41,7 @@ pub fn point_shading_model(
             format!("Kajiya-Kay {:?}", KajiyaKay::default()),
         )),
         Shading::Marschner => marschner_luts(request.preset, request.lut_size),
-        Shading::Artist => artist(request.artist_params),
+        Shading::Artist => artist(request.artist),
     }
 }
 
@@ -62,18 +63,22 @@ fn marschner_luts(preset: &str, lut_size: usize) -> anyhow::Result<(ShadingModel
     ))
 }
 
-fn artist(params_file: Option<&Path>) -> anyhow::Result<(ShadingModel, String)> {
-    let (params, from) = match params_file {
-        None => (ArtistParams::default(), "default controls".to_string()),
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("--artist-params {}", path.display()))?;
-            let params: ArtistParams = serde_json::from_str(&text)
-                .with_context(|| format!("--artist-params {}", path.display()))?;
-            (params, path.display().to_string())
-        }
+/// Artist controls from a JSON file (`--artist-params`), errors naming the file.
+pub fn read_artist_params(path: &Path) -> anyhow::Result<ArtistParams> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("--artist-params {}", path.display()))?;
+    let params: ArtistParams = serde_json::from_str(&text)
+        .with_context(|| format!("--artist-params {}", path.display()))?;
+    ArtistModel::new(params).with_context(|| format!("--artist-params {}", path.display()))?;
+    Ok(params)
+}
+
+fn artist(params: Option<ArtistParams>) -> anyhow::Result<(ShadingModel, String)> {
+    let from = match params {
+        None => "default controls",
+        Some(_) => "custom controls",
     };
-    let model = ArtistModel::new(params).context("--artist-params")?;
+    let model = ArtistModel::new(params.unwrap_or_default()).context("artist controls")?;
     Ok((
         ShadingModel::Artist(model),
         format!("artist-friendly (Sadeghi 2010), {from}"),
@@ -89,7 +94,7 @@ mod tests {
             shading,
             preset: "brown",
             lut_size: 16,
-            artist_params: None,
+            artist: None,
         }
     }
 
@@ -121,11 +126,7 @@ mod tests {
         .unwrap_err();
         assert!(format!("{e:#}").contains("--lut-size 1"), "{e:#}");
         let missing = Path::new("/nonexistent/artist.json");
-        let e = point_shading_model(&PointShadingRequest {
-            artist_params: Some(missing),
-            ..request(Shading::Artist)
-        })
-        .unwrap_err();
+        let e = read_artist_params(missing).unwrap_err();
         assert!(format!("{e:#}").contains("artist.json"), "{e:#}");
     }
 }

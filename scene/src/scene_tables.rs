@@ -13,7 +13,7 @@ use strandlight_precompute::srbf_set::SrbfSet;
 use strandlight_tables::asset::{Storage, TableAsset, expect_parameters, read_asset};
 
 /// The fiber model whose tables shade the hair.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum EnvShading {
@@ -22,7 +22,7 @@ pub enum EnvShading {
 }
 
 /// Single scattering only, or with multiple scattering (Ren §3.2).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum ScatteringMode {

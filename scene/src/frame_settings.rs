@@ -1,0 +1,448 @@
+//! Everything that decides one rendered picture, as one serializable value: what `render` builds
+//! from its flags, what the viewer edits live and writes beside every screenshot, and what
+//! `render --replay` reads back to reproduce that screenshot.
+
+use crate::camera_choice::{CameraChoice, UpChoice};
+use crate::look::{EnvTransparency, LookArgs, ViewArgs};
+use crate::point_shading::Shading;
+use crate::scene_tables::{EnvShading, ScatteringMode};
+use anyhow::{Context, bail};
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use strandlight_runtime::camera::{Camera, MAX_FOV_Y_DEGREES, Projection};
+use strandlight_runtime::hair::HairModel;
+use strandlight_runtime::lights::Light;
+use strandlight_runtime::passes::convolution_depth::{DodmSettings, MAX_DODM_RESOLUTION};
+use strandlight_tables::artist::{ArtistModel, ArtistParams};
+
+/// One picture: hair, camera, fiber and lighting.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FrameSettings {
+    /// Hair file; None: the procedural groom.
+    pub hair: Option<PathBuf>,
+    /// Width and height in pixels.
+    pub size: [u32; 2],
+    pub camera: CameraSettings,
+    /// Fiber model; None: Kajiya-Kay under point lights, Marschner under an environment.
+    pub shading: Option<Shading>,
+    /// Melanin preset of the Marschner fiber (and the fiber whose tables an environment bakes).
+    pub preset: String,
+    /// Artist controls of `--shading artist`; None: the built-in light brown.
+    pub artist: Option<ArtistParams>,
+    /// Every fiber this many pixels wide; None: the file's thickness, projected.
+    pub fiber_width_px: Option<f32>,
+    pub lighting: Lighting,
+}
+
+/// Where the camera is.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CameraSettings {
+    /// Framing the hair's bounds (`render --camera --up --eye`).
+    Framed(CameraChoice),
+    /// Exactly this view (the viewer's orbit camera, replayed as it was).
+    Exact(ExactCamera),
+}
+
+/// A camera written out in full.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExactCamera {
+    pub eye: [f32; 3],
+    pub target: [f32; 3],
+    pub up: [f32; 3],
+    /// Vertical field of view in degrees; None: orthographic with `half_height`.
+    pub fov_y_deg: Option<f32>,
+    /// Half the visible height (orthographic only), world units.
+    pub half_height: Option<f32>,
+    pub near: f32,
+    pub far: f32,
+}
+
+impl ExactCamera {
+    pub fn of(camera: &Camera) -> Self {
+        let (fov_y_deg, half_height) = match camera.projection {
+            Projection::Perspective { fov_y } => (Some(fov_y.to_degrees()), None),
+            Projection::Orthographic { half_height } => (None, Some(half_height)),
+        };
+        Self {
+            eye: camera.eye.to_array(),
+            target: camera.target.to_array(),
+            up: camera.up.to_array(),
+            fov_y_deg,
+            half_height,
+            near: camera.near,
+            far: camera.far,
+        }
+    }
+
+    pub fn camera(&self) -> anyhow::Result<Camera> {
+        let projection = match (self.fov_y_deg, self.half_height) {
+            (Some(fov), None) if fov > 0.0 && fov <= MAX_FOV_Y_DEGREES => Projection::Perspective {
+                fov_y: fov.to_radians(),
+            },
+            (None, Some(h)) if h > 0.0 && h.is_finite() => {
+                Projection::Orthographic { half_height: h }
+            }
+            _ => bail!(
+                "camera: give either fov_y_deg in (0, {MAX_FOV_Y_DEGREES}] or a positive half_height"
+            ),
+        };
+        let camera = Camera {
+            eye: Vec3::from(self.eye),
+            target: Vec3::from(self.target),
+            up: Vec3::from(self.up),
+            projection,
+            near: self.near,
+            far: self.far,
+        };
+        let finite = [camera.eye, camera.target, camera.up]
+            .iter()
+            .all(|v| v.is_finite());
+        let view = camera.target - camera.eye;
+        if !finite
+            || view.length() <= 0.0
+            || camera.up.cross(view).length() <= 1e-6 * view.length() * camera.up.length()
+        {
+            bail!(
+                "camera: eye {:?}, target {:?} and up {:?} must be finite, distinct and not collinear",
+                self.eye,
+                self.target,
+                self.up
+            );
+        }
+        if !(self.near > 0.0 && self.far > self.near && self.far.is_finite()) {
+            bail!(
+                "camera: near {} and far {} must satisfy 0 < near < far",
+                self.near,
+                self.far
+            );
+        }
+        Ok(camera)
+    }
+}
+
+impl CameraSettings {
+    /// The camera for `model` at `width`/`height`.
+    pub fn camera(&self, model: &HairModel, width: u32, height: u32) -> anyhow::Result<Camera> {
+        match self {
+            CameraSettings::Framed(choice) => choice.camera(model, width as f32 / height as f32),
+            CameraSettings::Exact(exact) => exact.camera(),
+        }
+    }
+}
+
+/// What lights the hair.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Lighting {
+    /// Directional, point and spot lights with the thesis techniques.
+    Lights(PointLighting),
+    /// An environment map fitted with SRBFs (Ren 2010).
+    Environment(EnvLighting),
+}
+
+/// Shadows of point-lit frames.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum Shadows {
+    #[default]
+    None,
+    Dom,
+}
+
+/// Transparency of point-lit frames (`occupancy` is the env-lit view's).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum Transparency {
+    #[default]
+    None,
+    Abuffer,
+    Dbk,
+    /// With an environment only: every fiber weighted by its visibility through an occupancy map.
+    Occupancy,
+}
+
+/// The default light when none is given: from the upper right front.
+pub const DEFAULT_LIGHT: &str = "directional:0.5,0.7,1:2";
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLighting {
+    /// `directional:X,Y,Z[:I]`, `point:X,Y,Z[:I]`, `spot:X,Y,Z:DX,DY,DZ:HALF_ANGLE[:I]`.
+    pub lights: Vec<String>,
+    pub shadows: Shadows,
+    pub transparency: Transparency,
+    /// Deep opacity map layers (1..=8).
+    pub dom_layers: u32,
+    /// Layer spacing in world units; None: 1% of the hair's bounding-box diagonal.
+    pub dom_spacing: Option<f32>,
+    /// Deep opacity map resolution (square).
+    pub dom_size: u32,
+    /// A-buffer and DBK node buffer, nodes per pixel.
+    pub abuffer_nodes_per_pixel: u32,
+    /// DBK layer depth Δ in world units; None: 5% of the hair's bounding-box diagonal.
+    pub dbk_delta: Option<f32>,
+    /// Nodes per axis of the Marschner lookup textures.
+    pub lut_size: usize,
+}
+
+impl Default for PointLighting {
+    fn default() -> Self {
+        Self {
+            lights: vec![DEFAULT_LIGHT.to_string()],
+            shadows: Shadows::None,
+            transparency: Transparency::None,
+            dom_layers: 4,
+            dom_spacing: None,
+            dom_size: 512,
+            abuffer_nodes_per_pixel: 16,
+            dbk_delta: None,
+            lut_size: 128,
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EnvLighting {
+    /// A .hdr/.exr map or `procedural:NAME`.
+    pub map: String,
+    pub scattering: ScatteringMode,
+    /// Fraction of the strands drawn into the light maps (Ren §7).
+    pub kappa: f32,
+    /// Use only the N most powerful SRBF lobes (a fit's compact sources are always kept);
+    /// None: all of them.
+    pub lobes: Option<usize>,
+    /// The environment turned about the hair's up axis, degrees: the fitted lobes are rotated
+    /// exactly, nothing is refitted.
+    pub rotation_deg: f32,
+    /// Convolution optical depth map resolution (square).
+    pub dodm_size: u32,
+    pub transparency: EnvTransparency,
+    pub view: ViewArgs,
+}
+
+impl EnvLighting {
+    pub fn new(map: impl Into<String>) -> Self {
+        Self {
+            map: map.into(),
+            scattering: ScatteringMode::Full,
+            kappa: 0.1,
+            lobes: None,
+            rotation_deg: 0.0,
+            dodm_size: DodmSettings::default().resolution,
+            transparency: EnvTransparency::Opaque,
+            view: ViewArgs::default(),
+        }
+    }
+
+    pub fn look_args(&self) -> LookArgs {
+        LookArgs {
+            transparency: self.transparency,
+            view: self.view,
+        }
+    }
+}
+
+impl FrameSettings {
+    /// The procedural groom, framed from the front, at `size`, under `lighting`.
+    pub fn new(lighting: Lighting, size: [u32; 2]) -> Self {
+        Self {
+            hair: None,
+            size,
+            camera: CameraSettings::Framed(CameraChoice::default()),
+            shading: None,
+            preset: "brown".into(),
+            artist: None,
+            fiber_width_px: None,
+            lighting,
+        }
+    }
+
+    /// Reads the JSON sidecar a viewer screenshot wrote (or any settings file).
+    pub fn read(path: &Path) -> anyhow::Result<Self> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("reading settings {}", path.display()))?;
+        let settings: Self = serde_json::from_str(&text)
+            .with_context(|| format!("settings {}: not a frame-settings JSON", path.display()))?;
+        settings
+            .check()
+            .with_context(|| format!("settings {}", path.display()))?;
+        Ok(settings)
+    }
+
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("settings serialize")
+    }
+
+    /// The fiber model, with the default of the lighting.
+    pub fn shading(&self) -> Shading {
+        self.shading.unwrap_or(match self.lighting {
+            Lighting::Lights(_) => Shading::KajiyaKay,
+            Lighting::Environment(_) => Shading::Marschner,
+        })
+    }
+
+    /// The env renderer's fiber model (it reads one RGB 4D table: Marschner or artist).
+    pub fn env_shading(&self) -> anyhow::Result<EnvShading> {
+        match self.shading() {
+            Shading::Marschner => Ok(EnvShading::Marschner),
+            Shading::Artist => Ok(EnvShading::Artist),
+            Shading::KajiyaKay => bail!(
+                "--shading kajiya-kay with --env: the env renderer reads one RGB 4D table (Marschner I_M or the artist I_A); use --shading marschner or artist"
+            ),
+        }
+    }
+
+    /// Every value in range, before anything is loaded or rendered. Errors name the setting.
+    pub fn check(&self) -> anyhow::Result<()> {
+        let [w, h] = self.size;
+        if w == 0 || h == 0 {
+            bail!("--size {w}x{h}: both sides must be at least 1 pixel");
+        }
+        if let Some(w) = self.fiber_width_px
+            && !(w.is_finite() && w > 0.0)
+        {
+            bail!("--fiber-width-px {w}: must be a positive number of pixels");
+        }
+        if let CameraSettings::Exact(exact) = &self.camera {
+            exact.camera()?;
+        }
+        if let Some(params) = self.artist {
+            ArtistModel::new(params).context("artist controls")?;
+        }
+        match &self.lighting {
+            Lighting::Lights(point) => point.check(),
+            Lighting::Environment(env) => {
+                self.env_shading()?;
+                env.check()
+            }
+        }
+    }
+}
+
+impl PointLighting {
+    fn check(&self) -> anyhow::Result<()> {
+        if self.transparency == Transparency::Occupancy {
+            bail!(
+                "--transparency occupancy is the view of --env (environment lighting); with point lights use none, abuffer or dbk"
+            );
+        }
+        if self.lights.is_empty() {
+            bail!("--light: at least one light is needed");
+        }
+        for spec in &self.lights {
+            Light::parse(spec)?;
+        }
+        if let Some(d) = self.dbk_delta
+            && !(d.is_finite() && d >= 0.0)
+        {
+            bail!("--dbk-delta {d}: must be a non-negative number of world units");
+        }
+        Ok(())
+    }
+
+    pub fn parsed_lights(&self) -> anyhow::Result<Vec<Light>> {
+        Ok(self
+            .lights
+            .iter()
+            .map(|s| Light::parse(s))
+            .collect::<Result<Vec<_>, _>>()?)
+    }
+}
+
+impl EnvLighting {
+    fn check(&self) -> anyhow::Result<()> {
+        if !(self.kappa > 0.0 && self.kappa <= 1.0) {
+            bail!("--kappa {}: must lie in (0, 1]", self.kappa);
+        }
+        if self.lobes == Some(0) {
+            bail!("--lobes 0: use at least one SRBF lobe (or leave it out for all)");
+        }
+        if !self.rotation_deg.is_finite() {
+            bail!(
+                "--env-rotation {}: must be a finite angle",
+                self.rotation_deg
+            );
+        }
+        if !(16..=MAX_DODM_RESOLUTION).contains(&self.dodm_size) {
+            bail!(
+                "--dodm-size {}: must lie in 16..={MAX_DODM_RESOLUTION} texels",
+                self.dodm_size
+            );
+        }
+        self.look_args().look()?;
+        Ok(())
+    }
+}
+
+/// The up axis `settings` frames the hair with (Exact cameras carry their own up; the
+/// environment's +y still turns onto the file's up axis).
+pub fn up_choice(settings: &FrameSettings) -> UpChoice {
+    match settings.camera {
+        CameraSettings::Framed(choice) => choice.up,
+        CameraSettings::Exact(_) => UpChoice::Auto,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn settings_survive_a_json_round_trip_exactly() {
+        let mut settings = FrameSettings::new(
+            Lighting::Environment(EnvLighting::new("procedural:studio")),
+            [64, 48],
+        );
+        settings.camera = CameraSettings::Exact(ExactCamera {
+            eye: [0.1, 0.2, 3.000_000_2],
+            target: [0.0, 0.0, 0.0],
+            up: [0.0, 1.0, 0.0],
+            fov_y_deg: Some(31.7),
+            half_height: None,
+            near: 0.01,
+            far: 100.0,
+        });
+        settings.artist = Some(ArtistParams::default());
+        let back: FrameSettings = serde_json::from_str(&settings.to_json()).unwrap();
+        assert_eq!(back, settings);
+    }
+
+    #[test]
+    fn bad_values_are_refused_with_the_setting_named() {
+        let env = |f: &dyn Fn(&mut EnvLighting)| {
+            let mut e = EnvLighting::new("procedural:studio");
+            f(&mut e);
+            let s = FrameSettings::new(Lighting::Environment(e), [8, 8]);
+            format!("{:#}", s.check().unwrap_err())
+        };
+        assert!(env(&|e| e.kappa = 0.0).contains("--kappa"));
+        assert!(env(&|e| e.lobes = Some(0)).contains("--lobes"));
+        assert!(env(&|e| e.dodm_size = 4).contains("--dodm-size"));
+        assert!(env(&|e| e.rotation_deg = f32::NAN).contains("--env-rotation"));
+        let mut s = FrameSettings::new(Lighting::Lights(PointLighting::default()), [8, 8]);
+        s.shading = Some(Shading::KajiyaKay);
+        s.check().unwrap();
+        s.lighting = Lighting::Environment(EnvLighting::new("procedural:studio"));
+        assert!(format!("{:#}", s.check().unwrap_err()).contains("kajiya-kay"));
+        s.size = [0, 8];
+        assert!(format!("{:#}", s.check().unwrap_err()).contains("--size"));
+        let mut exact = ExactCamera::of(&Camera {
+            eye: Vec3::Z,
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            projection: Projection::Perspective { fov_y: 0.5 },
+            near: 0.1,
+            far: 10.0,
+        });
+        exact.camera().unwrap();
+        exact.up = [0.0, 0.0, 1.0];
+        assert!(exact.camera().is_err(), "up along the view is refused");
+    }
+}
