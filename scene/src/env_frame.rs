@@ -96,6 +96,11 @@ fn gpu_renderer() -> anyhow::Result<&'static GpuRenderer> {
         .map_err(|e| anyhow::anyhow!("no GPU device for the environment-lit renderer: {e}"))
 }
 
+/// The adapter the environment-lit renderer runs on (creating the device on first use).
+pub fn env_adapter() -> anyhow::Result<String> {
+    Ok(gpu_renderer()?.gpu.report.to_string())
+}
+
 /// Passes an application pays once (device, pipelines, uploads of hair and tables), not per
 /// frame; everything else the renderer times is the frame.
 const SETUP_PASSES: [&str; 3] = ["pipelines", "upload", "table upload"];

@@ -188,10 +188,7 @@ pub fn prepare_env(
 /// The lights of a frame: the `env.lobes` most powerful SRBFs (all when None) and every
 /// compact source, turned `env.rotation_deg` about the up axis, most powerful first.
 pub fn frame_lights(prepared: &PreparedEnv, env: &EnvLighting) -> Vec<EnvLight> {
-    let luminance = |l: &EnvLight| {
-        let [r, g, b] = l.power();
-        0.2126 * r + 0.7152 * g + 0.0722 * b
-    };
+    let luminance = light_luminance;
     let mut lights = prepared.scene.lights.clone();
     lights.sort_by(|a, b| luminance(b).total_cmp(&luminance(a)));
     let mut srbf_kept = 0;
@@ -205,6 +202,12 @@ pub fn frame_lights(prepared: &PreparedEnv, env: &EnvLighting) -> Vec<EnvLight> 
         light.direction = (turn * light.direction).normalize_or(Vec3::Y);
     }
     lights
+}
+
+/// The luminance of a light's power (Rec. 709 weights).
+pub fn light_luminance(light: &EnvLight) -> f32 {
+    let [r, g, b] = light.power();
+    0.2126 * r + 0.7152 * g + 0.0722 * b
 }
 
 /// How an env-lit frame of `env` looks.

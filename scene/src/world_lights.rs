@@ -21,6 +21,15 @@ pub fn env_to_world(d: DVec3, up: UpAxis) -> DVec3 {
     }
 }
 
+/// The inverse of [`env_to_world`]: a world direction in the map's frame (what a background
+/// seen along it shows).
+pub fn world_to_env(w: DVec3, up: UpAxis) -> DVec3 {
+    match up {
+        UpAxis::Y => w,
+        UpAxis::Z => DVec3::new(-w.x, w.z, w.y),
+    }
+}
+
 /// The runtime lights of a set, with their directions in the world of `up`.
 pub fn to_env_lights(specs: &[LightSpec], up: UpAxis) -> Vec<EnvLight> {
     specs
@@ -68,6 +77,15 @@ mod tests {
                 env_to_world(DVec3::Z, up),
             );
             assert!((x.cross(y).dot(z) - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn world_to_env_undoes_env_to_world() {
+        for up in [UpAxis::Y, UpAxis::Z] {
+            for d in [DVec3::X, DVec3::Y, DVec3::Z, DVec3::new(0.3, -0.5, 0.81).normalize()] {
+                assert!((world_to_env(env_to_world(d, up), up) - d).length() < 1e-12);
+            }
         }
     }
 

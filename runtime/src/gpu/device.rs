@@ -60,11 +60,13 @@ impl GpuContext {
 
     async fn new_headless_async() -> Result<Self, DeviceError> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
-        desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::VULKAN);
+        // Vulkan, Metal, DX12: every pass needs compute and storage buffers, which the GL
+        // backend lacks. WGPU_BACKEND overrides.
+        desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
         let instance = wgpu::Instance::new(desc);
         let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
         let looked_at = if adapters.is_empty() {
-            "no Vulkan adapters".to_string()
+            "no Vulkan, Metal or DX12 adapters".to_string()
         } else {
             adapters
                 .iter()

@@ -1,0 +1,10 @@
+//! `strandlight view`: a window on hair lit live, through the same runtime and scene layer as
+//! `render`. The window thread handles input and presents at its own pace; a render thread
+//! draws a preview and then refines the full frame (progressive); table bakes run in the
+//! background while the old tables stay on screen.
+
+pub mod display;
+pub mod orbit;
+pub mod progressive;
+pub mod recompute;
+pub mod worker;

@@ -1,0 +1,534 @@
+//! The render thread: the window hands it the latest settings and never waits for it. For each
+//! request it draws a cheap preview (half size, the brightest lobes, small light maps, single
+//! scattering), then refines the full frame one batch of lights at a time, publishing the running
+//! sum after each batch. A newer request abandons the old one between batches. Table bakes run
+//! on a thread of their own, and the previous tables keep lighting frames until they finish.
+
+use crate::progressive::{Accumulator, Step, plan_steps, preview_lights, preview_look};
+use anyhow::Context;
+use std::path::PathBuf;
+use std::sync::mpsc::{Receiver, TryRecvError, channel};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+use std::time::{Duration, Instant};
+use strandlight_runtime::gpu::GpuContext;
+use strandlight_scene::env_frame::{env_adapter, render_lights};
+use strandlight_scene::env_scene::PrepareProgress;
+use strandlight_scene::frame_render::{
+    LoadedHair, PreparedEnv, PreparedPoint, env_frame, env_look, frame_lights, light_luminance,
+    load_settings_hair, prepare_env, prepare_point, render_point,
+};
+use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting, PointLighting};
+use strandlight_scene::scene_tables::ScatteringMode;
+use strandlight_scene::steps::Steps;
+
+use crate::recompute::{TablesKey, tables_key};
+
+/// A frame in linear, pre-multiplied RGBA.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinearImage {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<[f32; 4]>,
+}
+
+/// How far the shown image is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stage {
+    Preview,
+    /// `done` of `total` light batches summed.
+    Refining { done: usize, total: usize },
+    Converged,
+}
+
+/// What the overlay reports of the shown image.
+#[derive(Clone, Debug, Default)]
+pub struct FrameStats {
+    /// Milliseconds per pass, summed over the batches so far.
+    pub passes: Vec<(String, f64)>,
+    /// GPU memory per resource while one batch renders, bytes.
+    pub memory: Vec<(String, u64)>,
+    /// Lights drawn (SRBF lobes and directional sources, or point lights).
+    pub lights: usize,
+    /// Render calls (light batches) so far.
+    pub batches: usize,
+    pub adapter: String,
+    pub timing_method: String,
+}
+
+/// The worker's latest image of a request.
+#[derive(Clone, Debug)]
+pub struct Shown {
+    pub job: u64,
+    pub settings: FrameSettings,
+    pub image: Arc<LinearImage>,
+    pub stage: Stage,
+    pub stats: FrameStats,
+    /// Rendered with the previous tables while this request's tables bake.
+    pub stale_tables: bool,
+    /// Seconds from the request to this image.
+    pub seconds: f64,
+}
+
+/// A bake in progress.
+#[derive(Clone, Debug)]
+pub struct BakeStatus {
+    pub what: String,
+    /// 0..=1.
+    pub fraction: f32,
+    pub started: Instant,
+}
+
+/// Everything the window reads from the worker.
+#[derive(Clone, Debug, Default)]
+pub struct Status {
+    pub shown: Option<Shown>,
+    pub bake: Option<BakeStatus>,
+    /// The last request that failed, and why (bad file, bad value, GPU error).
+    pub error: Option<(u64, String)>,
+    /// Seconds from each request to its preview and to its converged image (latest request).
+    pub preview_seconds: Option<f64>,
+    pub converged_seconds: Option<f64>,
+}
+
+struct Shared {
+    request: Mutex<Option<(u64, FrameSettings)>>,
+    wake_worker: Condvar,
+    status: Mutex<Status>,
+    quit: Mutex<bool>,
+    wake_window: Box<dyn Fn() + Send + Sync>,
+}
+
+pub struct Worker {
+    shared: Arc<Shared>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Worker {
+    /// Starts the thread; `wake_window` is called whenever the status changes.
+    pub fn spawn(cache_dir: PathBuf, wake_window: Box<dyn Fn() + Send + Sync>) -> Self {
+        let shared = Arc::new(Shared {
+            request: Mutex::new(None),
+            wake_worker: Condvar::new(),
+            status: Mutex::new(Status::default()),
+            quit: Mutex::new(false),
+            wake_window,
+        });
+        let for_thread = shared.clone();
+        let thread = std::thread::Builder::new()
+            .name("strandlight render".into())
+            .spawn(move || WorkerState::new(cache_dir, for_thread).run())
+            .expect("spawn the render thread");
+        Self {
+            shared,
+            thread: Some(thread),
+        }
+    }
+
+    /// Replaces whatever request is waiting (the latest settings win).
+    pub fn submit(&self, job: u64, settings: FrameSettings) {
+        *self.shared.request.lock().unwrap() = Some((job, settings));
+        self.shared.wake_worker.notify_all();
+    }
+
+    pub fn status(&self) -> MutexGuard<'_, Status> {
+        self.shared.status.lock().unwrap()
+    }
+}
+
+impl Drop for Worker {
+    fn drop(&mut self) {
+        *self.shared.quit.lock().unwrap() = true;
+        self.shared.wake_worker.notify_all();
+        // A render in flight finishes its batch; a bake thread is left to the process exit.
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+/// A request being refined.
+struct Job {
+    id: u64,
+    settings: FrameSettings,
+    started: Instant,
+    steps: Vec<Step>,
+    next: usize,
+    accumulator: Accumulator,
+    stale_tables: bool,
+}
+
+type BakeResult = Result<PreparedEnv, String>;
+
+struct WorkerState {
+    cache_dir: PathBuf,
+    shared: Arc<Shared>,
+    hair: Option<(Option<PathBuf>, Arc<LoadedHair>)>,
+    point: Option<(String, Arc<PreparedPoint>)>,
+    env: Option<(TablesKey, Arc<PreparedEnv>)>,
+    baking: Option<(TablesKey, Receiver<BakeResult>)>,
+    gpu: Option<GpuContext>,
+    job: Option<Job>,
+}
+
+impl WorkerState {
+    fn new(cache_dir: PathBuf, shared: Arc<Shared>) -> Self {
+        Self {
+            cache_dir,
+            shared,
+            hair: None,
+            point: None,
+            env: None,
+            baking: None,
+            gpu: None,
+            job: None,
+        }
+    }
+
+    fn run(mut self) {
+        loop {
+            if *self.shared.quit.lock().unwrap() {
+                return;
+            }
+            if let Some((id, settings)) = self.take_request() {
+                self.start(id, settings);
+            }
+            self.poll_bake();
+            if self.job.as_ref().is_some_and(|j| j.next < j.steps.len()) {
+                self.step();
+            } else {
+                self.wait_for_work();
+            }
+        }
+    }
+
+    fn take_request(&self) -> Option<(u64, FrameSettings)> {
+        self.shared.request.lock().unwrap().take()
+    }
+
+    /// Sleeps until a request arrives, or a bake may have finished.
+    fn wait_for_work(&self) {
+        let guard = self.shared.request.lock().unwrap();
+        if guard.is_none() {
+            let _ = self
+                .shared
+                .wake_worker
+                .wait_timeout(guard, Duration::from_millis(50));
+        }
+    }
+
+    fn publish(&self, change: impl FnOnce(&mut Status)) {
+        change(&mut self.shared.status.lock().unwrap());
+        (self.shared.wake_window)();
+    }
+
+    fn fail(&mut self, id: u64, error: anyhow::Error) {
+        self.job = None;
+        self.publish(|s| s.error = Some((id, format!("{error:#}"))));
+    }
+
+    fn start(&mut self, id: u64, settings: FrameSettings) {
+        self.publish(|s| {
+            s.preview_seconds = None;
+            s.converged_seconds = None;
+        });
+        let started = Instant::now();
+        match self.plan(&settings) {
+            Ok(Some((steps, stale_tables))) => {
+                let mut accumulator = Accumulator::default();
+                accumulator.expect_batches(
+                    steps
+                        .iter()
+                        .filter(|s| matches!(s, Step::Batch { .. }))
+                        .count(),
+                );
+                self.job = Some(Job {
+                    id,
+                    settings,
+                    started,
+                    steps,
+                    next: 0,
+                    accumulator,
+                    stale_tables,
+                });
+            }
+            // Waits for its tables: planned again when the bake ends.
+            Ok(None) => {
+                self.job = Some(Job {
+                    id,
+                    settings,
+                    started,
+                    steps: Vec::new(),
+                    next: 0,
+                    accumulator: Accumulator::default(),
+                    stale_tables: true,
+                })
+            }
+            Err(e) => self.fail(id, e),
+        }
+    }
+
+    /// The steps of `settings`, and whether they use the previous tables; None while there are
+    /// no tables to use yet.
+    fn plan(&mut self, settings: &FrameSettings) -> anyhow::Result<Option<(Vec<Step>, bool)>> {
+        settings.check()?;
+        let hair = self.hair(settings)?;
+        match &settings.lighting {
+            Lighting::Lights(point) => {
+                self.prepared_point(settings, point)?;
+                Ok(Some((plan_steps(None), false)))
+            }
+            Lighting::Environment(env) => {
+                let key = tables_key(settings);
+                let current = self.env.as_ref().is_some_and(|(k, _)| *k == key);
+                if !current && self.baking.as_ref().is_none_or(|(k, _)| *k != key) {
+                    self.start_bake(settings.clone(), env.clone(), hair, key);
+                }
+                Ok(self.env.as_ref().map(|(_, prepared)| {
+                    let powers: Vec<f32> = frame_lights(prepared, env)
+                        .iter()
+                        .map(light_luminance)
+                        .collect();
+                    let batch = env_look(env).map_or(16, |l| l.dodm.batch_size) as usize;
+                    (plan_steps(Some((&powers, batch))), !current)
+                }))
+            }
+        }
+    }
+
+    fn hair(&mut self, settings: &FrameSettings) -> anyhow::Result<Arc<LoadedHair>> {
+        if let Some((path, hair)) = &self.hair
+            && *path == settings.hair
+        {
+            return Ok(hair.clone());
+        }
+        let hair = Arc::new(load_settings_hair(settings)?);
+        self.hair = Some((settings.hair.clone(), hair.clone()));
+        Ok(hair)
+    }
+
+    fn prepared_point(
+        &mut self,
+        settings: &FrameSettings,
+        point: &PointLighting,
+    ) -> anyhow::Result<Arc<PreparedPoint>> {
+        let key = format!(
+            "{:?} {:?} {:?}",
+            tables_key(settings),
+            settings.shading(),
+            settings.artist
+        );
+        if let Some((k, p)) = &self.point
+            && *k == key
+        {
+            return Ok(p.clone());
+        }
+        let prepared = Arc::new(prepare_point(settings, point)?);
+        self.point = Some((key, prepared.clone()));
+        Ok(prepared)
+    }
+
+    fn start_bake(
+        &mut self,
+        settings: FrameSettings,
+        env: EnvLighting,
+        hair: Arc<LoadedHair>,
+        key: TablesKey,
+    ) {
+        let (send, receive) = channel();
+        let shared = self.shared.clone();
+        let cache_dir = self.cache_dir.clone();
+        let what = format!("{} ({:?})", env.map, settings.shading());
+        self.publish(|s| {
+            s.bake = Some(BakeStatus {
+                what: format!("fitting {what}"),
+                fraction: 0.0,
+                started: Instant::now(),
+            })
+        });
+        std::thread::spawn(move || {
+            let mut steps = Steps::new(true);
+            let mut progress = |p: PrepareProgress| {
+                let (text, fraction) = match p {
+                    PrepareProgress::Fitting => (format!("fitting {what}"), 0.0),
+                    PrepareProgress::Baking { done, total, table } => (
+                        format!("baked {table} ({done}/{total}) for {what}"),
+                        done as f32 / total.max(1) as f32,
+                    ),
+                };
+                if let Some(bake) = &mut shared.status.lock().unwrap().bake {
+                    bake.what = text;
+                    bake.fraction = fraction;
+                }
+                (shared.wake_window)();
+            };
+            let prepared = prepare_env(
+                &settings,
+                &env,
+                &hair.model,
+                &cache_dir,
+                &mut steps,
+                &mut progress,
+            )
+            .map_err(|e| format!("{e:#}"));
+            let _ = send.send(prepared);
+        });
+        self.baking = Some((key, receive));
+    }
+
+    /// Installs finished tables and plans the waiting request again with them.
+    fn poll_bake(&mut self) {
+        let Some((key, receive)) = &self.baking else {
+            return;
+        };
+        let result = match receive.try_recv() {
+            Err(TryRecvError::Empty) => return,
+            Ok(result) => result,
+            Err(TryRecvError::Disconnected) => Err("the bake thread stopped".into()),
+        };
+        let key = key.clone();
+        self.baking = None;
+        self.publish(|s| s.bake = None);
+        match result {
+            Ok(prepared) => {
+                self.env = Some((key, Arc::new(prepared)));
+                if let Some(job) = self.job.take() {
+                    self.start(job.id, job.settings);
+                }
+            }
+            Err(e) => {
+                let id = self.job.as_ref().map_or(0, |j| j.id);
+                self.fail(id, anyhow::anyhow!("preparing the environment: {e}"));
+            }
+        }
+    }
+
+    fn step(&mut self) {
+        let job = self.job.as_mut().expect("a job to step");
+        let step = job.steps[job.next];
+        job.next += 1;
+        let id = job.id;
+        match self.render_step(step) {
+            Ok(()) => {}
+            Err(e) => self.fail(id, e),
+        }
+    }
+
+    fn render_step(&mut self, step: Step) -> anyhow::Result<()> {
+        let job = self.job.as_ref().expect("a job");
+        let settings = job.settings.clone();
+        let hair = self.hair(&settings)?;
+        let (image, stats) = match &settings.lighting {
+            Lighting::Lights(point) => {
+                let prepared = self.prepared_point(&settings, point)?;
+                self.point_step(&settings, point, &hair, &prepared, step)?
+            }
+            Lighting::Environment(env) => {
+                let (_, prepared) = self.env.as_ref().context("no tables yet")?;
+                let prepared = prepared.clone();
+                env_step(&settings, env, &hair, &prepared, step)?
+            }
+        };
+        let job = self.job.as_mut().expect("a job");
+        let shown_stage = job.accumulator.add(step, image, stats);
+        let (image, stats) = job.accumulator.shown();
+        let seconds = job.started.elapsed().as_secs_f64();
+        let shown = Shown {
+            job: job.id,
+            settings: job.settings.clone(),
+            image,
+            stage: shown_stage,
+            stats,
+            stale_tables: job.stale_tables,
+            seconds,
+        };
+        let converged = shown_stage == Stage::Converged && !job.stale_tables;
+        self.publish(|s| {
+            if shown.stage == Stage::Preview {
+                s.preview_seconds = Some(seconds);
+            }
+            if converged {
+                s.converged_seconds = Some(seconds);
+            }
+            s.error = None;
+            s.shown = Some(shown);
+        });
+        Ok(())
+    }
+
+    fn point_step(
+        &mut self,
+        settings: &FrameSettings,
+        point: &PointLighting,
+        hair: &LoadedHair,
+        prepared: &PreparedPoint,
+        step: Step,
+    ) -> anyhow::Result<(LinearImage, FrameStats)> {
+        if self.gpu.is_none() {
+            self.gpu = Some(GpuContext::new_headless()?);
+        }
+        let gpu = self.gpu.as_ref().expect("created above");
+        let size = step.size(settings.size);
+        let frame = render_point(gpu, settings, point, &hair.model, prepared, size)?;
+        let stats = FrameStats {
+            passes: frame
+                .stats
+                .timings
+                .iter()
+                .map(|t| (t.pass.clone(), t.milliseconds))
+                .collect(),
+            memory: frame.stats.memory_bytes.clone(),
+            lights: point.lights.len(),
+            batches: 1,
+            adapter: frame.stats.adapter.to_string(),
+            timing_method: frame.stats.timing_method.to_string(),
+        };
+        let image = LinearImage {
+            width: frame.width,
+            height: frame.height,
+            pixels: frame.pixels,
+        };
+        Ok((image, stats))
+    }
+}
+
+/// One step of an env-lit request: the preview, or one batch of the full frame's lights.
+fn env_step(
+    settings: &FrameSettings,
+    env: &EnvLighting,
+    hair: &LoadedHair,
+    prepared: &PreparedEnv,
+    step: Step,
+) -> anyhow::Result<(LinearImage, FrameStats)> {
+    let all = frame_lights(prepared, env);
+    let (lights, look, mode) = match step {
+        Step::Preview => (
+            preview_lights(&all),
+            preview_look(env_look(env)?),
+            ScatteringMode::Single,
+        ),
+        Step::Batch { first, count, .. } => (
+            all[first..first + count].to_vec(),
+            env_look(env)?,
+            prepared.scene.mode,
+        ),
+        Step::Full => anyhow::bail!("an env-lit frame is refined in batches"),
+    };
+    let size = step.size(settings.size);
+    let mut frame = env_frame(settings, env, &hair.model, prepared, &lights, size, look)?;
+    frame.mode = mode;
+    let rendered = render_lights(&frame)?;
+    let stats = FrameStats {
+        passes: rendered.passes,
+        memory: rendered.memory_per_batch,
+        lights: lights.len(),
+        batches: 1,
+        adapter: env_adapter()?,
+        timing_method: "CPU wall clock around submit + wait for idle".into(),
+    };
+    let image = LinearImage {
+        width: rendered.image.width,
+        height: rendered.image.height,
+        pixels: rendered.image.pixels,
+    };
+    Ok((image, stats))
+}
