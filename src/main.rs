@@ -10,6 +10,7 @@ mod render;
 mod summary;
 mod sweep_cmd;
 mod tables_cmd;
+mod view;
 
 use clap::{Parser, Subcommand};
 
@@ -49,6 +50,9 @@ enum Command {
     ImageError(image_error::ImageErrorArgs),
     /// The procedural groom under the project's sun-and-sky: fit → bake → env-lit render.
     Demo(demo::DemoArgs),
+    /// Open a window on hair lit live: orbit, environment or lights, artist controls,
+    /// progressive refinement, screenshots that `render --replay` reproduces.
+    View(view::ViewArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -66,5 +70,6 @@ fn main() -> anyhow::Result<()> {
         Command::CompareTable(args) => compare_table::run(args),
         Command::ImageError(args) => image_error::run(args),
         Command::Demo(args) => demo::run(args),
+        Command::View(args) => view::run(args),
     }
 }

@@ -3,8 +3,16 @@
 //! draws a preview and then refines the full frame (progressive); table bakes run in the
 //! background while the old tables stay on screen.
 
+mod app;
 pub mod display;
 pub mod orbit;
+mod panel;
 pub mod progressive;
 pub mod recompute;
+pub mod screenshot;
+pub mod script;
+mod session;
 pub mod worker;
+
+pub use app::{ViewOptions, run};
+pub use session::{RequestTiming, SessionReport};

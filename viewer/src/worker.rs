@@ -6,7 +6,9 @@
 
 use crate::progressive::{Accumulator, Step, plan_steps, preview_lights, preview_look};
 use anyhow::Context;
+use glam::Vec3;
 use std::path::PathBuf;
+use strandlight_runtime::camera::Camera;
 use std::sync::mpsc::{Receiver, TryRecvError, channel};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
@@ -15,9 +17,11 @@ use strandlight_scene::env_frame::{env_adapter, render_lights};
 use strandlight_scene::env_scene::PrepareProgress;
 use strandlight_scene::frame_render::{
     LoadedHair, PreparedEnv, PreparedPoint, env_frame, env_look, frame_lights, light_luminance,
-    load_settings_hair, prepare_env, prepare_point, render_point,
+    load_settings_hair, prepare_env, prepare_point, render_point, settings_camera,
 };
-use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting, PointLighting};
+use strandlight_scene::frame_settings::{
+    EnvLighting, FrameSettings, Lighting, PointLighting, up_choice,
+};
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 
@@ -56,7 +60,7 @@ pub struct FrameStats {
 }
 
 /// The worker's latest image of a request.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct Shown {
     pub job: u64,
     pub settings: FrameSettings,
@@ -67,6 +71,12 @@ pub struct Shown {
     pub stale_tables: bool,
     /// Seconds from the request to this image.
     pub seconds: f64,
+    /// The camera it was rendered with, the hair's front and bounding radius (for the orbit).
+    pub camera: Camera,
+    pub front: Vec3,
+    pub radius: f32,
+    /// The environment lighting it (for the background).
+    pub env: Option<Arc<PreparedEnv>>,
 }
 
 /// A bake in progress.
@@ -79,7 +89,7 @@ pub struct BakeStatus {
 }
 
 /// Everything the window reads from the worker.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Default)]
 pub struct Status {
     pub shown: Option<Shown>,
     pub bake: Option<BakeStatus>,
@@ -417,6 +427,7 @@ impl WorkerState {
         let job = self.job.as_ref().expect("a job");
         let settings = job.settings.clone();
         let hair = self.hair(&settings)?;
+        let mut env_used = None;
         let (image, stats) = match &settings.lighting {
             Lighting::Lights(point) => {
                 let prepared = self.prepared_point(&settings, point)?;
@@ -425,9 +436,14 @@ impl WorkerState {
             Lighting::Environment(env) => {
                 let (_, prepared) = self.env.as_ref().context("no tables yet")?;
                 let prepared = prepared.clone();
-                env_step(&settings, env, &hair, &prepared, step)?
+                let out = env_step(&settings, env, &hair, &prepared, step)?;
+                env_used = Some(prepared);
+                out
             }
         };
+        let camera = settings_camera(&settings, &hair.model)?;
+        let front = up_choice(&settings).axis(&hair.model).toward_front();
+        let radius = 0.5 * hair.model.bounds().diagonal();
         let job = self.job.as_mut().expect("a job");
         let shown_stage = job.accumulator.add(step, image, stats);
         let (image, stats) = job.accumulator.shown();
@@ -440,6 +456,10 @@ impl WorkerState {
             stats,
             stale_tables: job.stale_tables,
             seconds,
+            camera,
+            front,
+            radius,
+            env: env_used,
         };
         let converged = shown_stage == Stage::Converged && !job.stale_tables;
         self.publish(|s| {

@@ -1,0 +1,397 @@
+//! The window: winit's event loop, a wgpu surface, egui drawn through egui-wgpu, and scripted
+//! input injected into egui's input like the mouse and keyboard. The window presents at its own
+//! pace (about 30 frames a second while anything is changing, on events otherwise).
+
+use crate::script::{Action, Script};
+use crate::session::{Session, SessionReport};
+use crate::worker::Worker;
+use anyhow::{Context, bail};
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+use strandlight_scene::frame_settings::FrameSettings;
+use winit::application::ApplicationHandler;
+use winit::event::WindowEvent;
+use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
+use winit::window::{Window, WindowId};
+
+/// Frame interval while something changes.
+const BUSY_FRAME: Duration = Duration::from_millis(33);
+/// Width of the side panel, points.
+const PANEL_WIDTH: f64 = 320.0;
+
+/// What `strandlight view` was asked to do.
+pub struct ViewOptions {
+    pub settings: FrameSettings,
+    /// Holds `fits/` and `tables/` (shared with `render`).
+    pub cache_dir: PathBuf,
+    pub script: Option<PathBuf>,
+    /// After the script (or the first converged image without one): save here and exit.
+    pub screenshot: Option<PathBuf>,
+    /// Exit after this many presented frames.
+    pub frames: Option<u64>,
+    /// Write the session's measurements here as JSON at exit.
+    pub report: Option<PathBuf>,
+    /// A scripted run that has not finished by then fails.
+    pub timeout: Duration,
+}
+
+/// Opens the window and runs until it is closed or the script ends.
+pub fn run(options: ViewOptions) -> anyhow::Result<()> {
+    options.settings.check()?;
+    let mut script = options.script.as_deref().map(Script::read).transpose()?;
+    if script.is_none() && options.screenshot.is_some() {
+        script = Some(Script::converged_then_exit());
+    }
+    let event_loop = EventLoop::<()>::with_user_event()
+        .build()
+        .context("opening a window: no display (on a headless machine run under xvfb-run -a)")?;
+    let proxy = Mutex::new(event_loop.create_proxy());
+    let wake: Box<dyn Fn() + Send + Sync> = Box::new(move || {
+        let _ = proxy.lock().unwrap().send_event(());
+    });
+    let worker = Worker::spawn(options.cache_dir.clone(), wake);
+    let mut app = App {
+        options,
+        script,
+        worker: Some(worker),
+        window: None,
+        session: None,
+        egui: egui::Context::default(),
+        started: Instant::now(),
+        last_redraw: Instant::now(),
+        outcome: Ok(()),
+    };
+    event_loop.run_app(&mut app)?;
+    app.finish()
+}
+
+struct App {
+    options: ViewOptions,
+    script: Option<Script>,
+    worker: Option<Worker>,
+    window: Option<WindowGpu>,
+    session: Option<Session>,
+    egui: egui::Context,
+    started: Instant,
+    last_redraw: Instant,
+    outcome: anyhow::Result<()>,
+}
+
+/// The window's own device (the renderer has its own; frames cross as pixels).
+struct WindowGpu {
+    window: Arc<Window>,
+    surface: wgpu::Surface<'static>,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    config: wgpu::SurfaceConfiguration,
+    renderer: egui_wgpu::Renderer,
+    egui_input: egui_winit::State,
+}
+
+impl WindowGpu {
+    fn new(event_loop: &ActiveEventLoop, egui: &egui::Context, size: [u32; 2]) -> anyhow::Result<(Self, String)> {
+        let attributes = Window::default_attributes()
+            .with_title("strandlight")
+            .with_inner_size(winit::dpi::LogicalSize::new(
+                size[0] as f64 + PANEL_WIDTH + 16.0,
+                (size[1] as f64 + 16.0).max(560.0),
+            ));
+        let window = Arc::new(event_loop.create_window(attributes)?);
+        let mut desc = wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(
+            event_loop.owned_display_handle(),
+        ));
+        desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all());
+        let instance = wgpu::Instance::new(desc);
+        let surface = instance.create_surface(window.clone())?;
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            compatible_surface: Some(&surface),
+            ..Default::default()
+        }))
+        .context("no adapter can present to this window")?;
+        let info = adapter.get_info();
+        let adapter_name = format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type);
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("strandlight window"),
+            ..Default::default()
+        }))?;
+        let physical = window.inner_size();
+        let mut config = surface
+            .get_default_config(&adapter, physical.width.max(1), physical.height.max(1))
+            .context("the window's surface has no configuration on this adapter")?;
+        let caps = surface.get_capabilities(&adapter);
+        config.format = caps
+            .formats
+            .iter()
+            .copied()
+            .find(|f| !f.is_srgb())
+            .unwrap_or(caps.formats[0]);
+        surface.configure(&device, &config);
+        let renderer = egui_wgpu::Renderer::new(&device, config.format, egui_wgpu::RendererOptions::default());
+        let egui_input = egui_winit::State::new(
+            egui.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            None,
+            Some(device.limits().max_texture_dimension_2d as usize),
+        );
+        Ok((
+            Self {
+                window,
+                surface,
+                device,
+                queue,
+                config,
+                renderer,
+                egui_input,
+            },
+            adapter_name,
+        ))
+    }
+
+    fn resize(&mut self, width: u32, height: u32) {
+        if width > 0 && height > 0 {
+            self.config.width = width;
+            self.config.height = height;
+            self.surface.configure(&self.device, &self.config);
+        }
+    }
+
+    /// Draws egui's output; false when no frame could be acquired (it is tried again).
+    fn paint(&mut self, egui: &egui::Context, output: egui::FullOutput) -> bool {
+        self.egui_input
+            .handle_platform_output(&self.window, output.platform_output);
+        let jobs = egui.tessellate(output.shapes, output.pixels_per_point);
+        for (id, delta) in &output.textures_delta.set {
+            for delta in delta {
+                self.renderer
+                    .update_texture(&self.device, &self.queue, *id, delta);
+            }
+        }
+        let frame = match self.surface.get_current_texture() {
+            wgpu::CurrentSurfaceTexture::Success(f) | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                self.surface.configure(&self.device, &self.config);
+                return false;
+            }
+            _ => return false,
+        };
+        let view = frame.texture.create_view(&Default::default());
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [self.config.width, self.config.height],
+            pixels_per_point: output.pixels_per_point,
+        };
+        let mut encoder = self.device.create_command_encoder(&Default::default());
+        let extra = self
+            .renderer
+            .update_buffers(&self.device, &self.queue, &mut encoder, &jobs, &screen);
+        {
+            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("egui"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &view,
+                    resolve_target: None,
+                    depth_slice: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                ..Default::default()
+            });
+            let mut pass = pass.forget_lifetime();
+            self.renderer.render(&mut pass, &jobs, &screen);
+        }
+        self.queue
+            .submit(extra.into_iter().chain([encoder.finish()]));
+        self.queue.present(frame);
+        for id in &output.textures_delta.free {
+            self.renderer.free_texture(id);
+        }
+        true
+    }
+}
+
+impl App {
+    /// One frame: script actions into egui's input, the session's UI, paint, exit checks.
+    fn redraw(&mut self, event_loop: &ActiveEventLoop) {
+        let (Some(gpu), Some(session)) = (&mut self.window, &mut self.session) else {
+            return;
+        };
+        self.last_redraw = Instant::now();
+        let mut input = gpu.egui_input.take_egui_input(&gpu.window);
+        let actions = match &mut self.script {
+            Some(script) => script.advance(&|cond| session.wait_done(cond)),
+            None => Vec::new(),
+        };
+        let image_rect = session.image_rect();
+        for action in &actions {
+            inject(&mut input, action, image_rect);
+            if let Err(e) = session.apply(action) {
+                self.outcome = Err(e);
+                event_loop.exit();
+            }
+        }
+        let output = self.egui.run_ui(input, |ui| session.frame(ui));
+        let repaint = output
+            .viewport_output
+            .get(&egui::ViewportId::ROOT)
+            .is_some_and(|v| v.repaint_delay.is_zero());
+        if gpu.paint(&self.egui, output) {
+            session.presented();
+        }
+        if repaint {
+            gpu.window.request_redraw();
+        }
+        self.check_exit(event_loop);
+    }
+
+    fn check_exit(&mut self, event_loop: &ActiveEventLoop) {
+        let Some(session) = &self.session else { return };
+        if let Some(n) = self.options.frames
+            && session.report.frames_presented >= n
+        {
+            event_loop.exit();
+        }
+        let Some(script) = &self.script else { return };
+        if script.finished() && !session.screenshots_pending() {
+            if let Some(stem) = self.options.screenshot.take() {
+                self.session
+                    .as_mut()
+                    .expect("checked")
+                    .apply(&Action::Screenshot(stem))
+                    .expect("a screenshot action");
+                return;
+            }
+            event_loop.exit();
+        } else if self.started.elapsed() > self.options.timeout {
+            self.outcome = Err(anyhow::anyhow!(
+                "--script did not finish within {} s (at {})",
+                self.options.timeout.as_secs(),
+                script.position()
+            ));
+            event_loop.exit();
+        }
+    }
+
+    fn finish(mut self) -> anyhow::Result<()> {
+        let report = self.session.take().map(|s| s.report).unwrap_or_default();
+        // Stop the renderer before the window's device goes.
+        drop(self.worker.take());
+        if let Some(path) = &self.options.report {
+            write_report(path, &report)?;
+        }
+        std::mem::replace(&mut self.outcome, Ok(()))?;
+        if self.options.screenshot.is_some() || self.options.script.is_some() {
+            if let Some(e) = report.errors.first() {
+                bail!("the scripted session met an error: {e}");
+            }
+        }
+        Ok(())
+    }
+}
+
+fn write_report(path: &std::path::Path, report: &SessionReport) -> anyhow::Result<()> {
+    let json = serde_json::to_string_pretty(report)?;
+    std::fs::write(path, json).with_context(|| format!("--report {}", path.display()))
+}
+
+/// A script action as the input events a person's mouse or keyboard would produce.
+fn inject(input: &mut egui::RawInput, action: &Action, image: egui::Rect) {
+    let at = |f: [f32; 2]| image.min + egui::vec2(f[0] * image.width(), f[1] * image.height());
+    match action {
+        Action::Pointer { at: f, button } => {
+            let pos = at(*f);
+            input.events.push(egui::Event::PointerMoved(pos));
+            if let Some((primary, pressed)) = button {
+                input.events.push(egui::Event::PointerButton {
+                    pos,
+                    button: if *primary {
+                        egui::PointerButton::Primary
+                    } else {
+                        egui::PointerButton::Secondary
+                    },
+                    pressed: *pressed,
+                    modifiers: Default::default(),
+                });
+            }
+        }
+        Action::Scroll(steps) => input.events.push(egui::Event::MouseWheel {
+            unit: egui::MouseWheelUnit::Line,
+            delta: egui::vec2(0.0, *steps),
+            phase: egui::TouchPhase::Move,
+            modifiers: Default::default(),
+        }),
+        Action::Key(key) => {
+            for pressed in [true, false] {
+                input.events.push(egui::Event::Key {
+                    key: *key,
+                    physical_key: None,
+                    pressed,
+                    repeat: false,
+                    modifiers: Default::default(),
+                });
+            }
+        }
+        _ => {}
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.window.is_some() {
+            return;
+        }
+        match WindowGpu::new(event_loop, &self.egui, self.options.settings.size) {
+            Ok((gpu, adapter)) => {
+                gpu.window.request_redraw();
+                self.window = Some(gpu);
+                let worker = self.worker.take().expect("the worker starts once");
+                self.session = Some(Session::new(self.options.settings.clone(), worker, adapter));
+            }
+            Err(e) => {
+                self.outcome = Err(e.context("opening the window"));
+                event_loop.exit();
+            }
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
+        let Some(gpu) = &mut self.window else { return };
+        let response = gpu.egui_input.on_window_event(&gpu.window, &event);
+        match event {
+            WindowEvent::CloseRequested => event_loop.exit(),
+            WindowEvent::Resized(size) => gpu.resize(size.width, size.height),
+            WindowEvent::RedrawRequested => self.redraw(event_loop),
+            _ => {}
+        }
+        if response.repaint
+            && let Some(gpu) = &self.window
+        {
+            gpu.window.request_redraw();
+        }
+    }
+
+    fn user_event(&mut self, _: &ActiveEventLoop, _: ()) {
+        if let Some(gpu) = &self.window {
+            gpu.window.request_redraw();
+        }
+    }
+
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        let (Some(gpu), Some(session)) = (&self.window, &self.session) else {
+            return;
+        };
+        if session.busy() || self.script.as_ref().is_some_and(|s| !s.finished()) {
+            let due = self.last_redraw + BUSY_FRAME;
+            if Instant::now() >= due {
+                gpu.window.request_redraw();
+            } else {
+                event_loop.set_control_flow(ControlFlow::WaitUntil(due));
+            }
+        } else {
+            event_loop.set_control_flow(ControlFlow::Wait);
+        }
+    }
+}

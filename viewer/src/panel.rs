@@ -1,0 +1,403 @@
+//! The side panel (every choice `render` offers, the artist controls, display and screenshot)
+//! and the overlay on the image (adapter, frame time per pass, GPU memory, lights and batches).
+//! Each group says what its changes cost ([`Recompute::label`]).
+
+use crate::recompute::{Recompute, ViewState};
+use crate::worker::{Stage, Status};
+use egui_file_dialog::FileDialog;
+use std::path::PathBuf;
+use strandlight_scene::frame_settings::{
+    EnvLighting, Lighting, PointLighting, Shadows, Transparency,
+};
+use strandlight_scene::look::{BoxAverageArg, EnvTransparency};
+use strandlight_scene::point_shading::Shading;
+use strandlight_scene::scene_tables::ScatteringMode;
+use strandlight_tables::artist::ArtistParams;
+
+const PRESETS: [&str; 5] = ["dark", "brown", "red", "blonde", "white"];
+const MAPS: [&str; 2] = ["procedural:sun_and_sky", "procedural:studio"];
+
+/// What the panel asks of the session besides settings edits.
+#[derive(Default)]
+pub struct PanelOutcome {
+    pub open: Option<PathBuf>,
+    pub screenshot: bool,
+    pub reset_camera: bool,
+}
+
+#[derive(Default)]
+pub struct Panel {
+    dialog: Option<FileDialog>,
+    /// Lobes when "all" is unticked.
+    lobes: usize,
+}
+
+impl Panel {
+    pub fn show(
+        &mut self,
+        root: &mut egui::Ui,
+        state: &mut ViewState,
+        status: &Status,
+        message: &Option<String>,
+    ) -> PanelOutcome {
+        let mut outcome = PanelOutcome::default();
+        let ctx = root.ctx().clone();
+        egui::Panel::left("controls")
+            .default_size(300.0)
+            .show(root, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| {
+                    self.status_lines(ui, status, message);
+                    self.scene(ui, state, &mut outcome);
+                    lighting(ui, state, &mut self.lobes, status);
+                    artist(ui, state);
+                    display(ui, state, &mut outcome);
+                });
+            });
+        if let Some(dialog) = &mut self.dialog {
+            dialog.update(&ctx);
+            if let Some(path) = dialog.take_picked() {
+                outcome.open = Some(path);
+                self.dialog = None;
+            }
+        }
+        outcome
+    }
+
+    fn status_lines(&self, ui: &mut egui::Ui, status: &Status, message: &Option<String>) {
+        if let Some(bake) = &status.bake {
+            ui.label(format!(
+                "baking in the background ({:.0} s); the old tables stay on screen",
+                bake.started.elapsed().as_secs_f32()
+            ));
+            ui.add(egui::ProgressBar::new(bake.fraction).text(&bake.what));
+        }
+        if let Some(shown) = &status.shown {
+            let (fraction, text) = match shown.stage {
+                Stage::Preview => (0.0, "preview".to_string()),
+                Stage::Refining { done, total } => (
+                    done as f32 / total as f32,
+                    format!("refining: {done}/{total} light batches"),
+                ),
+                Stage::Converged => (1.0, format!("converged in {:.2} s", shown.seconds)),
+            };
+            ui.add(egui::ProgressBar::new(fraction).text(text));
+        }
+        if let Some(m) = message {
+            ui.colored_label(egui::Color32::LIGHT_RED, m);
+        }
+        ui.separator();
+    }
+
+    fn scene(&mut self, ui: &mut egui::Ui, state: &mut ViewState, outcome: &mut PanelOutcome) {
+        let s = &mut state.settings;
+        ui.heading("Scene");
+        ui.label(format!(
+            "hair: {}",
+            s.hair
+                .as_ref()
+                .map_or("procedural groom".into(), |p| p.display().to_string())
+        ));
+        ui.horizontal(|ui| {
+            if ui.button("Open hair or map…").clicked() {
+                let mut dialog = FileDialog::new()
+                    .add_file_filter_extensions(
+                        "hair and maps",
+                        vec!["hair", "tfx", "data", "ply", "hdr", "exr"],
+                    )
+                    .default_file_filter("hair and maps");
+                dialog.pick_file();
+                self.dialog = Some(dialog);
+            }
+            if ui.button("Procedural groom").clicked() {
+                s.hair = None;
+                outcome.reset_camera = true;
+            }
+        });
+        ui.small("or drop a .hair/.tfx/.data/.ply or .hdr/.exr file on the window");
+        let mut shading = s.shading();
+        egui::ComboBox::from_label("fiber model")
+            .selected_text(format!("{shading:?}"))
+            .show_ui(ui, |ui| {
+                for m in [Shading::KajiyaKay, Shading::Marschner, Shading::Artist] {
+                    let allowed = !(m == Shading::KajiyaKay
+                        && matches!(s.lighting, Lighting::Environment(_)));
+                    ui.add_enabled_ui(allowed, |ui| {
+                        ui.selectable_value(&mut shading, m, format!("{m:?}"));
+                    });
+                }
+            });
+        s.shading = Some(shading);
+        egui::ComboBox::from_label("melanin preset")
+            .selected_text(&s.preset)
+            .show_ui(ui, |ui| {
+                for p in PRESETS {
+                    ui.selectable_value(&mut s.preset, p.to_string(), p);
+                }
+            });
+        ui.separator();
+    }
+}
+
+fn lighting(ui: &mut egui::Ui, state: &mut ViewState, lobes: &mut usize, status: &Status) {
+    let s = &mut state.settings;
+    ui.heading("Lighting");
+    let mut env = matches!(s.lighting, Lighting::Environment(_));
+    ui.horizontal(|ui| {
+        ui.radio_value(&mut env, true, "environment (SRBF)");
+        ui.radio_value(&mut env, false, "point / directional / spot");
+    });
+    match (&s.lighting, env) {
+        (Lighting::Lights(_), true) => {
+            s.lighting = Lighting::Environment(EnvLighting::new(MAPS[0]));
+            if s.shading == Some(Shading::KajiyaKay) {
+                s.shading = Some(Shading::Marschner);
+            }
+        }
+        (Lighting::Environment(_), false) => s.lighting = Lighting::Lights(PointLighting::default()),
+        _ => {}
+    }
+    let total_lobes = status
+        .shown
+        .as_ref()
+        .and_then(|sh| sh.env.as_ref())
+        .map_or(64, |e| e.scene.fit.set.lobes.len());
+    match &mut s.lighting {
+        Lighting::Environment(e) => env_controls(ui, e, lobes, total_lobes),
+        Lighting::Lights(p) => point_controls(ui, p),
+    }
+    ui.separator();
+}
+
+fn env_controls(ui: &mut egui::Ui, e: &mut EnvLighting, lobes: &mut usize, total: usize) {
+    egui::ComboBox::from_label("map")
+        .selected_text(&e.map)
+        .show_ui(ui, |ui| {
+            for m in MAPS {
+                ui.selectable_value(&mut e.map, m.to_string(), m);
+            }
+        });
+    ui.label(Recompute::Tables.label());
+    ui.horizontal(|ui| {
+        ui.radio_value(&mut e.scattering, ScatteringMode::Single, "single");
+        ui.radio_value(&mut e.scattering, ScatteringMode::Full, "single + multiple");
+    });
+    ui.label(Recompute::ShadowMaps.label());
+    ui.add(egui::Slider::new(&mut e.rotation_deg, -180.0..=180.0).text("rotate map °"));
+    let mut all = e.lobes.is_none();
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut all, "all lobes");
+        if *lobes == 0 {
+            *lobes = e.lobes.unwrap_or(total.min(16)).max(1);
+        }
+        ui.add_enabled(
+            !all,
+            egui::Slider::new(lobes, 1..=total.max(1)).text("lobes"),
+        );
+    });
+    e.lobes = (!all).then_some(*lobes);
+    ui.add(
+        egui::Slider::new(&mut e.kappa, 0.02..=1.0)
+            .logarithmic(true)
+            .text("κ (strands in light maps)"),
+    );
+    egui::ComboBox::from_label("DODM resolution")
+        .selected_text(e.dodm_size.to_string())
+        .show_ui(ui, |ui| {
+            for r in [128, 256, 512, 1024] {
+                ui.selectable_value(&mut e.dodm_size, r, r.to_string());
+            }
+        });
+    ui.label(Recompute::Frame.label());
+    ui.horizontal(|ui| {
+        ui.radio_value(&mut e.transparency, EnvTransparency::Opaque, "opaque");
+        ui.radio_value(&mut e.transparency, EnvTransparency::Occupancy, "occupancy");
+    });
+    ui.horizontal(|ui| {
+        ui.label("box average");
+        ui.radio_value(&mut e.view.box_average, BoxAverageArg::OpticalDepth, "optical depth");
+        ui.radio_value(&mut e.view.box_average, BoxAverageArg::Transmittance, "transmittance");
+    });
+}
+
+fn point_controls(ui: &mut egui::Ui, p: &mut PointLighting) {
+    ui.label(format!("{} (edit a spec, Enter to apply)", Recompute::ShadowMaps.label()));
+    let mut remove = None;
+    for (i, spec) in p.lights.iter_mut().enumerate() {
+        ui.horizontal(|ui| {
+            let mut text = spec.clone();
+            let response = ui.text_edit_singleline(&mut text);
+            if response.lost_focus()
+                && strandlight_runtime::lights::Light::parse(&text).is_ok()
+            {
+                *spec = text;
+            }
+            if ui.small_button("✕").clicked() {
+                remove = Some(i);
+            }
+        });
+    }
+    if let Some(i) = remove.filter(|_| p.lights.len() > 1) {
+        p.lights.remove(i);
+    }
+    if ui.button("add a point light").clicked() {
+        p.lights.push("point:0,1,2:4".into());
+    }
+    ui.horizontal(|ui| {
+        ui.label("shadows");
+        ui.radio_value(&mut p.shadows, Shadows::None, "none");
+        ui.radio_value(&mut p.shadows, Shadows::Dom, "deep opacity maps");
+    });
+    if p.shadows == Shadows::Dom {
+        ui.add(egui::Slider::new(&mut p.dom_layers, 1..=8).text("DOM layers"));
+        egui::ComboBox::from_label("DOM resolution")
+            .selected_text(p.dom_size.to_string())
+            .show_ui(ui, |ui| {
+                for r in [256, 512, 1024, 2048] {
+                    ui.selectable_value(&mut p.dom_size, r, r.to_string());
+                }
+            });
+    }
+    ui.label(Recompute::Frame.label());
+    ui.horizontal(|ui| {
+        ui.label("transparency");
+        ui.radio_value(&mut p.transparency, Transparency::None, "opaque");
+        ui.radio_value(&mut p.transparency, Transparency::Abuffer, "A-buffer");
+        ui.radio_value(&mut p.transparency, Transparency::Dbk, "DBK");
+    });
+}
+
+/// Sadeghi's controls: shader constants under point lights, baked into the tables under an
+/// environment.
+fn artist(ui: &mut egui::Ui, state: &mut ViewState) {
+    let s = &mut state.settings;
+    if s.shading() != Shading::Artist {
+        return;
+    }
+    let cost = match s.lighting {
+        Lighting::Lights(_) => Recompute::Frame,
+        Lighting::Environment(_) => Recompute::Tables,
+    };
+    ui.heading("Artist controls (Sadeghi 2010)");
+    ui.label(cost.label());
+    let mut a = s.artist.unwrap_or_default();
+    lobe(ui, "primary highlight R", &mut a.r.color, &mut a.r.intensity, &mut a.r.shift_deg, &mut a.r.width_deg);
+    lobe(ui, "transmission TT", &mut a.tt.color, &mut a.tt.intensity, &mut a.tt.shift_deg, &mut a.tt.width_deg);
+    ui.add(egui::Slider::new(&mut a.tt.azimuthal_width_deg, 1.0..=90.0).text("TT azimuthal width °"));
+    lobe(ui, "secondary highlight TRT", &mut a.trt.color, &mut a.trt.intensity, &mut a.trt.shift_deg, &mut a.trt.width_deg);
+    ui.add(egui::Slider::new(&mut a.glints.relative_intensity, 0.0..=5.0).text("glint intensity"));
+    ui.add(egui::Slider::new(&mut a.glints.half_angle_deg, 30.0..=45.0).text("glint half angle °"));
+    if ui.button("default controls").clicked() {
+        a = ArtistParams::default();
+    }
+    s.artist = (a != ArtistParams::default()).then_some(a);
+    ui.separator();
+}
+
+fn lobe(
+    ui: &mut egui::Ui,
+    name: &str,
+    color: &mut [f64; 3],
+    intensity: &mut f64,
+    shift: &mut f64,
+    width: &mut f64,
+) {
+    ui.horizontal(|ui| {
+        let mut rgb = color.map(|c| c as f32);
+        if ui.color_edit_button_rgb(&mut rgb).changed() {
+            *color = rgb.map(f64::from);
+        }
+        ui.label(name);
+    });
+    ui.add(egui::Slider::new(intensity, 0.0..=5.0).text("intensity"));
+    ui.add(egui::Slider::new(shift, -15.0..=15.0).text("longitudinal shift °"));
+    ui.add(egui::Slider::new(width, 0.5..=30.0).text("longitudinal width °"));
+}
+
+fn display(ui: &mut egui::Ui, state: &mut ViewState, outcome: &mut PanelOutcome) {
+    let d = &mut state.display;
+    ui.heading("Display");
+    ui.label(Recompute::Nothing.label());
+    let mut auto = d.exposure_stops.is_none();
+    ui.checkbox(&mut auto, "automatic exposure");
+    let mut stops = d.exposure_stops.unwrap_or(0.0);
+    ui.add_enabled(!auto, egui::Slider::new(&mut stops, -10.0..=10.0).text("exposure (stops)"));
+    d.exposure_stops = (!auto).then_some(stops);
+    ui.checkbox(&mut d.background, "environment as background (B)");
+    ui.horizontal(|ui| {
+        outcome.screenshot = ui.button("Screenshot (S)").clicked();
+        outcome.reset_camera = outcome.reset_camera || ui.button("Reset camera (R)").clicked();
+    });
+    ui.small("drag: orbit · right drag: pan · scroll: zoom");
+}
+
+/// Adapter, stage, per-pass times, GPU memory and lights over the image's top left corner.
+pub fn overlay(ui: &egui::Ui, rect: egui::Rect, status: &Status, exposure: Option<f32>) {
+    let Some(shown) = &status.shown else {
+        let text = if status.bake.is_some() {
+            "fitting and baking…"
+        } else {
+            "starting…"
+        };
+        ui.painter().text(
+            rect.center(),
+            egui::Align2::CENTER_CENTER,
+            text,
+            egui::FontId::proportional(16.0),
+            egui::Color32::WHITE,
+        );
+        return;
+    };
+    let st = &shown.stats;
+    let mut lines = vec![
+        st.adapter.clone(),
+        format!(
+            "{}{}",
+            match shown.stage {
+                Stage::Preview => "preview".to_string(),
+                Stage::Refining { done, total } => format!("refining {done}/{total}"),
+                Stage::Converged => "converged".to_string(),
+            },
+            if shown.stale_tables { " (previous tables)" } else { "" }
+        ),
+    ];
+    if let Some(p) = status.preview_seconds {
+        lines.push(format!("first preview {:.2} s", p));
+    }
+    if let Some(c) = status.converged_seconds {
+        lines.push(format!("converged {:.2} s", c));
+    }
+    let total_ms: f64 = st.passes.iter().map(|(_, ms)| ms).sum();
+    lines.push(format!(
+        "{} lights in {} batch{}, {:.0} ms ({})",
+        st.lights,
+        st.batches,
+        if st.batches == 1 { "" } else { "es" },
+        total_ms,
+        st.timing_method
+    ));
+    let mut passes = st.passes.clone();
+    passes.sort_by(|a, b| b.1.total_cmp(&a.1));
+    for (pass, ms) in passes.iter().take(6) {
+        lines.push(format!("  {pass:<22} {ms:>8.1} ms"));
+    }
+    let memory: u64 = st.memory.iter().map(|(_, b)| b).sum();
+    lines.push(format!("GPU memory {:.1} MB", memory as f64 / 1e6));
+    let mut memory_items = st.memory.clone();
+    memory_items.sort_by(|a, b| b.1.cmp(&a.1));
+    for (name, bytes) in memory_items.iter().take(4) {
+        lines.push(format!("  {name:<22} {:>8.1} MB", *bytes as f64 / 1e6));
+    }
+    if let Some(stops) = exposure {
+        lines.push(format!("exposure {stops:+.2} stops"));
+    }
+    let galley = ui.painter().layout_no_wrap(
+        lines.join("\n"),
+        egui::FontId::monospace(11.0),
+        egui::Color32::from_gray(230),
+    );
+    let at = rect.min + egui::vec2(6.0, 6.0);
+    let back = egui::Rect::from_min_size(at, galley.size()).expand(4.0);
+    ui.painter()
+        .rect_filled(back, 3.0, egui::Color32::from_black_alpha(150));
+    ui.painter().galley(at, galley, egui::Color32::WHITE);
+}

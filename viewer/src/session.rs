@@ -1,0 +1,539 @@
+//! One viewing session: the state the panel edits, the orbit, the worker it feeds, the image on
+//! screen and the screenshots asked for. It draws one egui frame at a time and never waits for
+//! the renderer.
+
+use crate::display::{auto_exposure_stops, background, composite, to_rgba8};
+use crate::orbit::Orbit;
+use crate::panel::{Panel, PanelOutcome};
+use crate::recompute::{Display, Recompute, ViewState, recompute};
+use crate::screenshot::{ScreenshotFiles, save};
+use crate::script::{Action, WaitFor, merge_patch};
+use crate::worker::{LinearImage, Shown, Stage, Status, Worker};
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+use strandlight_scene::camera_choice::CameraChoice;
+use strandlight_scene::frame_settings::{CameraSettings, ExactCamera, FrameSettings, Lighting};
+
+/// Changes that need a rebake wait this long after the last edit (a slider being dragged).
+const REBAKE_SETTLE: Duration = Duration::from_millis(400);
+
+/// What a session has measured, for `--report`.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct SessionReport {
+    pub frames_presented: u64,
+    pub frames_presented_during_bakes: u64,
+    pub longest_frame_gap_ms: f64,
+    pub longest_frame_gap_during_bakes_ms: f64,
+    pub bakes_seen: u64,
+    /// Per request that converged: seconds to its preview and to the converged image.
+    pub requests: Vec<RequestTiming>,
+    pub screenshots: Vec<PathBuf>,
+    pub adapter: String,
+    pub window_adapter: String,
+    pub errors: Vec<String>,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct RequestTiming {
+    pub job: u64,
+    pub lighting: String,
+    pub size: [u32; 2],
+    pub preview_seconds: Option<f64>,
+    pub converged_seconds: f64,
+}
+
+/// The shown image as a texture, and what it was made from.
+struct OnScreen {
+    texture: egui::TextureHandle,
+    job: u64,
+    stage: Stage,
+    display: Display,
+    image: Arc<LinearImage>,
+    exposure_stops: f32,
+    composited: Vec<[f32; 4]>,
+}
+
+pub struct Session {
+    pub state: ViewState,
+    submitted: Option<(u64, FrameSettings)>,
+    edited_at: Instant,
+    next_job: u64,
+    orbit: Option<Orbit>,
+    worker: Worker,
+    on_screen: Option<OnScreen>,
+    last_good: FrameSettings,
+    message: Option<String>,
+    panel: Panel,
+    screenshots: Vec<PathBuf>,
+    pub report: SessionReport,
+    last_present: Option<Instant>,
+    bake_was_running: bool,
+    timed_jobs: Vec<u64>,
+    handled_error: Option<u64>,
+    image_rect: egui::Rect,
+}
+
+impl Session {
+    pub fn new(settings: FrameSettings, worker: Worker, window_adapter: String) -> Self {
+        Self {
+            last_good: settings.clone(),
+            state: ViewState {
+                settings,
+                display: Display::default(),
+            },
+            submitted: None,
+            edited_at: Instant::now(),
+            next_job: 1,
+            orbit: None,
+            worker,
+            on_screen: None,
+            message: None,
+            panel: Panel::default(),
+            screenshots: Vec::new(),
+            report: SessionReport {
+                window_adapter,
+                ..Default::default()
+            },
+            last_present: None,
+            bake_was_running: false,
+            timed_jobs: Vec::new(),
+            handled_error: None,
+            image_rect: egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(640.0, 480.0)),
+        }
+    }
+
+    /// Something is still changing on screen (the window keeps presenting).
+    pub fn busy(&self) -> bool {
+        let status = self.worker.status();
+        let refining = status
+            .shown
+            .as_ref()
+            .is_none_or(|s| s.stage != Stage::Converged || s.stale_tables);
+        status.bake.is_some() || refining || !self.screenshots.is_empty() || self.unsubmitted()
+    }
+
+    fn unsubmitted(&self) -> bool {
+        self.submitted
+            .as_ref()
+            .is_none_or(|(_, s)| *s != self.state.settings)
+    }
+
+    /// The latest settings are on screen in full, with their own tables.
+    pub fn converged(&self) -> bool {
+        let status = self.worker.status();
+        let latest = self.submitted.as_ref().map(|(id, _)| *id);
+        status.bake.is_none()
+            && !self.unsubmitted()
+            && status.shown.as_ref().is_some_and(|s| {
+                Some(s.job) == latest && s.stage == Stage::Converged && !s.stale_tables
+            })
+    }
+
+    pub fn wait_done(&self, cond: WaitFor) -> bool {
+        match cond {
+            WaitFor::Converged => self.converged(),
+            WaitFor::Tables => self.worker.status().bake.is_none(),
+        }
+    }
+
+    /// Counts a presented frame.
+    pub fn presented(&mut self) {
+        let now = Instant::now();
+        let baking = self.worker.status().bake.is_some();
+        if let Some(last) = self.last_present {
+            let gap = now.duration_since(last).as_secs_f64() * 1e3;
+            self.report.longest_frame_gap_ms = self.report.longest_frame_gap_ms.max(gap);
+            if baking && self.bake_was_running {
+                self.report.longest_frame_gap_during_bakes_ms =
+                    self.report.longest_frame_gap_during_bakes_ms.max(gap);
+            }
+        }
+        if baking {
+            self.report.frames_presented_during_bakes += 1;
+            if !self.bake_was_running {
+                self.report.bakes_seen += 1;
+            }
+        }
+        self.bake_was_running = baking;
+        self.report.frames_presented += 1;
+        self.last_present = Some(now);
+    }
+
+    /// Applies a script's actions that are not input events.
+    pub fn apply(&mut self, action: &Action) -> anyhow::Result<()> {
+        match action {
+            Action::Settings(patch) => {
+                let mut value = serde_json::to_value(&self.state.settings)?;
+                merge_patch(&mut value, patch);
+                let settings: FrameSettings = serde_json::from_value(value)
+                    .map_err(|e| anyhow::anyhow!("script settings patch {patch}: {e}"))?;
+                self.edit(|s| s.settings = settings);
+            }
+            Action::Exposure(stops) => self.state.display.exposure_stops = *stops,
+            Action::Screenshot(path) => self.screenshots.push(path.clone()),
+            _ => {}
+        }
+        Ok(())
+    }
+
+    fn edit(&mut self, change: impl FnOnce(&mut ViewState)) {
+        change(&mut self.state);
+        self.edited_at = Instant::now();
+    }
+
+    /// One egui frame: panel, image, overlay; then requests, screenshots and errors.
+    pub fn frame(&mut self, ui: &mut egui::Ui) {
+        let ctx = &ui.ctx().clone();
+        let status = self.worker.status().clone();
+        self.take_error(&status);
+        self.time_requests(&status);
+        self.keys(ctx);
+        self.update_texture(ctx, &status);
+        let before = self.state.clone();
+        let outcome = self.panel.show(ui, &mut self.state, &status, &self.message);
+        if self.state != before {
+            self.edited_at = Instant::now();
+        }
+        self.apply_panel(outcome);
+        self.image_area(ui, &status);
+        self.submit_when_due(ctx);
+        self.save_screenshots(&status);
+    }
+
+    fn keys(&mut self, ctx: &egui::Context) {
+        if ctx.egui_wants_keyboard_input() {
+            return;
+        }
+        let (b, s, r) = ctx.input(|i| {
+            (
+                i.key_pressed(egui::Key::B),
+                i.key_pressed(egui::Key::S),
+                i.key_pressed(egui::Key::R),
+            )
+        });
+        if b {
+            self.state.display.background = !self.state.display.background;
+        }
+        if s {
+            self.screenshots.push(default_screenshot_stem());
+        }
+        if r {
+            self.reset_camera();
+        }
+        let dropped: Vec<PathBuf> =
+            ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).collect());
+        for path in dropped {
+            self.open(path);
+        }
+    }
+
+    fn reset_camera(&mut self) {
+        self.orbit = None;
+        self.edit(|s| s.settings.camera = CameraSettings::Framed(CameraChoice::default()));
+    }
+
+    /// A dropped or picked file: hair by its extension, else an environment map.
+    fn open(&mut self, path: PathBuf) {
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase();
+        match ext.as_str() {
+            "hair" | "tfx" | "data" | "ply" => {
+                self.orbit = None;
+                self.edit(|s| {
+                    s.settings.hair = Some(path);
+                    s.settings.camera = CameraSettings::Framed(CameraChoice::default());
+                });
+            }
+            "hdr" | "exr" => {
+                let map = path.display().to_string();
+                self.edit(|s| match &mut s.settings.lighting {
+                    Lighting::Environment(env) => env.map = map,
+                    Lighting::Lights(_) => {
+                        s.settings.lighting = Lighting::Environment(
+                            strandlight_scene::frame_settings::EnvLighting::new(map),
+                        );
+                        if s.settings.shading
+                            == Some(strandlight_scene::point_shading::Shading::KajiyaKay)
+                        {
+                            s.settings.shading = None;
+                        }
+                    }
+                });
+            }
+            _ => {
+                self.message = Some(format!(
+                    "{}: not a hair file (.hair, .tfx, .data, .ply) or an environment map (.hdr, .exr)",
+                    path.display()
+                ))
+            }
+        }
+    }
+
+    fn apply_panel(&mut self, outcome: PanelOutcome) {
+        if let Some(path) = outcome.open {
+            self.open(path);
+        }
+        if outcome.screenshot {
+            self.screenshots.push(default_screenshot_stem());
+        }
+        if outcome.reset_camera {
+            self.reset_camera();
+        }
+    }
+
+    /// A failed request: its message in the panel, and the last settings that rendered back.
+    fn take_error(&mut self, status: &Status) {
+        let latest = self.submitted.as_ref().map(|(id, _)| *id);
+        if let Some((job, error)) = &status.error
+            && Some(*job) == latest
+            && self.handled_error != Some(*job)
+        {
+            self.handled_error = Some(*job);
+            self.message = Some(error.clone());
+            self.report.errors.push(error.clone());
+            // Back to what rendered last; it differs from the failed request, so it is sent.
+            self.state.settings = self.last_good.clone();
+        }
+        if let Some(shown) = &status.shown
+            && Some(shown.job) == latest
+            && !shown.stale_tables
+        {
+            self.last_good = shown.settings.clone();
+        }
+    }
+
+    fn time_requests(&mut self, status: &Status) {
+        let (Some(shown), Some(converged)) = (&status.shown, status.converged_seconds) else {
+            return;
+        };
+        if shown.stage != Stage::Converged || self.timed_jobs.contains(&shown.job) {
+            return;
+        }
+        self.timed_jobs.push(shown.job);
+        self.report.adapter = shown.stats.adapter.clone();
+        self.report.requests.push(RequestTiming {
+            job: shown.job,
+            lighting: match &shown.settings.lighting {
+                Lighting::Lights(p) => format!("lights {:?}", p.lights),
+                Lighting::Environment(e) => format!("environment {}", e.map),
+            },
+            size: shown.settings.size,
+            preview_seconds: status.preview_seconds,
+            converged_seconds: converged,
+        });
+    }
+
+    /// Sends the settings to the worker: at once for a new frame, after the edits settle for a
+    /// rebake (a slider drag would otherwise start a bake per step).
+    fn submit_when_due(&mut self, ctx: &egui::Context) {
+        if !self.unsubmitted() {
+            return;
+        }
+        let cost = match &self.submitted {
+            None => Recompute::Hair,
+            Some((_, old)) => recompute(
+                &ViewState {
+                    settings: old.clone(),
+                    display: self.state.display,
+                },
+                &self.state,
+            ),
+        };
+        let dragging = ctx.input(|i| i.pointer.any_down());
+        if self.submitted.is_some()
+            && cost >= Recompute::Tables
+            && (dragging || self.edited_at.elapsed() < REBAKE_SETTLE)
+        {
+            ctx.request_repaint_after(REBAKE_SETTLE);
+            return;
+        }
+        let job = self.next_job;
+        self.next_job += 1;
+        self.worker.submit(job, self.state.settings.clone());
+        self.submitted = Some((job, self.state.settings.clone()));
+    }
+
+    fn exposure_for(&self, image: &LinearImage) -> f32 {
+        match self.state.display.exposure_stops {
+            Some(stops) => stops,
+            None => auto_exposure_stops(image),
+        }
+    }
+
+    fn update_texture(&mut self, ctx: &egui::Context, status: &Status) {
+        let Some(shown) = &status.shown else { return };
+        let unchanged = self.on_screen.as_ref().is_some_and(|o| {
+            o.job == shown.job
+                && o.stage == shown.stage
+                && Arc::ptr_eq(&o.image, &shown.image)
+                && o.display == self.state.display
+        });
+        if unchanged {
+            return;
+        }
+        let image = shown.image.clone();
+        let stops = self.exposure_for(&image);
+        let behind = self.background_of(shown, &image);
+        let composited = composite(&image, stops, behind.as_deref());
+        let rgba = to_rgba8(&composited);
+        let color = egui::ColorImage::from_rgba_unmultiplied(
+            [image.width as usize, image.height as usize],
+            &rgba,
+        );
+        let texture = match self.on_screen.take() {
+            Some(mut o) => {
+                o.texture.set(color, egui::TextureOptions::LINEAR);
+                o.texture
+            }
+            None => ctx.load_texture("frame", color, egui::TextureOptions::LINEAR),
+        };
+        self.on_screen = Some(OnScreen {
+            texture,
+            job: shown.job,
+            stage: shown.stage,
+            display: self.state.display,
+            image,
+            exposure_stops: stops,
+            composited,
+        });
+    }
+
+    fn background_of(&self, shown: &Shown, image: &LinearImage) -> Option<Vec<[f32; 3]>> {
+        if !self.state.display.background {
+            return None;
+        }
+        let (env, Lighting::Environment(lighting)) = (shown.env.as_ref()?, &shown.settings.lighting)
+        else {
+            return None;
+        };
+        Some(background(
+            &env.env.map,
+            &shown.camera,
+            [image.width, image.height],
+            env.up,
+            lighting.rotation_deg,
+        ))
+    }
+
+    /// The image, scaled to fit, taking orbit drags, pans and zoom; the overlay on top.
+    fn image_area(&mut self, ui: &mut egui::Ui, status: &Status) {
+        egui::CentralPanel::default()
+            .frame(egui::Frame::NONE.fill(egui::Color32::from_gray(20)))
+            .show(ui, |ui| {
+                let available = ui.available_rect_before_wrap();
+                let [w, h] = self.state.settings.size;
+                let scale = (available.width() / w as f32).min(available.height() / h as f32);
+                let size = egui::vec2(w as f32 * scale, h as f32 * scale);
+                let rect = egui::Rect::from_center_size(available.center(), size);
+                self.image_rect = rect;
+                let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
+                if let Some(o) = &self.on_screen {
+                    ui.painter().image(
+                        o.texture.id(),
+                        rect,
+                        egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
+                        egui::Color32::WHITE,
+                    );
+                }
+                self.camera_input(ui, &response, status, size.y / scale);
+                crate::panel::overlay(ui, rect, status, self.on_screen.as_ref().map(|o| o.exposure_stops));
+            });
+    }
+
+    fn camera_input(
+        &mut self,
+        ui: &egui::Ui,
+        response: &egui::Response,
+        status: &Status,
+        image_height: f32,
+    ) {
+        let scroll = if response.hovered() {
+            ui.input(|i| i.smooth_scroll_delta.y)
+        } else {
+            0.0
+        };
+        let orbit_drag = response.dragged_by(egui::PointerButton::Primary);
+        let pan_drag = response.dragged_by(egui::PointerButton::Secondary)
+            || response.dragged_by(egui::PointerButton::Middle);
+        if !(orbit_drag || pan_drag || scroll != 0.0) {
+            return;
+        }
+        if self.orbit.is_none() {
+            let Some(shown) = &status.shown else { return };
+            self.orbit = Some(Orbit::from_camera(&shown.camera, shown.front, shown.radius));
+        }
+        let orbit = self.orbit.as_mut().expect("set above");
+        let delta = response.drag_delta() / (response.rect.height() / image_height);
+        if orbit_drag {
+            orbit.rotate(delta.x, delta.y);
+        }
+        if pan_drag {
+            orbit.pan(delta.x, delta.y, image_height);
+        }
+        if scroll != 0.0 {
+            orbit.zoom(scroll / 50.0);
+        }
+        let camera = ExactCamera::of(&orbit.camera());
+        self.edit(|s| s.settings.camera = CameraSettings::Exact(camera));
+    }
+
+    /// Saves the screenshots asked for once the latest settings have converged.
+    fn save_screenshots(&mut self, status: &Status) {
+        if self.screenshots.is_empty() || !self.converged() {
+            return;
+        }
+        let (Some(on_screen), Some(shown)) = (&self.on_screen, &status.shown) else {
+            return;
+        };
+        if on_screen.job != shown.job || on_screen.stage != Stage::Converged {
+            return;
+        }
+        for stem in std::mem::take(&mut self.screenshots) {
+            match save(
+                &stem,
+                &shown.settings,
+                &self.state.display,
+                on_screen.exposure_stops,
+                &on_screen.image,
+                &on_screen.composited,
+            ) {
+                Ok(files) => {
+                    let ScreenshotFiles { png, exr, sidecar } = files;
+                    self.message = Some(format!(
+                        "saved {}, {} and {}",
+                        png.display(),
+                        exr.display(),
+                        sidecar.display()
+                    ));
+                    self.report.screenshots.push(png);
+                }
+                Err(e) => {
+                    let e = format!("screenshot {}: {e:#}", stem.display());
+                    self.report.errors.push(e.clone());
+                    self.message = Some(e);
+                }
+            }
+        }
+    }
+
+    /// Where the image was drawn last frame (scripted pointer positions are fractions of it).
+    pub fn image_rect(&self) -> egui::Rect {
+        self.image_rect
+    }
+
+    pub fn screenshots_pending(&self) -> bool {
+        !self.screenshots.is_empty()
+    }
+}
+
+/// `out/view-<unix seconds>`.
+fn default_screenshot_stem() -> PathBuf {
+    let seconds = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    PathBuf::from(format!("out/view-{seconds}"))
+}
