@@ -71,7 +71,9 @@ fn settings(args: &ViewArgs) -> anyhow::Result<FrameSettings> {
         })
     } else {
         if args.env.is_some() {
-            anyhow::bail!("--env and --light: choose an environment or lights (the panel switches)");
+            anyhow::bail!(
+                "--env and --light: choose an environment or lights (the panel switches)"
+            );
         }
         Lighting::Lights(PointLighting {
             lights: args.lights.clone(),

@@ -83,7 +83,12 @@ mod tests {
     #[test]
     fn world_to_env_undoes_env_to_world() {
         for up in [UpAxis::Y, UpAxis::Z] {
-            for d in [DVec3::X, DVec3::Y, DVec3::Z, DVec3::new(0.3, -0.5, 0.81).normalize()] {
+            for d in [
+                DVec3::X,
+                DVec3::Y,
+                DVec3::Z,
+                DVec3::new(0.3, -0.5, 0.81).normalize(),
+            ] {
                 assert!((world_to_env(env_to_world(d, up), up) - d).length() < 1e-12);
             }
         }

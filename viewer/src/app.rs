@@ -60,6 +60,7 @@ pub fn run(options: ViewOptions) -> anyhow::Result<()> {
         egui: egui::Context::default(),
         started: Instant::now(),
         last_redraw: Instant::now(),
+        repaint_asked: false,
         outcome: Ok(()),
     };
     event_loop.run_app(&mut app)?;
@@ -75,6 +76,7 @@ struct App {
     egui: egui::Context,
     started: Instant,
     last_redraw: Instant,
+    repaint_asked: bool,
     outcome: anyhow::Result<()>,
 }
 
@@ -90,7 +92,11 @@ struct WindowGpu {
 }
 
 impl WindowGpu {
-    fn new(event_loop: &ActiveEventLoop, egui: &egui::Context, size: [u32; 2]) -> anyhow::Result<(Self, String)> {
+    fn new(
+        event_loop: &ActiveEventLoop,
+        egui: &egui::Context,
+        size: [u32; 2],
+    ) -> anyhow::Result<(Self, String)> {
         let attributes = Window::default_attributes()
             .with_title("strandlight")
             .with_inner_size(winit::dpi::LogicalSize::new(
@@ -111,10 +117,11 @@ impl WindowGpu {
         .context("no adapter can present to this window")?;
         let info = adapter.get_info();
         let adapter_name = format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type);
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("strandlight window"),
-            ..Default::default()
-        }))?;
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+                label: Some("strandlight window"),
+                ..Default::default()
+            }))?;
         let physical = window.inner_size();
         let mut config = surface
             .get_default_config(&adapter, physical.width.max(1), physical.height.max(1))
@@ -127,7 +134,11 @@ impl WindowGpu {
             .find(|f| !f.is_srgb())
             .unwrap_or(caps.formats[0]);
         surface.configure(&device, &config);
-        let renderer = egui_wgpu::Renderer::new(&device, config.format, egui_wgpu::RendererOptions::default());
+        let renderer = egui_wgpu::Renderer::new(
+            &device,
+            config.format,
+            egui_wgpu::RendererOptions::default(),
+        );
         let egui_input = egui_winit::State::new(
             egui.clone(),
             egui::ViewportId::ROOT,
@@ -170,7 +181,8 @@ impl WindowGpu {
             }
         }
         let frame = match self.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(f) | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
+            wgpu::CurrentSurfaceTexture::Success(f)
+            | wgpu::CurrentSurfaceTexture::Suboptimal(f) => f,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
                 self.surface.configure(&self.device, &self.config);
                 return false;
@@ -183,9 +195,9 @@ impl WindowGpu {
             pixels_per_point: output.pixels_per_point,
         };
         let mut encoder = self.device.create_command_encoder(&Default::default());
-        let extra = self
-            .renderer
-            .update_buffers(&self.device, &self.queue, &mut encoder, &jobs, &screen);
+        let extra =
+            self.renderer
+                .update_buffers(&self.device, &self.queue, &mut encoder, &jobs, &screen);
         {
             let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("egui"),
@@ -241,9 +253,8 @@ impl App {
         if gpu.paint(&self.egui, output) {
             session.presented();
         }
-        if repaint {
-            gpu.window.request_redraw();
-        }
+        // egui asks for a repaint while anything animates; about_to_wait paces it.
+        self.repaint_asked = repaint;
         self.check_exit(event_loop);
     }
 
@@ -283,10 +294,10 @@ impl App {
             write_report(path, &report)?;
         }
         std::mem::replace(&mut self.outcome, Ok(()))?;
-        if self.options.screenshot.is_some() || self.options.script.is_some() {
-            if let Some(e) = report.errors.first() {
-                bail!("the scripted session met an error: {e}");
-            }
+        if (self.options.screenshot.is_some() || self.options.script.is_some())
+            && let Some(e) = report.errors.first()
+        {
+            bail!("the scripted session met an error: {e}");
         }
         Ok(())
     }
@@ -359,6 +370,9 @@ impl ApplicationHandler for App {
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _: WindowId, event: WindowEvent) {
         let Some(gpu) = &mut self.window else { return };
+        if let WindowEvent::DroppedFile(_) = &event {
+            self.repaint_asked = true;
+        }
         let response = gpu.egui_input.on_window_event(&gpu.window, &event);
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
@@ -366,24 +380,23 @@ impl ApplicationHandler for App {
             WindowEvent::RedrawRequested => self.redraw(event_loop),
             _ => {}
         }
-        if response.repaint
-            && let Some(gpu) = &self.window
-        {
-            gpu.window.request_redraw();
-        }
+        // Input is shown at the next paced frame (at most BUSY_FRAME later).
+        self.repaint_asked |= response.repaint;
     }
 
+    /// The worker changed its status: shown at the next paced frame.
     fn user_event(&mut self, _: &ActiveEventLoop, _: ()) {
-        if let Some(gpu) = &self.window {
-            gpu.window.request_redraw();
-        }
+        self.repaint_asked = true;
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
         let (Some(gpu), Some(session)) = (&self.window, &self.session) else {
             return;
         };
-        if session.busy() || self.script.as_ref().is_some_and(|s| !s.finished()) {
+        if self.repaint_asked
+            || session.busy()
+            || self.script.as_ref().is_some_and(|s| !s.finished())
+        {
             let due = self.last_redraw + BUSY_FRAME;
             if Instant::now() >= due {
                 gpu.window.request_redraw();

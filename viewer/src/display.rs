@@ -4,7 +4,7 @@
 //! show the same thing.
 
 use crate::worker::LinearImage;
-use glam::{DVec3, Quat, Vec4};
+use glam::{Quat, Vec4};
 use strandlight_precompute::envmap::EnvMap;
 use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::image_out::tonemap_channel;
@@ -42,8 +42,7 @@ pub fn background(
     rotation_deg: f32,
 ) -> Vec<[f32; 3]> {
     let [w, h] = size;
-    let clip_to_world =
-        (camera.projection_matrix(w as f32 / h as f32) * camera.view()).inverse();
+    let clip_to_world = (camera.projection_matrix(w as f32 / h as f32) * camera.view()).inverse();
     let unturn = Quat::from_axis_angle(up.vector(), -rotation_deg.to_radians());
     let mut out = Vec::with_capacity(w as usize * h as usize);
     for y in 0..h {
@@ -54,7 +53,7 @@ pub fn background(
             let near = clip_to_world * Vec4::new(ndc_x, ndc_y, 0.0, 1.0);
             let ray = far.truncate() / far.w - near.truncate() / near.w;
             let world = unturn * ray.normalize_or_zero();
-            out.push(map.radiance(world_to_env(DVec3::from(world.as_dvec3()), up)));
+            out.push(map.radiance(world_to_env(world.as_dvec3(), up)));
         }
     }
     out
@@ -99,7 +98,7 @@ pub fn to_rgba8(pixels: &[[f32; 4]]) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::Vec3;
+    use glam::{DVec3, Vec3};
     use strandlight_runtime::camera::Projection;
 
     #[test]

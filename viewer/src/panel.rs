@@ -153,7 +153,9 @@ fn lighting(ui: &mut egui::Ui, state: &mut ViewState, lobes: &mut usize, status:
                 s.shading = Some(Shading::Marschner);
             }
         }
-        (Lighting::Environment(_), false) => s.lighting = Lighting::Lights(PointLighting::default()),
+        (Lighting::Environment(_), false) => {
+            s.lighting = Lighting::Lights(PointLighting::default())
+        }
         _ => {}
     }
     let total_lobes = status
@@ -214,21 +216,30 @@ fn env_controls(ui: &mut egui::Ui, e: &mut EnvLighting, lobes: &mut usize, total
     });
     ui.horizontal(|ui| {
         ui.label("box average");
-        ui.radio_value(&mut e.view.box_average, BoxAverageArg::OpticalDepth, "optical depth");
-        ui.radio_value(&mut e.view.box_average, BoxAverageArg::Transmittance, "transmittance");
+        ui.radio_value(
+            &mut e.view.box_average,
+            BoxAverageArg::OpticalDepth,
+            "optical depth",
+        );
+        ui.radio_value(
+            &mut e.view.box_average,
+            BoxAverageArg::Transmittance,
+            "transmittance",
+        );
     });
 }
 
 fn point_controls(ui: &mut egui::Ui, p: &mut PointLighting) {
-    ui.label(format!("{} (edit a spec, Enter to apply)", Recompute::ShadowMaps.label()));
+    ui.label(format!(
+        "{} (edit a spec, Enter to apply)",
+        Recompute::ShadowMaps.label()
+    ));
     let mut remove = None;
     for (i, spec) in p.lights.iter_mut().enumerate() {
         ui.horizontal(|ui| {
             let mut text = spec.clone();
             let response = ui.text_edit_singleline(&mut text);
-            if response.lost_focus()
-                && strandlight_runtime::lights::Light::parse(&text).is_ok()
-            {
+            if response.lost_focus() && strandlight_runtime::lights::Light::parse(&text).is_ok() {
                 *spec = text;
             }
             if ui.small_button("✕").clicked() {
@@ -280,10 +291,33 @@ fn artist(ui: &mut egui::Ui, state: &mut ViewState) {
     ui.heading("Artist controls (Sadeghi 2010)");
     ui.label(cost.label());
     let mut a = s.artist.unwrap_or_default();
-    lobe(ui, "primary highlight R", &mut a.r.color, &mut a.r.intensity, &mut a.r.shift_deg, &mut a.r.width_deg);
-    lobe(ui, "transmission TT", &mut a.tt.color, &mut a.tt.intensity, &mut a.tt.shift_deg, &mut a.tt.width_deg);
-    ui.add(egui::Slider::new(&mut a.tt.azimuthal_width_deg, 1.0..=90.0).text("TT azimuthal width °"));
-    lobe(ui, "secondary highlight TRT", &mut a.trt.color, &mut a.trt.intensity, &mut a.trt.shift_deg, &mut a.trt.width_deg);
+    lobe(
+        ui,
+        "primary highlight R",
+        &mut a.r.color,
+        &mut a.r.intensity,
+        &mut a.r.shift_deg,
+        &mut a.r.width_deg,
+    );
+    lobe(
+        ui,
+        "transmission TT",
+        &mut a.tt.color,
+        &mut a.tt.intensity,
+        &mut a.tt.shift_deg,
+        &mut a.tt.width_deg,
+    );
+    ui.add(
+        egui::Slider::new(&mut a.tt.azimuthal_width_deg, 1.0..=90.0).text("TT azimuthal width °"),
+    );
+    lobe(
+        ui,
+        "secondary highlight TRT",
+        &mut a.trt.color,
+        &mut a.trt.intensity,
+        &mut a.trt.shift_deg,
+        &mut a.trt.width_deg,
+    );
     ui.add(egui::Slider::new(&mut a.glints.relative_intensity, 0.0..=5.0).text("glint intensity"));
     ui.add(egui::Slider::new(&mut a.glints.half_angle_deg, 30.0..=45.0).text("glint half angle °"));
     if ui.button("default controls").clicked() {
@@ -320,7 +354,10 @@ fn display(ui: &mut egui::Ui, state: &mut ViewState, outcome: &mut PanelOutcome)
     let mut auto = d.exposure_stops.is_none();
     ui.checkbox(&mut auto, "automatic exposure");
     let mut stops = d.exposure_stops.unwrap_or(0.0);
-    ui.add_enabled(!auto, egui::Slider::new(&mut stops, -10.0..=10.0).text("exposure (stops)"));
+    ui.add_enabled(
+        !auto,
+        egui::Slider::new(&mut stops, -10.0..=10.0).text("exposure (stops)"),
+    );
     d.exposure_stops = (!auto).then_some(stops);
     ui.checkbox(&mut d.background, "environment as background (B)");
     ui.horizontal(|ui| {
@@ -357,7 +394,11 @@ pub fn overlay(ui: &egui::Ui, rect: egui::Rect, status: &Status, exposure: Optio
                 Stage::Refining { done, total } => format!("refining {done}/{total}"),
                 Stage::Converged => "converged".to_string(),
             },
-            if shown.stale_tables { " (previous tables)" } else { "" }
+            if shown.stale_tables {
+                " (previous tables)"
+            } else {
+                ""
+            }
         ),
     ];
     if let Some(p) = status.preview_seconds {
@@ -383,7 +424,7 @@ pub fn overlay(ui: &egui::Ui, rect: egui::Rect, status: &Status, exposure: Optio
     let memory: u64 = st.memory.iter().map(|(_, b)| b).sum();
     lines.push(format!("GPU memory {:.1} MB", memory as f64 / 1e6));
     let mut memory_items = st.memory.clone();
-    memory_items.sort_by(|a, b| b.1.cmp(&a.1));
+    memory_items.sort_by_key(|item| std::cmp::Reverse(item.1));
     for (name, bytes) in memory_items.iter().take(4) {
         lines.push(format!("  {name:<22} {:>8.1} MB", *bytes as f64 / 1e6));
     }

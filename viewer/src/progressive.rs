@@ -203,7 +203,9 @@ mod tests {
         }
         assert_eq!(covered, vec![0, 1, 2, 3, 4]);
         assert_eq!(last, 1.0);
-        assert!(matches!(steps[1], Step::Batch { power_after, .. } if (power_after - 0.6).abs() < 1e-6));
+        assert!(
+            matches!(steps[1], Step::Batch { power_after, .. } if (power_after - 0.6).abs() < 1e-6)
+        );
         assert_eq!(plan_steps(None), vec![Step::Preview, Step::Full]);
     }
 

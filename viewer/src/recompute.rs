@@ -219,8 +219,10 @@ mod tests {
         );
         let point = state(lights(), Shading::KajiyaKay);
         assert_eq!(
-            cost(&point, |s| if let Lighting::Lights(p) = &mut s.settings.lighting {
-                p.shadows = Shadows::Dom
+            cost(&point, |s| {
+                if let Lighting::Lights(p) = &mut s.settings.lighting {
+                    p.shadows = Shadows::Dom
+                }
             }),
             Recompute::ShadowMaps
         );

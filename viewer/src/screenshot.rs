@@ -42,14 +42,19 @@ pub fn save(
 ) -> anyhow::Result<ScreenshotFiles> {
     let files = ScreenshotFiles::at(stem);
     if let Some(dir) = files.png.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).with_context(|| format!("screenshot folder {}", dir.display()))?;
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("screenshot folder {}", dir.display()))?;
     }
     let json = settings.to_json();
     let compact = serde_json::to_string(settings)?;
     let look = format!(
         "strandlight view screenshot; exposure {exposure_stops:+.2} stops ({}), background {}; \
          replay: strandlight render --replay {}; settings {compact}",
-        if display.exposure_stops.is_none() { "auto" } else { "manual" },
+        if display.exposure_stops.is_none() {
+            "auto"
+        } else {
+            "manual"
+        },
         if display.background { "on" } else { "off" },
         files.sidecar.display()
     );

@@ -108,7 +108,11 @@ impl Script {
 
     /// How far: "step 3/7".
     pub fn position(&self) -> String {
-        format!("step {}/{}", self.next.min(self.steps.len()), self.steps.len())
+        format!(
+            "step {}/{}",
+            self.next.min(self.steps.len()),
+            self.steps.len()
+        )
     }
 
     /// This frame's actions; `waiting_done(cond)` tells whether a wait is over.
@@ -202,7 +206,10 @@ mod tests {
     #[test]
     fn a_drag_presses_moves_and_releases_and_waits_hold_the_script() {
         let mut script = Script {
-            steps: vec![Step::Wait(WaitFor::Converged), Step::Drag([[0.0, 0.0], [1.0, 0.5]])],
+            steps: vec![
+                Step::Wait(WaitFor::Converged),
+                Step::Drag([[0.0, 0.0], [1.0, 0.5]]),
+            ],
             next: 0,
             frame: 0,
         };

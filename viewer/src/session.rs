@@ -221,8 +221,13 @@ impl Session {
         if r {
             self.reset_camera();
         }
-        let dropped: Vec<PathBuf> =
-            ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).collect());
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_path_buf())
+                .collect()
+        });
         for path in dropped {
             self.open(path);
         }
@@ -406,7 +411,8 @@ impl Session {
         if !self.state.display.background {
             return None;
         }
-        let (env, Lighting::Environment(lighting)) = (shown.env.as_ref()?, &shown.settings.lighting)
+        let (env, Lighting::Environment(lighting)) =
+            (shown.env.as_ref()?, &shown.settings.lighting)
         else {
             return None;
         };
@@ -440,7 +446,12 @@ impl Session {
                     );
                 }
                 self.camera_input(ui, &response, status, size.y / scale);
-                crate::panel::overlay(ui, rect, status, self.on_screen.as_ref().map(|o| o.exposure_stops));
+                crate::panel::overlay(
+                    ui,
+                    rect,
+                    status,
+                    self.on_screen.as_ref().map(|o| o.exposure_stops),
+                );
             });
     }
 

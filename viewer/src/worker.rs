@@ -8,10 +8,10 @@ use crate::progressive::{Accumulator, Step, plan_steps, preview_lights, preview_
 use anyhow::Context;
 use glam::Vec3;
 use std::path::PathBuf;
-use strandlight_runtime::camera::Camera;
 use std::sync::mpsc::{Receiver, TryRecvError, channel};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
+use strandlight_runtime::camera::Camera;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_scene::env_frame::{env_adapter, render_lights};
 use strandlight_scene::env_scene::PrepareProgress;
@@ -40,7 +40,10 @@ pub struct LinearImage {
 pub enum Stage {
     Preview,
     /// `done` of `total` light batches summed.
-    Refining { done: usize, total: usize },
+    Refining {
+        done: usize,
+        total: usize,
+    },
     Converged,
 }
 
