@@ -170,10 +170,20 @@ impl WindowGpu {
     }
 
     /// Draws egui's output; false when no frame could be acquired (it is tried again).
-    fn paint(&mut self, egui: &egui::Context, output: egui::FullOutput) -> bool {
+    fn paint(&mut self, egui: &egui::Context, mut output: egui::FullOutput) -> bool {
+        let presented = self.paint_frame(egui, &mut output);
+        for id in &output.textures_delta.free {
+            self.renderer.free_texture(id);
+        }
+        // Every delta is applied now (egui checks that none is dropped unapplied).
+        output.textures_delta.clear();
+        presented
+    }
+
+    fn paint_frame(&mut self, egui: &egui::Context, output: &mut egui::FullOutput) -> bool {
         self.egui_input
-            .handle_platform_output(&self.window, output.platform_output);
-        let jobs = egui.tessellate(output.shapes, output.pixels_per_point);
+            .handle_platform_output(&self.window, std::mem::take(&mut output.platform_output));
+        let jobs = egui.tessellate(std::mem::take(&mut output.shapes), output.pixels_per_point);
         for (id, delta) in &output.textures_delta.set {
             for delta in delta {
                 self.renderer
@@ -218,9 +228,6 @@ impl WindowGpu {
         self.queue
             .submit(extra.into_iter().chain([encoder.finish()]));
         self.queue.present(frame);
-        for id in &output.textures_delta.free {
-            self.renderer.free_texture(id);
-        }
         true
     }
 }

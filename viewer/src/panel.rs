@@ -14,7 +14,7 @@ use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_tables::artist::ArtistParams;
 
-const PRESETS: [&str; 5] = ["dark", "brown", "red", "blonde", "white"];
+const PRESETS: [&str; 6] = ["white", "blonde", "red", "auburn", "brown", "dark"];
 const MAPS: [&str; 2] = ["procedural:sun_and_sky", "procedural:studio"];
 
 /// What the panel asks of the session besides settings edits.
