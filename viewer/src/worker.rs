@@ -401,16 +401,23 @@ impl WorkerState {
         let key = key.clone();
         self.baking = None;
         self.publish(|s| s.bake = None);
+        // Only an env-lit request waits for tables; a point-lit one carries on untouched.
+        let env_job = self
+            .job
+            .as_ref()
+            .filter(|j| matches!(j.settings.lighting, Lighting::Environment(_)))
+            .map(|j| (j.id, j.settings.clone()));
         match result {
             Ok(prepared) => {
                 self.env = Some((key, Arc::new(prepared)));
-                if let Some(job) = self.job.take() {
-                    self.start(job.id, job.settings);
+                if let Some((id, settings)) = env_job {
+                    self.start(id, settings);
                 }
             }
             Err(e) => {
-                let id = self.job.as_ref().map_or(0, |j| j.id);
-                self.fail(id, anyhow::anyhow!("preparing the environment: {e}"));
+                if let Some((id, _)) = env_job {
+                    self.fail(id, anyhow::anyhow!("preparing the environment: {e}"));
+                }
             }
         }
     }
