@@ -288,6 +288,21 @@ impl FrameSettings {
         })
     }
 
+    /// Lit by the map `map`: the map is swapped in an existing environment (its other choices
+    /// kept), or an environment replaces the lights; Kajiya-Kay, which has no env tables, gives
+    /// way to the environment's default model.
+    pub fn light_with_environment(&mut self, map: String) {
+        match &mut self.lighting {
+            Lighting::Environment(env) => env.map = map,
+            Lighting::Lights(_) => {
+                self.lighting = Lighting::Environment(EnvLighting::new(map));
+                if self.shading == Some(Shading::KajiyaKay) {
+                    self.shading = None;
+                }
+            }
+        }
+    }
+
     /// The env renderer's fiber model (it reads one RGB 4D table: Marschner or artist).
     pub fn env_shading(&self) -> anyhow::Result<EnvShading> {
         match self.shading() {

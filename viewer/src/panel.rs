@@ -147,12 +147,7 @@ fn lighting(ui: &mut egui::Ui, state: &mut ViewState, lobes: &mut usize, status:
         ui.radio_value(&mut env, false, "point / directional / spot");
     });
     match (&s.lighting, env) {
-        (Lighting::Lights(_), true) => {
-            s.lighting = Lighting::Environment(EnvLighting::new(MAPS[0]));
-            if s.shading == Some(Shading::KajiyaKay) {
-                s.shading = Some(Shading::Marschner);
-            }
-        }
+        (Lighting::Lights(_), true) => s.light_with_environment(MAPS[0].into()),
         (Lighting::Environment(_), false) => {
             s.lighting = Lighting::Lights(PointLighting::default())
         }

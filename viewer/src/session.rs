@@ -72,6 +72,17 @@ pub struct Session {
     timed_jobs: Vec<u64>,
     handled_error: Option<u64>,
     image_rect: egui::Rect,
+    background: Option<(BackgroundKey, Arc<Vec<[f32; 3]>>)>,
+}
+
+/// What the background behind the hair depends on.
+#[derive(PartialEq)]
+struct BackgroundKey {
+    camera: ExactCamera,
+    size: [u32; 2],
+    rotation_deg: f32,
+    /// The map's pixel hash.
+    map: String,
 }
 
 impl Session {
@@ -100,6 +111,7 @@ impl Session {
             timed_jobs: Vec::new(),
             handled_error: None,
             image_rect: egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(640.0, 480.0)),
+            background: None,
         }
     }
 
@@ -255,19 +267,7 @@ impl Session {
             }
             "hdr" | "exr" => {
                 let map = path.display().to_string();
-                self.edit(|s| match &mut s.settings.lighting {
-                    Lighting::Environment(env) => env.map = map,
-                    Lighting::Lights(_) => {
-                        s.settings.lighting = Lighting::Environment(
-                            strandlight_scene::frame_settings::EnvLighting::new(map),
-                        );
-                        if s.settings.shading
-                            == Some(strandlight_scene::point_shading::Shading::KajiyaKay)
-                        {
-                            s.settings.shading = None;
-                        }
-                    }
-                });
+                self.edit(|s| s.settings.light_with_environment(map));
             }
             _ => {
                 self.message = Some(format!(
@@ -383,7 +383,7 @@ impl Session {
         let image = shown.image.clone();
         let stops = self.exposure_for(&image);
         let behind = self.background_of(shown, &image);
-        let composited = composite(&image, stops, behind.as_deref());
+        let composited = composite(&image, stops, behind.as_deref().map(|b| b.as_slice()));
         let rgba = to_rgba8(&composited);
         let color = egui::ColorImage::from_rgba_unmultiplied(
             [image.width as usize, image.height as usize],
@@ -407,7 +407,9 @@ impl Session {
         });
     }
 
-    fn background_of(&self, shown: &Shown, image: &LinearImage) -> Option<Vec<[f32; 3]>> {
+    /// The map behind the hair, computed once per view (the refinement steps of one request
+    /// share it).
+    fn background_of(&mut self, shown: &Shown, image: &LinearImage) -> Option<Arc<Vec<[f32; 3]>>> {
         if !self.state.display.background {
             return None;
         }
@@ -416,13 +418,26 @@ impl Session {
         else {
             return None;
         };
-        Some(background(
+        let key = BackgroundKey {
+            camera: ExactCamera::of(&shown.camera),
+            size: [image.width, image.height],
+            rotation_deg: lighting.rotation_deg,
+            map: env.env.sha256.clone(),
+        };
+        if let Some((cached, pixels)) = &self.background
+            && *cached == key
+        {
+            return Some(pixels.clone());
+        }
+        let pixels = Arc::new(background(
             &env.env.map,
             &shown.camera,
-            [image.width, image.height],
+            key.size,
             env.up,
-            lighting.rotation_deg,
-        ))
+            key.rotation_deg,
+        ));
+        self.background = Some((key, pixels.clone()));
+        Some(pixels)
     }
 
     /// The image, scaled to fit, taking orbit drags, pans and zoom; the overlay on top.

@@ -324,12 +324,8 @@ impl WorkerState {
         settings: &FrameSettings,
         point: &PointLighting,
     ) -> anyhow::Result<Arc<PreparedPoint>> {
-        let key = format!(
-            "{:?} {:?} {:?}",
-            tables_key(settings),
-            settings.shading(),
-            settings.artist
-        );
+        // The artist controls are shader constants here: cheap to rebuild, not a table.
+        let key = format!("{:?} {:?}", tables_key(settings), settings.artist);
         if let Some((k, p)) = &self.point
             && *k == key
         {
