@@ -6,6 +6,7 @@ use clap::Args;
 use std::path::{Path, PathBuf};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
+use strandlight_runtime::render::{PassTiming, TIMING_METHOD};
 use strandlight_scene::camera_choice::{CameraChoice, CameraKind, UpChoice};
 use strandlight_scene::env_frame::{light_summary, render_lights};
 use strandlight_scene::frame_render::{
@@ -250,7 +251,8 @@ fn run_point(
                 "driver": stats.adapter.driver,
             },
             "timing_method": stats.timing_method,
-            "pass_ms": stats.timings.iter().map(|t| (t.pass.clone(), serde_json::json!(t.milliseconds))).collect::<serde_json::Map<_, _>>(),
+            "pass_ms": pass_ms(&stats.timings),
+            "pass_gpu_ms": pass_gpu_ms(&stats.timings),
             "gpu_memory_bytes": stats.memory_bytes.iter().map(|(n, b)| (n.clone(), serde_json::json!(b))).collect::<serde_json::Map<_, _>>(),
             "covered_pixels": covered,
             "fragments_stored": stats.fragments.map(|f| f.stored),
@@ -352,8 +354,9 @@ fn run_env(args: &RenderArgs, settings: &FrameSettings, env: &EnvLighting) -> an
             "memory_per_batch_bytes": rendered.memory_per_batch.iter().map(|(n, b)| (n.clone(), serde_json::json!(b))).collect::<serde_json::Map<_, _>>(),
             "memory_per_batch_total_bytes": rendered.memory_per_batch.iter().map(|(_, b)| b).sum::<u64>(),
             "fragments": rendered.fragments.map(|f| serde_json::json!({ "rasterized": f.rasterized, "shaded": f.shaded, "note": "per batch (each batch draws the same fragments)" })),
-            "pass_ms": rendered.passes.iter().map(|(n, ms)| (n.clone(), serde_json::json!(ms))).collect::<serde_json::Map<_, _>>(),
-            "timing_method": "CPU wall clock around submit + wait for idle, summed over batches",
+            "pass_ms": pass_ms(&rendered.passes),
+            "pass_gpu_ms": pass_gpu_ms(&rendered.passes),
+            "timing_method": format!("{TIMING_METHOD}; summed over batches"),
             "exr": exr_path,
             "png": png_path,
         });
@@ -372,4 +375,20 @@ fn run_env(args: &RenderArgs, settings: &FrameSettings, env: &EnvLighting) -> an
         ));
     }
     Ok(())
+}
+
+/// Wall-clock milliseconds per pass, for the JSON report.
+fn pass_ms(passes: &[PassTiming]) -> serde_json::Map<String, serde_json::Value> {
+    passes
+        .iter()
+        .map(|t| (t.pass.clone(), serde_json::json!(t.milliseconds)))
+        .collect()
+}
+
+/// GPU milliseconds per pass from timestamp queries (null where unmeasured).
+fn pass_gpu_ms(passes: &[PassTiming]) -> serde_json::Map<String, serde_json::Value> {
+    passes
+        .iter()
+        .map(|t| (t.pass.clone(), serde_json::json!(t.gpu_milliseconds)))
+        .collect()
 }

@@ -3,6 +3,7 @@
 //! change that needs a table rebake, ending in a screenshot. Checks that can fail:
 //! - the window kept presenting frames while the rebake ran (no gap near the bake's length);
 //! - the screenshot is not blank, and its sidecar holds the orbited camera and the new control;
+//! - the capture of the whole window shows the screenshot's picture where the image sits;
 //! - `render --replay` of the sidecar reproduces the screenshot's linear EXR.
 
 use serde_json::{Value, json};
@@ -23,16 +24,56 @@ fn strandlight(dir: &Path) -> Command {
     c
 }
 
-/// Share of pixels that are not black in an 8-bit RGB PNG.
-fn lit_share(path: &Path) -> f64 {
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+/// An 8-bit PNG as (width, height, RGB pixels).
+fn read_rgb8(path: &Path) -> (u32, u32, Vec<[u8; 3]>) {
+    let file = std::fs::File::open(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let decoder = png::Decoder::new(std::io::BufReader::new(file));
     let mut reader = decoder.read_info().unwrap();
     let mut buf = vec![0; reader.output_buffer_size().unwrap()];
     let info = reader.next_frame(&mut buf).unwrap();
     let channels = info.color_type.samples();
-    let pixels = buf[..info.buffer_size()].chunks(channels);
-    let n = (info.width * info.height) as f64;
-    pixels.filter(|p| p[..3].iter().any(|&c| c > 8)).count() as f64 / n
+    let pixels = buf[..info.buffer_size()]
+        .chunks(channels)
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
+    (info.width, info.height, pixels)
+}
+
+/// Share of pixels that are not black in an 8-bit PNG.
+fn lit_share(path: &Path) -> f64 {
+    let (_, _, pixels) = read_rgb8(path);
+    let lit = pixels.iter().filter(|p| p.iter().any(|&c| c > 8)).count();
+    lit as f64 / pixels.len() as f64
+}
+
+/// Mean absolute difference (8-bit levels) between the screenshot and the window capture
+/// sampled at the centre of each screenshot pixel's footprint in `rect` (physical pixels),
+/// where the window's bilinear magnification reproduces the texel.
+fn window_against_screenshot(window: &Path, shot: &Path, rect: [f64; 4]) -> f64 {
+    let (ww, wh, win) = read_rgb8(window);
+    let (sw, sh, shot) = read_rgb8(shot);
+    let (sx, sy) = (
+        (rect[2] - rect[0]) / sw as f64,
+        (rect[3] - rect[1]) / sh as f64,
+    );
+    let mut sum = 0.0;
+    for y in 0..sh {
+        for x in 0..sw {
+            let wx = (rect[0] + (x as f64 + 0.5) * sx).floor() as u32;
+            let wy = (rect[1] + (y as f64 + 0.5) * sy).floor() as u32;
+            assert!(
+                wx < ww && wy < wh,
+                "image rect {rect:?} outside the {ww}x{wh} window"
+            );
+            let a = shot[(y * sw + x) as usize];
+            let b = win[(wy * ww + wx) as usize];
+            sum += (0..3)
+                .map(|c| (a[c] as f64 - b[c] as f64).abs())
+                .sum::<f64>()
+                / 3.0;
+        }
+    }
+    sum / (sw * sh) as f64
 }
 
 #[test]
@@ -58,6 +99,8 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
         {"settings": {"artist": artist}},
         {"frames": 20},
         {"wait": "converged"},
+        {"key": "O"},
+        {"frames": 2},
         {"screenshot": "shot"}
     ]);
     std::fs::write(dir.join("script.json"), script.to_string()).unwrap();
@@ -106,6 +149,29 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
     assert!(gap < 1500.0, "the window stalled {gap} ms during a bake");
 
     assert!(lit_share(&dir.join("shot.png")) > 0.02, "blank screenshot");
+
+    // The whole window, panel included: larger than the frame, and showing the same picture
+    // where the frame sits.
+    let window = dir.join("shot-window.png");
+    assert_eq!(report["window_captures"], json!(["shot-window.png"]));
+    let (ww, wh, _) = read_rgb8(&window);
+    assert!(ww > 160 + 300 && wh > 120, "window capture {ww}x{wh}");
+    let rect: Vec<f64> = report["image_rect_px"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let difference =
+        window_against_screenshot(&window, &dir.join("shot.png"), rect.try_into().unwrap());
+    println!(
+        "window capture against the screenshot in the image rect: mean |Δ| {difference:.2} levels"
+    );
+    // Both are the same 8-bit tonemap; the window adds an sRGB texture round trip.
+    assert!(
+        difference < 2.0,
+        "the window shows another picture: {difference} levels"
+    );
     let sidecar: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("shot.json")).unwrap()).unwrap();
     assert!(

@@ -1,8 +1,6 @@
 //! One headless frame end to end: upload, strand pass, readback, with per-pass timings and the
 //! GPU memory each buffer and texture holds.
 
-use std::time::Instant;
-
 use crate::camera::light_camera;
 use crate::gpu::readback::ReadbackError;
 use crate::gpu::{AdapterReport, GpuContext, GpuLimits, LimitError, read_texture_rgba};
@@ -35,13 +33,37 @@ pub enum RenderError {
     Gpu(String),
 }
 
-/// Wall-clock milliseconds of one pass: CPU time around submit and wait-for-idle (timestamp
-/// queries are not used yet).
+/// The time one pass took.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PassTiming {
     pub pass: String,
+    /// Wall clock around recording, submit and wait-for-idle.
     pub milliseconds: f64,
+    /// The GPU's own time for the pass's render and compute passes, from timestamp queries;
+    /// `None` where the adapter lacks them or the pass recorded none (CPU-only work).
+    pub gpu_milliseconds: Option<f64>,
 }
+
+impl PassTiming {
+    /// Adds `self` to the entry of the same pass in `totals` (appending a new one). A GPU
+    /// total stays known only while every addend had one: a partial sum would understate.
+    pub fn add_to(self, totals: &mut Vec<PassTiming>) {
+        match totals.iter_mut().find(|t| t.pass == self.pass) {
+            Some(t) => {
+                t.milliseconds += self.milliseconds;
+                t.gpu_milliseconds = t
+                    .gpu_milliseconds
+                    .zip(self.gpu_milliseconds)
+                    .map(|(a, b)| a + b);
+            }
+            None => totals.push(self),
+        }
+    }
+}
+
+/// How [`PassTiming`]s are measured, for reports.
+pub const TIMING_METHOD: &str = "wall clock around submit + wait for idle; GPU time from \
+                                 timestamp queries where the adapter has them";
 
 #[derive(Clone, Debug)]
 pub struct RenderStats {
@@ -135,12 +157,11 @@ fn timed<T>(
     pass: &str,
     work: impl FnOnce() -> T,
 ) -> T {
-    let start = Instant::now();
-    let out = work();
-    gpu.wait_idle();
+    let (out, milliseconds, gpu_milliseconds) = gpu.time_passes(work);
     timings.push(PassTiming {
         pass: pass.to_string(),
-        milliseconds: start.elapsed().as_secs_f64() * 1e3,
+        milliseconds,
+        gpu_milliseconds,
     });
     out
 }
@@ -278,7 +299,7 @@ pub fn render_frame_with_model(
             timings,
             memory_bytes,
             segments: geometry.segment_count,
-            timing_method: "CPU wall clock around submit + wait for idle",
+            timing_method: TIMING_METHOD,
             fragments,
         },
     })

@@ -17,6 +17,7 @@ use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::multiple::{
     CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering,
 };
+use strandlight_runtime::render::PassTiming;
 
 /// "N SRBF lights" or "N SRBF lights + k directional" for a frame's lights.
 pub fn light_summary(lights: &[EnvLight]) -> String {
@@ -69,8 +70,8 @@ pub struct EnvFrame<'a> {
 pub struct RenderedEnv {
     pub image: Image,
     pub milliseconds: f64,
-    /// Per pass (summed over batches), milliseconds; empty for stand-in renderers.
-    pub passes: Vec<(String, f64)>,
+    /// Per pass (summed over batches); empty for stand-in renderers.
+    pub passes: Vec<PassTiming>,
     /// With [`EnvLook::count_fragments`].
     pub fragments: Option<FragmentCounts>,
     /// GPU memory held while one batch renders, per resource (bytes); empty for stand-ins.
@@ -243,12 +244,7 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
         })?;
     Ok(RenderedEnv {
         milliseconds: frame_milliseconds(&out.stats),
-        passes: out
-            .stats
-            .timings
-            .iter()
-            .map(|t| (t.pass.clone(), t.milliseconds))
-            .collect(),
+        passes: out.stats.timings.clone(),
         fragments: out.stats.fragments,
         memory_per_batch: out.stats.memory_per_batch.clone(),
         image: Image {

@@ -3,7 +3,9 @@
 //! pace (about 30 frames a second while anything is changing, on events otherwise).
 
 use crate::script::{Action, Script};
+use crate::session::WindowCapture;
 use crate::session::{Session, SessionReport};
+use crate::window_capture::CaptureTarget;
 use crate::worker::Worker;
 use anyhow::{Context, bail};
 use std::path::PathBuf;
@@ -169,9 +171,15 @@ impl WindowGpu {
         }
     }
 
-    /// Draws egui's output; false when no frame could be acquired (it is tried again).
-    fn paint(&mut self, egui: &egui::Context, mut output: egui::FullOutput) -> bool {
-        let presented = self.paint_frame(egui, &mut output);
+    /// Draws egui's output, and into `captures` too when it has any; false when no frame
+    /// could be acquired (it is tried again, captures included).
+    fn paint(
+        &mut self,
+        egui: &egui::Context,
+        mut output: egui::FullOutput,
+        captures: &mut [WindowCapture],
+    ) -> bool {
+        let presented = self.paint_frame(egui, &mut output, captures);
         for id in &output.textures_delta.free {
             self.renderer.free_texture(id);
         }
@@ -180,7 +188,12 @@ impl WindowGpu {
         presented
     }
 
-    fn paint_frame(&mut self, egui: &egui::Context, output: &mut egui::FullOutput) -> bool {
+    fn paint_frame(
+        &mut self,
+        egui: &egui::Context,
+        output: &mut egui::FullOutput,
+        captures: &mut [WindowCapture],
+    ) -> bool {
         self.egui_input
             .handle_platform_output(&self.window, std::mem::take(&mut output.platform_output));
         let jobs = egui.tessellate(std::mem::take(&mut output.shapes), output.pixels_per_point);
@@ -208,27 +221,57 @@ impl WindowGpu {
         let extra =
             self.renderer
                 .update_buffers(&self.device, &self.queue, &mut encoder, &jobs, &screen);
-        {
-            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("egui"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &view,
-                    resolve_target: None,
-                    depth_slice: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                ..Default::default()
-            });
-            let mut pass = pass.forget_lifetime();
-            self.renderer.render(&mut pass, &jobs, &screen);
+        self.draw_egui(&mut encoder, &view, &jobs, &screen);
+        let target = match captures.is_empty() {
+            true => None,
+            false => Some(CaptureTarget::new(
+                &self.device,
+                self.config.width,
+                self.config.height,
+                self.config.format,
+            )),
+        };
+        if let Some(Ok(target)) = &target {
+            self.draw_egui(&mut encoder, &target.view(), &jobs, &screen);
+            target.encode_copy(&mut encoder);
         }
         self.queue
             .submit(extra.into_iter().chain([encoder.finish()]));
         self.queue.present(frame);
+        if let Some(target) = target {
+            let rgb = target.and_then(|t| Ok((t.read_rgb(&self.device)?, t)));
+            for capture in captures.iter_mut() {
+                capture.result = Some(match &rgb {
+                    Ok((rgb, t)) => t.write_png(&capture.path, rgb),
+                    Err(e) => Err(anyhow::anyhow!("{e:#}")),
+                });
+            }
+        }
         true
+    }
+
+    fn draw_egui(
+        &mut self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        jobs: &[egui::ClippedPrimitive],
+        screen: &egui_wgpu::ScreenDescriptor,
+    ) {
+        let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("egui"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                resolve_target: None,
+                depth_slice: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            ..Default::default()
+        });
+        let mut pass = pass.forget_lifetime();
+        self.renderer.render(&mut pass, jobs, screen);
     }
 }
 
@@ -257,9 +300,11 @@ impl App {
             .viewport_output
             .get(&egui::ViewportId::ROOT)
             .is_some_and(|v| v.repaint_delay.is_zero());
-        if gpu.paint(&self.egui, output) {
+        let mut captures = session.take_window_captures();
+        if gpu.paint(&self.egui, output, &mut captures) {
             session.presented();
         }
+        session.window_captures_done(captures);
         // egui asks for a repaint while anything animates; about_to_wait paces it.
         self.repaint_asked = repaint;
         self.check_exit(event_loop);

@@ -12,6 +12,7 @@ pub mod recompute;
 pub mod screenshot;
 pub mod script;
 mod session;
+pub mod window_capture;
 pub mod worker;
 
 pub use app::{ViewOptions, run};

@@ -3,7 +3,7 @@
 //! Each group says what its changes cost ([`Recompute::label`]).
 
 use crate::recompute::{Recompute, ViewState};
-use crate::worker::{Stage, Status};
+use crate::worker::{FrameStats, Stage, Status};
 use egui_file_dialog::FileDialog;
 use std::path::PathBuf;
 use strandlight_scene::frame_settings::{
@@ -355,6 +355,7 @@ fn display(ui: &mut egui::Ui, state: &mut ViewState, outcome: &mut PanelOutcome)
     );
     d.exposure_stops = (!auto).then_some(stops);
     ui.checkbox(&mut d.background, "environment as background (B)");
+    ui.checkbox(&mut d.overlay, "timing overlay (O)");
     ui.horizontal(|ui| {
         outcome.screenshot = ui.button("Screenshot (S)").clicked();
         outcome.reset_camera = outcome.reset_camera || ui.button("Reset camera (R)").clicked();
@@ -402,20 +403,7 @@ pub fn overlay(ui: &egui::Ui, rect: egui::Rect, status: &Status, exposure: Optio
     if let Some(c) = status.converged_seconds {
         lines.push(format!("converged {:.2} s", c));
     }
-    let total_ms: f64 = st.passes.iter().map(|(_, ms)| ms).sum();
-    lines.push(format!(
-        "{} lights in {} batch{}, {:.0} ms ({})",
-        st.lights,
-        st.batches,
-        if st.batches == 1 { "" } else { "es" },
-        total_ms,
-        st.timing_method
-    ));
-    let mut passes = st.passes.clone();
-    passes.sort_by(|a, b| b.1.total_cmp(&a.1));
-    for (pass, ms) in passes.iter().take(6) {
-        lines.push(format!("  {pass:<22} {ms:>8.1} ms"));
-    }
+    lines.extend(pass_time_lines(st));
     let memory: u64 = st.memory.iter().map(|(_, b)| b).sum();
     lines.push(format!("GPU memory {:.1} MB", memory as f64 / 1e6));
     let mut memory_items = st.memory.clone();
@@ -436,4 +424,33 @@ pub fn overlay(ui: &egui::Ui, rect: egui::Rect, status: &Status, exposure: Optio
     ui.painter()
         .rect_filled(back, 3.0, egui::Color32::from_black_alpha(150));
     ui.painter().galley(at, galley, egui::Color32::WHITE);
+}
+
+/// The frame's total and its six slowest passes: wall clock, and the GPU's own time where the
+/// adapter has timestamp queries.
+fn pass_time_lines(st: &FrameStats) -> Vec<String> {
+    let wall: f64 = st.passes.iter().map(|t| t.milliseconds).sum();
+    let gpu: f64 = st.passes.iter().filter_map(|t| t.gpu_milliseconds).sum();
+    let has_gpu = st.passes.iter().any(|t| t.gpu_milliseconds.is_some());
+    let mut lines = vec![format!(
+        "{} lights in {} batch{}: {wall:.0} ms wall{}",
+        st.lights,
+        st.batches,
+        if st.batches == 1 { "" } else { "es" },
+        if has_gpu {
+            format!(", {gpu:.0} ms GPU (timestamp queries)")
+        } else {
+            " (no timestamp queries: CPU timing)".to_string()
+        }
+    )];
+    let mut passes = st.passes.clone();
+    passes.sort_by(|a, b| b.milliseconds.total_cmp(&a.milliseconds));
+    lines.push(format!("  {:<22} {:>8} {:>8}", "pass", "wall ms", "GPU ms"));
+    for t in passes.iter().take(6) {
+        let gpu = t
+            .gpu_milliseconds
+            .map_or("-".to_string(), |g| format!("{g:.1}"));
+        lines.push(format!("  {:<22} {:>8.1} {gpu:>8}", t.pass, t.milliseconds));
+    }
+    lines
 }

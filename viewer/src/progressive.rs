@@ -156,11 +156,8 @@ impl Accumulator {
 
 /// Pass times add up over batches; memory is per batch (the latest); lights and batches count.
 fn add_stats(total: &mut FrameStats, batch: FrameStats) {
-    for (pass, ms) in batch.passes {
-        match total.passes.iter_mut().find(|(p, _)| *p == pass) {
-            Some((_, t)) => *t += ms,
-            None => total.passes.push((pass, ms)),
-        }
+    for pass in batch.passes {
+        pass.add_to(&mut total.passes);
     }
     total.memory = batch.memory;
     total.lights += batch.lights;

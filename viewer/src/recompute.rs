@@ -44,6 +44,8 @@ pub struct Display {
     pub exposure_stops: Option<f32>,
     /// The environment map drawn behind the hair.
     pub background: bool,
+    /// The adapter, timing and memory readout drawn over the image.
+    pub overlay: bool,
 }
 
 impl Default for Display {
@@ -51,6 +53,7 @@ impl Default for Display {
         Self {
             exposure_stops: None,
             background: true,
+            overlay: true,
         }
     }
 }
@@ -189,6 +192,10 @@ mod tests {
         );
         assert_eq!(
             cost(&lit, |s| s.display.background = false),
+            Recompute::Nothing
+        );
+        assert_eq!(
+            cost(&lit, |s| s.display.overlay = false),
             Recompute::Nothing
         );
         assert_eq!(cost(&lit, |s| s.settings.size = [32, 24]), Recompute::Frame);

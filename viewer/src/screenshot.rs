@@ -1,6 +1,7 @@
 //! A screenshot: the window's picture as PNG, the linear frame as EXR (what `render` writes), and
 //! the frame's settings as a JSON sidecar that `strandlight render --replay` renders again. The
-//! settings also go into both images' metadata.
+//! settings also go into both images' metadata. The whole window, panel included, is captured
+//! beside them when the window next paints (`window_capture`).
 
 use crate::recompute::Display;
 use crate::worker::LinearImage;
@@ -10,11 +11,13 @@ use strandlight_runtime::image_out::{write_exr, write_png};
 use strandlight_scene::frame_settings::FrameSettings;
 use strandlight_tables::atomic_write::write_atomically;
 
-/// The three files of a screenshot at `stem`.
+/// The files of a screenshot at `stem`.
 pub struct ScreenshotFiles {
     pub png: PathBuf,
     pub exr: PathBuf,
     pub sidecar: PathBuf,
+    /// `STEM-window.png`: the whole window.
+    pub window: PathBuf,
 }
 
 impl ScreenshotFiles {
@@ -23,7 +26,10 @@ impl ScreenshotFiles {
             Some("png" | "exr" | "json") => stem.with_extension(""),
             _ => stem.to_path_buf(),
         };
+        let mut window = stem.clone().into_os_string();
+        window.push("-window.png");
         Self {
+            window: window.into(),
             png: stem.with_extension("png"),
             exr: stem.with_extension("exr"),
             sidecar: stem.with_extension("json"),

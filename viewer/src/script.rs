@@ -32,7 +32,7 @@ pub enum Step {
     Pan([[f32; 2]; 2]),
     /// Scroll steps over the image (zoom; positive is closer).
     Scroll(f32),
-    /// A key press: B (background), S (screenshot), R (reset camera).
+    /// A key press: B (background), O (overlay), S (screenshot), R (reset camera).
     Key(String),
     /// A JSON merge patch (RFC 7396) on the frame settings, as a panel control would change them.
     Settings(Value),
@@ -179,7 +179,7 @@ fn drag_frame(from: [f32; 2], to: [f32; 2], primary: bool, frame: usize) -> Vec<
 fn key(name: &str) -> anyhow::Result<egui::Key> {
     match egui::Key::from_name(name) {
         Some(k) => Ok(k),
-        None => bail!("unknown key {name:?} (e.g. B, S, R)"),
+        None => bail!("unknown key {name:?} (e.g. B, O, S, R)"),
     }
 }
 

@@ -29,6 +29,10 @@ pub struct SessionReport {
     /// Per request that converged: seconds to its preview and to the converged image.
     pub requests: Vec<RequestTiming>,
     pub screenshots: Vec<PathBuf>,
+    /// Captures of the whole window (panel included), one per screenshot.
+    pub window_captures: Vec<PathBuf>,
+    /// Where the image sat in the window when last drawn, physical pixels: [x0, y0, x1, y1].
+    pub image_rect_px: [f32; 4],
     pub adapter: String,
     pub window_adapter: String,
     pub errors: Vec<String>,
@@ -41,6 +45,13 @@ pub struct RequestTiming {
     pub size: [u32; 2],
     pub preview_seconds: Option<f64>,
     pub converged_seconds: f64,
+}
+
+/// A capture of the whole window that the next painted frame writes.
+pub struct WindowCapture {
+    pub path: PathBuf,
+    /// Set by the paint that wrote it (or failed to).
+    pub result: Option<anyhow::Result<()>>,
 }
 
 /// The shown image as a texture, and what it was made from.
@@ -66,6 +77,7 @@ pub struct Session {
     message: Option<String>,
     panel: Panel,
     screenshots: Vec<PathBuf>,
+    window_captures: Vec<WindowCapture>,
     pub report: SessionReport,
     last_present: Option<Instant>,
     bake_was_running: bool,
@@ -102,6 +114,7 @@ impl Session {
             message: None,
             panel: Panel::default(),
             screenshots: Vec::new(),
+            window_captures: Vec::new(),
             report: SessionReport {
                 window_adapter,
                 ..Default::default()
@@ -122,7 +135,7 @@ impl Session {
             .shown
             .as_ref()
             .is_none_or(|s| s.stage != Stage::Converged || s.stale_tables);
-        status.bake.is_some() || refining || !self.screenshots.is_empty() || self.unsubmitted()
+        status.bake.is_some() || refining || self.screenshots_pending() || self.unsubmitted()
     }
 
     fn unsubmitted(&self) -> bool {
@@ -217,15 +230,19 @@ impl Session {
         if ctx.egui_wants_keyboard_input() {
             return;
         }
-        let (b, s, r) = ctx.input(|i| {
+        let (b, o, s, r) = ctx.input(|i| {
             (
                 i.key_pressed(egui::Key::B),
+                i.key_pressed(egui::Key::O),
                 i.key_pressed(egui::Key::S),
                 i.key_pressed(egui::Key::R),
             )
         });
         if b {
             self.state.display.background = !self.state.display.background;
+        }
+        if o {
+            self.state.display.overlay = !self.state.display.overlay;
         }
         if s {
             self.screenshots.push(default_screenshot_stem());
@@ -451,6 +468,9 @@ impl Session {
                 let size = egui::vec2(w as f32 * scale, h as f32 * scale);
                 let rect = egui::Rect::from_center_size(available.center(), size);
                 self.image_rect = rect;
+                let ppp = ui.ctx().pixels_per_point();
+                self.report.image_rect_px =
+                    [rect.min.x, rect.min.y, rect.max.x, rect.max.y].map(|v| v * ppp);
                 let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
                 if let Some(o) = &self.on_screen {
                     ui.painter().image(
@@ -461,12 +481,14 @@ impl Session {
                     );
                 }
                 self.camera_input(ui, &response, status, size.y / scale);
-                crate::panel::overlay(
-                    ui,
-                    rect,
-                    status,
-                    self.on_screen.as_ref().map(|o| o.exposure_stops),
-                );
+                if self.state.display.overlay {
+                    crate::panel::overlay(
+                        ui,
+                        rect,
+                        status,
+                        self.on_screen.as_ref().map(|o| o.exposure_stops),
+                    );
+                }
             });
     }
 
@@ -528,12 +550,22 @@ impl Session {
                 &on_screen.composited,
             ) {
                 Ok(files) => {
-                    let ScreenshotFiles { png, exr, sidecar } = files;
+                    let ScreenshotFiles {
+                        png,
+                        exr,
+                        sidecar,
+                        window,
+                    } = files;
+                    self.window_captures.push(WindowCapture {
+                        path: window.clone(),
+                        result: None,
+                    });
                     self.message = Some(format!(
-                        "saved {}, {} and {}",
+                        "saved {}, {}, {} and {}",
                         png.display(),
                         exr.display(),
-                        sidecar.display()
+                        sidecar.display(),
+                        window.display()
                     ));
                     self.report.screenshots.push(png);
                 }
@@ -552,7 +584,27 @@ impl Session {
     }
 
     pub fn screenshots_pending(&self) -> bool {
-        !self.screenshots.is_empty()
+        !self.screenshots.is_empty() || !self.window_captures.is_empty()
+    }
+
+    /// The window captures the next paint should write.
+    pub fn take_window_captures(&mut self) -> Vec<WindowCapture> {
+        std::mem::take(&mut self.window_captures)
+    }
+
+    /// Back from the paint: written, failed, or (no frame was presented) still to do.
+    pub fn window_captures_done(&mut self, captures: Vec<WindowCapture>) {
+        for capture in captures {
+            match capture.result {
+                None => self.window_captures.push(capture),
+                Some(Ok(())) => self.report.window_captures.push(capture.path),
+                Some(Err(e)) => {
+                    let e = format!("window capture {}: {e:#}", capture.path.display());
+                    self.report.errors.push(e.clone());
+                    self.message = Some(e);
+                }
+            }
+        }
     }
 }
 

@@ -13,6 +13,7 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 use strandlight_runtime::camera::Camera;
 use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::render::{PassTiming, TIMING_METHOD};
 use strandlight_scene::env_frame::{env_adapter, render_lights};
 use strandlight_scene::env_scene::PrepareProgress;
 use strandlight_scene::frame_render::{
@@ -50,8 +51,8 @@ pub enum Stage {
 /// What the overlay reports of the shown image.
 #[derive(Clone, Debug, Default)]
 pub struct FrameStats {
-    /// Milliseconds per pass, summed over the batches so far.
-    pub passes: Vec<(String, f64)>,
+    /// Time per pass, summed over the batches so far.
+    pub passes: Vec<PassTiming>,
     /// GPU memory per resource while one batch renders, bytes.
     pub memory: Vec<(String, u64)>,
     /// Lights drawn (SRBF lobes and directional sources, or point lights).
@@ -496,12 +497,7 @@ impl WorkerState {
         let size = step.size(settings.size);
         let frame = render_point(gpu, settings, point, &hair.model, prepared, size)?;
         let stats = FrameStats {
-            passes: frame
-                .stats
-                .timings
-                .iter()
-                .map(|t| (t.pass.clone(), t.milliseconds))
-                .collect(),
+            passes: frame.stats.timings.clone(),
             memory: frame.stats.memory_bytes.clone(),
             lights: point.lights.len(),
             batches: 1,
@@ -549,7 +545,7 @@ fn env_step(
         lights: lights.len(),
         batches: 1,
         adapter: env_adapter()?,
-        timing_method: "CPU wall clock around submit + wait for idle".into(),
+        timing_method: TIMING_METHOD.into(),
     };
     let image = LinearImage {
         width: rendered.image.width,

@@ -3,8 +3,6 @@
 //! the end. [`EnvRenderer`] keeps the pipelines across frames; [`render_env_frame`] builds them
 //! for one frame.
 
-use std::time::Instant;
-
 use strandlight_tables::table::Table;
 use strandlight_tables::table_axes::{
     AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_SIGMA_F, AXIS_U_DOT_WO, AXIS_U_DOT_XI,
@@ -260,22 +258,18 @@ fn check_grid(grid: &ForwardScatteringGrid, lights: usize) -> Result<(), EnvRend
     Ok(())
 }
 
-/// Wall-clock totals per pass name.
+/// Totals per pass name over the frame's batches.
 struct Timings(Vec<PassTiming>);
 
 impl Timings {
     fn time<T>(&mut self, gpu: &GpuContext, pass: &str, work: impl FnOnce() -> T) -> T {
-        let start = Instant::now();
-        let out = work();
-        gpu.wait_idle();
-        let ms = start.elapsed().as_secs_f64() * 1e3;
-        match self.0.iter_mut().find(|t| t.pass == pass) {
-            Some(t) => t.milliseconds += ms,
-            None => self.0.push(PassTiming {
-                pass: pass.to_string(),
-                milliseconds: ms,
-            }),
+        let (out, milliseconds, gpu_milliseconds) = gpu.time_passes(work);
+        PassTiming {
+            pass: pass.to_string(),
+            milliseconds,
+            gpu_milliseconds,
         }
+        .add_to(&mut self.0);
         out
     }
 }
@@ -555,7 +549,7 @@ impl EnvRenderer {
                 lights: lights.len() as u32,
                 segments: frame.geometry.segment_count,
                 light_pass_segments: frame.light_geometry.segment_count,
-                timing_method: "CPU wall clock around submit + wait for idle, summed over batches",
+                timing_method: crate::render::TIMING_METHOD,
                 fragments,
             },
         })
@@ -642,6 +636,7 @@ impl EnvRenderer {
             let view = ViewBinding::new(gpu, &self.view.view_layout, None, &visibility);
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             self.view.visibility.encode(
+                gpu,
                 &mut encoder,
                 options.transparency,
                 &frame.strands,
@@ -738,6 +733,7 @@ impl EnvRenderer {
             usage.grid_bytes = usage.grid_bytes.max(view.bytes);
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             self.view.encode(
+                gpu,
                 &mut encoder,
                 &frame.geometry,
                 &frame.strands,

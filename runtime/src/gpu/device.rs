@@ -3,6 +3,8 @@
 
 use std::fmt;
 
+use super::pass_timer::PassTimer;
+
 /// Where the frames are computed: the adapter wgpu chose and why.
 #[derive(Clone, Debug, PartialEq)]
 pub struct AdapterReport {
@@ -49,6 +51,8 @@ pub struct GpuContext {
     pub report: AdapterReport,
     /// `Rgba32Float` can be a blended render target (else the passes use `Rgba16Float`).
     pub float32_blendable: bool,
+    /// GPU time per pass, on adapters with timestamp queries.
+    pub pass_timer: Option<PassTimer>,
 }
 
 impl GpuContext {
@@ -104,6 +108,9 @@ impl GpuContext {
         if float32_blendable {
             required_features |= wgpu::Features::FLOAT32_BLENDABLE;
         }
+        if adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
+            required_features |= wgpu::Features::TIMESTAMP_QUERY;
+        }
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("strandlight"),
@@ -116,7 +123,9 @@ impl GpuContext {
                 adapter: report.to_string(),
                 source,
             })?;
+        let pass_timer = PassTimer::new(&device, &queue);
         Ok(Self {
+            pass_timer,
             instance,
             adapter,
             device,

@@ -3,9 +3,11 @@
 pub mod bind_layout;
 pub mod device;
 pub mod limits;
+pub mod pass_timer;
 pub mod readback;
 pub mod texture;
 
 pub use device::{AdapterReport, DeviceError, GpuContext};
 pub use limits::{GpuLimits, LimitError};
+pub use pass_timer::PassTimer;
 pub use readback::{read_buffer, read_texture_rgba};

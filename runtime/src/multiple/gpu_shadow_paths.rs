@@ -205,7 +205,7 @@ impl<'g> GpuForwardScattering<'g> {
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("shadow paths"),
-                timestamp_writes: None,
+                timestamp_writes: self.gpu.compute_timestamps(),
             });
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &group, &[]);

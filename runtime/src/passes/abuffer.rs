@@ -607,8 +607,10 @@ impl ABufferPass {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         resources.reset(gpu, &mut encoder, frame);
         match &resources.nearest_depth {
-            Some(nearest) => self.encode_dbk(&mut encoder, geometry, nearest, resources, groups),
-            None => self.encode_abuffer(&mut encoder, geometry, resources, groups),
+            Some(nearest) => {
+                self.encode_dbk(gpu, &mut encoder, geometry, nearest, resources, groups)
+            }
+            None => self.encode_abuffer(gpu, &mut encoder, geometry, resources, groups),
         }
         self.encode_resolve(&mut encoder, resources);
         gpu.queue.submit([encoder.finish()]);
@@ -632,6 +634,7 @@ impl ABufferPass {
     /// A-buffer: every fragment into the lists.
     fn encode_abuffer(
         &self,
+        gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         geometry: &StrandGeometry,
         resources: &ABufferResources,
@@ -642,7 +645,7 @@ impl ABufferPass {
             label: Some("abuffer build"),
             color_attachments: &[],
             depth_stencil_attachment: cleared_depth(&depth_view, false),
-            timestamp_writes: None,
+            timestamp_writes: gpu.render_timestamps(),
             occlusion_query_set: None,
             multiview_mask: None,
         });
@@ -655,6 +658,7 @@ impl ABufferPass {
     /// the depth-tested fallback.
     fn encode_dbk(
         &self,
+        gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         geometry: &StrandGeometry,
         nearest_depth: &wgpu::Texture,
@@ -667,7 +671,7 @@ impl ABufferPass {
                 label: Some("dbk depth prepass"),
                 color_attachments: &[],
                 depth_stencil_attachment: cleared_depth(&nearest_view, true),
-                timestamp_writes: None,
+                timestamp_writes: gpu.render_timestamps(),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -681,7 +685,7 @@ impl ABufferPass {
             label: Some("dbk build"),
             color_attachments: &[cleared_color(&color_view)],
             depth_stencil_attachment: cleared_depth(&depth_view, false),
-            timestamp_writes: None,
+            timestamp_writes: gpu.render_timestamps(),
             occlusion_query_set: None,
             multiview_mask: None,
         });

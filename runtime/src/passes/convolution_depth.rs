@@ -430,7 +430,7 @@ impl ConvolutionDepthPass {
                     label: Some("dodm depth"),
                     color_attachments: &[],
                     depth_stencil_attachment: cleared_depth(&depth_view, true),
-                    timestamp_writes: None,
+                    timestamp_writes: gpu.render_timestamps(),
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });
@@ -443,7 +443,7 @@ impl ConvolutionDepthPass {
                     label: Some("dodm layers"),
                     color_attachments: &[cleared_color(&optical_view)],
                     depth_stencil_attachment: None,
-                    timestamp_writes: None,
+                    timestamp_writes: gpu.render_timestamps(),
                     occlusion_query_set: None,
                     multiview_mask: None,
                 });

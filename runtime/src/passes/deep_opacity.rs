@@ -277,7 +277,7 @@ impl DeepOpacityPass {
                 label: Some("dom depth"),
                 color_attachments: &[],
                 depth_stencil_attachment: cleared_depth(&depth_view, true),
-                timestamp_writes: None,
+                timestamp_writes: gpu.render_timestamps(),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -296,7 +296,7 @@ impl DeepOpacityPass {
                 label: Some("dom layers"),
                 color_attachments: &attachments,
                 depth_stencil_attachment: None,
-                timestamp_writes: None,
+                timestamp_writes: gpu.render_timestamps(),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });

@@ -766,6 +766,7 @@ impl EnvViewPass {
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
+        gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         geometry: &StrandGeometry,
         strands: &wgpu::BindGroup,
@@ -788,7 +789,7 @@ impl EnvViewPass {
                 label: Some("env view"),
                 color_attachments: &[cleared_color(&single), cleared_color(&multiple)],
                 depth_stencil_attachment: depth_attachment,
-                timestamp_writes: None,
+                timestamp_writes: gpu.render_timestamps(),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -801,7 +802,7 @@ impl EnvViewPass {
         }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("env accumulate"),
-            timestamp_writes: None,
+            timestamp_writes: gpu.compute_timestamps(),
         });
         pass.set_pipeline(&self.accumulate);
         pass.set_bind_group(0, &sums.group, &[]);

@@ -135,7 +135,7 @@ impl StrandPass {
                 label: Some("strands"),
                 color_attachments: &[cleared_color(&color_view)],
                 depth_stencil_attachment: cleared_depth(&depth_view, true),
-                timestamp_writes: None,
+                timestamp_writes: gpu.render_timestamps(),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });

@@ -213,7 +213,7 @@ impl SummedAreaPass {
         for pipeline in [&self.rows, &self.columns] {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("summed area"),
-                timestamp_writes: None,
+                timestamp_writes: gpu.compute_timestamps(),
             });
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &group, &[]);

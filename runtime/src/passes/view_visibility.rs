@@ -219,6 +219,7 @@ impl ViewVisibilityPass {
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
+        gpu: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         transparency: ViewTransparency,
         strands: &wgpu::BindGroup,
@@ -267,7 +268,7 @@ impl ViewVisibilityPass {
                 } else {
                     None
                 },
-                timestamp_writes: None,
+                timestamp_writes: gpu.render_timestamps(),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
@@ -306,7 +307,7 @@ impl ViewVisibilityPass {
                 label: Some("count fragments"),
                 color_attachments: &[cleared_color(&target)],
                 depth_stencil_attachment: prepassed_depth(depth),
-                timestamp_writes: None,
+                timestamp_writes: gpu.render_timestamps(),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
