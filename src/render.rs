@@ -79,9 +79,10 @@ pub struct RenderArgs {
     /// Deep opacity map resolution (square).
     #[arg(long, default_value_t = 512)]
     dom_size: u32,
-    /// A-buffer node buffer size, in nodes per pixel (clamped to the adapter's limit).
-    #[arg(long, default_value_t = 16)]
-    abuffer_nodes_per_pixel: u32,
+    /// A-buffer/DBK node pool in nodes per pixel (clamped to the adapter's limit). Default:
+    /// sized to exactly the fragments the technique stores, counted by a first build.
+    #[arg(long)]
+    abuffer_nodes_per_pixel: Option<u32>,
     /// DBK layer depth Δ in world units (default: 5% of the hair's bounding-box diagonal).
     #[arg(long)]
     dbk_delta: Option<f32>,

@@ -278,7 +278,7 @@ fn main() -> Result<(), BoxError> {
         &model,
         &frame,
         Transparency::ABuffer {
-            nodes_per_pixel: max_npp,
+            nodes_per_pixel: Some(max_npp),
         },
     )?;
     let dbk = probe_fragments(
@@ -286,7 +286,7 @@ fn main() -> Result<(), BoxError> {
         &model,
         &frame,
         Transparency::Dbk {
-            nodes_per_pixel: max_npp,
+            nodes_per_pixel: Some(max_npp),
             delta,
         },
     )?;
@@ -308,13 +308,13 @@ fn main() -> Result<(), BoxError> {
                 (
                     format!("A-buffer{tag}"),
                     Transparency::ABuffer {
-                        nodes_per_pixel: abuffer_npp,
+                        nodes_per_pixel: Some(abuffer_npp),
                     },
                 ),
                 (
                     format!("DBK{tag}"),
                     Transparency::Dbk {
-                        nodes_per_pixel: dbk_npp,
+                        nodes_per_pixel: Some(dbk_npp),
                         delta,
                     },
                 ),

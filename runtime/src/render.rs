@@ -31,6 +31,8 @@ pub enum RenderError {
     Readback(#[from] ReadbackError),
     #[error("the GPU reported an error: {0}")]
     Gpu(String),
+    #[error("A-buffer nodes per pixel 0: must be at least 1 (or left unset to size the pool)")]
+    NoListNodes,
 }
 
 /// The time one pass took.
@@ -126,12 +128,16 @@ pub enum Transparency {
     /// Depth-tested, coverage blended in draw order (plain opaque rendering).
     #[default]
     Opaque,
-    /// Per-pixel linked lists sorted at resolve; `nodes_per_pixel` × pixels nodes (clamped to
-    /// the adapter's storage-binding limit).
-    ABuffer { nodes_per_pixel: u32 },
+    /// Per-pixel linked lists sorted at resolve. The node pool holds `nodes_per_pixel` ×
+    /// pixels nodes, or with `None` exactly the fragments stored (counted by a first build);
+    /// either way clamped to the adapter's storage-binding limit, with overflow counted.
+    ABuffer { nodes_per_pixel: Option<u32> },
     /// DBK-buffer: lists for fragments within `delta` (world units of view depth) behind each
-    /// pixel's nearest fiber, an opaque fallback for the rest.
-    Dbk { nodes_per_pixel: u32, delta: f32 },
+    /// pixel's nearest fiber, an opaque fallback for the rest. Pool as for the A-buffer.
+    Dbk {
+        nodes_per_pixel: Option<u32>,
+        delta: f32,
+    },
 }
 
 /// Everything besides the frame that changes how it is rendered.
@@ -267,7 +273,14 @@ pub fn render_frame_with_model(
             let abuffer = timed(&mut timings, gpu, "abuffer pipeline", || {
                 ABufferPass::with_model(gpu, shading)
             });
-            let wanted = frame.width as u64 * frame.height as u64 * nodes_per_pixel as u64;
+            let wanted = match nodes_per_pixel {
+                Some(0) => return Err(RenderError::NoListNodes),
+                Some(n) => frame.width as u64 * frame.height as u64 * n as u64,
+                None => timed(&mut timings, gpu, "abuffer count", || {
+                    abuffer.count_fragments(gpu, &geometry, frame, &shadows, list_mode)
+                })?
+                .max(1),
+            };
             let capacity = ABufferPass::max_capacity(gpu, wanted);
             let out = timed(
                 &mut timings,

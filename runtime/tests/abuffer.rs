@@ -382,3 +382,73 @@ fn abuffer_and_dbk_shade_like_the_opaque_pass_for_every_model() {
         );
     }
 }
+
+/// With no nodes-per-pixel given, `render_frame` sizes the pool to exactly the fragments each
+/// technique stores: three strands through the A-buffer need one node per covered pixel centre
+/// each; DBK with Δ = 0.1 over two strands 0.4 apart lists only the front one. The pictures equal
+/// those from a generous fixed pool.
+#[test]
+fn an_unsized_pool_holds_exactly_what_each_technique_stores() {
+    use strandlight_runtime::render::{RenderOptions, Transparency, render_frame};
+    let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+    let front = (0.2f32, Vec3::new(0.8, 0.2, 0.1));
+    let back = (-0.2f32, Vec3::new(0.1, 0.3, 0.9));
+    let middle = (0.0f32, Vec3::new(0.2, 0.9, 0.2));
+    let cases = [
+        (
+            "A-buffer, three strands",
+            strands(&[back, front, middle]),
+            Transparency::ABuffer {
+                nodes_per_pixel: None,
+            },
+            Transparency::ABuffer {
+                nodes_per_pixel: Some(16),
+            },
+            3 * COVERED_ROWS,
+        ),
+        (
+            "DBK Δ = 0.1, two strands",
+            strands(&[back, front]),
+            Transparency::Dbk {
+                nodes_per_pixel: None,
+                delta: 0.1,
+            },
+            Transparency::Dbk {
+                nodes_per_pixel: Some(16),
+                delta: 0.1,
+            },
+            COVERED_ROWS,
+        ),
+    ];
+    for (name, model, sized, fixed, expected_nodes) in cases {
+        let render = |transparency| {
+            let options = RenderOptions {
+                transparency,
+                ..Default::default()
+            };
+            render_frame(&gpu, &model, &frame(), &options).unwrap()
+        };
+        let (sized, fixed) = (render(sized), render(fixed));
+        let counts = sized.stats.fragments.unwrap();
+        eprintln!("{name}: {counts:?}");
+        assert_eq!(counts.capacity, expected_nodes, "{name}");
+        assert_eq!(counts.stored, expected_nodes, "{name}");
+        assert_eq!(counts.dropped, 0, "{name}");
+        assert_eq!(
+            fixed.stats.fragments.unwrap().capacity,
+            16 * (SIZE * SIZE) as u64
+        );
+        let diff = max_abs_diff(&sized.pixels, &fixed.pixels);
+        assert!(diff < 1e-6, "{name}: sized vs fixed pool differ by {diff}");
+    }
+    let zero = RenderOptions {
+        transparency: Transparency::ABuffer {
+            nodes_per_pixel: Some(0),
+        },
+        ..Default::default()
+    };
+    let Err(e) = render_frame(&gpu, &strands(&[front]), &frame(), &zero) else {
+        panic!("a zero-node pool rendered");
+    };
+    assert!(e.to_string().contains("nodes per pixel 0"), "{e}");
+}

@@ -183,8 +183,10 @@ pub struct PointLighting {
     pub dom_spacing: Option<f32>,
     /// Deep opacity map resolution (square).
     pub dom_size: u32,
-    /// A-buffer and DBK node buffer, nodes per pixel.
-    pub abuffer_nodes_per_pixel: u32,
+    /// A-buffer and DBK node pool, nodes per pixel; None: sized to the fragments the
+    /// technique stores (a counting build first).
+    #[serde(default)]
+    pub abuffer_nodes_per_pixel: Option<u32>,
     /// DBK layer depth Δ in world units; None: 5% of the hair's bounding-box diagonal.
     pub dbk_delta: Option<f32>,
     /// Nodes per axis of the Marschner lookup textures.
@@ -200,7 +202,7 @@ impl Default for PointLighting {
             dom_layers: 4,
             dom_spacing: None,
             dom_size: 512,
-            abuffer_nodes_per_pixel: 16,
+            abuffer_nodes_per_pixel: None,
             dbk_delta: None,
             lut_size: 128,
         }

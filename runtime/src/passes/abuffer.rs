@@ -601,20 +601,52 @@ impl ABufferPass {
                 height: resources.height,
             });
         }
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.encode_build(gpu, &mut encoder, resources, geometry, frame, shadows)?;
+        self.encode_resolve(gpu, &mut encoder, resources);
+        gpu.queue.submit([encoder.finish()]);
+        Ok(resources.read(gpu)?)
+    }
+
+    /// The nodes a frame's lists need in `mode`: the build run into a one-node pool, whose
+    /// request counter still counts every fragment the technique would store. A pool sized
+    /// from it costs each technique only what it keeps (DBK far less than the A-buffer).
+    pub fn count_fragments(
+        &self,
+        gpu: &GpuContext,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        shadows: &[ShadowInput<'_>],
+        mode: ListMode,
+    ) -> Result<u64, ABufferError> {
+        let resources = ABufferResources::new(gpu, self, (frame.width, frame.height), 1, mode)?;
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.encode_build(gpu, &mut encoder, &resources, geometry, frame, shadows)?;
+        gpu.queue.submit([encoder.finish()]);
+        let counters = read_buffer(gpu, &resources.counters)?;
+        let counts: &[u32] = bytemuck::cast_slice(&counters);
+        Ok(u64::from(counts[0]))
+    }
+
+    /// Empties `resources` and records the list build of `frame`.
+    fn encode_build(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        resources: &ABufferResources,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        shadows: &[ShadowInput<'_>],
+    ) -> Result<(), ABufferError> {
         let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows)?;
         let strands = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
         let groups = [&strands, &shadow_group, &resources.lists];
-        let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        resources.reset(gpu, &mut encoder, frame);
+        resources.reset(gpu, encoder, frame);
         match &resources.nearest_depth {
-            Some(nearest) => {
-                self.encode_dbk(gpu, &mut encoder, geometry, nearest, resources, groups)
-            }
-            None => self.encode_abuffer(gpu, &mut encoder, geometry, resources, groups),
+            Some(nearest) => self.encode_dbk(gpu, encoder, geometry, nearest, resources, groups),
+            None => self.encode_abuffer(gpu, encoder, geometry, resources, groups),
         }
-        self.encode_resolve(&mut encoder, resources);
-        gpu.queue.submit([encoder.finish()]);
-        Ok(resources.read(gpu)?)
+        Ok(())
     }
 
     /// Groups 0–3 of the build passes.
@@ -695,8 +727,16 @@ impl ABufferPass {
     }
 
     /// Sorts and composites every pixel's list (8×8 pixels a workgroup).
-    fn encode_resolve(&self, encoder: &mut wgpu::CommandEncoder, resources: &ABufferResources) {
-        let mut pass = encoder.begin_compute_pass(&Default::default());
+    fn encode_resolve(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        resources: &ABufferResources,
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("abuffer resolve"),
+            timestamp_writes: gpu.compute_timestamps(),
+        });
         pass.set_pipeline(&self.resolve);
         pass.set_bind_group(0, &resources.resolve, &[]);
         pass.dispatch_workgroups(resources.width.div_ceil(8), resources.height.div_ceil(8), 1);
