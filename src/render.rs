@@ -76,7 +76,10 @@ pub struct RenderArgs {
     /// Layer spacing in world units (default: 1% of the hair's bounding-box diagonal).
     #[arg(long)]
     dom_spacing: Option<f32>,
-    /// Deep opacity map resolution (square).
+    /// Opacity shadow map slices across the hair's depth range (1..=8), with --shadows osm.
+    #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_OSM_SLICES)]
+    osm_slices: u32,
+    /// Deep or opacity shadow map resolution (square).
     #[arg(long, default_value_t = 512)]
     dom_size: u32,
     /// A-buffer/DBK node pool in nodes per pixel (clamped to the adapter's limit). Default:
@@ -178,6 +181,7 @@ fn settings_from_args(args: &RenderArgs) -> anyhow::Result<FrameSettings> {
             shadows: args.shadows,
             transparency: args.transparency,
             dom_layers: args.dom_layers,
+            osm_slices: args.osm_slices,
             dom_spacing: args.dom_spacing,
             dom_size: args.dom_size,
             abuffer_nodes_per_pixel: args.abuffer_nodes_per_pixel,

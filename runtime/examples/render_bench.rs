@@ -18,7 +18,7 @@ use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::abuffer::NODE_BYTES;
 use strandlight_runtime::passes::deep_opacity::DomSettings;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{Frame, RenderOptions, Transparency, render_frame};
+use strandlight_runtime::render::{Frame, RenderOptions, ShadowMaps, Transparency, render_frame};
 
 const WIDTH: u32 = 656;
 const HEIGHT: u32 = 861;
@@ -299,7 +299,7 @@ fn main() -> Result<(), BoxError> {
         "runs: 1 warm-up + {timed_runs} timed per configuration, interleaved (round-robin); medians; timing = CPU wall clock around submit + wait for idle"
     );
 
-    let configs: Vec<(String, RenderOptions)> = [None, Some(dom)]
+    let configs: Vec<(String, RenderOptions)> = [None, Some(ShadowMaps::Deep(dom))]
         .into_iter()
         .flat_map(|shadows| {
             let tag = if shadows.is_some() { " + DOM" } else { "" };

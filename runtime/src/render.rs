@@ -108,13 +108,13 @@ impl From<ABufferError> for RenderError {
 fn check_frame_limits(
     gpu: &GpuContext,
     frame: &FrameParams,
-    shadowed_lights: &[(DomSettings, u32, glam::Vec3)],
+    shadowed_lights: &[(ShadowMaps, u32, glam::Vec3)],
 ) -> Result<(), LimitError> {
     let limits = GpuLimits::of(gpu);
     limits.check_image(frame.width, frame.height)?;
     // Every light's map has the same settings.
     if let Some((settings, _, _)) = shadowed_lights.first() {
-        let res = settings.resolution;
+        let res = settings.resolution();
         limits.check_texture_2d("deep opacity map", res, res, |max| {
             format!("use a deep opacity map resolution of at most {max}")
         })?;
@@ -140,12 +140,60 @@ pub enum Transparency {
     },
 }
 
+/// How directional lights are shadowed: both kinds are layers of optical depth along the light,
+/// looked up the same way; they differ in where the layers start.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShadowMaps {
+    /// Deep opacity maps (Yuksel & Keyser 2008): layers from each texel's nearest fiber.
+    Deep(DomSettings),
+    /// Opacity shadow maps (Kim & Neumann 2001): `slices` equal slices spanning the hair's
+    /// depth range along the light, the same for every texel.
+    OpacitySlices { resolution: u32, slices: u32 },
+}
+
+impl ShadowMaps {
+    pub fn resolution(&self) -> u32 {
+        match *self {
+            ShadowMaps::Deep(settings) => settings.resolution,
+            ShadowMaps::OpacitySlices { resolution, .. } => resolution,
+        }
+    }
+
+    fn check(&self) -> Result<(), DomSettingsError> {
+        match *self {
+            ShadowMaps::Deep(settings) => settings.check(),
+            ShadowMaps::OpacitySlices { resolution, slices } => DomSettings {
+                resolution,
+                layers: slices,
+                spacing: 1.0,
+            }
+            .check(),
+        }
+    }
+
+    /// The map of the light shining from `toward_light` onto hair within `bounds`.
+    fn map_for(
+        &self,
+        gpu: &GpuContext,
+        toward_light: glam::Vec3,
+        bounds: crate::hair::Aabb,
+    ) -> Result<DeepOpacityMap, DomSettingsError> {
+        let camera = light_camera(toward_light, bounds);
+        match *self {
+            ShadowMaps::Deep(settings) => Ok(DeepOpacityMap::new(gpu, camera, settings)),
+            ShadowMaps::OpacitySlices { resolution, slices } => {
+                DeepOpacityMap::opacity_slices(gpu, camera, bounds, resolution, slices)
+            }
+        }
+    }
+}
+
 /// Everything besides the frame that changes how it is rendered.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RenderOptions {
-    /// Deep opacity maps for every directional light (at most
-    /// [`MAX_SHADOWED_LIGHTS`]), used by every transparency mode.
-    pub shadows: Option<DomSettings>,
+    /// Light maps for every directional light (at most [`MAX_SHADOWED_LIGHTS`]), used by every
+    /// transparency mode.
+    pub shadows: Option<ShadowMaps>,
     pub transparency: Transparency,
 }
 
@@ -193,7 +241,7 @@ pub fn render_frame_with_model(
     shading: &ShadingModel,
 ) -> Result<Frame, RenderError> {
     // Every directional light gets a deep opacity map; every pass shadows them all.
-    let shadowed_lights: Vec<(DomSettings, u32, glam::Vec3)> = match options.shadows {
+    let shadowed_lights: Vec<(ShadowMaps, u32, glam::Vec3)> = match options.shadows {
         None => Vec::new(),
         Some(settings) => {
             settings.check()?;
@@ -230,7 +278,7 @@ pub fn render_frame_with_model(
             DeepOpacityPass::new(gpu)
         });
         for &(settings, index, direction) in &shadowed_lights {
-            let map = DeepOpacityMap::new(gpu, light_camera(direction, model.bounds()), settings);
+            let map = settings.map_for(gpu, direction, model.bounds())?;
             // One entry per light, so that reports keyed by pass name keep them all.
             let label = format!("deep opacity (light {index})");
             timed(&mut timings, gpu, &label, || {

@@ -82,6 +82,51 @@ fn slab_of_parallel_strands_matches_the_closed_form() {
     }
 }
 
+/// Opacity shadow maps: the slab's rows (z = 0.3 … 0.0, 0.1 apart) over 8 equal slices of its
+/// 0.3 depth range fall at slices 0, 2.67, 5.33 and 8 (the far bound, clamped into the last),
+/// so slices 0, 2, 5 and 7 each hold one row's optical depth and the rest none, whatever a
+/// texel's nearest fiber; the transmittance in front of each slice is the closed form.
+#[test]
+fn opacity_slices_span_the_hair_depth_range_and_match_the_closed_form() {
+    let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+    let thickness = 0.01f32;
+    let coverage = thickness as f64 * PER_UNIT;
+    let model = slab(4, thickness);
+    let geometry = StrandGeometry::upload(&gpu, &model).unwrap();
+    let map = DeepOpacityMap::opacity_slices(&gpu, ortho_camera(), model.bounds(), RES, 8).unwrap();
+    assert!(
+        (map.settings.spacing - 0.3 / 8.0).abs() < 1e-6,
+        "{:?}",
+        map.settings
+    );
+    DeepOpacityPass::new(&gpu).draw(&gpu, &geometry, &map);
+    let texels = map.read_layers(&gpu).unwrap();
+    let rows_per_slice = [1.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 1.0];
+    let tau_row = -(1.0 - coverage).ln();
+    let mut worst_t = 0.0f64;
+    for ty in 8..56usize {
+        for tx in 2..62usize {
+            let t = &texels[ty * RES as usize + tx];
+            let mut rows_before = 0.0;
+            for (k, &rows) in rows_per_slice.iter().enumerate() {
+                assert!(
+                    (t[k] as f64 - rows * tau_row).abs() < 1e-4,
+                    "texel ({tx},{ty}) slice {k}: {} vs {}",
+                    t[k],
+                    rows * tau_row
+                );
+                let closed = (1.0 - coverage).powf(rows_before);
+                worst_t = worst_t.max((transmittance_before_layer(t, k) - closed).abs() / closed);
+                rows_before += rows;
+            }
+        }
+    }
+    eprintln!("OSM 8 slices: worst relative transmittance error in front of a slice {worst_t:.2e}");
+    assert!(worst_t < 1e-3);
+    // Slices are checked like layers: more than the two targets hold is refused.
+    assert!(DeepOpacityMap::opacity_slices(&gpu, ortho_camera(), model.bounds(), RES, 9).is_err());
+}
+
 #[test]
 fn bad_settings_are_refused() {
     assert!(
@@ -121,8 +166,9 @@ fn shading_behind_the_slab_is_dimmed_by_the_closed_form_transmittance() {
     let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
     let thickness = 0.01f32;
     let coverage = thickness as f64 * PER_UNIT;
-    let slab_geometry = StrandGeometry::upload(&gpu, &slab(4, thickness)).unwrap();
-    let map = DeepOpacityMap::new(
+    let slab_model = slab(4, thickness);
+    let slab_geometry = StrandGeometry::upload(&gpu, &slab_model).unwrap();
+    let dom = DeepOpacityMap::new(
         &gpu,
         ortho_camera(),
         DomSettings {
@@ -131,7 +177,11 @@ fn shading_behind_the_slab_is_dimmed_by_the_closed_form_transmittance() {
             spacing: 0.08,
         },
     );
-    DeepOpacityPass::new(&gpu).draw(&gpu, &slab_geometry, &map);
+    let osm =
+        DeepOpacityMap::opacity_slices(&gpu, ortho_camera(), slab_model.bounds(), RES, 8).unwrap();
+    for map in [&dom, &osm] {
+        DeepOpacityPass::new(&gpu).draw(&gpu, &slab_geometry, map);
+    }
 
     let color = Vec3::new(0.5, 0.3, 0.2);
     let shading = KajiyaKay {
@@ -140,7 +190,11 @@ fn shading_behind_the_slab_is_dimmed_by_the_closed_form_transmittance() {
         shininess: 40.0,
     };
     let strand_pass = StrandPass::new(&gpu);
-    for (z, expected_t) in [(-0.5f32, (1.0 - coverage).powi(4)), (0.5, 1.0)] {
+    let cases = [(-0.5f32, (1.0 - coverage).powi(4)), (0.5, 1.0)];
+    for ((z, expected_t), (name, map)) in cases
+        .into_iter()
+        .flat_map(|c| [(c, ("DOM", &dom)), (c, ("OSM", &osm))])
+    {
         // Along x at y = 0.5 (image row 16 ± 2 px): probe covers pixel rows 14..=17, columns 7..=56.
         let probe = HairModel::new(
             vec![Vec3::new(-0.8, 0.5, z), Vec3::new(0.8, 0.5, z)],
@@ -169,7 +223,7 @@ fn shading_behind_the_slab_is_dimmed_by_the_closed_form_transmittance() {
             &frame,
             &target,
             Some(ShadowInput {
-                map: &map,
+                map,
                 light_index: 0,
             }),
         );
@@ -185,14 +239,14 @@ fn shading_behind_the_slab_is_dimmed_by_the_closed_form_transmittance() {
                     worst = worst.max(err);
                     assert!(
                         err < 1e-3,
-                        "probe z {z} pixel ({x},{y}) channel {k}: {} vs {expected}",
+                        "{name}: probe z {z} pixel ({x},{y}) channel {k}: {} vs {expected}",
                         got[k]
                     );
                 }
             }
         }
         eprintln!(
-            "probe at z = {z}: transmittance {expected_t:.5} expected; worst relative error of the shaded pixels {worst:.2e}"
+            "{name}: probe at z = {z}: transmittance {expected_t:.5} expected; worst relative error of the shaded pixels {worst:.2e}"
         );
     }
 }

@@ -9,7 +9,7 @@ use glam::Vec3;
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::DomSettings;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{RenderOptions, render_frame};
+use strandlight_runtime::render::{RenderOptions, ShadowMaps, render_frame};
 
 #[test]
 fn gpu_pass_times_are_reported_where_supported_and_fit_inside_the_wall_clock() {
@@ -34,11 +34,11 @@ fn gpu_pass_times_are_reported_where_supported_and_fit_inside_the_wall_clock() {
         width_override_px: None,
     };
     let options = RenderOptions {
-        shadows: Some(DomSettings {
+        shadows: Some(ShadowMaps::Deep(DomSettings {
             resolution: 256,
             layers: 4,
             spacing: 0.05,
-        }),
+        })),
         ..Default::default()
     };
     let out = render_frame(&gpu, &slab(6, 0.02), &frame, &options).unwrap();

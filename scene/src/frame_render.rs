@@ -25,7 +25,7 @@ use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::passes::deep_opacity::DomSettings;
 use strandlight_runtime::passes::fiber_shading::ShadingModel;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{self, RenderOptions, render_frame_with_model};
+use strandlight_runtime::render::{self, RenderOptions, ShadowMaps, render_frame_with_model};
 use strandlight_tables::checksum::sha256_hex;
 
 /// A loaded hair and a line naming where it came from.
@@ -73,10 +73,14 @@ pub fn point_render_options(point: &PointLighting, hair: &HairModel) -> RenderOp
     let diagonal = hair.bounds().diagonal();
     let shadows = match point.shadows {
         Shadows::None => None,
-        Shadows::Dom => Some(DomSettings {
+        Shadows::Dom => Some(ShadowMaps::Deep(DomSettings {
             resolution: point.dom_size,
             layers: point.dom_layers,
             spacing: point.dom_spacing.unwrap_or(diagonal * 0.01),
+        })),
+        Shadows::Osm => Some(ShadowMaps::OpacitySlices {
+            resolution: point.dom_size,
+            slices: point.osm_slices,
         }),
     };
     let transparency = match point.transparency {

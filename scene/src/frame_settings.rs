@@ -151,7 +151,10 @@ pub enum Lighting {
 pub enum Shadows {
     #[default]
     None,
+    /// Deep opacity maps (layers from each texel's nearest fiber).
     Dom,
+    /// Opacity shadow maps (equal slices across the hair's depth range).
+    Osm,
 }
 
 /// Transparency of point-lit frames (`occupancy` is the env-lit view's).
@@ -181,8 +184,11 @@ pub struct PointLighting {
     pub dom_layers: u32,
     /// Layer spacing in world units; None: 1% of the hair's bounding-box diagonal.
     pub dom_spacing: Option<f32>,
-    /// Deep opacity map resolution (square).
+    /// Deep or opacity shadow map resolution (square).
     pub dom_size: u32,
+    /// Opacity shadow map slices (1..=8).
+    #[serde(default = "default_osm_slices")]
+    pub osm_slices: u32,
     /// A-buffer and DBK node pool, nodes per pixel; None: sized to the fragments the
     /// technique stores (a counting build first).
     #[serde(default)]
@@ -191,6 +197,13 @@ pub struct PointLighting {
     pub dbk_delta: Option<f32>,
     /// Nodes per axis of the Marschner lookup textures.
     pub lut_size: usize,
+}
+
+/// Opacity shadow map slices: all that the two RGBA layer targets hold (Kim 2003 uses 16+).
+pub const DEFAULT_OSM_SLICES: u32 = 8;
+
+fn default_osm_slices() -> u32 {
+    DEFAULT_OSM_SLICES
 }
 
 impl Default for PointLighting {
@@ -202,6 +215,7 @@ impl Default for PointLighting {
             dom_layers: 4,
             dom_spacing: None,
             dom_size: 512,
+            osm_slices: DEFAULT_OSM_SLICES,
             abuffer_nodes_per_pixel: None,
             dbk_delta: None,
             lut_size: 128,

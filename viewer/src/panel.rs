@@ -252,10 +252,16 @@ fn point_controls(ui: &mut egui::Ui, p: &mut PointLighting) {
         ui.label("shadows");
         ui.radio_value(&mut p.shadows, Shadows::None, "none");
         ui.radio_value(&mut p.shadows, Shadows::Dom, "deep opacity maps");
+        ui.radio_value(&mut p.shadows, Shadows::Osm, "opacity shadow maps");
     });
     if p.shadows == Shadows::Dom {
         ui.add(egui::Slider::new(&mut p.dom_layers, 1..=8).text("DOM layers"));
-        egui::ComboBox::from_label("DOM resolution")
+    }
+    if p.shadows == Shadows::Osm {
+        ui.add(egui::Slider::new(&mut p.osm_slices, 1..=8).text("OSM slices"));
+    }
+    if p.shadows != Shadows::None {
+        egui::ComboBox::from_label("map resolution")
             .selected_text(p.dom_size.to_string())
             .show_ui(ui, |ui| {
                 for r in [256, 512, 1024, 2048] {

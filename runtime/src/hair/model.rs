@@ -72,6 +72,16 @@ impl Aabb {
     pub fn diagonal(&self) -> f32 {
         self.size().length()
     }
+
+    pub fn corners(&self) -> [Vec3; 8] {
+        std::array::from_fn(|i| {
+            Vec3::new(
+                if i & 1 == 0 { self.min.x } else { self.max.x },
+                if i & 2 == 0 { self.min.y } else { self.max.y },
+                if i & 4 == 0 { self.min.z } else { self.max.z },
+            )
+        })
+    }
 }
 
 /// Strands of hair as polylines.

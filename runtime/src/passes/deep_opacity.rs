@@ -1,6 +1,10 @@
 //! Deep opacity maps for a directional light: a light-space depth prepass (nearest fiber per
 //! texel), then one additive pass that sorts every fragment's optical depth into K layers of
 //! configurable spacing, the last layer taking what lies beyond (`deep_opacity.wgsl`).
+//! Opacity shadow maps (Kim & Neumann 2001, Kim 2003) are the same layers started at one depth
+//! for every texel, the hair's nearest extent, and spaced to span its whole depth range
+//! ([`DeepOpacityMap::opacity_slices`]): no prepass, so the slices do not follow the hair's
+//! surface and need more of them for the same accuracy.
 //! Inputs: [`StrandGeometry`], the light's direction, the hair's bounds, [`DomSettings`].
 //! Output: [`DeepOpacityMap`] (layer textures + nearest-depth texture + the light's camera).
 //! The pipelines are built once and the per-light targets can be reused, so the pass repeats
@@ -18,6 +22,7 @@ use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{depth_texture_entry, uniform_entry};
 use crate::gpu::readback::{ReadbackError, read_texture_rgba};
 use crate::gpu::texture::texture_2d;
+use crate::hair::Aabb;
 
 /// At most this many layers (two RGBA targets).
 pub const MAX_LAYERS: u32 = 8;
@@ -64,10 +69,21 @@ struct DomUniform {
     layers: u32,
 }
 
+/// Where a map's first layer begins.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LayerStart {
+    /// At each texel's nearest fiber, found by a depth prepass (deep opacity maps).
+    NearestFiber,
+    /// At one depth for every texel, normalized between the light camera's near (0) and far
+    /// (1) planes (opacity shadow maps).
+    Fixed(f32),
+}
+
 /// One light's maps.
 pub struct DeepOpacityMap {
     pub camera: Camera,
     pub settings: DomSettings,
+    pub layer_start: LayerStart,
     pub nearest_depth: wgpu::Texture,
     /// Layers 0–3 and 4–7 in the channels of two textures.
     pub layers: [wgpu::Texture; 2],
@@ -87,6 +103,7 @@ impl DeepOpacityMap {
         Self {
             camera,
             settings,
+            layer_start: LayerStart::NearestFiber,
             nearest_depth: texture(
                 "dom nearest depth",
                 DEPTH_FORMAT,
@@ -97,6 +114,34 @@ impl DeepOpacityMap {
                 texture("dom layers 4-7", gpu.hdr_format(), layer_usage),
             ],
         }
+    }
+
+    /// An opacity shadow map: `slices` layers of equal thickness from the nearest to the
+    /// farthest extent of `bounds` along the (orthographic) light camera's view direction.
+    pub fn opacity_slices(
+        gpu: &GpuContext,
+        camera: Camera,
+        bounds: Aabb,
+        resolution: u32,
+        slices: u32,
+    ) -> Result<Self, DomSettingsError> {
+        let forward = (camera.target - camera.eye).normalize();
+        let depths = bounds.corners().map(|c| (c - camera.eye).dot(forward));
+        let nearest = depths.iter().copied().fold(f32::INFINITY, f32::min);
+        let farthest = depths.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+        // A flat hair (all corners at one depth) still gets a usable, positive spacing.
+        let range = (farthest - nearest).max(1e-6 * (camera.far - camera.near));
+        let settings = DomSettings {
+            resolution,
+            layers: slices,
+            spacing: range / slices as f32,
+        };
+        settings.check()?;
+        let start = ((nearest - camera.near) / (camera.far - camera.near)).clamp(0.0, 1.0);
+        Ok(Self {
+            layer_start: LayerStart::Fixed(start),
+            ..Self::new(gpu, camera, settings)
+        })
     }
 
     /// Per texel, the K layers' optical depths (row-major from the top).
@@ -272,18 +317,35 @@ impl DeepOpacityPass {
             ],
         });
         let mut encoder = device.create_command_encoder(&Default::default());
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("dom depth"),
-                color_attachments: &[],
-                depth_stencil_attachment: cleared_depth(&depth_view, true),
-                timestamp_writes: gpu.render_timestamps(),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.depth_pipeline);
-            pass.set_bind_group(0, &strands, &[]);
-            pass.draw(0..6, 0..geometry.segment_count);
+        match map.layer_start {
+            LayerStart::NearestFiber => {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("dom depth"),
+                    color_attachments: &[],
+                    depth_stencil_attachment: cleared_depth(&depth_view, true),
+                    timestamp_writes: gpu.render_timestamps(),
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.depth_pipeline);
+                pass.set_bind_group(0, &strands, &[]);
+                pass.draw(0..6, 0..geometry.segment_count);
+            }
+            LayerStart::Fixed(start) => {
+                // The layer pass and the lookup read the start from the depth texture either way.
+                encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("osm start depth"),
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &depth_view,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(start),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    ..Default::default()
+                });
+            }
         }
         let views: Vec<_> = map
             .layers
