@@ -153,13 +153,25 @@ impl GpuContext {
     /// wall-clock milliseconds and, where the adapter has timestamp queries, the GPU
     /// milliseconds of the passes it recorded.
     pub fn time_passes<T>(&self, work: impl FnOnce() -> T) -> (T, f64, Option<f64>) {
-        let timing = self.pass_timer.as_ref().filter(|t| t.begin());
+        let mut open = CloseOnUnwind(self.pass_timer.as_ref().filter(|t| t.begin()));
         let start = std::time::Instant::now();
         let out = work();
         self.wait_idle();
         let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        let gpu_ms = timing.and_then(|t| t.end(self));
+        let gpu_ms = open.0.take().and_then(|t| t.end(self));
         (out, wall_ms, gpu_ms)
+    }
+}
+
+/// Closes a section whose work panicked: left open, it would belong to that thread forever and
+/// every later section on a shared device would go untimed.
+struct CloseOnUnwind<'a>(Option<&'a PassTimer>);
+
+impl Drop for CloseOnUnwind<'_> {
+    fn drop(&mut self) {
+        if let Some(timer) = self.0 {
+            *timer.lock() = Section::default();
+        }
     }
 }
 
@@ -203,5 +215,13 @@ mod tests {
             timer.end(&gpu).is_none(),
             "an empty section has no GPU time"
         );
+
+        // A panic inside a timed section leaves it closed for the next one.
+        let panicked = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            gpu.time_passes(|| panic!("injected"))
+        }));
+        assert!(panicked.is_err());
+        assert!(timer.begin(), "the panicked section was left open");
+        assert!(timer.end(&gpu).is_none());
     }
 }
