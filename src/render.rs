@@ -79,9 +79,21 @@ pub struct RenderArgs {
     /// Opacity shadow map slices across the hair's depth range (1..=8), with --shadows osm.
     #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_OSM_SLICES)]
     osm_slices: u32,
-    /// Deep or opacity shadow map resolution (square).
+    /// Light map resolution (square) of every --shadows technique.
     #[arg(long, default_value_t = 512)]
     dom_size: u32,
+    /// Shadow map and ADSM percentage-closer filter, texels per side (odd, 1..=9).
+    #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_PCF_KERNEL)]
+    pcf: u32,
+    /// Shadow map and ADSM depth bias along the light, world units (default: two map texels).
+    #[arg(long)]
+    shadow_bias: Option<f32>,
+    /// ADSM: opacity of one fiber, in (0, 1).
+    #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_ADSM_ALPHA)]
+    adsm_alpha: f32,
+    /// ADSM: world units between fibers along the light (default: 1% of the hair's diagonal).
+    #[arg(long)]
+    adsm_spacing: Option<f32>,
     /// A-buffer/DBK node pool in nodes per pixel (clamped to the adapter's limit). Default:
     /// sized to exactly the fragments the technique stores, counted by a first build.
     #[arg(long)]
@@ -182,6 +194,10 @@ fn settings_from_args(args: &RenderArgs) -> anyhow::Result<FrameSettings> {
             transparency: args.transparency,
             dom_layers: args.dom_layers,
             osm_slices: args.osm_slices,
+            pcf_kernel: args.pcf,
+            shadow_bias: args.shadow_bias,
+            adsm_alpha: args.adsm_alpha,
+            adsm_spacing: args.adsm_spacing,
             dom_spacing: args.dom_spacing,
             dom_size: args.dom_size,
             abuffer_nodes_per_pixel: args.abuffer_nodes_per_pixel,

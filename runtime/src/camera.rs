@@ -226,6 +226,16 @@ impl Camera {
         }
     }
 
+    /// The depth-buffer value (wgpu's 0..1) of a point `distance` along the view axis.
+    pub fn depth_buffer_value(&self, distance: f32) -> f32 {
+        let (near, far) = (self.near, self.far);
+        if self.is_perspective() {
+            far * (distance - near) / (distance * (far - near))
+        } else {
+            (distance - near) / (far - near)
+        }
+    }
+
     pub fn is_perspective(&self) -> bool {
         matches!(self.projection, Projection::Perspective { .. })
     }
@@ -253,6 +263,70 @@ pub fn light_camera(toward_light: Vec3, bounds: Aabb) -> Camera {
         near: radius * 0.5,
         far: radius * 3.5,
     }
+}
+
+/// A point or spot light inside (or too close to) the hair's bounding box: no single
+/// perspective shadow map sees all of the hair from there.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[error(
+    "light at {position} sees the hair's bounding box ({min} to {max}) over {cone_degrees:.0}° or from inside it; a single perspective shadow map covers at most {MAX_LIGHT_CONE_DEGREES}°: move the light farther out or use a directional light"
+)]
+pub struct LightInsideHair {
+    pub position: Vec3,
+    pub min: Vec3,
+    pub max: Vec3,
+    /// The full cone angle the box needs from the light (NaN where a corner lies behind it).
+    pub cone_degrees: f32,
+}
+
+/// The widest cone a point light's single shadow map covers.
+pub const MAX_LIGHT_CONE_DEGREES: f32 = 150.0;
+
+/// The perspective camera of a point or spot light at `position`: one frustum aimed at the
+/// box's centre whose cone just holds its eight corners (so the whole box, which is their convex
+/// hull). A cube or dual-paraboloid layout would serve lights inside the hair; a light that
+/// lights a groom from outside needs only this frustum, with all of its texels on the hair.
+pub fn point_light_camera(position: Vec3, bounds: Aabb) -> Result<Camera, LightInsideHair> {
+    let refuse = |cone_degrees| LightInsideHair {
+        position,
+        min: bounds.min,
+        max: bounds.max,
+        cone_degrees,
+    };
+    let axis = (bounds.center() - position).normalize_or_zero();
+    if !position.is_finite() || axis == Vec3::ZERO {
+        return Err(refuse(f32::NAN));
+    }
+    let mut nearest = f32::INFINITY;
+    let mut farthest = 0.0f32;
+    let mut half_angle = 0.0f32;
+    for corner in bounds.corners() {
+        let to_corner = corner - position;
+        let depth = to_corner.dot(axis);
+        if !(depth > 0.0) {
+            return Err(refuse(f32::NAN));
+        }
+        nearest = nearest.min(depth);
+        farthest = farthest.max(depth);
+        half_angle = half_angle.max(to_corner.angle_between(axis));
+    }
+    // A square frustum holds the cone of its half-width.
+    let cone_degrees = 2.0 * half_angle.to_degrees();
+    if !(cone_degrees <= MAX_LIGHT_CONE_DEGREES) {
+        return Err(refuse(cone_degrees));
+    }
+    let up = if axis.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    Ok(Camera {
+        eye: position,
+        target: bounds.center(),
+        up,
+        projection: Projection::Perspective {
+            fov_y: 2.0 * half_angle * 1.01,
+        },
+        // Margins keep the nearest and farthest fibers off the clip planes.
+        near: nearest * 0.95,
+        far: farthest * 1.05,
+    })
 }
 
 #[cfg(test)]
@@ -445,6 +519,28 @@ mod tests {
         assert!(matches!(inside, Err(EyeInsideBounds { .. })));
         let nan = Camera::framing_from_eye(bounds, 1.0, false, Vec3::NAN, Vec3::Z);
         assert!(nan.is_err(), "a NaN eye must be refused");
+    }
+
+    #[test]
+    fn a_point_light_camera_holds_the_box_or_refuses_a_light_beside_it() {
+        let bounds = Aabb {
+            min: Vec3::new(-1.0, -2.0, 0.0),
+            max: Vec3::new(1.0, 2.0, 3.0),
+        };
+        // Far away, near a face (cone ≈ 112°), and along the y axis (another up).
+        for light in [
+            Vec3::new(0.0, -40.0, 2.0),
+            Vec3::new(0.0, 0.0, 4.5),
+            Vec3::new(0.0, 12.0, 1.5),
+        ] {
+            let cam = point_light_camera(light, bounds).unwrap();
+            let widest = assert_in_view(&cam, bounds, 1.0, &format!("light {light}"));
+            assert!(widest > 0.6, "light {light}: the box fills {widest} of the map");
+        }
+        for light in [Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 0.0, 3.05), Vec3::NAN] {
+            let refused = point_light_camera(light, bounds);
+            assert!(refused.is_err(), "light {light}: {refused:?}");
+        }
     }
 
     fn hanging(direction: Vec3) -> HairModel {

@@ -1,13 +1,15 @@
 //! One headless frame end to end: upload, strand pass, readback, with per-pass timings and the
 //! GPU memory each buffer and texture holds.
 
-use crate::camera::light_camera;
+use crate::camera::{light_camera, point_light_camera};
 use crate::gpu::readback::ReadbackError;
 use crate::gpu::{AdapterReport, GpuContext, GpuLimits, LimitError, read_texture_rgba};
 use crate::hair::HairModel;
 use crate::lights::Light;
 use crate::passes::abuffer::{ABufferError, ABufferPass, ListMode};
-use crate::passes::deep_opacity::{DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError};
+use crate::passes::deep_opacity::{
+    DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError, ShadowLookup, ShadowMapError,
+};
 use crate::passes::fiber_shading::ShadingModel;
 use crate::passes::frame_params::FrameParams;
 use crate::passes::render_target::RenderTarget;
@@ -23,8 +25,10 @@ pub enum RenderError {
     TooManyPoints(#[from] TooManyPoints),
     #[error(transparent)]
     DomSettings(#[from] DomSettingsError),
-    #[error("deep opacity maps need a directional light; the frame has none")]
-    NoDirectionalLight,
+    #[error(transparent)]
+    ShadowMap(#[from] ShadowMapError),
+    #[error("shadows were asked for but the frame has no light")]
+    NoLight,
     #[error(transparent)]
     TooManyShadowMaps(#[from] TooManyShadowMaps),
     #[error(transparent)]
@@ -108,15 +112,15 @@ impl From<ABufferError> for RenderError {
 fn check_frame_limits(
     gpu: &GpuContext,
     frame: &FrameParams,
-    shadowed_lights: &[(ShadowMaps, u32, glam::Vec3)],
+    shadowed_lights: &[(ShadowMaps, u32, Light)],
 ) -> Result<(), LimitError> {
     let limits = GpuLimits::of(gpu);
     limits.check_image(frame.width, frame.height)?;
     // Every light's map has the same settings.
     if let Some((settings, _, _)) = shadowed_lights.first() {
         let res = settings.resolution();
-        limits.check_texture_2d("deep opacity map", res, res, |max| {
-            format!("use a deep opacity map resolution of at most {max}")
+        limits.check_texture_2d("light map", res, res, |max| {
+            format!("use a shadow map resolution of at most {max}")
         })?;
     }
     Ok(())
@@ -140,8 +144,10 @@ pub enum Transparency {
     },
 }
 
-/// How directional lights are shadowed: both kinds are layers of optical depth along the light,
-/// looked up the same way; they differ in where the layers start.
+/// How lights are shadowed. Deep opacity and opacity shadow maps are layers of optical depth
+/// along the light, looked up the same way, differing in where the layers start; shadow maps
+/// and ADSM keep only the nearest fiber's depth. Directional lights get an orthographic map,
+/// point and spot lights a perspective one ([`point_light_camera`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ShadowMaps {
     /// Deep opacity maps (Yuksel & Keyser 2008): layers from each texel's nearest fiber.
@@ -149,6 +155,11 @@ pub enum ShadowMaps {
     /// Opacity shadow maps (Kim & Neumann 2001): `slices` equal slices spanning the hair's
     /// depth range along the light, the same for every texel.
     OpacitySlices { resolution: u32, slices: u32 },
+    /// Shadow maps with PCF or ADSM ([`ShadowLookup::Hard`], [`ShadowLookup::Adsm`]).
+    Depth {
+        resolution: u32,
+        lookup: ShadowLookup,
+    },
 }
 
 impl ShadowMaps {
@@ -156,42 +167,74 @@ impl ShadowMaps {
         match *self {
             ShadowMaps::Deep(settings) => settings.resolution,
             ShadowMaps::OpacitySlices { resolution, .. } => resolution,
+            ShadowMaps::Depth { resolution, .. } => resolution,
         }
     }
 
-    fn check(&self) -> Result<(), DomSettingsError> {
+    fn check(&self) -> Result<(), ShadowMapError> {
         match *self {
-            ShadowMaps::Deep(settings) => settings.check(),
+            ShadowMaps::Deep(settings) => settings.check()?,
             ShadowMaps::OpacitySlices { resolution, slices } => DomSettings {
                 resolution,
                 layers: slices,
                 spacing: 1.0,
             }
-            .check(),
+            .check()?,
+            ShadowMaps::Depth { resolution, lookup } => {
+                DomSettings {
+                    resolution,
+                    layers: 1,
+                    spacing: 1.0,
+                }
+                .check()?;
+                lookup.check()?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The name of the pass that draws one light's map, in timings.
+    pub fn pass_name(&self) -> &'static str {
+        match self {
+            ShadowMaps::Deep(_) => "deep opacity",
+            ShadowMaps::OpacitySlices { .. } => "opacity shadow",
+            ShadowMaps::Depth {
+                lookup: ShadowLookup::Adsm { .. },
+                ..
+            } => "adsm depth",
+            ShadowMaps::Depth { .. } => "shadow map",
         }
     }
 
-    /// The map of the light shining from `toward_light` onto hair within `bounds`.
+    /// The map of `light` shining onto hair within `bounds`.
     fn map_for(
         &self,
         gpu: &GpuContext,
-        toward_light: glam::Vec3,
+        light: &Light,
         bounds: crate::hair::Aabb,
-    ) -> Result<DeepOpacityMap, DomSettingsError> {
-        let camera = light_camera(toward_light, bounds);
-        match *self {
-            ShadowMaps::Deep(settings) => Ok(DeepOpacityMap::new(gpu, camera, settings)),
-            ShadowMaps::OpacitySlices { resolution, slices } => {
-                DeepOpacityMap::opacity_slices(gpu, camera, bounds, resolution, slices)
+    ) -> Result<DeepOpacityMap, ShadowMapError> {
+        let camera = match *light {
+            Light::Directional { direction, .. } => light_camera(direction, bounds),
+            Light::Point { position, .. } | Light::Spot { position, .. } => {
+                point_light_camera(position, bounds)?
             }
-        }
+        };
+        Ok(match *self {
+            ShadowMaps::Deep(settings) => DeepOpacityMap::new(gpu, camera, settings),
+            ShadowMaps::OpacitySlices { resolution, slices } => {
+                DeepOpacityMap::opacity_slices(gpu, camera, bounds, resolution, slices)?
+            }
+            ShadowMaps::Depth { resolution, lookup } => {
+                DeepOpacityMap::depth_only(gpu, camera, resolution, lookup)?
+            }
+        })
     }
 }
 
 /// Everything besides the frame that changes how it is rendered.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct RenderOptions {
-    /// Light maps for every directional light (at most [`MAX_SHADOWED_LIGHTS`]), used by every
+    /// Light maps for every light (at most [`MAX_SHADOWED_LIGHTS`]), used by every
     /// transparency mode.
     pub shadows: Option<ShadowMaps>,
     pub transparency: Transparency,
@@ -220,8 +263,8 @@ fn timed<T>(
     out
 }
 
-/// Renders `model` with `frame` and reads the picture back. With `shadows`, every directional
-/// light is shadowed through its own deep opacity map (point and spot lights are unshadowed).
+/// Renders `model` with `frame` and reads the picture back. With `shadows`, every light is
+/// shadowed through its own map.
 pub fn render_frame(
     gpu: &GpuContext,
     model: &HairModel,
@@ -240,29 +283,23 @@ pub fn render_frame_with_model(
     options: &RenderOptions,
     shading: &ShadingModel,
 ) -> Result<Frame, RenderError> {
-    // Every directional light gets a deep opacity map; every pass shadows them all.
-    let shadowed_lights: Vec<(ShadowMaps, u32, glam::Vec3)> = match options.shadows {
+    // Every light gets a map; every pass shadows them all.
+    let shadowed_lights: Vec<(ShadowMaps, u32, Light)> = match options.shadows {
         None => Vec::new(),
         Some(settings) => {
             settings.check()?;
-            let directional: Vec<_> = frame
-                .lights
-                .iter()
-                .enumerate()
-                .filter_map(|(i, l)| match l {
-                    Light::Directional { direction, .. } => Some((settings, i as u32, *direction)),
-                    _ => None,
-                })
-                .collect();
-            if directional.is_empty() {
-                return Err(RenderError::NoDirectionalLight);
+            if frame.lights.is_empty() {
+                return Err(RenderError::NoLight);
             }
-            if directional.len() > MAX_SHADOWED_LIGHTS {
+            if frame.lights.len() > MAX_SHADOWED_LIGHTS {
                 return Err(RenderError::TooManyShadowMaps(TooManyShadowMaps {
-                    maps: directional.len(),
+                    maps: frame.lights.len(),
                 }));
             }
-            directional
+            (0..)
+                .zip(&frame.lights)
+                .map(|(i, light)| (settings, i, *light))
+                .collect()
         }
     };
     check_frame_limits(gpu, frame, &shadowed_lights)?;
@@ -274,13 +311,13 @@ pub fn render_frame_with_model(
     let mut memory_bytes = geometry.memory();
     let mut shadow_maps = Vec::new();
     if !shadowed_lights.is_empty() {
-        let dom_pass = timed(&mut timings, gpu, "dom pipeline", || {
+        let dom_pass = timed(&mut timings, gpu, "light map pipeline", || {
             DeepOpacityPass::new(gpu)
         });
-        for &(settings, index, direction) in &shadowed_lights {
-            let map = settings.map_for(gpu, direction, model.bounds())?;
+        for &(settings, index, light) in &shadowed_lights {
+            let map = settings.map_for(gpu, &light, model.bounds())?;
             // One entry per light, so that reports keyed by pass name keep them all.
-            let label = format!("deep opacity (light {index})");
+            let label = format!("{} (light {index})", settings.pass_name());
             timed(&mut timings, gpu, &label, || {
                 dom_pass.draw(gpu, &geometry, &map)
             });

@@ -22,7 +22,7 @@ use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
-use strandlight_runtime::passes::deep_opacity::DomSettings;
+use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
 use strandlight_runtime::passes::fiber_shading::ShadingModel;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
 use strandlight_runtime::render::{self, RenderOptions, ShadowMaps, render_frame_with_model};
@@ -82,6 +82,26 @@ pub fn point_render_options(point: &PointLighting, hair: &HairModel) -> RenderOp
             resolution: point.dom_size,
             slices: point.osm_slices,
         }),
+        Shadows::Sm | Shadows::Adsm => {
+            let kernel = point.pcf_kernel;
+            // A fiber slanted across a texel spans about a texel in depth: two keep it from
+            // shadowing itself.
+            let texel = diagonal / point.dom_size.max(1) as f32;
+            let bias = point.shadow_bias.unwrap_or(2.0 * texel);
+            let lookup = match point.shadows {
+                Shadows::Sm => ShadowLookup::Hard { kernel, bias },
+                _ => ShadowLookup::Adsm {
+                    kernel,
+                    bias,
+                    alpha: point.adsm_alpha,
+                    spacing: point.adsm_spacing.unwrap_or(diagonal * 0.01),
+                },
+            };
+            Some(ShadowMaps::Depth {
+                resolution: point.dom_size,
+                lookup,
+            })
+        }
     };
     let transparency = match point.transparency {
         Transparency::None | Transparency::Occupancy => render::Transparency::Opaque,

@@ -155,6 +155,10 @@ pub enum Shadows {
     Dom,
     /// Opacity shadow maps (equal slices across the hair's depth range).
     Osm,
+    /// Shadow maps with percentage-closer filtering.
+    Sm,
+    /// Approximate deep shadow maps (TressFX; a fiber count from the depth behind the nearest).
+    Adsm,
 }
 
 /// Transparency of point-lit frames (`occupancy` is the env-lit view's).
@@ -189,6 +193,18 @@ pub struct PointLighting {
     /// Opacity shadow map slices (1..=8).
     #[serde(default = "default_osm_slices")]
     pub osm_slices: u32,
+    /// Shadow map and ADSM filter: texels per side (odd, 1..=9).
+    #[serde(default = "default_pcf_kernel")]
+    pub pcf_kernel: u32,
+    /// Shadow map and ADSM bias along the light, world units; None: two light-map texels.
+    #[serde(default)]
+    pub shadow_bias: Option<f32>,
+    /// ADSM: opacity of one fiber, in (0, 1).
+    #[serde(default = "default_adsm_alpha")]
+    pub adsm_alpha: f32,
+    /// ADSM: world units between fibers along the light; None: 1% of the hair's diagonal.
+    #[serde(default)]
+    pub adsm_spacing: Option<f32>,
     /// A-buffer and DBK node pool, nodes per pixel; None: sized to the fragments the
     /// technique stores (a counting build first).
     #[serde(default)]
@@ -206,6 +222,20 @@ fn default_osm_slices() -> u32 {
     DEFAULT_OSM_SLICES
 }
 
+/// Hunz §6 filters shadow maps and ADSM with 3×3 PCF.
+pub const DEFAULT_PCF_KERNEL: u32 = 3;
+
+fn default_pcf_kernel() -> u32 {
+    DEFAULT_PCF_KERNEL
+}
+
+/// ADSM's fiber opacity (see docs/BENCHMARKS.md, "Shadow techniques", for how it was chosen).
+pub const DEFAULT_ADSM_ALPHA: f32 = 0.2;
+
+fn default_adsm_alpha() -> f32 {
+    DEFAULT_ADSM_ALPHA
+}
+
 impl Default for PointLighting {
     fn default() -> Self {
         Self {
@@ -216,6 +246,10 @@ impl Default for PointLighting {
             dom_spacing: None,
             dom_size: 512,
             osm_slices: DEFAULT_OSM_SLICES,
+            pcf_kernel: DEFAULT_PCF_KERNEL,
+            shadow_bias: None,
+            adsm_alpha: DEFAULT_ADSM_ALPHA,
+            adsm_spacing: None,
             abuffer_nodes_per_pixel: None,
             dbk_delta: None,
             lut_size: 128,

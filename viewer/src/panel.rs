@@ -253,12 +253,24 @@ fn point_controls(ui: &mut egui::Ui, p: &mut PointLighting) {
         ui.radio_value(&mut p.shadows, Shadows::None, "none");
         ui.radio_value(&mut p.shadows, Shadows::Dom, "deep opacity maps");
         ui.radio_value(&mut p.shadows, Shadows::Osm, "opacity shadow maps");
+        ui.radio_value(&mut p.shadows, Shadows::Sm, "shadow maps");
+        ui.radio_value(&mut p.shadows, Shadows::Adsm, "ADSM");
     });
     if p.shadows == Shadows::Dom {
         ui.add(egui::Slider::new(&mut p.dom_layers, 1..=8).text("DOM layers"));
     }
     if p.shadows == Shadows::Osm {
         ui.add(egui::Slider::new(&mut p.osm_slices, 1..=8).text("OSM slices"));
+    }
+    if matches!(p.shadows, Shadows::Sm | Shadows::Adsm) {
+        ui.add(
+            egui::Slider::new(&mut p.pcf_kernel, 1..=9)
+                .step_by(2.0)
+                .text("PCF kernel"),
+        );
+    }
+    if p.shadows == Shadows::Adsm {
+        ui.add(egui::Slider::new(&mut p.adsm_alpha, 0.01..=0.95).text("ADSM fiber opacity"));
     }
     if p.shadows != Shadows::None {
         egui::ComboBox::from_label("map resolution")

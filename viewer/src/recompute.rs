@@ -105,8 +105,17 @@ pub fn tables_key(settings: &FrameSettings) -> TablesKey {
 fn light_maps_key(settings: &FrameSettings) -> String {
     match &settings.lighting {
         Lighting::Lights(p) => format!(
-            "{:?} {:?} {} {:?} {} {}",
-            p.lights, p.shadows, p.dom_layers, p.dom_spacing, p.dom_size, p.osm_slices
+            "{:?} {:?} {} {:?} {} {} {} {:?} {} {:?}",
+            p.lights,
+            p.shadows,
+            p.dom_layers,
+            p.dom_spacing,
+            p.dom_size,
+            p.osm_slices,
+            p.pcf_kernel,
+            p.shadow_bias,
+            p.adsm_alpha,
+            p.adsm_spacing
         ),
         Lighting::Environment(e) => format!(
             "{} {:?} {} {}",

@@ -1,11 +1,17 @@
 //! Deep opacity maps for a directional light: a light-space depth prepass (nearest fiber per
 //! texel), then one additive pass that sorts every fragment's optical depth into K layers of
 //! configurable spacing, the last layer taking what lies beyond (`deep_opacity.wgsl`).
+//! Shadow maps and ADSM (Hunz §4) use only the depth prepass: the lookup compares against the
+//! nearest fiber ([`ShadowLookup`]). Point and spot lights use a perspective light camera
+//! ([`point_light_camera`]); depths are linearized wherever layers are measured.
 //! Opacity shadow maps (Kim & Neumann 2001, Kim 2003) are the same layers started at one depth
 //! for every texel, the hair's nearest extent, and spaced to span its whole depth range
 //! ([`DeepOpacityMap::opacity_slices`]): no prepass, so the slices do not follow the hair's
 //! surface and need more of them for the same accuracy.
-//! Inputs: [`StrandGeometry`], the light's direction, the hair's bounds, [`DomSettings`].
+//!
+//! [`point_light_camera`]: crate::camera::point_light_camera
+//!
+//! Inputs: [`StrandGeometry`], the light's camera, the hair's bounds, [`DomSettings`].
 //! Output: [`DeepOpacityMap`] (layer textures + nearest-depth texture + the light's camera).
 //! The pipelines are built once and the per-light targets can be reused, so the pass repeats
 //! cheaply for many lights.
@@ -67,6 +73,8 @@ struct DomUniform {
     far: f32,
     spacing: f32,
     layers: u32,
+    perspective: u32,
+    _pad: [u32; 3],
 }
 
 /// Where a map's first layer begins.
@@ -79,11 +87,81 @@ pub enum LayerStart {
     Fixed(f32),
 }
 
+/// How the shading passes read a light's map.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShadowLookup {
+    /// Optical depth layers (deep opacity and opacity shadow maps).
+    Layers,
+    /// A shadow map: lit where the fragment lies no more than `bias` (world units along the
+    /// light) behind the nearest fiber, averaged over `kernel`×`kernel` texels (PCF).
+    Hard { kernel: u32, bias: f32 },
+    /// Approximate deep shadow maps (TressFX; Hunz §4): behind the nearest fiber by b (beyond
+    /// `bias`), the light passes (1 − `alpha`)^(1 + b / `spacing`), i.e. one fiber of opacity
+    /// `alpha` every `spacing` world units; PCF as for [`ShadowLookup::Hard`].
+    Adsm {
+        kernel: u32,
+        bias: f32,
+        alpha: f32,
+        spacing: f32,
+    },
+}
+
+/// The largest PCF kernel (texels per side).
+pub const MAX_PCF_KERNEL: u32 = 9;
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ShadowLookupError {
+    #[error("PCF kernel {0}: must be odd and 1..={MAX_PCF_KERNEL}")]
+    Kernel(u32),
+    #[error("shadow bias {0}: must be finite and ≥ 0 (world units)")]
+    Bias(f32),
+    #[error("ADSM fiber opacity {0}: must be in (0, 1)")]
+    Alpha(f32),
+    #[error("ADSM fiber spacing {0}: must be positive and finite (world units)")]
+    Spacing(f32),
+}
+
+impl ShadowLookup {
+    pub fn check(&self) -> Result<(), ShadowLookupError> {
+        let (kernel, bias) = match *self {
+            ShadowLookup::Layers => return Ok(()),
+            ShadowLookup::Hard { kernel, bias } => (kernel, bias),
+            ShadowLookup::Adsm {
+                kernel,
+                bias,
+                alpha,
+                spacing,
+            } => {
+                if !(alpha > 0.0 && alpha < 1.0) {
+                    return Err(ShadowLookupError::Alpha(alpha));
+                }
+                if !(spacing > 0.0 && spacing.is_finite()) {
+                    return Err(ShadowLookupError::Spacing(spacing));
+                }
+                (kernel, bias)
+            }
+        };
+        if kernel % 2 == 0 || !(1..=MAX_PCF_KERNEL).contains(&kernel) {
+            return Err(ShadowLookupError::Kernel(kernel));
+        }
+        if !(bias >= 0.0 && bias.is_finite()) {
+            return Err(ShadowLookupError::Bias(bias));
+        }
+        Ok(())
+    }
+
+    /// Whether the map needs its optical depth layers (else only the nearest depth).
+    pub fn uses_layers(&self) -> bool {
+        matches!(self, ShadowLookup::Layers)
+    }
+}
+
 /// One light's maps.
 pub struct DeepOpacityMap {
     pub camera: Camera,
     pub settings: DomSettings,
     pub layer_start: LayerStart,
+    pub lookup: ShadowLookup,
     pub nearest_depth: wgpu::Texture,
     /// Layers 0–3 and 4–7 in the channels of two textures.
     pub layers: [wgpu::Texture; 2],
@@ -104,6 +182,7 @@ impl DeepOpacityMap {
             camera,
             settings,
             layer_start: LayerStart::NearestFiber,
+            lookup: ShadowLookup::Layers,
             nearest_depth: texture(
                 "dom nearest depth",
                 DEPTH_FORMAT,
@@ -117,7 +196,7 @@ impl DeepOpacityMap {
     }
 
     /// An opacity shadow map: `slices` layers of equal thickness from the nearest to the
-    /// farthest extent of `bounds` along the (orthographic) light camera's view direction.
+    /// farthest extent of `bounds` along the light camera's axis.
     pub fn opacity_slices(
         gpu: &GpuContext,
         camera: Camera,
@@ -125,6 +204,8 @@ impl DeepOpacityMap {
         resolution: u32,
         slices: u32,
     ) -> Result<Self, DomSettingsError> {
+        // View-space depth along the axis: for a perspective camera too, the quantity the layer
+        // pass linearizes to.
         let forward = (camera.target - camera.eye).normalize();
         let depths = bounds.corners().map(|c| (c - camera.eye).dot(forward));
         let nearest = depths.iter().copied().fold(f32::INFINITY, f32::min);
@@ -137,11 +218,40 @@ impl DeepOpacityMap {
             spacing: range / slices as f32,
         };
         settings.check()?;
-        let start = ((nearest - camera.near) / (camera.far - camera.near)).clamp(0.0, 1.0);
+        let start = camera.depth_buffer_value(nearest).clamp(0.0, 1.0);
         Ok(Self {
             layer_start: LayerStart::Fixed(start),
             ..Self::new(gpu, camera, settings)
         })
+    }
+
+    /// A shadow map (or ADSM) of `resolution`²: the nearest depth only, with 1×1 layer
+    /// placeholders for the shading passes' bindings.
+    pub fn depth_only(
+        gpu: &GpuContext,
+        camera: Camera,
+        resolution: u32,
+        lookup: ShadowLookup,
+    ) -> Result<Self, ShadowMapError> {
+        lookup.check()?;
+        let settings = DomSettings {
+            resolution,
+            layers: 1,
+            spacing: 1.0,
+        };
+        settings.check()?;
+        let mut map = Self::new(gpu, camera, settings);
+        let placeholder = Self::new(
+            gpu,
+            camera,
+            DomSettings {
+                resolution: 1,
+                ..settings
+            },
+        );
+        map.layers = placeholder.layers;
+        map.lookup = lookup;
+        Ok(map)
     }
 
     /// Per texel, the K layers' optical depths (row-major from the top).
@@ -157,12 +267,26 @@ impl DeepOpacityMap {
 
     pub fn memory(&self) -> Vec<(String, u64)> {
         let texels = self.settings.resolution as u64 * self.settings.resolution as u64;
+        if !self.lookup.uses_layers() {
+            return vec![("shadow map depth".into(), texels * 4)];
+        }
         let layer_texel = self.layers[0].format().block_copy_size(None).unwrap_or(16) as u64;
         vec![
             ("dom nearest depth".into(), texels * 4),
             ("dom layers".into(), 2 * texels * layer_texel),
         ]
     }
+}
+
+/// A light's map could not be made.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum ShadowMapError {
+    #[error(transparent)]
+    Settings(#[from] DomSettingsError),
+    #[error(transparent)]
+    Lookup(#[from] ShadowLookupError),
+    #[error(transparent)]
+    LightInsideHair(#[from] crate::camera::LightInsideHair),
 }
 
 /// Transmittance in front of layer `k` from one texel's layers: exp(−Σ_{j<k} layer_j).
@@ -298,6 +422,8 @@ impl DeepOpacityPass {
                 far: map.camera.far,
                 spacing: map.settings.spacing,
                 layers: map.settings.layers,
+                perspective: map.camera.is_perspective() as u32,
+                _pad: [0; 3],
             }),
             usage: wgpu::BufferUsages::UNIFORM,
         });
@@ -346,6 +472,10 @@ impl DeepOpacityPass {
                     ..Default::default()
                 });
             }
+        }
+        if !map.lookup.uses_layers() {
+            gpu.queue.submit([encoder.finish()]);
+            return;
         }
         let views: Vec<_> = map
             .layers

@@ -1,5 +1,5 @@
 // Deep opacity map layers (Yuksel & Keyser; Svoboda §4, Hunz §4), appended to strand_quads.wgsl
-// and drawn from the light's orthographic camera after a depth prepass that left the nearest
+// and drawn from the light's camera after a depth prepass that left the nearest
 // fiber depth z0 per texel. Each fragment adds its optical depth τ = −ln(1 − α) (α: coverage ×
 // opacity) to layer k = floor((d − d0) / spacing), the last layer taking everything beyond, so
 // the transmittance in front of layer k is exp(−Σ_{j<k} layer_j) = Π(1 − α) of the fibers there.
@@ -10,6 +10,11 @@ struct DomParams {
     far: f32,
     spacing: f32,
     layers: u32,
+    // 1: a point or spot light's perspective camera (depths are linearized).
+    perspective: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 @group(1) @binding(0) var nearest_depth: texture_depth_2d;
@@ -24,11 +29,20 @@ struct Layers {
 // which keeps τ finite.
 const MAX_ALPHA: f32 = 0.999;
 
+// Distance along the light camera's axis from a depth-buffer value (wgpu's 0..1 depth of glam's
+// "directx" projections).
+fn dom_depth(z: f32) -> f32 {
+    if (dom.perspective != 0u) {
+        return dom.far * dom.near / (dom.far - z * (dom.far - dom.near));
+    }
+    return dom.near + z * (dom.far - dom.near);
+}
+
 @fragment
 fn fs_layers(in: VertexOut) -> Layers {
     let z0 = textureLoad(nearest_depth, vec2<i32>(in.clip.xy), 0);
-    let d0 = dom.near + z0 * (dom.far - dom.near);
-    let d = dom.near + in.clip.z * (dom.far - dom.near);
+    let d0 = dom_depth(z0);
+    let d = dom_depth(in.clip.z);
     let k = min(u32(max(d - d0, 0.0) / dom.spacing), dom.layers - 1u);
     let tau = -log(1.0 - min(in.alpha, MAX_ALPHA));
     var out: Layers;

@@ -1,10 +1,10 @@
-//! Group 1 of the shading passes (`strands.wgsl`): up to [`MAX_SHADOWED_LIGHTS`] deep opacity
-//! maps, each shadowing one light of the frame, in fixed slots; unused slots hold 1×1
+//! Group 1 of the shading passes (`strands.wgsl`): up to [`MAX_SHADOWED_LIGHTS`] light maps
+//! (deep opacity, opacity shadow, shadow maps or ADSM), each shadowing one light of the frame, in fixed slots; unused slots hold 1×1
 //! placeholders that shadow no light.
 
 use wgpu::util::DeviceExt;
 
-use super::deep_opacity::{DeepOpacityMap, DomSettings};
+use super::deep_opacity::{DeepOpacityMap, DomSettings, ShadowLookup};
 use super::frame_params::FrameParams;
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{depth_texture_entry, float_texture_entry, uniform_entry};
@@ -37,7 +37,21 @@ struct ShadowUniform {
     layers: u32,
     light_index: u32,
     resolution: f32,
-    _pad: [f32; 2],
+    lookup: u32,
+    perspective: u32,
+    kernel: u32,
+    bias: f32,
+    adsm_alpha: f32,
+    adsm_spacing: f32,
+}
+
+/// `ShadowParams.lookup` in `strands.wgsl`.
+fn lookup_code(lookup: &ShadowLookup) -> u32 {
+    match lookup {
+        ShadowLookup::Layers => 0,
+        ShadowLookup::Hard { .. } => 1,
+        ShadowLookup::Adsm { .. } => 2,
+    }
 }
 
 /// Group 1 of the shading passes: per slot (up to [`MAX_SHADOWED_LIGHTS`]) the nearest depth and
@@ -101,15 +115,33 @@ pub fn shadow_bind_group_for(
         .collect();
     let uniforms: Vec<ShadowUniform> = slots
         .iter()
-        .map(|&(map, light_index)| ShadowUniform {
-            view_proj: (map.camera.projection_matrix(1.0) * map.camera.view()).to_cols_array_2d(),
-            near: map.camera.near,
-            far: map.camera.far,
-            spacing: map.settings.spacing,
-            layers: map.settings.layers,
-            light_index,
-            resolution: map.settings.resolution as f32,
-            _pad: [0.0; 2],
+        .map(|&(map, light_index)| {
+            let (kernel, bias, adsm_alpha, adsm_spacing) = match map.lookup {
+                ShadowLookup::Layers => (1, 0.0, 0.5, 1.0),
+                ShadowLookup::Hard { kernel, bias } => (kernel, bias, 0.5, 1.0),
+                ShadowLookup::Adsm {
+                    kernel,
+                    bias,
+                    alpha,
+                    spacing,
+                } => (kernel, bias, alpha, spacing),
+            };
+            ShadowUniform {
+                view_proj: (map.camera.projection_matrix(1.0) * map.camera.view())
+                    .to_cols_array_2d(),
+                near: map.camera.near,
+                far: map.camera.far,
+                spacing: map.settings.spacing,
+                layers: map.settings.layers,
+                light_index,
+                resolution: map.settings.resolution as f32,
+                lookup: lookup_code(&map.lookup),
+                perspective: map.camera.is_perspective() as u32,
+                kernel,
+                bias,
+                adsm_alpha,
+                adsm_spacing,
+            }
         })
         .collect();
     let shadow_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {

@@ -2,7 +2,7 @@
 // pre-multiplied alpha. The fiber model is `fiber_radiance`, defined by one of the fiber_*.wgsl
 // files appended after this one (Kajiya-Kay, Marschner through lookup tables, artist-friendly).
 
-// Deep opacity maps of up to four directional lights (Svoboda §4, Hunz §4); slot k shadows light
+// The maps of up to four lights (Svoboda §4, Hunz §4); slot k shadows light
 // shadow[k].light_index, 0xffffffff: an unused slot (a 1×1 placeholder map is bound there).
 struct ShadowParams {
     view_proj: mat4x4<f32>,
@@ -12,9 +12,21 @@ struct ShadowParams {
     layers: u32,
     light_index: u32,
     resolution: f32,
-    _pad0: f32,
-    _pad1: f32,
+    // LOOKUP_*.
+    lookup: u32,
+    // 1: a point or spot light's perspective camera.
+    perspective: u32,
+    // Shadow map and ADSM: PCF kernel (texels per side), bias (world units along the light).
+    kernel: u32,
+    bias: f32,
+    // ADSM: one fiber of this opacity every adsm_spacing world units behind the nearest one.
+    adsm_alpha: f32,
+    adsm_spacing: f32,
 };
+
+const LOOKUP_LAYERS: u32 = 0u;
+const LOOKUP_HARD: u32 = 1u;
+const LOOKUP_ADSM: u32 = 2u;
 
 const SHADOW_SLOTS: u32 = 4u;
 
@@ -37,9 +49,44 @@ fn layer_value(a: vec4<f32>, b: vec4<f32>, k: u32) -> f32 {
     return b[k - 4u];
 }
 
-// exp(−optical depth in front of `world`) in one map: the layers before its own, plus the part
-// of its own layer in front of it (linear within the layer), the last layer being spread over
-// one spacing.
+// Distance along the light camera's axis from a depth-buffer value.
+fn light_depth(p: ShadowParams, z: f32) -> f32 {
+    if (p.perspective != 0u) {
+        return p.far * p.near / (p.far - z * (p.far - p.near));
+    }
+    return p.near + z * (p.far - p.near);
+}
+
+// The light a fragment at light depth `d` receives past one texel's nearest fiber: a hard test
+// (shadow map) or TressFX's fiber count (ADSM).
+fn depth_test_texel(depth: texture_depth_2d, texel: vec2<i32>, d: f32, p: ShadowParams) -> f32 {
+    let z0 = textureLoad(depth, texel, 0);
+    if (z0 >= 1.0) { return 1.0; }
+    let behind = d - light_depth(p, z0) - p.bias;
+    if (behind <= 0.0) { return 1.0; }
+    if (p.lookup == LOOKUP_HARD) { return 0.0; }
+    return pow(1.0 - p.adsm_alpha, 1.0 + behind / p.adsm_spacing);
+}
+
+// Percentage-closer filtering: the depth test averaged over kernel × kernel texels (clamped at
+// the map's edges).
+fn filtered_depth_test(depth: texture_depth_2d, texel: vec2<i32>, d: f32, p: ShadowParams) -> f32 {
+    let r = i32(p.kernel / 2u);
+    let last = vec2<i32>(textureDimensions(depth)) - vec2<i32>(1);
+    var sum = 0.0;
+    for (var dy = -r; dy <= r; dy++) {
+        for (var dx = -r; dx <= r; dx++) {
+            let t = clamp(texel + vec2<i32>(dx, dy), vec2<i32>(0), last);
+            sum += depth_test_texel(depth, t, d, p);
+        }
+    }
+    let side = f32(2 * r + 1);
+    return sum / (side * side);
+}
+
+// The fraction of the light that reaches `world` through one map. Layers: exp(−optical depth in
+// front of it), the layers before its own plus the part of its own layer in front of it (linear
+// within the layer), the last layer being spread over one spacing.
 fn map_transmittance(
     depth: texture_depth_2d,
     layers_a: texture_2d<f32>,
@@ -48,13 +95,16 @@ fn map_transmittance(
     world: vec3<f32>,
 ) -> f32 {
     let clip = p.view_proj * vec4<f32>(world, 1.0);
-    let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
+    if (clip.w <= 0.0) { return 1.0; }
+    let ndc = clip.xyz / clip.w;
+    let uv = vec2<f32>(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
     if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }
     let texel = vec2<i32>(uv * p.resolution);
+    let d = light_depth(p, ndc.z);
+    if (p.lookup != LOOKUP_LAYERS) { return filtered_depth_test(depth, texel, d, p); }
     let z0 = textureLoad(depth, texel, 0);
     if (z0 >= 1.0) { return 1.0; }
-    let d0 = p.near + z0 * (p.far - p.near);
-    let d = p.near + clip.z * (p.far - p.near);
+    let d0 = light_depth(p, z0);
     let position = max(d - d0, 0.0) / p.spacing;
     let a = textureLoad(layers_a, texel, 0);
     let b = textureLoad(layers_b, texel, 0);
