@@ -315,7 +315,11 @@ pub fn point_light_camera(position: Vec3, bounds: Aabb) -> Result<Camera, LightI
     if !(cone_degrees <= MAX_LIGHT_CONE_DEGREES) {
         return Err(refuse(cone_degrees));
     }
-    let up = if axis.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    let up = if axis.y.abs() > 0.99 {
+        Vec3::Z
+    } else {
+        Vec3::Y
+    };
     Ok(Camera {
         eye: position,
         target: bounds.center(),
@@ -535,9 +539,16 @@ mod tests {
         ] {
             let cam = point_light_camera(light, bounds).unwrap();
             let widest = assert_in_view(&cam, bounds, 1.0, &format!("light {light}"));
-            assert!(widest > 0.6, "light {light}: the box fills {widest} of the map");
+            assert!(
+                widest > 0.6,
+                "light {light}: the box fills {widest} of the map"
+            );
         }
-        for light in [Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 0.0, 3.05), Vec3::NAN] {
+        for light in [
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(0.0, 0.0, 3.05),
+            Vec3::NAN,
+        ] {
             let refused = point_light_camera(light, bounds);
             assert!(refused.is_err(), "light {light}: {refused:?}");
         }

@@ -6,7 +6,7 @@ mod common;
 use common::*;
 
 use glam::Vec3;
-use strandlight_runtime::camera::Camera;
+use strandlight_runtime::camera::{Camera, Projection};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::gpu::read_texture_rgba;
 use strandlight_runtime::hair::{Attribute, HairModel};
@@ -285,4 +285,109 @@ fn a_reused_map_equals_a_fresh_one_for_each_light() {
         "a re-aimed map must hold exactly what a fresh one holds"
     );
     assert_ne!(a, first, "the two lights must see different optical depths");
+}
+
+/// A point light very far away is a directional light: its perspective map (the camera at the
+/// light, its frustum matching the orthographic test camera's footprint at z = 0) must hold the
+/// same layers as the directional map, texel for texel, and shade a probe fiber behind the slab
+/// with the same closed-form transmittance. This checks the perspective path: depths
+/// linearized in the layer pass and in the lookup, and the lookup's divide by w.
+#[test]
+fn a_far_point_light_map_equals_the_directional_one() {
+    let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+    let thickness = 0.01f32;
+    let coverage = thickness as f64 * PER_UNIT;
+    let distance = 1000.0f32;
+    let far_point = Camera {
+        eye: Vec3::new(0.0, 0.0, distance),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        projection: Projection::Perspective {
+            fov_y: 2.0 * (1.0 / distance).atan(),
+        },
+        near: distance - 10.0,
+        far: distance + 10.0,
+    };
+    let slab_model = slab(4, thickness);
+    let slab_geometry = StrandGeometry::upload(&gpu, &slab_model).unwrap();
+    let settings = DomSettings {
+        resolution: RES,
+        layers: 4,
+        spacing: 0.08,
+    };
+    let pass = DeepOpacityPass::new(&gpu);
+    let directional = DeepOpacityMap::new(&gpu, ortho_camera(), settings);
+    let point = DeepOpacityMap::new(&gpu, far_point, settings);
+    for map in [&directional, &point] {
+        pass.draw(&gpu, &slab_geometry, map);
+    }
+    let (a, b) = (
+        directional.read_layers(&gpu).unwrap(),
+        point.read_layers(&gpu).unwrap(),
+    );
+    let mut worst = 0.0f32;
+    for ty in 8..56usize {
+        for tx in 2..62usize {
+            let i = ty * RES as usize + tx;
+            for k in 0..4 {
+                worst = worst.max((a[i][k] - b[i][k]).abs());
+            }
+        }
+    }
+    eprintln!("far point vs directional map: worst layer difference {worst:.2e}");
+    assert!(worst < 1e-3, "layers differ by {worst}");
+
+    // The probe fiber behind the slab, lit by the far point light (I / d² ≈ 1).
+    let intensity = distance * distance;
+    let probe = HairModel::new(
+        vec![Vec3::new(-0.8, 0.5, -0.5), Vec3::new(0.8, 0.5, -0.5)],
+        vec![0, 2],
+        None,
+        None,
+        Some(Attribute::Uniform(Vec3::new(0.5, 0.3, 0.2))),
+    )
+    .unwrap();
+    let geometry = StrandGeometry::upload(&gpu, &probe).unwrap();
+    let frame = FrameParams {
+        camera: ortho_camera(),
+        width: RES,
+        height: RES,
+        lights: vec![Light::Point {
+            position: far_point.eye,
+            intensity,
+        }],
+        shading: KajiyaKay {
+            kd: 0.6,
+            ks: 0.25,
+            shininess: 40.0,
+        },
+        width_override_px: Some(4.0),
+    };
+    let target = RenderTarget::new(&gpu, RES, RES);
+    StrandPass::new(&gpu).draw(
+        &gpu,
+        &geometry,
+        &frame,
+        &target,
+        Some(ShadowInput {
+            map: &point,
+            light_index: 0,
+        }),
+    );
+    let pixels = read_texture_rgba(&gpu, &target.color).unwrap();
+    let expected_t = (1.0 - coverage).powi(4);
+    let mut worst = 0.0f64;
+    for x in 8..56usize {
+        for y in [14usize, 15, 16] {
+            let world = Vec3::new((x as f32 + 0.5) / 32.0 - 1.0, 0.5, -0.5);
+            let irradiance = intensity as f64 / far_point.eye.distance_squared(world) as f64;
+            let got = pixels[y * RES as usize + x];
+            for (k, c) in [0.5f64, 0.3, 0.2].into_iter().enumerate() {
+                let expected = expected_t * irradiance * (0.6 * c + 0.25);
+                worst = worst.max((got[k] as f64 - expected).abs() / expected);
+            }
+        }
+    }
+    eprintln!("far point light behind the slab: worst relative shading error {worst:.2e}");
+    assert!(worst < 2e-3, "shading behind the slab off by {worst}");
 }
