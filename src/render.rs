@@ -94,6 +94,12 @@ pub struct RenderArgs {
     /// ADSM: world units between fibers along the light (default: 1% of the hair's diagonal).
     #[arg(long)]
     adsm_spacing: Option<f32>,
+    /// Sorted blending (--transparency sorted): depth bins of the counting sort.
+    #[arg(long, default_value_t = strandlight_runtime::passes::sorted_blend::DEFAULT_SORT_BINS)]
+    sort_bins: u32,
+    /// K-buffer (--transparency kbuffer): fragments kept per pixel, nearest first.
+    #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_KBUFFER_K)]
+    kbuffer_k: u32,
     /// A-buffer/DBK node pool in nodes per pixel (clamped to the adapter's limit). Default:
     /// sized to exactly the fragments the technique stores, counted by a first build.
     #[arg(long)]
@@ -167,8 +173,10 @@ fn settings_from_args(args: &RenderArgs) -> anyhow::Result<FrameSettings> {
     let (width, height) = parse_size(&args.size)?;
     let lighting = match &args.env {
         Some(map) => {
-            if matches!(args.transparency, Transparency::Abuffer | Transparency::Dbk)
-                || args.shadows != Shadows::None
+            if !matches!(
+                args.transparency,
+                Transparency::None | Transparency::Occupancy
+            ) || args.shadows != Shadows::None
             {
                 bail!(
                     "--env shadows every SRBF light with its convolution optical depth map and renders opaque (none) or through an occupancy map (occupancy); --shadows, --transparency abuffer/dbk apply to point lights only"
@@ -195,6 +203,8 @@ fn settings_from_args(args: &RenderArgs) -> anyhow::Result<FrameSettings> {
             dom_layers: args.dom_layers,
             osm_slices: args.osm_slices,
             pcf_kernel: args.pcf,
+            sort_bins: args.sort_bins,
+            kbuffer_k: args.kbuffer_k,
             shadow_bias: args.shadow_bias,
             adsm_alpha: args.adsm_alpha,
             adsm_spacing: args.adsm_spacing,

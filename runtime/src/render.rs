@@ -12,8 +12,10 @@ use crate::passes::deep_opacity::{
 };
 use crate::passes::fiber_shading::ShadingModel;
 use crate::passes::frame_params::FrameParams;
+use crate::passes::kbuffer::{KBufferError, KBufferPass};
 use crate::passes::render_target::RenderTarget;
 use crate::passes::shadow_slots::{MAX_SHADOWED_LIGHTS, ShadowInput, TooManyShadowMaps};
+use crate::passes::sorted_blend::{BadSortBins, SortedBlendPass};
 use crate::passes::strand_geometry::{StrandGeometry, TooManyPoints};
 use crate::passes::strands::StrandPass;
 
@@ -35,6 +37,10 @@ pub enum RenderError {
     Readback(#[from] ReadbackError),
     #[error("the GPU reported an error: {0}")]
     Gpu(String),
+    #[error(transparent)]
+    SortBins(#[from] BadSortBins),
+    #[error("{0}")]
+    Settings(String),
     #[error("A-buffer nodes per pixel 0: must be at least 1 (or left unset to size the pool)")]
     NoListNodes,
 }
@@ -94,6 +100,17 @@ pub struct FragmentCounts {
     pub requested_capacity: u64,
 }
 
+impl From<KBufferError> for RenderError {
+    fn from(e: KBufferError) -> Self {
+        match e {
+            KBufferError::TooManyShadowMaps(e) => Self::TooManyShadowMaps(e),
+            KBufferError::Readback(e) => Self::Readback(e),
+            KBufferError::Limit(e) => Self::Limit(e),
+            KBufferError::K(_) => Self::Settings(e.to_string()),
+        }
+    }
+}
+
 impl From<ABufferError> for RenderError {
     fn from(e: ABufferError) -> Self {
         match e {
@@ -132,6 +149,11 @@ pub enum Transparency {
     /// Depth-tested, coverage blended in draw order (plain opaque rendering).
     #[default]
     Opaque,
+    /// Segments bin-sorted back to front by a compute counting sort into `bins` depth bins,
+    /// then blended in that order without a depth test.
+    Sorted { bins: u32 },
+    /// The `k` nearest fragments per pixel composited; the rest dropped and counted.
+    KBuffer { k: u32 },
     /// Per-pixel linked lists sorted at resolve. The node pool holds `nodes_per_pixel` ×
     /// pixels nodes, or with `None` exactly the fragments stored (counted by a first build);
     /// either way clamped to the adapter's storage-binding limit, with overflow counted.
@@ -346,6 +368,44 @@ pub fn render_frame_with_model(
             timed(&mut timings, gpu, "readback", || {
                 read_texture_rgba(gpu, &target.color)
             })?
+        }
+        Transparency::Sorted { bins } => {
+            let pass = timed(&mut timings, gpu, "sorted blend pipeline", || {
+                SortedBlendPass::with_model(gpu, shading)
+            });
+            let order = timed(&mut timings, gpu, "segment sort", || {
+                pass.sort(gpu, &geometry, frame, model.bounds(), bins)
+            })?;
+            let target = RenderTarget::new(gpu, frame.width, frame.height);
+            timed(&mut timings, gpu, "sorted blend", || {
+                pass.draw(gpu, &geometry, frame, &shadows, &order, &target)
+            })?;
+            memory_bytes.extend(order.memory());
+            memory_bytes.extend(target.memory());
+            timed(&mut timings, gpu, "readback", || {
+                read_texture_rgba(gpu, &target.color)
+            })?
+        }
+        Transparency::KBuffer { k } => {
+            let pass = timed(&mut timings, gpu, "kbuffer pipeline", || {
+                KBufferPass::with_model(gpu, shading)
+            });
+            let out = timed(
+                &mut timings,
+                gpu,
+                "kbuffer build + resolve + readback",
+                || pass.draw(gpu, &geometry, frame, &shadows, k),
+            )?;
+            memory_bytes.extend(out.memory_bytes);
+            let slots = frame.width as u64 * frame.height as u64 * k as u64;
+            fragments = Some(FragmentCounts {
+                stored: out.fragments_kept,
+                dropped: out.fragments_dropped,
+                truncated: 0,
+                capacity: slots,
+                requested_capacity: slots,
+            });
+            out.pixels
         }
         Transparency::ABuffer { nodes_per_pixel }
         | Transparency::Dbk {

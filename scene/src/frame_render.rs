@@ -105,6 +105,10 @@ pub fn point_render_options(point: &PointLighting, hair: &HairModel) -> RenderOp
     };
     let transparency = match point.transparency {
         Transparency::None | Transparency::Occupancy => render::Transparency::Opaque,
+        Transparency::Sorted => render::Transparency::Sorted {
+            bins: point.sort_bins,
+        },
+        Transparency::Kbuffer => render::Transparency::KBuffer { k: point.kbuffer_k },
         Transparency::Abuffer => render::Transparency::ABuffer {
             nodes_per_pixel: point.abuffer_nodes_per_pixel,
         },

@@ -166,9 +166,16 @@ pub enum Shadows {
 #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Transparency {
+    /// Depth-tested, coverage blended in draw order.
     #[default]
+    #[cfg_attr(feature = "cli", value(alias = "opaque"))]
+    #[serde(alias = "opaque")]
     None,
+    /// Segments bin-sorted back to front, blended without a depth test.
+    Sorted,
     Abuffer,
+    /// The k nearest fragments per pixel, the rest dropped (counted).
+    Kbuffer,
     Dbk,
     /// With an environment only: every fiber weighted by its visibility through an occupancy map.
     Occupancy,
@@ -205,6 +212,12 @@ pub struct PointLighting {
     /// ADSM: world units between fibers along the light; None: 1% of the hair's diagonal.
     #[serde(default)]
     pub adsm_spacing: Option<f32>,
+    /// Sorted blending: depth bins of the counting sort.
+    #[serde(default = "default_sort_bins")]
+    pub sort_bins: u32,
+    /// K-buffer: fragments kept per pixel.
+    #[serde(default = "default_kbuffer_k")]
+    pub kbuffer_k: u32,
     /// A-buffer and DBK node pool, nodes per pixel; None: sized to the fragments the
     /// technique stores (a counting build first).
     #[serde(default)]
@@ -220,6 +233,17 @@ pub const DEFAULT_OSM_SLICES: u32 = 8;
 
 fn default_osm_slices() -> u32 {
     DEFAULT_OSM_SLICES
+}
+
+fn default_sort_bins() -> u32 {
+    strandlight_runtime::passes::sorted_blend::DEFAULT_SORT_BINS
+}
+
+/// Hunz §6 keeps k = 8 fragments per pixel.
+pub const DEFAULT_KBUFFER_K: u32 = 8;
+
+fn default_kbuffer_k() -> u32 {
+    DEFAULT_KBUFFER_K
 }
 
 /// Hunz §6 filters shadow maps and ADSM with 3×3 PCF.
@@ -247,6 +271,8 @@ impl Default for PointLighting {
             dom_size: 512,
             osm_slices: DEFAULT_OSM_SLICES,
             pcf_kernel: DEFAULT_PCF_KERNEL,
+            sort_bins: default_sort_bins(),
+            kbuffer_k: DEFAULT_KBUFFER_K,
             shadow_bias: None,
             adsm_alpha: DEFAULT_ADSM_ALPHA,
             adsm_spacing: None,

@@ -285,7 +285,9 @@ fn point_controls(ui: &mut egui::Ui, p: &mut PointLighting) {
     ui.horizontal(|ui| {
         ui.label("transparency");
         ui.radio_value(&mut p.transparency, Transparency::None, "opaque");
+        ui.radio_value(&mut p.transparency, Transparency::Sorted, "sorted");
         ui.radio_value(&mut p.transparency, Transparency::Abuffer, "A-buffer");
+        ui.radio_value(&mut p.transparency, Transparency::Kbuffer, "K-buffer");
         ui.radio_value(&mut p.transparency, Transparency::Dbk, "DBK");
     });
 }

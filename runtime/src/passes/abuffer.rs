@@ -162,7 +162,7 @@ fn depth_tested() -> wgpu::DepthStencilState {
 }
 
 /// A depth attachment only to give the A-buffer build a size; every fragment passes.
-fn every_fragment() -> wgpu::DepthStencilState {
+pub(crate) fn every_fragment() -> wgpu::DepthStencilState {
     wgpu::DepthStencilState {
         format: DEPTH_FORMAT,
         depth_write_enabled: Some(false),
@@ -174,7 +174,7 @@ fn every_fragment() -> wgpu::DepthStencilState {
 
 /// A pipeline drawing strand quads (`vs_main`), with fragment entry point `fragment` and its
 /// colour targets, or depth only.
-fn strand_quad_pipeline(
+pub(crate) fn strand_quad_pipeline(
     device: &wgpu::Device,
     label: &str,
     layout: &wgpu::PipelineLayout,

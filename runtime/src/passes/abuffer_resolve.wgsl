@@ -1,5 +1,5 @@
-// A-buffer resolve: per pixel, the list's fragments sorted front to back (insertion sort of at
-// most MAX_SORTED; the rest are counted as truncated) and composited with pre-multiplied "under".
+// A-buffer resolve: per pixel, the list's fragments sorted front to back (insertion sort keeping
+// the nearest MAX_SORTED; the rest are counted as truncated) and composited with pre-multiplied "under".
 
 struct Node {
     color: vec4<f32>,
@@ -41,8 +41,11 @@ fn resolve(@builtin(global_invocation_id) id: vec3<u32>) {
         let node = nodes[index];
         index = node.next;
         if (count == MAX_SORTED) {
+            // Keep the nearest MAX_SORTED: the farther of this node and the farthest kept one
+            // is the fragment left out.
             atomicAdd(&truncated, 1u);
-            continue;
+            if (node.depth >= depths[MAX_SORTED - 1u]) { continue; }
+            count = MAX_SORTED - 1u;
         }
         var j = count;
         while (j > 0u && depths[j - 1u] > node.depth) {

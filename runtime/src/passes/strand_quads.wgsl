@@ -74,8 +74,9 @@ fn corner(k: u32) -> vec2<f32> {
     return vec2<f32>(ends[k], sides[k]);
 }
 
-@vertex
-fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment: u32) -> VertexOut {
+// Corner `vertex` of segment `segment`'s quad: the body of every strand vertex entry point (the
+// sorted pass draws segments in another order than their instance index).
+fn strand_vertex(vertex: u32, segment: u32) -> VertexOut {
     let packed = segments[segment];
     let i0 = packed & 0x3fffffffu;
     let is_first = (packed & 0x40000000u) != 0u;
@@ -141,3 +142,7 @@ fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment:
     return out;
 }
 
+@vertex
+fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment: u32) -> VertexOut {
+    return strand_vertex(vertex, segment);
+}

@@ -1,0 +1,288 @@
+//! K-buffer transparency (Hunz §5.2; Vasilakis & Fudos' k+-buffer): only the k nearest fragments
+//! of each pixel are stored and composited; the rest are dropped and counted. Without fragment
+//! interlock the slots are filled in two passes over the strands (`kbuffer.wgsl`: the k nearest
+//! depths by an atomicMin cascade, then the colours of those fragments), then a compute resolve
+//! composites them front to back (`kbuffer_resolve.wgsl`).
+//! Inputs: [`StrandGeometry`], [`FrameParams`], shadow maps, k. Output: [`KBufferFrame`].
+//! Memory: k × (4 B depth + 8 B RGBA16F colour) per pixel, plus the resolved image.
+
+use wgpu::util::DeviceExt;
+
+use super::abuffer::{every_fragment, strand_quad_pipeline};
+use super::attachments::cleared_depth;
+use super::fiber_shading::{ModelBinding, ShadingModel};
+use super::frame_params::FrameParams;
+use super::render_target::RenderTarget;
+use super::shadow_slots::{
+    ShadowInput, TooManyShadowMaps, shadow_bind_group_for, shadow_bind_group_layout,
+};
+use super::strand_geometry::StrandGeometry;
+use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
+use super::strands::shading_source;
+use crate::gpu::bind_layout::{bind_group, pipeline_layout, storage_entry, uniform_entry};
+use crate::gpu::readback::{ReadbackError, read_buffer};
+use crate::gpu::{GpuContext, GpuLimits, LimitError};
+
+/// Hunz §6 keeps 8 fragments per pixel.
+pub const DEFAULT_K: u32 = 8;
+/// Bounds each fragment's walk over its pixel's slots.
+pub const MAX_K: u32 = 64;
+
+#[derive(Debug, thiserror::Error)]
+pub enum KBufferError {
+    #[error("K-buffer k {0}: must be 1..={MAX_K}")]
+    K(u32),
+    #[error(transparent)]
+    Limit(#[from] LimitError),
+    #[error(transparent)]
+    TooManyShadowMaps(#[from] TooManyShadowMaps),
+    #[error(transparent)]
+    Readback(#[from] ReadbackError),
+}
+
+/// A resolved frame and what the slots held.
+pub struct KBufferFrame {
+    /// Pre-multiplied RGBA, row-major from the top.
+    pub pixels: Vec<[f32; 4]>,
+    /// Fragments composited (at most k per pixel).
+    pub fragments_kept: u64,
+    /// Fragments beyond the k nearest of their pixel, left out.
+    pub fragments_dropped: u64,
+    pub memory_bytes: Vec<(String, u64)>,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Params {
+    width: u32,
+    second: u32,
+    third: u32,
+    _pad: u32,
+}
+
+pub struct KBufferPass {
+    depths: wgpu::RenderPipeline,
+    colors: wgpu::RenderPipeline,
+    resolve: wgpu::ComputePipeline,
+    strand_layout: wgpu::BindGroupLayout,
+    shadow_layout: wgpu::BindGroupLayout,
+    slots_layout: wgpu::BindGroupLayout,
+    resolve_layout: wgpu::BindGroupLayout,
+    model: Option<ModelBinding>,
+}
+
+impl KBufferPass {
+    pub fn with_model(gpu: &GpuContext, shading: &ShadingModel) -> Self {
+        let device = &gpu.device;
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let slots_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("kbuffer slots"),
+            entries: &[
+                storage_entry(0, fragment, false),
+                storage_entry(1, fragment, false),
+                storage_entry(2, fragment, false),
+                uniform_entry(3, fragment),
+            ],
+        });
+        let strand_layout = strand_bind_group_layout(device);
+        let shadow_layout = shadow_bind_group_layout(device);
+        let model = ModelBinding::new(gpu, shading);
+        let build_layout = pipeline_layout(
+            device,
+            "kbuffer build",
+            &[
+                Some(&strand_layout),
+                Some(&shadow_layout),
+                model.as_ref().map(|m| &m.layout),
+                Some(&slots_layout),
+            ],
+        );
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("kbuffer.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(
+                shading_source(shading, include_str!("kbuffer.wgsl")).into(),
+            ),
+        });
+        let build = |label, entry| {
+            strand_quad_pipeline(
+                device,
+                label,
+                &build_layout,
+                &shader,
+                Some((entry, &[])),
+                every_fragment(),
+            )
+        };
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("kbuffer resolve"),
+            entries: &[
+                storage_entry(0, compute, true),
+                storage_entry(1, compute, true),
+                storage_entry(2, compute, false),
+                storage_entry(3, compute, false),
+                uniform_entry(4, compute),
+            ],
+        });
+        let resolve_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("kbuffer_resolve.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("kbuffer_resolve.wgsl").into()),
+        });
+        let resolve = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("kbuffer resolve"),
+            layout: Some(&pipeline_layout(
+                device,
+                "kbuffer resolve",
+                &[Some(&resolve_layout)],
+            )),
+            module: &resolve_shader,
+            entry_point: Some("resolve"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Self {
+            depths: build("kbuffer depths", "fs_kbuffer_depths"),
+            colors: build("kbuffer colours", "fs_kbuffer_colors"),
+            resolve,
+            strand_layout,
+            shadow_layout,
+            slots_layout,
+            resolve_layout,
+            model,
+        }
+    }
+
+    /// The k nearest fragments of every pixel of `frame`, composited.
+    pub fn draw(
+        &self,
+        gpu: &GpuContext,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        shadows: &[ShadowInput<'_>],
+        k: u32,
+    ) -> Result<KBufferFrame, KBufferError> {
+        if !(1..=MAX_K).contains(&k) {
+            return Err(KBufferError::K(k));
+        }
+        let device = &gpu.device;
+        let (width, height) = (frame.width, frame.height);
+        let pixels = width as u64 * height as u64;
+        let limits = GpuLimits::of(gpu);
+        let fix = |max: u64| format!("use k ≤ {} at this image size", max / (pixels * 8));
+        limits.check_storage_buffer("K-buffer colours", pixels * k as u64 * 8, fix)?;
+        limits.check_storage_buffer("resolved image", pixels * 16, |_| {
+            "render a smaller image".into()
+        })?;
+        let storage = |label, contents: &[u8]| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            })
+        };
+        let slots = (pixels * k as u64) as usize;
+        let depths = storage("kbuffer depths", &vec![0xffu8; slots * 4]);
+        let colors = storage("kbuffer colours", &vec![0u8; slots * 8]);
+        let counters = storage("kbuffer counters", &[0u8; 8]);
+        let resolved = storage("kbuffer resolved", &vec![0u8; pixels as usize * 16]);
+        let uniform = |label, params: Params| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytemuck::bytes_of(&params),
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+        };
+        let build_params = uniform(
+            "kbuffer params",
+            Params {
+                width,
+                second: k,
+                third: 0,
+                _pad: 0,
+            },
+        );
+        let resolve_params = uniform(
+            "kbuffer resolve params",
+            Params {
+                width,
+                second: height,
+                third: k,
+                _pad: 0,
+            },
+        );
+        let slots_group = bind_group(
+            device,
+            "kbuffer slots",
+            &self.slots_layout,
+            &[
+                depths.as_entire_binding(),
+                colors.as_entire_binding(),
+                counters.as_entire_binding(),
+                build_params.as_entire_binding(),
+            ],
+        );
+        let resolve_group = bind_group(
+            device,
+            "kbuffer resolve",
+            &self.resolve_layout,
+            &[
+                depths.as_entire_binding(),
+                colors.as_entire_binding(),
+                resolved.as_entire_binding(),
+                counters.as_entire_binding(),
+                resolve_params.as_entire_binding(),
+            ],
+        );
+        let shadow_group = shadow_bind_group_for(gpu, &self.shadow_layout, frame, shadows)?;
+        let strands = strand_bind_group(gpu, &self.strand_layout, geometry, frame);
+        // Only to give the build passes a size: every fragment passes its test.
+        let target = RenderTarget::new(gpu, width, height);
+        let depth_view = target.depth.create_view(&Default::default());
+        let mut encoder = device.create_command_encoder(&Default::default());
+        for (label, pipeline) in [
+            ("kbuffer depths", &self.depths),
+            ("kbuffer colours", &self.colors),
+        ] {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(label),
+                color_attachments: &[],
+                depth_stencil_attachment: cleared_depth(&depth_view, false),
+                timestamp_writes: gpu.render_timestamps(),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &strands, &[]);
+            pass.set_bind_group(1, &shadow_group, &[]);
+            if let Some(model) = &self.model {
+                pass.set_bind_group(2, &model.group, &[]);
+            }
+            pass.set_bind_group(3, &slots_group, &[]);
+            pass.draw(0..6, 0..geometry.segment_count);
+        }
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("kbuffer resolve"),
+                timestamp_writes: gpu.compute_timestamps(),
+            });
+            pass.set_pipeline(&self.resolve);
+            pass.set_bind_group(0, &resolve_group, &[]);
+            pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        let image = read_buffer(gpu, &resolved)?;
+        let counts = read_buffer(gpu, &counters)?;
+        let counts: &[u32] = bytemuck::cast_slice(&counts);
+        Ok(KBufferFrame {
+            pixels: bytemuck::cast_slice::<u8, [f32; 4]>(&image).to_vec(),
+            fragments_dropped: u64::from(counts[0]),
+            fragments_kept: u64::from(counts[1]),
+            memory_bytes: vec![
+                ("kbuffer depths".into(), depths.size()),
+                ("kbuffer colours".into(), colors.size()),
+                ("kbuffer resolved image".into(), resolved.size()),
+                ("kbuffer pass depth".into(), pixels * 4),
+            ],
+        })
+    }
+}

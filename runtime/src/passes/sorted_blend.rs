@@ -1,0 +1,300 @@
+//! Bin-sorted back-to-front blending (Kim 2003, Svoboda §2.5): a compute counting sort orders the
+//! segments by the view depth of their farther endpoint in `bins` equal bins
+//! (`sorted_blend.wgsl`), then the segments are drawn in that order with pre-multiplied "over"
+//! and no depth test (`sorted_blend_draw.wgsl`). Exact where no two segments of one bin overlap
+//! in a pixel; otherwise their order within the bin is arbitrary.
+//! Inputs: [`StrandGeometry`], [`FrameParams`], the hair's bounds, shadow maps. Output: the
+//! colour texture of a [`RenderTarget`].
+
+use glam::Vec3;
+use wgpu::util::DeviceExt;
+
+use super::attachments::cleared_color;
+use super::fiber_shading::{ModelBinding, ShadingModel};
+use super::frame_params::FrameParams;
+use super::render_target::RenderTarget;
+use super::shadow_slots::{
+    ShadowInput, TooManyShadowMaps, shadow_bind_group_for, shadow_bind_group_layout,
+};
+use super::strand_geometry::StrandGeometry;
+use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
+use super::strands::shading_source;
+use crate::gpu::GpuContext;
+use crate::gpu::bind_layout::{bind_group, pipeline_layout, storage_entry, uniform_entry};
+use crate::hair::Aabb;
+
+/// Kim 2003 and Hunz use a few hundred depth bins.
+pub const DEFAULT_SORT_BINS: u32 = 256;
+pub const MAX_SORT_BINS: u32 = 65536;
+
+const SORT_GROUP: u32 = 256;
+const MAX_GROUPS_PER_DIMENSION: u32 = 65535;
+
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[error("sort bins {0}: must be 1..={MAX_SORT_BINS}")]
+pub struct BadSortBins(pub u32);
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct SortUniform {
+    eye: [f32; 4],
+    forward: [f32; 4],
+    nearest: f32,
+    farthest: f32,
+    bins: u32,
+    segment_count: u32,
+}
+
+/// The segments in back-to-front draw order, on the GPU.
+pub struct SegmentOrder {
+    order: wgpu::Buffer,
+    bins: wgpu::Buffer,
+}
+
+impl SegmentOrder {
+    pub fn memory(&self) -> Vec<(String, u64)> {
+        vec![
+            ("sorted segment order".into(), self.order.size()),
+            ("sort bins".into(), self.bins.size()),
+        ]
+    }
+}
+
+pub struct SortedBlendPass {
+    histogram: wgpu::ComputePipeline,
+    scan: wgpu::ComputePipeline,
+    scatter: wgpu::ComputePipeline,
+    sort_layout: wgpu::BindGroupLayout,
+    draw: wgpu::RenderPipeline,
+    strand_layout: wgpu::BindGroupLayout,
+    shadow_layout: wgpu::BindGroupLayout,
+    order_layout: wgpu::BindGroupLayout,
+    model: Option<ModelBinding>,
+}
+
+impl SortedBlendPass {
+    pub fn with_model(gpu: &GpuContext, shading: &ShadingModel) -> Self {
+        let device = &gpu.device;
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let sort_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("segment sort"),
+            entries: &[
+                uniform_entry(0, compute),
+                storage_entry(1, compute, true),
+                storage_entry(2, compute, true),
+                storage_entry(3, compute, false),
+                storage_entry(4, compute, false),
+            ],
+        });
+        let sort_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("sorted_blend.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("sorted_blend.wgsl").into()),
+        });
+        let sort_pipeline_layout = pipeline_layout(device, "segment sort", &[Some(&sort_layout)]);
+        let stage = |entry| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&sort_pipeline_layout),
+                module: &sort_shader,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let (histogram, scan, scatter) = (stage("histogram"), stage("scan"), stage("scatter"));
+
+        let strand_layout = strand_bind_group_layout(device);
+        let shadow_layout = shadow_bind_group_layout(device);
+        let order_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("draw order"),
+            entries: &[storage_entry(0, wgpu::ShaderStages::VERTEX, true)],
+        });
+        let model = ModelBinding::new(gpu, shading);
+        let draw_layout = pipeline_layout(
+            device,
+            "sorted blend",
+            &[
+                Some(&strand_layout),
+                Some(&shadow_layout),
+                model.as_ref().map(|m| &m.layout),
+                Some(&order_layout),
+            ],
+        );
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("sorted_blend_draw.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(
+                shading_source(shading, include_str!("sorted_blend_draw.wgsl")).into(),
+            ),
+        });
+        let premultiplied_over = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let draw = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("sorted blend"),
+            layout: Some(&draw_layout),
+            vertex: wgpu::VertexState {
+                module: &shader,
+                entry_point: Some("vs_sorted"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &shader,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: gpu.hdr_format(),
+                    blend: Some(wgpu::BlendState {
+                        color: premultiplied_over,
+                        alpha: premultiplied_over,
+                    }),
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: None,
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        Self {
+            histogram,
+            scan,
+            scatter,
+            sort_layout,
+            draw,
+            strand_layout,
+            shadow_layout,
+            order_layout,
+            model,
+        }
+    }
+
+    /// The segments of `geometry` ordered back to front for `frame`'s camera, in `bins` equal
+    /// depth bins spanning `bounds` along the view axis.
+    pub fn sort(
+        &self,
+        gpu: &GpuContext,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        bounds: Aabb,
+        bins: u32,
+    ) -> Result<SegmentOrder, BadSortBins> {
+        if !(1..=MAX_SORT_BINS).contains(&bins) {
+            return Err(BadSortBins(bins));
+        }
+        let device = &gpu.device;
+        let camera = &frame.camera;
+        let forward = (camera.target - camera.eye).normalize();
+        let depths = bounds.corners().map(|c| (c - camera.eye).dot(forward));
+        let uniform = SortUniform {
+            eye: camera.eye.extend(0.0).into(),
+            forward: Vec3::from(forward).extend(0.0).into(),
+            nearest: depths.iter().copied().fold(f32::INFINITY, f32::min),
+            farthest: depths.iter().copied().fold(f32::NEG_INFINITY, f32::max),
+            bins,
+            segment_count: geometry.segment_count,
+        };
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("segment sort params"),
+            contents: bytemuck::bytes_of(&uniform),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let bin_counts = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("sort bins"),
+            contents: &vec![0u8; bins as usize * 4],
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let order = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sorted segment order"),
+            size: geometry.segment_count.max(1) as u64 * 4,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let group = bind_group(
+            device,
+            "segment sort",
+            &self.sort_layout,
+            &[
+                params.as_entire_binding(),
+                geometry.points.as_entire_binding(),
+                geometry.segments.as_entire_binding(),
+                bin_counts.as_entire_binding(),
+                order.as_entire_binding(),
+            ],
+        );
+        let groups = geometry.segment_count.div_ceil(SORT_GROUP);
+        let (gx, gy) = (
+            groups.clamp(1, MAX_GROUPS_PER_DIMENSION),
+            groups.div_ceil(MAX_GROUPS_PER_DIMENSION).max(1),
+        );
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("segment sort"),
+                timestamp_writes: gpu.compute_timestamps(),
+            });
+            pass.set_bind_group(0, &group, &[]);
+            pass.set_pipeline(&self.histogram);
+            pass.dispatch_workgroups(gx, gy, 1);
+            pass.set_pipeline(&self.scan);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&self.scatter);
+            pass.dispatch_workgroups(gx, gy, 1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        Ok(SegmentOrder {
+            order,
+            bins: bin_counts,
+        })
+    }
+
+    /// Clears `target` and blends every segment over it in `order`.
+    pub fn draw(
+        &self,
+        gpu: &GpuContext,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        shadows: &[ShadowInput<'_>],
+        order: &SegmentOrder,
+        target: &RenderTarget,
+    ) -> Result<(), TooManyShadowMaps> {
+        let device = &gpu.device;
+        let shadow_group = shadow_bind_group_for(gpu, &self.shadow_layout, frame, shadows)?;
+        let strands = strand_bind_group(gpu, &self.strand_layout, geometry, frame);
+        let order_group = bind_group(
+            device,
+            "draw order",
+            &self.order_layout,
+            &[order.order.as_entire_binding()],
+        );
+        let color_view = target.color.create_view(&Default::default());
+        let mut encoder = device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("sorted blend"),
+                color_attachments: &[cleared_color(&color_view)],
+                depth_stencil_attachment: None,
+                timestamp_writes: gpu.render_timestamps(),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.draw);
+            pass.set_bind_group(0, &strands, &[]);
+            pass.set_bind_group(1, &shadow_group, &[]);
+            if let Some(model) = &self.model {
+                pass.set_bind_group(2, &model.group, &[]);
+            }
+            pass.set_bind_group(3, &order_group, &[]);
+            pass.draw(0..6, 0..geometry.segment_count);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+}
