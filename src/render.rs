@@ -100,6 +100,9 @@ pub struct RenderArgs {
     /// K-buffer (--transparency kbuffer): fragments kept per pixel, nearest first.
     #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_KBUFFER_K)]
     kbuffer_k: u32,
+    /// Random subsets (--transparency subsets): how many (1..=16).
+    #[arg(long, default_value_t = strandlight_runtime::passes::random_subsets::DEFAULT_SUBSETS)]
+    subsets: u32,
     /// A-buffer/DBK node pool in nodes per pixel (clamped to the adapter's limit). Default:
     /// sized to exactly the fragments the technique stores, counted by a first build.
     #[arg(long)]
@@ -179,7 +182,7 @@ fn settings_from_args(args: &RenderArgs) -> anyhow::Result<FrameSettings> {
             ) || args.shadows != Shadows::None
             {
                 bail!(
-                    "--env shadows every SRBF light with its convolution optical depth map and renders opaque (none) or through an occupancy map (occupancy); --shadows, --transparency abuffer/dbk apply to point lights only"
+                    "--env shadows every SRBF light with its convolution optical depth map and renders opaque (none) or through an occupancy map (occupancy); --shadows and --transparency sorted/abuffer/kbuffer/dbk/subsets apply to point lights only"
                 );
             }
             Lighting::Environment(EnvLighting {
@@ -205,6 +208,7 @@ fn settings_from_args(args: &RenderArgs) -> anyhow::Result<FrameSettings> {
             pcf_kernel: args.pcf,
             sort_bins: args.sort_bins,
             kbuffer_k: args.kbuffer_k,
+            subsets: args.subsets,
             shadow_bias: args.shadow_bias,
             adsm_alpha: args.adsm_alpha,
             adsm_spacing: args.adsm_spacing,

@@ -13,6 +13,7 @@ use crate::passes::deep_opacity::{
 use crate::passes::fiber_shading::ShadingModel;
 use crate::passes::frame_params::FrameParams;
 use crate::passes::kbuffer::{KBufferError, KBufferPass};
+use crate::passes::random_subsets::{RandomSubsetsPass, SubsetsError};
 use crate::passes::render_target::RenderTarget;
 use crate::passes::shadow_slots::{MAX_SHADOWED_LIGHTS, ShadowInput, TooManyShadowMaps};
 use crate::passes::sorted_blend::{BadSortBins, SortedBlendPass};
@@ -111,6 +112,17 @@ impl From<KBufferError> for RenderError {
     }
 }
 
+impl From<SubsetsError> for RenderError {
+    fn from(e: SubsetsError) -> Self {
+        match e {
+            SubsetsError::TooManyShadowMaps(e) => Self::TooManyShadowMaps(e),
+            SubsetsError::Readback(e) => Self::Readback(e),
+            SubsetsError::Limit(e) => Self::Limit(e),
+            SubsetsError::Count(_) => Self::Settings(e.to_string()),
+        }
+    }
+}
+
 impl From<ABufferError> for RenderError {
     fn from(e: ABufferError) -> Self {
         match e {
@@ -154,6 +166,9 @@ pub enum Transparency {
     Sorted { bins: u32 },
     /// The `k` nearest fragments per pixel composited; the rest dropped and counted.
     KBuffer { k: u32 },
+    /// Strands split at random into `subsets` subsets, each drawn depth-tested into its own
+    /// layer; per pixel the layers' fragments sorted and composited.
+    RandomSubsets { subsets: u32 },
     /// Per-pixel linked lists sorted at resolve. The node pool holds `nodes_per_pixel` ×
     /// pixels nodes, or with `None` exactly the fragments stored (counted by a first build);
     /// either way clamped to the adapter's storage-binding limit, with overflow counted.
@@ -405,6 +420,19 @@ pub fn render_frame_with_model(
                 capacity: slots,
                 requested_capacity: slots,
             });
+            out.pixels
+        }
+        Transparency::RandomSubsets { subsets } => {
+            let pass = timed(&mut timings, gpu, "random subsets pipeline", || {
+                RandomSubsetsPass::with_model(gpu, shading)
+            });
+            let out = timed(
+                &mut timings,
+                gpu,
+                "random subsets + resolve + readback",
+                || pass.draw(gpu, model, &geometry, frame, &shadows, subsets),
+            )?;
+            memory_bytes.extend(out.memory_bytes);
             out.pixels
         }
         Transparency::ABuffer { nodes_per_pixel }

@@ -5,6 +5,7 @@
 //!   RGBA16F slots; with smaller k the error never grows as k grows.
 //! - Bin-sorted blending is exact where the segments of one bin do not overlap in a pixel;
 //!   with short segments and many bins it comes within a stated tolerance.
+//! - One random subset is the opaque pass; more subsets come closer to the A-buffer.
 //! (DBK with Δ covering the volume is checked against the A-buffer in `abuffer.rs`.)
 
 mod common;
@@ -124,8 +125,29 @@ fn every_technique_approaches_the_abuffer() {
         let frame = render(&gpu, &hair, Transparency::Sorted { bins });
         sorted.push((bins, relative_rmse(&frame, &reference)));
     }
-    let opaque = relative_rmse(&render(&gpu, &hair, Transparency::Opaque), &reference);
+    let opaque_frame = render(&gpu, &hair, Transparency::Opaque);
+    let opaque = relative_rmse(&opaque_frame, &reference);
     eprintln!("sorted blending (bins, relative RMSE): {sorted:?}; opaque: {opaque:.4}");
+
+    // One subset is the opaque pass (same segments, same order); more approach the A-buffer.
+    let one = render(&gpu, &hair, Transparency::RandomSubsets { subsets: 1 });
+    assert_eq!(
+        one.pixels, opaque_frame.pixels,
+        "one random subset must be the opaque pass"
+    );
+    let subsets: Vec<(u32, f64)> = [2, 4, 8, 16]
+        .into_iter()
+        .map(|n| {
+            let frame = render(&gpu, &hair, Transparency::RandomSubsets { subsets: n });
+            (n, relative_rmse(&frame, &reference))
+        })
+        .collect();
+    eprintln!("random subsets (k, relative RMSE): {subsets:?}");
+    assert!(
+        subsets.windows(2).all(|w| w[1].1 < w[0].1),
+        "more subsets must come closer"
+    );
+    assert!(subsets[0].1 < opaque);
     assert!(sorted[2].1 < 0.02, "4096 bins: {}", sorted[2].1);
     assert!(
         sorted[1].1 < opaque,
@@ -153,6 +175,8 @@ fn bad_counts_are_refused() {
         Transparency::KBuffer { k: 65 },
         Transparency::Sorted { bins: 0 },
         Transparency::Sorted { bins: 1 << 20 },
+        Transparency::RandomSubsets { subsets: 0 },
+        Transparency::RandomSubsets { subsets: 17 },
     ] {
         let options = RenderOptions {
             shadows: None,

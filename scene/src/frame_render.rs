@@ -108,6 +108,9 @@ pub fn point_render_options(point: &PointLighting, hair: &HairModel) -> RenderOp
         Transparency::Sorted => render::Transparency::Sorted {
             bins: point.sort_bins,
         },
+        Transparency::Subsets => render::Transparency::RandomSubsets {
+            subsets: point.subsets,
+        },
         Transparency::Kbuffer => render::Transparency::KBuffer { k: point.kbuffer_k },
         Transparency::Abuffer => render::Transparency::ABuffer {
             nodes_per_pixel: point.abuffer_nodes_per_pixel,

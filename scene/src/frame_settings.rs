@@ -177,6 +177,8 @@ pub enum Transparency {
     /// The k nearest fragments per pixel, the rest dropped (counted).
     Kbuffer,
     Dbk,
+    /// Strands in k random subsets, each drawn opaque, the layers sorted per pixel.
+    Subsets,
     /// With an environment only: every fiber weighted by its visibility through an occupancy map.
     Occupancy,
 }
@@ -218,6 +220,9 @@ pub struct PointLighting {
     /// K-buffer: fragments kept per pixel.
     #[serde(default = "default_kbuffer_k")]
     pub kbuffer_k: u32,
+    /// Random subsets: how many.
+    #[serde(default = "default_subsets")]
+    pub subsets: u32,
     /// A-buffer and DBK node pool, nodes per pixel; None: sized to the fragments the
     /// technique stores (a counting build first).
     #[serde(default)]
@@ -233,6 +238,10 @@ pub const DEFAULT_OSM_SLICES: u32 = 8;
 
 fn default_osm_slices() -> u32 {
     DEFAULT_OSM_SLICES
+}
+
+fn default_subsets() -> u32 {
+    strandlight_runtime::passes::random_subsets::DEFAULT_SUBSETS
 }
 
 fn default_sort_bins() -> u32 {
@@ -273,6 +282,7 @@ impl Default for PointLighting {
             pcf_kernel: DEFAULT_PCF_KERNEL,
             sort_bins: default_sort_bins(),
             kbuffer_k: DEFAULT_KBUFFER_K,
+            subsets: default_subsets(),
             shadow_bias: None,
             adsm_alpha: DEFAULT_ADSM_ALPHA,
             adsm_spacing: None,
@@ -421,7 +431,7 @@ impl PointLighting {
     fn check(&self) -> anyhow::Result<()> {
         if self.transparency == Transparency::Occupancy {
             bail!(
-                "--transparency occupancy is the view of --env (environment lighting); with point lights use none, abuffer or dbk"
+                "--transparency occupancy is the view of --env (environment lighting); with point lights use none, sorted, abuffer, kbuffer, dbk or subsets"
             );
         }
         if self.lights.is_empty() {

@@ -289,7 +289,24 @@ fn point_controls(ui: &mut egui::Ui, p: &mut PointLighting) {
         ui.radio_value(&mut p.transparency, Transparency::Abuffer, "A-buffer");
         ui.radio_value(&mut p.transparency, Transparency::Kbuffer, "K-buffer");
         ui.radio_value(&mut p.transparency, Transparency::Dbk, "DBK");
+        ui.radio_value(&mut p.transparency, Transparency::Subsets, "random subsets");
     });
+    match p.transparency {
+        Transparency::Sorted => {
+            ui.add(
+                egui::Slider::new(&mut p.sort_bins, 1..=4096)
+                    .logarithmic(true)
+                    .text("depth bins"),
+            );
+        }
+        Transparency::Kbuffer => {
+            ui.add(egui::Slider::new(&mut p.kbuffer_k, 1..=64).text("k"));
+        }
+        Transparency::Subsets => {
+            ui.add(egui::Slider::new(&mut p.subsets, 1..=16).text("subsets"));
+        }
+        _ => {}
+    }
 }
 
 /// Sadeghi's controls: shader constants under point lights, baked into the tables under an

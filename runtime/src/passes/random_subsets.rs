@@ -1,0 +1,354 @@
+//! Random subsets (Hunz §5.4): the strands are split at random into k subsets; each is drawn
+//! depth-tested into its own layer (its nearest fiber per pixel, coverage-blended as the opaque
+//! pass blends), and a compute resolve sorts the k layers of each pixel by depth and composites
+//! them front to back (`random_subsets_resolve.wgsl`). No per-pixel lists: memory is k colour
+//! and depth layers, and a pixel composites at most k fragments.
+//! Inputs: [`StrandGeometry`], the hair (its strands), [`FrameParams`], shadow maps, k.
+//! Output: the resolved image.
+
+use wgpu::util::DeviceExt;
+
+use super::attachments::{cleared_color, cleared_depth};
+use super::fiber_shading::{ModelBinding, ShadingModel};
+use super::frame_params::FrameParams;
+use super::render_target::DEPTH_FORMAT;
+use super::shadow_slots::{
+    ShadowInput, TooManyShadowMaps, shadow_bind_group_for, shadow_bind_group_layout,
+};
+use super::strand_geometry::StrandGeometry;
+use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
+use super::strands::shading_source;
+use crate::gpu::bind_layout::{
+    bind_group, pipeline_layout, storage_entry, texture_entry, uniform_entry,
+};
+use crate::gpu::readback::{ReadbackError, read_buffer};
+use crate::gpu::texture::texture_2d;
+use crate::gpu::{GpuContext, GpuLimits, LimitError};
+use crate::hair::HairModel;
+
+/// Hunz §6 renders 8 subsets.
+pub const DEFAULT_SUBSETS: u32 = 8;
+/// The resolve sorts a pixel's layers in registers.
+pub const MAX_SUBSETS: u32 = 16;
+
+#[derive(Debug, thiserror::Error)]
+pub enum SubsetsError {
+    #[error("random subsets {0}: must be 1..={MAX_SUBSETS}")]
+    Count(u32),
+    #[error(transparent)]
+    Limit(#[from] LimitError),
+    #[error(transparent)]
+    TooManyShadowMaps(#[from] TooManyShadowMaps),
+    #[error(transparent)]
+    Readback(#[from] ReadbackError),
+}
+
+pub struct SubsetsFrame {
+    pub pixels: Vec<[f32; 4]>,
+    pub memory_bytes: Vec<(String, u64)>,
+}
+
+/// Strand `strand`'s subset among `subsets`: a fixed hash, so frames are repeatable.
+pub fn subset_of(strand: usize, subsets: u32) -> u32 {
+    // SplitMix64's finalizer.
+    let mut z = (strand as u64).wrapping_add(0x9e37_79b9_7f4a_7c15);
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce5_e4b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    ((z ^ (z >> 31)) % subsets as u64) as u32
+}
+
+/// The segments grouped by subset, and where each subset's run starts (k + 1 bounds).
+fn segments_by_subset(model: &HairModel, subsets: u32) -> (Vec<u32>, Vec<u32>) {
+    let mut runs = vec![Vec::new(); subsets as usize];
+    let mut segment = 0u32;
+    for (strand, w) in model.strand_offsets().windows(2).enumerate() {
+        let segments = w[1] - w[0] - 1;
+        runs[subset_of(strand, subsets) as usize].extend(segment..segment + segments);
+        segment += segments;
+    }
+    let mut bounds = vec![0u32];
+    for run in &runs {
+        bounds.push(bounds.last().unwrap() + run.len() as u32);
+    }
+    (runs.concat(), bounds)
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ResolveParams {
+    width: u32,
+    height: u32,
+    subsets: u32,
+    _pad: u32,
+}
+
+pub struct RandomSubsetsPass {
+    draw: wgpu::RenderPipeline,
+    resolve: wgpu::ComputePipeline,
+    strand_layout: wgpu::BindGroupLayout,
+    shadow_layout: wgpu::BindGroupLayout,
+    order_layout: wgpu::BindGroupLayout,
+    resolve_layout: wgpu::BindGroupLayout,
+    model: Option<ModelBinding>,
+}
+
+impl RandomSubsetsPass {
+    pub fn with_model(gpu: &GpuContext, shading: &ShadingModel) -> Self {
+        let device = &gpu.device;
+        let strand_layout = strand_bind_group_layout(device);
+        let shadow_layout = shadow_bind_group_layout(device);
+        let order_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("subset segments"),
+            entries: &[storage_entry(0, wgpu::ShaderStages::VERTEX, true)],
+        });
+        let model = ModelBinding::new(gpu, shading);
+        let layout = pipeline_layout(
+            device,
+            "random subsets",
+            &[
+                Some(&strand_layout),
+                Some(&shadow_layout),
+                model.as_ref().map(|m| &m.layout),
+                Some(&order_layout),
+            ],
+        );
+        // The sorted pass's vertex stage reads segments through an index list: here, a subset's.
+        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("random subsets"),
+            source: wgpu::ShaderSource::Wgsl(
+                shading_source(shading, include_str!("sorted_blend_draw.wgsl")).into(),
+            ),
+        });
+        let premultiplied_over = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::One,
+            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+            operation: wgpu::BlendOperation::Add,
+        };
+        let draw = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("random subsets"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &shader,
+                entry_point: Some("vs_sorted"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &shader,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: gpu.hdr_format(),
+                    blend: Some(wgpu::BlendState {
+                        color: premultiplied_over,
+                        alpha: premultiplied_over,
+                    }),
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Less),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            multiview_mask: None,
+            cache: None,
+        });
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("random subsets resolve"),
+            entries: &[
+                texture_entry(
+                    0,
+                    compute,
+                    wgpu::TextureSampleType::Float { filterable: false },
+                    wgpu::TextureViewDimension::D2Array,
+                ),
+                texture_entry(
+                    1,
+                    compute,
+                    wgpu::TextureSampleType::Depth,
+                    wgpu::TextureViewDimension::D2Array,
+                ),
+                storage_entry(2, compute, false),
+                uniform_entry(3, compute),
+            ],
+        });
+        let resolve_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("random_subsets_resolve.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("random_subsets_resolve.wgsl").into()),
+        });
+        let resolve = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("random subsets resolve"),
+            layout: Some(&pipeline_layout(
+                device,
+                "random subsets resolve",
+                &[Some(&resolve_layout)],
+            )),
+            module: &resolve_shader,
+            entry_point: Some("resolve"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Self {
+            draw,
+            resolve,
+            strand_layout,
+            shadow_layout,
+            order_layout,
+            resolve_layout,
+            model,
+        }
+    }
+
+    /// `model`'s strands (uploaded as `geometry`) in `subsets` random subsets, composited.
+    pub fn draw(
+        &self,
+        gpu: &GpuContext,
+        model: &HairModel,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        shadows: &[ShadowInput<'_>],
+        subsets: u32,
+    ) -> Result<SubsetsFrame, SubsetsError> {
+        if !(1..=MAX_SUBSETS).contains(&subsets) {
+            return Err(SubsetsError::Count(subsets));
+        }
+        let device = &gpu.device;
+        let (width, height) = (frame.width, frame.height);
+        let limits = GpuLimits::of(gpu);
+        limits.check_texture_layers("random subset layers", subsets, |max| {
+            format!("use at most {max} subsets")
+        })?;
+        let pixels = width as u64 * height as u64;
+        limits.check_storage_buffer("resolved image", pixels * 16, |_| {
+            "render a smaller image".into()
+        })?;
+        let (order, bounds) = segments_by_subset(model, subsets);
+        let order = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("subset segments"),
+            contents: bytemuck::cast_slice(if order.is_empty() { &[0u32] } else { &order }),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: subsets,
+        };
+        let colors = texture_2d(
+            gpu,
+            "subset colours",
+            size,
+            gpu.hdr_format(),
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let depths = texture_2d(
+            gpu,
+            "subset depths",
+            size,
+            DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let resolved = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("random subsets resolved"),
+            size: pixels * 16,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("random subsets params"),
+            contents: bytemuck::bytes_of(&ResolveParams {
+                width,
+                height,
+                subsets,
+                _pad: 0,
+            }),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let shadow_group = shadow_bind_group_for(gpu, &self.shadow_layout, frame, shadows)?;
+        let strands = strand_bind_group(gpu, &self.strand_layout, geometry, frame);
+        let order_group = bind_group(
+            device,
+            "subset segments",
+            &self.order_layout,
+            &[order.as_entire_binding()],
+        );
+        let layer_view = |texture: &wgpu::Texture, layer| {
+            texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: layer,
+                array_layer_count: Some(1),
+                ..Default::default()
+            })
+        };
+        let mut encoder = device.create_command_encoder(&Default::default());
+        for subset in 0..subsets {
+            let color_view = layer_view(&colors, subset);
+            let depth_view = layer_view(&depths, subset);
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("random subset"),
+                color_attachments: &[cleared_color(&color_view)],
+                depth_stencil_attachment: cleared_depth(&depth_view, true),
+                timestamp_writes: gpu.render_timestamps(),
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.draw);
+            pass.set_bind_group(0, &strands, &[]);
+            pass.set_bind_group(1, &shadow_group, &[]);
+            if let Some(model) = &self.model {
+                pass.set_bind_group(2, &model.group, &[]);
+            }
+            pass.set_bind_group(3, &order_group, &[]);
+            let (start, end) = (bounds[subset as usize], bounds[subset as usize + 1]);
+            pass.draw(0..6, start..end);
+        }
+        let array_view = |texture: &wgpu::Texture| {
+            texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            })
+        };
+        let (color_array, depth_array) = (array_view(&colors), array_view(&depths));
+        let resolve_group = bind_group(
+            device,
+            "random subsets resolve",
+            &self.resolve_layout,
+            &[
+                wgpu::BindingResource::TextureView(&color_array),
+                wgpu::BindingResource::TextureView(&depth_array),
+                resolved.as_entire_binding(),
+                params.as_entire_binding(),
+            ],
+        );
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("random subsets resolve"),
+                timestamp_writes: gpu.compute_timestamps(),
+            });
+            pass.set_pipeline(&self.resolve);
+            pass.set_bind_group(0, &resolve_group, &[]);
+            pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+        }
+        gpu.queue.submit([encoder.finish()]);
+        let image = read_buffer(gpu, &resolved)?;
+        let texel = gpu.hdr_format().block_copy_size(None).unwrap_or(16) as u64;
+        Ok(SubsetsFrame {
+            pixels: bytemuck::cast_slice::<u8, [f32; 4]>(&image).to_vec(),
+            memory_bytes: vec![
+                ("subset colours".into(), pixels * subsets as u64 * texel),
+                ("subset depths".into(), pixels * subsets as u64 * 4),
+                ("subset segment lists".into(), order.size()),
+                ("random subsets resolved image".into(), resolved.size()),
+            ],
+        })
+    }
+}
