@@ -5,7 +5,7 @@
 //!   RGBA16F slots; with smaller k the error never grows as k grows.
 //! - Bin-sorted blending is exact where the segments of one bin do not overlap in a pixel;
 //!   with short segments and many bins it comes within a stated tolerance.
-//! - One random subset is the opaque pass; more subsets come closer to the A-buffer.
+//! - One random subset is the opaque pass (up to its RGBA16F layer); more subsets come closer to the A-buffer.
 //! (DBK with Δ covering the volume is checked against the A-buffer in `abuffer.rs`.)
 
 mod common;
@@ -131,9 +131,12 @@ fn every_technique_approaches_the_abuffer() {
 
     // One subset is the opaque pass (same segments, same order); more approach the A-buffer.
     let one = render(&gpu, &hair, Transparency::RandomSubsets { subsets: 1 });
-    assert_eq!(
-        one.pixels, opaque_frame.pixels,
-        "one random subset must be the opaque pass"
+    // Same segments in the same order; only the subset layer's half floats differ.
+    let one_error = relative_rmse(&one, &opaque_frame);
+    eprintln!("one random subset against the opaque pass: relative RMSE {one_error:.2e}");
+    assert!(
+        one_error < 2e-3,
+        "one random subset must be the opaque pass: {one_error}"
     );
     let subsets: Vec<(u32, f64)> = [2, 4, 8, 16]
         .into_iter()

@@ -263,7 +263,7 @@ fn default_pcf_kernel() -> u32 {
 }
 
 /// ADSM's fiber opacity (see docs/BENCHMARKS.md, "Shadow techniques", for how it was chosen).
-pub const DEFAULT_ADSM_ALPHA: f32 = 0.2;
+pub const DEFAULT_ADSM_ALPHA: f32 = 0.4;
 
 fn default_adsm_alpha() -> f32 {
     DEFAULT_ADSM_ALPHA

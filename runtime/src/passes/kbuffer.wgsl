@@ -4,8 +4,10 @@
 // 1. `fs_kbuffer_depths` inserts each fragment's depth into its pixel's k slots, kept sorted, by
 //    a cascade of atomicMin: the slot keeps the smaller value and the larger one moves on to the
 //    next slot. Concurrent insertions commute, so the slots end as the k smallest depths.
-// 2. `fs_kbuffer_colors` shades each fragment whose depth is among them into its slot; the others
-//    (the fragments beyond the k nearest) are dropped and counted, as the k+-buffer drops them.
+// 2. `fs_kbuffer_colors` shades each fragment whose depth is among them into its slot, claiming
+//    the slot by setting its depth's sign bit (so two fragments of equal depth take two slots, or
+//    the second is dropped when only one of them made the k); the others (beyond the k nearest)
+//    are dropped and counted, as the k+-buffer drops them.
 
 struct KBufferParams {
     width: u32,
@@ -15,6 +17,8 @@ struct KBufferParams {
 };
 
 const EMPTY_SLOT: u32 = 0xffffffffu;
+// Depths are ≥ 0, so their sign bit is free to mark a slot whose colour is written.
+const CLAIMED: u32 = 0x80000000u;
 
 @group(3) @binding(0) var<storage, read_write> slot_depths: array<atomic<u32>>;
 // Pre-multiplied RGBA as two pack2x16float words.
@@ -50,10 +54,15 @@ fn fs_kbuffer_colors(in: VertexOut) {
     let base = first_slot(in);
     let key = depth_key(in);
     for (var i = 0u; i < kbuffer.k; i++) {
-        if (atomicLoad(&slot_depths[base + i]) == key) {
-            let color = shade(in);
-            slot_colors[base + i] = vec2<u32>(pack2x16float(color.rg), pack2x16float(color.ba));
-            return;
+        // The weak exchange may fail spuriously: retry while the slot still holds our depth.
+        loop {
+            let r = atomicCompareExchangeWeak(&slot_depths[base + i], key, key | CLAIMED);
+            if (r.exchanged) {
+                let color = shade(in);
+                slot_colors[base + i] = vec2<u32>(pack2x16float(color.rg), pack2x16float(color.ba));
+                return;
+            }
+            if (r.old_value != key) { break; }
         }
     }
     atomicAdd(&kbuffer_counters[0], 1u);

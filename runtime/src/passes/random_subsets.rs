@@ -26,6 +26,9 @@ use crate::gpu::texture::texture_2d;
 use crate::gpu::{GpuContext, GpuLimits, LimitError};
 use crate::hair::HairModel;
 
+/// Each subset's colour layer: half floats, as Hunz's RGBA16 layers (and blendable everywhere).
+const SUBSET_COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
 /// Hunz §6 renders 8 subsets.
 pub const DEFAULT_SUBSETS: u32 = 8;
 /// The resolve sorts a pixel's layers in registers.
@@ -138,7 +141,7 @@ impl RandomSubsetsPass {
                 entry_point: Some("fs_main"),
                 compilation_options: Default::default(),
                 targets: &[Some(wgpu::ColorTargetState {
-                    format: gpu.hdr_format(),
+                    format: SUBSET_COLOR_FORMAT,
                     blend: Some(wgpu::BlendState {
                         color: premultiplied_over,
                         alpha: premultiplied_over,
@@ -247,7 +250,7 @@ impl RandomSubsetsPass {
             gpu,
             "subset colours",
             size,
-            gpu.hdr_format(),
+            SUBSET_COLOR_FORMAT,
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
         );
         let depths = texture_2d(
@@ -340,7 +343,7 @@ impl RandomSubsetsPass {
         }
         gpu.queue.submit([encoder.finish()]);
         let image = read_buffer(gpu, &resolved)?;
-        let texel = gpu.hdr_format().block_copy_size(None).unwrap_or(16) as u64;
+        let texel = SUBSET_COLOR_FORMAT.block_copy_size(None).unwrap_or(8) as u64;
         Ok(SubsetsFrame {
             pixels: bytemuck::cast_slice::<u8, [f32; 4]>(&image).to_vec(),
             memory_bytes: vec![

@@ -1,0 +1,296 @@
+//! Hunz (2016) §6's comparison, ours: straight.hair at 656 × 861 under one point light, every
+//! shadow technique × every transparency technique, with GPU milliseconds per pass (timestamp
+//! queries), the GPU memory the renderer allocates, and the image error against the A-buffer
+//! with the most converged shadows this renderer makes (DOM, 8 layers, 2048²).
+//!
+//! Each configuration renders once to warm up, then `TIMED_RUNS` times, configurations
+//! interleaved round by round; figures are medians. Prints Markdown.
+//!
+//! Run: `cargo run --release -p strandlight-runtime --example shadow_transparency_table [TIMED_RUNS]`
+//! (reads ../shared/data/hair/straight.hair; skips with a message when it is absent).
+
+use glam::Vec3;
+use strandlight_runtime::camera::{Camera, UpAxis};
+use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::hair::{self, HairModel};
+use strandlight_runtime::lights::Light;
+use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
+use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
+use strandlight_runtime::render::{Frame, RenderOptions, ShadowMaps, Transparency, render_frame};
+
+const WIDTH: u32 = 656;
+const HEIGHT: u32 = 861;
+const MAP_RES: u32 = 512;
+
+type BoxError = Box<dyn std::error::Error>;
+
+fn median(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    if n % 2 == 1 {
+        values[n / 2]
+    } else {
+        0.5 * (values[n / 2 - 1] + values[n / 2])
+    }
+}
+
+/// Relative RMSE of `a` against `reference` over the reference's hair pixels (alpha > 0).
+fn relative_rmse(a: &Frame, reference: &Frame) -> f64 {
+    let (mut err, mut norm) = (0.0f64, 0.0f64);
+    for (p, q) in a.pixels.iter().zip(&reference.pixels) {
+        if q[3] <= 0.0 {
+            continue;
+        }
+        for k in 0..3 {
+            err += (p[k] as f64 - q[k] as f64).powi(2);
+            norm += (q[k] as f64).powi(2);
+        }
+    }
+    (err / norm).sqrt()
+}
+
+fn is_setup(pass: &str) -> bool {
+    pass.contains("pipeline") || pass == "upload"
+}
+
+fn is_light_map(pass: &str) -> bool {
+    pass.contains("(light ")
+}
+
+/// GPU ms where the pass recorded GPU work, else its wall clock (readbacks).
+fn pass_ms(t: &strandlight_runtime::render::PassTiming) -> f64 {
+    t.gpu_milliseconds.unwrap_or(t.milliseconds)
+}
+
+struct Config {
+    shadows: &'static str,
+    transparency: &'static str,
+    options: RenderOptions,
+    map_ms: Vec<f64>,
+    hair_ms: Vec<f64>,
+    passes: Vec<(String, Vec<f64>)>,
+    last: Option<Frame>,
+}
+
+fn shadow_choices(diagonal: f32) -> Vec<(&'static str, Option<ShadowMaps>)> {
+    let texel = diagonal / MAP_RES as f32;
+    let kernel = 3;
+    let bias = 2.0 * texel;
+    vec![
+        ("none", None),
+        (
+            "SM 3×3 PCF",
+            Some(ShadowMaps::Depth {
+                resolution: MAP_RES,
+                lookup: ShadowLookup::Hard { kernel, bias },
+            }),
+        ),
+        (
+            "ADSM 3×3 PCF",
+            Some(ShadowMaps::Depth {
+                resolution: MAP_RES,
+                lookup: ShadowLookup::Adsm {
+                    kernel,
+                    bias,
+                    alpha: 0.4,
+                    spacing: diagonal * 0.01,
+                },
+            }),
+        ),
+        (
+            "OSM 8 slices",
+            Some(ShadowMaps::OpacitySlices {
+                resolution: MAP_RES,
+                slices: 8,
+            }),
+        ),
+        (
+            "DOM 4 layers",
+            Some(ShadowMaps::Deep(DomSettings {
+                resolution: MAP_RES,
+                layers: 4,
+                spacing: diagonal * 0.01,
+            })),
+        ),
+    ]
+}
+
+fn transparency_choices(diagonal: f32) -> Vec<(&'static str, Transparency)> {
+    vec![
+        ("opaque", Transparency::Opaque),
+        ("sorted (256 bins)", Transparency::Sorted { bins: 256 }),
+        (
+            "A-buffer",
+            Transparency::ABuffer {
+                nodes_per_pixel: None,
+            },
+        ),
+        ("K-buffer (k = 8)", Transparency::KBuffer { k: 8 }),
+        (
+            "DBK",
+            Transparency::Dbk {
+                nodes_per_pixel: None,
+                delta: diagonal * 0.05,
+            },
+        ),
+        (
+            "random subsets (8)",
+            Transparency::RandomSubsets { subsets: 8 },
+        ),
+    ]
+}
+
+fn converged_dom(diagonal: f32, resolution: u32) -> ShadowMaps {
+    ShadowMaps::Deep(DomSettings {
+        resolution,
+        layers: 8,
+        spacing: diagonal * 0.01,
+    })
+}
+
+fn main() -> Result<(), BoxError> {
+    let runs: usize = std::env::args()
+        .nth(1)
+        .map(|s| s.parse())
+        .transpose()?
+        .unwrap_or(3);
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/data/hair/straight.hair");
+    if !path.exists() {
+        println!("skipped: {} is absent", path.display());
+        return Ok(());
+    }
+    let model: HairModel = hair::load(&path)?.model;
+    let bounds = model.bounds();
+    let diagonal = bounds.diagonal();
+    let up = UpAxis::detect(&model);
+    let camera = Camera::framing_front(bounds, WIDTH as f32 / HEIGHT as f32, false, up);
+    // From the viewer's upper right front, 2.5 bounding radii from the centre; irradiance 2 there.
+    let toward = (0.5 * Vec3::X + up.toward_front() + 0.7 * up.vector()).normalize();
+    let distance = 2.5 * diagonal * 0.5;
+    let position = bounds.center() + toward * distance;
+    let frame = FrameParams {
+        camera,
+        width: WIDTH,
+        height: HEIGHT,
+        lights: vec![Light::Point {
+            position,
+            intensity: 2.0 * distance * distance,
+        }],
+        shading: KajiyaKay::default(),
+        width_override_px: None,
+    };
+    let gpu = GpuContext::new_headless()?;
+    let render = |options: RenderOptions| render_frame(&gpu, &model, &frame, &options);
+
+    let reference_options = |resolution| RenderOptions {
+        shadows: Some(converged_dom(diagonal, resolution)),
+        transparency: Transparency::ABuffer {
+            nodes_per_pixel: None,
+        },
+    };
+    let reference = render(reference_options(2048))?;
+    let half_res = render(reference_options(1024))?;
+
+    let mut configs = Vec::new();
+    for (shadows, shadow) in shadow_choices(diagonal) {
+        for (transparency, t) in transparency_choices(diagonal) {
+            configs.push(Config {
+                shadows,
+                transparency,
+                options: RenderOptions {
+                    shadows: shadow,
+                    transparency: t,
+                },
+                map_ms: Vec::new(),
+                hair_ms: Vec::new(),
+                passes: Vec::new(),
+                last: None,
+            });
+        }
+    }
+    for round in 0..=runs {
+        for c in configs.iter_mut() {
+            let frame = render(c.options)?;
+            if round > 0 {
+                let timings = &frame.stats.timings;
+                let work = || timings.iter().filter(|t| !is_setup(&t.pass));
+                c.map_ms
+                    .push(work().filter(|t| is_light_map(&t.pass)).map(pass_ms).sum());
+                c.hair_ms
+                    .push(work().filter(|t| !is_light_map(&t.pass)).map(pass_ms).sum());
+                if c.passes.is_empty() {
+                    c.passes = work().map(|t| (t.pass.clone(), Vec::new())).collect();
+                }
+                for (slot, t) in c.passes.iter_mut().zip(work()) {
+                    slot.1.push(pass_ms(t));
+                }
+            }
+            c.last = Some(frame);
+        }
+        eprintln!("round {round} of {runs} done");
+    }
+
+    let adapter = &reference.stats.adapter;
+    println!(
+        "adapter: {} ({:?}, {:?}); {} segments; point light at {position} (irradiance 2 at the hair's centre); camera eye {}",
+        adapter.name, adapter.backend, adapter.device_type, reference.stats.segments, camera.eye
+    );
+    println!(
+        "reference: A-buffer + DOM 8 layers at 2048²; the same at 1024² differs from it by relative RMSE {:.4}",
+        relative_rmse(&half_res, &reference)
+    );
+    println!(
+        "runs: 1 warm-up + {runs} timed per configuration, interleaved; medians; GPU ms from timestamp queries (readback: wall clock)\n"
+    );
+    println!(
+        "| shadows | transparency | light map GPU ms | hair GPU ms (incl. readback) | frame ms | GPU MB | fragments kept / dropped | relative RMSE vs A-buffer, same shadows | relative RMSE vs reference |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|");
+    for c in &configs {
+        let same_shadows = configs
+            .iter()
+            .find(|a| a.shadows == c.shadows && a.transparency == "A-buffer")
+            .and_then(|a| a.last.as_ref())
+            .unwrap();
+        let frame = c.last.as_ref().unwrap();
+        let mb = frame.stats.memory_bytes.iter().map(|(_, b)| b).sum::<u64>() as f64 / 1e6;
+        let fragments = frame
+            .stats
+            .fragments
+            .map(|f| format!("{} / {}", f.stored, f.dropped))
+            .unwrap_or_else(|| "–".into());
+        let (map, hair) = (median(c.map_ms.clone()), median(c.hair_ms.clone()));
+        println!(
+            "| {} | {} | {} | {:.0} | {:.0} | {:.1} | {} | {:.4} | {:.4} |",
+            c.shadows,
+            c.transparency,
+            if map > 0.0 {
+                format!("{map:.0}")
+            } else {
+                "–".into()
+            },
+            hair,
+            map + hair,
+            mb,
+            fragments,
+            relative_rmse(frame, same_shadows),
+            relative_rmse(frame, &reference)
+        );
+    }
+    println!("\nPasses of each configuration (median GPU ms):\n");
+    for c in &configs {
+        let passes: Vec<String> = c
+            .passes
+            .iter()
+            .map(|(name, ms)| format!("{name} {:.0}", median(ms.clone())))
+            .collect();
+        println!(
+            "* {} + {}: {}",
+            c.shadows,
+            c.transparency,
+            passes.join(", ")
+        );
+    }
+    Ok(())
+}
