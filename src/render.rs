@@ -70,13 +70,13 @@ pub struct RenderArgs {
     /// With --env: the env-lit renderer's view choices.
     #[command(flatten)]
     env_view: strandlight_scene::look::ViewArgs,
-    /// Deep opacity map layers (1..=8), with --shadows dom.
+    /// Deep opacity map layers (1..=32), with --shadows dom.
     #[arg(long, default_value_t = 4)]
     dom_layers: u32,
     /// Layer spacing in world units (default: 1% of the hair's bounding-box diagonal).
     #[arg(long)]
     dom_spacing: Option<f32>,
-    /// Opacity shadow map slices across the hair's depth range (1..=8), with --shadows osm.
+    /// Opacity shadow map slices across the hair's depth range (1..=32), with --shadows osm.
     #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_OSM_SLICES)]
     osm_slices: u32,
     /// Light map resolution (square) of every --shadows technique.

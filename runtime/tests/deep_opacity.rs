@@ -12,7 +12,7 @@ use strandlight_runtime::gpu::read_texture_rgba;
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::{
-    DeepOpacityMap, DeepOpacityPass, DomSettings, transmittance_before_layer,
+    DeepOpacityMap, DeepOpacityPass, DomSettings, MAX_LAYERS, transmittance_before_layer,
 };
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
 use strandlight_runtime::passes::render_target::RenderTarget;
@@ -123,8 +123,11 @@ fn opacity_slices_span_the_hair_depth_range_and_match_the_closed_form() {
     }
     eprintln!("OSM 8 slices: worst relative transmittance error in front of a slice {worst_t:.2e}");
     assert!(worst_t < 1e-3);
-    // Slices are checked like layers: more than the two targets hold is refused.
-    assert!(DeepOpacityMap::opacity_slices(&gpu, ortho_camera(), model.bounds(), RES, 9).is_err());
+    // Slices are checked like layers: more than the layer array holds is refused.
+    assert!(
+        DeepOpacityMap::opacity_slices(&gpu, ortho_camera(), model.bounds(), RES, MAX_LAYERS + 1)
+            .is_err()
+    );
 }
 
 #[test]
@@ -132,7 +135,7 @@ fn bad_settings_are_refused() {
     assert!(
         DomSettings {
             resolution: 64,
-            layers: 9,
+            layers: MAX_LAYERS + 1,
             spacing: 0.1
         }
         .check()
@@ -249,6 +252,131 @@ fn shading_behind_the_slab_is_dimmed_by_the_closed_form_transmittance() {
             "{name}: probe at z = {z}: transmittance {expected_t:.5} expected; worst relative error of the shaded pixels {worst:.2e}"
         );
     }
+}
+
+/// Light a probe fiber receives through `map`, as the strand pass shades it: one horizontal
+/// probe per depth in `depths`, each on its own image row (map texels and pixels coincide), read
+/// back as the shaded value over the unshadowed one, averaged along the row.
+fn probe_transmittances(gpu: &GpuContext, map: &DeepOpacityMap, depths: &[f32]) -> Vec<f64> {
+    let color = Vec3::new(0.5, 0.3, 0.2);
+    // Pixel row r's centre: y = 1 − (r + 0.5)/32; probes 4 rows apart, all over the slab.
+    let rows: Vec<usize> = (0..depths.len()).map(|m| 8 + 4 * m).collect();
+    let mut points = Vec::new();
+    let mut offsets = vec![0u32];
+    for (&row, &z) in rows.iter().zip(depths) {
+        let y = 1.0 - (row as f32 + 0.5) / PER_UNIT as f32;
+        points.extend([Vec3::new(-0.8, y, z), Vec3::new(0.8, y, z)]);
+        offsets.push(points.len() as u32);
+    }
+    let probes =
+        HairModel::new(points, offsets, None, None, Some(Attribute::Uniform(color))).unwrap();
+    let geometry = StrandGeometry::upload(gpu, &probes).unwrap();
+    let frame = FrameParams {
+        camera: ortho_camera(),
+        width: RES,
+        height: RES,
+        lights: vec![Light::Directional {
+            direction: Vec3::Z,
+            intensity: 1.0,
+        }],
+        shading: KajiyaKay {
+            kd: 0.6,
+            ks: 0.25,
+            shininess: 40.0,
+        },
+        width_override_px: Some(3.0),
+    };
+    let target = RenderTarget::new(gpu, RES, RES);
+    StrandPass::new(gpu).draw(
+        gpu,
+        &geometry,
+        &frame,
+        &target,
+        Some(ShadowInput {
+            map,
+            light_index: 0,
+        }),
+    );
+    let pixels = read_texture_rgba(gpu, &target.color).unwrap();
+    // t = x, l = e = z: L = T·(kd·c + ks) per channel; the red channel.
+    let unshadowed = 0.6 * 0.5 + 0.25;
+    rows.iter()
+        .map(|&row| {
+            let sum: f64 = (8..56usize)
+                .map(|x| pixels[row * RES as usize + x][0] as f64)
+                .sum();
+            sum / 48.0 / unshadowed
+        })
+        .collect()
+}
+
+/// Kim 2003's opacity shadow maps converge to the deep opacity map, and both to the slab's
+/// closed form, inside a slab 12 rows deep: a probe midway between rows m and m + 1 receives
+/// (1 − d/s)^(m+1). Few slices are thick, and the lookup spreads a slice's opacity over its
+/// depth, so the rows a probe shares a slice with shadow it only in part; as slices thin that
+/// error vanishes. DOM layers start at the slab's first row and, 0.04 apart, put every row in a
+/// layer wholly in front of the next probe.
+#[test]
+fn opacity_slices_converge_to_deep_opacity_and_the_closed_form_inside_a_slab() {
+    let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+    let thickness = 0.01f32;
+    let coverage = thickness as f64 * PER_UNIT;
+    let rows = 12;
+    let slab_model = slab(rows, thickness);
+    let slab_geometry = StrandGeometry::upload(&gpu, &slab_model).unwrap();
+    let depths: Vec<f32> = (0..rows).map(|m| 0.3 - 0.1 * m as f32 - 0.05).collect();
+    let closed: Vec<f64> = (0..rows)
+        .map(|m| (1.0 - coverage).powi(m as i32 + 1))
+        .collect();
+    // Worst error relative to the transmittance, with a floor of 1e-3 of full light so the
+    // deepest probes (0.68^12 ≈ 0.01) do not dominate through half-float rounding.
+    let worst_error = |t: &[f64], reference: &[f64]| {
+        t.iter()
+            .zip(reference)
+            .map(|(a, b)| (a - b).abs() / b.max(1e-3))
+            .fold(0.0f64, f64::max)
+    };
+    let pass = DeepOpacityPass::new(&gpu);
+    let mut osm = Vec::new();
+    for slices in [4u32, 8, 16, 32] {
+        let map =
+            DeepOpacityMap::opacity_slices(&gpu, ortho_camera(), slab_model.bounds(), RES, slices)
+                .unwrap();
+        pass.draw(&gpu, &slab_geometry, &map);
+        let t = probe_transmittances(&gpu, &map, &depths);
+        osm.push((slices, worst_error(&t, &closed), t));
+    }
+    let dom_map = DeepOpacityMap::new(
+        &gpu,
+        ortho_camera(),
+        DomSettings {
+            resolution: RES,
+            layers: 32,
+            spacing: 0.04,
+        },
+    );
+    pass.draw(&gpu, &slab_geometry, &dom_map);
+    let dom = probe_transmittances(&gpu, &dom_map, &depths);
+    let dom_error = worst_error(&dom, &closed);
+    for (slices, error, t) in &osm {
+        eprintln!(
+            "OSM {slices:2} slices: worst relative error {error:.4} against the closed form, {:.4} against DOM 32 layers",
+            worst_error(t, &dom)
+        );
+    }
+    eprintln!(
+        "DOM 32 layers: worst relative error {dom_error:.2e}: {dom:.4?}; closed form {closed:.4?}"
+    );
+    assert!(dom_error < 5e-3, "DOM against the closed form: {dom_error}");
+    assert!(
+        osm.windows(2).all(|w| w[1].1 <= w[0].1 + 1e-3),
+        "more slices must not be worse: {:?}",
+        osm.iter().map(|o| (o.0, o.1)).collect::<Vec<_>>()
+    );
+    assert!(osm[0].1 > 0.1, "4 slices are far off: {}", osm[0].1);
+    let (_, last_error, last) = &osm[3];
+    assert!(*last_error < 5e-3, "OSM 32 slices: {last_error}");
+    assert!(worst_error(last, &dom) < 5e-3);
 }
 
 /// The reference renderer of the environment-lit pipeline draws one map per light for

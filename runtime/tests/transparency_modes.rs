@@ -5,8 +5,10 @@
 //!   RGBA16F slots; with smaller k the error never grows as k grows.
 //! - Bin-sorted blending is exact where the segments of one bin do not overlap in a pixel;
 //!   with short segments and many bins it comes within a stated tolerance.
-//! - One random subset is the opaque pass (up to its RGBA16F layer); more subsets come closer to the A-buffer.
-//! (DBK with Δ covering the volume is checked against the A-buffer in `abuffer.rs`.)
+//! - One random subset is the opaque pass (up to its RGBA16F layer); more subsets come closer
+//!   to the A-buffer.
+//! - DBK with Δ covering the whole hair lists every fragment and equals it (also on three
+//!   strands in `abuffer.rs`).
 
 mod common;
 use common::*;
@@ -95,6 +97,25 @@ fn every_technique_approaches_the_abuffer() {
     let full_error = relative_rmse(&full, &reference);
     eprintln!("K-buffer k = 64: relative RMSE {full_error:.2e} against the A-buffer");
     assert!(full_error < 2e-3, "k = 64: {full_error}");
+
+    // DBK with Δ across the whole hair lists every fragment: the A-buffer's image.
+    let whole = render(
+        &gpu,
+        &hair,
+        Transparency::Dbk {
+            nodes_per_pixel: None,
+            delta: 2.0 * hair.bounds().diagonal(),
+        },
+    );
+    let whole_counts = whole.stats.fragments.unwrap();
+    assert_eq!(
+        (whole_counts.stored, whole_counts.dropped),
+        (counts.stored, 0),
+        "DBK with Δ over the whole hair keeps every fragment"
+    );
+    let dbk_error = relative_rmse(&whole, &reference);
+    eprintln!("DBK, Δ = twice the diagonal: relative RMSE {dbk_error:.2e} against the A-buffer");
+    assert!(dbk_error < 2e-3, "DBK over the whole volume: {dbk_error}");
 
     let mut previous = f64::INFINITY;
     let mut errors = Vec::new();

@@ -233,8 +233,8 @@ pub struct PointLighting {
     pub lut_size: usize,
 }
 
-/// Opacity shadow map slices: all that the two RGBA layer targets hold (Kim 2003 uses 16+).
-pub const DEFAULT_OSM_SLICES: u32 = 8;
+/// Opacity shadow map slices: Kim 2003's smallest count (two layer passes).
+pub const DEFAULT_OSM_SLICES: u32 = 16;
 
 fn default_osm_slices() -> u32 {
     DEFAULT_OSM_SLICES

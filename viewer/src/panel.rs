@@ -6,6 +6,7 @@ use crate::recompute::{Recompute, ViewState};
 use crate::worker::{FrameStats, Stage, Status};
 use egui_file_dialog::FileDialog;
 use std::path::PathBuf;
+use strandlight_runtime::passes::deep_opacity::MAX_LAYERS;
 use strandlight_scene::frame_settings::{
     EnvLighting, Lighting, PointLighting, Shadows, Transparency,
 };
@@ -257,10 +258,10 @@ fn point_controls(ui: &mut egui::Ui, p: &mut PointLighting) {
         ui.radio_value(&mut p.shadows, Shadows::Adsm, "ADSM");
     });
     if p.shadows == Shadows::Dom {
-        ui.add(egui::Slider::new(&mut p.dom_layers, 1..=8).text("DOM layers"));
+        ui.add(egui::Slider::new(&mut p.dom_layers, 1..=MAX_LAYERS).text("DOM layers"));
     }
     if p.shadows == Shadows::Osm {
-        ui.add(egui::Slider::new(&mut p.osm_slices, 1..=8).text("OSM slices"));
+        ui.add(egui::Slider::new(&mut p.osm_slices, 1..=MAX_LAYERS).text("OSM slices"));
     }
     if matches!(p.shadows, Shadows::Sm | Shadows::Adsm) {
         ui.add(

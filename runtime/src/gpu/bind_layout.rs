@@ -71,6 +71,19 @@ pub fn float_texture_entry(
     )
 }
 
+/// A 2D float texture array read with `textureLoad` (unfilterable, as [`float_texture_entry`]).
+pub fn float_array_texture_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayoutEntry {
+    texture_entry(
+        binding,
+        visibility,
+        wgpu::TextureSampleType::Float { filterable: false },
+        wgpu::TextureViewDimension::D2Array,
+    )
+}
+
 /// A 2D depth texture read with `textureLoad`.
 pub fn depth_texture_entry(
     binding: u32,

@@ -12,10 +12,20 @@ pub enum ReadbackError {
     MapRange(#[from] wgpu::MapRangeError),
 }
 
-/// The texture's pixels, row-major from the top row, 4 floats per pixel.
+/// The texture's pixels (of its first array layer), row-major from the top row, 4 floats per
+/// pixel.
 pub fn read_texture_rgba(
     gpu: &GpuContext,
     texture: &wgpu::Texture,
+) -> Result<Vec<[f32; 4]>, ReadbackError> {
+    read_texture_layer_rgba(gpu, texture, 0)
+}
+
+/// Array layer `layer` of the texture, row-major from the top row, 4 floats per pixel.
+pub fn read_texture_layer_rgba(
+    gpu: &GpuContext,
+    texture: &wgpu::Texture,
+    layer: u32,
 ) -> Result<Vec<[f32; 4]>, ReadbackError> {
     let format = texture.format();
     let bytes_per_pixel = match format {
@@ -36,7 +46,14 @@ pub fn read_texture_rgba(
     });
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     encoder.copy_texture_to_buffer(
-        texture.as_image_copy(),
+        wgpu::TexelCopyTextureInfo {
+            origin: wgpu::Origin3d {
+                x: 0,
+                y: 0,
+                z: layer,
+            },
+            ..texture.as_image_copy()
+        },
         wgpu::TexelCopyBufferInfo {
             buffer: &buffer,
             layout: wgpu::TexelCopyBufferLayout {
@@ -45,7 +62,10 @@ pub fn read_texture_rgba(
                 rows_per_image: Some(height),
             },
         },
-        texture.size(),
+        wgpu::Extent3d {
+            depth_or_array_layers: 1,
+            ..texture.size()
+        },
     );
     gpu.queue.submit([encoder.finish()]);
     let slice = buffer.slice(..);

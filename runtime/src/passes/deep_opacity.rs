@@ -1,6 +1,7 @@
-//! Deep opacity maps for a directional light: a light-space depth prepass (nearest fiber per
-//! texel), then one additive pass that sorts every fragment's optical depth into K layers of
-//! configurable spacing, the last layer taking what lies beyond (`deep_opacity.wgsl`).
+//! Deep opacity maps: a light-space depth prepass (nearest fiber per texel), then additive
+//! passes that sort every fragment's optical depth into K layers of configurable spacing, the
+//! last layer taking what lies beyond (`deep_opacity.wgsl`); one pass fills
+//! [`LAYERS_PER_PASS`] layers.
 //! Shadow maps and ADSM (Hunz §4) use only the depth prepass: the lookup compares against the
 //! nearest fiber ([`ShadowLookup`]). Point and spot lights use a perspective light camera
 //! ([`point_light_camera`]); depths are linearized wherever layers are measured.
@@ -25,13 +26,19 @@ use super::strand_geometry::StrandGeometry;
 use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
 use crate::camera::Camera;
 use crate::gpu::GpuContext;
-use crate::gpu::bind_layout::{depth_texture_entry, uniform_entry};
-use crate::gpu::readback::{ReadbackError, read_texture_rgba};
+use crate::gpu::bind_layout::{bind_group, depth_texture_entry, uniform_entry};
+use crate::gpu::readback::{ReadbackError, read_texture_layer_rgba};
 use crate::gpu::texture::texture_2d;
 use crate::hair::Aabb;
 
-/// At most this many layers (two RGBA targets).
-pub const MAX_LAYERS: u32 = 8;
+/// At most this many layers (eight RGBA array layers; the layer pass fills them
+/// [`LAYERS_PER_PASS`] at a time).
+pub const MAX_LAYERS: u32 = 32;
+
+/// Layers one rasterization of the hair fills: two RGBA32F targets are the 32 bytes per sample
+/// that WebGPU's default limits allow every adapter, so 16 layers take two passes, 32 four.
+pub const LAYERS_PER_PASS: u32 = 8;
+const TARGETS_PER_PASS: u32 = LAYERS_PER_PASS / 4;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DomSettings {
@@ -74,7 +81,9 @@ struct DomUniform {
     spacing: f32,
     layers: u32,
     perspective: u32,
-    _pad: [u32; 3],
+    /// The first layer this pass writes (a multiple of [`LAYERS_PER_PASS`]).
+    first_layer: u32,
+    _pad: [u32; 2],
 }
 
 /// Where a map's first layer begins.
@@ -163,8 +172,13 @@ pub struct DeepOpacityMap {
     pub layer_start: LayerStart,
     pub lookup: ShadowLookup,
     pub nearest_depth: wgpu::Texture,
-    /// Layers 0–3 and 4–7 in the channels of two textures.
-    pub layers: [wgpu::Texture; 2],
+    /// Layer k in channel k % 4 of array layer k / 4 (rounded up to whole passes).
+    pub layers: wgpu::Texture,
+}
+
+/// Array layers holding `layers` optical depth layers: whole passes of [`TARGETS_PER_PASS`].
+fn array_layers_for(layers: u32) -> u32 {
+    layers.max(1).div_ceil(LAYERS_PER_PASS) * TARGETS_PER_PASS
 }
 
 impl DeepOpacityMap {
@@ -188,10 +202,16 @@ impl DeepOpacityMap {
                 DEPTH_FORMAT,
                 wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
             ),
-            layers: [
-                texture("dom layers 0-3", gpu.hdr_format(), layer_usage),
-                texture("dom layers 4-7", gpu.hdr_format(), layer_usage),
-            ],
+            layers: texture_2d(
+                gpu,
+                "dom layers",
+                wgpu::Extent3d {
+                    depth_or_array_layers: array_layers_for(settings.layers),
+                    ..size
+                },
+                gpu.hdr_format(),
+                layer_usage,
+            ),
         }
     }
 
@@ -256,12 +276,13 @@ impl DeepOpacityMap {
 
     /// Per texel, the K layers' optical depths (row-major from the top).
     pub fn read_layers(&self, gpu: &GpuContext) -> Result<Vec<Vec<f32>>, ReadbackError> {
-        let a = read_texture_rgba(gpu, &self.layers[0])?;
-        let b = read_texture_rgba(gpu, &self.layers[1])?;
         let k = self.settings.layers as usize;
-        Ok(a.iter()
-            .zip(&b)
-            .map(|(x, y)| x.iter().chain(y.iter()).take(k).copied().collect())
+        let groups = (0..k.div_ceil(4) as u32)
+            .map(|g| read_texture_layer_rgba(gpu, &self.layers, g))
+            .collect::<Result<Vec<_>, _>>()?;
+        let texels = groups[0].len();
+        Ok((0..texels)
+            .map(|t| groups.iter().flat_map(|g| g[t]).take(k).collect())
             .collect())
     }
 
@@ -270,10 +291,11 @@ impl DeepOpacityMap {
         if !self.lookup.uses_layers() {
             return vec![("shadow map depth".into(), texels * 4)];
         }
-        let layer_texel = self.layers[0].format().block_copy_size(None).unwrap_or(16) as u64;
+        let layer_texel = self.layers.format().block_copy_size(None).unwrap_or(16) as u64;
+        let array_layers = self.layers.depth_or_array_layers() as u64;
         vec![
             ("dom nearest depth".into(), texels * 4),
-            ("dom layers".into(), 2 * texels * layer_texel),
+            ("dom layers".into(), array_layers * texels * layer_texel),
         ]
     }
 }
@@ -378,6 +400,7 @@ impl DeepOpacityPass {
             }),
             write_mask: wgpu::ColorWrites::ALL,
         });
+        let targets = vec![target; TARGETS_PER_PASS as usize];
         let layer_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("dom layers"),
             layout: Some(&layer_layout),
@@ -386,7 +409,7 @@ impl DeepOpacityPass {
                 module: &shader,
                 entry_point: Some("fs_layers"),
                 compilation_options: Default::default(),
-                targets: &[target.clone(), target],
+                targets: &targets,
             }),
             primitive,
             depth_stencil: None,
@@ -415,33 +438,7 @@ impl DeepOpacityPass {
             width_override_px: None,
         };
         let strands = strand_bind_group(gpu, &self.strand_layout, geometry, &frame);
-        let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("dom params"),
-            contents: bytemuck::bytes_of(&DomUniform {
-                near: map.camera.near,
-                far: map.camera.far,
-                spacing: map.settings.spacing,
-                layers: map.settings.layers,
-                perspective: map.camera.is_perspective() as u32,
-                _pad: [0; 3],
-            }),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
         let depth_view = map.nearest_depth.create_view(&Default::default());
-        let dom_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("dom"),
-            layout: &self.dom_layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&depth_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: uniform.as_entire_binding(),
-                },
-            ],
-        });
         let mut encoder = device.create_command_encoder(&Default::default());
         match map.layer_start {
             LayerStart::NearestFiber => {
@@ -477,13 +474,12 @@ impl DeepOpacityPass {
             gpu.queue.submit([encoder.finish()]);
             return;
         }
-        let views: Vec<_> = map
-            .layers
-            .iter()
-            .map(|t| t.create_view(&Default::default()))
-            .collect();
-        let attachments: Vec<_> = views.iter().map(cleared_color).collect();
-        {
+        for first_layer in (0..map.settings.layers).step_by(LAYERS_PER_PASS as usize) {
+            let dom_group = self.layer_group(gpu, map, &depth_view, first_layer);
+            let views: Vec<_> = (0..TARGETS_PER_PASS)
+                .map(|t| array_layer_view(&map.layers, first_layer / 4 + t))
+                .collect();
+            let attachments: Vec<_> = views.iter().map(cleared_color).collect();
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("dom layers"),
                 color_attachments: &attachments,
@@ -499,4 +495,48 @@ impl DeepOpacityPass {
         }
         gpu.queue.submit([encoder.finish()]);
     }
+
+    /// Group 1 of the layer pass that fills layers `first_layer..first_layer + LAYERS_PER_PASS`.
+    fn layer_group(
+        &self,
+        gpu: &GpuContext,
+        map: &DeepOpacityMap,
+        depth_view: &wgpu::TextureView,
+        first_layer: u32,
+    ) -> wgpu::BindGroup {
+        let uniform = gpu
+            .device
+            .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("dom params"),
+                contents: bytemuck::bytes_of(&DomUniform {
+                    near: map.camera.near,
+                    far: map.camera.far,
+                    spacing: map.settings.spacing,
+                    layers: map.settings.layers,
+                    perspective: map.camera.is_perspective() as u32,
+                    first_layer,
+                    _pad: [0; 2],
+                }),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+        bind_group(
+            &gpu.device,
+            "dom",
+            &self.dom_layout,
+            &[
+                wgpu::BindingResource::TextureView(depth_view),
+                uniform.as_entire_binding(),
+            ],
+        )
+    }
+}
+
+/// A 2D view of one array layer, to render into.
+fn array_layer_view(texture: &wgpu::Texture, layer: u32) -> wgpu::TextureView {
+    texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2),
+        base_array_layer: layer,
+        array_layer_count: Some(1),
+        ..Default::default()
+    })
 }

@@ -3,7 +3,8 @@
 // fiber depth z0 per texel. Each fragment adds its optical depth τ = −ln(1 − α) (α: coverage ×
 // opacity) to layer k = floor((d − d0) / spacing), the last layer taking everything beyond, so
 // the transmittance in front of layer k is exp(−Σ_{j<k} layer_j) = Π(1 − α) of the fibers there.
-// Up to 8 layers: two RGBA targets, additive blending.
+// One pass fills the 8 layers first_layer.. (two RGBA targets, additive blending); more layers
+// take more passes.
 
 struct DomParams {
     near: f32,
@@ -12,7 +13,8 @@ struct DomParams {
     layers: u32,
     // 1: a point or spot light's perspective camera (depths are linearized).
     perspective: u32,
-    _pad0: u32,
+    // The first layer this pass writes.
+    first_layer: u32,
     _pad1: u32,
     _pad2: u32,
 };
@@ -48,10 +50,15 @@ fn fs_layers(in: VertexOut) -> Layers {
     var out: Layers;
     out.first = vec4<f32>(0.0);
     out.second = vec4<f32>(0.0);
-    if (k < 4u) {
-        out.first[k] = tau;
+    // Another pass's layer: add nothing here (a discard would cost the same).
+    if (k < dom.first_layer || k >= dom.first_layer + 8u) {
+        return out;
+    }
+    let slot = k - dom.first_layer;
+    if (slot < 4u) {
+        out.first[slot] = tau;
     } else {
-        out.second[k - 4u] = tau;
+        out.second[slot - 4u] = tau;
     }
     return out;
 }

@@ -7,7 +7,7 @@ use wgpu::util::DeviceExt;
 use super::deep_opacity::{DeepOpacityMap, DomSettings, ShadowLookup};
 use super::frame_params::FrameParams;
 use crate::gpu::GpuContext;
-use crate::gpu::bind_layout::{depth_texture_entry, float_texture_entry, uniform_entry};
+use crate::gpu::bind_layout::{depth_texture_entry, float_array_texture_entry, uniform_entry};
 
 /// A deep opacity map that shadows light `light_index` of the frame.
 #[derive(Clone, Copy)]
@@ -55,18 +55,16 @@ fn lookup_code(lookup: &ShadowLookup) -> u32 {
 }
 
 /// Group 1 of the shading passes: per slot (up to [`MAX_SHADOWED_LIGHTS`]) the nearest depth and
-/// the two layer textures of a deep opacity map (bindings 3k, 3k+1, 3k+2), then the uniform array
-/// of the slots' parameters (binding 12).
+/// the layer array of a light's map (bindings 2k, 2k+1), then the uniform array of the slots'
+/// parameters (binding 8).
 pub fn shadow_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let fragment = wgpu::ShaderStages::FRAGMENT;
     let mut entries = Vec::new();
     for slot in 0..MAX_SHADOWED_LIGHTS as u32 {
-        entries.push(depth_texture_entry(3 * slot, fragment));
-        for layer in 1..3 {
-            entries.push(float_texture_entry(3 * slot + layer, fragment));
-        }
+        entries.push(depth_texture_entry(2 * slot, fragment));
+        entries.push(float_array_texture_entry(2 * slot + 1, fragment));
     }
-    entries.push(uniform_entry(3 * MAX_SHADOWED_LIGHTS as u32, fragment));
+    entries.push(uniform_entry(2 * MAX_SHADOWED_LIGHTS as u32, fragment));
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("strand shadows"),
         entries: &entries,
@@ -154,8 +152,10 @@ pub fn shadow_bind_group_for(
         .flat_map(|(map, _)| {
             [
                 map.nearest_depth.create_view(&Default::default()),
-                map.layers[0].create_view(&Default::default()),
-                map.layers[1].create_view(&Default::default()),
+                map.layers.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2Array),
+                    ..Default::default()
+                }),
             ]
         })
         .collect();
@@ -168,7 +168,7 @@ pub fn shadow_bind_group_for(
         })
         .collect();
     entries.push(wgpu::BindGroupEntry {
-        binding: 3 * MAX_SHADOWED_LIGHTS as u32,
+        binding: 2 * MAX_SHADOWED_LIGHTS as u32,
         resource: shadow_buffer.as_entire_binding(),
     });
     Ok(device.create_bind_group(&wgpu::BindGroupDescriptor {

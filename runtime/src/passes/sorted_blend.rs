@@ -6,7 +6,6 @@
 //! Inputs: [`StrandGeometry`], [`FrameParams`], the hair's bounds, shadow maps. Output: the
 //! colour texture of a [`RenderTarget`].
 
-use glam::Vec3;
 use wgpu::util::DeviceExt;
 
 use super::attachments::cleared_color;
@@ -195,7 +194,7 @@ impl SortedBlendPass {
         let depths = bounds.corners().map(|c| (c - camera.eye).dot(forward));
         let uniform = SortUniform {
             eye: camera.eye.extend(0.0).into(),
-            forward: Vec3::from(forward).extend(0.0).into(),
+            forward: forward.extend(0.0).into(),
             nearest: depths.iter().copied().fold(f32::INFINITY, f32::min),
             farthest: depths.iter().copied().fold(f32::NEG_INFINITY, f32::max),
             bins,

@@ -31,23 +31,14 @@ const LOOKUP_ADSM: u32 = 2u;
 const SHADOW_SLOTS: u32 = 4u;
 
 @group(1) @binding(0) var shadow_depth_0: texture_depth_2d;
-@group(1) @binding(1) var shadow_layers_a_0: texture_2d<f32>;
-@group(1) @binding(2) var shadow_layers_b_0: texture_2d<f32>;
-@group(1) @binding(3) var shadow_depth_1: texture_depth_2d;
-@group(1) @binding(4) var shadow_layers_a_1: texture_2d<f32>;
-@group(1) @binding(5) var shadow_layers_b_1: texture_2d<f32>;
-@group(1) @binding(6) var shadow_depth_2: texture_depth_2d;
-@group(1) @binding(7) var shadow_layers_a_2: texture_2d<f32>;
-@group(1) @binding(8) var shadow_layers_b_2: texture_2d<f32>;
-@group(1) @binding(9) var shadow_depth_3: texture_depth_2d;
-@group(1) @binding(10) var shadow_layers_a_3: texture_2d<f32>;
-@group(1) @binding(11) var shadow_layers_b_3: texture_2d<f32>;
-@group(1) @binding(12) var<uniform> shadow: array<ShadowParams, 4>;
-
-fn layer_value(a: vec4<f32>, b: vec4<f32>, k: u32) -> f32 {
-    if (k < 4u) { return a[k]; }
-    return b[k - 4u];
-}
+@group(1) @binding(1) var shadow_layers_0: texture_2d_array<f32>;
+@group(1) @binding(2) var shadow_depth_1: texture_depth_2d;
+@group(1) @binding(3) var shadow_layers_1: texture_2d_array<f32>;
+@group(1) @binding(4) var shadow_depth_2: texture_depth_2d;
+@group(1) @binding(5) var shadow_layers_2: texture_2d_array<f32>;
+@group(1) @binding(6) var shadow_depth_3: texture_depth_2d;
+@group(1) @binding(7) var shadow_layers_3: texture_2d_array<f32>;
+@group(1) @binding(8) var<uniform> shadow: array<ShadowParams, 4>;
 
 // Distance along the light camera's axis from a depth-buffer value.
 fn light_depth(p: ShadowParams, z: f32) -> f32 {
@@ -89,8 +80,7 @@ fn filtered_depth_test(depth: texture_depth_2d, texel: vec2<i32>, d: f32, p: Sha
 // within the layer), the last layer being spread over one spacing.
 fn map_transmittance(
     depth: texture_depth_2d,
-    layers_a: texture_2d<f32>,
-    layers_b: texture_2d<f32>,
+    layers: texture_2d_array<f32>,
     p: ShadowParams,
     world: vec3<f32>,
 ) -> f32 {
@@ -106,12 +96,15 @@ fn map_transmittance(
     if (z0 >= 1.0) { return 1.0; }
     let d0 = light_depth(p, z0);
     let position = max(d - d0, 0.0) / p.spacing;
-    let a = textureLoad(layers_a, texel, 0);
-    let b = textureLoad(layers_b, texel, 0);
+    // Layer k is channel k % 4 of array layer k / 4; only the layers in front are read.
+    let reached = min(p.layers, u32(ceil(position)));
     var tau = 0.0;
-    for (var k = 0u; k < p.layers; k++) {
-        let fraction = clamp(position - f32(k), 0.0, 1.0);
-        tau += fraction * layer_value(a, b, k);
+    for (var group = 0u; group * 4u < reached; group++) {
+        let four = textureLoad(layers, texel, group, 0);
+        for (var c = 0u; c < 4u; c++) {
+            let k = group * 4u + c;
+            tau += clamp(position - f32(k), 0.0, 1.0) * four[c];
+        }
     }
     return exp(-tau);
 }
@@ -119,16 +112,16 @@ fn map_transmittance(
 // The fraction of light `light_index` that reaches `world`: 1 unless a slot shadows that light.
 fn shadow_transmittance(light_index: u32, world: vec3<f32>) -> f32 {
     if (shadow[0].light_index == light_index) {
-        return map_transmittance(shadow_depth_0, shadow_layers_a_0, shadow_layers_b_0, shadow[0], world);
+        return map_transmittance(shadow_depth_0, shadow_layers_0, shadow[0], world);
     }
     if (shadow[1].light_index == light_index) {
-        return map_transmittance(shadow_depth_1, shadow_layers_a_1, shadow_layers_b_1, shadow[1], world);
+        return map_transmittance(shadow_depth_1, shadow_layers_1, shadow[1], world);
     }
     if (shadow[2].light_index == light_index) {
-        return map_transmittance(shadow_depth_2, shadow_layers_a_2, shadow_layers_b_2, shadow[2], world);
+        return map_transmittance(shadow_depth_2, shadow_layers_2, shadow[2], world);
     }
     if (shadow[3].light_index == light_index) {
-        return map_transmittance(shadow_depth_3, shadow_layers_a_3, shadow_layers_b_3, shadow[3], world);
+        return map_transmittance(shadow_depth_3, shadow_layers_3, shadow[3], world);
     }
     return 1.0;
 }
