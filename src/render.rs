@@ -82,7 +82,7 @@ pub struct RenderArgs {
     /// Light map resolution (square) of every --shadows technique.
     #[arg(long, default_value_t = 512)]
     dom_size: u32,
-    /// Shadow map and ADSM percentage-closer filter, texels per side (odd, 1..=9).
+    /// Percentage-closer filter of every light map, texels per side (odd, 1..=9).
     #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_PCF_KERNEL)]
     pcf: u32,
     /// Shadow map and ADSM depth bias along the light, world units (default: two map texels).

@@ -299,37 +299,43 @@ fn main() -> Result<(), BoxError> {
         "runs: 1 warm-up + {timed_runs} timed per configuration, interleaved (round-robin); medians; timing = CPU wall clock around submit + wait for idle"
     );
 
-    let configs: Vec<(String, RenderOptions)> = [None, Some(ShadowMaps::Deep(dom))]
-        .into_iter()
-        .flat_map(|shadows| {
-            let tag = if shadows.is_some() { " + DOM" } else { "" };
-            [
-                (format!("opaque{tag}"), Transparency::Opaque),
-                (
-                    format!("A-buffer{tag}"),
-                    Transparency::ABuffer {
-                        nodes_per_pixel: Some(abuffer_npp),
-                    },
-                ),
-                (
-                    format!("DBK{tag}"),
-                    Transparency::Dbk {
-                        nodes_per_pixel: Some(dbk_npp),
-                        delta,
-                    },
-                ),
-            ]
-            .map(|(name, transparency)| {
-                (
-                    name,
-                    RenderOptions {
-                        shadows,
-                        transparency,
-                    },
-                )
-            })
+    let configs: Vec<(String, RenderOptions)> = [
+        None,
+        Some(ShadowMaps::Deep {
+            settings: dom,
+            pcf: 1,
+        }),
+    ]
+    .into_iter()
+    .flat_map(|shadows| {
+        let tag = if shadows.is_some() { " + DOM" } else { "" };
+        [
+            (format!("opaque{tag}"), Transparency::Opaque),
+            (
+                format!("A-buffer{tag}"),
+                Transparency::ABuffer {
+                    nodes_per_pixel: Some(abuffer_npp),
+                },
+            ),
+            (
+                format!("DBK{tag}"),
+                Transparency::Dbk {
+                    nodes_per_pixel: Some(dbk_npp),
+                    delta,
+                },
+            ),
+        ]
+        .map(|(name, transparency)| {
+            (
+                name,
+                RenderOptions {
+                    shadows,
+                    transparency,
+                },
+            )
         })
-        .collect();
+    })
+    .collect();
     let results = measure_interleaved(&gpu, &model, &frame, configs, timed_runs)?;
     print_table(&results);
     print_ratios(&results);

@@ -118,6 +118,45 @@ pub fn write_png(
             ]
         })
         .collect();
+    encode_png(
+        path,
+        width,
+        height,
+        &bytes,
+        &[("Description", description), ("Tonemap", PNG_TONEMAP)],
+    )
+}
+
+/// An 8-bit sRGB picture already made (3 bytes per pixel, e.g. a false-colour error map), with
+/// its description in the file.
+pub fn write_png_rgb8(
+    path: &Path,
+    width: u32,
+    height: u32,
+    bytes: &[u8],
+    description: &str,
+) -> Result<(), ImageWriteError> {
+    let expected = width as usize * height as usize;
+    if bytes.len() != 3 * expected {
+        return Err(ImageWriteError::WrongSize {
+            path: path.into(),
+            width,
+            height,
+            expected,
+            got: bytes.len() / 3,
+        });
+    }
+    encode_png(path, width, height, bytes, &[("Description", description)])
+}
+
+/// RGB8 PNG written atomically, with the software's name and `text` as iTXt chunks.
+fn encode_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    bytes: &[u8],
+    text: &[(&str, &str)],
+) -> Result<(), ImageWriteError> {
     let encode = |w: &mut std::io::BufWriter<std::fs::File>| -> Result<(), png::EncodingError> {
         let mut encoder = png::Encoder::new(w, width, height);
         encoder.set_color(png::ColorType::Rgb);
@@ -126,10 +165,11 @@ pub fn write_png(
             "Software".into(),
             concat!("strandlight-runtime ", env!("CARGO_PKG_VERSION")).into(),
         )?;
-        encoder.add_itxt_chunk("Description".into(), description.into())?;
-        encoder.add_itxt_chunk("Tonemap".into(), PNG_TONEMAP.into())?;
+        for (key, value) in text {
+            encoder.add_itxt_chunk((*key).into(), (*value).into())?;
+        }
         let mut writer = encoder.write_header()?;
-        writer.write_image_data(&bytes)?;
+        writer.write_image_data(bytes)?;
         writer.finish()
     };
     write_atomically(path, |w| encode(w).map_err(io::Error::other)).map_err(|source| {

@@ -187,11 +187,16 @@ pub enum Transparency {
 /// point and spot lights a perspective one ([`point_light_camera`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ShadowMaps {
-    /// Deep opacity maps (Yuksel & Keyser 2008): layers from each texel's nearest fiber.
-    Deep(DomSettings),
+    /// Deep opacity maps (Yuksel & Keyser 2008): layers from each texel's nearest fiber, read
+    /// through `pcf`×`pcf` PCF.
+    Deep { settings: DomSettings, pcf: u32 },
     /// Opacity shadow maps (Kim & Neumann 2001): `slices` equal slices spanning the hair's
-    /// depth range along the light, the same for every texel.
-    OpacitySlices { resolution: u32, slices: u32 },
+    /// depth range along the light, the same for every texel, read through `pcf`×`pcf` PCF.
+    OpacitySlices {
+        resolution: u32,
+        slices: u32,
+        pcf: u32,
+    },
     /// Shadow maps with PCF or ADSM ([`ShadowLookup::Hard`], [`ShadowLookup::Adsm`]).
     Depth {
         resolution: u32,
@@ -202,7 +207,7 @@ pub enum ShadowMaps {
 impl ShadowMaps {
     pub fn resolution(&self) -> u32 {
         match *self {
-            ShadowMaps::Deep(settings) => settings.resolution,
+            ShadowMaps::Deep { settings, .. } => settings.resolution,
             ShadowMaps::OpacitySlices { resolution, .. } => resolution,
             ShadowMaps::Depth { resolution, .. } => resolution,
         }
@@ -210,13 +215,23 @@ impl ShadowMaps {
 
     fn check(&self) -> Result<(), ShadowMapError> {
         match *self {
-            ShadowMaps::Deep(settings) => settings.check()?,
-            ShadowMaps::OpacitySlices { resolution, slices } => DomSettings {
-                resolution,
-                layers: slices,
-                spacing: 1.0,
+            ShadowMaps::Deep { settings, pcf } => {
+                settings.check()?;
+                ShadowLookup::Layers { kernel: pcf }.check()?;
             }
-            .check()?,
+            ShadowMaps::OpacitySlices {
+                resolution,
+                slices,
+                pcf,
+            } => {
+                DomSettings {
+                    resolution,
+                    layers: slices,
+                    spacing: 1.0,
+                }
+                .check()?;
+                ShadowLookup::Layers { kernel: pcf }.check()?;
+            }
             ShadowMaps::Depth { resolution, lookup } => {
                 DomSettings {
                     resolution,
@@ -233,7 +248,7 @@ impl ShadowMaps {
     /// The name of the pass that draws one light's map, in timings.
     pub fn pass_name(&self) -> &'static str {
         match self {
-            ShadowMaps::Deep(_) => "deep opacity",
+            ShadowMaps::Deep { .. } => "deep opacity",
             ShadowMaps::OpacitySlices { .. } => "opacity shadow",
             ShadowMaps::Depth {
                 lookup: ShadowLookup::Adsm { .. },
@@ -257,10 +272,15 @@ impl ShadowMaps {
             }
         };
         Ok(match *self {
-            ShadowMaps::Deep(settings) => DeepOpacityMap::new(gpu, camera, settings),
-            ShadowMaps::OpacitySlices { resolution, slices } => {
-                DeepOpacityMap::opacity_slices(gpu, camera, bounds, resolution, slices)?
+            ShadowMaps::Deep { settings, pcf } => {
+                DeepOpacityMap::new(gpu, camera, settings).with_layer_pcf(pcf)?
             }
+            ShadowMaps::OpacitySlices {
+                resolution,
+                slices,
+                pcf,
+            } => DeepOpacityMap::opacity_slices(gpu, camera, bounds, resolution, slices)?
+                .with_layer_pcf(pcf)?,
             ShadowMaps::Depth { resolution, lookup } => {
                 DeepOpacityMap::depth_only(gpu, camera, resolution, lookup)?
             }

@@ -379,6 +379,107 @@ fn opacity_slices_converge_to_deep_opacity_and_the_closed_form_inside_a_slab() {
     assert!(worst_error(last, &dom) < 5e-3);
 }
 
+/// PCF on a deep opacity map averages the transmittance of the texels around the lookup: behind
+/// a slab that covers only the left half of the map (texel columns 0..32), a probe fiber is lit
+/// (1 − d/s)^4 on the left and fully on the right through one texel; through 3×3 PCF the two
+/// columns at the edge get the mean of their three neighbours: (2T + 1)/3 and (T + 2)/3.
+#[test]
+fn pcf_averages_the_layer_transmittance_of_neighbouring_texels() {
+    let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+    let thickness = 0.01f32;
+    let coverage = thickness as f64 * PER_UNIT;
+    let full = slab(4, thickness);
+    // Keep the strands of columns 0..32 (x < 0): each strand is one column's fiber.
+    let mut points = Vec::new();
+    let mut offsets = vec![0u32];
+    for strand in full.strands() {
+        if strand[0].x < 0.0 {
+            points.extend_from_slice(strand);
+            offsets.push(points.len() as u32);
+        }
+    }
+    let half = HairModel::new(
+        points,
+        offsets,
+        Some(Attribute::Uniform(thickness)),
+        None,
+        None,
+    )
+    .unwrap();
+    let geometry = StrandGeometry::upload(&gpu, &half).unwrap();
+    let settings = DomSettings {
+        resolution: RES,
+        layers: 4,
+        spacing: 0.08,
+    };
+    let pass = DeepOpacityPass::new(&gpu);
+    let t = (1.0 - coverage).powi(4);
+    for kernel in [1u32, 3] {
+        let map = DeepOpacityMap::new(&gpu, ortho_camera(), settings)
+            .with_layer_pcf(kernel)
+            .unwrap();
+        pass.draw(&gpu, &geometry, &map);
+        // One probe behind the slab, read per column on pixel row 8 + 4·0 (y = 0.73).
+        let color = Vec3::new(0.5, 0.3, 0.2);
+        let probe = HairModel::new(
+            vec![
+                Vec3::new(-0.95, 0.734375, -0.5),
+                Vec3::new(0.95, 0.734375, -0.5),
+            ],
+            vec![0, 2],
+            None,
+            None,
+            Some(Attribute::Uniform(color)),
+        )
+        .unwrap();
+        let frame = FrameParams {
+            camera: ortho_camera(),
+            width: RES,
+            height: RES,
+            lights: vec![Light::Directional {
+                direction: Vec3::Z,
+                intensity: 1.0,
+            }],
+            shading: KajiyaKay {
+                kd: 0.6,
+                ks: 0.25,
+                shininess: 40.0,
+            },
+            width_override_px: Some(3.0),
+        };
+        let target = RenderTarget::new(&gpu, RES, RES);
+        StrandPass::new(&gpu).draw(
+            &gpu,
+            &StrandGeometry::upload(&gpu, &probe).unwrap(),
+            &frame,
+            &target,
+            Some(ShadowInput {
+                map: &map,
+                light_index: 0,
+            }),
+        );
+        let pixels = read_texture_rgba(&gpu, &target.color).unwrap();
+        let per_texel = |c: usize| if c < 32 { t } else { 1.0 };
+        let mut worst = 0.0f64;
+        for column in 26..38usize {
+            let expected = if kernel == 1 {
+                per_texel(column)
+            } else {
+                (per_texel(column - 1) + per_texel(column) + per_texel(column + 1)) / 3.0
+            };
+            let got = pixels[8 * RES as usize + column][0] as f64 / (0.6 * 0.5 + 0.25);
+            worst = worst.max((got - expected).abs() / expected);
+            assert!(
+                (got - expected).abs() < 2e-3 * expected,
+                "kernel {kernel}, column {column}: {got} vs {expected}"
+            );
+        }
+        eprintln!("PCF {kernel}×{kernel}: worst relative error at the slab's edge {worst:.2e}");
+    }
+    let bad = DeepOpacityMap::new(&gpu, ortho_camera(), settings).with_layer_pcf(2);
+    assert!(bad.is_err(), "an even kernel is refused");
+}
+
 /// The reference renderer of the environment-lit pipeline draws one map per light for
 /// thousands of lights: one map re-aimed and redrawn must equal a fresh map for the new light
 /// (no state left over from the previous light), so its textures can be reused.

@@ -34,11 +34,14 @@ fn gpu_pass_times_are_reported_where_supported_and_fit_inside_the_wall_clock() {
         width_override_px: None,
     };
     let options = RenderOptions {
-        shadows: Some(ShadowMaps::Deep(DomSettings {
-            resolution: 256,
-            layers: 4,
-            spacing: 0.05,
-        })),
+        shadows: Some(ShadowMaps::Deep {
+            settings: DomSettings {
+                resolution: 256,
+                layers: 4,
+                spacing: 0.05,
+            },
+            pcf: 1,
+        }),
         ..Default::default()
     };
     let out = render_frame(&gpu, &slab(6, 0.02), &frame, &options).unwrap();

@@ -73,14 +73,18 @@ pub fn point_render_options(point: &PointLighting, hair: &HairModel) -> RenderOp
     let diagonal = hair.bounds().diagonal();
     let shadows = match point.shadows {
         Shadows::None => None,
-        Shadows::Dom => Some(ShadowMaps::Deep(DomSettings {
-            resolution: point.dom_size,
-            layers: point.dom_layers,
-            spacing: point.dom_spacing.unwrap_or(diagonal * 0.01),
-        })),
+        Shadows::Dom => Some(ShadowMaps::Deep {
+            settings: DomSettings {
+                resolution: point.dom_size,
+                layers: point.dom_layers,
+                spacing: point.dom_spacing.unwrap_or(diagonal * 0.01),
+            },
+            pcf: point.pcf_kernel,
+        }),
         Shadows::Osm => Some(ShadowMaps::OpacitySlices {
             resolution: point.dom_size,
             slices: point.osm_slices,
+            pcf: point.pcf_kernel,
         }),
         Shadows::Sm | Shadows::Adsm => {
             let kernel = point.pcf_kernel;

@@ -99,8 +99,9 @@ pub enum LayerStart {
 /// How the shading passes read a light's map.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ShadowLookup {
-    /// Optical depth layers (deep opacity and opacity shadow maps).
-    Layers,
+    /// Optical depth layers (deep opacity and opacity shadow maps): the transmittance averaged
+    /// over `kernel`×`kernel` texels (PCF; 1: the texel alone).
+    Layers { kernel: u32 },
     /// A shadow map: lit where the fragment lies no more than `bias` (world units along the
     /// light) behind the nearest fiber, averaged over `kernel`×`kernel` texels (PCF).
     Hard { kernel: u32, bias: f32 },
@@ -133,7 +134,7 @@ pub enum ShadowLookupError {
 impl ShadowLookup {
     pub fn check(&self) -> Result<(), ShadowLookupError> {
         let (kernel, bias) = match *self {
-            ShadowLookup::Layers => return Ok(()),
+            ShadowLookup::Layers { kernel } => (kernel, 0.0),
             ShadowLookup::Hard { kernel, bias } => (kernel, bias),
             ShadowLookup::Adsm {
                 kernel,
@@ -161,7 +162,7 @@ impl ShadowLookup {
 
     /// Whether the map needs its optical depth layers (else only the nearest depth).
     pub fn uses_layers(&self) -> bool {
-        matches!(self, ShadowLookup::Layers)
+        matches!(self, ShadowLookup::Layers { .. })
     }
 }
 
@@ -196,7 +197,7 @@ impl DeepOpacityMap {
             camera,
             settings,
             layer_start: LayerStart::NearestFiber,
-            lookup: ShadowLookup::Layers,
+            lookup: ShadowLookup::Layers { kernel: 1 },
             nearest_depth: texture(
                 "dom nearest depth",
                 DEPTH_FORMAT,
@@ -243,6 +244,14 @@ impl DeepOpacityMap {
             layer_start: LayerStart::Fixed(start),
             ..Self::new(gpu, camera, settings)
         })
+    }
+
+    /// The same map read through `kernel`×`kernel` PCF (layer lookups only).
+    pub fn with_layer_pcf(mut self, kernel: u32) -> Result<Self, ShadowLookupError> {
+        let lookup = ShadowLookup::Layers { kernel };
+        lookup.check()?;
+        self.lookup = lookup;
+        Ok(self)
     }
 
     /// A shadow map (or ADSM) of `resolution`²: the nearest depth only, with 1×1 layer

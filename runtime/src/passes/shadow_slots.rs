@@ -48,7 +48,7 @@ struct ShadowUniform {
 /// `ShadowParams.lookup` in `strands.wgsl`.
 fn lookup_code(lookup: &ShadowLookup) -> u32 {
     match lookup {
-        ShadowLookup::Layers => 0,
+        ShadowLookup::Layers { .. } => 0,
         ShadowLookup::Hard { .. } => 1,
         ShadowLookup::Adsm { .. } => 2,
     }
@@ -115,7 +115,7 @@ pub fn shadow_bind_group_for(
         .iter()
         .map(|&(map, light_index)| {
             let (kernel, bias, adsm_alpha, adsm_spacing) = match map.lookup {
-                ShadowLookup::Layers => (1, 0.0, 0.5, 1.0),
+                ShadowLookup::Layers { kernel } => (kernel, 0.0, 0.5, 1.0),
                 ShadowLookup::Hard { kernel, bias } => (kernel, bias, 0.5, 1.0),
                 ShadowLookup::Adsm {
                     kernel,

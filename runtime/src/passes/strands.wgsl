@@ -92,6 +92,28 @@ fn map_transmittance(
     let texel = vec2<i32>(uv * p.resolution);
     let d = light_depth(p, ndc.z);
     if (p.lookup != LOOKUP_LAYERS) { return filtered_depth_test(depth, texel, d, p); }
+    // PCF: the transmittance of each texel in the kernel, averaged (clamped at the edges).
+    let r = i32(p.kernel / 2u);
+    let last = vec2<i32>(textureDimensions(depth)) - vec2<i32>(1);
+    var sum = 0.0;
+    for (var dy = -r; dy <= r; dy++) {
+        for (var dx = -r; dx <= r; dx++) {
+            let t = clamp(texel + vec2<i32>(dx, dy), vec2<i32>(0), last);
+            sum += layer_transmittance(depth, layers, p, t, d);
+        }
+    }
+    let side = f32(2 * r + 1);
+    return sum / (side * side);
+}
+
+// Transmittance at light depth `d` through one texel's layers.
+fn layer_transmittance(
+    depth: texture_depth_2d,
+    layers: texture_2d_array<f32>,
+    p: ShadowParams,
+    texel: vec2<i32>,
+    d: f32,
+) -> f32 {
     let z0 = textureLoad(depth, texel, 0);
     if (z0 >= 1.0) { return 1.0; }
     let d0 = light_depth(p, z0);
