@@ -1,12 +1,14 @@
-//! `strandlight image-error TEST.exr REFERENCE.exr`: the relative RMSE `compare` reports, between
-//! any two of its EXR images — e.g. a 384-light reference against a 1536-light one, to show how
-//! far a reduced reference is from converged.
+//! `strandlight image-error TEST.exr REF.exr`: the errors `compare` reports (relative RMSE and
+//! HDR-FLIP over the reference's hair pixels), between any two of its EXR images — e.g. a
+//! 384-light reference against a 1536-light one, to show how far a reduced reference is from
+//! converged.
 
 use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
 
+use strandlight_scene::hdr_flip::{error_map_magma, hdr_flip};
 use strandlight_scene::image_metrics::relative_rmse;
 use strandlight_scene::reference_cache::read_rgba_exr;
 
@@ -16,6 +18,9 @@ pub struct ImageErrorArgs {
     pub test: PathBuf,
     /// The reference (its alpha decides which pixels are hair).
     pub reference: PathBuf,
+    /// Also write HDR-FLIP's error map here (PNG, magma colour map from 0 to 1).
+    #[arg(long, value_name = "PNG")]
+    pub flip_map: Option<PathBuf>,
 }
 
 pub fn run(args: ImageErrorArgs) -> anyhow::Result<()> {
@@ -23,17 +28,33 @@ pub fn run(args: ImageErrorArgs) -> anyhow::Result<()> {
         read_rgba_exr(&args.test).with_context(|| format!("reading {}", args.test.display()))?;
     let reference = read_rgba_exr(&args.reference)
         .with_context(|| format!("reading {}", args.reference.display()))?;
-    let error = relative_rmse(&test, &reference).with_context(|| {
+    let pair = || {
         format!(
             "{} against {}",
             args.test.display(),
             args.reference.display()
         )
-    })?;
+    };
+    let error = relative_rmse(&test, &reference).with_context(pair)?;
+    let flip = hdr_flip(&test, &reference).with_context(pair)?;
     println!(
-        "relative RMSE {error:.4}  ({} against {}, over the reference's hair pixels)",
-        args.test.display(),
-        args.reference.display()
+        "relative RMSE {error:.4}, HDR-FLIP {:.4} ({} exposures {:+.2} to {:+.2})  ({}, over the reference's hair pixels)",
+        flip.mean_over_hair,
+        flip.exposures,
+        flip.start_exposure,
+        flip.stop_exposure,
+        pair()
     );
+    if let Some(path) = &args.flip_map {
+        let (w, h) = (reference.width, reference.height);
+        strandlight_runtime::image_out::write_png_rgb8(
+            path,
+            w,
+            h,
+            &error_map_magma(&flip, w, h),
+            &format!("HDR-FLIP error map (magma, 0 → 1): {}", pair()),
+        )?;
+        println!("wrote {}", path.display());
+    }
     Ok(())
 }

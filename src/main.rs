@@ -1,6 +1,7 @@
 //! `strandlight`: the command-line front end. Parsing, progress and dispatch only; the work
 //! lives in the library crates.
 
+mod bench;
 mod compare;
 mod compare_table;
 mod demo;
@@ -44,9 +45,12 @@ enum Command {
     /// SRBF lights vs the brute-force cube-texel reference and the equal-time median-cut
     /// baseline (Ren 2010 §8): frame times, relative RMSE over hair pixels, images side by side.
     Compare(strandlight_scene::compare::CompareArgs),
+    /// Speed against error on the shared data: fit, tables and env-lit frames against the
+    /// converged reference, with plots; rewrites docs/BENCHMARKS.md's generated section.
+    Bench(bench::BenchArgs),
     /// The markdown table of docs/BENCHMARKS.md from `compare --json` reports.
     CompareTable(compare_table::CompareTableArgs),
-    /// Relative RMSE between two EXR images over the reference's hair pixels.
+    /// Relative RMSE and HDR-FLIP between two EXR images over the reference's hair pixels.
     ImageError(image_error::ImageErrorArgs),
     /// The procedural groom under the project's sun-and-sky: fit → bake → env-lit render.
     Demo(demo::DemoArgs),
@@ -67,6 +71,7 @@ fn main() -> anyhow::Result<()> {
         Command::Inspect(args) => tables_cmd::inspect(args),
         Command::Render(args) => render::run(args),
         Command::Compare(args) => compare::run(args),
+        Command::Bench(args) => bench::run(args),
         Command::CompareTable(args) => compare_table::run(args),
         Command::ImageError(args) => image_error::run(args),
         Command::Demo(args) => demo::run(args),

@@ -234,11 +234,12 @@ pub fn check(args: CheckArgs) -> anyhow::Result<()> {
             say(
                 &bar,
                 format!(
-                    "{:<18} max {:>9.3e}  rms {:>9.3e}  max rel (>1% of max) {:>9.3e} | off-axis: max {:>9.3e} rms {:>9.3e} | vs p99.9: max {:>9.3e} rms {:>9.3e}  {} samples  {:.1} s",
+                    "{:<18} max {:>9.3e}  rms {:>9.3e}  max rel {:>9.3e} over {} points (> 1% of min(max, p99.9)) | off-axis: max {:>9.3e} rms {:>9.3e} | vs p99.9: max {:>9.3e} rms {:>9.3e}  {} samples  {:.1} s",
                     acc.name,
                     acc.max_abs_error,
                     acc.rms_abs_error,
                     acc.max_rel_error,
+                    acc.rel_samples,
                     acc.off_axis_max_abs_error,
                     acc.off_axis_rms_abs_error,
                     acc.max_abs_error_p999,

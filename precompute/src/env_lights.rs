@@ -7,6 +7,7 @@
 //! turned by `rotate_degrees` about +Y exactly as [`crate::srbf_set::SrbfSet`] stores its
 //! lobes, so all three sets of one map agree.
 
+use crate::compact_sources::{self, SourceOptions};
 use crate::cube_lights::{CubeLightsError, cube_face_lights};
 use crate::envmap::{EnvMap, rotate_about_up};
 use crate::median_cut::{DirectionalLight, median_cut};
@@ -80,17 +81,26 @@ fn directional(lights: Vec<DirectionalLight>, rotate_degrees: f64) -> Vec<LightS
         .collect()
 }
 
-/// The brute-force reference: `6 · face_resolution²` directional lights, one per cube texel
-/// (32 → the paper's 6144), each carrying its texels' ∫ L dω ([`cube_face_lights`]).
+/// The brute-force reference: the compact sources of `map` that `sources` picks (a sun, a lamp:
+/// [`compact_sources::extract`], as the fit takes them out), each an exact directional light at
+/// its power-weighted direction, then what is left of the map as `6 · face_resolution²`
+/// directional lights, one per cube texel (32 → the paper's 6144), each carrying its texel's
+/// ∫ L dω from its radiance centroid ([`cube_face_lights`]). The sets hold the map's power
+/// exactly; with the sources out, the texel lights sample a smooth map and converge fast.
 pub fn reference_lights(
     map: &EnvMap,
     face_resolution: usize,
     rotate_degrees: f64,
+    sources: &SourceOptions,
 ) -> Result<Vec<LightSpec>, CubeLightsError> {
-    Ok(directional(
-        cube_face_lights(map, face_resolution)?,
-        rotate_degrees,
-    ))
+    let (found, residual) = compact_sources::extract(map, sources);
+    let source_lights = found.iter().map(|s| DirectionalLight {
+        direction: DVec3::from(s.direction),
+        power: s.power,
+    });
+    let mut lights: Vec<DirectionalLight> = source_lights.collect();
+    lights.extend(cube_face_lights(&residual, face_resolution)?);
+    Ok(directional(lights, rotate_degrees))
 }
 
 /// The equal-cost baseline: `count` median-cut directional lights (Debevec 2005).
@@ -143,13 +153,26 @@ mod tests {
 
     #[test]
     fn reference_and_median_cut_carry_the_whole_map() {
-        let map = procedural_env::by_name("sun_and_sky", 256).unwrap();
+        // A sky with a sun 0.5° across holding most of the power: a compact source.
+        let sun = DVec3::new(0.4, 0.6, -0.69).normalize();
+        let map = EnvMap::from_fn(1024, 512, |w| {
+            let sky = 0.5 + 0.3 * w.y.max(0.0);
+            let disc = if w.dot(sun) > 0.25f64.to_radians().cos() {
+                2e5
+            } else {
+                0.0
+            };
+            [sky + disc, sky + 0.9 * disc, sky + 0.7 * disc]
+        });
         let truth = pixel_sum_integral(&map);
         // Both partition the map's solid angle (every sub-pixel / pixel goes to exactly one
         // light), so only f64 summation order separates them from the pixel sum: 1e-9.
         for n in [4, 8] {
-            let lights = reference_lights(&map, n, 30.0).unwrap();
-            assert_eq!(lights.len(), 6 * n * n);
+            let sources = SourceOptions::default();
+            let (found, _) = compact_sources::extract(&map, &sources);
+            assert_eq!(found.len(), 1, "the procedural sun is taken out");
+            let lights = reference_lights(&map, n, 30.0, &sources).unwrap();
+            assert_eq!(lights.len(), 1 + 6 * n * n);
             let gap = relative_gap(total_power(&lights), truth);
             println!(
                 "cube reference n = {n}: {} lights, relative power gap {gap:.2e}",
@@ -174,8 +197,8 @@ mod tests {
     #[test]
     fn rotation_moves_the_reference_lights_about_up() {
         let map = procedural_env::by_name("studio", 128).unwrap();
-        let a = reference_lights(&map, 4, 0.0).unwrap();
-        let b = reference_lights(&map, 4, 90.0).unwrap();
+        let a = reference_lights(&map, 4, 0.0, &SourceOptions::default()).unwrap();
+        let b = reference_lights(&map, 4, 90.0, &SourceOptions::default()).unwrap();
         for (x, y) in a.iter().zip(&b) {
             // +90° about +Y takes azimuth φ to φ + 90°: with ω = (sinθ sinφ, cosθ, −sinθ cosφ),
             // (x, y, z) ↦ (−z, y, x).

@@ -19,8 +19,12 @@ pub struct TableAccuracy {
     pub max_abs_error: f64,
     /// RMS of the same.
     pub rms_abs_error: f64,
-    /// max |table − reference| / reference over values above 1% of the table maximum.
+    /// max |table − reference| / reference over the points whose reference exceeds
+    /// [`relative_error_floor`] (1% of the smaller of the table's maximum and its 99.9th
+    /// percentile), 0 when none does: see `rel_samples`.
     pub max_rel_error: f64,
+    /// How many points the relative error was taken over.
+    pub rel_samples: usize,
     pub samples: usize,
     /// The worst point, as (u·ξ, u·ω_o, cos Δφ, 1/λ).
     pub worst_point: [f64; 4],
@@ -37,6 +41,15 @@ pub struct TableAccuracy {
     /// `max_abs_error` and `rms_abs_error` rescaled to the 99.9th percentile.
     pub max_abs_error_p999: f64,
     pub rms_abs_error_p999: f64,
+}
+
+/// The reference value below which a point's relative error is not taken: 1% of the table's
+/// scale, the smaller of its maximum and its 99.9th percentile. A corner singularity (I_G: a
+/// maximum of 81.8 against a 99.9th percentile of 2.7) would otherwise put every sampled point
+/// below 1% of the maximum, leaving a relative error of 0 that measured nothing.
+pub fn relative_error_floor(table: &Table) -> f64 {
+    let max = table.stats().max.abs().max(table.stats().min.abs()) as f64;
+    0.01 * max.min(percentile_999(table.values()))
 }
 
 /// The 99.9th percentile of |v| over a table's values.
@@ -116,6 +129,7 @@ where
     F: Fn(&FiberAngles) -> Rgb + Sync,
 {
     let table_max = table.stats().max as f64;
+    let floor = relative_error_floor(table);
     let rows: Vec<Result<CheckedPoint, TableError>> = points
         .par_iter()
         .map(|p| {
@@ -134,7 +148,7 @@ where
             for c in 0..3 {
                 let e = (looked[c] as f64 - reference[c]).abs();
                 abs = abs.max(e);
-                if reference[c] > 0.01 * table_max {
+                if reference[c] > floor {
                     rel = Some(rel.unwrap_or(0.0).max(e / reference[c]));
                 }
             }
@@ -169,6 +183,7 @@ pub fn summarize(
 ) -> TableAccuracy {
     let scale = if table_max > 0.0 { table_max } else { 1.0 };
     let (mut max_abs, mut sum_sq, mut max_rel) = (0.0f64, 0.0, 0.0f64);
+    let rel_samples = rows.iter().filter(|r| r.2.is_some()).count();
     let (mut inner_max, mut inner_sq, mut inner_n) = (0.0f64, 0.0, 0usize);
     let mut worst = [0.0; 4];
     for (p, abs, rel) in rows {
@@ -190,6 +205,7 @@ pub fn summarize(
         max_abs_error: max_abs / scale,
         rms_abs_error: (sum_sq / rows.len().max(1) as f64).sqrt() / scale,
         max_rel_error: max_rel,
+        rel_samples,
         samples: rows.len(),
         worst_point: worst,
         off_axis_max_abs_error: inner_max / scale,

@@ -6,8 +6,10 @@
 use crate::env_frame::{EnvFrame, FrameRole, RenderedEnv, fit_summary, forward_settings};
 use crate::environment::load_env;
 use crate::equal_time::{EqualTimeSearch, equal_error_lights, equal_time_lights};
+use crate::error_metric::ErrorMetric;
 use crate::fit_cache::fit_cached;
 use crate::hair_input::{load_hair, parse_size};
+use crate::hdr_flip::{HdrFlip, error_map_magma, hdr_flip};
 use crate::image_metrics::{Image, error_legend, relative_rmse, write_side_by_side};
 use crate::look::{EnvLook, LookArgs};
 use crate::reference_cache::{ReferenceCache, ReferenceRecord};
@@ -53,9 +55,17 @@ pub struct CompareArgs {
     #[cfg_attr(any(feature = "cli", test), arg(long))]
     pub json: bool,
     /// Lights of the brute-force reference, 6n² for n×n texels per cube face (6144 = the
-    /// paper's 32×32×6; 1536, 384, 96 for quick runs).
+    /// paper's 32×32×6; 1536, 384, 96 for quick runs). Default: converged, the first N of 96,
+    /// 384, 1536, … whose image and that of 4N lights differ by at most
+    /// --reference-tolerance; the 4N image is the reference.
+    #[cfg_attr(any(feature = "cli", test), arg(long))]
+    pub reference_lights: Option<usize>,
+    /// Relative RMSE between the N- and 4N-light references that counts as converged.
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0.01))]
+    pub reference_tolerance: f64,
+    /// Most lights a converged reference may use (6n²); reached unconverged, the report says so.
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 6144))]
-    pub reference_lights: usize,
+    pub reference_max_lights: usize,
     #[cfg_attr(
         any(feature = "cli", test),
         arg(long, value_enum, default_value = "marschner")
@@ -100,10 +110,23 @@ pub struct CompareArgs {
     /// --reference-lights baseline lights.
     #[cfg_attr(any(feature = "cli", test), arg(long))]
     pub equal_error: bool,
+    /// The error --equal-error matches: relative RMSE, or HDR-FLIP over the hair.
+    #[cfg_attr(
+        any(feature = "cli", test),
+        arg(long, value_enum, default_value = "relative-rmse")
+    )]
+    pub equal_error_metric: ErrorMetric,
     /// Diagnostic: every single-scattering transmittance 1 in all three renders, so the error
     /// left is the lighting (fit, median cut) and table error without the shadowing error.
     #[cfg_attr(any(feature = "cli", test), arg(long))]
     pub unshadowed: bool,
+    /// Split every SRBF lobe into a centre and this many ring sub-lobes (0: off), each an SRBF
+    /// light with its own shadow map (precompute/src/srbf_split.rs).
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0))]
+    pub split_lobes: usize,
+    /// Bandwidth of the sub-lobes relative to their lobe's, with --split-lobes.
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 3.0))]
+    pub split_ratio: f64,
     /// The look of all three renders.
     #[cfg_attr(any(feature = "cli", test), command(flatten))]
     pub look: LookArgs,
@@ -118,8 +141,10 @@ pub struct CompareScene {
     pub size: (u32, u32),
     pub tables: SceneTables,
     pub srbf: Vec<EnvLight>,
-    pub reference: Vec<EnvLight>,
-    /// The map (rotated into place by `--rotate`) for the median-cut baseline.
+    /// The compact sources the reference takes out as exact directional lights (the fit's).
+    pub reference_sources: strandlight_precompute::compact_sources::SourceOptions,
+    /// The map (unrotated: every light set turns by `--rotate`) for the reference and the
+    /// median-cut baseline.
     pub map: strandlight_precompute::EnvMap,
     pub map_sha256: String,
     pub fiber: FiberDescription,
@@ -130,7 +155,7 @@ pub struct CompareScene {
     pub compact_sources: Vec<strandlight_precompute::compact_sources::CompactSource>,
 }
 
-fn validate(args: &CompareArgs) -> anyhow::Result<usize> {
+fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
     if args.lobes == 0 {
         bail!("--lobes 0: at least one SRBF lobe is needed");
     }
@@ -143,9 +168,42 @@ fn validate(args: &CompareArgs) -> anyhow::Result<usize> {
     {
         bail!("--table-resolution {n}: use 2 to 256 nodes per direction axis");
     }
-    face_resolution_for(args.reference_lights).with_context(|| {
-        format!("--reference-lights {}: must be 6n² for a cube of n×n texels per face (e.g. 6, 24, 96, 384, 1536, 6144)", args.reference_lights)
-    })
+    if !(args.reference_tolerance > 0.0 && args.reference_tolerance < 1.0) {
+        bail!(
+            "--reference-tolerance {}: must be in (0, 1)",
+            args.reference_tolerance
+        );
+    }
+    let check = |flag: &str, count: usize| {
+        face_resolution_for(count).with_context(|| {
+            format!("{flag} {count}: must be 6n² for a cube of n×n texels per face (e.g. 6, 24, 96, 384, 1536, 6144)")
+        })
+    };
+    let most = check("--reference-max-lights", args.reference_max_lights)?;
+    if most < 2 * FIRST_CONVERGENCE_FACE {
+        bail!(
+            "--reference-max-lights {}: a converged reference compares N with 4N lights from {} up; allow at least {}",
+            args.reference_max_lights,
+            6 * FIRST_CONVERGENCE_FACE * FIRST_CONVERGENCE_FACE,
+            24 * FIRST_CONVERGENCE_FACE * FIRST_CONVERGENCE_FACE
+        );
+    }
+    match args.reference_lights {
+        Some(count) => Ok(ReferenceChoice::Fixed(check("--reference-lights", count)?)),
+        None => Ok(ReferenceChoice::Converged { most_face: most }),
+    }
+}
+
+/// The smallest cube a converged reference starts from (n = 4: 96 lights).
+const FIRST_CONVERGENCE_FACE: usize = 4;
+
+/// Which reference `compare` renders.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum ReferenceChoice {
+    /// 6n² lights for n texels per face side.
+    Fixed(usize),
+    /// N = 6n², then 4N, … up to 6·most_face² lights, until N and 4N agree.
+    Converged { most_face: usize },
 }
 
 /// Loads the hair file, fits, bakes and builds the light sets (every step timed into `steps`).
@@ -173,7 +231,7 @@ pub fn prepare_with_hair(
     hair_sha256: String,
     steps: &mut Steps,
 ) -> anyhow::Result<CompareScene> {
-    let face_resolution = validate(args)?;
+    validate(args)?;
     let (width, height) = parse_size(&args.size)?;
     let fiber = FiberDescription::preset(&args.preset)
         .with_context(|| format!("--preset {:?}", args.preset))?;
@@ -205,12 +263,32 @@ pub fn prepare_with_hair(
             )
         },
     )?;
-    let lambda_range = lambda_range_of_set(&fit.set)?;
+    if args.split_lobes != 0 && !(3..=12).contains(&args.split_lobes) {
+        bail!(
+            "--split-lobes {}: use 0 (off) or a ring of 3 to 12",
+            args.split_lobes
+        );
+    }
+    if !(args.split_ratio >= 1.0 && args.split_ratio <= 16.0) {
+        bail!("--split-ratio {}: use 1 to 16", args.split_ratio);
+    }
+    let (set, split_error) =
+        strandlight_precompute::srbf_split::split_set(&fit.set, args.split_lobes, args.split_ratio);
+    if args.split_lobes > 0 {
+        steps.say(format!(
+            "split {} lobes into {} (ring {}, bandwidth × {}): worst relative L2 error of a split {split_error:.4}",
+            fit.set.lobes.len(),
+            set.lobes.len(),
+            args.split_lobes,
+            args.split_ratio
+        ));
+    }
+    let lambda_range = lambda_range_of_set(&set)?;
     let resolution = args
         .table_resolution
         .map(BakeResolution::reduced)
         .unwrap_or_default();
-    let wanted = wanted_tables(args.shading, &args.modes, !fit.set.lobes.is_empty(), true);
+    let wanted = wanted_tables(args.shading, &args.modes, !set.lobes.is_empty(), true);
     let table_dir = args
         .cache
         .join("tables")
@@ -241,22 +319,7 @@ pub fn prepare_with_hair(
     )?;
     let up = UpAxis::detect(&hair);
     let camera = Camera::framing_front(hair.bounds(), width as f32 / height as f32, false, up);
-    let srbf = to_env_lights(&srbf_set_lights(&fit.set), up);
-    let reference = steps.run(
-        "reference set",
-        || {
-            Ok(to_env_lights(
-                &reference_lights(&env.map, face_resolution, args.rotate)?,
-                up,
-            ))
-        },
-        |r: &Vec<EnvLight>| {
-            format!(
-                "{} cube-texel directional lights ({face_resolution}×{face_resolution}×6)",
-                r.len()
-            )
-        },
-    )?;
+    let srbf = to_env_lights(&srbf_set_lights(&set), up);
     let fit_relative_l2_error = fit.set.relative_l2_error;
     Ok(CompareScene {
         hair,
@@ -266,7 +329,7 @@ pub fn prepare_with_hair(
         size: (width, height),
         tables,
         srbf,
-        reference,
+        reference_sources: sources,
         map: env.map,
         map_sha256: env.sha256,
         fiber,
@@ -279,7 +342,11 @@ pub fn prepare_with_hair(
 pub type Renderer<'r> = &'r dyn Fn(&EnvFrame) -> anyhow::Result<RenderedEnv>;
 
 /// Renders `runs` times and keeps the last image with the median time.
-fn timed_render(render: Renderer, frame: &EnvFrame, runs: usize) -> anyhow::Result<RenderedEnv> {
+pub fn timed_render(
+    render: Renderer,
+    frame: &EnvFrame,
+    runs: usize,
+) -> anyhow::Result<RenderedEnv> {
     let mut times = Vec::with_capacity(runs);
     let mut last = None;
     for _ in 0..runs {
@@ -293,10 +360,40 @@ fn timed_render(render: Renderer, frame: &EnvFrame, runs: usize) -> anyhow::Resu
     Ok(r)
 }
 
+impl CompareScene {
+    /// The reference's lights for n×n texels per cube face: the compact sources exactly, the
+    /// rest of the map one light per texel at its radiance centroid.
+    pub fn reference_set(&self, face: usize, rotate: f64) -> anyhow::Result<Vec<EnvLight>> {
+        Ok(to_env_lights(
+            &reference_lights(&self.map, face, rotate, &self.reference_sources)?,
+            self.up,
+        ))
+    }
+}
+
+/// One reference image, rendered or from the cache.
+pub struct ReferenceImage {
+    pub image: Image,
+    pub record: ReferenceRecord,
+    pub cached: bool,
+}
+
+/// The reference a mode is measured against, and how it was reached.
+pub struct Reference {
+    pub chosen: ReferenceImage,
+    /// Per rung of a converged reference: N lights, their ms, and the relative RMSE of the
+    /// N-light image against the 4N-light one.
+    pub ladder: Vec<(usize, f64, f64)>,
+    /// Converged references: whether the last rung met the tolerance.
+    pub converged: Option<bool>,
+}
+
 /// One mode's results.
 struct ModeResult {
     srbf: RenderedEnv,
-    reference: (Image, ReferenceRecord, bool),
+    srbf_flip: HdrFlip,
+    baseline_flip: HdrFlip,
+    reference: Reference,
     baseline: RenderedEnv,
     baseline_lights: usize,
     baseline_search: Vec<(usize, f64)>,
@@ -321,7 +418,7 @@ impl EqualErrorResult {
 }
 
 /// The median-cut baseline with `lights` directional lights.
-fn render_baseline(
+pub fn render_baseline(
     render: Renderer,
     scene: &CompareScene,
     args: &CompareArgs,
@@ -341,24 +438,20 @@ fn equal_error_baseline(
     scene: &CompareScene,
     args: &CompareArgs,
     mode: ScatteringMode,
-    reference: &Image,
+    reference: &ReferenceImage,
     target_error: f64,
     start: usize,
 ) -> anyhow::Result<EqualErrorResult> {
     let mut renders = Vec::new();
-    let found = equal_error_lights(
-        target_error,
-        start,
-        scene.reference.len().max(16),
-        0.1,
-        10,
-        |n| {
-            let r = render_baseline(render, scene, args, mode, n)?;
-            let error = relative_rmse(&r.image, reference)?;
-            renders.push((n, r.milliseconds, error));
-            Ok::<f64, anyhow::Error>(error)
-        },
-    )?;
+    let most = reference.record.lights.max(16);
+    let found = equal_error_lights(target_error, start, most, 0.1, 10, |n| {
+        let r = render_baseline(render, scene, args, mode, n)?;
+        let error = args
+            .equal_error_metric
+            .measure(&r.image, &reference.image)?;
+        renders.push((n, r.milliseconds, error));
+        Ok::<f64, anyhow::Error>(error)
+    })?;
     Ok(EqualErrorResult {
         lights: found.lights,
         at_bound: found.at_bound,
@@ -366,7 +459,7 @@ fn equal_error_baseline(
     })
 }
 
-fn frame<'a>(
+pub fn frame<'a>(
     scene: &'a CompareScene,
     args: &CompareArgs,
     lights: &'a [EnvLight],
@@ -397,11 +490,12 @@ fn look(args: &CompareArgs) -> EnvLook {
 fn reference_frame<'a>(
     scene: &'a CompareScene,
     args: &CompareArgs,
+    lights: &'a [EnvLight],
     mode: ScatteringMode,
 ) -> EnvFrame<'a> {
     EnvFrame {
         role: FrameRole::Reference,
-        ..frame(scene, args, &scene.reference, mode)
+        ..frame(scene, args, lights, mode)
     }
 }
 
@@ -413,6 +507,7 @@ const REFERENCE_MULTIPLE_TABLES: [&str; 3] = ["multiple", "fiber_averages", "att
 fn reference_inputs(
     scene: &CompareScene,
     args: &CompareArgs,
+    lights: usize,
     mode: ScatteringMode,
 ) -> anyhow::Result<Value> {
     let direct = scene.tables.get(args.shading.direct_table(mode))?;
@@ -422,7 +517,9 @@ fn reference_inputs(
         "size": [scene.size.0, scene.size.1],
         "map_sha256": scene.map_sha256,
         "rotate": args.rotate,
-        "reference_lights": scene.reference.len(),
+        "reference_lights": lights,
+        "reference_placement": "compact sources exact, texel lights at radiance centroids",
+        "reference_sources": scene.reference_sources,
         "mode": mode.name(),
         "shading": args.shading,
         "fiber": scene.fiber,
@@ -458,34 +555,10 @@ fn run_mode(
             )
         },
     )?;
-    let cache = ReferenceCache::new(args.cache.join("reference"));
-    let inputs = reference_inputs(scene, args, mode)?;
-    let reference = steps.run(
-        &format!("{m}: reference"),
-        || match cache.load(&inputs) {
-            Some((image, record)) => Ok((image, record, true)),
-            None => {
-                let r = render(&reference_frame(scene, args, mode))?;
-                let record = ReferenceRecord {
-                    inputs: inputs.clone(),
-                    lights: scene.reference.len(),
-                    milliseconds: r.milliseconds,
-                };
-                cache.store(&r.image, &record)?;
-                Ok((r.image, record, false))
-            }
-        },
-        |(_, rec, cached): &(Image, ReferenceRecord, bool)| {
-            format!(
-                "{:.1} ms/frame, {} lights{}",
-                rec.milliseconds,
-                rec.lights,
-                if *cached { " (cached)" } else { "" }
-            )
-        },
-    )?;
+    let reference = reference(render, scene, args, mode, steps)?;
+    let reference_lights = reference.chosen.record.lights;
     let search = EqualTimeSearch {
-        max_lights: scene.reference.len().max(16),
+        max_lights: reference_lights.max(16),
         ..EqualTimeSearch::new(srbf.milliseconds)
     };
     // Every image the search renders is kept, so the chosen count need not be rendered again.
@@ -520,26 +593,132 @@ fn run_mode(
         None => render_baseline(render, scene, args, mode, found.lights)?,
     };
     let equal_error = if args.equal_error {
-        let target = relative_rmse(&srbf.image, &reference.0)?;
+        let metric = args.equal_error_metric;
+        let target = metric.measure(&srbf.image, &reference.chosen.image)?;
         Some(steps.run(
             &format!("{m}: equal-error baseline"),
-            || equal_error_baseline(render, scene, args, mode, &reference.0, target, found.lights),
+            || {
+                equal_error_baseline(
+                    render,
+                    scene,
+                    args,
+                    mode,
+                    &reference.chosen,
+                    target,
+                    found.lights,
+                )
+            },
             |e: &EqualErrorResult| {
                 let (n, ms, err) = e.chosen();
-                format!("{n} median-cut lights reach rel. RMSE {err:.4} ≤ {target:.4} at {ms:.2} ms/frame ({} renders{})", e.renders.len(), if e.at_bound { ", NOT reached at the search bound" } else { "" })
+                format!("{n} median-cut lights reach {} {err:.4} ≤ {target:.4} at {ms:.2} ms/frame ({} renders{})", metric.name(), e.renders.len(), if e.at_bound { ", NOT reached at the search bound" } else { "" })
             },
         )?)
     } else {
         None
     };
+    let srbf_flip = hdr_flip(&srbf.image, &reference.chosen.image)?;
+    let baseline_flip = hdr_flip(&baseline.image, &reference.chosen.image)?;
     Ok(ModeResult {
         srbf,
+        srbf_flip,
+        baseline_flip,
         reference,
         baseline,
         baseline_lights: found.lights,
         baseline_search: found.measurements,
         equal_error,
     })
+}
+
+/// The reference of `mode` with 6·face² lights, from the cache or rendered (and cached).
+fn reference_with_face(
+    render: Renderer,
+    scene: &CompareScene,
+    args: &CompareArgs,
+    mode: ScatteringMode,
+    face: usize,
+    steps: &mut Steps,
+) -> anyhow::Result<ReferenceImage> {
+    let lights = scene.reference_set(face, args.rotate)?;
+    let cache = ReferenceCache::new(args.cache.join("reference"));
+    let inputs = reference_inputs(scene, args, lights.len(), mode)?;
+    steps.run(
+        &format!("{}: reference, {} lights", mode.name(), lights.len()),
+        || match cache.load(&inputs) {
+            Some((image, record)) => Ok(ReferenceImage {
+                image,
+                record,
+                cached: true,
+            }),
+            None => {
+                let r = render(&reference_frame(scene, args, &lights, mode))?;
+                let record = ReferenceRecord {
+                    inputs: inputs.clone(),
+                    lights: lights.len(),
+                    milliseconds: r.milliseconds,
+                };
+                cache.store(&r.image, &record)?;
+                Ok(ReferenceImage {
+                    image: r.image,
+                    record,
+                    cached: false,
+                })
+            }
+        },
+        |r: &ReferenceImage| {
+            format!(
+                "{:.1} ms/frame{}",
+                r.record.milliseconds,
+                if r.cached { " (cached)" } else { "" }
+            )
+        },
+    )
+}
+
+/// The reference of `mode`: the fixed light count asked for, or the converged one (N and 4N
+/// lights within the tolerance, the 4N image kept).
+pub fn reference(
+    render: Renderer,
+    scene: &CompareScene,
+    args: &CompareArgs,
+    mode: ScatteringMode,
+    steps: &mut Steps,
+) -> anyhow::Result<Reference> {
+    let most_face = match validate(args)? {
+        ReferenceChoice::Fixed(face) => {
+            return Ok(Reference {
+                chosen: reference_with_face(render, scene, args, mode, face, steps)?,
+                ladder: Vec::new(),
+                converged: None,
+            });
+        }
+        ReferenceChoice::Converged { most_face } => most_face,
+    };
+    let mut face = FIRST_CONVERGENCE_FACE;
+    let mut coarse = reference_with_face(render, scene, args, mode, face, steps)?;
+    let mut ladder = Vec::new();
+    loop {
+        let fine = reference_with_face(render, scene, args, mode, 2 * face, steps)?;
+        let difference = relative_rmse(&coarse.image, &fine.image)?;
+        ladder.push((coarse.record.lights, coarse.record.milliseconds, difference));
+        steps.say(format!(
+            "{}: reference with {} lights against {}: relative RMSE {difference:.4} (tolerance {})",
+            mode.name(),
+            coarse.record.lights,
+            fine.record.lights,
+            args.reference_tolerance
+        ));
+        let converged = difference <= args.reference_tolerance;
+        if converged || 4 * face > most_face {
+            return Ok(Reference {
+                chosen: fine,
+                ladder,
+                converged: Some(converged),
+            });
+        }
+        face *= 2;
+        coarse = fine;
+    }
 }
 
 fn write_mode_images(
@@ -553,7 +732,7 @@ fn write_mode_images(
     let mut written = Vec::new();
     for (name, image) in [
         ("srbf", &r.srbf.image),
-        ("reference", &r.reference.0),
+        ("reference", &r.reference.chosen.image),
         ("baseline", &r.baseline.image),
     ] {
         let stem = args.out.join(format!("{}-{name}", mode.name()));
@@ -573,11 +752,26 @@ fn write_mode_images(
         )?;
         written.push(stem.with_extension("png"));
     }
+    for (name, flip) in [("srbf", &r.srbf_flip), ("baseline", &r.baseline_flip)] {
+        let path = args.out.join(format!("{}-{name}-flip.png", mode.name()));
+        let (w, h) = (
+            r.reference.chosen.image.width,
+            r.reference.chosen.image.height,
+        );
+        strandlight_runtime::image_out::write_png_rgb8(
+            &path,
+            w,
+            h,
+            &error_map_magma(flip, w, h),
+            &format!("HDR-FLIP error map (magma, 0 → 1) of the {name} frame: {description}"),
+        )?;
+        written.push(path);
+    }
     let side = args.out.join(format!("{}-compare.png", mode.name()));
     write_side_by_side(
         &side,
         &r.srbf.image,
-        &r.reference.0,
+        &r.reference.chosen.image,
         &r.baseline.image,
         description,
     )?;
@@ -611,26 +805,34 @@ pub fn execute(
     }
     for &mode in &args.modes {
         let r = run_mode(render, scene, args, mode, steps)?;
-        let srbf_error = relative_rmse(&r.srbf.image, &r.reference.0)?;
-        let baseline_error = relative_rmse(&r.baseline.image, &r.reference.0)?;
+        let reference = &r.reference.chosen;
+        let srbf_error = relative_rmse(&r.srbf.image, &reference.image)?;
+        let baseline_error = relative_rmse(&r.baseline.image, &reference.image)?;
         let written = write_mode_images(args, mode, &r, &description)?;
-        let reference_ms = r.reference.1.milliseconds;
+        let reference_ms = reference.record.milliseconds;
+        let ladder: Vec<Value> = r
+            .reference
+            .ladder
+            .iter()
+            .map(|&(lights, ms, d)| json!({"lights": lights, "ms": ms, "relative_rmse_vs_4x": d}))
+            .collect();
         let mut entry = json!({
-                "srbf": { "lights": scene.srbf.len(), "ms": r.srbf.milliseconds, "relative_rmse": srbf_error },
-                "baseline": { "lights": r.baseline_lights, "ms": r.baseline.milliseconds, "relative_rmse": baseline_error, "search": r.baseline_search },
-                "reference": { "lights": r.reference.1.lights, "ms": reference_ms, "cached": r.reference.2 },
+                "srbf": { "lights": scene.srbf.len(), "ms": r.srbf.milliseconds, "relative_rmse": srbf_error, "hdr_flip": r.srbf_flip.mean_over_hair },
+                "baseline": { "lights": r.baseline_lights, "ms": r.baseline.milliseconds, "relative_rmse": baseline_error, "hdr_flip": r.baseline_flip.mean_over_hair, "search": r.baseline_search },
+                "hdr_flip_exposures": { "start": r.srbf_flip.start_exposure, "stop": r.srbf_flip.stop_exposure, "count": r.srbf_flip.exposures },
+                "reference": { "lights": reference.record.lights, "ms": reference_ms, "cached": reference.cached, "converged": r.reference.converged, "convergence": ladder },
                 "speedup_vs_reference": reference_ms / r.srbf.milliseconds,
                 "images": written,
         });
         if let Some(e) = &r.equal_error {
             let (lights, ms, error) = e.chosen();
-            entry["baseline_equal_error"] = json!({ "lights": lights, "ms": ms, "relative_rmse": error, "at_bound": e.at_bound, "renders": e.renders });
+            entry["baseline_equal_error"] = json!({ "lights": lights, "ms": ms, "metric": args.equal_error_metric, "error": error, "at_bound": e.at_bound, "renders": e.renders });
             entry["speedup_at_equal_error"] = json!(ms / r.srbf.milliseconds);
         }
         report.insert(mode.name().into(), entry);
         steps.say(format!(
-            "{:<6} SRBF {:>8.2} ms rel. RMSE {:.4} | baseline {} lights {:>8.2} ms rel. RMSE {:.4} | reference {} lights {:>10.1} ms | speed-up vs reference {:.0}×",
-            mode.name(), r.srbf.milliseconds, srbf_error, r.baseline_lights, r.baseline.milliseconds, baseline_error, r.reference.1.lights, reference_ms, reference_ms / r.srbf.milliseconds
+            "{:<6} SRBF {:>8.2} ms rel. RMSE {:.4} HDR-FLIP {:.4} | baseline {} lights {:>8.2} ms rel. RMSE {:.4} HDR-FLIP {:.4} | reference {} lights {:>10.1} ms | speed-up vs reference {:.0}×",
+            mode.name(), r.srbf.milliseconds, srbf_error, r.srbf_flip.mean_over_hair, r.baseline_lights, r.baseline.milliseconds, baseline_error, r.baseline_flip.mean_over_hair, reference.record.lights, reference_ms, reference_ms / r.srbf.milliseconds
         ));
     }
     steps.say(error_legend());
@@ -639,6 +841,7 @@ pub fn execute(
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
             "preset": args.preset, "kappa": args.kappa, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "split_lobes": args.split_lobes, "split_ratio": args.split_ratio,
             "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,
             "compact_sources": scene.compact_sources,
@@ -677,9 +880,21 @@ mod tests {
         let a = args(&["--hair", "h.hair", "--env", "procedural:studio"]).unwrap();
         assert_eq!(
             (a.lobes, a.size.as_str(), a.reference_lights, a.shading),
-            (64, "640x480", 6144, EnvShading::Marschner)
+            (64, "640x480", None, EnvShading::Marschner)
         );
-        assert_eq!(validate(&a).unwrap(), 32);
+        assert_eq!(
+            validate(&a).unwrap(),
+            ReferenceChoice::Converged { most_face: 32 }
+        );
+        for (flag, value, wanted) in [
+            ("--reference-max-lights", "100", "6n²"),
+            ("--reference-max-lights", "96", "allow at least 384"),
+            ("--reference-tolerance", "0", "(0, 1)"),
+        ] {
+            let a = args(&["--hair", "h", "--env", "e", flag, value]).unwrap();
+            let e = validate(&a).unwrap_err().to_string();
+            assert!(e.contains(flag) && e.contains(wanted), "{e}");
+        }
         assert!(args(&["--env", "x.hdr"]).is_err(), "--hair is required");
         let a = args(&["--hair", "h", "--env", "e", "--reference-lights", "100"]).unwrap();
         let e = validate(&a).unwrap_err().to_string();
@@ -703,7 +918,7 @@ mod tests {
         .unwrap();
         assert_eq!(
             (a.shading, validate(&a).unwrap(), a.json),
-            (EnvShading::Artist, 4, true)
+            (EnvShading::Artist, ReferenceChoice::Fixed(4), true)
         );
         assert!(args(&["--hair", "h", "--env", "e", "--shading", "kajiya-kay"]).is_err());
     }
@@ -752,6 +967,92 @@ mod tests {
             fragments: None,
             memory_per_batch: Vec::new(),
         })
+    }
+
+    /// [`power_renderer`] whose reference frames carry a discretization error of 1/N for N
+    /// lights: the N- and 4N-light references differ by (3/4N)/(1 + 1/4N).
+    fn converging_renderer(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
+        let mut r = power_renderer(frame)?;
+        if frame.role == FrameRole::Reference {
+            let scale = 1.0 + 1.0 / frame.lights.len() as f32;
+            for p in &mut r.image.pixels {
+                for c in &mut p[..3] {
+                    *c *= scale;
+                }
+            }
+        }
+        Ok(r)
+    }
+
+    /// The converged reference climbs 96 → 384 → 1536 → 6144 lights until N and 4N agree
+    /// within the tolerance, keeps the 4N image and says when the bound came first.
+    #[test]
+    fn a_converged_reference_stops_at_the_first_n_that_agrees_with_4n() {
+        let dir = std::env::temp_dir().join(format!(
+            "strandlight-compare-converged-{}",
+            std::process::id()
+        ));
+        let _ = std::fs::remove_dir_all(&dir);
+        let groom =
+            strandlight_runtime::hair::generate_groom(&strandlight_runtime::hair::GroomParams {
+                strand_count: 40,
+                clump_count: 8,
+                ..Default::default()
+            })
+            .unwrap();
+        let expected = |n: f64| (0.75 / n) / (1.0 + 0.25 / n);
+        for (tolerance, lights, rungs, converged) in [
+            ("0.01", 384, 1, true),
+            ("0.001", 6144, 3, true),
+            ("0.0001", 6144, 3, false),
+        ] {
+            let (out, cache) = (
+                dir.join("out").display().to_string(),
+                dir.join("cache").display().to_string(),
+            );
+            let a = args(&[
+                "--hair",
+                "groom",
+                "--env",
+                "procedural:studio",
+                "--lobes",
+                "8",
+                "--size",
+                "16x12",
+                "--reference-tolerance",
+                tolerance,
+                "--table-resolution",
+                "4",
+                "--timing-runs",
+                "1",
+                "--modes",
+                "single",
+                "--out",
+                &out,
+                "--cache",
+                &cache,
+            ])
+            .unwrap();
+            let mut steps = Steps::new(true);
+            let scene = prepare_with_hair(&a, groom.clone(), "groom".into(), &mut steps).unwrap();
+            let report = execute(&a, &scene, &mut steps, &converging_renderer).unwrap();
+            let r = &report["single"]["reference"];
+            assert_eq!(r["lights"], lights, "tolerance {tolerance}: {r}");
+            assert_eq!(r["converged"], converged, "tolerance {tolerance}: {r}");
+            let ladder = r["convergence"].as_array().unwrap();
+            assert_eq!(ladder.len(), rungs, "tolerance {tolerance}: {r}");
+            for (k, rung) in ladder.iter().enumerate() {
+                let n = 96.0 * 4f64.powi(k as i32);
+                assert_eq!(rung["lights"].as_f64().unwrap(), n);
+                let d = rung["relative_rmse_vs_4x"].as_f64().unwrap();
+                assert!(
+                    (d - expected(n)).abs() < 1e-5,
+                    "{n}: {d} vs {}",
+                    expected(n)
+                );
+            }
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -6,7 +6,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, bail};
 use serde_json::Value;
 
-const HEADER: &str = "| map | fit L2 err (map without its sources) | mode | SRBF lights (+ compact sources) | SRBF ms | SRBF rel. RMSE | baseline lights | baseline ms | baseline rel. RMSE | reference lights | reference ms | speed-up vs reference | equal-error baseline lights | speed-up at equal error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
+const HEADER: &str = "| map | fit L2 err (map without its sources) | mode | SRBF lights (+ compact sources) | SRBF ms | SRBF rel. RMSE | SRBF HDR-FLIP | baseline lights | baseline ms | baseline rel. RMSE | baseline HDR-FLIP | reference lights | reference ms | speed-up vs reference | equal-error baseline lights | speed-up at equal error |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
+
+/// An optional figure (reports older than HDR-FLIP lack it): four decimals or "–".
+fn optional(v: &Value) -> String {
+    v.as_f64().map_or("–".to_string(), |x| format!("{x:.4}"))
+}
 
 fn number(v: &Value, path: &[&str], file: &Path) -> anyhow::Result<f64> {
     let mut at = v;
@@ -74,12 +79,14 @@ pub fn rows(report: &Value, file: &Path) -> anyhow::Result<Vec<String>> {
             },
         };
         out.push(format!(
-            "| {name} | {fit_error} | {mode} | {srbf_lights} | {:.0} | {:.4} | {:.0} | {:.0} | {:.4} | {:.0} | {:.0} | {:.1}× | {equal_lights} | {equal_speedup} |",
+            "| {name} | {fit_error} | {mode} | {srbf_lights} | {:.0} | {:.4} | {} | {:.0} | {:.0} | {:.4} | {} | {:.0} | {:.0} | {:.1}× | {equal_lights} | {equal_speedup} |",
             n(&["srbf", "ms"])?,
             n(&["srbf", "relative_rmse"])?,
+            optional(&m["srbf"]["hdr_flip"]),
             n(&["baseline", "lights"])?,
             n(&["baseline", "ms"])?,
             n(&["baseline", "relative_rmse"])?,
+            optional(&m["baseline"]["hdr_flip"]),
             n(&["reference", "lights"])?,
             n(&["reference", "ms"])?,
             n(&["speedup_vs_reference"])?,
@@ -123,7 +130,16 @@ mod tests {
         let report = json!({"single": mode(0.04), "full": mode(0.07), "scene": {"env": "maps/quarry_01_1k.hdr", "fit_relative_l2_error": 0.5}});
         let r = rows(&report, Path::new("x.json")).unwrap();
         assert_eq!(r.len(), 2);
-        assert!(r[0].starts_with("| quarry_01_1k | 0.500 | single | 30 | 100 | 0.0400 | 12 | 101 | 0.5000 | 6144 | 20000 | 200.0× | – | – |"), "{}", r[0]);
+        assert!(r[0].starts_with("| quarry_01_1k | 0.500 | single | 30 | 100 | 0.0400 | – | 12 | 101 | 0.5000 | – | 6144 | 20000 | 200.0× | – | – |"), "{}", r[0]);
+        let mut with_flip = report.clone();
+        with_flip["single"]["srbf"]["hdr_flip"] = json!(0.19);
+        with_flip["single"]["baseline"]["hdr_flip"] = json!(0.48);
+        let r = rows(&with_flip, Path::new("x.json")).unwrap();
+        assert!(
+            r[0].contains("| 0.0400 | 0.1900 | 12 | 101 | 0.5000 | 0.4800 |"),
+            "{}",
+            r[0]
+        );
         assert!(r[1].contains("| full |") && r[1].contains("0.0700"));
 
         let mut with_equal = report.clone();

@@ -60,6 +60,10 @@ pub enum CompareError {
     NoHair,
     #[error("the reference is black over the hair (Σ|r|² = 0): relative error undefined")]
     BlackReference,
+    #[error(
+        "half the reference's hair pixels or more are black: HDR-FLIP's exposure range (up to the median luminance) is undefined"
+    )]
+    DarkMedian,
     #[error("{}: {source}", .path.display())]
     Write {
         path: PathBuf,

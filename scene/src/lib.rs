@@ -6,6 +6,9 @@
 //!
 //! Dependencies point one way: `tables` ← `precompute`, `runtime` ← this crate ← the CLI.
 
+pub mod bench;
+pub mod bench_plots;
+pub mod bench_report;
 pub mod camera_choice;
 pub mod compare;
 pub mod compare_table;
@@ -13,10 +16,12 @@ pub mod env_frame;
 pub mod env_scene;
 pub mod environment;
 pub mod equal_time;
+pub mod error_metric;
 pub mod fit_cache;
 pub mod frame_render;
 pub mod frame_settings;
 pub mod hair_input;
+pub mod hdr_flip;
 pub mod image_metrics;
 pub mod look;
 pub mod point_shading;

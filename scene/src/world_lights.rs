@@ -97,7 +97,7 @@ mod tests {
     #[test]
     fn conversion_keeps_power_and_kind() {
         let map = procedural_env::by_name("studio", 256).unwrap();
-        let reference = reference_lights(&map, 4, 0.0).unwrap();
+        let reference = reference_lights(&map, 4, 0.0, &Default::default()).unwrap();
         let baseline = median_cut_lights(&map, 32, 0.0);
         for (specs, name) in [(&reference, "reference"), (&baseline, "median cut")] {
             let lights = to_env_lights(specs, UpAxis::Z);

@@ -5,8 +5,9 @@ use strandlight_precompute::bake::bake_job;
 use strandlight_precompute::bake_plan::{
     BakeResolution, FiberDescription, Model, PlanOptions, plan,
 };
-use strandlight_precompute::baked_tables_check::check_asset;
-use strandlight_tables::asset::{Storage, read_asset};
+use strandlight_precompute::baked_tables_check::{check_asset, check_asset_at_nodes};
+use strandlight_tables::asset::{Storage, TableAsset, read_asset};
+use strandlight_tables::table::Table;
 
 fn temp_dir(tag: &str) -> std::path::PathBuf {
     let d = std::env::temp_dir().join(format!("strandlight-e2e-{tag}-{}", std::process::id()));
@@ -102,4 +103,61 @@ fn dark_hair_skips_the_multiple_scattering_table_and_says_why() {
         .expect("dark hair skips I_G");
     println!("{}", skipped.reason);
     assert!(skipped.reason.contains("threshold"));
+}
+
+/// The multiple-scattering table's relative error is measured over real points and can fail:
+/// its maximum is a corner singularity (u·ξ = −u·ω_o = ±1, σ̄_f → 0) far above the rest, so
+/// relative errors are taken above 1% of the 99.9th percentile rather than of the maximum, which
+/// no sampled point reached (the check used to report 0). At the table's nodes, where
+/// interpolation adds nothing, the bake's product integration and the reference's 2D quadrature
+/// agree within a few percent (3.4% measured at 8 nodes, where narrow σ̄_f nodes are hardest),
+/// and a copy scaled by 1.05 shows 5% at the nodes both integrate alike.
+#[test]
+fn the_multiple_scattering_table_relative_error_can_fail() {
+    let dir = temp_dir("multiple-rel");
+    let options = PlanOptions {
+        models: vec![Model::Marschner],
+        resolution: BakeResolution::reduced(8),
+        force_multiple: true,
+        ..Default::default()
+    };
+    let fiber = FiberDescription::preset("brown").unwrap();
+    let job = plan(&fiber, &options)
+        .unwrap()
+        .jobs
+        .into_iter()
+        .find(|j| j.name == "multiple")
+        .expect("a multiple-scattering job");
+    let baked = bake_job(job, &dir, Storage::F32).unwrap();
+    let asset = read_asset(&baked.path).unwrap();
+    let scaled = TableAsset {
+        table: Table::new(
+            asset.table.axes().to_vec(),
+            asset.table.channels(),
+            asset.table.values().iter().map(|v| v * 1.05).collect(),
+        )
+        .unwrap(),
+        ..asset.clone()
+    };
+    let random = check_asset(&asset, 200, 5).unwrap();
+    let good = check_asset_at_nodes(&asset, 200, 5).unwrap();
+    let bad = check_asset_at_nodes(&scaled, 200, 5).unwrap();
+    println!(
+        "multiple at 8 nodes: random points max rel {:.3e} over {} of {}; at nodes {:.3e} over {}; scaled by 1.05 {:.3e}",
+        random.max_rel_error,
+        random.rel_samples,
+        random.samples,
+        good.max_rel_error,
+        good.rel_samples,
+        bad.max_rel_error
+    );
+    assert!(random.rel_samples > 0 && random.max_rel_error > 0.0);
+    assert!(good.rel_samples >= 20, "{} points", good.rel_samples);
+    assert!(good.max_rel_error < 0.06, "{}", good.max_rel_error);
+    assert!(
+        (bad.max_rel_error - 0.05).abs() < 0.01,
+        "{}",
+        bad.max_rel_error
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -147,11 +147,13 @@ fn build_scene() -> Result<Scene, String> {
     };
     let set = SrbfSet::fit(&source, &options, &mut |_| {}).expect("fit");
     let srbf_specs = srbf_set_lights(&set);
-    let reference_specs = reference_lights(&map, REFERENCE_FACE, 0.0).expect("reference lights");
+    let reference_specs =
+        reference_lights(&map, REFERENCE_FACE, 0.0, &options.sources).expect("reference lights");
     // The reference of the fitted lobes themselves: separates the fit's error from the method's.
     let fitted_map = procedural_env::from_srbf_lobes(256, &set.lobes);
     let fitted_reference_specs =
-        reference_lights(&fitted_map, REFERENCE_FACE, 0.0).expect("reference lights");
+        reference_lights(&fitted_map, REFERENCE_FACE, 0.0, &options.sources)
+            .expect("reference lights");
     eprintln!(
         "fit: {} lobes in {:.2} s (relative MSE {:.4} on the fit grid, {:.4} at full resolution); reference: {} lights",
         srbf_specs.len(),

@@ -1,0 +1,556 @@
+//! `strandlight bench`: speed against error for the environment-lit method, measured on the real
+//! data in `../shared/data` and written as the generated section of docs/BENCHMARKS.md with its
+//! plots (docs/bench/). Three sweeps:
+//! - the SRBF fit per map: relative L2 error and seconds against the lobe count;
+//! - the Marschner convolution table: error against resolution, bytes and bake seconds;
+//! - the env-lit frame per map and mode: relative RMSE and HDR-FLIP against the converged
+//!   reference, and milliseconds, for the SRBF path (lobe count, κ, light-map resolution varied
+//!   one at a time around the defaults), the median-cut baseline at several light counts and
+//!   the reference itself; with the equal-error speed-up of the SRBF default over median cut.
+//!
+//! Every render goes through [`compare`]'s scene, cache and converged reference, so `bench`
+//! and `compare` measure the same thing.
+
+use crate::compare::{self, CompareArgs, CompareScene};
+use crate::env_frame::{EnvFrame, FrameRole, render_lights};
+use crate::environment::load_env;
+use crate::fit_cache::fit_cached;
+use crate::hdr_flip::hdr_flip;
+use crate::image_metrics::{Image, relative_rmse};
+use crate::look::{BoxAverageArg, EnvTransparency, ForwardDevice, LookArgs, ViewArgs};
+use crate::scene_tables::{EnvShading, ScatteringMode};
+use crate::steps::Steps;
+use anyhow::Context;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use strandlight_precompute::FitOptions;
+use strandlight_precompute::bake::bake_job;
+use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription, Model, PlanOptions};
+use strandlight_precompute::baked_tables_check::check_asset;
+use strandlight_runtime::env::{EnvLight, ViewTransparency};
+
+/// What one run measures.
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchPlan {
+    pub name: &'static str,
+    pub maps: Vec<&'static str>,
+    pub size: (u32, u32),
+    pub modes: Vec<ScatteringMode>,
+    /// Fit sweep: most lobes.
+    pub fit_lobes: Vec<usize>,
+    /// Table sweep: nodes per direction axis of the Marschner table.
+    pub table_nodes: Vec<usize>,
+    pub table_check_points: usize,
+    /// Env-lit sweep, one parameter at a time around the defaults (first of each list).
+    pub lobes: Vec<usize>,
+    pub kappas: Vec<f32>,
+    pub dodm_sizes: Vec<u32>,
+    pub baseline_lights: Vec<usize>,
+    pub reference_max_lights: usize,
+}
+
+/// Every shared map, in the order of docs/BENCHMARKS.md's comparison table.
+const ALL_MAPS: [&str; 8] = [
+    "hdr_overcast_soil_puresky_1k.hdr",
+    "quarry_01_1k.hdr",
+    "photo_studio_01_1k.hdr",
+    "moonless_golf_1k.hdr",
+    "royal_esplanade_1k.hdr",
+    "spruit_sunrise_1k.hdr",
+    "venice_sunset_1k.hdr",
+    "piz_compressed.exr",
+];
+
+impl BenchPlan {
+    /// The whole report: every map, both modes, the sweeps.
+    pub fn full() -> Self {
+        Self {
+            name: "full",
+            maps: ALL_MAPS.to_vec(),
+            size: (320, 240),
+            modes: vec![ScatteringMode::Single, ScatteringMode::Full],
+            fit_lobes: vec![8, 16, 32, 49, 64],
+            table_nodes: vec![8, 16, 24, 32],
+            table_check_points: 500,
+            lobes: vec![64, 8, 16, 32, 49],
+            kappas: vec![0.1, 0.3, 1.0],
+            dodm_sizes: vec![512, 256, 1024],
+            baseline_lights: vec![4, 8, 16, 32, 64, 128],
+            reference_max_lights: 1536,
+        }
+    }
+
+    /// A few minutes: one smooth map and one sun map, single scattering, 160×120, a reference of
+    /// at most 384 lights.
+    pub fn quick() -> Self {
+        Self {
+            name: "quick",
+            maps: vec![ALL_MAPS[0]],
+            size: (160, 120),
+            modes: vec![ScatteringMode::Single],
+            fit_lobes: vec![8, 32, 64],
+            table_nodes: vec![8, 16],
+            table_check_points: 100,
+            lobes: vec![64, 8, 32],
+            kappas: vec![0.1, 1.0],
+            dodm_sizes: vec![512, 256],
+            baseline_lights: vec![4, 16, 64],
+            reference_max_lights: 384,
+        }
+    }
+}
+
+/// One measured frame.
+#[derive(Debug, Clone, Serialize)]
+pub struct Point {
+    /// "srbf", "median cut" or "reference".
+    pub family: &'static str,
+    /// What was varied ("lobes", "kappa", "dodm", "lights") and its value.
+    pub label: String,
+    pub lights: usize,
+    pub ms: f64,
+    pub relative_rmse: f64,
+    pub hdr_flip: f64,
+}
+
+/// One map and mode of the env-lit sweep.
+#[derive(Debug, Clone, Serialize)]
+pub struct EnvLitResult {
+    pub map: String,
+    pub mode: &'static str,
+    pub reference_lights: usize,
+    pub reference_ms: f64,
+    pub reference_converged: Option<bool>,
+    /// (N, relative RMSE of N against 4N lights).
+    pub reference_ladder: Vec<(usize, f64)>,
+    pub points: Vec<Point>,
+    /// The SRBF default's speed-up over median cut at equal relative RMSE / HDR-FLIP, from the
+    /// median-cut curve interpolated log-log (None where the curve never gets that accurate).
+    pub speedup_equal_rmse: Option<f64>,
+    pub speedup_equal_flip: Option<f64>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct FitPoint {
+    pub map: String,
+    pub max_lobes: usize,
+    pub lobes: usize,
+    pub sources: usize,
+    pub relative_l2_error: f64,
+    pub seconds: f64,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct TablePoint {
+    pub nodes: usize,
+    pub bytes: u64,
+    pub bake_seconds: f64,
+    pub max_error: f64,
+    pub rms_error: f64,
+    pub off_axis_max_error: f64,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct BenchReport {
+    pub plan: BenchPlan,
+    pub machine: String,
+    pub adapter: String,
+    pub date: String,
+    pub git_revision: String,
+    pub seconds: f64,
+    pub fits: Vec<FitPoint>,
+    pub tables: Vec<TablePoint>,
+    pub env_lit: Vec<EnvLitResult>,
+    /// Maps the plan named that were not found, with why.
+    pub skipped: Vec<String>,
+}
+
+/// The compare settings a bench scene of `map` is built with.
+fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> CompareArgs {
+    CompareArgs {
+        hair: PathBuf::new(),
+        env: map.display().to_string(),
+        lobes: plan.lobes[0],
+        sources: strandlight_precompute::compact_sources::SourceOptions::default().max_sources,
+        size: format!("{}x{}", plan.size.0, plan.size.1),
+        json: true,
+        reference_lights: None,
+        reference_tolerance: 0.01,
+        reference_max_lights: plan.reference_max_lights,
+        shading: EnvShading::Marschner,
+        preset: "brown".into(),
+        out: out.to_path_buf(),
+        cache: cache.to_path_buf(),
+        rotate: 0.0,
+        sanitize: false,
+        table_resolution: None,
+        modes: plan.modes.clone(),
+        kappa: plan.kappas[0],
+        timing_runs: 1,
+        equal_error: false,
+        equal_error_metric: crate::error_metric::ErrorMetric::RelativeRmse,
+        unshadowed: false,
+        split_lobes: 0,
+        split_ratio: 3.0,
+        look: LookArgs {
+            transparency: EnvTransparency::Opaque,
+            view: ViewArgs {
+                visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF,
+                box_average: BoxAverageArg::OpticalDepth,
+                forward_scattering: ForwardDevice::Auto,
+            },
+        },
+    }
+}
+
+/// The `n` most powerful SRBF lobes of the scene and every compact source.
+fn strongest_lights(scene: &CompareScene, n: usize) -> Vec<EnvLight> {
+    let luminance = |l: &EnvLight| {
+        let [r, g, b] = l.power();
+        0.2126 * r + 0.7152 * g + 0.0722 * b
+    };
+    let mut lights = scene.srbf.clone();
+    lights.sort_by(|a, b| luminance(b).total_cmp(&luminance(a)));
+    let mut kept = 0;
+    lights.retain(|l| {
+        let keep = l.lambda.is_none() || kept < n;
+        kept += usize::from(l.lambda.is_some() && keep);
+        keep
+    });
+    lights
+}
+
+fn measure(
+    family: &'static str,
+    label: String,
+    lights: usize,
+    ms: f64,
+    image: &Image,
+    reference: &Image,
+) -> anyhow::Result<Point> {
+    Ok(Point {
+        family,
+        label,
+        lights,
+        ms,
+        relative_rmse: relative_rmse(image, reference)?,
+        hdr_flip: hdr_flip(image, reference)?.mean_over_hair,
+    })
+}
+
+/// The SRBF frames of one map and mode: lobes, κ and light-map size varied one at a time.
+fn srbf_points(
+    plan: &BenchPlan,
+    scene: &CompareScene,
+    args: &CompareArgs,
+    mode: ScatteringMode,
+    reference: &Image,
+    steps: &mut Steps,
+) -> anyhow::Result<Vec<Point>> {
+    let mut configs: Vec<(String, usize, f32, u32)> = Vec::new();
+    let (lobes, kappa, dodm) = (plan.lobes[0], plan.kappas[0], plan.dodm_sizes[0]);
+    configs.push((
+        format!("default ({lobes} lobes, κ {kappa}, {dodm}²)"),
+        lobes,
+        kappa,
+        dodm,
+    ));
+    configs.extend(
+        plan.lobes[1..]
+            .iter()
+            .map(|&n| (format!("{n} lobes"), n, kappa, dodm)),
+    );
+    configs.extend(
+        plan.kappas[1..]
+            .iter()
+            .map(|&k| (format!("κ {k}"), lobes, k, dodm)),
+    );
+    configs.extend(
+        plan.dodm_sizes[1..]
+            .iter()
+            .map(|&d| (format!("light maps {d}²"), lobes, kappa, d)),
+    );
+    let mut points = Vec::new();
+    for (label, lobes, kappa, dodm) in configs {
+        let lights = strongest_lights(scene, lobes);
+        let mut frame: EnvFrame = compare::frame(scene, args, &lights, mode);
+        frame.role = FrameRole::Interactive { kappa };
+        frame.look.dodm.resolution = dodm;
+        let r = steps.run(
+            &format!("{}: SRBF {label}", mode.name()),
+            || compare::timed_render(&render_lights, &frame, 1),
+            |r| format!("{:.0} ms", r.milliseconds),
+        )?;
+        points.push(measure(
+            "srbf",
+            label,
+            lights.len(),
+            r.milliseconds,
+            &r.image,
+            reference,
+        )?);
+    }
+    Ok(points)
+}
+
+/// ms of the median-cut curve at `error` (log-log interpolation between the two measured
+/// counts around it), None when no measured count is that accurate.
+fn curve_ms_at(points: &[&Point], error: f64, metric: impl Fn(&Point) -> f64) -> Option<f64> {
+    let mut curve: Vec<(f64, f64)> = points.iter().map(|p| (metric(p), p.ms)).collect();
+    curve.sort_by(|a, b| b.0.total_cmp(&a.0)); // error falling
+    if curve.first().is_some_and(|c| c.0 <= error) {
+        return Some(curve[0].1);
+    }
+    curve.windows(2).find_map(|w| {
+        let ((e0, t0), (e1, t1)) = (w[0], w[1]);
+        (e1 <= error && error <= e0 && e0 > 0.0 && e1 > 0.0).then(|| {
+            let f = (error.ln() - e0.ln()) / (e1.ln() - e0.ln());
+            (t0.ln() + f * (t1.ln() - t0.ln())).exp()
+        })
+    })
+}
+
+fn env_lit(
+    plan: &BenchPlan,
+    map: &Path,
+    hair: &(strandlight_runtime::hair::HairModel, String),
+    cache: &Path,
+    scratch: &Path,
+    steps: &mut Steps,
+) -> anyhow::Result<Vec<EnvLitResult>> {
+    let args = compare_args(plan, map, cache, scratch);
+    let scene = compare::prepare_with_hair(&args, hair.0.clone(), hair.1.clone(), steps)?;
+    // The first frame compiles the driver's shader variants: not a frame's cost.
+    let lights = strongest_lights(&scene, plan.lobes[0]);
+    render_lights(&compare::frame(&scene, &args, &lights, plan.modes[0]))?;
+    let name = map_stem(map);
+    let mut out = Vec::new();
+    for &mode in &plan.modes {
+        let reference = compare::reference(&render_lights, &scene, &args, mode, steps)?;
+        let image = &reference.chosen.image;
+        let mut points = srbf_points(plan, &scene, &args, mode, image, steps)?;
+        for &n in &plan.baseline_lights {
+            let r = steps.run(
+                &format!("{}: median cut {n}", mode.name()),
+                || compare::render_baseline(&render_lights, &scene, &args, mode, n),
+                |r| format!("{:.0} ms", r.milliseconds),
+            )?;
+            points.push(measure(
+                "median cut",
+                format!("{n} lights"),
+                n,
+                r.milliseconds,
+                &r.image,
+                image,
+            )?);
+        }
+        let record = &reference.chosen.record;
+        points.push(Point {
+            family: "reference",
+            label: format!("{} lights", record.lights),
+            lights: record.lights,
+            ms: record.milliseconds,
+            relative_rmse: 0.0,
+            hdr_flip: 0.0,
+        });
+        let default = points[0].clone();
+        let median_cut: Vec<&Point> = points.iter().filter(|p| p.family == "median cut").collect();
+        let speedup = |metric: fn(&Point) -> f64| {
+            curve_ms_at(&median_cut, metric(&default), metric).map(|ms| ms / default.ms)
+        };
+        out.push(EnvLitResult {
+            map: name.clone(),
+            mode: mode.name(),
+            reference_lights: record.lights,
+            reference_ms: record.milliseconds,
+            reference_converged: reference.converged,
+            reference_ladder: reference.ladder.iter().map(|&(n, _, d)| (n, d)).collect(),
+            speedup_equal_rmse: speedup(|p| p.relative_rmse),
+            speedup_equal_flip: speedup(|p| p.hdr_flip),
+            points,
+        });
+    }
+    Ok(out)
+}
+
+/// A map's file name without its extension, as the report names it.
+fn map_stem(map: &Path) -> String {
+    map.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+fn fits(
+    plan: &BenchPlan,
+    map: &Path,
+    cache: &Path,
+    steps: &mut Steps,
+) -> anyhow::Result<Vec<FitPoint>> {
+    let env = load_env(&map.display().to_string(), false)?;
+    let mut out = Vec::new();
+    for &max_lobes in &plan.fit_lobes {
+        let options = FitOptions {
+            max_lobes,
+            initial_lobes: max_lobes.min(FitOptions::default().initial_lobes),
+            ..FitOptions::default()
+        };
+        let fit = steps.run(
+            &format!("fit {} ≤ {max_lobes} lobes", env.name),
+            || fit_cached(&env, &options, cache),
+            |f| {
+                format!(
+                    "{} lobes, {:.3}",
+                    f.set.lobes.len(),
+                    f.set.relative_l2_error
+                )
+            },
+        )?;
+        out.push(FitPoint {
+            map: map_stem(map),
+            max_lobes,
+            lobes: fit.set.lobes.len(),
+            sources: fit.set.sources.len(),
+            relative_l2_error: fit.set.relative_l2_error,
+            seconds: fit.set.seconds,
+        });
+    }
+    Ok(out)
+}
+
+fn tables(plan: &BenchPlan, scratch: &Path, steps: &mut Steps) -> anyhow::Result<Vec<TablePoint>> {
+    let fiber = FiberDescription::preset("brown").context("the brown preset")?;
+    let mut out = Vec::new();
+    for &nodes in &plan.table_nodes {
+        let dir = scratch.join(format!("tables-{nodes}"));
+        // A fresh folder: the bake is timed, never served from a cache.
+        let _ = std::fs::remove_dir_all(&dir);
+        let options = PlanOptions {
+            models: vec![Model::Marschner],
+            resolution: BakeResolution::reduced(nodes),
+            ..Default::default()
+        };
+        let job = strandlight_precompute::bake_plan::plan(&fiber, &options)?
+            .jobs
+            .into_iter()
+            .find(|j| j.name == "marschner")
+            .context("the Marschner convolution table is planned")?;
+        let point = steps.run(
+            &format!("table marschner {nodes}³×{}", 2 * nodes),
+            || -> anyhow::Result<TablePoint> {
+                let baked = bake_job(job, &dir, strandlight_tables::asset::Storage::F32)?;
+                let asset = strandlight_tables::asset::read_asset(&baked.path)?;
+                let acc = check_asset(&asset, plan.table_check_points, 11)?;
+                Ok(TablePoint {
+                    nodes,
+                    bytes: baked.bytes,
+                    bake_seconds: baked.seconds,
+                    max_error: acc.max_abs_error,
+                    rms_error: acc.rms_abs_error,
+                    off_axis_max_error: acc.off_axis_max_abs_error,
+                })
+            },
+            |t| format!("{:.2}% max, {:.1} s", 100.0 * t.max_error, t.bake_seconds),
+        )?;
+        out.push(point);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+    Ok(out)
+}
+
+/// Where things are and go.
+pub struct BenchPaths {
+    /// `../shared/data` (hair/straight.hair, envmaps/…).
+    pub data: PathBuf,
+    pub cache: PathBuf,
+    /// Scratch images and tables.
+    pub scratch: PathBuf,
+}
+
+/// Runs `plan`. Maps absent from `paths.data` are skipped and listed.
+pub fn run(plan: &BenchPlan, paths: &BenchPaths, steps: &mut Steps) -> anyhow::Result<BenchReport> {
+    let start = std::time::Instant::now();
+    let hair_path = paths.data.join("hair/straight.hair");
+    let bytes =
+        std::fs::read(&hair_path).with_context(|| format!("reading {}", hair_path.display()))?;
+    let (model, _) = crate::hair_input::load_hair(Some(&hair_path))?;
+    let hair = (model, strandlight_tables::checksum::sha256_hex(&bytes));
+    let mut report = BenchReport {
+        plan: plan.clone(),
+        machine: machine(),
+        adapter: crate::env_frame::env_adapter()?,
+        date: command_output("date", &["-u", "+%Y-%m-%d %H:%M UTC"]),
+        git_revision: command_output("git", &["rev-parse", "--short", "HEAD"]),
+        seconds: 0.0,
+        fits: Vec::new(),
+        tables: tables(plan, &paths.scratch, steps)?,
+        env_lit: Vec::new(),
+        skipped: Vec::new(),
+    };
+    for map in &plan.maps {
+        let path = paths.data.join("envmaps").join(map);
+        if !path.is_file() {
+            report.skipped.push(format!("{}: absent", path.display()));
+            continue;
+        }
+        report.fits.extend(fits(plan, &path, &paths.cache, steps)?);
+        let scratch = paths.scratch.join(map);
+        report
+            .env_lit
+            .extend(env_lit(plan, &path, &hair, &paths.cache, &scratch, steps)?);
+    }
+    report.seconds = start.elapsed().as_secs_f64();
+    Ok(report)
+}
+
+fn command_output(program: &str, args: &[&str]) -> String {
+    std::process::Command::new(program)
+        .args(args)
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// CPU model and logical CPU count.
+fn machine() -> String {
+    let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let model = cpuinfo
+        .lines()
+        .find_map(|l| l.strip_prefix("model name"))
+        .map(|l| l.trim_start_matches([' ', '\t', ':']).to_string())
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
+    let cpus = std::thread::available_parallelism().map_or(0, |n| n.get());
+    format!("{model}, {cpus} logical CPUs, {}", std::env::consts::OS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn point(family: &'static str, ms: f64, error: f64) -> Point {
+        Point {
+            family,
+            label: String::new(),
+            lights: 0,
+            ms,
+            relative_rmse: error,
+            hdr_flip: error,
+        }
+    }
+
+    #[test]
+    fn the_median_cut_curve_is_interpolated_log_log_at_an_error() {
+        let curve = [
+            point("m", 10.0, 0.4),
+            point("m", 40.0, 0.1),
+            point("m", 160.0, 0.025),
+        ];
+        let refs: Vec<&Point> = curve.iter().collect();
+        let err = |p: &Point| p.relative_rmse;
+        // Error ∝ 1/ms here: 0.2 lies halfway (in log) between 10 and 40 ms.
+        assert!((curve_ms_at(&refs, 0.2, err).unwrap() - 20.0).abs() < 1e-9);
+        assert_eq!(curve_ms_at(&refs, 0.5, err), Some(10.0));
+        assert_eq!(curve_ms_at(&refs, 0.01, err), None);
+    }
+}

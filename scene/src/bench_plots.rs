@@ -1,0 +1,223 @@
+//! The plots of `strandlight bench` (plotters): per map and mode, error against frame
+//! milliseconds on log-log axes, one plot for relative RMSE and one for HDR-FLIP, as PNG and SVG.
+//! The SRBF default, its one-at-a-time variations, the median-cut curve and the reference are
+//! marked, and the equal-error speed-up is written on the plot. Text uses the Hack font that
+//! egui ships (`epaint_default_fonts`), so a machine without system fonts draws the same PNG.
+
+use crate::bench::{EnvLitResult, Point};
+use anyhow::Context;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+const WIDTH: u32 = 720;
+const HEIGHT: u32 = 480;
+
+fn register_font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // A font that fails to register leaves plotters without text: the plot is still drawn.
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            epaint_default_fonts::HACK_REGULAR,
+        );
+    });
+}
+
+/// Which error a plot shows.
+#[derive(Clone, Copy)]
+pub enum Metric {
+    RelativeRmse,
+    HdrFlip,
+}
+
+impl Metric {
+    fn of(self, p: &Point) -> f64 {
+        match self {
+            Metric::RelativeRmse => p.relative_rmse,
+            Metric::HdrFlip => p.hdr_flip,
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Metric::RelativeRmse => "relative RMSE",
+            Metric::HdrFlip => "HDR-FLIP (mean over hair)",
+        }
+    }
+
+    pub fn file_tag(self) -> &'static str {
+        match self {
+            Metric::RelativeRmse => "rmse",
+            Metric::HdrFlip => "flip",
+        }
+    }
+
+    fn speedup(self, r: &EnvLitResult) -> Option<f64> {
+        match self {
+            Metric::RelativeRmse => r.speedup_equal_rmse,
+            Metric::HdrFlip => r.speedup_equal_flip,
+        }
+    }
+}
+
+/// Error against ms for one map and mode, drawn on any plotters backend.
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    r: &EnvLitResult,
+    metric: Metric,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let measured: Vec<&Point> = r
+        .points
+        .iter()
+        .filter(|p| p.family != "reference")
+        .collect();
+    let (mut lo_ms, mut hi_ms) = (f64::INFINITY, 0.0f64);
+    let (mut lo_e, mut hi_e) = (f64::INFINITY, 0.0f64);
+    for p in &r.points {
+        lo_ms = lo_ms.min(p.ms);
+        hi_ms = hi_ms.max(p.ms);
+    }
+    for p in &measured {
+        let e = metric.of(p).max(1e-4);
+        lo_e = lo_e.min(e);
+        hi_e = hi_e.max(e);
+    }
+    let title = format!("{} ({}): {}", r.map, r.mode, metric.name());
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(
+            (lo_ms * 0.7..hi_ms * 1.4).log_scale(),
+            (lo_e * 0.7..hi_e * 1.4).log_scale(),
+        )
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    chart
+        .configure_mesh()
+        .x_desc("frame ms")
+        .y_desc(metric.name())
+        .x_labels(8)
+        .y_labels(10)
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&|v| format!("{v:.2}"))
+        .label_style(("sans-serif", 13))
+        .draw()
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    let series = |family: &str, prefix: &str| -> Vec<(f64, f64)> {
+        let mut v: Vec<(f64, f64)> = measured
+            .iter()
+            .filter(|p| p.family == family && p.label.contains(prefix))
+            .map(|p| (p.ms, metric.of(p).max(1e-4)))
+            .collect();
+        v.sort_by(|a, b| a.0.total_cmp(&b.0));
+        v
+    };
+    let median_cut = series("median cut", "");
+    chart
+        .draw_series(LineSeries::new(median_cut.clone(), RED.stroke_width(2)))
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?
+        .label("median cut (light count)")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], RED.stroke_width(2)));
+    chart
+        .draw_series(median_cut.iter().map(|&p| Circle::new(p, 4, RED.filled())))
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    for (prefix, colour, label) in [
+        ("lobes", BLUE, "SRBF: lobe count"),
+        ("κ", GREEN, "SRBF: κ"),
+        ("light maps", MAGENTA, "SRBF: light-map size"),
+    ] {
+        let mut points = series("srbf", prefix);
+        points.extend(series("srbf", "default"));
+        points.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let style = colour.stroke_width(1);
+        chart
+            .draw_series(
+                points
+                    .iter()
+                    .map(|&p| TriangleMarker::new(p, 6, colour.filled())),
+            )
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?
+            .label(label)
+            .legend(move |(x, y)| TriangleMarker::new((x + 9, y), 6, style.filled()));
+    }
+    if let Some(default) = measured.iter().find(|p| p.label.starts_with("default")) {
+        let at = (default.ms, metric.of(default).max(1e-4));
+        let note = match metric.speedup(r) {
+            Some(s) => format!("SRBF default: {s:.1}× median cut at equal error"),
+            None => "SRBF default: median cut never as accurate here".into(),
+        };
+        chart
+            .draw_series([Cross::new(at, 9, BLACK.stroke_width(3))])
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?
+            .label(note)
+            .legend(|(x, y)| Cross::new((x + 9, y), 6, BLACK.stroke_width(2)));
+    }
+    if let Some(reference) = r.points.iter().find(|p| p.family == "reference") {
+        // The reference has no error of its own: drawn as a vertical line at its cost.
+        chart
+            .draw_series(LineSeries::new(
+                [(reference.ms, lo_e * 0.7), (reference.ms, hi_e * 1.4)],
+                BLACK.mix(0.5).stroke_width(1),
+            ))
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?
+            .label(format!("reference, {} lights", reference.lights))
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.mix(0.5)));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font(("sans-serif", 12))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    root.present().map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    Ok(())
+}
+
+/// Writes `STEM.png` and `STEM.svg` in `dir` (each atomically: a failed plot never leaves half
+/// a file); returns the two paths.
+pub fn plot(
+    dir: &Path,
+    stem: &str,
+    r: &EnvLitResult,
+    metric: Metric,
+) -> anyhow::Result<[PathBuf; 2]> {
+    register_font();
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let png = dir.join(format!("{stem}.png"));
+    let svg = dir.join(format!("{stem}.svg"));
+    let mut pixels = vec![0u8; (WIDTH * HEIGHT * 3) as usize];
+    draw(
+        BitMapBackend::with_buffer(&mut pixels, (WIDTH, HEIGHT)).into_drawing_area(),
+        r,
+        metric,
+    )
+    .with_context(|| format!("plotting {}", png.display()))?;
+    let description = format!(
+        "strandlight bench: {} ({}), {}",
+        r.map,
+        r.mode,
+        metric.name()
+    );
+    strandlight_runtime::image_out::write_png_rgb8(&png, WIDTH, HEIGHT, &pixels, &description)?;
+    let mut text = String::new();
+    draw(
+        SVGBackend::with_string(&mut text, (WIDTH, HEIGHT)).into_drawing_area(),
+        r,
+        metric,
+    )
+    .with_context(|| format!("plotting {}", svg.display()))?;
+    strandlight_tables::atomic_write::write_atomically(&svg, |w| {
+        std::io::Write::write_all(w, text.as_bytes())
+    })
+    .with_context(|| format!("writing {}", svg.display()))?;
+    Ok([png, svg])
+}

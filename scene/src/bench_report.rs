@@ -1,0 +1,149 @@
+//! The Markdown of `strandlight bench`: the generated section of docs/BENCHMARKS.md (between
+//! [`BEGIN`] and [`END`], replaced whole on every run; the rest of the page is left alone).
+
+use crate::bench::{BenchReport, EnvLitResult};
+use anyhow::bail;
+use std::fmt::Write;
+
+pub const BEGIN: &str = "<!-- strandlight bench: generated section, begin -->";
+pub const END: &str = "<!-- strandlight bench: generated section, end -->";
+
+fn optional_speedup(s: Option<f64>) -> String {
+    s.map_or("never as accurate".into(), |s| format!("{s:.1}×"))
+}
+
+fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str) {
+    let _ = writeln!(
+        out,
+        "\n#### {} — {} scattering\n\nReference: {} lights, {:.0} ms{}. Equal-error speed-up of the SRBF default over median cut: {} (relative RMSE), {} (HDR-FLIP).\n",
+        r.map,
+        r.mode,
+        r.reference_lights,
+        r.reference_ms,
+        match r.reference_converged {
+            Some(true) => ", converged (N and 4N lights within 1%)".to_string(),
+            Some(false) => format!(
+                ", NOT converged within the run's light budget (last rung {})",
+                r.reference_ladder
+                    .last()
+                    .map_or("–".into(), |(n, d)| format!("{n} vs {}: {d:.4}", 4 * n))
+            ),
+            None => String::new(),
+        },
+        optional_speedup(r.speedup_equal_rmse),
+        optional_speedup(r.speedup_equal_flip),
+    );
+    if !r.reference_ladder.is_empty() {
+        let ladder: Vec<String> = r
+            .reference_ladder
+            .iter()
+            .map(|(n, d)| format!("{n} vs {}: {d:.4}", 4 * n))
+            .collect();
+        let _ = writeln!(
+            out,
+            "Reference convergence (relative RMSE): {}.\n",
+            ladder.join("; ")
+        );
+    }
+    out.push_str("| frame | lights | ms | relative RMSE | HDR-FLIP |\n|---|---:|---:|---:|---:|\n");
+    for p in &r.points {
+        let _ = writeln!(
+            out,
+            "| {} {} | {} | {:.0} | {:.4} | {:.4} |",
+            p.family, p.label, p.lights, p.ms, p.relative_rmse, p.hdr_flip
+        );
+    }
+    let _ = writeln!(
+        out,
+        "\n![error against ms, relative RMSE]({plots}-rmse.png) ![error against ms, HDR-FLIP]({plots}-flip.png)"
+    );
+}
+
+/// The generated section, `plot_dir` relative to the Markdown file (e.g. `bench`).
+pub fn section(report: &BenchReport, plot_dir: &str) -> String {
+    let mut out = String::new();
+    let plan = &report.plan;
+    let _ = writeln!(
+        out,
+        "{BEGIN}\n## Speed against error (`strandlight bench{}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. Regenerate with `cargo run --release -- bench{}` (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and the opaque view; errors are over the hair pixels of the converged reference (compact sources exact, texel lights at radiance centroids; N and 4N lights within 1%, capped at {} lights); ms are frame times on this machine's adapter, one run each (lavapipe: ratios only).\n",
+        if plan.name == "quick" { " --quick" } else { "" },
+        report.date,
+        report.git_revision,
+        report.machine,
+        report.adapter,
+        report.seconds,
+        if plan.name == "quick" { " --quick" } else { "" },
+        plan.size.0,
+        plan.size.1,
+        plan.reference_max_lights,
+    );
+    if !report.skipped.is_empty() {
+        let _ = writeln!(out, "Skipped: {}.\n", report.skipped.join("; "));
+    }
+    out.push_str("### SRBF fit: error and time against the lobe count\n\n| map | most lobes | lobes | compact sources | relative L2 error (without sources) | fit s |\n|---|---:|---:|---:|---:|---:|\n");
+    for f in &report.fits {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {:.3} | {:.1} |",
+            f.map, f.max_lobes, f.lobes, f.sources, f.relative_l2_error, f.seconds
+        );
+    }
+    out.push_str("\n### Marschner convolution table: error against resolution\n\nMax and RMS error against f64 integration relative to the table's maximum (`check-tables`), direction nodes n (n³ × 2n with the 1/λ axis).\n\n| n | MB | bake s | max | RMS | off-axis max |\n|---:|---:|---:|---:|---:|---:|\n");
+    for t in &report.tables {
+        let _ = writeln!(
+            out,
+            "| {} | {:.1} | {:.1} | {:.2}% | {:.3}% | {:.2}% |",
+            t.nodes,
+            t.bytes as f64 / 1e6,
+            t.bake_seconds,
+            100.0 * t.max_error,
+            100.0 * t.rms_error,
+            100.0 * t.off_axis_max_error
+        );
+    }
+    out.push_str("\n### Env-lit frames: error against milliseconds\n\nThe SRBF default and one parameter varied at a time (lobes kept: the most powerful; κ: Ren's stochastic simplification; light-map size), the median-cut baseline at several light counts, and the reference.\n");
+    for r in &report.env_lit {
+        let stem = format!("{plot_dir}/{}-{}", r.map, r.mode);
+        env_lit_table(&mut out, r, &stem);
+    }
+    let _ = writeln!(out, "\n{END}");
+    out
+}
+
+/// `page` with its generated section replaced by `section` (appended when it has none).
+pub fn splice(page: &str, section: &str) -> anyhow::Result<String> {
+    match (page.find(BEGIN), page.find(END)) {
+        (Some(b), Some(e)) if b < e => {
+            let after = e + END.len();
+            let tail = page[after..].strip_prefix('\n').unwrap_or(&page[after..]);
+            Ok(format!("{}{}{}", &page[..b], section, tail))
+        }
+        (None, None) => Ok(format!(
+            "{}\n{}",
+            page.trim_end_matches('\n').to_owned() + "\n",
+            section
+        )),
+        _ => bail!(
+            "the page's generated-section markers are damaged (one missing or out of order): fix them by hand"
+        ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_generated_section_is_replaced_and_the_rest_kept() {
+        let page = "# Benchmarks\n\nhand-written\n";
+        let first = splice(page, &format!("{BEGIN}\nA\n{END}\n")).unwrap();
+        assert!(first.starts_with(page) && first.contains("\nA\n"));
+        let second = splice(&first, &format!("{BEGIN}\nB\n{END}\n")).unwrap();
+        assert!(second.contains("\nB\n") && !second.contains("\nA\n"));
+        assert!(second.starts_with(page));
+        let again = splice(&second, &format!("{BEGIN}\nB\n{END}\n")).unwrap();
+        assert_eq!(again, second, "idempotent");
+        let damaged = format!("{page}{END}\n{BEGIN}\n");
+        assert!(splice(&damaged, "x").is_err());
+    }
+}

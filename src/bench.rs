@@ -1,0 +1,118 @@
+//! `strandlight bench`: speed against error on the real data in `../shared/data`. The full run
+//! rewrites the generated section of docs/BENCHMARKS.md and its plots in docs/bench/; `--quick`
+//! (a few minutes) writes its report and plots to out/bench-quick/ and leaves docs/ alone.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Args;
+
+use strandlight_scene::bench::{BenchPaths, BenchPlan, run as run_bench};
+use strandlight_scene::bench_plots::{Metric, plot};
+use strandlight_scene::bench_report::{section, splice};
+use strandlight_scene::steps::Steps;
+use strandlight_tables::atomic_write::write_atomically;
+use strandlight_tables::shared_data::shared_data_dir;
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// One map, single scattering, 160×120, a reference of at most 384 lights: a few minutes.
+    #[arg(long)]
+    pub quick: bool,
+    /// The shared data folder (default: $STRANDLIGHT_SHARED_DATA or ../shared/data).
+    #[arg(long)]
+    pub data: Option<PathBuf>,
+    /// Where the report JSON and the plots go (default: docs/bench, or out/bench-quick with
+    /// --quick).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// The page whose generated section is rewritten (full runs only).
+    #[arg(long, default_value = "docs/BENCHMARKS.md")]
+    pub benchmarks: PathBuf,
+    /// Cache folder (fits, tables, reference images), shared with `compare`.
+    #[arg(long, default_value = "out/cache")]
+    pub cache: PathBuf,
+}
+
+pub fn run(args: BenchArgs) -> anyhow::Result<()> {
+    let Some(data) = args.data.clone().or_else(shared_data_dir) else {
+        println!(
+            "skipped: no ../shared/data folder beside the checkout (or --data, $STRANDLIGHT_SHARED_DATA): the benchmark measures the real maps and hair there"
+        );
+        return Ok(());
+    };
+    if !data.join("hair/straight.hair").is_file() {
+        println!(
+            "skipped: {} has no hair/straight.hair, the benchmark's hair",
+            data.display()
+        );
+        return Ok(());
+    }
+    let plan = if args.quick {
+        BenchPlan::quick()
+    } else {
+        BenchPlan::full()
+    };
+    let out = args.out.clone().unwrap_or_else(|| {
+        PathBuf::from(if args.quick {
+            "out/bench-quick"
+        } else {
+            "docs/bench"
+        })
+    });
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let mut steps = Steps::new(false);
+    let paths = BenchPaths {
+        data,
+        cache: args.cache.clone(),
+        scratch: PathBuf::from("out/bench-scratch"),
+    };
+    let report = run_bench(&plan, &paths, &mut steps)?;
+    let json = out.join(format!("report-{}.json", plan.name));
+    write_atomically(&json, |w| {
+        serde_json::to_writer_pretty(w, &report).map_err(std::io::Error::other)
+    })
+    .with_context(|| format!("writing {}", json.display()))?;
+    for r in &report.env_lit {
+        for metric in [Metric::RelativeRmse, Metric::HdrFlip] {
+            let stem = format!("{}-{}-{}", r.map, r.mode, metric.file_tag());
+            let [png, _] = plot(&out, &stem, r, metric)?;
+            println!("wrote {} (and .svg)", png.display());
+        }
+    }
+    if args.quick {
+        let page = out.join("REPORT.md");
+        write_atomically(&page, |w| {
+            std::io::Write::write_all(w, section(&report, ".").as_bytes())
+        })
+        .with_context(|| format!("writing {}", page.display()))?;
+        println!("wrote {} and {}", page.display(), json.display());
+    } else {
+        let page = std::fs::read_to_string(&args.benchmarks)
+            .with_context(|| format!("reading {}", args.benchmarks.display()))?;
+        let relative = pathdiff(
+            &out,
+            args.benchmarks.parent().unwrap_or(&PathBuf::from(".")),
+        );
+        let updated = splice(&page, &section(&report, &relative))
+            .with_context(|| args.benchmarks.display().to_string())?;
+        write_atomically(&args.benchmarks, |w| {
+            std::io::Write::write_all(w, updated.as_bytes())
+        })
+        .with_context(|| format!("writing {}", args.benchmarks.display()))?;
+        println!(
+            "rewrote the generated section of {} ({})",
+            args.benchmarks.display(),
+            json.display()
+        );
+    }
+    Ok(())
+}
+
+/// `path` relative to `base` when it lies below it (docs/bench from docs → "bench"), else as is.
+fn pathdiff(path: &std::path::Path, base: &std::path::Path) -> String {
+    path.strip_prefix(base)
+        .unwrap_or(path)
+        .display()
+        .to_string()
+}
