@@ -29,6 +29,9 @@ pub struct BenchArgs {
     /// The page whose generated section is rewritten (full runs only).
     #[arg(long, default_value = "docs/BENCHMARKS.md")]
     pub benchmarks: PathBuf,
+    /// Only these maps (file names in the data folder's envmaps/, comma-separated).
+    #[arg(long, value_delimiter = ',')]
+    pub maps: Vec<String>,
     /// Cache folder (fits, tables, reference images), shared with `compare`.
     #[arg(long, default_value = "out/cache")]
     pub cache: PathBuf,
@@ -48,11 +51,14 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         );
         return Ok(());
     }
-    let plan = if args.quick {
+    let mut plan = if args.quick {
         BenchPlan::quick()
     } else {
         BenchPlan::full()
     };
+    if !args.maps.is_empty() {
+        plan.maps = args.maps.clone();
+    }
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from(if args.quick {
             "out/bench-quick"

@@ -1,10 +1,6 @@
 //! The brute-force directional reference of Ren et al. 2010 §8: the environment map sampled as
 //! `6 · n²` directional lights, one per cube-map texel (n = 32 gives the paper's 6144), each
-//! carrying the texel's ∫ L dω and placed at the texel's radiance centroid: the normalized
-//! Σ (R + G + B)·dω·ω over its sub-pixels. The paper places them at texel centers, which moves a
-//! sun by up to half a texel (5.6° at 8 × 8 per face) and with it every highlight it casts;
-//! the centroid keeps a small source where it is, so the reference converges with far fewer
-//! lights (docs/BENCHMARKS.md).
+//! placed at its texel center's direction and carrying the texel's ∫ L dω.
 //!
 //! # Cube convention
 //!
@@ -166,36 +162,23 @@ pub fn cube_face_lights_subsampled(
     if bad.total() > 0 {
         return Err(CubeLightsError::BadPixels(bad));
     }
-    Ok(texel_sums(map, n, subsamples)
+    let power = texel_powers(map, n, subsamples);
+    Ok(power
         .into_iter()
         .enumerate()
-        .map(|(k, sum)| {
+        .map(|(k, power)| {
             let (face, rest) = (k / (n * n), k % (n * n));
             let t = CubeTexel {
                 face,
                 i: rest % n,
                 j: rest / n,
             };
-            // A dark texel has no centroid: its (zero-power) light stays at the centre.
-            let direction = sum
-                .moment
-                .try_normalize()
-                .unwrap_or_else(|| texel_center_direction(t, n));
             DirectionalLight {
-                direction,
-                power: sum.power,
+                direction: texel_center_direction(t, n),
+                power,
             }
         })
         .collect())
-}
-
-/// One texel's sums over its sub-pixels.
-#[derive(Clone, Copy, Default)]
-struct TexelSum {
-    /// ∫ L dω per channel.
-    power: [f64; 3],
-    /// ∫ (R + G + B) ω dω: its direction is the radiance centroid.
-    moment: DVec3,
 }
 
 /// One azimuth slice of the map: its center's (sin φ, cos φ), width Δφ and pixel column.
@@ -236,20 +219,19 @@ fn column_segments(width: usize, s: usize, n: usize) -> Vec<ColumnSegment> {
         .collect()
 }
 
-/// ∫ L dω and ∫ (R + G + B) ω dω per texel: every sub-pixel's exact solid angle, times its
-/// pixel's radiance, binned.
-fn texel_sums(map: &EnvMap, n: usize, s: usize) -> Vec<TexelSum> {
+/// ∫ L dω per texel: every sub-pixel's exact solid angle, times its pixel's radiance, binned.
+fn texel_powers(map: &EnvMap, n: usize, s: usize) -> Vec<[f64; 3]> {
     let (w, h) = (map.width(), map.height());
     let texels = 6 * n * n;
     if w == 0 || h == 0 {
-        return vec![TexelSum::default(); texels];
+        return vec![[0.0; 3]; texels];
     }
     let sub_h = h * s;
     let columns = column_segments(w, s, n);
-    let bands: Vec<Vec<TexelSum>> = (0..h.div_ceil(ROWS_PER_BAND))
+    let bands: Vec<Vec<[f64; 3]>> = (0..h.div_ceil(ROWS_PER_BAND))
         .into_par_iter()
         .map(|band| {
-            let mut acc = vec![TexelSum::default(); texels];
+            let mut acc = vec![[0.0f64; 3]; texels];
             let rows = band * ROWS_PER_BAND..((band + 1) * ROWS_PER_BAND).min(h);
             for y in rows {
                 let row = &map.pixels()[y * w..(y + 1) * w];
@@ -266,25 +248,21 @@ fn texel_sums(map: &EnvMap, n: usize, s: usize) -> Vec<TexelSum> {
                         let dir = DVec3::new(st * col.sin_phi, ct, -st * col.cos_phi);
                         let da = col.dphi * dcos;
                         let a = &mut acc[cube_texel(dir, n).index(n)];
-                        let mut sum = 0.0;
-                        for (power, &radiance) in a.power.iter_mut().zip(&p) {
-                            *power += da * radiance as f64;
-                            sum += radiance as f64;
+                        for c in 0..3 {
+                            a[c] += da * p[c] as f64;
                         }
-                        a.moment += (da * sum) * dir;
                     }
                 }
             }
             acc
         })
         .collect();
-    let mut total = vec![TexelSum::default(); texels];
+    let mut total = vec![[0.0f64; 3]; texels];
     for band in &bands {
         for (t, b) in total.iter_mut().zip(band) {
             for c in 0..3 {
-                t.power[c] += b.power[c];
+                t[c] += b[c];
             }
-            t.moment += b.moment;
         }
     }
     total
@@ -601,41 +579,8 @@ mod tests {
         }
     }
 
-    /// A sun of one pixel: its light sits on the pixel's own centroid (within the pixel's
-    /// sub-pixel grid), not at its texel's centre; a dark texel's light stays at its centre.
     #[test]
-    fn a_lights_direction_is_its_texels_radiance_centroid() {
-        let (width, height, n) = (1024, 512, 8);
-        let (x, y) = (700, 140);
-        let mut px = vec![[0.0f32; 3]; width * height];
-        px[y * width + x] = [1e5, 2e5, 3e5];
-        let map = EnvMap::from_pixels(width, height, px);
-        let lights = cube_face_lights(&map, n).unwrap();
-        let sun = pixel_direction(x, y, width, height);
-        let lit = cube_texel(sun, n).index(n);
-        let angle = lights[lit].direction.angle_between(sun);
-        let center = texel_center_direction(cube_texel(sun, n), n).angle_between(sun);
-        let pixel = PI / height as f64;
-        eprintln!(
-            "one-pixel sun: light {:.2e} rad from the pixel centre (pixel {pixel:.2e} rad; texel centre {center:.3} rad away)",
-            angle
-        );
-        assert!(angle < 0.05 * pixel, "{angle} rad");
-        assert!(
-            center > 5.0 * pixel,
-            "the test needs a sun off its texel's centre"
-        );
-        let dark = (lit + 1) % lights.len();
-        let t = CubeTexel {
-            face: dark / (n * n),
-            i: dark % n,
-            j: (dark % (n * n)) / n,
-        };
-        assert_eq!(lights[dark].direction, texel_center_direction(t, n));
-    }
-
-    #[test]
-    fn light_directions_are_unit_and_inside_their_texels() {
+    fn light_directions_are_unit_texel_centers() {
         let n = 32;
         let map = test_sky(64);
         let lights = cube_face_lights(&map, n).unwrap();

@@ -33,7 +33,7 @@ use strandlight_runtime::env::{EnvLight, ViewTransparency};
 #[derive(Debug, Clone, Serialize)]
 pub struct BenchPlan {
     pub name: &'static str,
-    pub maps: Vec<&'static str>,
+    pub maps: Vec<String>,
     pub size: (u32, u32),
     pub modes: Vec<ScatteringMode>,
     /// Fit sweep: most lobes.
@@ -66,7 +66,7 @@ impl BenchPlan {
     pub fn full() -> Self {
         Self {
             name: "full",
-            maps: ALL_MAPS.to_vec(),
+            maps: ALL_MAPS.iter().map(|m| m.to_string()).collect(),
             size: (320, 240),
             modes: vec![ScatteringMode::Single, ScatteringMode::Full],
             fit_lobes: vec![8, 16, 32, 49, 64],
@@ -80,12 +80,12 @@ impl BenchPlan {
         }
     }
 
-    /// A few minutes: one smooth map and one sun map, single scattering, 160×120, a reference of
+    /// A few minutes: the smooth overcast map, single scattering, 160×120, a reference of
     /// at most 384 lights.
     pub fn quick() -> Self {
         Self {
             name: "quick",
-            maps: vec![ALL_MAPS[0]],
+            maps: vec![ALL_MAPS[0].to_string()],
             size: (160, 120),
             modes: vec![ScatteringMode::Single],
             fit_lobes: vec![8, 32, 64],
@@ -171,6 +171,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         hair: PathBuf::new(),
         env: map.display().to_string(),
         lobes: plan.lobes[0],
+        fit_target: FitOptions::default().target_relative_mse,
         sources: strandlight_precompute::compact_sources::SourceOptions::default().max_sources,
         size: format!("{}x{}", plan.size.0, plan.size.1),
         json: true,

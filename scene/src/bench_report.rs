@@ -65,7 +65,7 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
     let plan = &report.plan;
     let _ = writeln!(
         out,
-        "{BEGIN}\n## Speed against error (`strandlight bench{}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. Regenerate with `cargo run --release -- bench{}` (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and the opaque view; errors are over the hair pixels of the converged reference (compact sources exact, texel lights at radiance centroids; N and 4N lights within 1%, capped at {} lights); ms are frame times on this machine's adapter, one run each (lavapipe: ratios only).\n",
+        "{BEGIN}\n## Speed against error (`strandlight bench{}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. Regenerate with `cargo run --release -- bench{}` (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and the opaque view; errors are over the hair pixels of the converged reference (compact sources exact, the rest one light per cube texel; N and 4N lights within 1%, capped at {} lights); ms are frame times on this machine's adapter, one run each (lavapipe: ratios only).\n",
         if plan.name == "quick" { " --quick" } else { "" },
         report.date,
         report.git_revision,

@@ -44,6 +44,10 @@ pub struct CompareArgs {
     /// Most SRBF lobes the fit may use.
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 64))]
     pub lobes: usize,
+    /// The fit's target relative MSE Σw‖fit−map‖²/Σw‖map‖² (lobes are added until it is met
+    /// or --lobes is reached; default: the paper's 15%).
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = FitOptions::default().target_relative_mse))]
+    pub fit_target: f64,
     /// Most compact bright sources (suns, lamps) the fit takes out as directional lights
     /// rendered beside the SRBFs; 0: SRBFs alone, as the paper.
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().max_sources))]
@@ -249,6 +253,7 @@ pub fn prepare_with_hair(
         initial_lobes: args.lobes.min(FitOptions::default().initial_lobes),
         rotate_degrees: args.rotate,
         sources,
+        target_relative_mse: args.fit_target,
         ..FitOptions::default()
     };
     let fit = steps.run(
@@ -362,7 +367,7 @@ pub fn timed_render(
 
 impl CompareScene {
     /// The reference's lights for n×n texels per cube face: the compact sources exactly, the
-    /// rest of the map one light per texel at its radiance centroid.
+    /// rest of the map one light per cube texel.
     pub fn reference_set(&self, face: usize, rotate: f64) -> anyhow::Result<Vec<EnvLight>> {
         Ok(to_env_lights(
             &reference_lights(&self.map, face, rotate, &self.reference_sources)?,
@@ -518,7 +523,7 @@ fn reference_inputs(
         "map_sha256": scene.map_sha256,
         "rotate": args.rotate,
         "reference_lights": lights,
-        "reference_placement": "compact sources exact, texel lights at radiance centroids",
+        "reference_placement": "compact sources exact, texel lights at texel centres",
         "reference_sources": scene.reference_sources,
         "mode": mode.name(),
         "shading": args.shading,
