@@ -1,13 +1,14 @@
 //! `strandlight bench`: speed against error on the real data in `../shared/data`. The full run
 //! rewrites the generated section of docs/BENCHMARKS.md and its plots in docs/bench/; `--quick`
 //! (a few minutes) writes its report and plots to out/bench-quick/ and leaves docs/ alone.
+//! `--from-report` draws the plots and the page again from a saved report without measuring.
 
 use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
 
-use strandlight_scene::bench::{BenchPaths, BenchPlan, run as run_bench};
+use strandlight_scene::bench::{BenchPaths, BenchPlan, BenchReport, run as run_bench};
 use strandlight_scene::bench_plots::{Metric, plot};
 use strandlight_scene::bench_report::{section, splice};
 use strandlight_scene::steps::Steps;
@@ -35,46 +36,30 @@ pub struct BenchArgs {
     /// Cache folder (fits, tables, reference images), shared with `compare`.
     #[arg(long, default_value = "out/cache")]
     pub cache: PathBuf,
+    /// Measure nothing: write the plots and the page again from a report JSON an earlier run
+    /// wrote (after a change to how they are drawn, without the hour of measuring).
+    #[arg(long, value_name = "REPORT_JSON", conflicts_with_all = ["quick", "maps", "data"])]
+    pub from_report: Option<PathBuf>,
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
-    let Some(data) = args.data.clone().or_else(shared_data_dir) else {
-        println!(
-            "skipped: no ../shared/data folder beside the checkout (or --data, $STRANDLIGHT_SHARED_DATA): the benchmark measures the real maps and hair there"
-        );
-        return Ok(());
+    let report = match &args.from_report {
+        Some(path) => read_report(path)?,
+        None => match measure(&args)? {
+            Some(report) => report,
+            None => return Ok(()),
+        },
     };
-    if !data.join("hair/straight.hair").is_file() {
-        println!(
-            "skipped: {} has no hair/straight.hair, the benchmark's hair",
-            data.display()
-        );
-        return Ok(());
-    }
-    let mut plan = if args.quick {
-        BenchPlan::quick()
-    } else {
-        BenchPlan::full()
-    };
-    if !args.maps.is_empty() {
-        plan.maps = args.maps.clone();
-    }
+    let quick = report.plan.name == "quick";
     let out = args.out.clone().unwrap_or_else(|| {
-        PathBuf::from(if args.quick {
+        PathBuf::from(if quick {
             "out/bench-quick"
         } else {
             "docs/bench"
         })
     });
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-    let mut steps = Steps::new(false);
-    let paths = BenchPaths {
-        data,
-        cache: args.cache.clone(),
-        scratch: PathBuf::from("out/bench-scratch"),
-    };
-    let report = run_bench(&plan, &paths, &mut steps)?;
-    let json = out.join(format!("report-{}.json", plan.name));
+    let json = out.join(format!("report-{}.json", report.plan.name));
     write_atomically(&json, |w| {
         serde_json::to_writer_pretty(w, &report).map_err(std::io::Error::other)
     })
@@ -86,7 +71,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             println!("wrote {} (and .svg)", png.display());
         }
     }
-    if args.quick {
+    if quick {
         let page = out.join("REPORT.md");
         write_atomically(&page, |w| {
             std::io::Write::write_all(w, section(&report, ".").as_bytes())
@@ -113,6 +98,49 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// Runs the plan on the shared data; None (with the reason printed) where that data is absent.
+fn measure(args: &BenchArgs) -> anyhow::Result<Option<BenchReport>> {
+    let Some(data) = args.data.clone().or_else(shared_data_dir) else {
+        println!(
+            "skipped: no ../shared/data folder beside the checkout (or --data, $STRANDLIGHT_SHARED_DATA): the benchmark measures the real maps and hair there"
+        );
+        return Ok(None);
+    };
+    if !data.join("hair/straight.hair").is_file() {
+        println!(
+            "skipped: {} has no hair/straight.hair, the benchmark's hair",
+            data.display()
+        );
+        return Ok(None);
+    }
+    let mut plan = if args.quick {
+        BenchPlan::quick()
+    } else {
+        BenchPlan::full()
+    };
+    if !args.maps.is_empty() {
+        plan.maps = args.maps.clone();
+    }
+    let mut steps = Steps::new(false);
+    let paths = BenchPaths {
+        data,
+        cache: args.cache.clone(),
+        scratch: PathBuf::from("out/bench-scratch"),
+    };
+    run_bench(&plan, &paths, &mut steps).map(Some)
+}
+
+fn read_report(path: &std::path::Path) -> anyhow::Result<BenchReport> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    serde_json::from_str(&text).with_context(|| {
+        format!(
+            "{} is not a report `strandlight bench` wrote",
+            path.display()
+        )
+    })
 }
 
 /// `path` relative to `base` when it lies below it (docs/bench from docs → "bench"), else as is.

@@ -21,7 +21,7 @@ use crate::look::{BoxAverageArg, EnvTransparency, ForwardDevice, LookArgs, ViewA
 use crate::scene_tables::{EnvShading, ScatteringMode};
 use crate::steps::Steps;
 use anyhow::Context;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake::bake_job;
@@ -30,9 +30,9 @@ use strandlight_precompute::baked_tables_check::check_asset;
 use strandlight_runtime::env::{EnvLight, ViewTransparency};
 
 /// What one run measures.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct BenchPlan {
-    pub name: &'static str,
+    pub name: String,
     pub maps: Vec<String>,
     pub size: (u32, u32),
     pub modes: Vec<ScatteringMode>,
@@ -65,7 +65,7 @@ impl BenchPlan {
     /// The whole report: every map, both modes, the sweeps.
     pub fn full() -> Self {
         Self {
-            name: "full",
+            name: "full".into(),
             maps: ALL_MAPS.iter().map(|m| m.to_string()).collect(),
             size: (320, 240),
             modes: vec![ScatteringMode::Single, ScatteringMode::Full],
@@ -84,7 +84,7 @@ impl BenchPlan {
     /// at most 384 lights.
     pub fn quick() -> Self {
         Self {
-            name: "quick",
+            name: "quick".into(),
             maps: vec![ALL_MAPS[0].to_string()],
             size: (160, 120),
             modes: vec![ScatteringMode::Single],
@@ -101,10 +101,10 @@ impl BenchPlan {
 }
 
 /// One measured frame.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Point {
     /// "srbf", "median cut" or "reference".
-    pub family: &'static str,
+    pub family: String,
     /// What was varied ("lobes", "kappa", "dodm", "lights") and its value.
     pub label: String,
     pub lights: usize,
@@ -114,10 +114,10 @@ pub struct Point {
 }
 
 /// One map and mode of the env-lit sweep.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct EnvLitResult {
     pub map: String,
-    pub mode: &'static str,
+    pub mode: String,
     pub reference_lights: usize,
     pub reference_ms: f64,
     pub reference_converged: Option<bool>,
@@ -130,7 +130,21 @@ pub struct EnvLitResult {
     pub speedup_equal_flip: Option<f64>,
 }
 
-#[derive(Debug, Clone, Serialize)]
+impl EnvLitResult {
+    /// Where the median-cut curve never gets as accurate as the SRBF default, its equal-error
+    /// speed-up is at least the costliest median-cut frame's time over the default's: that
+    /// frame's light count and the ratio.
+    pub fn speedup_lower_bound(&self) -> Option<(usize, f64)> {
+        let default = self.points.first()?;
+        self.points
+            .iter()
+            .filter(|p| p.family == "median cut")
+            .max_by(|a, b| a.ms.total_cmp(&b.ms))
+            .map(|p| (p.lights, p.ms / default.ms))
+    }
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct FitPoint {
     pub map: String,
     pub max_lobes: usize,
@@ -140,7 +154,7 @@ pub struct FitPoint {
     pub seconds: f64,
 }
 
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct TablePoint {
     pub nodes: usize,
     pub bytes: u64,
@@ -150,7 +164,7 @@ pub struct TablePoint {
     pub off_axis_max_error: f64,
 }
 
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct BenchReport {
     pub plan: BenchPlan,
     pub machine: String,
@@ -222,7 +236,7 @@ fn strongest_lights(scene: &CompareScene, n: usize) -> Vec<EnvLight> {
 }
 
 fn measure(
-    family: &'static str,
+    family: &str,
     label: String,
     lights: usize,
     ms: f64,
@@ -230,7 +244,7 @@ fn measure(
     reference: &Image,
 ) -> anyhow::Result<Point> {
     Ok(Point {
-        family,
+        family: family.into(),
         label,
         lights,
         ms,
@@ -347,7 +361,7 @@ fn env_lit(
         }
         let record = &reference.chosen.record;
         points.push(Point {
-            family: "reference",
+            family: "reference".into(),
             label: format!("{} lights", record.lights),
             lights: record.lights,
             ms: record.milliseconds,
@@ -361,7 +375,7 @@ fn env_lit(
         };
         out.push(EnvLitResult {
             map: name.clone(),
-            mode: mode.name(),
+            mode: mode.name().into(),
             reference_lights: record.lights,
             reference_ms: record.milliseconds,
             reference_converged: reference.converged,
@@ -529,9 +543,9 @@ fn machine() -> String {
 mod tests {
     use super::*;
 
-    fn point(family: &'static str, ms: f64, error: f64) -> Point {
+    fn point(family: &str, ms: f64, error: f64) -> Point {
         Point {
-            family,
+            family: family.into(),
             label: String::new(),
             lights: 0,
             ms,

@@ -151,7 +151,12 @@ where
         let at = (default.ms, metric.of(default).max(1e-4));
         let note = match metric.speedup(r) {
             Some(s) => format!("SRBF default: {s:.1}× median cut at equal error"),
-            None => "SRBF default: median cut never as accurate here".into(),
+            None => match r.speedup_lower_bound() {
+                Some((lights, bound)) => format!(
+                    "SRBF default: > {bound:.1}× median cut (its {lights} lights still less accurate)"
+                ),
+                None => "SRBF default".into(),
+            },
         };
         chart
             .draw_series([Cross::new(at, 9, BLACK.stroke_width(3))])

@@ -1,15 +1,21 @@
 //! The Markdown of `strandlight bench`: the generated section of docs/BENCHMARKS.md (between
 //! [`BEGIN`] and [`END`], replaced whole on every run; the rest of the page is left alone).
 
-use crate::bench::{BenchReport, EnvLitResult};
+use crate::bench::{BenchPlan, BenchReport, EnvLitResult};
 use anyhow::bail;
 use std::fmt::Write;
 
 pub const BEGIN: &str = "<!-- strandlight bench: generated section, begin -->";
 pub const END: &str = "<!-- strandlight bench: generated section, end -->";
 
-fn optional_speedup(s: Option<f64>) -> String {
-    s.map_or("never as accurate".into(), |s| format!("{s:.1}×"))
+fn optional_speedup(s: Option<f64>, r: &EnvLitResult) -> String {
+    match (s, r.speedup_lower_bound()) {
+        (Some(s), _) => format!("{s:.1}×"),
+        (None, Some((lights, bound))) => format!(
+            "more than {bound:.1}× (median cut with {lights} lights, the most measured, is still less accurate)"
+        ),
+        (None, None) => "not measured".into(),
+    }
 }
 
 fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str) {
@@ -30,8 +36,8 @@ fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str) {
             ),
             None => String::new(),
         },
-        optional_speedup(r.speedup_equal_rmse),
-        optional_speedup(r.speedup_equal_flip),
+        optional_speedup(r.speedup_equal_rmse, r),
+        optional_speedup(r.speedup_equal_flip, r),
     );
     if !r.reference_ladder.is_empty() {
         let ladder: Vec<String> = r
@@ -59,20 +65,35 @@ fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str) {
     );
 }
 
+/// The command line that reruns `report`'s plan: the plan's name and, where the run named its
+/// own maps, those maps.
+fn regenerate_args(report: &BenchReport) -> String {
+    let plan = &report.plan;
+    let (flag, default_maps) = if plan.name == "quick" {
+        (" --quick", BenchPlan::quick().maps)
+    } else {
+        ("", BenchPlan::full().maps)
+    };
+    if plan.maps == default_maps {
+        flag.to_string()
+    } else {
+        format!("{flag} --maps {}", plan.maps.join(","))
+    }
+}
+
 /// The generated section, `plot_dir` relative to the Markdown file (e.g. `bench`).
 pub fn section(report: &BenchReport, plot_dir: &str) -> String {
     let mut out = String::new();
     let plan = &report.plan;
+    let args = regenerate_args(report);
     let _ = writeln!(
         out,
-        "{BEGIN}\n## Speed against error (`strandlight bench{}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. Regenerate with `cargo run --release -- bench{}` (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and the opaque view; errors are over the hair pixels of the converged reference (compact sources exact, the rest one light per cube texel; N and 4N lights within 1%, capped at {} lights); ms are frame times on this machine's adapter, one run each (lavapipe: ratios only).\n",
-        if plan.name == "quick" { " --quick" } else { "" },
+        "{BEGIN}\n## Speed against error (`strandlight bench{args}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. Regenerate with `cargo run --release -- bench{args}` (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and the opaque view; errors are over the reference's hair pixels (compact sources exact, the rest one light per cube texel; the reference climbs N = 96, 384, … until N and 4N lights agree within 1% relative RMSE, or stops at {} lights: each map below says whether it converged); ms are frame times on this machine's adapter, one run each (lavapipe: ratios only).\n",
         report.date,
         report.git_revision,
         report.machine,
         report.adapter,
         report.seconds,
-        if plan.name == "quick" { " --quick" } else { "" },
         plan.size.0,
         plan.size.1,
         plan.reference_max_lights,
@@ -145,5 +166,34 @@ mod tests {
         assert_eq!(again, second, "idempotent");
         let damaged = format!("{page}{END}\n{BEGIN}\n");
         assert!(splice(&damaged, "x").is_err());
+    }
+
+    fn report_of(plan: BenchPlan) -> BenchReport {
+        BenchReport {
+            plan,
+            machine: String::new(),
+            adapter: String::new(),
+            date: String::new(),
+            git_revision: String::new(),
+            seconds: 0.0,
+            fits: Vec::new(),
+            tables: Vec::new(),
+            env_lit: Vec::new(),
+            skipped: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_regenerate_command_names_maps_only_when_the_run_chose_them() {
+        assert_eq!(regenerate_args(&report_of(BenchPlan::quick())), " --quick");
+        assert_eq!(regenerate_args(&report_of(BenchPlan::full())), "");
+        let mut every_map = BenchPlan::quick();
+        every_map.maps = BenchPlan::full().maps;
+        let args = regenerate_args(&report_of(every_map.clone()));
+        assert!(
+            args.starts_with(" --quick --maps hdr_overcast_soil_puresky_1k.hdr,quarry_01_1k.hdr,")
+        );
+        let page = section(&report_of(every_map), "bench");
+        assert!(page.contains(&format!("`cargo run --release -- bench{args}`")));
     }
 }
