@@ -454,6 +454,13 @@ fn equal_error_baseline(
         let error = args
             .equal_error_metric
             .measure(&r.image, &reference.image)?;
+        // A search near the reference's light count renders for many minutes: say each step
+        // (stderr, so `--json` keeps stdout for the JSON).
+        eprintln!(
+            "  equal-error search: {n} median-cut lights → {} {error:.4} (target {target_error:.4}), {:.0} ms/frame",
+            args.equal_error_metric.name(),
+            r.milliseconds
+        );
         renders.push((n, r.milliseconds, error));
         Ok::<f64, anyhow::Error>(error)
     })?;
@@ -615,7 +622,11 @@ fn run_mode(
             },
             |e: &EqualErrorResult| {
                 let (n, ms, err) = e.chosen();
-                format!("{n} median-cut lights reach {} {err:.4} ≤ {target:.4} at {ms:.2} ms/frame ({} renders{})", metric.name(), e.renders.len(), if e.at_bound { ", NOT reached at the search bound" } else { "" })
+                if e.at_bound {
+                    format!("NOT reached: {n} median-cut lights, the search bound, give {} {err:.4} > {target:.4} at {ms:.2} ms/frame ({} renders)", metric.name(), e.renders.len())
+                } else {
+                    format!("{n} median-cut lights reach {} {err:.4} ≤ {target:.4} at {ms:.2} ms/frame ({} renders)", metric.name(), e.renders.len())
+                }
             },
         )?)
     } else {
