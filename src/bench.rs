@@ -50,7 +50,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             None => return Ok(()),
         },
     };
-    let quick = report.plan.name == "quick";
+    let quick = report.plan.is_quick();
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from(if quick {
             "out/bench-quick"

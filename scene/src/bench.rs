@@ -80,6 +80,11 @@ impl BenchPlan {
         }
     }
 
+    /// Whether this is the `--quick` plan (its report goes to a scratch page, not docs/).
+    pub fn is_quick(&self) -> bool {
+        self.name == "quick"
+    }
+
     /// A few minutes: the smooth overcast map, single scattering, 160×120, a reference of
     /// at most 384 lights.
     pub fn quick() -> Self {

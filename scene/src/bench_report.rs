@@ -69,7 +69,7 @@ fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str) {
 /// own maps, those maps.
 fn regenerate_args(report: &BenchReport) -> String {
     let plan = &report.plan;
-    let (flag, default_maps) = if plan.name == "quick" {
+    let (flag, default_maps) = if plan.is_quick() {
         (" --quick", BenchPlan::quick().maps)
     } else {
         ("", BenchPlan::full().maps)
