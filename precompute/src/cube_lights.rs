@@ -63,6 +63,10 @@ pub enum CubeLightsError {
     ZeroFaceResolution,
     #[error("sub-samples per pixel side must be ≥ 1 (got 0)")]
     ZeroSubsamples,
+    #[error(
+        "a shading cube of {shading}² texels per face does not divide into the {face}² texels of the visibility cube: use a multiple of {face}"
+    )]
+    ShadingNotAMultiple { face: usize, shading: usize },
     #[error("environment map has bad pixels ({0}); sanitize it first")]
     BadPixels(BadPixelCounts),
 }

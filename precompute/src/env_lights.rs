@@ -8,7 +8,7 @@
 //! lobes, so all three sets of one map agree.
 
 use crate::compact_sources::{self, SourceOptions};
-use crate::cube_lights::{CubeLightsError, cube_face_lights};
+use crate::cube_lights::{CubeLightsError, CubeTexel, cube_face_lights, texel_center_direction};
 use crate::envmap::{EnvMap, rotate_about_up};
 use crate::median_cut::{DirectionalLight, median_cut};
 use crate::srbf_set::{LightKind, SrbfSet};
@@ -24,6 +24,9 @@ pub struct LightSpec {
     pub direction: DVec3,
     pub lambda: Option<f64>,
     pub rgb: [f64; 3],
+    /// Directional lights only: the direction of the shadow map whose visibility this light
+    /// takes (a reference sub-texel takes its cube texel's); `None`: its own direction.
+    pub shadowed_from: Option<DVec3>,
 }
 
 impl LightSpec {
@@ -55,17 +58,20 @@ pub fn srbf_set_lights(set: &SrbfSet) -> Vec<LightSpec> {
             direction: l.center().normalize(),
             lambda: Some(l.lambda),
             rgb: l.amplitude,
+            shadowed_from: None,
         },
         LightKind::Directional => LightSpec {
             direction: l.center().normalize(),
             lambda: None,
             rgb: crate::srbf_set::power(l),
+            shadowed_from: None,
         },
     });
     let sources = set.sources.iter().map(|s| LightSpec {
         direction: DVec3::from(s.direction).normalize(),
         lambda: None,
         rgb: s.power,
+        shadowed_from: None,
     });
     lobes.chain(sources).collect()
 }
@@ -77,6 +83,7 @@ fn directional(lights: Vec<DirectionalLight>, rotate_degrees: f64) -> Vec<LightS
             direction: rotate_about_up(l.direction, rotate_degrees).normalize(),
             lambda: None,
             rgb: l.power,
+            shadowed_from: None,
         })
         .collect()
 }
@@ -95,14 +102,112 @@ pub fn reference_lights(
     rotate_degrees: f64,
     sources: &SourceOptions,
 ) -> Result<Vec<LightSpec>, CubeLightsError> {
+    reference_lights_shaded(
+        map,
+        face_resolution,
+        face_resolution,
+        rotate_degrees,
+        sources,
+    )
+}
+
+/// [`reference_lights`] with each cube texel's light shaded over finer sub-texels: the map
+/// left after the compact sources becomes one light per texel of a `shading_face_resolution`
+/// cube (a multiple of `face_resolution`), whose visibility is interpolated between the shadow
+/// maps of the `face_resolution` cube's texel centres: each coarse texel's map
+/// ([`LightSpec::shadowed_from`]) shades the sub-texels around it weighted by a bilinear tent
+/// ([`tent_samples`]). A sub-texel thus appears under up to four maps, its power split by the
+/// weights. Lights are listed map by map; sub-texels with no luminance are left out.
+///
+/// Why: a texel light point-samples the fiber's response, whose R lobe is a few degrees wide,
+/// so a coarse cube moves highlights by up to half a texel, while visibility through the hair
+/// varies more slowly with the light's direction. Shading at the fine cube and interpolating
+/// visibility from the coarse one costs the coarse cube's light passes (the dominant cost) and
+/// converges at the rate of the interpolated visibility (docs/BENCHMARKS.md, "A converged
+/// reference").
+pub fn reference_lights_shaded(
+    map: &EnvMap,
+    face_resolution: usize,
+    shading_face_resolution: usize,
+    rotate_degrees: f64,
+    sources: &SourceOptions,
+) -> Result<Vec<LightSpec>, CubeLightsError> {
+    let (n, fine) = (face_resolution, shading_face_resolution);
+    if n == 0 || fine == 0 {
+        return Err(CubeLightsError::ZeroFaceResolution);
+    }
+    if !fine.is_multiple_of(n) {
+        return Err(CubeLightsError::ShadingNotAMultiple {
+            face: n,
+            shading: fine,
+        });
+    }
     let (found, residual) = compact_sources::extract(map, sources);
     let source_lights = found.iter().map(|s| DirectionalLight {
         direction: DVec3::from(s.direction),
         power: s.power,
     });
-    let mut lights: Vec<DirectionalLight> = source_lights.collect();
-    lights.extend(cube_face_lights(&residual, face_resolution)?);
-    Ok(directional(lights, rotate_degrees))
+    let mut lights = directional(source_lights.collect(), rotate_degrees);
+    let texel_lights = cube_face_lights(&residual, fine)?;
+    if fine == n {
+        lights.extend(directional(texel_lights, rotate_degrees));
+        return Ok(lights);
+    }
+    let m = fine / n;
+    for face in 0..6 {
+        for (j, i) in (0..n).flat_map(|j| (0..n).map(move |i| (j, i))) {
+            let texel = CubeTexel { face, i, j };
+            let shadow = texel_center_direction(texel, n);
+            let shadowed_from = Some(rotate_about_up(shadow, rotate_degrees).normalize());
+            let samples = tent_samples(texel, n, m).filter_map(|(t, w)| {
+                let l = &texel_lights[t.index(fine)];
+                (luminance(l.power) > 0.0).then(|| LightSpec {
+                    direction: rotate_about_up(l.direction, rotate_degrees).normalize(),
+                    lambda: None,
+                    rgb: l.power.map(|p| p * w),
+                    shadowed_from,
+                })
+            });
+            lights.extend(samples);
+        }
+    }
+    Ok(lights)
+}
+
+fn luminance(rgb: [f64; 3]) -> f64 {
+    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
+}
+
+/// The sub-texels of the `n·m` cube whose visibility the map of coarse `texel` contributes to,
+/// with their weights: the bilinear tent over the face between neighbouring coarse texel
+/// centres (constant beyond the outermost centres of the face; cube edges are not crossed).
+/// Over the coarse texels of a face the weights of every sub-texel sum to 1, so the map's
+/// power is kept and visibility is interpolated linearly between shadow maps instead of being
+/// piecewise constant (one order more accurate where it varies smoothly).
+fn tent_samples(texel: CubeTexel, n: usize, m: usize) -> impl Iterator<Item = (CubeTexel, f64)> {
+    // Sub-texel index k (0..n·m) in coarse texel units, centres at (k + ½)/m − ½.
+    let weight = move |coarse: usize, k: usize| {
+        let u = ((k as f64 + 0.5) / m as f64 - 0.5).clamp(0.0, (n - 1) as f64);
+        (1.0 - (u - coarse as f64).abs()).max(0.0)
+    };
+    let span = move |coarse: usize| {
+        let lo = coarse.saturating_sub(1) * m;
+        let hi = ((coarse + 2) * m).min(n * m);
+        (lo..hi).filter_map(move |k| {
+            let w = weight(coarse, k);
+            (w > 0.0).then_some((k, w))
+        })
+    };
+    span(texel.j).flat_map(move |(jj, wj)| {
+        span(texel.i).map(move |(ii, wi)| {
+            let t = CubeTexel {
+                face: texel.face,
+                i: ii,
+                j: jj,
+            };
+            (t, wi * wj)
+        })
+    })
 }
 
 /// The equal-cost baseline: `count` median-cut directional lights (Debevec 2005).
@@ -286,5 +391,86 @@ mod tests {
         assert_eq!(face_resolution_for(100), None);
         assert_eq!(face_resolution_for(0), None);
         assert_eq!(face_resolution_for(12), None);
+    }
+
+    /// The shaded reference keeps the map's power (the tent weights of every sub-texel sum to
+    /// 1), keeps the compact sources as they are, shares one map per texel, and refuses a
+    /// shading cube that does not divide into the visibility cube.
+    #[test]
+    fn shaded_reference_carries_the_whole_map_in_runs_sharing_a_map() {
+        let sun = DVec3::new(0.4, 0.6, -0.69).normalize();
+        let map = EnvMap::from_fn(512, 256, |w| {
+            let sky = 0.5 + 0.3 * w.y.max(0.0);
+            let disc = if w.dot(sun) > 0.5f64.to_radians().cos() {
+                2e5
+            } else {
+                0.0
+            };
+            [sky + disc, sky + 0.9 * disc, sky + 0.7 * disc]
+        });
+        let truth = pixel_sum_integral(&map);
+        let sources = SourceOptions::default();
+        for (n, fine) in [(2, 8), (4, 8), (4, 4)] {
+            let lights = reference_lights_shaded(&map, n, fine, 15.0, &sources).unwrap();
+            let gap = relative_gap(total_power(&lights), truth);
+            let maps = lights
+                .chunk_by(|a, b| a.shadowed_from.is_some() && a.shadowed_from == b.shadowed_from)
+                .count();
+            println!(
+                "n = {n}, shading {fine}: {} lights, {maps} maps, power gap {gap:.2e}",
+                lights.len()
+            );
+            assert!(gap < 1e-9, "{gap}");
+            assert_eq!(maps, 1 + 6 * n * n, "the sun, then one map per texel");
+            assert!(
+                lights[0].shadowed_from.is_none(),
+                "the sun casts its own map"
+            );
+            match fine == n {
+                true => assert!(lights.iter().all(|l| l.shadowed_from.is_none())),
+                false => assert!(lights[1..].iter().all(|l| l.shadowed_from.is_some())),
+            }
+        }
+        let e = reference_lights_shaded(&map, 4, 6, 0.0, &sources).unwrap_err();
+        assert!(e.to_string().contains("multiple of 4"), "{e}");
+    }
+
+    /// Visibility bilinear in a face's coordinates is reproduced exactly by the tent weights
+    /// between the coarse texel centres (what makes the interpolation one order more accurate
+    /// than one map per texel); beyond the outermost centres it is held constant.
+    #[test]
+    fn tent_weights_interpolate_bilinear_visibility_exactly() {
+        let (n, m) = (4usize, 4usize);
+        let centre = |k: usize, res: usize| 2.0 * (k as f64 + 0.5) / res as f64 - 1.0;
+        let visibility = |a: f64, b: f64| 1.0 + 0.3 * a - 0.2 * b + 0.1 * a * b;
+        let mut interpolated = vec![0.0f64; n * m * n * m];
+        let mut weight_sum = vec![0.0f64; n * m * n * m];
+        for (j, i) in (0..n).flat_map(|j| (0..n).map(move |i| (j, i))) {
+            let v = visibility(centre(i, n), centre(j, n));
+            for (t, w) in tent_samples(CubeTexel { face: 2, i, j }, n, m) {
+                assert_eq!(t.face, 2);
+                interpolated[t.j * n * m + t.i] += w * v;
+                weight_sum[t.j * n * m + t.i] += w;
+            }
+        }
+        let (lo, hi) = (centre(0, n), centre(n - 1, n));
+        let mut checked = 0;
+        for (jj, ii) in (0..n * m).flat_map(|j| (0..n * m).map(move |i| (j, i))) {
+            let k = jj * n * m + ii;
+            assert!(
+                (weight_sum[k] - 1.0).abs() < 1e-12,
+                "{ii},{jj}: {}",
+                weight_sum[k]
+            );
+            let (a, b) = (centre(ii, n * m), centre(jj, n * m));
+            let clamped = visibility(a.clamp(lo, hi), b.clamp(lo, hi));
+            assert!(
+                (interpolated[k] - clamped).abs() < 1e-12,
+                "{ii},{jj}: {} vs {clamped}",
+                interpolated[k]
+            );
+            checked += 1;
+        }
+        assert_eq!(checked, 256);
     }
 }

@@ -778,6 +778,19 @@ fn bad_inputs_are_typed_errors() {
         matches!(e, EnvRenderError::BadLight { index: 0, .. }),
         "{e}"
     );
+    let shared_srbf = EnvLight {
+        shadowed_from: Some(Vec3::Y),
+        ..EnvLight::srbf(Vec3::Z, 8.0, [1.0; 3])
+    };
+    let bad_from = EnvLight::directional_shadowed_from(Vec3::Z, [1.0; 3], Vec3::NAN);
+    for (index, lights) in [(0, vec![shared_srbf]), (1, vec![light[0], bad_from])] {
+        let e = render(&lights, &tables, &options);
+        assert!(
+            matches!(e, EnvRenderError::BadLight { index: i, .. } if i == index),
+            "{e}"
+        );
+        println!("{e}");
+    }
     // More SAT bytes than the adapter binds: a batch of 2048² maps sized past the limit.
     let limit = gpu.device.limits().max_storage_buffer_binding_size;
     let slots = (limit / (2048 * 2048 * 16) + 1) as u32;
@@ -936,6 +949,86 @@ fn shadowing_reaches_the_right_light_in_every_batch() {
                 p[k], lit1[k]
             );
             assert!(rel < 2e-3, "channel {k}: {} vs {want}", p[k]);
+        }
+    }
+}
+
+/// Lights that share a shadow map (`EnvLight::shadowed_from`, the reference's sub-texels) are
+/// shaded each along its own direction but with the visibility of the shared map: in the scene
+/// above, both lights shadowed from light 2's direction reach B unshadowed (lit1 + lit2), both
+/// shadowed from light 1's are blocked by A; each run is one map, one batch.
+#[test]
+fn lights_sharing_a_shadow_map_take_its_visibility_and_their_own_shading() {
+    let points = vec![
+        Vec3::new(-0.4, -0.5, 0.0),
+        Vec3::new(0.4, -0.5, 0.0),
+        Vec3::new(-0.6, 0.0, 0.5),
+        Vec3::new(0.6, 0.0, 0.5),
+    ];
+    let thickness = Attribute::PerPoint(vec![3.0 / 32.0, 3.0 / 32.0, 0.25, 0.25]);
+    let model = HairModel::new(points, vec![0, 2, 4], Some(thickness), None, None).unwrap();
+    let direct = synthetic_table(Axis::uniform("none", 0.0, 0.0, 1));
+    let tables = EnvTables {
+        direct: Some(direct.clone()),
+        ..Default::default()
+    };
+    let (d1, d2) = (Vec3::new(0.0, 1.0, 1.0), Vec3::new(0.0, -1.0, 1.0));
+    let (rgb1, rgb2) = ([1.0, 0.8, 0.6], [0.5, 0.7, 0.9]);
+    let gpu = gpu();
+    let probe = (32usize, ((1.0 - -0.5f32) * 32.0) as usize);
+    let contribution = |d: Vec3, rgb: [f32; 3]| -> [f64; 3] {
+        let [a, b, c] = coordinates(DVec3::X, d.normalize().as_dvec3(), DVec3::Z);
+        let v = direct.lookup_rgb(&[a, b, c, 0.0]).unwrap();
+        std::array::from_fn(|k| v[k] as f64 * rgb[k] as f64)
+    };
+    let unshadowed: [f64; 3] = {
+        let (a, b) = (contribution(d1, rgb1), contribution(d2, rgb2));
+        std::array::from_fn(|k| a[k] + b[k])
+    };
+    for (from, want, name) in [
+        (d2, unshadowed, "shadowed from light 2 (open)"),
+        (d1, [0.0; 3], "shadowed from light 1 (behind A)"),
+    ] {
+        let lights = [
+            EnvLight::directional_shadowed_from(d1, rgb1, from),
+            EnvLight::directional_shadowed_from(d2, rgb2, from),
+        ];
+        let options = EnvRenderOptions {
+            dodm: DodmSettings {
+                resolution: 64,
+                first_layer: Some(0.05),
+                batch_size: 1,
+            },
+            kappa: 1.0,
+            ..Default::default()
+        };
+        let frame = render_env_frame(
+            &gpu,
+            &model,
+            &ortho_camera(),
+            RES,
+            RES,
+            &lights,
+            &tables,
+            &options,
+            None,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(frame.stats.batches, 1, "{name}: one shared map, one batch");
+        let p = frame.pixels[probe.1 * RES as usize + probe.0];
+        for k in 0..3 {
+            println!(
+                "{name}, channel {k}: GPU {:.6}, expected {:.6}",
+                p[k], want[k]
+            );
+            // Blocked: T ≤ 0.001² of two opaque fibers, against lit values of order 0.1–1.
+            let tolerance = 2e-3 * unshadowed[k];
+            assert!(
+                (p[k] as f64 - want[k]).abs() <= tolerance,
+                "{name}, channel {k}: {} vs {}",
+                p[k],
+                want[k]
+            );
         }
     }
 }

@@ -197,6 +197,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         reference_lights: None,
         reference_tolerance: 0.01,
         reference_max_lights: plan.reference_max_lights,
+        reference_shading_lights: 0,
         shading: EnvShading::Marschner,
         preset: "brown".into(),
         out: out.to_path_buf(),

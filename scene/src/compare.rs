@@ -24,10 +24,10 @@ use std::path::PathBuf;
 use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_precompute::env_lights::{
-    face_resolution_for, median_cut_lights, reference_lights, srbf_set_lights,
+    face_resolution_for, median_cut_lights, reference_lights_shaded, srbf_set_lights,
 };
 use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_runtime::env::{EnvLight, EnvRenderOptions};
+use strandlight_runtime::env::{EnvLight, EnvRenderOptions, shadow_groups};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::image_out::{write_exr, write_png};
 use strandlight_tables::checksum::sha256_hex;
@@ -70,6 +70,13 @@ pub struct CompareArgs {
     /// Most lights a converged reference may use (6n²); reached unconverged, the report says so.
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 6144))]
     pub reference_max_lights: usize,
+    /// The reference's shading cube, 6m² texels (m a multiple of every reference cube's n;
+    /// 0, the default: every light shaded at its texel's centre, Ren 2010's brute force). The
+    /// map is then shaded at this cube's texels, their visibility interpolated between the
+    /// reference cube's shadow maps (precompute/src/env_lights.rs): the light passes stay the
+    /// reference's, the shading costs more (docs/BENCHMARKS.md, "Shading the reference finer").
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0))]
+    pub reference_shading_lights: usize,
     #[cfg_attr(
         any(feature = "cli", test),
         arg(long, value_enum, default_value = "marschner")
@@ -192,9 +199,29 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
             24 * FIRST_CONVERGENCE_FACE * FIRST_CONVERGENCE_FACE
         );
     }
-    match args.reference_lights {
-        Some(count) => Ok(ReferenceChoice::Fixed(check("--reference-lights", count)?)),
-        None => Ok(ReferenceChoice::Converged { most_face: most }),
+    let choice = match args.reference_lights {
+        Some(count) => ReferenceChoice::Fixed(check("--reference-lights", count)?),
+        None => ReferenceChoice::Converged { most_face: most },
+    };
+    if let Some(m) = shading_face(args)? {
+        let finest = choice.finest_face();
+        if m < finest || !m.is_multiple_of(finest) {
+            bail!(
+                "--reference-shading-lights {}: its {m}² texels per face must split every reference texel, up to the finest cube's {finest}²: use 6m² with m a multiple of {finest}",
+                args.reference_shading_lights
+            );
+        }
+    }
+    Ok(choice)
+}
+
+/// The reference's shading cube's face resolution m (None: shaded at the texel lights).
+fn shading_face(args: &CompareArgs) -> anyhow::Result<Option<usize>> {
+    match args.reference_shading_lights {
+        0 => Ok(None),
+        count => face_resolution_for(count).map(Some).with_context(|| {
+            format!("--reference-shading-lights {count}: must be 0 or 6m² (e.g. 24576 = 6·64², 98304 = 6·128²)")
+        }),
     }
 }
 
@@ -208,6 +235,22 @@ enum ReferenceChoice {
     Fixed(usize),
     /// N = 6n², then 4N, … up to 6·most_face² lights, until N and 4N agree.
     Converged { most_face: usize },
+}
+
+impl ReferenceChoice {
+    /// The face resolution of the finest cube it may render.
+    fn finest_face(&self) -> usize {
+        match *self {
+            Self::Fixed(n) => n,
+            Self::Converged { most_face } => {
+                let mut face = FIRST_CONVERGENCE_FACE;
+                while 2 * face <= most_face {
+                    face *= 2;
+                }
+                face
+            }
+        }
+    }
 }
 
 /// Loads the hair file, fits, bakes and builds the light sets (every step timed into `steps`).
@@ -368,11 +411,19 @@ pub fn timed_render(
 impl CompareScene {
     /// The reference's lights for n×n texels per cube face: the compact sources exactly, the
     /// rest of the map one light per cube texel.
-    pub fn reference_set(&self, face: usize, rotate: f64) -> anyhow::Result<Vec<EnvLight>> {
-        Ok(to_env_lights(
-            &reference_lights(&self.map, face, rotate, &self.reference_sources)?,
-            self.up,
-        ))
+    /// Shaded over a `shading_face`² cube per face when that is finer (see
+    /// [`CompareArgs::reference_shading_lights`]).
+    pub fn reference_set(
+        &self,
+        face: usize,
+        shading_face: Option<usize>,
+        rotate: f64,
+    ) -> anyhow::Result<Vec<EnvLight>> {
+        let shading = shading_face.unwrap_or(face).max(face);
+        let specs =
+            reference_lights_shaded(&self.map, face, shading, rotate, &self.reference_sources)
+                .with_context(|| format!("--reference-shading-lights {}", 6 * shading * shading))?;
+        Ok(to_env_lights(&specs, self.up))
     }
 }
 
@@ -519,11 +570,12 @@ const REFERENCE_MULTIPLE_TABLES: [&str; 3] = ["multiple", "fiber_averages", "att
 fn reference_inputs(
     scene: &CompareScene,
     args: &CompareArgs,
+    face: usize,
     lights: usize,
     mode: ScatteringMode,
 ) -> anyhow::Result<Value> {
     let direct = scene.tables.get(args.shading.direct_table(mode))?;
-    Ok(json!({
+    let mut inputs = json!({
         "hair_sha256": scene.hair_sha256,
         "camera": format!("{:?}", scene.camera),
         "size": [scene.size.0, scene.size.1],
@@ -539,7 +591,14 @@ fn reference_inputs(
         "multiple_tables_inputs": REFERENCE_MULTIPLE_TABLES.iter().filter(|_| mode == ScatteringMode::Full).filter_map(|n| scene.tables.assets.get(*n)).map(|a| a.metadata.description.inputs_key.clone()).collect::<Vec<_>>(),
         "generator": env!("CARGO_PKG_VERSION"),
         "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, transparency: look(args).transparency, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
-    }))
+    });
+    // Only a finer shading cube adds a key, so brute-force references keep their cache entries.
+    if let Some(m) = shading_face(args)?.filter(|&m| m > face) {
+        inputs["reference_shading"] = json!(format!(
+            "{m}² texels per face, visibility interpolated between the {face}² texels' maps"
+        ));
+    }
+    Ok(inputs)
 }
 
 fn run_mode(
@@ -655,11 +714,13 @@ fn reference_with_face(
     face: usize,
     steps: &mut Steps,
 ) -> anyhow::Result<ReferenceImage> {
-    let lights = scene.reference_set(face, args.rotate)?;
+    let lights = scene.reference_set(face, shading_face(args)?, args.rotate)?;
+    // What a reference costs is its shadow maps: one per compact source and per texel.
+    let maps = shadow_groups(&lights).len();
     let cache = ReferenceCache::new(args.cache.join("reference"));
-    let inputs = reference_inputs(scene, args, lights.len(), mode)?;
+    let inputs = reference_inputs(scene, args, face, maps, mode)?;
     steps.run(
-        &format!("{}: reference, {} lights", mode.name(), lights.len()),
+        &format!("{}: reference, {maps} lights", mode.name()),
         || match cache.load(&inputs) {
             Some((image, record)) => Ok(ReferenceImage {
                 image,
@@ -670,7 +731,8 @@ fn reference_with_face(
                 let r = render(&reference_frame(scene, args, &lights, mode))?;
                 let record = ReferenceRecord {
                     inputs: inputs.clone(),
-                    lights: lights.len(),
+                    lights: maps,
+                    shading_lights: lights.len(),
                     milliseconds: r.milliseconds,
                 };
                 cache.store(&r.image, &record)?;
@@ -903,6 +965,8 @@ mod tests {
             ReferenceChoice::Converged { most_face: 32 }
         );
         for (flag, value, wanted) in [
+            ("--reference-shading-lights", "100", "6m²"),
+            ("--reference-shading-lights", "1536", "multiple of 32"),
             ("--reference-max-lights", "100", "6n²"),
             ("--reference-max-lights", "96", "allow at least 384"),
             ("--reference-tolerance", "0", "(0, 1)"),
@@ -935,6 +999,19 @@ mod tests {
         assert_eq!(
             (a.shading, validate(&a).unwrap(), a.json),
             (EnvShading::Artist, ReferenceChoice::Fixed(4), true)
+        );
+        let a = args(&[
+            "--hair",
+            "h",
+            "--env",
+            "e",
+            "--reference-shading-lights",
+            "24576",
+        ])
+        .unwrap();
+        assert_eq!(
+            validate(&a).unwrap(),
+            ReferenceChoice::Converged { most_face: 32 }
         );
         assert!(args(&["--hair", "h", "--env", "e", "--shading", "kajiya-kay"]).is_err());
     }

@@ -37,9 +37,14 @@ pub fn to_env_lights(specs: &[LightSpec], up: UpAxis) -> Vec<EnvLight> {
         .map(|s| {
             let direction: Vec3 = env_to_world(s.direction, up).as_vec3();
             let rgb = s.rgb.map(|c| c as f32);
-            match s.lambda {
-                Some(lambda) => EnvLight::srbf(direction, lambda as f32, rgb),
-                None => EnvLight::directional(direction, rgb),
+            match (s.lambda, s.shadowed_from) {
+                (Some(lambda), _) => EnvLight::srbf(direction, lambda as f32, rgb),
+                (None, None) => EnvLight::directional(direction, rgb),
+                (None, Some(from)) => EnvLight::directional_shadowed_from(
+                    direction,
+                    rgb,
+                    env_to_world(from, up).as_vec3(),
+                ),
             }
         })
         .collect()
@@ -119,6 +124,7 @@ mod tests {
             direction: DVec3::new(0.0, 0.6, 0.8),
             lambda: Some(32.0),
             rgb: [1.0, 2.0, 3.0],
+            shadowed_from: None,
         }];
         let l = to_env_lights(&srbf, UpAxis::Y)[0];
         assert_eq!(l.lambda, Some(32.0));

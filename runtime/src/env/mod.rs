@@ -18,6 +18,12 @@ pub struct EnvLight {
     /// SRBF amplitude L_j (radiance) for an SRBF; for a directional light its irradiance at
     /// normal incidence (the radiance it stands for × the solid angle it covers).
     pub rgb: [f32; 3],
+    /// Directional lights only: the direction of the shadow map this light's visibility is read
+    /// from, shared by every light of one run of consecutive lights with the same value (one
+    /// light pass for the run; see [`ShadowGroup`]). `None`: its own map, along `direction`.
+    /// The reference uses it to shade a cube texel's light over finer sub-texels whose
+    /// visibility is the texel's (`precompute/src/env_lights.rs`).
+    pub shadowed_from: Option<Vec3>,
 }
 
 impl EnvLight {
@@ -26,6 +32,7 @@ impl EnvLight {
             direction: direction.normalize(),
             lambda: Some(lambda),
             rgb: amplitude,
+            shadowed_from: None,
         }
     }
 
@@ -34,7 +41,25 @@ impl EnvLight {
             direction: direction.normalize(),
             lambda: None,
             rgb: irradiance,
+            shadowed_from: None,
         }
+    }
+
+    /// A directional light whose visibility is that of the shadow map along `shadowed_from`.
+    pub fn directional_shadowed_from(
+        direction: Vec3,
+        irradiance: [f32; 3],
+        shadowed_from: Vec3,
+    ) -> Self {
+        Self {
+            shadowed_from: Some(shadowed_from.normalize()),
+            ..Self::directional(direction, irradiance)
+        }
+    }
+
+    /// The direction of the light pass whose map shadows this light.
+    pub fn shadow_direction(&self) -> Vec3 {
+        self.shadowed_from.unwrap_or(self.direction)
     }
 
     /// What the light delivers to a fiber facing it, before shadowing: for an SRBF its
@@ -50,6 +75,43 @@ impl EnvLight {
             }
         }
     }
+}
+
+/// Consecutive lights that share one shadow map (one DODM slot, one light pass, one
+/// forward-scattering grid block): a run of directional lights with the same
+/// [`EnvLight::shadowed_from`], or any other light alone.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowGroup<'a> {
+    /// The light pass's direction.
+    pub direction: Vec3,
+    /// The lights shaded with its visibility (at least one).
+    pub lights: &'a [EnvLight],
+}
+
+impl ShadowGroup<'_> {
+    /// One light standing for the group where only the map's direction matters (the light
+    /// pass, the forward-scattering march): the first light moved to the map's direction.
+    pub fn representative(&self) -> EnvLight {
+        EnvLight {
+            direction: self.direction,
+            shadowed_from: None,
+            ..self.lights[0]
+        }
+    }
+}
+
+/// `lights` cut into [`ShadowGroup`]s, in order.
+pub fn shadow_groups(lights: &[EnvLight]) -> Vec<ShadowGroup<'_>> {
+    let shares = |a: &EnvLight, b: &EnvLight| {
+        a.lambda.is_none() && a.shadowed_from.is_some() && a.shadowed_from == b.shadowed_from
+    };
+    lights
+        .chunk_by(shares)
+        .map(|run| ShadowGroup {
+            direction: run[0].shadow_direction(),
+            lights: run,
+        })
+        .collect()
 }
 
 /// The forward-scattering attenuation T_f (RGB) and spread σ̄_f (radians, the standard

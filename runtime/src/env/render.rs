@@ -8,7 +8,7 @@ use strandlight_tables::table_axes::{
     AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_SIGMA_F, AXIS_U_DOT_WO, AXIS_U_DOT_XI,
 };
 
-use super::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource};
+use super::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource, ShadowGroup, shadow_groups};
 use crate::camera::Camera;
 use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels, fit_within};
 use crate::gpu::readback::{ReadbackError, read_buffer};
@@ -228,6 +228,19 @@ fn check_light(index: usize, light: &EnvLight) -> Result<(), EnvRenderError> {
     }
     if light.rgb.iter().any(|c| !c.is_finite()) {
         return Err(bad(format!("rgb {:?} is not finite", light.rgb)));
+    }
+    if let Some(from) = light.shadowed_from {
+        if light.lambda.is_some() {
+            return Err(bad(
+                "an SRBF light casts its own shadow map (shadowed_from is for directional lights)"
+                    .into(),
+            ));
+        }
+        if !from.is_finite() || from.length() < 1e-6 {
+            return Err(bad(format!(
+                "shadowed_from {from:?} is not a usable unit vector"
+            )));
+        }
     }
     Ok(())
 }
@@ -519,9 +532,10 @@ impl EnvRenderer {
         for (kind_lights, binding) in &kind_tables {
             let Some(binding) = binding else { continue };
             usage.table_bytes += binding.bytes;
-            for chunk in kind_lights.chunks(options.dodm.batch_size as usize) {
+            let groups = shadow_groups(kind_lights);
+            for chunk in groups.chunks(options.dodm.batch_size as usize) {
                 let batch = LightBatch {
-                    lights: chunk,
+                    groups: chunk,
                     tables: binding,
                 };
                 self.render_batch(gpu, &mut frame, &batch, &request, &mut timings, &mut usage)?;
@@ -573,7 +587,8 @@ impl EnvRenderer {
             multiple,
         } = *request;
         let batch_size = options.dodm.batch_size as usize;
-        let slots = batch_size.min(kinds.srbf.len().max(kinds.directional.len())) as u32;
+        let maps = |lights: &[EnvLight]| shadow_groups(lights).len();
+        let slots = batch_size.min(maps(&kinds.srbf).max(maps(&kinds.directional))) as u32;
         let resolution = options.dodm.resolution;
         check_frame_limits(gpu, (width, height), resolution, slots)?;
         let sat = SummedAreaTables::new(gpu, resolution, slots)?;
@@ -683,9 +698,16 @@ impl EnvRenderer {
     ) -> Result<(), EnvRenderError> {
         let options = request.options;
         usage.batches += 1;
-        let srbf_kind = batch.lights.first().is_some_and(|l| l.lambda.is_some());
+        let srbf_kind = batch
+            .groups
+            .first()
+            .is_some_and(|g| g.lights[0].lambda.is_some());
         let grid = match request.multiple {
-            Some(source) => Some(batch_grid(gpu, source, batch.lights, timings)?),
+            Some(source) => {
+                let representatives: Vec<_> =
+                    batch.groups.iter().map(|g| g.representative()).collect();
+                Some(batch_grid(gpu, source, &representatives, timings)?)
+            }
             None => None,
         };
         timings.time(gpu, "light pass", || {
@@ -693,7 +715,7 @@ impl EnvRenderer {
                 true => (&frame.light_geometry, 1.0 / options.kappa),
                 false => (&frame.geometry, 1.0),
             };
-            let directions: Vec<_> = batch.lights.iter().map(|l| l.direction).collect();
+            let directions: Vec<_> = batch.groups.iter().map(|g| g.direction).collect();
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             self.depth.encode(
                 gpu,
@@ -718,10 +740,10 @@ impl EnvRenderer {
             gpu.queue.submit([encoder.finish()]);
         });
         timings.time(gpu, "view", || {
-            let lights = BatchBinding::with_filter(
+            let lights = BatchBinding::with_groups(
                 gpu,
                 &self.view.batch_layout,
-                batch.lights,
+                batch.groups,
                 &frame.dodm,
                 &frame.sat,
                 options.shadowed,
@@ -750,9 +772,10 @@ impl EnvRenderer {
     }
 }
 
-/// One batch: lights of one kind (at most the batch size) and their kind's tables.
+/// One batch: lights of one kind (at most the batch size of shadow groups) and their kind's
+/// tables.
 struct LightBatch<'a> {
-    lights: &'a [EnvLight],
+    groups: &'a [ShadowGroup<'a>],
     tables: &'a TableBinding,
 }
 

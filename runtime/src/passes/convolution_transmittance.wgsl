@@ -22,6 +22,22 @@ struct EnvLightGpu {
     far: f32,
     first_layer: f32,
     texels_per_unit: f32,
+    // The lights shaded with this slot's visibility: shading_samples[first_sample ..+ count].
+    first_sample: u32,
+    sample_count: u32,
+    _pad0: u32,
+    _pad1: u32,
+};
+
+// One light as the view pass shades it (the slot's light itself, or one of the sub-texel lights
+// of a reference texel that share the slot's shadow map).
+struct ShadingSample {
+    // xyz: unit vector toward the light; w: 1/λ (0 for a directional light).
+    direction: vec4<f32>,
+    // xyz: L_j (SRBF) or irradiance (directional).
+    rgb: vec4<f32>,
+    // xyz: EnvLight::power().
+    power: vec4<f32>,
 };
 
 struct BatchParams {
@@ -37,6 +53,7 @@ struct BatchParams {
 @group(1) @binding(1) var<storage, read> env_lights: array<EnvLightGpu>;
 @group(1) @binding(2) var dodm_depth: texture_depth_2d_array;
 @group(1) @binding(3) var<storage, read> sat: array<vec4<u32>>;
+@group(1) @binding(4) var<storage, read> shading_samples: array<ShadingSample>;
 
 const SAT_FIXED_POINT_SCALE: f32 = 256.0;
 const SAT_TRANSMITTANCE_SCALE: f32 = 4096.0;

@@ -21,7 +21,7 @@ use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
 use super::summed_area::{BoxAverage, MAX_BOX_HALF_SIZE, SummedAreaTables};
 use super::transmittance_filter::TransmittanceFilter;
 use super::view_visibility::{OccupancyMap, ViewTransparency, ViewVisibilityPass};
-use crate::env::{EnvLight, ForwardScatteringGrid};
+use crate::env::{EnvLight, ForwardScatteringGrid, ShadowGroup};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{
     float_texture_entry, pipeline_layout, storage_entry, texture_entry, uniform_entry,
@@ -39,6 +39,32 @@ pub(crate) struct EnvLightGpu {
     far: f32,
     first_layer: f32,
     texels_per_unit: f32,
+    /// The slot's lights in the batch's shading samples: `first_sample ..+ sample_count`.
+    first_sample: u32,
+    sample_count: u32,
+    _pad: [u32; 2],
+}
+
+/// One light as the view pass shades it, with the visibility of its shadow group's slot.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct ShadingSampleGpu {
+    /// xyz: unit vector toward the light; w: 1/λ (0 for a directional light).
+    direction: [f32; 4],
+    rgb: [f32; 4],
+    power: [f32; 4],
+}
+
+impl ShadingSampleGpu {
+    fn of(light: &EnvLight) -> Self {
+        let inv_lambda = light.lambda.map_or(0.0, |l| 1.0 / l);
+        let power = light.power();
+        Self {
+            direction: light.direction.normalize().extend(inv_lambda).into(),
+            rgb: [light.rgb[0], light.rgb[1], light.rgb[2], 0.0],
+            power: [power[0], power[1], power[2], 0.0],
+        }
+    }
 }
 
 #[repr(C)]
@@ -71,6 +97,7 @@ pub fn transmittance_bind_group_layout(
                 wgpu::TextureViewDimension::D2Array,
             ),
             storage_entry(3, visibility, true),
+            storage_entry(4, visibility, true),
         ],
     })
 }
@@ -116,27 +143,60 @@ impl BatchBinding {
         with_grid: bool,
         filter: TransmittanceFilter,
     ) -> Self {
+        let groups: Vec<_> = lights
+            .chunks(1)
+            .map(|one| ShadowGroup {
+                direction: one[0].direction,
+                lights: one,
+            })
+            .collect();
+        Self::with_groups(gpu, layout, &groups, dodm, sat, shadowed, with_grid, filter)
+    }
+
+    /// `groups[slot]` shaded with the visibility of DODM slot `slot`; `shadowed = false`
+    /// forces T̃ = 1.
+    #[allow(clippy::too_many_arguments)]
+    pub fn with_groups(
+        gpu: &GpuContext,
+        layout: &wgpu::BindGroupLayout,
+        groups: &[ShadowGroup<'_>],
+        dodm: &DodmBatch,
+        sat: &SummedAreaTables,
+        shadowed: bool,
+        with_grid: bool,
+        filter: TransmittanceFilter,
+    ) -> Self {
         let device = &gpu.device;
-        let mut gpu_lights: Vec<EnvLightGpu> = lights
+        let mut samples: Vec<ShadingSampleGpu> = Vec::new();
+        let mut gpu_lights: Vec<EnvLightGpu> = groups
             .iter()
             .enumerate()
-            .map(|(slot, light)| {
+            .map(|(slot, group)| {
                 let camera = dodm.cameras[slot];
                 let view_proj = camera.projection_matrix(1.0) * camera.view();
+                let light = group.representative();
                 let inv_lambda = light.lambda.map_or(0.0, |l| 1.0 / l);
                 let power = light.power();
+                let first_sample = samples.len() as u32;
+                samples.extend(group.lights.iter().map(ShadingSampleGpu::of));
                 EnvLightGpu {
                     view_proj: view_proj.to_cols_array_2d(),
                     direction: light.direction.normalize().extend(inv_lambda).into(),
-                    rgb: Vec3::from(light.rgb).extend(filter.slope(light)).into(),
+                    rgb: Vec3::from(light.rgb).extend(filter.slope(&light)).into(),
                     power: [power[0], power[1], power[2], 0.0],
                     near: camera.near,
                     far: camera.far,
                     first_layer: dodm.first_layer,
                     texels_per_unit: dodm.texels_per_unit(slot),
+                    first_sample,
+                    sample_count: group.lights.len() as u32,
+                    _pad: [0; 2],
                 }
             })
             .collect();
+        if samples.is_empty() {
+            samples.push(bytemuck::Zeroable::zeroed());
+        }
         if gpu_lights.is_empty() {
             gpu_lights.push(bytemuck::Zeroable::zeroed());
         }
@@ -150,7 +210,7 @@ impl BatchBinding {
         let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("env batch"),
             contents: bytemuck::bytes_of(&BatchUniform {
-                light_count: lights.len() as u32,
+                light_count: groups.len() as u32,
                 resolution: dodm.resolution,
                 max_half_size: MAX_BOX_HALF_SIZE,
                 flags,
@@ -160,6 +220,11 @@ impl BatchBinding {
         let light_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("env lights"),
             contents: bytemuck::cast_slice(&gpu_lights),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let sample_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("env shading samples"),
+            contents: bytemuck::cast_slice(&samples),
             usage: wgpu::BufferUsages::STORAGE,
         });
         let depth_view = DodmBatch::array_view(&dodm.nearest_depth);
@@ -182,6 +247,10 @@ impl BatchBinding {
                 wgpu::BindGroupEntry {
                     binding: 3,
                     resource: sat.buffer.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: sample_buffer.as_entire_binding(),
                 },
             ],
         });

@@ -1,6 +1,7 @@
 // The env-lit view pass (Ren 2010 §3.1, §5, §6), appended to strand_quads.wgsl, fiber_frame.wgsl,
 // convolution_transmittance.wgsl and occupancy_map.wgsl: every fragment loops over the batch's
-// lights and sums
+// light slots (one shadow map each) and each slot's shading samples (the light itself, or the
+// reference's sub-texel lights sharing the slot's visibility), and sums
 //   single:   T̃_j(x) · I(u·ξ_j, u·ω_o, cos Δφ, 1/λ_j) · L_j
 //   multiple: power_j · T_f,j(x) · I_G(u·ξ_j, u·ω_o, cos Δφ, σ̄_f,j(x))
 // writing each, weighted by what the viewer sees of the fragment, into its own target. For
@@ -180,16 +181,20 @@ fn shade(in: VertexOut, weight: f32) -> EnvOut {
     var single = vec3<f32>(0.0);
     var multiple = vec3<f32>(0.0);
     let with_grid = (batch.flags & FLAG_GRID) != 0u;
-    for (var i = 0u; i < batch.light_count; i++) {
-        let light = env_lights[i];
-        let f = fiber_frame(t, light.direction.xyz, e);
-        let coords = vec4<f32>(f.sin_theta_i, f.sin_theta_o, f.cos_phi, light.direction.w);
-        let visible = effective_transmittance(i, in.world);
-        single += visible * single_lookup(coords) * light.rgb.xyz;
-        if (with_grid) {
-            let g = forward_scattering(i, in.world);
-            let cm = vec4<f32>(coords.xyz, g.w);
-            multiple += light.power.xyz * g.xyz * multiple_lookup(cm);
+    for (var slot = 0u; slot < batch.light_count; slot++) {
+        let light = env_lights[slot];
+        let visible = effective_transmittance(slot, in.world);
+        var g = vec4<f32>(0.0);
+        if (with_grid) { g = forward_scattering(slot, in.world); }
+        for (var s = light.first_sample; s < light.first_sample + light.sample_count; s++) {
+            let sample = shading_samples[s];
+            let f = fiber_frame(t, sample.direction.xyz, e);
+            let coords = vec4<f32>(f.sin_theta_i, f.sin_theta_o, f.cos_phi, sample.direction.w);
+            single += visible * single_lookup(coords) * sample.rgb.xyz;
+            if (with_grid) {
+                let cm = vec4<f32>(coords.xyz, g.w);
+                multiple += sample.power.xyz * g.xyz * multiple_lookup(cm);
+            }
         }
     }
     var out: EnvOut;
