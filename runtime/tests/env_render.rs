@@ -888,8 +888,8 @@ fn stochastic_simplification_keeps_the_mean_optical_depth() {
 
 /// Strand B (probed) at y = −0.5, z = 0; a thick strand A at y = 0, z = 0.5 lies between B and
 /// light 1 (toward (0, 1, 1)) but nowhere near B on screen or toward light 2 (toward (0, −1, 1)).
-#[test]
-fn shadowing_reaches_the_right_light_in_every_batch() {
+/// The model, its direct table and the tables holding it.
+fn occluder_scene() -> (HairModel, Table, EnvTables) {
     let points = vec![
         Vec3::new(-0.4, -0.5, 0.0),
         Vec3::new(0.4, -0.5, 0.0),
@@ -903,6 +903,27 @@ fn shadowing_reaches_the_right_light_in_every_batch() {
         direct: Some(direct.clone()),
         ..Default::default()
     };
+    (model, direct, tables)
+}
+
+/// Full-strand 64² maps with a thin first layer, so A's shadow on B is opaque.
+fn occluder_options(batch_size: u32) -> EnvRenderOptions {
+    EnvRenderOptions {
+        dodm: DodmSettings {
+            resolution: 64,
+            first_layer: Some(0.05),
+            batch_size,
+        },
+        kappa: 1.0,
+        ..Default::default()
+    }
+}
+
+/// In [`occluder_scene`], each light's own map shadows B from it: light 1 is blocked by A,
+/// light 2 reaches B, whatever the batching.
+#[test]
+fn shadowing_reaches_the_right_light_in_every_batch() {
+    let (model, direct, tables) = occluder_scene();
     let lights = [
         EnvLight::directional(Vec3::new(0.0, 1.0, 1.0), [1.0, 0.8, 0.6]),
         EnvLight::directional(Vec3::new(0.0, -1.0, 1.0), [0.5, 0.7, 0.9]),
@@ -916,15 +937,7 @@ fn shadowing_reaches_the_right_light_in_every_batch() {
     };
     let (lit1, lit2) = (contribution(&lights[0]), contribution(&lights[1]));
     for batch_size in [1u32, 2] {
-        let options = EnvRenderOptions {
-            dodm: DodmSettings {
-                resolution: 64,
-                first_layer: Some(0.05),
-                batch_size,
-            },
-            kappa: 1.0,
-            ..Default::default()
-        };
+        let options = occluder_options(batch_size);
         let frame = render_env_frame(
             &gpu,
             &model,
@@ -954,24 +967,12 @@ fn shadowing_reaches_the_right_light_in_every_batch() {
 }
 
 /// Lights that share a shadow map (`EnvLight::shadowed_from`, the reference's sub-texels) are
-/// shaded each along its own direction but with the visibility of the shared map: in the scene
-/// above, both lights shadowed from light 2's direction reach B unshadowed (lit1 + lit2), both
+/// shaded each along its own direction but with the visibility of the shared map: in
+/// [`occluder_scene`], both lights shadowed from light 2's direction reach B unshadowed (lit1 + lit2), both
 /// shadowed from light 1's are blocked by A; each run is one map, one batch.
 #[test]
 fn lights_sharing_a_shadow_map_take_its_visibility_and_their_own_shading() {
-    let points = vec![
-        Vec3::new(-0.4, -0.5, 0.0),
-        Vec3::new(0.4, -0.5, 0.0),
-        Vec3::new(-0.6, 0.0, 0.5),
-        Vec3::new(0.6, 0.0, 0.5),
-    ];
-    let thickness = Attribute::PerPoint(vec![3.0 / 32.0, 3.0 / 32.0, 0.25, 0.25]);
-    let model = HairModel::new(points, vec![0, 2, 4], Some(thickness), None, None).unwrap();
-    let direct = synthetic_table(Axis::uniform("none", 0.0, 0.0, 1));
-    let tables = EnvTables {
-        direct: Some(direct.clone()),
-        ..Default::default()
-    };
+    let (model, direct, tables) = occluder_scene();
     let (d1, d2) = (Vec3::new(0.0, 1.0, 1.0), Vec3::new(0.0, -1.0, 1.0));
     let (rgb1, rgb2) = ([1.0, 0.8, 0.6], [0.5, 0.7, 0.9]);
     let gpu = gpu();
@@ -993,15 +994,7 @@ fn lights_sharing_a_shadow_map_take_its_visibility_and_their_own_shading() {
             EnvLight::directional_shadowed_from(d1, rgb1, from),
             EnvLight::directional_shadowed_from(d2, rgb2, from),
         ];
-        let options = EnvRenderOptions {
-            dodm: DodmSettings {
-                resolution: 64,
-                first_layer: Some(0.05),
-                batch_size: 1,
-            },
-            kappa: 1.0,
-            ..Default::default()
-        };
+        let options = occluder_options(1);
         let frame = render_env_frame(
             &gpu,
             &model,
