@@ -9,8 +9,8 @@ use glam::{DVec3, Vec3};
 use strandlight_runtime::camera::Camera;
 use strandlight_runtime::env::TransmittanceFilter;
 use strandlight_runtime::env::{
-    EnvLight, EnvRenderOptions, EnvTables, ForwardScatteringGrid, ForwardScatteringSource,
-    render_env_frame,
+    EnvFrame, EnvLight, EnvRenderOptions, EnvTables, ForwardScatteringGrid,
+    ForwardScatteringSource, render_env_frame,
 };
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
@@ -906,9 +906,18 @@ fn occluder_scene() -> (HairModel, Table, EnvTables) {
     (model, direct, tables)
 }
 
-/// Full-strand 64² maps with a thin first layer, so A's shadow on B is opaque.
-fn occluder_options(batch_size: u32) -> EnvRenderOptions {
-    EnvRenderOptions {
+/// The pixel of [`occluder_scene`] that sees strand B.
+const OCCLUDER_PROBE: (usize, usize) = (32, 48);
+
+/// [`occluder_scene`] under `lights` with full-strand 64² maps and a thin first layer (so A's
+/// shadow on B is opaque), `batch_size` maps per batch: the frame and its probe pixel.
+fn render_occluder(
+    gpu: &GpuContext,
+    (model, tables): (&HairModel, &EnvTables),
+    lights: &[EnvLight],
+    batch_size: u32,
+) -> (EnvFrame, [f32; 4]) {
+    let options = EnvRenderOptions {
         dodm: DodmSettings {
             resolution: 64,
             first_layer: Some(0.05),
@@ -916,7 +925,29 @@ fn occluder_options(batch_size: u32) -> EnvRenderOptions {
         },
         kappa: 1.0,
         ..Default::default()
-    }
+    };
+    let frame = render_env_frame(
+        gpu,
+        model,
+        &ortho_camera(),
+        RES,
+        RES,
+        lights,
+        tables,
+        &options,
+        None,
+    )
+    .unwrap_or_else(|e| panic!("{e}"));
+    let p = frame.pixels[OCCLUDER_PROBE.1 * RES as usize + OCCLUDER_PROBE.0];
+    (frame, p)
+}
+
+/// What a directional light toward `d` gives strand B (tangent +x, seen along +z) unshadowed:
+/// the direct table's value × its irradiance.
+fn direct_contribution(direct: &Table, d: Vec3, rgb: [f32; 3]) -> [f64; 3] {
+    let [a, b, c] = coordinates(DVec3::X, d.normalize().as_dvec3(), DVec3::Z);
+    let v = direct.lookup_rgb(&[a, b, c, 0.0]).unwrap();
+    std::array::from_fn(|k| v[k] as f64 * rgb[k] as f64)
 }
 
 /// In [`occluder_scene`], each light's own map shadows B from it: light 1 is blocked by A,
@@ -929,29 +960,11 @@ fn shadowing_reaches_the_right_light_in_every_batch() {
         EnvLight::directional(Vec3::new(0.0, -1.0, 1.0), [0.5, 0.7, 0.9]),
     ];
     let gpu = gpu();
-    let probe = (32usize, ((1.0 - -0.5f32) * 32.0) as usize);
-    let contribution = |l: &EnvLight| -> [f64; 3] {
-        let [a, b, c] = coordinates(DVec3::X, l.direction.as_dvec3(), DVec3::Z);
-        let v = direct.lookup_rgb(&[a, b, c, 0.0]).unwrap();
-        std::array::from_fn(|k| v[k] as f64 * l.rgb[k] as f64)
-    };
+    let contribution = |l: &EnvLight| direct_contribution(&direct, l.direction, l.rgb);
     let (lit1, lit2) = (contribution(&lights[0]), contribution(&lights[1]));
     for batch_size in [1u32, 2] {
-        let options = occluder_options(batch_size);
-        let frame = render_env_frame(
-            &gpu,
-            &model,
-            &ortho_camera(),
-            RES,
-            RES,
-            &lights,
-            &tables,
-            &options,
-            None,
-        )
-        .unwrap_or_else(|e| panic!("{e}"));
+        let (frame, p) = render_occluder(&gpu, (&model, &tables), &lights, batch_size);
         assert_eq!(frame.stats.batches, 2 / batch_size);
-        let p = frame.pixels[probe.1 * RES as usize + probe.0];
         // Light 1 reaches B through A and B's own fiber (the last DODM boundary holds both):
         // T ≤ 0.001² of an opaque fiber; light 2 is unshadowed (T = 1 at B's own depth).
         for k in 0..3 {
@@ -968,20 +981,15 @@ fn shadowing_reaches_the_right_light_in_every_batch() {
 
 /// Lights that share a shadow map (`EnvLight::shadowed_from`, the reference's sub-texels) are
 /// shaded each along its own direction but with the visibility of the shared map: in
-/// [`occluder_scene`], both lights shadowed from light 2's direction reach B unshadowed (lit1 + lit2), both
-/// shadowed from light 1's are blocked by A; each run is one map, one batch.
+/// [`occluder_scene`], both lights shadowed from light 2's direction reach B unshadowed
+/// (lit1 + lit2), both shadowed from light 1's are blocked by A; each run is one map, one batch.
 #[test]
 fn lights_sharing_a_shadow_map_take_its_visibility_and_their_own_shading() {
     let (model, direct, tables) = occluder_scene();
     let (d1, d2) = (Vec3::new(0.0, 1.0, 1.0), Vec3::new(0.0, -1.0, 1.0));
     let (rgb1, rgb2) = ([1.0, 0.8, 0.6], [0.5, 0.7, 0.9]);
     let gpu = gpu();
-    let probe = (32usize, ((1.0 - -0.5f32) * 32.0) as usize);
-    let contribution = |d: Vec3, rgb: [f32; 3]| -> [f64; 3] {
-        let [a, b, c] = coordinates(DVec3::X, d.normalize().as_dvec3(), DVec3::Z);
-        let v = direct.lookup_rgb(&[a, b, c, 0.0]).unwrap();
-        std::array::from_fn(|k| v[k] as f64 * rgb[k] as f64)
-    };
+    let contribution = |d: Vec3, rgb: [f32; 3]| direct_contribution(&direct, d, rgb);
     let unshadowed: [f64; 3] = {
         let (a, b) = (contribution(d1, rgb1), contribution(d2, rgb2));
         std::array::from_fn(|k| a[k] + b[k])
@@ -994,21 +1002,8 @@ fn lights_sharing_a_shadow_map_take_its_visibility_and_their_own_shading() {
             EnvLight::directional_shadowed_from(d1, rgb1, from),
             EnvLight::directional_shadowed_from(d2, rgb2, from),
         ];
-        let options = occluder_options(1);
-        let frame = render_env_frame(
-            &gpu,
-            &model,
-            &ortho_camera(),
-            RES,
-            RES,
-            &lights,
-            &tables,
-            &options,
-            None,
-        )
-        .unwrap_or_else(|e| panic!("{e}"));
+        let (frame, p) = render_occluder(&gpu, (&model, &tables), &lights, 1);
         assert_eq!(frame.stats.batches, 1, "{name}: one shared map, one batch");
-        let p = frame.pixels[probe.1 * RES as usize + probe.0];
         for k in 0..3 {
             println!(
                 "{name}, channel {k}: GPU {:.6}, expected {:.6}",

@@ -732,7 +732,6 @@ fn reference_with_face(
                 let record = ReferenceRecord {
                     inputs: inputs.clone(),
                     lights: maps,
-                    shading_lights: lights.len(),
                     milliseconds: r.milliseconds,
                 };
                 cache.store(&r.image, &record)?;

@@ -20,9 +20,6 @@ pub struct ReferenceRecord {
     pub inputs: Value,
     /// Its shadow maps: the compact sources and the cube texels (with power).
     pub lights: usize,
-    /// The lights shaded: `lights`, or the sub-texels sharing the texels' maps.
-    #[serde(default)]
-    pub shading_lights: usize,
     /// Frame time of the reference render.
     pub milliseconds: f64,
 }
@@ -146,7 +143,6 @@ mod tests {
         let record = ReferenceRecord {
             inputs: inputs.clone(),
             lights: 6144,
-            shading_lights: 6144,
             milliseconds: 1234.5,
         };
         cache.store(&image, &record).unwrap();

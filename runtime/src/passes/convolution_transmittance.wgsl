@@ -14,10 +14,9 @@ struct EnvLightGpu {
     view_proj: mat4x4<f32>,
     // xyz: unit vector toward the light (ξ); w: 1/λ (0 for a directional light).
     direction: vec4<f32>,
-    // xyz: L_j (SRBF) or irradiance (directional); w: the box slope s (0 for a directional light).
+    // xyz: the slot's first light's L_j or irradiance (the view shades `shading_samples`); w: the
+    // box slope s (0 for a directional light).
     rgb: vec4<f32>,
-    // xyz: EnvLight::power(); w unused.
-    power: vec4<f32>,
     near: f32,
     far: f32,
     first_layer: f32,

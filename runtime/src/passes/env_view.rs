@@ -33,8 +33,8 @@ use crate::gpu::texture::texture_2d;
 pub(crate) struct EnvLightGpu {
     view_proj: [[f32; 4]; 4],
     direction: [f32; 4],
+    /// xyz: the representative light's rgb (the view shades the samples); w: the box slope.
     rgb: [f32; 4],
-    power: [f32; 4],
     near: f32,
     far: f32,
     first_layer: f32,
@@ -176,14 +176,12 @@ impl BatchBinding {
                 let view_proj = camera.projection_matrix(1.0) * camera.view();
                 let light = group.representative();
                 let inv_lambda = light.lambda.map_or(0.0, |l| 1.0 / l);
-                let power = light.power();
                 let first_sample = samples.len() as u32;
                 samples.extend(group.lights.iter().map(ShadingSampleGpu::of));
                 EnvLightGpu {
                     view_proj: view_proj.to_cols_array_2d(),
                     direction: light.direction.normalize().extend(inv_lambda).into(),
                     rgb: Vec3::from(light.rgb).extend(filter.slope(&light)).into(),
-                    power: [power[0], power[1], power[2], 0.0],
                     near: camera.near,
                     far: camera.far,
                     first_layer: dodm.first_layer,
