@@ -8,7 +8,8 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 
-use strandlight_scene::bench::{BenchPaths, BenchPlan, BenchReport, run as run_bench};
+use strandlight_scene::bench::{BenchPaths, BenchPlan, BenchReport, PlanChanges, run as run_bench};
+use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::bench_plots::{Metric, plot};
 use strandlight_scene::bench_report::{section, splice};
 use strandlight_scene::steps::Steps;
@@ -33,12 +34,22 @@ pub struct BenchArgs {
     /// Only these maps (file names in the data folder's envmaps/, comma-separated).
     #[arg(long, value_delimiter = ',')]
     pub maps: Vec<String>,
+    /// Only these scattering modes (default: the plan's; single with --quick, both without).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub modes: Vec<ScatteringMode>,
+    /// The most lights the converged reference may climb to (6n²; default: the plan's, 384
+    /// with --quick, 1536 without). A map converges when N and 4N lights agree within 1%.
+    #[arg(long)]
+    pub reference_max_lights: Option<usize>,
+    /// The median-cut light counts measured (default: the plan's, 4,16,64 with --quick).
+    #[arg(long, value_delimiter = ',')]
+    pub baseline_lights: Vec<usize>,
     /// Cache folder (fits, tables, reference images), shared with `compare`.
     #[arg(long, default_value = "out/cache")]
     pub cache: PathBuf,
     /// Measure nothing: write the plots and the page again from a report JSON an earlier run
     /// wrote (after a change to how they are drawn, without the hour of measuring).
-    #[arg(long, value_name = "REPORT_JSON", conflicts_with_all = ["quick", "maps", "data"])]
+    #[arg(long, value_name = "REPORT_JSON", conflicts_with_all = ["quick", "maps", "data", "modes", "reference_max_lights", "baseline_lights"])]
     pub from_report: Option<PathBuf>,
 }
 
@@ -115,14 +126,17 @@ fn measure(args: &BenchArgs) -> anyhow::Result<Option<BenchReport>> {
         );
         return Ok(None);
     }
-    let mut plan = if args.quick {
+    let base = if args.quick {
         BenchPlan::quick()
     } else {
         BenchPlan::full()
     };
-    if !args.maps.is_empty() {
-        plan.maps = args.maps.clone();
-    }
+    let plan = base.changed(&PlanChanges {
+        maps: args.maps.clone(),
+        modes: args.modes.clone(),
+        reference_max_lights: args.reference_max_lights,
+        baseline_lights: args.baseline_lights.clone(),
+    })?;
     let mut steps = Steps::new(false);
     let paths = BenchPaths {
         data,

@@ -105,6 +105,65 @@ impl BenchPlan {
     }
 }
 
+/// What a run changes of its base plan (`bench --maps --modes --reference-max-lights
+/// --baseline-lights`): a subset, or a longer ladder and more median-cut points where one map
+/// needs them, without editing the plan.
+#[derive(Debug, Clone, Default)]
+pub struct PlanChanges {
+    pub maps: Vec<String>,
+    pub modes: Vec<ScatteringMode>,
+    pub reference_max_lights: Option<usize>,
+    pub baseline_lights: Vec<usize>,
+}
+
+/// The most median-cut lights a bench frame may ask for (a light map each; the largest
+/// reference rung the paper uses).
+const MOST_BASELINE_LIGHTS: usize = 6144;
+
+impl BenchPlan {
+    /// The plan this one was changed from: the quick or the full one.
+    pub fn base(&self) -> Self {
+        match self.is_quick() {
+            true => Self::quick(),
+            false => Self::full(),
+        }
+    }
+
+    /// This plan with `changes` applied, checked: every mode once, median-cut light counts in
+    /// 1..=6144 (sorted, each once), the reference budget one `compare` accepts.
+    pub fn changed(mut self, changes: &PlanChanges) -> anyhow::Result<Self> {
+        if !changes.maps.is_empty() {
+            self.maps = changes.maps.clone();
+        }
+        if !changes.modes.is_empty() {
+            self.modes.clear();
+            for &mode in &changes.modes {
+                if !self.modes.contains(&mode) {
+                    self.modes.push(mode);
+                }
+            }
+        }
+        if let Some(most) = changes.reference_max_lights {
+            self.reference_max_lights = most;
+        }
+        if !changes.baseline_lights.is_empty() {
+            if let Some(n) = changes
+                .baseline_lights
+                .iter()
+                .find(|&&n| !(1..=MOST_BASELINE_LIGHTS).contains(&n))
+            {
+                anyhow::bail!("--baseline-lights {n}: use 1 to {MOST_BASELINE_LIGHTS} lights");
+            }
+            self.baseline_lights = changes.baseline_lights.clone();
+            self.baseline_lights.sort_unstable();
+            self.baseline_lights.dedup();
+        }
+        let probe = compare_args(&self, Path::new("map"), Path::new("cache"), Path::new("out"));
+        compare::check_args(&probe)?;
+        Ok(self)
+    }
+}
+
 /// One measured frame.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Point {

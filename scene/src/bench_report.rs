@@ -1,7 +1,7 @@
 //! The Markdown of `strandlight bench`: the generated section of docs/BENCHMARKS.md (between
 //! [`BEGIN`] and [`END`], replaced whole on every run; the rest of the page is left alone).
 
-use crate::bench::{BenchPlan, BenchReport, EnvLitResult};
+use crate::bench::{BenchReport, EnvLitResult};
 use anyhow::bail;
 use std::fmt::Write;
 
@@ -65,20 +65,27 @@ fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str) {
     );
 }
 
-/// The command line that reruns `report`'s plan: the plan's name and, where the run named its
-/// own maps, those maps.
+/// The command line that reruns `report`'s plan: the plan's name and each flag whose value the
+/// run changed from that plan's.
 fn regenerate_args(report: &BenchReport) -> String {
     let plan = &report.plan;
-    let (flag, default_maps) = if plan.is_quick() {
-        (" --quick", BenchPlan::quick().maps)
-    } else {
-        ("", BenchPlan::full().maps)
-    };
-    if plan.maps == default_maps {
-        flag.to_string()
-    } else {
-        format!("{flag} --maps {}", plan.maps.join(","))
+    let base = plan.base();
+    let list = |v: &[usize]| v.iter().map(usize::to_string).collect::<Vec<_>>().join(",");
+    let mut args = String::from(if plan.is_quick() { " --quick" } else { "" });
+    if plan.maps != base.maps {
+        args += &format!(" --maps {}", plan.maps.join(","));
     }
+    if plan.modes != base.modes {
+        let modes: Vec<_> = plan.modes.iter().map(|m| m.name()).collect();
+        args += &format!(" --modes {}", modes.join(","));
+    }
+    if plan.reference_max_lights != base.reference_max_lights {
+        args += &format!(" --reference-max-lights {}", plan.reference_max_lights);
+    }
+    if plan.baseline_lights != base.baseline_lights {
+        args += &format!(" --baseline-lights {}", list(&plan.baseline_lights));
+    }
+    args
 }
 
 /// The generated section, `plot_dir` relative to the Markdown file (e.g. `bench`).
@@ -153,6 +160,8 @@ pub fn splice(page: &str, section: &str) -> anyhow::Result<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::bench::{BenchPlan, PlanChanges};
+    use crate::scene_tables::ScatteringMode;
 
     #[test]
     fn the_generated_section_is_replaced_and_the_rest_kept() {
@@ -195,5 +204,48 @@ mod tests {
         );
         let page = section(&report_of(every_map), "bench");
         assert!(page.contains(&format!("`cargo run --release -- bench{args}`")));
+    }
+
+    #[test]
+    fn the_regenerate_command_repeats_every_changed_flag_and_only_those() {
+        let changes = PlanChanges {
+            maps: vec!["quarry_01_1k.hdr".into()],
+            modes: vec![ScatteringMode::Full],
+            reference_max_lights: Some(6144),
+            baseline_lights: vec![256, 16, 64, 16],
+        };
+        let plan = BenchPlan::quick().changed(&changes).unwrap();
+        assert_eq!(plan.baseline_lights, [16, 64, 256]);
+        assert_eq!(
+            regenerate_args(&report_of(plan)),
+            " --quick --maps quarry_01_1k.hdr --modes full --reference-max-lights 6144 --baseline-lights 16,64,256"
+        );
+        let unchanged = PlanChanges {
+            modes: BenchPlan::full().modes,
+            reference_max_lights: Some(BenchPlan::full().reference_max_lights),
+            ..PlanChanges::default()
+        };
+        let plan = BenchPlan::full().changed(&unchanged).unwrap();
+        assert_eq!(regenerate_args(&report_of(plan)), "");
+    }
+
+    #[test]
+    fn a_changed_plan_names_its_bad_value() {
+        let bad = |changes: PlanChanges| {
+            BenchPlan::quick()
+                .changed(&changes)
+                .unwrap_err()
+                .to_string()
+        };
+        let too_many = bad(PlanChanges {
+            baseline_lights: vec![16, 0],
+            ..PlanChanges::default()
+        });
+        assert!(too_many.contains("--baseline-lights 0"), "{too_many}");
+        let not_a_cube = bad(PlanChanges {
+            reference_max_lights: Some(1000),
+            ..PlanChanges::default()
+        });
+        assert!(not_a_cube.contains("--reference-max-lights 1000"), "{not_a_cube}");
     }
 }

@@ -166,6 +166,11 @@ pub struct CompareScene {
     pub compact_sources: Vec<strandlight_precompute::compact_sources::CompactSource>,
 }
 
+/// The flags' values checked together, before any work (for callers that build the args).
+pub(crate) fn check_args(args: &CompareArgs) -> anyhow::Result<()> {
+    validate(args).map(drop)
+}
+
 fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
     if args.lobes == 0 {
         bail!("--lobes 0: at least one SRBF lobe is needed");
