@@ -9,9 +9,9 @@ use anyhow::Context;
 use clap::Args;
 
 use strandlight_scene::bench::{BenchPaths, BenchPlan, BenchReport, PlanChanges, run as run_bench};
-use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::bench_plots::{Metric, plot};
 use strandlight_scene::bench_report::{section, splice};
+use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 use strandlight_tables::atomic_write::write_atomically;
 use strandlight_tables::shared_data::shared_data_dir;

@@ -783,7 +783,15 @@ fn bad_inputs_are_typed_errors() {
         ..EnvLight::srbf(Vec3::Z, 8.0, [1.0; 3])
     };
     let bad_from = EnvLight::directional_shadowed_from(Vec3::Z, [1.0; 3], Vec3::NAN);
-    for (index, lights) in [(0, vec![shared_srbf]), (1, vec![light[0], bad_from])] {
+    let every_strand_sun = EnvLight {
+        every_strand: true,
+        ..EnvLight::directional(Vec3::Z, [1.0; 3])
+    };
+    for (index, lights) in [
+        (0, vec![shared_srbf]),
+        (1, vec![light[0], bad_from]),
+        (0, vec![every_strand_sun]),
+    ] {
         let e = render(&lights, &tables, &options);
         assert!(
             matches!(e, EnvRenderError::BadLight { index: i, .. } if i == index),
@@ -1273,9 +1281,8 @@ fn empty_texel_points_read_the_box_around_them() {
 /// frame is the sum of the SRBF-only and directional-only frames (each kind its own batches,
 /// maps and table), and a directional light's light pass draws every strand whatever κ (its
 /// one sharp shadow is what the simplification would blur), so its image does not depend on κ.
-#[test]
-fn srbf_and_directional_lights_in_one_frame_add_and_directional_ignores_kappa() {
-    let gpu = gpu();
+/// A 300-strand groom framed by the camera, with synthetic SRBF and direct tables.
+fn groom_scene() -> (HairModel, Camera, EnvTables) {
     let model = generate_groom(&GroomParams {
         strand_count: 300,
         ..Default::default()
@@ -1292,30 +1299,92 @@ fn srbf_and_directional_lights_in_one_frame_add_and_directional_ignores_kappa() 
         direct: Some(synthetic_table(Axis::uniform("none", 0.0, 0.0, 1))),
         ..Default::default()
     };
-    let srbf = [
+    (model, camera, tables)
+}
+
+/// [`groom_scene`] under `lights` at κ `kappa`, 128² maps, two per batch.
+fn render_groom(
+    gpu: &GpuContext,
+    (model, camera, tables): &(HairModel, Camera, EnvTables),
+    lights: &[EnvLight],
+    kappa: f32,
+) -> Vec<[f32; 4]> {
+    let options = EnvRenderOptions {
+        dodm: DodmSettings {
+            resolution: 128,
+            first_layer: None,
+            batch_size: 2,
+        },
+        kappa,
+        ..Default::default()
+    };
+    render_env_frame(gpu, model, camera, RES, RES, lights, tables, &options, None)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .pixels
+}
+
+/// The two SRBF lobes of the groom tests.
+fn groom_lobes() -> [EnvLight; 2] {
+    [
         EnvLight::srbf(Vec3::new(0.3, 1.0, 0.4), 20.0, [0.5, 0.4, 0.3]),
         EnvLight::srbf(Vec3::new(-0.8, 0.2, 0.5), 40.0, [0.2, 0.3, 0.4]),
-    ];
+    ]
+}
+
+/// Largest |a − b| / max(|b|, 10⁻³) over the pixels' RGB.
+fn worst_relative(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    a.iter()
+        .zip(b)
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] as f64, q[c] as f64)))
+        .map(|(x, y)| (x - y).abs() / y.abs().max(1e-3))
+        .fold(0.0, f64::max)
+}
+
+/// Adaptive κ: in a κ 0.1 frame, a lobe marked `every_strand` is shadowed exactly as at κ 1,
+/// and the unmarked one as at κ 0.1 (the frame is the sum of those two renders).
+#[test]
+fn a_lobe_drawing_every_strand_is_shadowed_as_at_kappa_one() {
+    let gpu = gpu();
+    let scene = groom_scene();
+    let [strong, weak] = groom_lobes();
+    let marked = EnvLight {
+        every_strand: true,
+        ..strong
+    };
+    let adaptive = render_groom(&gpu, &scene, &[marked, weak], 0.1);
+    let strong_full = render_groom(&gpu, &scene, &[strong], 1.0);
+    let strong_simplified = render_groom(&gpu, &scene, &[strong], 0.1);
+    let weak_simplified = render_groom(&gpu, &scene, &[weak], 0.1);
+    let sum: Vec<[f32; 4]> = strong_full
+        .iter()
+        .zip(&weak_simplified)
+        .map(|(a, b)| std::array::from_fn(|c| a[c] + b[c]))
+        .collect();
+    let against_parts = worst_relative(&adaptive, &sum);
+    let kappa_effect = worst_relative(&strong_simplified, &strong_full);
+    println!(
+        "adaptive vs κ 1 + κ 0.1 parts: {against_parts:.2e}; κ 0.1 vs 1 on the lobe: {kappa_effect:.2e}"
+    );
+    assert!(
+        kappa_effect > 1e-2,
+        "κ must change this lobe's shadow for the test to mean anything"
+    );
+    assert!(
+        against_parts < 1e-4,
+        "marked lobe not drawn with every strand: {against_parts}"
+    );
+}
+
+#[test]
+fn srbf_and_directional_lights_in_one_frame_add_and_directional_ignores_kappa() {
+    let gpu = gpu();
+    let scene = groom_scene();
+    let srbf = groom_lobes();
     let sun = [EnvLight::directional(
         Vec3::new(0.5, 0.7, 0.6),
         [2.0, 1.8, 1.5],
     )];
-    let render = |lights: &[EnvLight], kappa: f32| {
-        let options = EnvRenderOptions {
-            dodm: DodmSettings {
-                resolution: 128,
-                first_layer: None,
-                batch_size: 2,
-            },
-            kappa,
-            ..Default::default()
-        };
-        render_env_frame(
-            &gpu, &model, &camera, RES, RES, lights, &tables, &options, None,
-        )
-        .unwrap_or_else(|e| panic!("{e}"))
-        .pixels
-    };
+    let render = |lights: &[EnvLight], kappa: f32| render_groom(&gpu, &scene, lights, kappa);
     let both: Vec<EnvLight> = srbf.iter().chain(&sun).copied().collect();
     let (mixed, srbf_only, sun_only) = (render(&both, 0.1), render(&srbf, 0.1), render(&sun, 0.1));
     let sun_full = render(&sun, 1.0);

@@ -158,7 +158,12 @@ impl BenchPlan {
             self.baseline_lights.sort_unstable();
             self.baseline_lights.dedup();
         }
-        let probe = compare_args(&self, Path::new("map"), Path::new("cache"), Path::new("out"));
+        let probe = compare_args(
+            &self,
+            Path::new("map"),
+            Path::new("cache"),
+            Path::new("out"),
+        );
         compare::check_args(&probe)?;
         Ok(self)
     }
@@ -266,6 +271,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         table_resolution: None,
         modes: plan.modes.clone(),
         kappa: plan.kappas[0],
+        every_strand_share: 0.0,
         timing_runs: 1,
         equal_error: false,
         equal_error_metric: crate::error_metric::ErrorMetric::RelativeRmse,

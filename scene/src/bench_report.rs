@@ -246,6 +246,9 @@ mod tests {
             reference_max_lights: Some(1000),
             ..PlanChanges::default()
         });
-        assert!(not_a_cube.contains("--reference-max-lights 1000"), "{not_a_cube}");
+        assert!(
+            not_a_cube.contains("--reference-max-lights 1000"),
+            "{not_a_cube}"
+        );
     }
 }

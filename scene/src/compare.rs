@@ -27,7 +27,7 @@ use strandlight_precompute::env_lights::{
     face_resolution_for, median_cut_lights, reference_lights_shaded, srbf_set_lights,
 };
 use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_runtime::env::{EnvLight, EnvRenderOptions, shadow_groups};
+use strandlight_runtime::env::{EnvLight, EnvRenderOptions, mark_every_strand, shadow_groups};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::image_out::{write_exr, write_png};
 use strandlight_tables::checksum::sha256_hex;
@@ -113,6 +113,12 @@ pub struct CompareArgs {
     /// into the light maps (1 = all). The reference and the baseline always draw all.
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0.1))]
     pub kappa: f32,
+    /// Adaptive κ: the most powerful SRBF lobes holding this share of the lobes' power draw
+    /// every strand into their light maps, the rest κ (0: κ for every lobe, as the paper; 1:
+    /// every lobe at κ 1). κ's noise costs most on the few strong, narrow lobes
+    /// (docs/BENCHMARKS.md, "Adaptive κ").
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0.0))]
+    pub every_strand_share: f32,
     /// Renders per timing (the median is reported).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 3))]
     pub timing_runs: usize,
@@ -183,6 +189,12 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
         && !(2..=256).contains(&n)
     {
         bail!("--table-resolution {n}: use 2 to 256 nodes per direction axis");
+    }
+    if !(0.0..=1.0).contains(&args.every_strand_share) {
+        bail!(
+            "--every-strand-share {}: a share of the lobes' power, in [0, 1]",
+            args.every_strand_share
+        );
     }
     if !(args.reference_tolerance > 0.0 && args.reference_tolerance < 1.0) {
         bail!(
@@ -372,7 +384,15 @@ pub fn prepare_with_hair(
     )?;
     let up = UpAxis::detect(&hair);
     let camera = Camera::framing_front(hair.bounds(), width as f32 / height as f32, false, up);
-    let srbf = to_env_lights(&srbf_set_lights(&set), up);
+    let mut srbf = to_env_lights(&srbf_set_lights(&set), up);
+    let marked = mark_every_strand(&mut srbf, args.every_strand_share);
+    if marked > 0 {
+        steps.say(format!(
+            "adaptive κ: the {marked} strongest lobes (≥ {:.0}% of the lobes' power) draw every strand, the rest κ {}",
+            100.0 * args.every_strand_share,
+            args.kappa
+        ));
+    }
     let fit_relative_l2_error = fit.set.relative_l2_error;
     Ok(CompareScene {
         hair,
@@ -922,7 +942,7 @@ pub fn execute(
         "scene".into(),
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
-            "preset": args.preset, "kappa": args.kappa, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "preset": args.preset, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
             "split_lobes": args.split_lobes, "split_ratio": args.split_ratio,
             "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,
@@ -974,6 +994,8 @@ mod tests {
             ("--reference-max-lights", "100", "6n²"),
             ("--reference-max-lights", "96", "allow at least 384"),
             ("--reference-tolerance", "0", "(0, 1)"),
+            ("--every-strand-share", "1.5", "[0, 1]"),
+            ("--every-strand-share", "NaN", "[0, 1]"),
         ] {
             let a = args(&["--hair", "h", "--env", "e", flag, value]).unwrap();
             let e = validate(&a).unwrap_err().to_string();

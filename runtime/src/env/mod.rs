@@ -24,6 +24,11 @@ pub struct EnvLight {
     /// The reference uses it to shade a cube texel's light over finer sub-texels whose
     /// visibility is the texel's (`precompute/src/env_lights.rs`).
     pub shadowed_from: Option<Vec3>,
+    /// SRBF lights only: draw every strand into this light's map whatever the frame's κ. The
+    /// stochastic simplification's noise costs most on the few powerful lobes (docs/BENCHMARKS.md,
+    /// "Adaptive κ"); [`mark_every_strand`] picks them. Directional lights always draw every
+    /// strand.
+    pub every_strand: bool,
 }
 
 impl EnvLight {
@@ -33,6 +38,7 @@ impl EnvLight {
             lambda: Some(lambda),
             rgb: amplitude,
             shadowed_from: None,
+            every_strand: false,
         }
     }
 
@@ -42,6 +48,7 @@ impl EnvLight {
             lambda: None,
             rgb: irradiance,
             shadowed_from: None,
+            every_strand: false,
         }
     }
 
@@ -62,6 +69,12 @@ impl EnvLight {
         self.shadowed_from.unwrap_or(self.direction)
     }
 
+    /// [`EnvLight::power`]'s luminance (Rec. 709 weights): how lights are ranked by strength.
+    pub fn luminous_power(&self) -> f32 {
+        let [r, g, b] = self.power();
+        0.2126 * r + 0.7152 * g + 0.0722 * b
+    }
+
     /// What the light delivers to a fiber facing it, before shadowing: for an SRBF its
     /// amplitude × ∫G dω = L_j · 2π/λ · (1 − e^{−2λ}); for a directional light its irradiance.
     /// The multiple-scattering term (normalized spread function ψ_f) is weighted by this.
@@ -75,6 +88,33 @@ impl EnvLight {
             }
         }
     }
+}
+
+/// Marks the most powerful SRBF lights holding at least `share` of the SRBF lights' luminous
+/// power as [`EnvLight::every_strand`] (and clears the mark on the rest): adaptive κ, the
+/// simplification kept for the many weak lobes where its noise costs little. `share` ≤ 0 marks
+/// none, ≥ 1 all. Returns how many were marked.
+pub fn mark_every_strand(lights: &mut [EnvLight], share: f32) -> usize {
+    let mut order: Vec<usize> = (0..lights.len())
+        .filter(|&i| lights[i].lambda.is_some())
+        .collect();
+    order.sort_by(|&a, &b| {
+        lights[b]
+            .luminous_power()
+            .total_cmp(&lights[a].luminous_power())
+    });
+    let total: f32 = order.iter().map(|&i| lights[i].luminous_power()).sum();
+    let mut held = 0.0;
+    let mut marked = 0;
+    for i in order {
+        let mark = share > 0.0 && (held < share * total || share >= 1.0);
+        lights[i].every_strand = mark;
+        if mark {
+            held += lights[i].luminous_power();
+            marked += 1;
+        }
+    }
+    marked
 }
 
 /// Consecutive lights that share one shadow map (one DODM slot, one light pass, one
@@ -148,3 +188,32 @@ pub use render::{
     EnvTableError, EnvTables, FragmentCounts, OccupancyError, TransmittanceFilter,
     ViewTransparency, render_env_frame,
 };
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lobe(amplitude: f32) -> EnvLight {
+        EnvLight::srbf(Vec3::Z, 10.0, [amplitude; 3])
+    }
+
+    #[test]
+    fn every_strand_goes_to_the_strongest_lobes_until_the_share_is_held() {
+        // Powers 4 : 3 : 2 : 1 (same λ); the sun is directional and never marked.
+        let sun = EnvLight::directional(Vec3::X, [100.0; 3]);
+        let mut lights = vec![lobe(2.0), sun, lobe(4.0), lobe(1.0), lobe(3.0)];
+        let marked =
+            |lights: &[EnvLight]| -> Vec<bool> { lights.iter().map(|l| l.every_strand).collect() };
+        // 40% of 10: the strongest (4) alone holds it.
+        assert_eq!(mark_every_strand(&mut lights, 0.4), 1);
+        assert_eq!(marked(&lights), [false, false, true, false, false]);
+        // 50%: 4 holds 40%, so 3 joins (70%).
+        assert_eq!(mark_every_strand(&mut lights, 0.5), 2);
+        assert_eq!(marked(&lights), [false, false, true, false, true]);
+        assert_eq!(mark_every_strand(&mut lights, 1.0), 4);
+        assert_eq!(marked(&lights), [true, false, true, true, true]);
+        // 0 clears every earlier mark.
+        assert_eq!(mark_every_strand(&mut lights, 0.0), 0);
+        assert_eq!(marked(&lights), [false; 5]);
+    }
+}

@@ -229,6 +229,11 @@ fn check_light(index: usize, light: &EnvLight) -> Result<(), EnvRenderError> {
     if light.rgb.iter().any(|c| !c.is_finite()) {
         return Err(bad(format!("rgb {:?} is not finite", light.rgb)));
     }
+    if light.every_strand && light.lambda.is_none() {
+        return Err(bad(
+            "every_strand is for SRBF lights (directional lights always draw every strand)".into(),
+        ));
+    }
     if let Some(from) = light.shadowed_from {
         if light.lambda.is_some() {
             return Err(bad(
@@ -295,15 +300,28 @@ pub struct EnvRenderer {
 }
 
 /// A frame's lights split by kind: each kind is shaded with its own table and batched apart.
+/// SRBF lights drawing every strand and those drawing κ of them batch apart (one light-pass
+/// geometry per batch).
 struct LightKinds {
+    srbf_every_strand: Vec<EnvLight>,
     srbf: Vec<EnvLight>,
     directional: Vec<EnvLight>,
 }
 
 impl LightKinds {
     fn of(lights: &[EnvLight]) -> Self {
-        let (srbf, directional) = lights.iter().partition(|l| l.lambda.is_some());
-        Self { srbf, directional }
+        let (srbf, directional): (Vec<EnvLight>, _) =
+            lights.iter().partition(|l| l.lambda.is_some());
+        let (srbf_every_strand, srbf) = srbf.into_iter().partition(|l| l.every_strand);
+        Self {
+            srbf_every_strand,
+            srbf,
+            directional,
+        }
+    }
+
+    fn has_srbf(&self) -> bool {
+        !(self.srbf.is_empty() && self.srbf_every_strand.is_empty())
     }
 }
 
@@ -339,7 +357,7 @@ fn check_inputs(
     options.dodm.check()?;
     check_kappa(options.kappa)?;
     options.transparency.check()?;
-    if !kinds.srbf.is_empty() {
+    if kinds.has_srbf() {
         required_table(&tables.srbf, "srbf", "SRBF lights", Some(AXIS_INV_LAMBDA))?;
     }
     if !kinds.directional.is_empty() {
@@ -525,13 +543,19 @@ impl EnvRenderer {
             false => None,
         };
         let mut usage = BatchUsage::default();
+        let (srbf_tables, directional_tables) =
+            (frame.srbf_tables.take(), frame.directional_tables.take());
+        usage.table_bytes = [&srbf_tables, &directional_tables]
+            .iter()
+            .filter_map(|t| t.as_ref().map(|t| t.bytes))
+            .sum();
         let kind_tables = [
-            (&kinds.srbf, frame.srbf_tables.take()),
-            (&kinds.directional, frame.directional_tables.take()),
+            (&kinds.srbf_every_strand, srbf_tables.as_ref()),
+            (&kinds.srbf, srbf_tables.as_ref()),
+            (&kinds.directional, directional_tables.as_ref()),
         ];
-        for (kind_lights, binding) in &kind_tables {
+        for (kind_lights, binding) in kind_tables {
             let Some(binding) = binding else { continue };
-            usage.table_bytes += binding.bytes;
             let groups = shadow_groups(kind_lights);
             for chunk in groups.chunks(options.dodm.batch_size as usize) {
                 let batch = LightBatch {
@@ -588,7 +612,12 @@ impl EnvRenderer {
         } = *request;
         let batch_size = options.dodm.batch_size as usize;
         let maps = |lights: &[EnvLight]| shadow_groups(lights).len();
-        let slots = batch_size.min(maps(&kinds.srbf).max(maps(&kinds.directional))) as u32;
+        let most_maps = [&kinds.srbf_every_strand, &kinds.srbf, &kinds.directional]
+            .map(|k| maps(k))
+            .into_iter()
+            .max()
+            .unwrap_or(0);
+        let slots = batch_size.min(most_maps) as u32;
         let resolution = options.dodm.resolution;
         check_frame_limits(gpu, (width, height), resolution, slots)?;
         let sat = SummedAreaTables::new(gpu, resolution, slots)?;
@@ -617,7 +646,7 @@ impl EnvRenderer {
                     .map(|t| TableBinding::new(gpu, &self.view.table_layout, t, multiple_table))
             };
             (
-                bind(!kinds.srbf.is_empty(), &tables.srbf),
+                bind(kinds.has_srbf(), &tables.srbf),
                 bind(!kinds.directional.is_empty(), &tables.direct),
             )
         });
@@ -698,10 +727,9 @@ impl EnvRenderer {
     ) -> Result<(), EnvRenderError> {
         let options = request.options;
         usage.batches += 1;
-        let srbf_kind = batch
-            .groups
-            .first()
-            .is_some_and(|g| g.lights[0].lambda.is_some());
+        let first = batch.groups.first().map(|g| g.lights[0]);
+        let srbf_kind = first.is_some_and(|l| l.lambda.is_some());
+        let simplified = srbf_kind && first.is_some_and(|l| !l.every_strand);
         let grid = match request.multiple {
             Some(source) => {
                 let representatives: Vec<_> =
@@ -711,7 +739,7 @@ impl EnvRenderer {
             None => None,
         };
         timings.time(gpu, "light pass", || {
-            let (geometry, enlargement) = match srbf_kind {
+            let (geometry, enlargement) = match simplified {
                 true => (&frame.light_geometry, 1.0 / options.kappa),
                 false => (&frame.geometry, 1.0),
             };
