@@ -291,12 +291,8 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
 
 /// The `n` most powerful SRBF lobes of the scene and every compact source.
 fn strongest_lights(scene: &CompareScene, n: usize) -> Vec<EnvLight> {
-    let luminance = |l: &EnvLight| {
-        let [r, g, b] = l.power();
-        0.2126 * r + 0.7152 * g + 0.0722 * b
-    };
     let mut lights = scene.srbf.clone();
-    lights.sort_by(|a, b| luminance(b).total_cmp(&luminance(a)));
+    lights.sort_by(|a, b| b.luminous_power().total_cmp(&a.luminous_power()));
     let mut kept = 0;
     lights.retain(|l| {
         let keep = l.lambda.is_none() || kept < n;

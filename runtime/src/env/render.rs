@@ -299,9 +299,9 @@ pub struct EnvRenderer {
     view: EnvViewPass,
 }
 
-/// A frame's lights split by kind: each kind is shaded with its own table and batched apart.
-/// SRBF lights drawing every strand and those drawing κ of them batch apart (one light-pass
-/// geometry per batch).
+/// A frame's lights split by kind, each batched apart: SRBFs drawing every strand into their
+/// maps, SRBFs drawing κ of them (one light-pass geometry per batch), directional lights (their
+/// own table).
 struct LightKinds {
     srbf_every_strand: Vec<EnvLight>,
     srbf: Vec<EnvLight>,
