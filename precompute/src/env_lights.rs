@@ -258,19 +258,21 @@ mod tests {
             .fold(0.0, f64::max)
     }
 
+    /// A sky brighter overhead with a sun disc of `radius_deg` holding most of the power.
+    fn sun_and_sky(width: usize, height: usize, radius_deg: f64) -> EnvMap {
+        let sun = DVec3::new(0.4, 0.6, -0.69).normalize();
+        let inside = radius_deg.to_radians().cos();
+        EnvMap::from_fn(width, height, |w| {
+            let sky = 0.5 + 0.3 * w.y.max(0.0);
+            let disc = if w.dot(sun) > inside { 2e5 } else { 0.0 };
+            [sky + disc, sky + 0.9 * disc, sky + 0.7 * disc]
+        })
+    }
+
     #[test]
     fn reference_and_median_cut_carry_the_whole_map() {
         // A sky with a sun 0.5° across holding most of the power: a compact source.
-        let sun = DVec3::new(0.4, 0.6, -0.69).normalize();
-        let map = EnvMap::from_fn(1024, 512, |w| {
-            let sky = 0.5 + 0.3 * w.y.max(0.0);
-            let disc = if w.dot(sun) > 0.25f64.to_radians().cos() {
-                2e5
-            } else {
-                0.0
-            };
-            [sky + disc, sky + 0.9 * disc, sky + 0.7 * disc]
-        });
+        let map = sun_and_sky(1024, 512, 0.25);
         let truth = pixel_sum_integral(&map);
         // Both partition the map's solid angle (every sub-pixel / pixel goes to exactly one
         // light), so only f64 summation order separates them from the pixel sum: 1e-9.
@@ -398,16 +400,7 @@ mod tests {
     /// shading cube that does not divide into the visibility cube.
     #[test]
     fn shaded_reference_carries_the_whole_map_in_runs_sharing_a_map() {
-        let sun = DVec3::new(0.4, 0.6, -0.69).normalize();
-        let map = EnvMap::from_fn(512, 256, |w| {
-            let sky = 0.5 + 0.3 * w.y.max(0.0);
-            let disc = if w.dot(sun) > 0.5f64.to_radians().cos() {
-                2e5
-            } else {
-                0.0
-            };
-            [sky + disc, sky + 0.9 * disc, sky + 0.7 * disc]
-        });
+        let map = sun_and_sky(512, 256, 0.5);
         let truth = pixel_sum_integral(&map);
         let sources = SourceOptions::default();
         for (n, fine) in [(2, 8), (4, 8), (4, 4)] {
