@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 
+use strandlight_scene::baseline::Baseline;
 use strandlight_scene::bench::{BenchPaths, BenchPlan, BenchReport, PlanChanges, run as run_bench};
 use strandlight_scene::bench_plots::{Metric, plot};
 use strandlight_scene::bench_report::{section, splice};
@@ -44,12 +45,16 @@ pub struct BenchArgs {
     /// The median-cut light counts measured (default: the plan's, 4,16,64 with --quick).
     #[arg(long, value_delimiter = ',')]
     pub baseline_lights: Vec<usize>,
+    /// The directional-light baseline (default: median cut over the whole map, as published;
+    /// median-cut-sources: the compact sources exactly, median cut over the rest).
+    #[arg(long, value_enum)]
+    pub baseline: Option<Baseline>,
     /// Cache folder (fits, tables, reference images), shared with `compare`.
     #[arg(long, default_value = "out/cache")]
     pub cache: PathBuf,
     /// Measure nothing: write the plots and the page again from a report JSON an earlier run
     /// wrote (after a change to how they are drawn, without the hour of measuring).
-    #[arg(long, value_name = "REPORT_JSON", conflicts_with_all = ["quick", "maps", "data", "modes", "reference_max_lights", "baseline_lights"])]
+    #[arg(long, value_name = "REPORT_JSON", conflicts_with_all = ["quick", "maps", "data", "modes", "reference_max_lights", "baseline_lights", "baseline"])]
     pub from_report: Option<PathBuf>,
 }
 
@@ -136,6 +141,7 @@ fn measure(args: &BenchArgs) -> anyhow::Result<Option<BenchReport>> {
         modes: args.modes.clone(),
         reference_max_lights: args.reference_max_lights,
         baseline_lights: args.baseline_lights.clone(),
+        baseline: args.baseline,
     })?;
     let mut steps = Steps::new(false);
     let paths = BenchPaths {

@@ -11,6 +11,7 @@
 //! Every render goes through [`compare`]'s scene, cache and converged reference, so `bench`
 //! and `compare` measure the same thing.
 
+use crate::baseline::Baseline;
 use crate::compare::{self, CompareArgs, CompareScene};
 use crate::env_frame::{EnvFrame, FrameRole, render_lights};
 use crate::environment::load_env;
@@ -46,6 +47,9 @@ pub struct BenchPlan {
     pub kappas: Vec<f32>,
     pub dodm_sizes: Vec<u32>,
     pub baseline_lights: Vec<usize>,
+    /// Which directional-light baseline (reports written before it existed: median cut).
+    #[serde(default)]
+    pub baseline: Baseline,
     pub reference_max_lights: usize,
 }
 
@@ -76,6 +80,7 @@ impl BenchPlan {
             kappas: vec![0.1, 0.3, 1.0],
             dodm_sizes: vec![512, 256, 1024],
             baseline_lights: vec![4, 8, 16, 32, 64, 128],
+            baseline: Baseline::MedianCut,
             reference_max_lights: 1536,
         }
     }
@@ -100,20 +105,22 @@ impl BenchPlan {
             kappas: vec![0.1, 1.0],
             dodm_sizes: vec![512, 256],
             baseline_lights: vec![4, 16, 64],
+            baseline: Baseline::MedianCut,
             reference_max_lights: 384,
         }
     }
 }
 
 /// What a run changes of its base plan (`bench --maps --modes --reference-max-lights
-/// --baseline-lights`): a subset, or a longer ladder and more median-cut points where one map
-/// needs them, without editing the plan.
+/// --baseline-lights --baseline`): a subset, or a longer ladder, more baseline points or the
+/// other baseline where one map needs them, without editing the plan.
 #[derive(Debug, Clone, Default)]
 pub struct PlanChanges {
     pub maps: Vec<String>,
     pub modes: Vec<ScatteringMode>,
     pub reference_max_lights: Option<usize>,
     pub baseline_lights: Vec<usize>,
+    pub baseline: Option<Baseline>,
 }
 
 /// The most median-cut lights a bench frame may ask for (a light map each; the largest
@@ -158,6 +165,9 @@ impl BenchPlan {
             self.baseline_lights.sort_unstable();
             self.baseline_lights.dedup();
         }
+        if let Some(baseline) = changes.baseline {
+            self.baseline = baseline;
+        }
         let probe = compare_args(
             &self,
             Path::new("map"),
@@ -172,7 +182,7 @@ impl BenchPlan {
 /// One measured frame.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Point {
-    /// "srbf", "median cut" or "reference".
+    /// "srbf", "reference" or the baseline's name ([`Baseline::name`]).
     pub family: String,
     /// What was varied ("lobes", "kappa", "dodm", "lights") and its value.
     pub label: String,
@@ -180,6 +190,13 @@ pub struct Point {
     pub ms: f64,
     pub relative_rmse: f64,
     pub hdr_flip: f64,
+}
+
+impl Point {
+    /// A frame of the directional-light baseline (whichever the plan chose).
+    pub fn is_baseline(&self) -> bool {
+        self.family != "srbf" && self.family != "reference"
+    }
 }
 
 /// One map and mode of the env-lit sweep.
@@ -207,7 +224,7 @@ impl EnvLitResult {
         let default = self.points.first()?;
         self.points
             .iter()
-            .filter(|p| p.family == "median cut")
+            .filter(|p| p.is_baseline())
             .max_by(|a, b| a.ms.total_cmp(&b.ms))
             .map(|p| (p.lights, p.ms / default.ms))
     }
@@ -274,6 +291,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         every_strand_share: 0.0,
         timing_runs: 1,
         equal_error: false,
+        baseline: plan.baseline,
         equal_error_metric: crate::error_metric::ErrorMetric::RelativeRmse,
         unshadowed: false,
         split_lobes: 0,
@@ -411,14 +429,15 @@ fn env_lit(
         let reference = compare::reference(&render_lights, &scene, &args, mode, steps)?;
         let image = &reference.chosen.image;
         let mut points = srbf_points(plan, &scene, &args, mode, image, steps)?;
+        let family = plan.baseline.name();
         for &n in &plan.baseline_lights {
             let r = steps.run(
-                &format!("{}: median cut {n}", mode.name()),
+                &format!("{}: {family} {n}", mode.name()),
                 || compare::render_baseline(&render_lights, &scene, &args, mode, n),
                 |r| format!("{:.0} ms", r.milliseconds),
             )?;
             points.push(measure(
-                "median cut",
+                family,
                 format!("{n} lights"),
                 n,
                 r.milliseconds,
@@ -436,9 +455,9 @@ fn env_lit(
             hdr_flip: 0.0,
         });
         let default = points[0].clone();
-        let median_cut: Vec<&Point> = points.iter().filter(|p| p.family == "median cut").collect();
+        let baseline: Vec<&Point> = points.iter().filter(|p| p.is_baseline()).collect();
         let speedup = |metric: fn(&Point) -> f64| {
-            curve_ms_at(&median_cut, metric(&default), metric).map(|ms| ms / default.ms)
+            curve_ms_at(&baseline, metric(&default), metric).map(|ms| ms / default.ms)
         };
         out.push(EnvLitResult {
             map: name.clone(),

@@ -119,14 +119,19 @@ where
         v.sort_by(|a, b| a.0.total_cmp(&b.0));
         v
     };
-    let median_cut = series("median cut", "");
+    let baseline_family = r
+        .points
+        .iter()
+        .find(|p| p.is_baseline())
+        .map_or("median cut", |p| p.family.as_str());
+    let baseline = series(baseline_family, "");
     chart
-        .draw_series(LineSeries::new(median_cut.clone(), RED.stroke_width(2)))
+        .draw_series(LineSeries::new(baseline.clone(), RED.stroke_width(2)))
         .map_err(|e| anyhow::anyhow!("{e:?}"))?
-        .label("median cut (light count)")
+        .label(format!("{baseline_family} (light count)"))
         .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], RED.stroke_width(2)));
     chart
-        .draw_series(median_cut.iter().map(|&p| Circle::new(p, 4, RED.filled())))
+        .draw_series(baseline.iter().map(|&p| Circle::new(p, 4, RED.filled())))
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
     for (prefix, colour, label) in [
         ("lobes", BLUE, "SRBF: lobe count"),
@@ -150,10 +155,10 @@ where
     if let Some(default) = measured.iter().find(|p| p.label.starts_with("default")) {
         let at = (default.ms, metric.of(default).max(1e-4));
         let note = match metric.speedup(r) {
-            Some(s) => format!("SRBF default: {s:.1}× median cut at equal error"),
+            Some(s) => format!("SRBF default: {s:.1}× {baseline_family} at equal error"),
             None => match r.speedup_lower_bound() {
                 Some((lights, bound)) => format!(
-                    "SRBF default: > {bound:.1}× median cut (its {lights} lights still less accurate)"
+                    "SRBF default: > {bound:.1}× {baseline_family} (its {lights} lights still less accurate)"
                 ),
                 None => "SRBF default".into(),
             },

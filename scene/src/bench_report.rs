@@ -8,20 +8,20 @@ use std::fmt::Write;
 pub const BEGIN: &str = "<!-- strandlight bench: generated section, begin -->";
 pub const END: &str = "<!-- strandlight bench: generated section, end -->";
 
-fn optional_speedup(s: Option<f64>, r: &EnvLitResult) -> String {
+fn optional_speedup(s: Option<f64>, r: &EnvLitResult, baseline: &str) -> String {
     match (s, r.speedup_lower_bound()) {
         (Some(s), _) => format!("{s:.1}×"),
         (None, Some((lights, bound))) => format!(
-            "more than {bound:.1}× (median cut with {lights} lights, the most measured, is still less accurate)"
+            "more than {bound:.1}× ({baseline} with {lights} lights, the most measured, is still less accurate)"
         ),
         (None, None) => "not measured".into(),
     }
 }
 
-fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str) {
+fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str, baseline: &str) {
     let _ = writeln!(
         out,
-        "\n#### {} — {} scattering\n\nReference: {} lights, {:.0} ms{}. Equal-error speed-up of the SRBF default over median cut: {} (relative RMSE), {} (HDR-FLIP).\n",
+        "\n#### {} — {} scattering\n\nReference: {} lights, {:.0} ms{}. Equal-error speed-up of the SRBF default over {baseline}: {} (relative RMSE), {} (HDR-FLIP).\n",
         r.map,
         r.mode,
         r.reference_lights,
@@ -36,8 +36,8 @@ fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str) {
             ),
             None => String::new(),
         },
-        optional_speedup(r.speedup_equal_rmse, r),
-        optional_speedup(r.speedup_equal_flip, r),
+        optional_speedup(r.speedup_equal_rmse, r, baseline),
+        optional_speedup(r.speedup_equal_flip, r, baseline),
     );
     if !r.reference_ladder.is_empty() {
         let ladder: Vec<String> = r
@@ -85,6 +85,10 @@ fn regenerate_args(report: &BenchReport) -> String {
     if plan.baseline_lights != base.baseline_lights {
         args += &format!(" --baseline-lights {}", list(&plan.baseline_lights));
     }
+    if plan.baseline != base.baseline {
+        let flag = serde_json::to_value(plan.baseline).expect("a unit enum serializes");
+        args += &format!(" --baseline {}", flag.as_str().unwrap_or_default());
+    }
     args
 }
 
@@ -129,10 +133,14 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
             100.0 * t.off_axis_max_error
         );
     }
-    out.push_str("\n### Env-lit frames: error against milliseconds\n\nThe SRBF default and one parameter varied at a time (lobes kept: the most powerful; κ: Ren's stochastic simplification; light-map size), the median-cut baseline at several light counts, and the reference.\n");
+    let _ = writeln!(
+        out,
+        "\n### Env-lit frames: error against milliseconds\n\nThe SRBF default and one parameter varied at a time (lobes kept: the most powerful; κ: Ren's stochastic simplification; light-map size), the {} baseline at several light counts, and the reference.",
+        plan.baseline.name()
+    );
     for r in &report.env_lit {
         let stem = format!("{plot_dir}/{}-{}", r.map, r.mode);
-        env_lit_table(&mut out, r, &stem);
+        env_lit_table(&mut out, r, &stem, plan.baseline.name());
     }
     let _ = writeln!(out, "\n{END}");
     out
@@ -160,6 +168,7 @@ pub fn splice(page: &str, section: &str) -> anyhow::Result<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::baseline::Baseline;
     use crate::bench::{BenchPlan, PlanChanges};
     use crate::scene_tables::ScatteringMode;
 
@@ -213,16 +222,18 @@ mod tests {
             modes: vec![ScatteringMode::Full],
             reference_max_lights: Some(6144),
             baseline_lights: vec![256, 16, 64, 16],
+            baseline: Some(Baseline::MedianCutSources),
         };
         let plan = BenchPlan::quick().changed(&changes).unwrap();
         assert_eq!(plan.baseline_lights, [16, 64, 256]);
         assert_eq!(
             regenerate_args(&report_of(plan)),
-            " --quick --maps quarry_01_1k.hdr --modes full --reference-max-lights 6144 --baseline-lights 16,64,256"
+            " --quick --maps quarry_01_1k.hdr --modes full --reference-max-lights 6144 --baseline-lights 16,64,256 --baseline median-cut-sources"
         );
         let unchanged = PlanChanges {
             modes: BenchPlan::full().modes,
             reference_max_lights: Some(BenchPlan::full().reference_max_lights),
+            baseline: Some(Baseline::MedianCut),
             ..PlanChanges::default()
         };
         let plan = BenchPlan::full().changed(&unchanged).unwrap();

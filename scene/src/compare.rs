@@ -3,6 +3,7 @@
 //! the equal-time median-cut baseline; per scattering mode the frame times, the relative RMSE
 //! against the reference over hair pixels, and the speed ratios; the images side by side.
 
+use crate::baseline::Baseline;
 use crate::env_frame::{EnvFrame, FrameRole, RenderedEnv, fit_summary, forward_settings};
 use crate::environment::load_env;
 use crate::equal_time::{EqualTimeSearch, equal_error_lights, equal_time_lights};
@@ -24,7 +25,7 @@ use std::path::PathBuf;
 use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_precompute::env_lights::{
-    face_resolution_for, median_cut_lights, reference_lights_shaded, srbf_set_lights,
+    face_resolution_for, reference_lights_shaded, srbf_set_lights,
 };
 use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::{EnvLight, EnvRenderOptions, mark_every_strand, shadow_groups};
@@ -127,6 +128,13 @@ pub struct CompareArgs {
     /// --reference-lights baseline lights.
     #[cfg_attr(any(feature = "cli", test), arg(long))]
     pub equal_error: bool,
+    /// The directional-light baseline: median cut over the whole map (Debevec 2005, Ren's
+    /// baseline), or the compact sources exactly and median cut over the rest.
+    #[cfg_attr(
+        any(feature = "cli", test),
+        arg(long, value_enum, default_value = "median-cut")
+    )]
+    pub baseline: Baseline,
     /// The error --equal-error matches: relative RMSE, or HDR-FLIP over the hair.
     #[cfg_attr(
         any(feature = "cli", test),
@@ -498,7 +506,7 @@ impl EqualErrorResult {
     }
 }
 
-/// The median-cut baseline with `lights` directional lights.
+/// The baseline (`--baseline`) with `lights` directional lights.
 pub fn render_baseline(
     render: Renderer,
     scene: &CompareScene,
@@ -506,10 +514,10 @@ pub fn render_baseline(
     mode: ScatteringMode,
     lights: usize,
 ) -> anyhow::Result<RenderedEnv> {
-    let lights = to_env_lights(
-        &median_cut_lights(&scene.map, lights, args.rotate),
-        scene.up,
-    );
+    let specs = args
+        .baseline
+        .lights(&scene.map, lights, args.rotate, &scene.reference_sources);
+    let lights = to_env_lights(&specs, scene.up);
     timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)
 }
 
@@ -533,7 +541,8 @@ fn equal_error_baseline(
         // A search near the reference's light count renders for many minutes: say each step
         // (stderr, so `--json` keeps stdout for the JSON).
         eprintln!(
-            "  equal-error search: {n} median-cut lights → {} {error:.4} (target {target_error:.4}), {:.0} ms/frame",
+            "  equal-error search: {n} lights of {} → {} {error:.4} (target {target_error:.4}), {:.0} ms/frame",
+            args.baseline.name(),
             args.equal_error_metric.name(),
             r.milliseconds
         );
@@ -672,8 +681,9 @@ fn run_mode(
         },
         |f| {
             format!(
-                "{} median-cut lights at {:.2} ms/frame ({} searches{})",
+                "{} lights of {} at {:.2} ms/frame ({} searches{})",
                 f.lights,
+                args.baseline.name(),
                 f.milliseconds,
                 f.measurements.len(),
                 if f.at_bound {
@@ -707,9 +717,9 @@ fn run_mode(
             |e: &EqualErrorResult| {
                 let (n, ms, err) = e.chosen();
                 if e.at_bound {
-                    format!("NOT reached: {n} median-cut lights, the search bound, give {} {err:.4} > {target:.4} at {ms:.2} ms/frame ({} renders)", metric.name(), e.renders.len())
+                    format!("NOT reached: {n} lights of {}, the search bound, give {} {err:.4} > {target:.4} at {ms:.2} ms/frame ({} renders)", args.baseline.name(), metric.name(), e.renders.len())
                 } else {
-                    format!("{n} median-cut lights reach {} {err:.4} ≤ {target:.4} at {ms:.2} ms/frame ({} renders)", metric.name(), e.renders.len())
+                    format!("{n} lights of {} reach {} {err:.4} ≤ {target:.4} at {ms:.2} ms/frame ({} renders)", args.baseline.name(), metric.name(), e.renders.len())
                 }
             },
         )?)
@@ -942,7 +952,7 @@ pub fn execute(
         "scene".into(),
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
-            "preset": args.preset, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "preset": args.preset, "baseline": args.baseline, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
             "split_lobes": args.split_lobes, "split_ratio": args.split_ratio,
             "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,

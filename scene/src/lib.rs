@@ -6,6 +6,7 @@
 //!
 //! Dependencies point one way: `tables` ← `precompute`, `runtime` ← this crate ← the CLI.
 
+pub mod baseline;
 pub mod bench;
 pub mod bench_plots;
 pub mod bench_report;
