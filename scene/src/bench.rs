@@ -580,7 +580,9 @@ pub fn run(plan: &BenchPlan, paths: &BenchPaths, steps: &mut Steps) -> anyhow::R
         machine: machine(),
         adapter: crate::env_frame::env_adapter()?,
         date: command_output("date", &["-u", "+%Y-%m-%d %H:%M UTC"]),
-        git_revision: command_output("git", &["rev-parse", "--short", "HEAD"]),
+        // "-dirty" when the tree has uncommitted changes: the revision alone would not say
+        // what was measured.
+        git_revision: command_output("git", &["describe", "--always", "--dirty", "--abbrev=7"]),
         seconds: 0.0,
         fits: Vec::new(),
         tables: tables(plan, &paths.scratch, steps)?,
