@@ -29,6 +29,7 @@ use strandlight_precompute::bake::bake_job;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription, Model, PlanOptions};
 use strandlight_precompute::baked_tables_check::check_asset;
 use strandlight_runtime::env::{EnvLight, ViewTransparency};
+use strandlight_runtime::passes::convolution_depth::DodmSettings;
 
 /// What one run measures.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -296,6 +297,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         unshadowed: false,
         split_lobes: 0,
         split_ratio: 3.0,
+        light_map_size: plan.dodm_sizes[0],
         look: LookArgs {
             transparency: EnvTransparency::Opaque,
             view: ViewArgs {
@@ -375,7 +377,7 @@ fn srbf_points(
         let lights = strongest_lights(scene, lobes);
         let mut frame: EnvFrame = compare::frame(scene, args, &lights, mode);
         frame.role = FrameRole::Interactive { kappa };
-        frame.look.dodm.resolution = dodm;
+        frame.look.dodm = DodmSettings::at_resolution(dodm);
         let r = steps.run(
             &format!("{}: SRBF {label}", mode.name()),
             || compare::timed_render(&render_lights, &frame, 1),

@@ -31,6 +31,7 @@ use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::{EnvLight, EnvRenderOptions, mark_every_strand, shadow_groups};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::image_out::{write_exr, write_png};
+use strandlight_runtime::passes::convolution_depth::{DodmSettings, MAX_DODM_RESOLUTION};
 use strandlight_tables::checksum::sha256_hex;
 
 #[derive(Debug)]
@@ -152,6 +153,11 @@ pub struct CompareArgs {
     /// Bandwidth of the sub-lobes relative to their lobe's, with --split-lobes.
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 3.0))]
     pub split_ratio: f64,
+    /// Texels across every light map (DODM) of all three renders, the reference's included:
+    /// the reference converges in its light count at this size, and light maps of another size
+    /// shadow each strand differently (docs/BENCHMARKS.md, "Light-map size").
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = DodmSettings::default().resolution))]
+    pub light_map_size: u32,
     /// The look of all three renders.
     #[cfg_attr(any(feature = "cli", test), command(flatten))]
     pub look: LookArgs,
@@ -193,6 +199,14 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
         bail!("--timing-runs 0: at least one render per timing");
     }
     args.look.look()?;
+    DodmSettings::at_resolution(args.light_map_size)
+        .check()
+        .with_context(|| {
+            format!(
+                "--light-map-size {}: texels across a light map, 1 to {MAX_DODM_RESOLUTION}",
+                args.light_map_size
+            )
+        })?;
     if let Some(n) = args.table_resolution
         && !(2..=256).contains(&n)
     {
@@ -580,6 +594,7 @@ pub fn frame<'a>(
 fn look(args: &CompareArgs) -> EnvLook {
     EnvLook {
         shadowed: !args.unshadowed,
+        dodm: DodmSettings::at_resolution(args.light_map_size),
         ..args.look.look().expect("checked by validate")
     }
 }
@@ -624,7 +639,7 @@ fn reference_inputs(
         "direct_table_inputs": direct.metadata.description.inputs_key,
         "multiple_tables_inputs": REFERENCE_MULTIPLE_TABLES.iter().filter(|_| mode == ScatteringMode::Full).filter_map(|n| scene.tables.assets.get(*n)).map(|a| a.metadata.description.inputs_key.clone()).collect::<Vec<_>>(),
         "generator": env!("CARGO_PKG_VERSION"),
-        "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, transparency: look(args).transparency, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
+        "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, transparency: look(args).transparency, dodm: look(args).dodm, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
     });
     // Only a finer shading cube adds a key, so brute-force references keep their cache entries.
     if let Some(m) = shading_face(args)?.filter(|&m| m > face) {
@@ -952,7 +967,7 @@ pub fn execute(
         "scene".into(),
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
-            "preset": args.preset, "baseline": args.baseline, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "preset": args.preset, "baseline": args.baseline, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
             "split_lobes": args.split_lobes, "split_ratio": args.split_ratio,
             "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,
@@ -1006,6 +1021,8 @@ mod tests {
             ("--reference-tolerance", "0", "(0, 1)"),
             ("--every-strand-share", "1.5", "[0, 1]"),
             ("--every-strand-share", "NaN", "[0, 1]"),
+            ("--light-map-size", "0", "1 to 2048"),
+            ("--light-map-size", "4096", "1 to 2048"),
         ] {
             let a = args(&["--hair", "h", "--env", "e", flag, value]).unwrap();
             let e = validate(&a).unwrap_err().to_string();
