@@ -9,7 +9,7 @@ use anyhow::Context;
 use clap::Args;
 
 use strandlight_scene::hdr_flip::{error_map_magma, hdr_flip};
-use strandlight_scene::image_metrics::relative_rmse;
+use strandlight_scene::image_metrics::{mean_ratio, relative_rmse};
 use strandlight_scene::reference_cache::read_rgba_exr;
 
 #[derive(Args, Debug)]
@@ -37,8 +37,9 @@ pub fn run(args: ImageErrorArgs) -> anyhow::Result<()> {
     };
     let error = relative_rmse(&test, &reference).with_context(pair)?;
     let flip = hdr_flip(&test, &reference).with_context(pair)?;
+    let mean = mean_ratio(&test, &reference).with_context(pair)?;
     println!(
-        "relative RMSE {error:.4}, HDR-FLIP {:.4} ({} exposures {:+.2} to {:+.2})  ({}, over the reference's hair pixels)",
+        "relative RMSE {error:.4}, HDR-FLIP {:.4} ({} exposures {:+.2} to {:+.2}), mean {mean:.4}× the reference's  ({}, over the reference's hair pixels)",
         flip.mean_over_hair,
         flip.exposures,
         flip.start_exposure,

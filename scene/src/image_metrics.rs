@@ -144,6 +144,29 @@ pub fn relative_rmse(approx: &Image, reference: &Image) -> Result<f64, CompareEr
     Ok((num / den).sqrt())
 }
 
+/// Σa / Σr over RGB of the reference's hair pixels: how much brighter the image is on average.
+/// Beside the relative RMSE it tells a bias (a ratio far from 1) from a pattern that moves
+/// light between pixels while keeping the mean (a ratio near 1 with a large RMSE).
+pub fn mean_ratio(approx: &Image, reference: &Image) -> Result<f64, CompareError> {
+    check_finite("the reference", reference)?;
+    approx.check_against("the image", reference)?;
+    let (mut sum_a, mut sum_r, mut hair) = (0.0f64, 0.0f64, 0usize);
+    for (a, r) in approx.pixels.iter().zip(&reference.pixels) {
+        if is_hair(r) {
+            hair += 1;
+            sum_a += (0..3).map(|c| a[c] as f64).sum::<f64>();
+            sum_r += (0..3).map(|c| r[c] as f64).sum::<f64>();
+        }
+    }
+    if hair == 0 {
+        return Err(CompareError::NoHair);
+    }
+    if sum_r == 0.0 {
+        return Err(CompareError::BlackReference);
+    }
+    Ok(sum_a / sum_r)
+}
+
 /// [`VIRIDIS`] at t ∈ [0, 1] (clamped), linearly interpolated between its samples.
 pub fn colormap(t: f64) -> [u8; 3] {
     let t = if t.is_finite() {
@@ -303,6 +326,28 @@ mod tests {
         let e = relative_rmse(&approx, &reference).unwrap();
         assert!((e - 0.1).abs() < 1e-7, "{e}");
         assert_eq!(relative_rmse(&reference, &reference).unwrap(), 0.0);
+    }
+
+    #[test]
+    fn mean_ratio_by_hand() {
+        // Hair RGB sums 1 and 2 in the reference, 1.1 and 2.2 in the image: 3.3 / 3 = 1.1; the
+        // non-hair pixel does not count. Swapping the two hair pixels' light keeps the mean.
+        let reference = image(vec![[1.0, 0.0, 0.0, 1.0], [0.0, 2.0, 0.0, 0.5], [0.0; 4]]);
+        let approx = image(vec![
+            [1.1, 0.0, 0.0, 1.0],
+            [0.0, 2.0, 0.2, 0.5],
+            [50.0, 50.0, 50.0, 1.0],
+        ]);
+        let r = mean_ratio(&approx, &reference).unwrap();
+        assert!((r - 1.1).abs() < 1e-7, "{r}");
+        let swapped = image(vec![[0.0, 2.0, 0.0, 1.0], [1.0, 0.0, 0.0, 0.5], [0.0; 4]]);
+        assert!((mean_ratio(&swapped, &reference).unwrap() - 1.0).abs() < 1e-12);
+        assert!(relative_rmse(&swapped, &reference).unwrap() > 1.0);
+        let black = image(vec![[0.0, 0.0, 0.0, 1.0]; 3]);
+        assert!(matches!(
+            mean_ratio(&black, &black),
+            Err(CompareError::BlackReference)
+        ));
     }
 
     #[test]
