@@ -438,10 +438,11 @@ fn env_lit(
                 || compare::render_baseline(&render_lights, &scene, &args, mode, n),
                 |r| format!("{:.0} ms", r.milliseconds),
             )?;
+            let count = compare::baseline_set(&scene, &args, n).len();
             points.push(measure(
                 family,
-                format!("{n} lights"),
-                n,
+                format!("{count} lights"),
+                count,
                 r.milliseconds,
                 &r.image,
                 image,

@@ -520,7 +520,16 @@ impl EqualErrorResult {
     }
 }
 
-/// The baseline (`--baseline`) with `lights` directional lights.
+/// The baseline's (`--baseline`) lights for a budget of `count`: exactly `count`, except that
+/// median cut with exact sources keeps every source and at least one light for the rest.
+pub fn baseline_set(scene: &CompareScene, args: &CompareArgs, count: usize) -> Vec<EnvLight> {
+    let specs = args
+        .baseline
+        .lights(&scene.map, count, args.rotate, &scene.reference_sources);
+    to_env_lights(&specs, scene.up)
+}
+
+/// The baseline (`--baseline`) with a budget of `lights` directional lights ([`baseline_set`]).
 pub fn render_baseline(
     render: Renderer,
     scene: &CompareScene,
@@ -528,10 +537,7 @@ pub fn render_baseline(
     mode: ScatteringMode,
     lights: usize,
 ) -> anyhow::Result<RenderedEnv> {
-    let specs = args
-        .baseline
-        .lights(&scene.map, lights, args.rotate, &scene.reference_sources);
-    let lights = to_env_lights(&specs, scene.up);
+    let lights = baseline_set(scene, args, lights);
     timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)
 }
 
@@ -749,7 +755,7 @@ fn run_mode(
         baseline_flip,
         reference,
         baseline,
-        baseline_lights: found.lights,
+        baseline_lights: baseline_set(scene, args, found.lights).len(),
         baseline_search: found.measurements,
         equal_error,
     })
