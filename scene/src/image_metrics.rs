@@ -308,21 +308,22 @@ mod tests {
         Image::new(pixels.len() as u32, 1, pixels)
     }
 
-    #[test]
-    fn relative_rmse_by_hand() {
-        // Hair pixels r = (1,0,0), (0,2,0); errors 0.1 and 0.2 → Σ|a−r|² = 0.01 + 0.04 = 0.05,
-        // Σ|r|² = 1 + 4 = 5, √(0.05/5) = 0.1. The third pixel has no hair in the reference and
-        // a huge difference that must not count.
-        let reference = image(vec![
-            [1.0, 0.0, 0.0, 1.0],
-            [0.0, 2.0, 0.0, 0.5],
-            [0.0, 0.0, 0.0, 0.0],
-        ]);
+    /// (image, reference): hair pixels r = (1,0,0), (0,2,0) with errors 0.1 and 0.2; the third
+    /// pixel has no hair in the reference and a huge difference that must not count.
+    fn worked_pair() -> (Image, Image) {
+        let reference = image(vec![[1.0, 0.0, 0.0, 1.0], [0.0, 2.0, 0.0, 0.5], [0.0; 4]]);
         let approx = image(vec![
             [1.1, 0.0, 0.0, 1.0],
             [0.0, 2.0, 0.2, 0.5],
             [50.0, 50.0, 50.0, 1.0],
         ]);
+        (approx, reference)
+    }
+
+    #[test]
+    fn relative_rmse_by_hand() {
+        // Σ|a−r|² = 0.01 + 0.04 = 0.05, Σ|r|² = 1 + 4 = 5, √(0.05/5) = 0.1.
+        let (approx, reference) = worked_pair();
         let e = relative_rmse(&approx, &reference).unwrap();
         assert!((e - 0.1).abs() < 1e-7, "{e}");
         assert_eq!(relative_rmse(&reference, &reference).unwrap(), 0.0);
@@ -332,12 +333,7 @@ mod tests {
     fn mean_ratio_by_hand() {
         // Hair RGB sums 1 and 2 in the reference, 1.1 and 2.2 in the image: 3.3 / 3 = 1.1; the
         // non-hair pixel does not count. Swapping the two hair pixels' light keeps the mean.
-        let reference = image(vec![[1.0, 0.0, 0.0, 1.0], [0.0, 2.0, 0.0, 0.5], [0.0; 4]]);
-        let approx = image(vec![
-            [1.1, 0.0, 0.0, 1.0],
-            [0.0, 2.0, 0.2, 0.5],
-            [50.0, 50.0, 50.0, 1.0],
-        ]);
+        let (approx, reference) = worked_pair();
         let r = mean_ratio(&approx, &reference).unwrap();
         assert!((r - 1.1).abs() < 1e-7, "{r}");
         let swapped = image(vec![[0.0, 2.0, 0.0, 1.0], [1.0, 0.0, 0.0, 0.5], [0.0; 4]]);
