@@ -18,6 +18,20 @@ fn optional_speedup(s: Option<f64>, r: &EnvLitResult, baseline: &str) -> String 
     }
 }
 
+/// "N vs M: d" per rung of the reference's ladder: each rung against the next, the last against
+/// the reference (M is not 4N where compact sources add the same lights to every rung).
+fn ladder_rungs(r: &EnvLitResult) -> Vec<String> {
+    let ladder = &r.reference_ladder;
+    ladder
+        .iter()
+        .enumerate()
+        .map(|(i, (n, d))| {
+            let next = ladder.get(i + 1).map_or(r.reference_lights, |rung| rung.0);
+            format!("{n} vs {next}: {d:.4}")
+        })
+        .collect()
+}
+
 fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str, baseline: &str) {
     let _ = writeln!(
         out,
@@ -30,9 +44,7 @@ fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str, baseline: &str
             Some(true) => ", converged (N and 4N lights within 1%)".to_string(),
             Some(false) => format!(
                 ", NOT converged within the run's light budget (last rung {})",
-                r.reference_ladder
-                    .last()
-                    .map_or("–".into(), |(n, d)| format!("{n} vs {}: {d:.4}", 4 * n))
+                ladder_rungs(r).last().map_or("–".into(), String::clone)
             ),
             None => String::new(),
         },
@@ -40,11 +52,7 @@ fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str, baseline: &str
         optional_speedup(r.speedup_equal_flip, r, baseline),
     );
     if !r.reference_ladder.is_empty() {
-        let ladder: Vec<String> = r
-            .reference_ladder
-            .iter()
-            .map(|(n, d)| format!("{n} vs {}: {d:.4}", 4 * n))
-            .collect();
+        let ladder = ladder_rungs(r);
         let _ = writeln!(
             out,
             "Reference convergence (relative RMSE): {}.\n",
@@ -199,6 +207,30 @@ mod tests {
             env_lit: Vec::new(),
             skipped: Vec::new(),
         }
+    }
+
+    #[test]
+    fn the_ladder_names_the_lights_each_rung_was_compared_with() {
+        // Eight compact sources ride on every rung: 104 = 8 + 96 is compared with 392 = 8 + 384,
+        // not 416, and the last rung with the reference.
+        let r = EnvLitResult {
+            map: "golf".into(),
+            mode: "single".into(),
+            reference_lights: 1544,
+            reference_ms: 1.0,
+            reference_converged: Some(false),
+            reference_ladder: vec![(104, 0.12), (392, 0.045)],
+            points: Vec::new(),
+            speedup_equal_rmse: None,
+            speedup_equal_flip: None,
+        };
+        assert_eq!(
+            ladder_rungs(&r),
+            ["104 vs 392: 0.1200", "392 vs 1544: 0.0450"]
+        );
+        let mut table = String::new();
+        env_lit_table(&mut table, &r, "plots", "median cut");
+        assert!(table.contains("(last rung 392 vs 1544: 0.0450)"), "{table}");
     }
 
     #[test]
