@@ -24,7 +24,8 @@ pub enum Baseline {
 }
 
 impl Baseline {
-    /// `count` directional lights for `map`, turned by `rotate_degrees` like every light set.
+    /// `count` directional lights for `map` (with exact sources: every source and at least one
+    /// more, so possibly more than `count`), turned by `rotate_degrees` like every light set.
     pub fn lights(
         self,
         map: &EnvMap,
