@@ -28,7 +28,7 @@ use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake::bake_job;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription, Model, PlanOptions};
 use strandlight_precompute::baked_tables_check::check_asset;
-use strandlight_runtime::env::{EnvLight, ViewTransparency};
+use strandlight_runtime::env::{EnvLight, ViewTransparency, mark_every_strand};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 
 /// What one run measures.
@@ -47,6 +47,10 @@ pub struct BenchPlan {
     pub lobes: Vec<usize>,
     pub kappas: Vec<f32>,
     pub dodm_sizes: Vec<u32>,
+    /// Adaptive κ: frames whose strongest lobes holding this share of the lobes' power draw
+    /// every strand (`compare --every-strand-share`); reports written before it existed: none.
+    #[serde(default)]
+    pub every_strand_shares: Vec<f32>,
     pub baseline_lights: Vec<usize>,
     /// Which directional-light baseline (reports written before it existed: median cut).
     #[serde(default)]
@@ -80,6 +84,7 @@ impl BenchPlan {
             lobes: vec![64, 8, 16, 32, 49],
             kappas: vec![0.1, 0.3, 1.0],
             dodm_sizes: vec![512, 256, 1024],
+            every_strand_shares: vec![0.2, 0.4],
             baseline_lights: vec![4, 8, 16, 32, 64, 128],
             baseline: Baseline::MedianCut,
             reference_max_lights: 1536,
@@ -105,6 +110,7 @@ impl BenchPlan {
             lobes: vec![64, 8, 32],
             kappas: vec![0.1, 1.0],
             dodm_sizes: vec![512, 256],
+            every_strand_shares: vec![0.4],
             baseline_lights: vec![4, 16, 64],
             baseline: Baseline::MedianCut,
             reference_max_lights: 384,
@@ -340,7 +346,57 @@ fn measure(
     })
 }
 
-/// The SRBF frames of one map and mode: lobes, κ and light-map size varied one at a time.
+/// One SRBF frame of the sweep: the defaults with one setting changed.
+struct SrbfConfig {
+    label: String,
+    lobes: usize,
+    kappa: f32,
+    dodm: u32,
+    every_strand_share: f32,
+}
+
+/// The SRBF frames of `plan`: the default, then lobes, κ, light-map size and adaptive κ's
+/// share varied one at a time.
+fn srbf_configs(plan: &BenchPlan) -> Vec<SrbfConfig> {
+    let (lobes, kappa, dodm) = (plan.lobes[0], plan.kappas[0], plan.dodm_sizes[0]);
+    let default = SrbfConfig {
+        label: format!("default ({lobes} lobes, κ {kappa}, {dodm}²)"),
+        lobes,
+        kappa,
+        dodm,
+        every_strand_share: 0.0,
+    };
+    let changed = |label: String| SrbfConfig { label, ..default };
+    let mut configs = Vec::new();
+    for &n in &plan.lobes[1..] {
+        configs.push(SrbfConfig {
+            lobes: n,
+            ..changed(format!("{n} lobes"))
+        });
+    }
+    for &k in &plan.kappas[1..] {
+        configs.push(SrbfConfig {
+            kappa: k,
+            ..changed(format!("κ {k}"))
+        });
+    }
+    for &d in &plan.dodm_sizes[1..] {
+        configs.push(SrbfConfig {
+            dodm: d,
+            ..changed(format!("light maps {d}²"))
+        });
+    }
+    for &share in &plan.every_strand_shares {
+        configs.push(SrbfConfig {
+            every_strand_share: share,
+            ..changed(format!("adaptive κ, share {share}"))
+        });
+    }
+    configs.insert(0, default);
+    configs
+}
+
+/// The SRBF frames of one map and mode ([`srbf_configs`]).
 fn srbf_points(
     plan: &BenchPlan,
     scene: &CompareScene,
@@ -349,43 +405,23 @@ fn srbf_points(
     reference: &Image,
     steps: &mut Steps,
 ) -> anyhow::Result<Vec<Point>> {
-    let mut configs: Vec<(String, usize, f32, u32)> = Vec::new();
-    let (lobes, kappa, dodm) = (plan.lobes[0], plan.kappas[0], plan.dodm_sizes[0]);
-    configs.push((
-        format!("default ({lobes} lobes, κ {kappa}, {dodm}²)"),
-        lobes,
-        kappa,
-        dodm,
-    ));
-    configs.extend(
-        plan.lobes[1..]
-            .iter()
-            .map(|&n| (format!("{n} lobes"), n, kappa, dodm)),
-    );
-    configs.extend(
-        plan.kappas[1..]
-            .iter()
-            .map(|&k| (format!("κ {k}"), lobes, k, dodm)),
-    );
-    configs.extend(
-        plan.dodm_sizes[1..]
-            .iter()
-            .map(|&d| (format!("light maps {d}²"), lobes, kappa, d)),
-    );
     let mut points = Vec::new();
-    for (label, lobes, kappa, dodm) in configs {
-        let lights = strongest_lights(scene, lobes);
+    for config in srbf_configs(plan) {
+        let mut lights = strongest_lights(scene, config.lobes);
+        mark_every_strand(&mut lights, config.every_strand_share);
         let mut frame: EnvFrame = compare::frame(scene, args, &lights, mode);
-        frame.role = FrameRole::Interactive { kappa };
-        frame.look.dodm = DodmSettings::at_resolution(dodm);
+        frame.role = FrameRole::Interactive {
+            kappa: config.kappa,
+        };
+        frame.look.dodm = DodmSettings::at_resolution(config.dodm);
         let r = steps.run(
-            &format!("{}: SRBF {label}", mode.name()),
+            &format!("{}: SRBF {}", mode.name(), config.label),
             || compare::timed_render(&render_lights, &frame, 1),
             |r| format!("{:.0} ms", r.milliseconds),
         )?;
         points.push(measure(
             "srbf",
-            label,
+            config.label,
             lights.len(),
             r.milliseconds,
             &r.image,
@@ -642,6 +678,28 @@ mod tests {
             ms,
             relative_rmse: error,
             hdr_flip: error,
+        }
+    }
+
+    #[test]
+    fn each_srbf_frame_changes_one_setting_of_the_default() {
+        for plan in [BenchPlan::quick(), BenchPlan::full()] {
+            let configs = srbf_configs(&plan);
+            let default = &configs[0];
+            assert!(default.label.starts_with("default"));
+            assert_eq!(default.every_strand_share, 0.0);
+            let expected = plan.lobes.len() - 1 + plan.kappas.len() - 1 + plan.dodm_sizes.len() - 1
+                + plan.every_strand_shares.len();
+            assert_eq!(configs.len(), 1 + expected, "{}", plan.name);
+            for c in &configs[1..] {
+                let changed = [
+                    c.lobes != default.lobes,
+                    c.kappa != default.kappa,
+                    c.dodm != default.dodm,
+                    c.every_strand_share != default.every_strand_share,
+                ];
+                assert_eq!(changed.iter().filter(|&&x| x).count(), 1, "{}", c.label);
+            }
         }
     }
 

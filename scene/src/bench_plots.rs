@@ -110,10 +110,12 @@ where
         .label_style(("sans-serif", 13))
         .draw()
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    let series = |family: &str, prefix: &str| -> Vec<(f64, f64)> {
+    // Labels name what was changed ("8 lobes", "κ 1", "light maps 256²", "adaptive κ, share
+    // 0.4"); the default's names every setting and joins every SRBF series.
+    let series = |family: &str, label: &dyn Fn(&str) -> bool| -> Vec<(f64, f64)> {
         let mut v: Vec<(f64, f64)> = measured
             .iter()
-            .filter(|p| p.family == family && p.label.contains(prefix))
+            .filter(|p| p.family == family && label(&p.label))
             .map(|p| (p.ms, metric.of(p).max(1e-4)))
             .collect();
         v.sort_by(|a, b| a.0.total_cmp(&b.0));
@@ -124,7 +126,7 @@ where
         .iter()
         .find(|p| p.is_baseline())
         .map_or("median cut", |p| p.family.as_str());
-    let baseline = series(baseline_family, "");
+    let baseline = series(baseline_family, &|_| true);
     chart
         .draw_series(LineSeries::new(baseline.clone(), RED.stroke_width(2)))
         .map_err(|e| anyhow::anyhow!("{e:?}"))?
@@ -133,13 +135,23 @@ where
     chart
         .draw_series(baseline.iter().map(|&p| Circle::new(p, 4, RED.filled())))
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    for (prefix, colour, label) in [
-        ("lobes", BLUE, "SRBF: lobe count"),
-        ("κ", GREEN, "SRBF: κ"),
-        ("light maps", MAGENTA, "SRBF: light-map size"),
-    ] {
-        let mut points = series("srbf", prefix);
-        points.extend(series("srbf", "default"));
+    let srbf_series: [(&dyn Fn(&str) -> bool, RGBColor, &str); 4] = [
+        (&|l| l.ends_with(" lobes"), BLUE, "SRBF: lobe count"),
+        (&|l| l.starts_with("κ"), GREEN, "SRBF: κ"),
+        (
+            &|l| l.starts_with("light maps"),
+            MAGENTA,
+            "SRBF: light-map size",
+        ),
+        (
+            &|l| l.starts_with("adaptive"),
+            CYAN,
+            "SRBF: adaptive κ share",
+        ),
+    ];
+    for (matches, colour, label) in srbf_series {
+        let mut points = series("srbf", matches);
+        points.extend(series("srbf", &|l| l.starts_with("default")));
         points.sort_by(|a, b| a.0.total_cmp(&b.0));
         let style = colour.stroke_width(1);
         chart
