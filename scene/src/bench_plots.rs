@@ -151,6 +151,9 @@ where
     ];
     for (matches, colour, label) in srbf_series {
         let mut points = series("srbf", matches);
+        if points.is_empty() {
+            continue; // not in this plan (or a report written before it)
+        }
         points.extend(series("srbf", &|l| l.starts_with("default")));
         points.sort_by(|a, b| a.0.total_cmp(&b.0));
         let style = colour.stroke_width(1);
