@@ -738,35 +738,10 @@ impl EnvRenderer {
             }
             None => None,
         };
-        timings.time(gpu, "light pass", || {
-            let (geometry, enlargement) = match simplified {
-                true => (&frame.light_geometry, 1.0 / options.kappa),
-                false => (&frame.geometry, 1.0),
-            };
-            let directions: Vec<_> = batch.groups.iter().map(|g| g.direction).collect();
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            self.depth.encode(
-                gpu,
-                &mut encoder,
-                geometry,
-                &directions,
-                frame.bounds,
-                enlargement,
-                enlargement,
-                &mut frame.dodm,
-            );
-            gpu.queue.submit([encoder.finish()]);
-        });
-        frame.sat.average = match srbf_kind {
-            true => options.box_average,
-            false => BoxAverage::OpticalDepth,
-        };
-        timings.time(gpu, "summed-area tables", || {
-            let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            self.sat
-                .encode(gpu, &mut encoder, &frame.dodm.optical_depth, &frame.sat);
-            gpu.queue.submit([encoder.finish()]);
-        });
+        // Unshadowed frames never read the light maps: skip drawing them.
+        if options.shadowed {
+            self.encode_light_maps(gpu, frame, batch, srbf_kind, simplified, options, timings);
+        }
         timings.time(gpu, "view", || {
             let lights = BatchBinding::with_groups(
                 gpu,
@@ -797,6 +772,49 @@ impl EnvRenderer {
             gpu.queue.submit([encoder.finish()]);
         });
         Ok(())
+    }
+
+    /// The batch's light maps: the light pass into the DODM, then its summed-area tables.
+    #[allow(clippy::too_many_arguments)]
+    fn encode_light_maps(
+        &self,
+        gpu: &GpuContext,
+        frame: &mut FrameResources,
+        batch: &LightBatch<'_>,
+        srbf_kind: bool,
+        simplified: bool,
+        options: &EnvRenderOptions,
+        timings: &mut Timings,
+    ) {
+        timings.time(gpu, "light pass", || {
+            let (geometry, enlargement) = match simplified {
+                true => (&frame.light_geometry, 1.0 / options.kappa),
+                false => (&frame.geometry, 1.0),
+            };
+            let directions: Vec<_> = batch.groups.iter().map(|g| g.direction).collect();
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            self.depth.encode(
+                gpu,
+                &mut encoder,
+                geometry,
+                &directions,
+                frame.bounds,
+                enlargement,
+                enlargement,
+                &mut frame.dodm,
+            );
+            gpu.queue.submit([encoder.finish()]);
+        });
+        frame.sat.average = match srbf_kind {
+            true => options.box_average,
+            false => BoxAverage::OpticalDepth,
+        };
+        timings.time(gpu, "summed-area tables", || {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            self.sat
+                .encode(gpu, &mut encoder, &frame.dodm.optical_depth, &frame.sat);
+            gpu.queue.submit([encoder.finish()]);
+        });
     }
 }
 

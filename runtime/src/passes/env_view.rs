@@ -172,8 +172,14 @@ impl BatchBinding {
             .iter()
             .enumerate()
             .map(|(slot, group)| {
-                let camera = dodm.cameras[slot];
-                let view_proj = camera.projection_matrix(1.0) * camera.view();
+                // An unshadowed frame drew no light maps, so there is no camera to read.
+                let map = shadowed.then(|| {
+                    let camera = dodm.cameras[slot];
+                    let view_proj = camera.projection_matrix(1.0) * camera.view();
+                    (view_proj, camera.near, camera.far, dodm.texels_per_unit(slot))
+                });
+                let (view_proj, near, far, texels_per_unit) =
+                    map.unwrap_or((glam::Mat4::IDENTITY, 0.0, 1.0, 0.0));
                 let light = group.representative();
                 let inv_lambda = light.lambda.map_or(0.0, |l| 1.0 / l);
                 let first_sample = samples.len() as u32;
@@ -182,10 +188,10 @@ impl BatchBinding {
                     view_proj: view_proj.to_cols_array_2d(),
                     direction: light.direction.normalize().extend(inv_lambda).into(),
                     rgb: Vec3::from(light.rgb).extend(filter.slope(&light)).into(),
-                    near: camera.near,
-                    far: camera.far,
+                    near,
+                    far,
                     first_layer: dodm.first_layer,
-                    texels_per_unit: dodm.texels_per_unit(slot),
+                    texels_per_unit,
                     first_sample,
                     sample_count: group.lights.len() as u32,
                     _pad: [0; 2],
