@@ -280,6 +280,10 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         lobes: plan.lobes[0],
         fit_target: FitOptions::default().target_relative_mse,
         sources: strandlight_precompute::compact_sources::SourceOptions::default().max_sources,
+        source_radius: strandlight_precompute::compact_sources::SourceOptions::default()
+            .radius_degrees,
+        source_min_share: strandlight_precompute::compact_sources::SourceOptions::default()
+            .min_norm_share,
         size: format!("{}x{}", plan.size.0, plan.size.1),
         json: true,
         reference_lights: None,

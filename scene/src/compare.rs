@@ -54,6 +54,13 @@ pub struct CompareArgs {
     /// rendered beside the SRBFs; 0: SRBFs alone, as the paper.
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().max_sources))]
     pub sources: usize,
+    /// Angular radius of a compact source's disc, degrees (the fit's; the reference always
+    /// takes the default sources out, so its cache holds across fit settings).
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().radius_degrees))]
+    pub source_radius: f64,
+    /// Least share of the remaining map's squared norm a compact source must hold (the fit's).
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().min_norm_share))]
+    pub source_min_share: f64,
     /// Image size WxH (the paper's 640x480).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value = "640x480"))]
     pub size: String,
@@ -218,6 +225,18 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
             args.every_strand_share
         );
     }
+    if !(args.source_radius > 0.0 && args.source_radius <= 30.0) {
+        bail!(
+            "--source-radius {}: a compact source's angular radius in degrees, in (0, 30]",
+            args.source_radius
+        );
+    }
+    if !(args.source_min_share > 0.0 && args.source_min_share <= 1.0) {
+        bail!(
+            "--source-min-share {}: a share of the map's squared norm, in (0, 1]",
+            args.source_min_share
+        );
+    }
     if !(args.reference_tolerance > 0.0 && args.reference_tolerance < 1.0) {
         bail!(
             "--reference-tolerance {}: must be in (0, 1)",
@@ -328,7 +347,8 @@ pub fn prepare_with_hair(
     )?;
     let sources = strandlight_precompute::compact_sources::SourceOptions {
         max_sources: args.sources,
-        ..Default::default()
+        radius_degrees: args.source_radius,
+        min_norm_share: args.source_min_share,
     };
     let options = FitOptions {
         max_lobes: args.lobes,
@@ -424,7 +444,9 @@ pub fn prepare_with_hair(
         size: (width, height),
         tables,
         srbf,
-        reference_sources: sources,
+        // The reference's discretization, not the method's: any choice converges to the same
+        // image, and a fixed one keeps the cached ladders valid whatever the fit is given.
+        reference_sources: strandlight_precompute::compact_sources::SourceOptions::default(),
         map: env.map,
         map_sha256: env.sha256,
         fiber,
@@ -973,7 +995,7 @@ pub fn execute(
         "scene".into(),
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
-            "preset": args.preset, "baseline": args.baseline, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "preset": args.preset, "baseline": args.baseline, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
             "split_lobes": args.split_lobes, "split_ratio": args.split_ratio,
             "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,

@@ -176,7 +176,12 @@ impl BatchBinding {
                 let map = shadowed.then(|| {
                     let camera = dodm.cameras[slot];
                     let view_proj = camera.projection_matrix(1.0) * camera.view();
-                    (view_proj, camera.near, camera.far, dodm.texels_per_unit(slot))
+                    (
+                        view_proj,
+                        camera.near,
+                        camera.far,
+                        dodm.texels_per_unit(slot),
+                    )
                 });
                 let (view_proj, near, far, texels_per_unit) =
                     map.unwrap_or((glam::Mat4::IDENTITY, 0.0, 1.0, 0.0));
