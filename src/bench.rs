@@ -52,16 +52,24 @@ pub struct BenchArgs {
     /// Cache folder (fits, tables, reference images), shared with `compare`.
     #[arg(long, default_value = "out/cache")]
     pub cache: PathBuf,
-    /// Measure nothing: write the plots and the page again from a report JSON an earlier run
-    /// wrote (after a change to how they are drawn, without the hour of measuring).
-    #[arg(long, value_name = "REPORT_JSON", conflicts_with_all = ["quick", "maps", "data", "modes", "reference_max_lights", "baseline_lights", "baseline"])]
-    pub from_report: Option<PathBuf>,
+    /// Measure nothing: write the plots and the page again from report JSONs earlier runs
+    /// wrote (after a change to how they are drawn, without the hour of measuring). Several
+    /// reports of the same plan on different maps (a sweep run map by map) make one page.
+    #[arg(long, value_name = "REPORT_JSON", num_args = 1.., conflicts_with_all = ["quick", "maps", "data", "modes", "reference_max_lights", "baseline_lights", "baseline"])]
+    pub from_report: Vec<PathBuf>,
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
-    let report = match &args.from_report {
-        Some(path) => read_report(path)?,
-        None => match measure(&args)? {
+    let report = match args.from_report.is_empty() {
+        false => {
+            let reports = args
+                .from_report
+                .iter()
+                .map(|path| read_report(path))
+                .collect::<anyhow::Result<Vec<_>>>()?;
+            BenchReport::merged(reports).context("merging the --from-report reports")?
+        }
+        true => match measure(&args)? {
             Some(report) => report,
             None => return Ok(()),
         },

@@ -32,7 +32,7 @@ use strandlight_runtime::env::{EnvLight, ViewTransparency, mark_every_strand};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 
 /// What one run measures.
-#[derive(Debug, Clone, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BenchPlan {
     pub name: String,
     pub maps: Vec<String>,
@@ -270,6 +270,62 @@ pub struct BenchReport {
     pub env_lit: Vec<EnvLitResult>,
     /// Maps the plan named that were not found, with why.
     pub skipped: Vec<String>,
+}
+
+impl BenchReport {
+    /// One report of runs that measured the same plan on different maps (a long sweep split
+    /// into one run per map): maps, fits and env-lit results in the order given, the first
+    /// run's table sweep, the runs' dates and revisions named, their seconds summed.
+    pub fn merged(reports: Vec<BenchReport>) -> anyhow::Result<BenchReport> {
+        let mut reports = reports.into_iter();
+        let mut merged = reports.next().context("no report to merge")?;
+        let (first_date, mut last_date) = (merged.date.clone(), merged.date.clone());
+        let mut revisions = vec![merged.git_revision.clone()];
+        for report in reports {
+            let plan_without_maps = |p: &BenchPlan| BenchPlan {
+                maps: Vec::new(),
+                ..p.clone()
+            };
+            if plan_without_maps(&report.plan) != plan_without_maps(&merged.plan) {
+                anyhow::bail!(
+                    "the reports measured different plans (apart from the maps): {:?} and {:?}",
+                    plan_without_maps(&merged.plan),
+                    plan_without_maps(&report.plan)
+                );
+            }
+            if (&report.machine, &report.adapter) != (&merged.machine, &merged.adapter) {
+                anyhow::bail!(
+                    "the reports were measured on different machines: {} ({}) and {} ({})",
+                    merged.machine,
+                    merged.adapter,
+                    report.machine,
+                    report.adapter
+                );
+            }
+            if let Some(map) = report
+                .plan
+                .maps
+                .iter()
+                .find(|m| merged.plan.maps.contains(m))
+            {
+                anyhow::bail!("{map} is in more than one report");
+            }
+            merged.plan.maps.extend(report.plan.maps);
+            merged.fits.extend(report.fits);
+            merged.env_lit.extend(report.env_lit);
+            merged.skipped.extend(report.skipped);
+            merged.seconds += report.seconds;
+            if !revisions.contains(&report.git_revision) {
+                revisions.push(report.git_revision);
+            }
+            last_date = report.date;
+        }
+        if last_date != first_date {
+            merged.date = format!("{first_date} to {last_date}");
+        }
+        merged.git_revision = revisions.join(", ");
+        Ok(merged)
+    }
 }
 
 /// The compare settings a bench scene of `map` is built with.
@@ -683,6 +739,54 @@ mod tests {
             relative_rmse: error,
             hdr_flip: error,
         }
+    }
+
+    fn report(map: &str, date: &str, revision: &str) -> BenchReport {
+        let mut plan = BenchPlan::quick();
+        plan.maps = vec![map.into()];
+        BenchReport {
+            plan,
+            machine: "m".into(),
+            adapter: "a".into(),
+            date: date.into(),
+            git_revision: revision.into(),
+            seconds: 10.0,
+            fits: Vec::new(),
+            tables: Vec::new(),
+            env_lit: Vec::new(),
+            skipped: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn reports_of_one_plan_on_different_maps_merge() {
+        let merged = BenchReport::merged(vec![
+            report("a.hdr", "d1", "r1"),
+            report("b.hdr", "d2", "r1"),
+            report("c.hdr", "d3", "r2"),
+        ])
+        .unwrap();
+        assert_eq!(merged.plan.maps, ["a.hdr", "b.hdr", "c.hdr"]);
+        assert_eq!(merged.date, "d1 to d3");
+        assert_eq!(merged.git_revision, "r1, r2");
+        assert_eq!(merged.seconds, 30.0);
+    }
+
+    #[test]
+    fn reports_of_different_plans_machines_or_the_same_map_do_not_merge() {
+        let mut other_plan = report("b.hdr", "d", "r");
+        other_plan.plan.reference_max_lights = 1536;
+        let mut other_machine = report("b.hdr", "d", "r");
+        other_machine.adapter = "b".into();
+        for (second, says) in [
+            (other_plan, "different plans"),
+            (other_machine, "different machines"),
+            (report("a.hdr", "d", "r"), "more than one report"),
+        ] {
+            let error = BenchReport::merged(vec![report("a.hdr", "d", "r"), second]).unwrap_err();
+            assert!(error.to_string().contains(says), "{error}");
+        }
+        assert!(BenchReport::merged(Vec::new()).is_err());
     }
 
     #[test]
