@@ -177,6 +177,37 @@ pub fn extract(map: &EnvMap, options: &SourceOptions) -> (Vec<CompactSource>, En
     (sources, EnvMap::from_pixels(width, height, pixels))
 }
 
+/// How much more of the map's power (luminance share) the sources at the wider radius must
+/// hold before [`extract_widening`] takes them: a sun's glow adds a few points, a softbox whose
+/// light spills past the narrow disc adds tens.
+pub const WIDENING_GAIN: f64 = 0.10;
+
+/// [`extract`] at `options.radius_degrees`, or at `wider_degrees` where the sources found there
+/// hold at least [`WIDENING_GAIN`] more of the map's power: extended lamps (studio softboxes),
+/// whose light the narrow disc leaves to lobes too wide for it (λ ≤ 64). A sun keeps the narrow
+/// disc: collapsing a wider one into a point sharpens the glow's shadows (docs/BENCHMARKS.md,
+/// "Wider compact sources"). Returns the radius used beside the sources and the residual.
+pub fn extract_widening(
+    map: &EnvMap,
+    options: &SourceOptions,
+    wider_degrees: Option<f64>,
+) -> (Vec<CompactSource>, EnvMap, f64) {
+    let narrow = extract(map, options);
+    let Some(wider) = wider_degrees.filter(|&w| w > options.radius_degrees) else {
+        return (narrow.0, narrow.1, options.radius_degrees);
+    };
+    let wide_options = SourceOptions {
+        radius_degrees: wider,
+        ..*options
+    };
+    let wide = extract(map, &wide_options);
+    let held = |sources: &[CompactSource]| sources.iter().map(|s| s.power_share).sum::<f64>();
+    match held(&wide.0) >= held(&narrow.0) + WIDENING_GAIN {
+        true => (wide.0, wide.1, wider),
+        false => (narrow.0, narrow.1, options.radius_degrees),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -252,6 +283,47 @@ mod tests {
         let (found, residual) = extract(&coarse, &SourceOptions::default());
         assert!(found.is_empty(), "{found:?}");
         assert_eq!(residual, coarse);
+    }
+
+    /// A softbox: a disc `radius` wide of near-uniform radiance `level` (5% brighter at its
+    /// centre, so the brightest pixel is there), on a sky.
+    fn sky_with_softbox(sky: f32, lamp: DVec3, radius: f64, level: f32) -> EnvMap {
+        EnvMap::from_fn(1024, 512, |w| {
+            let t = w.dot(lamp).clamp(-1.0, 1.0).acos() / radius;
+            let l = if t <= 1.0 {
+                level * (1.0 + 0.05 * (1.0 - t * t) as f32)
+            } else {
+                0.0
+            };
+            [(sky + l) as f64; 3]
+        })
+    }
+
+    #[test]
+    fn an_extended_lamp_widens_the_disc_and_a_sun_keeps_it() {
+        let options = SourceOptions::default();
+        let held = |s: &[CompactSource]| s.iter().map(|s| s.power_share).sum::<f64>();
+        let toward = DVec3::new(0.3, 0.8, -0.52).normalize();
+        let lamp = sky_with_softbox(0.5, toward, 6f64.to_radians(), 200.0);
+        let narrow = extract(&lamp, &options).0;
+        // Within 2.5° of the centre the softbox's own radiance is the background.
+        let (wide, residual, radius) = extract_widening(&lamp, &options, Some(5.0));
+        assert_eq!(radius, 5.0, "{narrow:?} vs {wide:?}");
+        assert!(
+            held(&wide) >= held(&narrow) + WIDENING_GAIN,
+            "{narrow:?} vs {wide:?}"
+        );
+        let (m, r) = (lamp.integral(), residual.integral());
+        let power: f64 = wide.iter().map(|s| s.power[0]).sum();
+        assert!((r[0] + power - m[0]).abs() < 1e-9 * m[0]);
+        // A sun half a degree wide: the wider disc adds only sky, so the narrow one stays.
+        let sun = sky_with_sun(0.5, toward, 0.25f64.to_radians(), 20000.0);
+        let (kept, _, radius) = extract_widening(&sun, &options, Some(5.0));
+        assert_eq!(radius, options.radius_degrees);
+        assert_eq!(kept, extract(&sun, &options).0);
+        // No wider radius, or one no wider: the narrow extraction as is.
+        assert_eq!(extract_widening(&lamp, &options, None).2, 2.5);
+        assert_eq!(extract_widening(&lamp, &options, Some(2.0)).2, 2.5);
     }
 
     #[test]

@@ -70,6 +70,11 @@ pub struct FitOptions {
     /// field predate extraction: none.
     #[serde(default = "crate::compact_sources::SourceOptions::none")]
     pub sources: crate::compact_sources::SourceOptions,
+    /// A wider disc radius (degrees) the sources take instead where it holds markedly more of
+    /// the map's power ([`crate::compact_sources::extract_widening`]: extended lamps). Options
+    /// saved without the field predate it: none.
+    #[serde(default)]
+    pub wider_source_radius: Option<f64>,
 }
 
 fn default_true() -> bool {
@@ -90,6 +95,7 @@ impl Default for FitOptions {
             rotate_degrees: 0.0,
             preserve_power: true,
             sources: Default::default(),
+            wider_source_radius: Some(5.0),
         }
     }
 }

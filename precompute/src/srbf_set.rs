@@ -235,7 +235,11 @@ impl SrbfSet {
     ) -> Result<SrbfSet, crate::srbf_fit::FitError> {
         let start = std::time::Instant::now();
         options.validate()?;
-        let (sources, residual) = crate::compact_sources::extract(source.map, &options.sources);
+        let (sources, residual, _) = crate::compact_sources::extract_widening(
+            source.map,
+            &options.sources,
+            options.wider_source_radius,
+        );
         let (lobes, grid_map, history) = match crate::srbf_fit::fit(&residual, options, progress) {
             Ok(fit) => (fit.lobes, fit.grid_map, fit.history),
             // Nothing but the sources: no lobes.
