@@ -279,7 +279,8 @@ impl BenchReport {
     pub fn merged(reports: Vec<BenchReport>) -> anyhow::Result<BenchReport> {
         let mut reports = reports.into_iter();
         let mut merged = reports.next().context("no report to merge")?;
-        let (first_date, mut last_date) = (merged.date.clone(), merged.date.clone());
+        // Dates are "YYYY-MM-DD HH:MM UTC": their order as text is their order in time.
+        let (mut first_date, mut last_date) = (merged.date.clone(), merged.date.clone());
         let mut revisions = vec![merged.git_revision.clone()];
         for report in reports {
             let plan_without_maps = |p: &BenchPlan| BenchPlan {
@@ -318,7 +319,8 @@ impl BenchReport {
             if !revisions.contains(&report.git_revision) {
                 revisions.push(report.git_revision);
             }
-            last_date = report.date;
+            first_date = first_date.min(report.date.clone());
+            last_date = last_date.max(report.date);
         }
         if last_date != first_date {
             merged.date = format!("{first_date} to {last_date}");
@@ -762,8 +764,8 @@ mod tests {
     fn reports_of_one_plan_on_different_maps_merge() {
         let merged = BenchReport::merged(vec![
             report("a.hdr", "d1", "r1"),
-            report("b.hdr", "d2", "r1"),
-            report("c.hdr", "d3", "r2"),
+            report("b.hdr", "d3", "r1"),
+            report("c.hdr", "d2", "r2"),
         ])
         .unwrap();
         assert_eq!(merged.plan.maps, ["a.hdr", "b.hdr", "c.hdr"]);
