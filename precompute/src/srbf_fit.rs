@@ -71,8 +71,10 @@ pub struct FitOptions {
     #[serde(default = "crate::compact_sources::SourceOptions::none")]
     pub sources: crate::compact_sources::SourceOptions,
     /// A wider disc radius (degrees) the sources take instead where it holds markedly more of
-    /// the map's power ([`crate::compact_sources::extract_widening`]: extended lamps). Options
-    /// saved without the field predate it: none.
+    /// the map's power ([`crate::compact_sources::extract_widening`]: extended lamps). Off by
+    /// default: it was measured on the shared maps (it helps the photo studio only) but it
+    /// also widens the demo's procedural 6° sun, where it is not measured. Options saved
+    /// without the field predate it: none.
     #[serde(default)]
     pub wider_source_radius: Option<f64>,
 }
@@ -95,7 +97,7 @@ impl Default for FitOptions {
             rotate_degrees: 0.0,
             preserve_power: true,
             sources: Default::default(),
-            wider_source_radius: Some(5.0),
+            wider_source_radius: None,
         }
     }
 }
@@ -160,6 +162,15 @@ impl FitOptions {
             |v| v > 0.0 && v <= 1.0,
             "must be in (0, 1]",
         )?;
+        if let Some(wider) = self.wider_source_radius {
+            let narrow = self.sources.radius_degrees;
+            check(
+                "wider_source_radius",
+                wider,
+                |v| v > narrow && v <= 20.0,
+                "must be wider than source_radius_degrees and at most 20",
+            )?;
+        }
         Ok(())
     }
 }

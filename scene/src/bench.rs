@@ -342,6 +342,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
             .radius_degrees,
         source_min_share: strandlight_precompute::compact_sources::SourceOptions::default()
             .min_norm_share,
+        wider_source_radius: None,
         size: format!("{}x{}", plan.size.0, plan.size.1),
         json: true,
         reference_lights: None,

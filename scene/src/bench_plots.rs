@@ -10,6 +10,9 @@ use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Once;
 
+/// Which points' labels belong to a plotted series.
+type LabelFilter<'a> = &'a dyn Fn(&str) -> bool;
+
 const WIDTH: u32 = 720;
 const HEIGHT: u32 = 480;
 
@@ -112,7 +115,7 @@ where
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
     // Labels name what was changed ("8 lobes", "κ 1", "light maps 256²", "adaptive κ, share
     // 0.4"); the default's names every setting and joins every SRBF series.
-    let series = |family: &str, label: &dyn Fn(&str) -> bool| -> Vec<(f64, f64)> {
+    let series = |family: &str, label: LabelFilter| -> Vec<(f64, f64)> {
         let mut v: Vec<(f64, f64)> = measured
             .iter()
             .filter(|p| p.family == family && label(&p.label))
@@ -135,7 +138,7 @@ where
     chart
         .draw_series(baseline.iter().map(|&p| Circle::new(p, 4, RED.filled())))
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    let srbf_series: [(&dyn Fn(&str) -> bool, RGBColor, &str); 4] = [
+    let srbf_series: [(LabelFilter, RGBColor, &str); 4] = [
         (&|l| l.ends_with(" lobes"), BLUE, "SRBF: lobe count"),
         (&|l| l.starts_with("κ"), GREEN, "SRBF: κ"),
         (

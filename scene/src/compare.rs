@@ -61,6 +61,10 @@ pub struct CompareArgs {
     /// Least share of the remaining map's squared norm a compact source must hold (the fit's).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().min_norm_share))]
     pub source_min_share: f64,
+    /// The fit takes its sources at this wider radius (degrees) where they hold ≥ 10 points
+    /// more of the map's power (extended lamps; off by default; docs/BENCHMARKS.md).
+    #[cfg_attr(any(feature = "cli", test), arg(long, value_name = "DEGREES"))]
+    pub wider_source_radius: Option<f64>,
     /// Image size WxH (the paper's 640x480).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value = "640x480"))]
     pub size: String,
@@ -225,9 +229,17 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
             args.every_strand_share
         );
     }
-    if !(args.source_radius > 0.0 && args.source_radius <= 30.0) {
+    if !(args.source_radius > 0.0 && args.source_radius <= 20.0) {
         bail!(
-            "--source-radius {}: a compact source's angular radius in degrees, in (0, 30]",
+            "--source-radius {}: a compact source's angular radius in degrees, in (0, 20]",
+            args.source_radius
+        );
+    }
+    if let Some(r) = args.wider_source_radius
+        && !(r > args.source_radius && r <= 20.0)
+    {
+        bail!(
+            "--wider-source-radius {r}: must be wider than --source-radius ({}) and at most 20 degrees",
             args.source_radius
         );
     }
@@ -355,6 +367,7 @@ pub fn prepare_with_hair(
         initial_lobes: args.lobes.min(FitOptions::default().initial_lobes),
         rotate_degrees: args.rotate,
         sources,
+        wider_source_radius: args.wider_source_radius,
         target_relative_mse: args.fit_target,
         ..FitOptions::default()
     };
@@ -995,7 +1008,7 @@ pub fn execute(
         "scene".into(),
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
-            "preset": args.preset, "baseline": args.baseline, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "preset": args.preset, "baseline": args.baseline, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
             "split_lobes": args.split_lobes, "split_ratio": args.split_ratio,
             "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,
