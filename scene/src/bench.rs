@@ -282,11 +282,11 @@ impl BenchReport {
         // Dates are "YYYY-MM-DD HH:MM UTC": their order as text is their order in time.
         let (mut first_date, mut last_date) = (merged.date.clone(), merged.date.clone());
         let mut revisions = vec![merged.git_revision.clone()];
+        let plan_without_maps = |p: &BenchPlan| BenchPlan {
+            maps: Vec::new(),
+            ..p.clone()
+        };
         for report in reports {
-            let plan_without_maps = |p: &BenchPlan| BenchPlan {
-                maps: Vec::new(),
-                ..p.clone()
-            };
             if plan_without_maps(&report.plan) != plan_without_maps(&merged.plan) {
                 anyhow::bail!(
                     "the reports measured different plans (apart from the maps): {:?} and {:?}",

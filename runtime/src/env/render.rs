@@ -727,9 +727,6 @@ impl EnvRenderer {
     ) -> Result<(), EnvRenderError> {
         let options = request.options;
         usage.batches += 1;
-        let first = batch.groups.first().map(|g| g.lights[0]);
-        let srbf_kind = first.is_some_and(|l| l.lambda.is_some());
-        let simplified = srbf_kind && first.is_some_and(|l| !l.every_strand);
         let grid = match request.multiple {
             Some(source) => {
                 let representatives: Vec<_> =
@@ -740,7 +737,7 @@ impl EnvRenderer {
         };
         // Unshadowed frames never read the light maps: skip drawing them.
         if options.shadowed {
-            self.encode_light_maps(gpu, frame, batch, srbf_kind, simplified, options, timings);
+            self.encode_light_maps(gpu, frame, batch, options, timings);
         }
         timings.time(gpu, "view", || {
             let lights = BatchBinding::with_groups(
@@ -775,17 +772,18 @@ impl EnvRenderer {
     }
 
     /// The batch's light maps: the light pass into the DODM, then its summed-area tables.
-    #[allow(clippy::too_many_arguments)]
     fn encode_light_maps(
         &self,
         gpu: &GpuContext,
         frame: &mut FrameResources,
         batch: &LightBatch<'_>,
-        srbf_kind: bool,
-        simplified: bool,
         options: &EnvRenderOptions,
         timings: &mut Timings,
     ) {
+        // A batch holds one kind of light: its first tells the kind.
+        let first = batch.groups.first().map(|g| g.lights[0]);
+        let srbf_kind = first.is_some_and(|l| l.lambda.is_some());
+        let simplified = srbf_kind && first.is_some_and(|l| !l.every_strand);
         timings.time(gpu, "light pass", || {
             let (geometry, enlargement) = match simplified {
                 true => (&frame.light_geometry, 1.0 / options.kappa),
