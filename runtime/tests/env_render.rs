@@ -1375,6 +1375,44 @@ fn a_lobe_drawing_every_strand_is_shadowed_as_at_kappa_one() {
     );
 }
 
+/// Each simplified light draws its own window of strands: at κ ½ a lobe split into two halves
+/// is shadowed by the two complementary subsets (a different image from the one lobe with one
+/// subset), while at κ 1 the split changes nothing. And the frame is the sum of its lights'
+/// windows in order: the second half's part equals the lobe rendered as a frame's second light.
+#[test]
+fn each_simplified_light_draws_its_own_subset_of_strands() {
+    let gpu = gpu();
+    let scene = groom_scene();
+    let [lobe, other] = groom_lobes();
+    let half = EnvLight {
+        rgb: lobe.rgb.map(|c| 0.5 * c),
+        ..lobe
+    };
+    let render = |lights: &[EnvLight], kappa: f32| render_groom(&gpu, &scene, lights, kappa);
+    let split_full = worst_relative(&render(&[half, half], 1.0), &render(&[lobe], 1.0));
+    let (split, whole) = (render(&[half, half], 0.5), render(&[lobe], 0.5));
+    let split_simplified = worst_relative(&split, &whole);
+    // The lobe as a second light (window 1) and as a first (window 0).
+    let second = render(&[other, lobe], 0.5);
+    let other_alone = render(&[other], 0.5);
+    let halves: Vec<[f32; 4]> = (0..split.len())
+        .map(|i| {
+            std::array::from_fn(|c| 0.5 * whole[i][c] + 0.5 * (second[i][c] - other_alone[i][c]))
+        })
+        .collect();
+    let against_windows = worst_relative(&split, &halves);
+    println!(
+        "split vs whole lobe: κ 1 {split_full:.2e}, κ ½ {split_simplified:.2e}; \
+         split vs its two windows: {against_windows:.2e}"
+    );
+    assert!(split_full < 1e-4, "κ 1: {split_full}");
+    assert!(
+        split_simplified > 1e-2,
+        "at κ ½ both halves drew the same strands: {split_simplified}"
+    );
+    assert!(against_windows < 1e-3, "{against_windows}");
+}
+
 #[test]
 fn srbf_and_directional_lights_in_one_frame_add_and_directional_ignores_kappa() {
     let gpu = gpu();

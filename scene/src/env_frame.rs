@@ -142,6 +142,7 @@ fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
         box_average: look.box_average,
         count_fragments: look.count_fragments,
         dodm: look.dodm,
+        simplification_seed: look.simplification_seed,
         ..EnvRenderOptions::default()
     }
 }

@@ -3,7 +3,7 @@
 //! The `cli` feature lets the command line parse these settings directly.
 
 use anyhow::Context;
-use strandlight_runtime::env::{BoxAverage, ViewTransparency};
+use strandlight_runtime::env::{BoxAverage, DEFAULT_SIMPLIFICATION_SEED, ViewTransparency};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 
 /// What the view shows of each pixel's fibers (Ren §8).
@@ -78,6 +78,16 @@ pub struct ViewArgs {
         arg(long, value_enum, default_value = "auto")
     )]
     pub forward_scattering: ForwardDevice,
+    /// Seed of the strand shuffle behind stochastic simplification (κ < 1): each seed draws
+    /// other subsets, so an image's error under κ varies with it (docs/BENCHMARKS.md,
+    /// "One subset per light").
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = DEFAULT_SIMPLIFICATION_SEED))]
+    #[serde(default = "default_simplification_seed")]
+    pub simplification_seed: u64,
+}
+
+fn default_simplification_seed() -> u64 {
+    DEFAULT_SIMPLIFICATION_SEED
 }
 
 impl Default for ViewArgs {
@@ -86,6 +96,7 @@ impl Default for ViewArgs {
             visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF,
             box_average: BoxAverageArg::OpticalDepth,
             forward_scattering: ForwardDevice::Auto,
+            simplification_seed: DEFAULT_SIMPLIFICATION_SEED,
         }
     }
 }
@@ -123,6 +134,7 @@ impl LookArgs {
             count_fragments: false,
             forward_scattering: view.forward_scattering,
             dodm: DodmSettings::default(),
+            simplification_seed: view.simplification_seed,
         })
     }
 }
@@ -140,4 +152,6 @@ pub struct EnvLook {
     pub forward_scattering: ForwardDevice,
     /// Light-pass map resolution and lights per batch.
     pub dodm: DodmSettings,
+    /// Seed of the strand shuffle behind κ ([`ViewArgs::simplification_seed`]).
+    pub simplification_seed: u64,
 }

@@ -184,9 +184,9 @@ use crate::multiple::ForwardScatteringError;
 
 pub mod render;
 pub use render::{
-    BoxAverage, EnvFrame, EnvRenderError, EnvRenderOptions, EnvRenderStats, EnvRenderer,
-    EnvTableError, EnvTables, FragmentCounts, OccupancyError, TransmittanceFilter,
-    ViewTransparency, render_env_frame,
+    BoxAverage, DEFAULT_SIMPLIFICATION_SEED, EnvFrame, EnvRenderError, EnvRenderOptions,
+    EnvRenderStats, EnvRenderer, EnvTableError, EnvTables, FragmentCounts, OccupancyError,
+    TransmittanceFilter, ViewTransparency, render_env_frame,
 };
 
 #[cfg(test)]

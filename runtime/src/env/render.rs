@@ -109,6 +109,9 @@ pub fn check_env_table(
     Ok(())
 }
 
+/// The default seed of the strand shuffle behind stochastic simplification.
+pub const DEFAULT_SIMPLIFICATION_SEED: u64 = 0x5eed;
+
 /// Everything besides the scene that changes how a frame is rendered.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EnvRenderOptions {
@@ -145,7 +148,7 @@ impl Default for EnvRenderOptions {
         Self {
             dodm: DodmSettings::default(),
             kappa: 0.1,
-            simplification_seed: 0x5eed,
+            simplification_seed: DEFAULT_SIMPLIFICATION_SEED,
             transparency: ViewTransparency::Opaque,
             count_fragments: false,
             shadowed: true,
@@ -425,6 +428,10 @@ fn check_sums_limits(gpu: &GpuContext, width: u32, height: u32) -> Result<(), Li
 struct FrameResources {
     geometry: StrandGeometry,
     light_geometry: StrandGeometry,
+    /// κ < 1: the shuffled strands whose windows the simplified light passes draw, and the
+    /// next light's window.
+    shuffled: Option<SimplifiedSegments>,
+    next_window: u32,
     bounds: Aabb,
     dodm: DodmBatch,
     sat: SummedAreaTables,
@@ -453,6 +460,20 @@ impl FrameResources {
         }
     }
 
+    /// The strand windows of the next `lights` simplified light maps (the frame's κ-thinned
+    /// SRBF lights, counted across batches): each light its own subset
+    /// ([`SimplifiedSegments::window`]).
+    fn next_windows(&mut self, lights: usize, kappa: f32) -> Vec<Vec<std::ops::Range<u32>>> {
+        let Some(shuffled) = &self.shuffled else {
+            return vec![vec![0..self.light_geometry.segment_count]; lights];
+        };
+        let first = self.next_window;
+        self.next_window += lights as u32;
+        (first..self.next_window)
+            .map(|k| shuffled.window(kappa, k))
+            .collect()
+    }
+
     /// GPU memory held while one batch renders, per resource (tables and grid added later).
     fn memory(&self) -> Vec<(String, u64)> {
         let mut memory = self.geometry.memory();
@@ -465,24 +486,26 @@ impl FrameResources {
     }
 }
 
-/// The geometry the SRBF light passes draw: the first κ of the shuffled strands, or all.
+/// The geometry the SRBF light passes draw: the strands in shuffled order (with the shuffle,
+/// whose windows the passes draw) when κ < 1, else all of them.
 fn light_pass_geometry(
     gpu: &GpuContext,
     model: &HairModel,
     geometry: &StrandGeometry,
     options: &EnvRenderOptions,
-) -> StrandGeometry {
+) -> (StrandGeometry, Option<SimplifiedSegments>) {
     if options.kappa < 1.0 {
-        SimplifiedSegments::new(gpu, model, options.simplification_seed)
-            .geometry(geometry, options.kappa)
+        let shuffled = SimplifiedSegments::new(gpu, model, options.simplification_seed);
+        (shuffled.geometry(geometry, options.kappa), Some(shuffled))
     } else {
-        StrandGeometry {
+        let all = StrandGeometry {
             points: geometry.points.clone(),
             segments: geometry.segments.clone(),
             attributes: geometry.attributes.clone(),
             segment_count: geometry.segment_count,
             default_thickness: geometry.default_thickness,
-        }
+        };
+        (all, None)
     }
 }
 
@@ -624,7 +647,7 @@ impl EnvRenderer {
         let occupancy = OccupancyMap::new(gpu, options.transparency, width, height)?;
         check_sums_limits(gpu, width, height)?;
         let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;
-        let light_geometry = light_pass_geometry(gpu, model, &geometry, options);
+        let (light_geometry, shuffled) = light_pass_geometry(gpu, model, &geometry, options);
         let bounds = model.bounds();
         let first_layer = options.dodm.first_layer_for(bounds);
         let dodm = DodmBatch::new(gpu, resolution, slots, first_layer);
@@ -656,6 +679,8 @@ impl EnvRenderer {
             depth_view: targets.depth.create_view(&Default::default()),
             geometry,
             light_geometry,
+            shuffled,
+            next_window: 0,
             bounds,
             dodm,
             sat,
@@ -784,21 +809,25 @@ impl EnvRenderer {
         let first = batch.groups.first().map(|g| g.lights[0]);
         let srbf_kind = first.is_some_and(|l| l.lambda.is_some());
         let simplified = srbf_kind && first.is_some_and(|l| !l.every_strand);
+        let directions: Vec<_> = batch.groups.iter().map(|g| g.direction).collect();
+        let windows = match simplified {
+            true => frame.next_windows(directions.len(), options.kappa),
+            false => vec![vec![0..frame.geometry.segment_count]; directions.len()],
+        };
         timings.time(gpu, "light pass", || {
             let (geometry, enlargement) = match simplified {
                 true => (&frame.light_geometry, 1.0 / options.kappa),
                 false => (&frame.geometry, 1.0),
             };
-            let directions: Vec<_> = batch.groups.iter().map(|g| g.direction).collect();
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            self.depth.encode(
+            self.depth.encode_windows(
                 gpu,
                 &mut encoder,
                 geometry,
                 &directions,
+                &windows,
                 frame.bounds,
-                enlargement,
-                enlargement,
+                [enlargement; 2],
                 &mut frame.dodm,
             );
             gpu.queue.submit([encoder.finish()]);

@@ -9,6 +9,7 @@
 //! Output: [`DodmBatch`] (textures + the lights' cameras), read by `summed_area` and the view pass.
 
 use glam::Vec3;
+use std::ops::Range;
 use strandlight_tables::hard_case_sweep::SweepRng;
 use wgpu::util::DeviceExt;
 
@@ -137,6 +138,29 @@ pub fn shuffled_strand_order(model: &HairModel, seed: u64) -> Vec<u32> {
     keyed.into_iter().map(|(_, s)| s).collect()
 }
 
+/// Light `k`'s strands under simplification κ, as ranges of segments in the shuffled order
+/// (`segments_before[s]`: segments of the first s shuffled strands): the ⌈κ·S⌉ strands from
+/// strand (k·⌈κ·S⌉) mod S on, wrapping round. Consecutive lights thus draw disjoint random
+/// subsets (⌈1/κ⌉ lights draw every strand), so the simplification's noise is independent
+/// between lights and averages out over a frame's lobes, instead of one subset's pattern
+/// repeating in every lobe's shadow (docs/BENCHMARKS.md, "One subset per light").
+pub fn strand_window(segments_before: &[u32], kappa: f32, k: u32) -> Vec<Range<u32>> {
+    let strands = segments_before.len().saturating_sub(1);
+    if strands == 0 {
+        return Vec::new();
+    }
+    let drawn = ((kappa as f64 * strands as f64).ceil() as usize).clamp(1, strands);
+    let start = (k as usize % strands) * drawn % strands;
+    let end = start + drawn;
+    let mut ranges = Vec::with_capacity(2);
+    ranges.push(segments_before[start]..segments_before[end.min(strands)]);
+    if end > strands {
+        ranges.push(0..segments_before[end - strands]);
+    }
+    ranges.retain(|r| !r.is_empty());
+    ranges
+}
+
 impl SimplifiedSegments {
     pub fn new(gpu: &GpuContext, model: &HairModel, seed: u64) -> Self {
         let table = segment_table(model);
@@ -174,6 +198,12 @@ impl SimplifiedSegments {
         let strands = self.segments_before.len() - 1;
         let drawn = ((kappa as f64 * strands as f64).ceil() as usize).min(strands);
         self.segments_before[drawn]
+    }
+
+    /// Light `k`'s window of the shuffled order for fraction κ, as segment ranges
+    /// ([`strand_window`]).
+    pub fn window(&self, kappa: f32, k: u32) -> Vec<Range<u32>> {
+        strand_window(&self.segments_before, kappa, k)
     }
 
     /// `geometry` drawing the first κ fraction of strands in shuffled order.
@@ -397,6 +427,34 @@ impl ConvolutionDepthPass {
         width_scale: f32,
         batch: &mut DodmBatch,
     ) {
+        let everything = std::iter::once(0..geometry.segment_count).collect::<Vec<_>>();
+        let windows = vec![everything; toward_lights.len()];
+        self.encode_windows(
+            gpu,
+            encoder,
+            geometry,
+            toward_lights,
+            &windows,
+            bounds,
+            [tau_scale, width_scale],
+            batch,
+        );
+    }
+
+    /// [`Self::encode`] drawing, for light `i`, only the segments in `windows[i]` (ranges of
+    /// `geometry`'s segment table: [`SimplifiedSegments::window`]); `scales` = [τ, width].
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode_windows(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &StrandGeometry,
+        toward_lights: &[Vec3],
+        windows: &[Vec<Range<u32>>],
+        bounds: Aabb,
+        [tau_scale, width_scale]: [f32; 2],
+        batch: &mut DodmBatch,
+    ) {
         let device = &gpu.device;
         let res = batch.resolution;
         batch.cameras = toward_lights
@@ -452,7 +510,9 @@ impl ConvolutionDepthPass {
                 });
                 pass.set_pipeline(&self.depth_pipeline);
                 pass.set_bind_group(0, &strands, &[]);
-                pass.draw(0..6, 0..geometry.segment_count);
+                for range in &windows[slot as usize] {
+                    pass.draw(0..6, range.clone());
+                }
             }
             {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -466,7 +526,9 @@ impl ConvolutionDepthPass {
                 pass.set_pipeline(&self.layer_pipeline);
                 pass.set_bind_group(0, &strands, &[]);
                 pass.set_bind_group(1, &dodm_group, &[]);
-                pass.draw(0..6, 0..geometry.segment_count);
+                for range in &windows[slot as usize] {
+                    pass.draw(0..6, range.clone());
+                }
             }
         }
     }
@@ -538,5 +600,45 @@ mod tests {
             a, sorted,
             "a shuffle of 10 strands that is the identity is 1 in 3.6M"
         );
+    }
+
+    /// Strands of uneven length (1, 2, 3, 1, 2, 3, … segments), κ = 1/4 of 12 strands: each
+    /// window holds 3 strands, consecutive windows follow one another round the order (the
+    /// fifth wraps to the start), and 1/κ of them draw every segment once (counted here strand
+    /// by strand, not from the ranges' lengths).
+    #[test]
+    fn consecutive_windows_are_disjoint_and_cover_every_strand() {
+        let lengths: Vec<u32> = (0..12).map(|s| 1 + s % 3).collect();
+        let mut before = vec![0u32];
+        for l in &lengths {
+            before.push(before.last().unwrap() + l);
+        }
+        let total = *before.last().unwrap();
+        let mut drawn = vec![0u32; total as usize];
+        for k in 0..5 {
+            let ranges = strand_window(&before, 0.25, k);
+            let strands: std::collections::BTreeSet<usize> = ranges
+                .iter()
+                .flat_map(|r| r.clone())
+                .map(|seg| before.partition_point(|&b| b <= seg) - 1)
+                .collect();
+            assert_eq!(strands.len(), 3, "window {k}: {ranges:?}");
+            let first = (3 * k as usize) % 12;
+            let expected: std::collections::BTreeSet<usize> =
+                (first..first + 3).map(|s| s % 12).collect();
+            assert_eq!(strands, expected, "window {k}");
+            for seg in ranges.iter().flat_map(|r| r.clone()) {
+                drawn[seg as usize] += 1;
+            }
+        }
+        // Windows 0..4 cover strands 0..15: every segment once, strands 0..3 twice.
+        for (seg, &n) in drawn.iter().enumerate() {
+            let strand = before.partition_point(|&b| b <= seg as u32) - 1;
+            let want = if strand < 3 { 2 } else { 1 };
+            assert_eq!(n, want, "segment {seg} of strand {strand}");
+        }
+        // κ = 1: every window is the whole order; no strands: nothing.
+        assert_eq!(strand_window(&before, 1.0, 5), vec![0..total]);
+        assert!(strand_window(&[0], 0.5, 0).is_empty());
     }
 }
