@@ -455,6 +455,7 @@ impl ConvolutionDepthPass {
         [tau_scale, width_scale]: [f32; 2],
         batch: &mut DodmBatch,
     ) {
+        assert_eq!(windows.len(), toward_lights.len(), "one window per light");
         let device = &gpu.device;
         let res = batch.resolution;
         batch.cameras = toward_lights
