@@ -225,13 +225,13 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
     let multiple = source.as_deref();
     let out = r
         .renderer
-        .render(
+        .render_part(
             &r.gpu,
             frame.hair,
             &frame.camera,
             frame.width,
             frame.height,
-            frame.lights,
+            (frame.lights, frame.look.simplified_lights_before),
             &tables,
             &render_options(frame),
             multiple,

@@ -135,6 +135,7 @@ impl LookArgs {
             forward_scattering: view.forward_scattering,
             dodm: DodmSettings::default(),
             simplification_seed: view.simplification_seed,
+            simplified_lights_before: 0,
         })
     }
 }
@@ -154,4 +155,8 @@ pub struct EnvLook {
     pub dodm: DodmSettings,
     /// Seed of the strand shuffle behind κ ([`ViewArgs::simplification_seed`]).
     pub simplification_seed: u64,
+    /// A frame rendered in parts (the viewer's batches): the simplified SRBF lights in the
+    /// parts before this one, so that each light draws the strands it draws in the whole
+    /// frame (`EnvRenderer::render_part`). 0 for a whole frame.
+    pub simplified_lights_before: u32,
 }

@@ -12,6 +12,7 @@ use std::sync::mpsc::{Receiver, TryRecvError, channel};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 use strandlight_runtime::camera::Camera;
+use strandlight_runtime::env::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::render::{PassTiming, TIMING_METHOD};
 use strandlight_scene::env_frame::{env_adapter, render_lights};
@@ -23,6 +24,7 @@ use strandlight_scene::frame_render::{
 use strandlight_scene::frame_settings::{
     EnvLighting, FrameSettings, Lighting, PointLighting, up_choice,
 };
+use strandlight_scene::look::EnvLook;
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 
@@ -513,6 +515,15 @@ impl WorkerState {
     }
 }
 
+/// The lights of `lights` whose maps κ thins (SRBFs not drawing every strand): a batch's
+/// windows continue from there, so the batches sum to `render --replay`'s one-call frame.
+fn simplified_lights(lights: &[EnvLight]) -> u32 {
+    lights
+        .iter()
+        .filter(|l| l.lambda.is_some() && !l.every_strand)
+        .count() as u32
+}
+
 /// One step of an env-lit request: the preview, or one batch of the full frame's lights.
 fn env_step(
     settings: &FrameSettings,
@@ -530,7 +541,10 @@ fn env_step(
         ),
         Step::Batch { first, count, .. } => (
             all[first..first + count].to_vec(),
-            env_look(env)?,
+            EnvLook {
+                simplified_lights_before: simplified_lights(&all[..first]),
+                ..env_look(env)?
+            },
             prepared.scene.mode,
         ),
         Step::Full => anyhow::bail!("an env-lit frame is refined in batches"),

@@ -545,6 +545,29 @@ impl EnvRenderer {
         options: &EnvRenderOptions,
         multiple: Option<&dyn ForwardScatteringSource>,
     ) -> Result<EnvFrame, EnvRenderError> {
+        let part = (lights, 0);
+        self.render_part(
+            gpu, model, camera, width, height, part, tables, options, multiple,
+        )
+    }
+
+    /// [`Self::render`] for `lights` that continue a frame rendered in parts (the viewer's
+    /// progressive batches): its simplified lights draw the strand windows from `first_window`
+    /// on, the number of simplified lights in the parts before, so the parts sum to the frame
+    /// rendered at once ([`SimplifiedSegments::window`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_part(
+        &self,
+        gpu: &GpuContext,
+        model: &HairModel,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        (lights, first_window): (&[EnvLight], u32),
+        tables: &EnvTables,
+        options: &EnvRenderOptions,
+        multiple: Option<&dyn ForwardScatteringSource>,
+    ) -> Result<EnvFrame, EnvRenderError> {
         let request = FrameRequest {
             model,
             camera,
@@ -559,6 +582,7 @@ impl EnvRenderer {
         check_inputs(lights, &kinds, tables, options, multiple.is_some())?;
         let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let mut frame = self.frame_resources(gpu, &request, &kinds, &mut timings)?;
+        frame.next_window = first_window;
         let mut memory = frame.memory();
         self.encode_visibility(gpu, &frame, options, &mut timings);
         let fragments = match options.count_fragments {
