@@ -64,6 +64,12 @@ impl EnvLight {
         }
     }
 
+    /// Whether stochastic simplification thins this light's map (κ < 1 draws only its window
+    /// of the strands): an SRBF not marked [`EnvLight::every_strand`].
+    pub fn is_simplified(&self) -> bool {
+        self.lambda.is_some() && !self.every_strand
+    }
+
     /// The direction of the light pass whose map shadows this light.
     pub fn shadow_direction(&self) -> Vec3 {
         self.shadowed_from.unwrap_or(self.direction)

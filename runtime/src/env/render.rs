@@ -832,7 +832,7 @@ impl EnvRenderer {
         // A batch holds one kind of light: its first tells the kind.
         let first = batch.groups.first().map(|g| g.lights[0]);
         let srbf_kind = first.is_some_and(|l| l.lambda.is_some());
-        let simplified = srbf_kind && first.is_some_and(|l| !l.every_strand);
+        let simplified = first.is_some_and(|l| l.is_simplified());
         let directions: Vec<_> = batch.groups.iter().map(|g| g.direction).collect();
         let windows = match simplified {
             true => frame.next_windows(directions.len(), options.kappa),
