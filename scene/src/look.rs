@@ -78,9 +78,9 @@ pub struct ViewArgs {
         arg(long, value_enum, default_value = "auto")
     )]
     pub forward_scattering: ForwardDevice,
-    /// Seed of the strand shuffle behind stochastic simplification (κ < 1): each seed draws
+    /// Seed of the strand order behind stochastic simplification (κ < 1): each seed draws
     /// other subsets, so an image's error under κ varies with it (docs/BENCHMARKS.md,
-    /// "One subset per light").
+    /// "One subset per light", "Stratified subsets").
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = DEFAULT_SIMPLIFICATION_SEED))]
     #[serde(default = "default_simplification_seed")]
     pub simplification_seed: u64,
@@ -153,7 +153,7 @@ pub struct EnvLook {
     pub forward_scattering: ForwardDevice,
     /// Light-pass map resolution and lights per batch.
     pub dodm: DodmSettings,
-    /// Seed of the strand shuffle behind κ ([`ViewArgs::simplification_seed`]).
+    /// Seed of the strand order behind κ ([`ViewArgs::simplification_seed`]).
     pub simplification_seed: u64,
     /// A frame rendered in parts (the viewer's batches): the simplified SRBF lights in the
     /// parts before this one, so that each light draws the strands it draws in the whole

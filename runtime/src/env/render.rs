@@ -109,7 +109,7 @@ pub fn check_env_table(
     Ok(())
 }
 
-/// The default seed of the strand shuffle behind stochastic simplification.
+/// The default seed of the strand order behind stochastic simplification.
 pub const DEFAULT_SIMPLIFICATION_SEED: u64 = 0x5eed;
 
 /// Everything besides the scene that changes how a frame is rendered.
@@ -122,7 +122,7 @@ pub struct EnvRenderOptions {
     /// 0.1. Directional lights (a sun taken out of the map) always draw every strand: one sharp
     /// shadow is what the simplification would blur.
     pub kappa: f32,
-    /// Seed of the strand shuffle behind κ.
+    /// Seed of the strand order behind κ (`simplification_order`'s scramble).
     pub simplification_seed: u64,
     /// What the view sees of each pixel's fibers: the nearest one (default) or all of them
     /// through the occupancy map (Ren §8).
@@ -428,9 +428,9 @@ fn check_sums_limits(gpu: &GpuContext, width: u32, height: u32) -> Result<(), Li
 struct FrameResources {
     geometry: StrandGeometry,
     light_geometry: StrandGeometry,
-    /// κ < 1: the shuffled strands whose windows the simplified light passes draw, and the
-    /// next light's window.
-    shuffled: Option<SimplifiedSegments>,
+    /// κ < 1: the strands in simplification order, whose windows the simplified light passes
+    /// draw, and the next light's window.
+    simplified: Option<SimplifiedSegments>,
     next_window: u32,
     bounds: Aabb,
     dodm: DodmBatch,
@@ -464,13 +464,13 @@ impl FrameResources {
     /// SRBF lights, counted across batches): each light its own subset
     /// ([`SimplifiedSegments::window`]).
     fn next_windows(&mut self, lights: usize, kappa: f32) -> Vec<Vec<std::ops::Range<u32>>> {
-        let Some(shuffled) = &self.shuffled else {
+        let Some(simplified) = &self.simplified else {
             return vec![vec![0..self.light_geometry.segment_count]; lights];
         };
         let first = self.next_window;
         self.next_window += lights as u32;
         (first..self.next_window)
-            .map(|k| shuffled.window(kappa, k))
+            .map(|k| simplified.window(kappa, k))
             .collect()
     }
 
@@ -486,8 +486,8 @@ impl FrameResources {
     }
 }
 
-/// The geometry the SRBF light passes draw: the strands in shuffled order (with the shuffle,
-/// whose windows the passes draw) when κ < 1, else all of them.
+/// The geometry the SRBF light passes draw: the strands in simplification order (with that
+/// order, whose windows the passes draw) when κ < 1, else all of them.
 fn light_pass_geometry(
     gpu: &GpuContext,
     model: &HairModel,
@@ -495,8 +495,11 @@ fn light_pass_geometry(
     options: &EnvRenderOptions,
 ) -> (StrandGeometry, Option<SimplifiedSegments>) {
     if options.kappa < 1.0 {
-        let shuffled = SimplifiedSegments::new(gpu, model, options.simplification_seed);
-        (shuffled.geometry(geometry, options.kappa), Some(shuffled))
+        let simplified = SimplifiedSegments::new(gpu, model, options.simplification_seed);
+        (
+            simplified.geometry(geometry, options.kappa),
+            Some(simplified),
+        )
     } else {
         let all = StrandGeometry {
             points: geometry.points.clone(),
@@ -671,7 +674,7 @@ impl EnvRenderer {
         let occupancy = OccupancyMap::new(gpu, options.transparency, width, height)?;
         check_sums_limits(gpu, width, height)?;
         let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;
-        let (light_geometry, shuffled) = light_pass_geometry(gpu, model, &geometry, options);
+        let (light_geometry, simplified) = light_pass_geometry(gpu, model, &geometry, options);
         let bounds = model.bounds();
         let first_layer = options.dodm.first_layer_for(bounds);
         let dodm = DodmBatch::new(gpu, resolution, slots, first_layer);
@@ -703,7 +706,7 @@ impl EnvRenderer {
             depth_view: targets.depth.create_view(&Default::default()),
             geometry,
             light_geometry,
-            shuffled,
+            simplified,
             next_window: 0,
             bounds,
             dodm,

@@ -119,29 +119,81 @@ pub fn check_kappa(kappa: f32) -> Result<(), DodmSettingsError> {
     }
 }
 
-/// Stochastic simplification (Ren 2010 §7): the segment table with whole strands in an order
-/// shuffled once by a seeded random key, so the light pass may draw only the segments of the
-/// first κ fraction of strands (enlarged by 1/κ, `ConvolutionDepthPass::encode`).
+/// Stochastic simplification (Ren 2010 §7): the segment table with whole strands in the
+/// seeded [`simplification_order`], so the light pass may draw only the segments of a window
+/// of κ·strands consecutive strands (enlarged by 1/κ, `ConvolutionDepthPass::encode`).
 pub struct SimplifiedSegments {
     pub segments: wgpu::Buffer,
-    /// `segments_before[s]`: segments of the first s shuffled strands (strand_count + 1 entries).
+    /// `segments_before[s]`: segments of the first s strands in that order (strand_count + 1
+    /// entries).
     pub segments_before: Vec<u32>,
 }
 
-/// The strands of `model` in the shuffled order (a permutation of 0..strand_count).
-pub fn shuffled_strand_order(model: &HairModel, seed: u64) -> Vec<u32> {
-    let mut rng = SweepRng::new(seed);
-    let mut keyed: Vec<(u64, u32)> = (0..model.strand_count() as u32)
-        .map(|s| (rng.next_u64(), s))
+/// The order whose consecutive runs are the strand subsets κ draws: a permutation of
+/// 0..strand_count. Strands are sorted along a Morton curve through their roots and visited in
+/// bit-reversed order, scrambled by a seeded digital shift. Every run of consecutive entries
+/// is then spread evenly over the scalp (a run of 2^q aligned entries holds exactly one strand
+/// of each 2^q-th of the sorted strands), so a light map drawing one run thins the hair
+/// evenly instead of leaving the random clumps and gaps of a shuffled subset, whose shadow
+/// noise κ's 1/κ opacity then magnifies (docs/BENCHMARKS.md, "Stratified subsets").
+pub fn simplification_order(model: &HairModel, seed: u64) -> Vec<u32> {
+    let strands = model.strand_count();
+    if strands == 0 {
+        return Vec::new();
+    }
+    let along_curve = strands_along_morton_curve(model);
+    let bits = usize::BITS - (strands - 1).leading_zeros();
+    let shift = SweepRng::new(seed).next_u64() & ((1u64 << bits) - 1);
+    (0..1u64 << bits)
+        .map(|i| bit_reversed(i, bits) ^ shift)
+        .filter(|&r| (r as usize) < strands)
+        .map(|r| along_curve[r as usize])
+        .collect()
+}
+
+/// `i`'s lowest `bits` bits in reverse order.
+fn bit_reversed(i: u64, bits: u32) -> u64 {
+    match bits {
+        0 => 0,
+        _ => i.reverse_bits() >> (64 - bits),
+    }
+}
+
+/// Strand indices sorted by the Morton code of their roots on a 1024³ grid over the bounds,
+/// so strands near each other on the curve grow near each other.
+fn strands_along_morton_curve(model: &HairModel) -> Vec<u32> {
+    let bounds = model.bounds();
+    let extent = (bounds.max - bounds.min).max(Vec3::splat(1e-20));
+    let mut keyed: Vec<(u64, u32)> = model
+        .strands()
+        .enumerate()
+        .map(|(s, points)| {
+            let root = points.first().copied().unwrap_or(bounds.min);
+            let cell =
+                ((root - bounds.min) / extent * 1023.0).clamp(Vec3::ZERO, Vec3::splat(1023.0));
+            (morton_code(cell.as_uvec3()), s as u32)
+        })
         .collect();
     keyed.sort_unstable();
     keyed.into_iter().map(|(_, s)| s).collect()
 }
 
-/// Light `k`'s strands under simplification κ, as ranges of segments in the shuffled order
-/// (`segments_before[s]`: segments of the first s shuffled strands): the ⌈κ·S⌉ strands from
-/// strand (k·⌈κ·S⌉) mod S on, wrapping round. Consecutive lights thus draw disjoint random
-/// subsets (⌈1/κ⌉ lights draw every strand), so the simplification's noise is independent
+/// The 30-bit Morton code of a cell of a 1024³ grid (x, y and z bits interleaved).
+fn morton_code(cell: glam::UVec3) -> u64 {
+    fn spread(v: u32) -> u64 {
+        let mut v = v as u64 & 0x3ff;
+        v = (v | v << 16) & 0x0300_00ff;
+        v = (v | v << 8) & 0x0300_f00f;
+        v = (v | v << 4) & 0x030c_30c3;
+        (v | v << 2) & 0x0924_9249
+    }
+    spread(cell.x) | spread(cell.y) << 1 | spread(cell.z) << 2
+}
+
+/// Light `k`'s strands under simplification κ, as ranges of segments in the
+/// [`simplification_order`] (`segments_before[s]`: segments of its first s strands): the
+/// ⌈κ·S⌉ strands from strand (k·⌈κ·S⌉) mod S on, wrapping round. Consecutive lights thus draw
+/// disjoint subsets (⌈1/κ⌉ lights draw every strand), so the simplification's noise differs
 /// between lights and averages out over a frame's lobes, instead of one subset's pattern
 /// repeating in every lobe's shadow (docs/BENCHMARKS.md, "One subset per light").
 pub fn strand_window(segments_before: &[u32], kappa: f32, k: u32) -> Vec<Range<u32>> {
@@ -170,21 +222,21 @@ impl SimplifiedSegments {
         for w in model.strand_offsets().windows(2) {
             first.push(first.last().unwrap() + (w[1] - w[0]).saturating_sub(1) as usize);
         }
-        let mut shuffled = Vec::with_capacity(table.len());
+        let mut ordered = Vec::with_capacity(table.len());
         let mut segments_before = vec![0u32];
-        for s in shuffled_strand_order(model, seed) {
-            shuffled.extend_from_slice(&table[first[s as usize]..first[s as usize + 1]]);
-            segments_before.push(shuffled.len() as u32);
+        for s in simplification_order(model, seed) {
+            ordered.extend_from_slice(&table[first[s as usize]..first[s as usize + 1]]);
+            segments_before.push(ordered.len() as u32);
         }
         // A storage binding may not be empty.
-        if shuffled.is_empty() {
-            shuffled.push(0);
+        if ordered.is_empty() {
+            ordered.push(0);
         }
         let segments = gpu
             .device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("hair segments (shuffled strands)"),
-                contents: bytemuck::cast_slice(&shuffled),
+                label: Some("hair segments (simplification order)"),
+                contents: bytemuck::cast_slice(&ordered),
                 usage: wgpu::BufferUsages::STORAGE,
             });
         Self {
@@ -193,20 +245,20 @@ impl SimplifiedSegments {
         }
     }
 
-    /// Segments to draw for fraction κ: those of the first ⌈κ·strands⌉ shuffled strands.
+    /// Segments to draw for fraction κ: those of the first ⌈κ·strands⌉ strands in order.
     pub fn segment_count(&self, kappa: f32) -> u32 {
         let strands = self.segments_before.len() - 1;
         let drawn = ((kappa as f64 * strands as f64).ceil() as usize).min(strands);
         self.segments_before[drawn]
     }
 
-    /// Light `k`'s window of the shuffled order for fraction κ, as segment ranges
+    /// Light `k`'s window of the simplification order for fraction κ, as segment ranges
     /// ([`strand_window`]).
     pub fn window(&self, kappa: f32, k: u32) -> Vec<Range<u32>> {
         strand_window(&self.segments_before, kappa, k)
     }
 
-    /// `geometry` drawing the first κ fraction of strands in shuffled order.
+    /// `geometry` drawing the first κ fraction of strands in simplification order.
     pub fn geometry(&self, geometry: &StrandGeometry, kappa: f32) -> StrandGeometry {
         StrandGeometry {
             points: geometry.points.clone(),
@@ -586,21 +638,88 @@ mod tests {
         );
     }
 
+    /// Strands rooted along a line in a scrambled file order.
+    fn strands_on_a_line(count: u32) -> HairModel {
+        let mut points = Vec::new();
+        for s in 0..count {
+            let x = ((s as u64 * 7919) % count as u64) as f32;
+            points.extend([Vec3::new(x, 0.0, 0.0), Vec3::new(x, -1.0, 0.0)]);
+        }
+        let offsets = (0..=count).map(|s| 2 * s).collect();
+        HairModel::new(points, offsets, None, None, None).unwrap()
+    }
+
+    fn root_x(model: &HairModel, s: u32) -> usize {
+        model.strand(s as usize)[0].x as usize
+    }
+
     #[test]
-    fn shuffle_is_a_seeded_permutation() {
-        let points = (0..30).map(|i| Vec3::new(i as f32, 0.0, 0.0)).collect();
-        let offsets = (0..=10).map(|s| 3 * s).collect();
-        let model = HairModel::new(points, offsets, None, None, None).unwrap();
-        let a = shuffled_strand_order(&model, 7);
-        let mut sorted = a.clone();
-        sorted.sort();
-        assert_eq!(sorted, (0..10).collect::<Vec<_>>());
-        assert_eq!(a, shuffled_strand_order(&model, 7));
-        assert_ne!(a, shuffled_strand_order(&model, 8));
-        assert_ne!(
-            a, sorted,
-            "a shuffle of 10 strands that is the identity is 1 in 3.6M"
-        );
+    fn simplification_order_is_a_seeded_permutation() {
+        for count in [1, 2, 10, 1000] {
+            let model = strands_on_a_line(count);
+            let a = simplification_order(&model, 7);
+            let mut sorted = a.clone();
+            sorted.sort();
+            assert_eq!(sorted, (0..count).collect::<Vec<_>>(), "{count} strands");
+            assert_eq!(a, simplification_order(&model, 7));
+        }
+        let model = strands_on_a_line(1000);
+        let seeds: std::collections::HashSet<_> = (0..8)
+            .map(|seed| simplification_order(&model, seed))
+            .collect();
+        assert!(seeds.len() >= 6, "8 seeds gave {} orders", seeds.len());
+    }
+
+    /// 256 strands, windows of 2^q aligned entries: each window holds one strand from each
+    /// 2^q-th of the line, whatever the seed; a shuffle would clump.
+    #[test]
+    fn aligned_windows_hold_one_strand_per_stratum() {
+        let model = strands_on_a_line(256);
+        for seed in [0, 1, 24301] {
+            let order = simplification_order(&model, seed);
+            for window in [4usize, 16, 64] {
+                let stratum = 256 / window;
+                for run in order.chunks(window) {
+                    let mut strata: Vec<_> =
+                        run.iter().map(|&s| root_x(&model, s) / stratum).collect();
+                    strata.sort();
+                    assert_eq!(strata, (0..window).collect::<Vec<_>>(), "seed {seed}");
+                }
+            }
+        }
+    }
+
+    /// 10,000 strands (not a power of two) and κ = 1/8, windows at every light's offset: no gap
+    /// along the line between a window's strands reaches 3× their mean spacing (8), where a
+    /// random subset's largest gap is about ln(window) ≈ 7× it (measured here: 18).
+    #[test]
+    fn every_window_spreads_over_the_line() {
+        let model = strands_on_a_line(10_000);
+        let order = simplification_order(&model, 24301);
+        let mut before = vec![0u32];
+        for s in &order {
+            before.push(before.last().unwrap() + model.strand(*s as usize).len() as u32 - 1);
+        }
+        let w = 1250usize;
+        let bound = 3 * 10_000 / w;
+        for k in 0..25u32 {
+            let mut xs: Vec<usize> = strand_window(&before, 0.125, k)
+                .into_iter()
+                .flat_map(|r| r.start as usize..r.end as usize)
+                .map(|segment| root_x(&model, order[segment]))
+                .collect();
+            assert_eq!(xs.len(), w);
+            xs.sort();
+            let gap = xs
+                .windows(2)
+                .map(|p| p[1] - p[0])
+                .chain([xs[0], 10_000 - xs[w - 1]]);
+            assert!(
+                gap.clone().max().unwrap() < bound,
+                "light {k}: gap {:?} ≥ {bound}",
+                gap.max()
+            );
+        }
     }
 
     /// Strands of uneven length (1, 2, 3, 1, 2, 3, … segments), κ = 1/4 of 12 strands: each
