@@ -373,7 +373,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
                 visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF,
                 box_average: BoxAverageArg::OpticalDepth,
                 forward_scattering: ForwardDevice::Auto,
-                simplification_seed: strandlight_runtime::env::DEFAULT_SIMPLIFICATION_SEED,
+                ..ViewArgs::default()
             },
         },
     }

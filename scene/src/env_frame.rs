@@ -143,6 +143,7 @@ fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
         count_fragments: look.count_fragments,
         dodm: look.dodm,
         simplification_seed: look.simplification_seed,
+        lobe_spread: look.lobe_spread,
         ..EnvRenderOptions::default()
     }
 }

@@ -3,7 +3,9 @@
 //! The `cli` feature lets the command line parse these settings directly.
 
 use anyhow::Context;
-use strandlight_runtime::env::{BoxAverage, DEFAULT_SIMPLIFICATION_SEED, ViewTransparency};
+use strandlight_runtime::env::{
+    BoxAverage, DEFAULT_SIMPLIFICATION_SEED, LobeSpread, ViewTransparency,
+};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 
 /// What the view shows of each pixel's fibers (Ren §8).
@@ -84,6 +86,65 @@ pub struct ViewArgs {
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = DEFAULT_SIMPLIFICATION_SEED))]
     #[serde(default = "default_simplification_seed")]
     pub simplification_seed: u64,
+    /// Spread each SRBF light's visibility over its lobe: the mean over directions of the lobe,
+    /// each traced through the light's own map, instead of one filtered visibility per lobe
+    /// (docs/BENCHMARKS.md, "Lobe spread").
+    #[cfg_attr(any(feature = "cli", test), arg(long))]
+    #[serde(default)]
+    pub lobe_spread: bool,
+    /// Lobe spread: rings of directions.
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = LobeSpread::default().rings))]
+    #[serde(default = "spread_defaults::rings")]
+    pub lobe_spread_rings: u32,
+    /// Lobe spread: directions per ring.
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = LobeSpread::default().per_ring))]
+    #[serde(default = "spread_defaults::per_ring")]
+    pub lobe_spread_per_ring: u32,
+    /// Lobe spread: steps of each direction's march.
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = LobeSpread::default().steps))]
+    #[serde(default = "spread_defaults::steps")]
+    pub lobe_spread_steps: u32,
+    /// Lobe spread: depth marched before the point, in the light map's first layers.
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = LobeSpread::default().reach_layers))]
+    #[serde(default = "spread_defaults::reach")]
+    pub lobe_spread_reach: f32,
+    /// Lobe spread: tilt of the marched lines, times tan γ.
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = LobeSpread::default().cone_scale))]
+    #[serde(default = "spread_defaults::cone_scale")]
+    pub lobe_spread_cone_scale: f32,
+}
+
+/// Serde defaults of the lobe-spread arguments (reports written before they existed).
+mod spread_defaults {
+    use super::LobeSpread;
+    pub fn rings() -> u32 {
+        LobeSpread::default().rings
+    }
+    pub fn per_ring() -> u32 {
+        LobeSpread::default().per_ring
+    }
+    pub fn steps() -> u32 {
+        LobeSpread::default().steps
+    }
+    pub fn reach() -> f32 {
+        LobeSpread::default().reach_layers
+    }
+    pub fn cone_scale() -> f32 {
+        LobeSpread::default().cone_scale
+    }
+}
+
+impl ViewArgs {
+    /// The lobe spread these arguments ask for (None when off).
+    pub fn lobe_spread(&self) -> Option<LobeSpread> {
+        self.lobe_spread.then_some(LobeSpread {
+            rings: self.lobe_spread_rings,
+            per_ring: self.lobe_spread_per_ring,
+            steps: self.lobe_spread_steps,
+            reach_layers: self.lobe_spread_reach,
+            cone_scale: self.lobe_spread_cone_scale,
+        })
+    }
 }
 
 fn default_simplification_seed() -> u64 {
@@ -97,6 +158,12 @@ impl Default for ViewArgs {
             box_average: BoxAverageArg::OpticalDepth,
             forward_scattering: ForwardDevice::Auto,
             simplification_seed: DEFAULT_SIMPLIFICATION_SEED,
+            lobe_spread: false,
+            lobe_spread_rings: spread_defaults::rings(),
+            lobe_spread_per_ring: spread_defaults::per_ring(),
+            lobe_spread_steps: spread_defaults::steps(),
+            lobe_spread_reach: spread_defaults::reach(),
+            lobe_spread_cone_scale: spread_defaults::cone_scale(),
         }
     }
 }
@@ -123,6 +190,10 @@ impl LookArgs {
         transparency
             .check()
             .with_context(|| format!("--visibility-cutoff {}", view.visibility_cutoff))?;
+        let lobe_spread = view.lobe_spread();
+        if let Some(spread) = &lobe_spread {
+            spread.validate().context("--lobe-spread")?;
+        }
         let box_average = match view.box_average {
             BoxAverageArg::OpticalDepth => BoxAverage::OpticalDepth,
             BoxAverageArg::Transmittance => BoxAverage::Transmittance,
@@ -136,6 +207,7 @@ impl LookArgs {
             dodm: DodmSettings::default(),
             simplification_seed: view.simplification_seed,
             simplified_lights_before: 0,
+            lobe_spread,
         })
     }
 }
@@ -159,4 +231,6 @@ pub struct EnvLook {
     /// parts before this one, so that each light draws the strands it draws in the whole
     /// frame (`EnvRenderer::render_part`). 0 for a whole frame.
     pub simplified_lights_before: u32,
+    /// SRBF visibility spread over the lobe ([`ViewArgs::lobe_spread`]).
+    pub lobe_spread: Option<LobeSpread>,
 }

@@ -23,6 +23,8 @@ use crate::passes::env_view::{
     ViewBinding,
 };
 use crate::passes::frame_params::{FrameParams, KajiyaKay};
+pub use crate::passes::lobe_spread::LobeSpread;
+use crate::passes::lobe_spread::LobeSpreadError;
 use crate::passes::strand_geometry::{StrandGeometry, TooManyPoints};
 pub use crate::passes::summed_area::BoxAverage;
 use crate::passes::summed_area::{SummedAreaPass, SummedAreaTables};
@@ -112,8 +114,10 @@ pub fn check_env_table(
 /// The default seed of the strand order behind stochastic simplification.
 pub const DEFAULT_SIMPLIFICATION_SEED: u64 = 0x5eed;
 
-/// Everything besides the scene that changes how a frame is rendered.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Everything besides the scene that changes how a frame is rendered. Its `Debug` text is part
+/// of the cached references' keys (`compare`): options added later print only when set, so
+/// the references rendered before them keep their keys.
+#[derive(Clone, Copy, PartialEq)]
 pub struct EnvRenderOptions {
     /// Light-pass map resolution, first-layer depth and lights per batch.
     pub dodm: DodmSettings,
@@ -141,6 +145,28 @@ pub struct EnvRenderOptions {
     /// View pass only: every fiber this many pixels wide instead of its projected thickness (as
     /// `FrameParams::width_override_px`); the light pass always uses the file's thickness.
     pub width_override_px: Option<f32>,
+    /// SRBF lights' visibility spread over their lobes through a coarse density volume
+    /// ([`LobeSpread`]); `None` (default): Ren's one visibility per lobe.
+    pub lobe_spread: Option<LobeSpread>,
+}
+
+impl std::fmt::Debug for EnvRenderOptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut s = f.debug_struct("EnvRenderOptions");
+        s.field("dodm", &self.dodm)
+            .field("kappa", &self.kappa)
+            .field("simplification_seed", &self.simplification_seed)
+            .field("transparency", &self.transparency)
+            .field("count_fragments", &self.count_fragments)
+            .field("shadowed", &self.shadowed)
+            .field("transmittance_filter", &self.transmittance_filter)
+            .field("box_average", &self.box_average)
+            .field("width_override_px", &self.width_override_px);
+        if let Some(spread) = &self.lobe_spread {
+            s.field("lobe_spread", spread);
+        }
+        s.finish()
+    }
 }
 
 impl Default for EnvRenderOptions {
@@ -155,6 +181,7 @@ impl Default for EnvRenderOptions {
             transmittance_filter: TransmittanceFilter::default(),
             box_average: BoxAverage::default(),
             width_override_px: None,
+            lobe_spread: None,
         }
     }
 }
@@ -181,6 +208,8 @@ pub enum EnvRenderError {
     Readback(#[from] ReadbackError),
     #[error("the GPU reported an error: {0}")]
     Gpu(String),
+    #[error(transparent)]
+    LobeSpread(#[from] LobeSpreadError),
 }
 
 #[derive(Clone, Debug)]
@@ -360,6 +389,9 @@ fn check_inputs(
     options.dodm.check()?;
     check_kappa(options.kappa)?;
     options.transparency.check()?;
+    if let Some(spread) = &options.lobe_spread {
+        spread.validate()?;
+    }
     if kinds.has_srbf() {
         required_table(&tables.srbf, "srbf", "SRBF lights", Some(AXIS_INV_LAMBDA))?;
     }
@@ -801,6 +833,7 @@ impl EnvRenderer {
                 options.shadowed,
                 grid.is_some(),
                 options.transmittance_filter,
+                options.lobe_spread,
             );
             let visibility = frame.visibility(options);
             let view = ViewBinding::new(gpu, &self.view.view_layout, grid.as_ref(), &visibility);

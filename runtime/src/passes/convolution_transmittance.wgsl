@@ -9,6 +9,8 @@
 // texels, blended between the two nearest texel boxes) averages each boundary's optical depth
 // through the SAT; l(δ) interpolates linearly between (0, 0) and the boundaries (z_k, l̄_k); T̃ = exp(−l).
 // Directional lights (tan α = 0) read the single texel: a plain per-light deep opacity map.
+// With lobe spread on (lobe_spread.wgsl, appended after this file), SRBF lights take its
+// visibility instead of the box's.
 
 struct EnvLightGpu {
     view_proj: mat4x4<f32>,
@@ -46,6 +48,10 @@ struct BatchParams {
     // Bit 0: skip shadowing (T̃ = 1). Bit 1: a forward-scattering grid is bound. Bit 2: the
     // SATs hold transmittance (BoxAverage::Transmittance), not optical depth.
     flags: u32,
+    // Lobe spread (lobe_spread.wgsl): rings, directions per ring, steps (all 0 when off).
+    spread: vec4<u32>,
+    // Lobe spread: reach in first layers, cone scale.
+    spread_shape: vec4<f32>,
 };
 
 @group(1) @binding(0) var<uniform> batch: BatchParams;
@@ -128,6 +134,9 @@ fn nearest_depth_around(slot: u32, texel: vec2<i32>) -> f32 {
 fn effective_transmittance(slot: u32, world: vec3<f32>) -> f32 {
     if ((batch.flags & FLAG_UNSHADOWED) != 0u) { return 1.0; }
     let light = env_lights[slot];
+    if (lobe_spread_enabled() && light.direction.w > 0.0) {
+        return lobe_spread_transmittance(slot, world);
+    }
     let clip = light.view_proj * vec4<f32>(world, 1.0);
     let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
     if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }

@@ -15,6 +15,7 @@ use wgpu::util::DeviceExt;
 use super::attachments::{cleared_color, prepassed_depth};
 use super::convolution_depth::DodmBatch;
 use super::frame_params::FrameParams;
+use super::lobe_spread::{LobeSpread, spread_uniform};
 use super::render_target::DEPTH_FORMAT;
 use super::strand_geometry::StrandGeometry;
 use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
@@ -74,6 +75,10 @@ struct BatchUniform {
     resolution: u32,
     max_half_size: u32,
     flags: u32,
+    /// [`spread_uniform`]: rings, per ring, steps (0 when off).
+    spread: [u32; 4],
+    /// [`spread_uniform`]: reach in first layers, cone scale.
+    spread_shape: [f32; 4],
 }
 
 const FLAG_UNSHADOWED: u32 = 1;
@@ -150,11 +155,14 @@ impl BatchBinding {
                 lights: one,
             })
             .collect();
-        Self::with_groups(gpu, layout, &groups, dodm, sat, shadowed, with_grid, filter)
+        Self::with_groups(
+            gpu, layout, &groups, dodm, sat, shadowed, with_grid, filter, None,
+        )
     }
 
     /// `groups[slot]` shaded with the visibility of DODM slot `slot`; `shadowed = false`
-    /// forces T̃ = 1.
+    /// forces T̃ = 1. SRBF lights take the box of `filter`, or with `spread` the mean over
+    /// their lobe's directions ([`LobeSpread`]).
     #[allow(clippy::too_many_arguments)]
     pub fn with_groups(
         gpu: &GpuContext,
@@ -165,6 +173,7 @@ impl BatchBinding {
         shadowed: bool,
         with_grid: bool,
         filter: TransmittanceFilter,
+        spread: Option<LobeSpread>,
     ) -> Self {
         let device = &gpu.device;
         let mut samples: Vec<ShadingSampleGpu> = Vec::new();
@@ -223,6 +232,8 @@ impl BatchBinding {
                 resolution: dodm.resolution,
                 max_half_size: MAX_BOX_HALF_SIZE,
                 flags,
+                spread: spread_uniform(spread).0,
+                spread_shape: spread_uniform(spread).1,
             }),
             usage: wgpu::BufferUsages::UNIFORM,
         });
@@ -619,6 +630,7 @@ fn env_view_shader(device: &wgpu::Device) -> wgpu::ShaderModule {
         include_str!("strand_quads.wgsl"),
         include_str!("fiber_frame.wgsl"),
         include_str!("convolution_transmittance.wgsl"),
+        include_str!("lobe_spread.wgsl"),
         include_str!("occupancy_map.wgsl"),
         include_str!("env_view.wgsl"),
         include_str!("view_visibility.wgsl"),

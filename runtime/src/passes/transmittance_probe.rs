@@ -48,6 +48,7 @@ impl TransmittanceProbe {
         let device = &gpu.device;
         let source = [
             include_str!("convolution_transmittance.wgsl"),
+            include_str!("lobe_spread.wgsl"),
             include_str!("transmittance_probe.wgsl"),
         ]
         .concat();

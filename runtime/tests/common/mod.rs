@@ -34,12 +34,18 @@ pub fn ortho_camera() -> Camera {
 /// shifted by its own sub-texel offset: with fibers of diameter d spaced s = 1/PER_UNIT apart,
 /// each row transmits (1 − d/s).
 pub fn slab(rows: usize, thickness: f32) -> HairModel {
+    slab_with_gap(rows, thickness, 0..0)
+}
+
+/// [`slab`] without the fibers of texel columns `gap` in every row: a slot the light falls
+/// through, with the slab's shadow on both sides of it.
+pub fn slab_with_gap(rows: usize, thickness: f32, gap: std::ops::Range<u32>) -> HairModel {
     let offsets = [0.17, -0.23, 0.05, 0.29, -0.11, -0.02];
     let mut points = Vec::new();
     let mut strand_offsets = vec![0u32];
     for r in 0..rows {
         let z = 0.3 - 0.1 * r as f32;
-        for c in 0..RES {
+        for c in (0..RES).filter(|c| !gap.contains(c)) {
             let x = ((c as f64 + 0.5 + offsets[r % offsets.len()]) / PER_UNIT - 1.0) as f32;
             points.push(Vec3::new(x, -0.9, z));
             points.push(Vec3::new(x, 0.9, z));
