@@ -14,12 +14,17 @@
 //! Unlike the box filter of [`super::transmittance_filter`], whose radius grows only with the
 //! depth behind the point's own first fiber, this also shadows a lit point beside a shadow's
 //! edge (occluders in neighbouring columns), and it averages transmittance per direction, not
-//! optical depth over a box. The map resolves depth only to its last layer boundary (10 first
-//! layers behind each column's front, everything beyond lumped there), so a line marched far
-//! behind the columns it crosses loses their deeper fibers; the march therefore covers the last
-//! `reach` first layers before the point and the point's own column stands for every direction
-//! beyond, and the tilt is `cone_scale` × tan γ. Both were chosen on one map at κ = 1 and checked
-//! on the others (docs/BENCHMARKS.md).
+//! optical depth over a box. The march covers the last `reach` first layers before the point;
+//! beyond it the point's own column stands for every direction.
+//!
+//! The tilt is `cone_scale` × tan γ. Where the map resolves the hair's depth (a slab thinner
+//! than the last layer boundary, `lobe_spread_follows_the_cone_integral_beside_a_slot`) the
+//! geometry's own tilt, scale 1, follows the cone integral best. On a groom, scale 1 makes the
+//! hair ~10% brighter than the brute-force reference. Why is not settled: the map lumps every
+//! fiber deeper than 10 first layers behind a column's front at that boundary, but a march that
+//! fell back to the centre column wherever its line ran deeper than that was as bright. 0.3 was
+//! chosen on one map (venice, κ = 1) and checked on the others (docs/BENCHMARKS.md, "Lobe
+//! spread"): a calibration, not a derivation.
 
 /// How the lobe's visibility is spread over its directions.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,9 +44,9 @@ pub struct LobeSpread {
 impl Default for LobeSpread {
     fn default() -> Self {
         Self {
-            rings: 2,
-            per_ring: 4,
-            steps: 8,
+            rings: 1,
+            per_ring: 6,
+            steps: 4,
             reach_layers: 20.0,
             cone_scale: 0.3,
         }

@@ -22,7 +22,11 @@ fn column_optical_depth(slot: u32, texel: vec2<i32>, z: f32, near_offset: f32, f
     let light = env_lights[slot];
     let z0 = textureLoad(dodm_depth, texel, i32(slot), 0) * (light.far - light.near);
     if (z0 >= z - near_offset) { return 0.0; }
-    let l = box_mean(slot, texel, 0);
+    var l = box_mean(slot, texel, 0);
+    if ((batch.flags & FLAG_SAT_TRANSMITTANCE) != 0u) {
+        // One texel's transmittances back to its optical depths.
+        l = -log(max(l, vec4<f32>(1.0 / SAT_TRANSMITTANCE_SCALE)));
+    }
     let deep = layered_optical_depth(l, z - near_offset - z0, light.first_layer);
     let shallow = layered_optical_depth(l, max(z - far_offset - z0, 0.0), light.first_layer);
     return deep - shallow;
