@@ -145,8 +145,9 @@ pub struct EnvRenderOptions {
     /// View pass only: every fiber this many pixels wide instead of its projected thickness (as
     /// `FrameParams::width_override_px`); the light pass always uses the file's thickness.
     pub width_override_px: Option<f32>,
-    /// SRBF lights' visibility spread over their lobes through a coarse density volume
-    /// ([`LobeSpread`]); `None` (default): Ren's one visibility per lobe.
+    /// SRBF lights' visibility averaged over directions of their lobes, each marched through
+    /// the lobe's own light map ([`LobeSpread`]); `None` (default): Ren's one box-filtered
+    /// visibility per lobe.
     pub lobe_spread: Option<LobeSpread>,
 }
 

@@ -20,7 +20,7 @@
 //! The tilt is `cone_scale` × tan γ. Where the map resolves the hair's depth (a slab thinner
 //! than the last layer boundary, `lobe_spread_follows_the_cone_integral_beside_a_slot`) the
 //! geometry's own tilt, scale 1, follows the cone integral best. On a groom, scale 1 makes the
-//! hair ~10% brighter than the brute-force reference. Why is not settled: the map lumps every
+//! hair 5–40% brighter than the brute-force reference (by how far it marches). Why is not settled: the map lumps every
 //! fiber deeper than 10 first layers behind a column's front at that boundary, but a march that
 //! fell back to the centre column wherever its line ran deeper than that was as bright. 0.3 was
 //! chosen on one map (venice, κ = 1) and checked on the others (docs/BENCHMARKS.md, "Lobe
@@ -80,11 +80,6 @@ impl LobeSpread {
         };
         positive("reach (first layers)", self.reach_layers, 1000.0)?;
         positive("cone scale", self.cone_scale, 4.0)
-    }
-
-    /// Directions marched per SRBF light and shaded point.
-    pub fn directions(&self) -> u32 {
-        self.rings * self.per_ring
     }
 }
 
