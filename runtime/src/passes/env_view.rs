@@ -225,6 +225,7 @@ impl BatchBinding {
             } else {
                 0
             };
+        let (spread_counts, spread_shape) = spread_uniform(spread);
         let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("env batch"),
             contents: bytemuck::bytes_of(&BatchUniform {
@@ -232,8 +233,8 @@ impl BatchBinding {
                 resolution: dodm.resolution,
                 max_half_size: MAX_BOX_HALF_SIZE,
                 flags,
-                spread: spread_uniform(spread).0,
-                spread_shape: spread_uniform(spread).1,
+                spread: spread_counts,
+                spread_shape,
             }),
             usage: wgpu::BufferUsages::UNIFORM,
         });
