@@ -30,6 +30,7 @@ use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription, Model,
 use strandlight_precompute::baked_tables_check::check_asset;
 use strandlight_runtime::env::{EnvLight, ViewTransparency, mark_every_strand};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
+use strandlight_runtime::passes::lobe_spread::LobeSpread;
 
 /// What one run measures.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -51,6 +52,10 @@ pub struct BenchPlan {
     /// every strand (`compare --every-strand-share`); reports written before it existed: none.
     #[serde(default)]
     pub every_strand_shares: Vec<f32>,
+    /// Lobe spread (`compare --lobe-spread`, default settings) at these κ; reports written
+    /// before it existed: none.
+    #[serde(default)]
+    pub lobe_spread_kappas: Vec<f32>,
     pub baseline_lights: Vec<usize>,
     /// Which directional-light baseline (reports written before it existed: median cut).
     #[serde(default)]
@@ -85,6 +90,7 @@ impl BenchPlan {
             kappas: vec![0.1, 0.3, 1.0],
             dodm_sizes: vec![512, 256, 1024],
             every_strand_shares: vec![0.2, 0.4],
+            lobe_spread_kappas: vec![0.1, 0.3, 1.0],
             baseline_lights: vec![4, 8, 16, 32, 64, 128],
             baseline: Baseline::MedianCut,
             reference_max_lights: 1536,
@@ -111,6 +117,7 @@ impl BenchPlan {
             kappas: vec![0.1, 1.0],
             dodm_sizes: vec![512, 256],
             every_strand_shares: vec![0.4],
+            lobe_spread_kappas: vec![0.1, 1.0],
             baseline_lights: vec![4, 16, 64],
             baseline: Baseline::MedianCut,
             reference_max_lights: 384,
@@ -417,10 +424,12 @@ struct SrbfConfig {
     kappa: f32,
     dodm: u32,
     every_strand_share: f32,
+    lobe_spread: bool,
 }
 
 /// The SRBF frames of `plan`: the default, then lobes, κ, light-map size and adaptive κ's
-/// share varied one at a time.
+/// share varied one at a time, then lobe spread at each of its κ (a series of its own: at the
+/// default κ it changes one setting, elsewhere two).
 fn srbf_configs(plan: &BenchPlan) -> Vec<SrbfConfig> {
     let (lobes, kappa, dodm) = (plan.lobes[0], plan.kappas[0], plan.dodm_sizes[0]);
     let default = SrbfConfig {
@@ -429,6 +438,7 @@ fn srbf_configs(plan: &BenchPlan) -> Vec<SrbfConfig> {
         kappa,
         dodm,
         every_strand_share: 0.0,
+        lobe_spread: false,
     };
     let changed = |label: String| SrbfConfig { label, ..default };
     let mut configs = Vec::new();
@@ -456,6 +466,13 @@ fn srbf_configs(plan: &BenchPlan) -> Vec<SrbfConfig> {
             ..changed(format!("adaptive κ, share {share}"))
         });
     }
+    for &k in &plan.lobe_spread_kappas {
+        configs.push(SrbfConfig {
+            kappa: k,
+            lobe_spread: true,
+            ..changed(format!("lobe spread, κ {k}"))
+        });
+    }
     configs.insert(0, default);
     configs
 }
@@ -478,6 +495,7 @@ fn srbf_points(
             kappa: config.kappa,
         };
         frame.look.dodm = DodmSettings::at_resolution(config.dodm);
+        frame.look.lobe_spread = config.lobe_spread.then(LobeSpread::default);
         let r = steps.run(
             &format!("{}: SRBF {}", mode.name(), config.label),
             || compare::timed_render(&render_lights, &frame, 1),
@@ -800,18 +818,35 @@ mod tests {
             let default = &configs[0];
             assert!(default.label.starts_with("default"));
             assert_eq!(default.every_strand_share, 0.0);
+            assert!(!default.lobe_spread);
             let expected = plan.lobes.len() - 1 + plan.kappas.len() - 1 + plan.dodm_sizes.len() - 1
-                + plan.every_strand_shares.len();
+                + plan.every_strand_shares.len()
+                + plan.lobe_spread_kappas.len();
             assert_eq!(configs.len(), 1 + expected, "{}", plan.name);
             for c in &configs[1..] {
                 let changed = [
                     c.lobes != default.lobes,
-                    c.kappa != default.kappa,
                     c.dodm != default.dodm,
                     c.every_strand_share != default.every_strand_share,
+                    c.lobe_spread != default.lobe_spread,
                 ];
-                assert_eq!(changed.iter().filter(|&&x| x).count(), 1, "{}", c.label);
+                let one_other = changed.iter().filter(|&&x| x).count() == 1;
+                match c.lobe_spread {
+                    // The spread series: spread on, κ free, nothing else changed.
+                    true => assert!(one_other, "{}", c.label),
+                    false => assert!(
+                        one_other != (c.kappa != default.kappa),
+                        "{}: one setting changed",
+                        c.label
+                    ),
+                }
             }
+            let spread_kappas: Vec<f32> = configs
+                .iter()
+                .filter(|c| c.lobe_spread)
+                .map(|c| c.kappa)
+                .collect();
+            assert_eq!(spread_kappas, plan.lobe_spread_kappas, "{}", plan.name);
         }
     }
 

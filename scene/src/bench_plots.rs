@@ -138,7 +138,7 @@ where
     chart
         .draw_series(baseline.iter().map(|&p| Circle::new(p, 4, RED.filled())))
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    let srbf_series: [(LabelFilter, RGBColor, &str); 4] = [
+    let srbf_series: [(LabelFilter, RGBColor, &str); 5] = [
         (&|l| l.ends_with(" lobes"), BLUE, "SRBF: lobe count"),
         (&|l| l.starts_with("κ"), GREEN, "SRBF: κ"),
         (
@@ -150,6 +150,11 @@ where
             &|l| l.starts_with("adaptive"),
             CYAN,
             "SRBF: adaptive κ share",
+        ),
+        (
+            &|l| l.starts_with("lobe spread"),
+            RGBColor(230, 120, 0),
+            "SRBF: lobe spread (κ)",
         ),
     ];
     for (matches, colour, label) in srbf_series {
