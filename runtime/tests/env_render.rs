@@ -1579,3 +1579,80 @@ fn srbf_and_directional_lights_in_one_frame_add_and_directional_ignores_kappa() 
         "a directional light's map must not depend on κ"
     );
 }
+
+/// Lobe spread's fiber weighting is a weighted mean of the directions' transmittances: where
+/// every direction marches the same columns (a vanishing tilt) the weights cancel and the frame
+/// is the unweighted one; at the default tilt they change it, by less than the spread itself
+/// changes Ren's box.
+#[test]
+fn fiber_weighting_is_a_normalized_mean_over_the_lobe() {
+    let gpu = gpu();
+    let scene = groom_scene();
+    let (model, camera, tables) = &scene;
+    let render = |spread: Option<LobeSpread>| {
+        let options = EnvRenderOptions {
+            dodm: DodmSettings {
+                resolution: 128,
+                first_layer: None,
+                batch_size: 2,
+            },
+            lobe_spread: spread,
+            ..Default::default()
+        };
+        render_env_frame(
+            &gpu,
+            model,
+            camera,
+            RES,
+            RES,
+            &groom_lobes(),
+            tables,
+            &options,
+            None,
+        )
+        .unwrap_or_else(|e| panic!("{e}"))
+        .pixels
+    };
+    let spread = |cone_scale: f32, fiber_weighted: bool| {
+        Some(LobeSpread {
+            cone_scale,
+            fiber_weighted,
+            ..LobeSpread::default()
+        })
+    };
+    let lit = |a: &[[f32; 4]]| a.iter().filter(|p| p[0] > 1e-4).count();
+    // Mean |a − b| / b over the lit pixels' RGB: a point on a texel's edge may cross into the
+    // next column under any tilt, so the worst pixel says little here.
+    let mean_relative = |a: &[[f32; 4]], b: &[[f32; 4]]| {
+        let pairs: Vec<f64> = a
+            .iter()
+            .zip(b)
+            .filter(|(_, q)| q[0] > 1e-4)
+            .flat_map(|(p, q)| (0..3).map(move |c| ((p[c] - q[c]) / q[c].max(1e-4)).abs() as f64))
+            .collect();
+        pairs.iter().sum::<f64>() / pairs.len().max(1) as f64
+    };
+    let flat = [render(spread(1e-4, false)), render(spread(1e-4, true))];
+    let flat_gap = mean_relative(&flat[1], &flat[0]);
+    let tilted = [render(spread(0.3, false)), render(spread(0.3, true))];
+    let weighting = mean_relative(&tilted[1], &tilted[0]);
+    let box_gap = mean_relative(&tilted[0], &render(None));
+    println!(
+        "{} lit pixels; no tilt: weighted vs unweighted {flat_gap:.2e}; tilt 0.3: {weighting:.2e} (spread vs box: {box_gap:.2e})",
+        lit(&flat[0])
+    );
+    assert!(lit(&flat[0]) > 100, "the groom is lit");
+    assert!(tilted[1].iter().flatten().all(|v| v.is_finite()));
+    assert!(
+        flat_gap < 0.1 * weighting,
+        "weights do not cancel: {flat_gap} vs {weighting}"
+    );
+    assert!(
+        weighting > 1e-5,
+        "the weights change nothing at the default tilt"
+    );
+    assert!(
+        weighting < box_gap,
+        "weighting {weighting} vs the spread's own change {box_gap}"
+    );
+}

@@ -112,6 +112,11 @@ pub struct ViewArgs {
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = LobeSpread::default().cone_scale))]
     #[serde(default = "spread_defaults::cone_scale")]
     pub lobe_spread_cone_scale: f32,
+    /// Lobe spread: weigh each direction by the fiber's response to it (the lobe times the
+    /// fiber, not the lobe alone).
+    #[cfg_attr(any(feature = "cli", test), arg(long))]
+    #[serde(default)]
+    pub lobe_spread_fiber_weighted: bool,
 }
 
 /// Serde defaults of the lobe-spread arguments (reports written before they existed).
@@ -143,6 +148,7 @@ impl ViewArgs {
             steps: self.lobe_spread_steps,
             reach_layers: self.lobe_spread_reach,
             cone_scale: self.lobe_spread_cone_scale,
+            fiber_weighted: self.lobe_spread_fiber_weighted,
         })
     }
 }
@@ -164,6 +170,7 @@ impl Default for ViewArgs {
             lobe_spread_steps: spread_defaults::steps(),
             lobe_spread_reach: spread_defaults::reach(),
             lobe_spread_cone_scale: spread_defaults::cone_scale(),
+            lobe_spread_fiber_weighted: false,
         }
     }
 }

@@ -466,8 +466,11 @@ struct FrameResources {
     simplified: Option<SimplifiedSegments>,
     next_window: u32,
     bounds: Aabb,
-    dodm: DodmBatch,
-    sat: SummedAreaTables,
+    /// The light maps of every-strand SRBFs and directional lights, at the DODM resolution.
+    full_maps: LightMaps,
+    /// The light maps of κ-simplified SRBFs, at [`DodmSettings::simplified_resolution`]
+    /// (None where that is the full resolution: they share `full_maps`).
+    simplified_maps: Option<LightMaps>,
     occupancy: OccupancyMap,
     targets: EnvViewTargets,
     sums: EnvAccumulator,
@@ -481,7 +484,44 @@ struct FrameResources {
     directional_tables: Option<TableBinding>,
 }
 
+/// One resolution's light maps: the batch's DODM and its summed-area tables.
+struct LightMaps {
+    dodm: DodmBatch,
+    sat: SummedAreaTables,
+}
+
+impl LightMaps {
+    fn new(
+        gpu: &GpuContext,
+        resolution: u32,
+        slots: u32,
+        first_layer: f32,
+    ) -> Result<Self, EnvRenderError> {
+        Ok(Self {
+            sat: SummedAreaTables::new(gpu, resolution, slots)?,
+            dodm: DodmBatch::new(gpu, resolution, slots, first_layer),
+        })
+    }
+
+    /// The maps a batch draws: the simplified ones for κ-thinned SRBFs where the frame has them.
+    fn choose<'a>(
+        simplified: bool,
+        full: &'a mut LightMaps,
+        simplified_maps: &'a mut Option<LightMaps>,
+    ) -> &'a mut LightMaps {
+        match (simplified, simplified_maps) {
+            (true, Some(maps)) => maps,
+            _ => full,
+        }
+    }
+}
+
 impl FrameResources {
+    /// The light maps a batch draws ([`LightMaps::choose`]).
+    fn maps(&mut self, simplified: bool) -> &mut LightMaps {
+        LightMaps::choose(simplified, &mut self.full_maps, &mut self.simplified_maps)
+    }
+
     /// The visibility input of group 3 for this frame.
     fn visibility(&self, options: &EnvRenderOptions) -> FrameVisibility<'_> {
         FrameVisibility {
@@ -510,8 +550,10 @@ impl FrameResources {
     /// GPU memory held while one batch renders, per resource (tables and grid added later).
     fn memory(&self) -> Vec<(String, u64)> {
         let mut memory = self.geometry.memory();
-        memory.extend(self.dodm.memory());
-        memory.extend(self.sat.memory());
+        for maps in std::iter::once(&self.full_maps).chain(&self.simplified_maps) {
+            memory.extend(maps.dodm.memory());
+            memory.extend(maps.sat.memory());
+        }
         memory.extend(self.targets.memory());
         memory.push(self.occupancy.memory());
         memory.push(("env sums".into(), self.sums.sums.size()));
@@ -703,14 +745,26 @@ impl EnvRenderer {
         let slots = batch_size.min(most_maps) as u32;
         let resolution = options.dodm.resolution;
         check_frame_limits(gpu, (width, height), resolution, slots)?;
-        let sat = SummedAreaTables::new(gpu, resolution, slots)?;
         let occupancy = OccupancyMap::new(gpu, options.transparency, width, height)?;
         check_sums_limits(gpu, width, height)?;
         let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;
         let (light_geometry, simplified) = light_pass_geometry(gpu, model, &geometry, options);
         let bounds = model.bounds();
         let first_layer = options.dodm.first_layer_for(bounds);
-        let dodm = DodmBatch::new(gpu, resolution, slots, first_layer);
+        let full_maps = LightMaps::new(gpu, resolution, slots, first_layer)?;
+        let simplified_resolution = options.dodm.simplified_resolution(options.kappa);
+        let simplified_maps = match kinds.srbf.is_empty() || simplified_resolution == resolution {
+            true => None,
+            false => {
+                let slots = batch_size.min(maps(&kinds.srbf)) as u32;
+                Some(LightMaps::new(
+                    gpu,
+                    simplified_resolution,
+                    slots,
+                    first_layer,
+                )?)
+            }
+        };
         let targets = EnvViewTargets::new(gpu, width, height, options.transparency);
         let sums = self.view.accumulator(gpu, &targets);
         let view_params = FrameParams {
@@ -742,8 +796,8 @@ impl EnvRenderer {
             simplified,
             next_window: 0,
             bounds,
-            dodm,
-            sat,
+            full_maps,
+            simplified_maps,
             occupancy,
             targets,
             sums,
@@ -824,13 +878,15 @@ impl EnvRenderer {
         if options.shadowed {
             self.encode_light_maps(gpu, frame, batch, options, timings);
         }
+        let simplified = batch.is_simplified();
         timings.time(gpu, "view", || {
+            let maps = frame.maps(simplified);
             let lights = BatchBinding::with_groups(
                 gpu,
                 &self.view.batch_layout,
                 batch.groups,
-                &frame.dodm,
-                &frame.sat,
+                &maps.dodm,
+                &maps.sat,
                 options.shadowed,
                 grid.is_some(),
                 options.transmittance_filter,
@@ -866,20 +922,33 @@ impl EnvRenderer {
         options: &EnvRenderOptions,
         timings: &mut Timings,
     ) {
-        // A batch holds one kind of light: its first tells the kind.
-        let first = batch.groups.first().map(|g| g.lights[0]);
-        let srbf_kind = first.is_some_and(|l| l.lambda.is_some());
-        let simplified = first.is_some_and(|l| l.is_simplified());
+        let srbf_kind = batch.first_light().is_some_and(|l| l.lambda.is_some());
+        let simplified = batch.is_simplified();
         let directions: Vec<_> = batch.groups.iter().map(|g| g.direction).collect();
         let windows = match simplified {
             true => frame.next_windows(directions.len(), options.kappa),
             false => vec![vec![0..frame.geometry.segment_count]; directions.len()],
         };
+        // A simplified map draws 1/κ-times the optical depth of each drawn fiber, enlarged to
+        // the same world width at whatever resolution its maps have.
+        let (tau_scale, enlargement) = match simplified {
+            true => (
+                1.0 / options.kappa,
+                options.dodm.simplified_enlargement(options.kappa),
+            ),
+            false => (1.0, 1.0),
+        };
+        let FrameResources {
+            geometry,
+            light_geometry,
+            bounds,
+            full_maps,
+            simplified_maps,
+            ..
+        } = frame;
+        let geometry = if simplified { light_geometry } else { geometry };
+        let maps = LightMaps::choose(simplified, full_maps, simplified_maps);
         timings.time(gpu, "light pass", || {
-            let (geometry, enlargement) = match simplified {
-                true => (&frame.light_geometry, 1.0 / options.kappa),
-                false => (&frame.geometry, 1.0),
-            };
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             self.depth.encode_windows(
                 gpu,
@@ -887,20 +956,20 @@ impl EnvRenderer {
                 geometry,
                 &directions,
                 &windows,
-                frame.bounds,
-                [enlargement; 2],
-                &mut frame.dodm,
+                *bounds,
+                [tau_scale, enlargement],
+                &mut maps.dodm,
             );
             gpu.queue.submit([encoder.finish()]);
         });
-        frame.sat.average = match srbf_kind {
+        maps.sat.average = match srbf_kind {
             true => options.box_average,
             false => BoxAverage::OpticalDepth,
         };
         timings.time(gpu, "summed-area tables", || {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             self.sat
-                .encode(gpu, &mut encoder, &frame.dodm.optical_depth, &frame.sat);
+                .encode(gpu, &mut encoder, &maps.dodm.optical_depth, &maps.sat);
             gpu.queue.submit([encoder.finish()]);
         });
     }
@@ -911,6 +980,18 @@ impl EnvRenderer {
 struct LightBatch<'a> {
     groups: &'a [ShadowGroup<'a>],
     tables: &'a TableBinding,
+}
+
+impl LightBatch<'_> {
+    /// A batch holds one kind of light: its first tells the kind.
+    fn first_light(&self) -> Option<&EnvLight> {
+        self.groups.first().map(|g| &g.lights[0])
+    }
+
+    /// Whether stochastic simplification thins this batch's maps.
+    fn is_simplified(&self) -> bool {
+        self.first_light().is_some_and(|l| l.is_simplified())
+    }
 }
 
 /// Counts over the batches, for the stats.

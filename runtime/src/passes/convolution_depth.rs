@@ -67,6 +67,24 @@ pub enum DodmSettingsError {
 const PORTABLE_STORAGE_BINDING_BYTES: u64 = 128 << 20;
 
 impl DodmSettings {
+    /// Texels across the maps of κ-simplified lights: `resolution` × √κ (at least 16, at most
+    /// `resolution`). A simplified map holds κ of the strands, each widened to cover the ones
+    /// left out, so it carries about κ of a full map's detail: √κ per side keeps the texels per
+    /// drawn strand, and the light pass's fill (the light pass's largest cost) falls with κ
+    /// (docs/BENCHMARKS.md, "Simplified light maps at √κ resolution").
+    pub fn simplified_resolution(&self, kappa: f32) -> u32 {
+        let scaled = (self.resolution as f32 * kappa.clamp(0.0, 1.0).sqrt()).round() as u32;
+        scaled.clamp(16.min(self.resolution), self.resolution)
+    }
+
+    /// The fiber enlargement of a simplified light map at [`Self::simplified_resolution`]: 1/κ
+    /// of a full-resolution texel (Ren 2010 §7, the drawn fibers cover those left out), so the
+    /// same world width whatever the map's texels; a quad is never narrower than its texel.
+    pub fn simplified_enlargement(&self, kappa: f32) -> f32 {
+        let texel_ratio = self.simplified_resolution(kappa) as f32 / self.resolution as f32;
+        (texel_ratio / kappa).max(1.0)
+    }
+
     /// The default settings with `resolution`² maps and the largest batch, up to the default
     /// 16, whose summed-area tables fit one storage binding on any adapter (2048² maps: 2).
     pub fn at_resolution(resolution: u32) -> Self {
@@ -590,6 +608,32 @@ impl ConvolutionDepthPass {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn simplified_maps_shrink_with_the_root_of_kappa_and_keep_the_world_width() {
+        let settings = DodmSettings::default();
+        assert_eq!(settings.simplified_resolution(1.0), settings.resolution);
+        assert_eq!(settings.simplified_enlargement(1.0), 1.0);
+        for kappa in [0.5f32, 0.25, 0.1, 0.05] {
+            let r = settings.simplified_resolution(kappa);
+            let expected = settings.resolution as f32 * kappa.sqrt();
+            assert!((r as f32 - expected).abs() <= 0.5, "κ {kappa}: {r}");
+            // The enlarged quad spans 1/κ full-resolution texels in the world.
+            let world = settings.simplified_enlargement(kappa) / r as f32;
+            let wanted = 1.0 / (kappa * settings.resolution as f32);
+            assert!(
+                (world / wanted - 1.0).abs() < 1e-5,
+                "κ {kappa}: {world} vs {wanted}"
+            );
+        }
+        // Tiny maps stop at 16 texels (or the map's own size), and quads at one texel.
+        let small = DodmSettings::at_resolution(32);
+        assert_eq!(small.simplified_resolution(0.01), 16);
+        assert!((small.simplified_enlargement(0.01) - 50.0).abs() < 1e-3);
+        let tiny = DodmSettings::at_resolution(8);
+        assert_eq!(tiny.simplified_resolution(0.1), 8);
+        assert!((tiny.simplified_enlargement(0.9) - 1.0 / 0.9).abs() < 1e-6);
+    }
 
     #[test]
     fn a_resolution_gets_the_largest_batch_that_fits_a_portable_binding() {

@@ -75,7 +75,7 @@ struct BatchUniform {
     resolution: u32,
     max_half_size: u32,
     flags: u32,
-    /// [`spread_uniform`]: rings, per ring, steps (0 when off).
+    /// [`spread_uniform`]: rings, per ring, steps, fiber weighting (0 when off).
     spread: [u32; 4],
     /// [`spread_uniform`]: reach in first layers, cone scale.
     spread_shape: [f32; 4],

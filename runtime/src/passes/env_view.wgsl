@@ -167,6 +167,16 @@ fn forward_scattering(slot: u32, world: vec3<f32>) -> vec4<f32> {
     return acc;
 }
 
+// Lobe spread's weight of direction ω (lobe_spread.wgsl): with fiber weighting, the fiber's
+// response to ω, read from the single table at its narrowest width (the 1/λ axis clamps 0 to
+// its first node), so the lobe's visibility is the mean of V over G·S rather than over G.
+fn spread_weight(omega: vec3<f32>, t: vec3<f32>, e: vec3<f32>) -> f32 {
+    if (batch.spread.w == 0u) { return 1.0; }
+    let f = fiber_frame(t, omega, e);
+    let s = single_lookup(vec4<f32>(f.sin_theta_i, f.sin_theta_o, f.cos_phi, 0.0));
+    return max(s.r + s.g + s.b, 0.0);
+}
+
 struct EnvOut {
     @location(0) single: vec4<f32>,
     @location(1) multiple: vec4<f32>,
@@ -183,7 +193,7 @@ fn shade(in: VertexOut, weight: f32) -> EnvOut {
     let with_grid = (batch.flags & FLAG_GRID) != 0u;
     for (var slot = 0u; slot < batch.light_count; slot++) {
         let light = env_lights[slot];
-        let visible = effective_transmittance(slot, in.world);
+        let visible = effective_transmittance(slot, in.world, t, e);
         var g = vec4<f32>(0.0);
         if (with_grid) { g = forward_scattering(slot, in.world); }
         for (var s = light.first_sample; s < light.first_sample + light.sample_count; s++) {

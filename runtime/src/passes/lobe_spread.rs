@@ -39,6 +39,9 @@ pub struct LobeSpread {
     pub reach_layers: f32,
     /// Tilt of the marched lines: tan γ times this.
     pub cone_scale: f32,
+    /// Weigh each direction by the fiber's response to it (the single table at its narrowest
+    /// width), so the visibility is averaged over the lobe times the fiber, not the lobe alone.
+    pub fiber_weighted: bool,
 }
 
 impl Default for LobeSpread {
@@ -49,6 +52,7 @@ impl Default for LobeSpread {
             steps: 4,
             reach_layers: 20.0,
             cone_scale: 0.3,
+            fiber_weighted: false,
         }
     }
 }
@@ -84,12 +88,13 @@ impl LobeSpread {
 }
 
 /// The spread as the batch uniform carries it (`BatchParams` in `convolution_transmittance.wgsl`):
-/// counts (rings, per ring, steps; all 0 when off) and shape (reach in first layers, cone scale).
+/// counts (rings, per ring, steps, fiber weighting 0/1; all 0 when off) and shape (reach in
+/// first layers, cone scale).
 pub fn spread_uniform(spread: Option<LobeSpread>) -> ([u32; 4], [f32; 4]) {
     match spread {
         None => ([0; 4], [0.0; 4]),
         Some(s) => (
-            [s.rings, s.per_ring, s.steps, 0],
+            [s.rings, s.per_ring, s.steps, u32::from(s.fiber_weighted)],
             [s.reach_layers, s.cone_scale, 0.0, 0.0],
         ),
     }

@@ -58,8 +58,31 @@ fn sheared_optical_depth(slot: u32, p: vec2<f32>, z: f32, shift: vec2<f32>) -> f
     return tau;
 }
 
-// The lobe's visibility at `world`: mean of exp(−τ) over its ring directions.
-fn lobe_spread_transmittance(slot: u32, world: vec3<f32>) -> f32 {
+// Direction k of a lobe: the march's shift (texels per unit of depth toward the light) and the
+// world direction it stands for.
+struct SpreadDirection {
+    shift: vec2<f32>,
+    omega: vec3<f32>,
+};
+
+fn spread_direction(slot: u32, cos_g: f32, phi: f32) -> SpreadDirection {
+    let light = env_lights[slot];
+    let sin_g = sqrt(max(0.0, 1.0 - cos_g * cos_g));
+    let side = vec2<f32>(cos(phi), sin(phi));
+    // The map's +x and +y (rows run down) in the world: its projection's first two rows.
+    let m = light.view_proj;
+    let right = normalize(vec3<f32>(m[0].x, m[1].x, m[2].x));
+    let down = -normalize(vec3<f32>(m[0].y, m[1].y, m[2].y));
+    var d: SpreadDirection;
+    d.shift = batch.spread_shape.y * (sin_g / cos_g) * light.texels_per_unit * side;
+    d.omega = cos_g * light.direction.xyz + sin_g * (side.x * right + side.y * down);
+    return d;
+}
+
+// The lobe's visibility at `world`: the mean of exp(−τ) over its ring directions, each weighted
+// by `spread_weight` (the fiber's response to it, where the module defines one; t and e are the
+// fiber's tangent and the direction toward the eye).
+fn lobe_spread_transmittance(slot: u32, world: vec3<f32>, t: vec3<f32>, e: vec3<f32>) -> f32 {
     let light = env_lights[slot];
     let clip = light.view_proj * vec4<f32>(world, 1.0);
     let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
@@ -69,16 +92,18 @@ fn lobe_spread_transmittance(slot: u32, world: vec3<f32>) -> f32 {
     let rings = batch.spread.x;
     let per_ring = batch.spread.y;
     var sum = 0.0;
+    var weights = 0.0;
     for (var r = 0u; r < rings; r++) {
         let cos_g = max(1.0 - srbf_quantile((f32(r) + 0.5) / f32(rings), light.direction.w), 0.05);
-        let tan_g = sqrt(max(0.0, 1.0 - cos_g * cos_g)) / cos_g;
-        let length = batch.spread_shape.y * tan_g * light.texels_per_unit;
         for (var j = 0u; j < per_ring; j++) {
             // Alternate rings are turned by half a step, so the directions interleave.
             let phi = TWO_PI * (f32(j) + 0.5 * f32(r & 1u)) / f32(per_ring);
-            let shift = length * vec2<f32>(cos(phi), sin(phi));
-            sum += exp(-sheared_optical_depth(slot, p, z, shift));
+            let d = spread_direction(slot, cos_g, phi);
+            let w = spread_weight(d.omega, t, e);
+            sum += w * exp(-sheared_optical_depth(slot, p, z, d.shift));
+            weights += w;
         }
     }
-    return sum / f32(rings * per_ring);
+    if (weights <= 0.0) { return 1.0; }
+    return sum / weights;
 }

@@ -20,11 +20,16 @@ struct ProbeBox {
 @group(0) @binding(2) var<storage, read> probe_boxes: array<ProbeBox>;
 @group(0) @binding(3) var<storage, read_write> probe_box_out: array<vec4<u32>>;
 
+// No fiber here: lobe spread's directions weigh the same.
+fn spread_weight(omega: vec3<f32>, t: vec3<f32>, e: vec3<f32>) -> f32 {
+    return 1.0;
+}
+
 @compute @workgroup_size(64)
 fn probe_transmittance(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= arrayLength(&probe_points)) { return; }
     let p = probe_points[id.x].position;
-    probe_transmittance_out[id.x] = effective_transmittance(u32(p.w), p.xyz);
+    probe_transmittance_out[id.x] = effective_transmittance(u32(p.w), p.xyz, vec3<f32>(0.0), vec3<f32>(0.0));
 }
 
 @compute @workgroup_size(64)
