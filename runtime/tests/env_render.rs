@@ -933,7 +933,8 @@ fn bad_inputs_are_typed_errors() {
         );
         println!("{e}");
     }
-    // More SAT bytes than the adapter binds: a batch of 2048² maps sized past the limit.
+    // More SAT bytes than the adapter binds: a batch of 2048² maps sized past the limit (κ 1:
+    // simplified lobes' maps would be smaller).
     let limit = gpu.device.limits().max_storage_buffer_binding_size;
     let slots = (limit / (2048 * 2048 * 16) + 1) as u32;
     let many: Vec<EnvLight> = (0..slots).map(|_| light[0]).collect();
@@ -943,6 +944,7 @@ fn bad_inputs_are_typed_errors() {
             first_layer: None,
             batch_size: slots,
         },
+        kappa: 1.0,
         ..options
     };
     let e = render(&many, &tables, &big);

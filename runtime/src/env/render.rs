@@ -466,8 +466,9 @@ struct FrameResources {
     simplified: Option<SimplifiedSegments>,
     next_window: u32,
     bounds: Aabb,
-    /// The light maps of every-strand SRBFs and directional lights, at the DODM resolution.
-    full_maps: LightMaps,
+    /// The light maps of every-strand SRBFs and directional lights, at the DODM resolution
+    /// (None where the frame has only simplified SRBFs).
+    full_maps: Option<LightMaps>,
     /// The light maps of κ-simplified SRBFs, at [`DodmSettings::simplified_resolution`]
     /// (None where that is the full resolution: they share `full_maps`).
     simplified_maps: Option<LightMaps>,
@@ -503,15 +504,64 @@ impl LightMaps {
         })
     }
 
+    /// A frame's full-resolution maps and its simplified ones (each None where no batch draws
+    /// them), with as many slots as the most maps one batch of their kinds holds.
+    fn for_frame(
+        gpu: &GpuContext,
+        options: &EnvRenderOptions,
+        kinds: &LightKinds,
+        first_layer: f32,
+    ) -> Result<(Option<Self>, Option<Self>), EnvRenderError> {
+        let dodm = &options.dodm;
+        let slots = |lights: &[&Vec<EnvLight>]| {
+            let most = lights
+                .iter()
+                .map(|k| shadow_groups(k).len())
+                .max()
+                .unwrap_or(0);
+            (dodm.batch_size as usize).min(most) as u32
+        };
+        let simplified_resolution = dodm.simplified_resolution(options.kappa);
+        let full_kinds = [&kinds.srbf_every_strand, &kinds.directional];
+        if kinds.srbf.is_empty() || simplified_resolution == dodm.resolution {
+            let all = slots(&[&kinds.srbf, full_kinds[0], full_kinds[1]]);
+            return Ok((
+                Some(Self::new(gpu, dodm.resolution, all, first_layer)?),
+                None,
+            ));
+        }
+        let full = match slots(&full_kinds) {
+            0 => None,
+            n => Some(Self::new(gpu, dodm.resolution, n, first_layer)?),
+        };
+        let simplified = Self::new(
+            gpu,
+            simplified_resolution,
+            slots(&[&kinds.srbf]),
+            first_layer,
+        )?;
+        Ok((full, Some(simplified)))
+    }
+
+    /// GPU memory per resource, each name after `prefix`.
+    fn memory(&self, prefix: &str) -> Vec<(String, u64)> {
+        let named = |(name, bytes): (String, u64)| (format!("{prefix}{name}"), bytes);
+        let mut memory: Vec<_> = self.dodm.memory().into_iter().map(named).collect();
+        memory.extend(self.sat.memory().into_iter().map(named));
+        memory
+    }
+
     /// The maps a batch draws: the simplified ones for κ-thinned SRBFs where the frame has them.
     fn choose<'a>(
         simplified: bool,
-        full: &'a mut LightMaps,
+        full: &'a mut Option<LightMaps>,
         simplified_maps: &'a mut Option<LightMaps>,
     ) -> &'a mut LightMaps {
         match (simplified, simplified_maps) {
             (true, Some(maps)) => maps,
-            _ => full,
+            _ => full
+                .as_mut()
+                .expect("a frame holds full-resolution maps for every batch not simplified"),
         }
     }
 }
@@ -550,9 +600,11 @@ impl FrameResources {
     /// GPU memory held while one batch renders, per resource (tables and grid added later).
     fn memory(&self) -> Vec<(String, u64)> {
         let mut memory = self.geometry.memory();
-        for maps in std::iter::once(&self.full_maps).chain(&self.simplified_maps) {
-            memory.extend(maps.dodm.memory());
-            memory.extend(maps.sat.memory());
+        if let Some(maps) = &self.full_maps {
+            memory.extend(maps.memory(""));
+        }
+        if let Some(maps) = &self.simplified_maps {
+            memory.extend(maps.memory("simplified "));
         }
         memory.extend(self.targets.memory());
         memory.push(self.occupancy.memory());
@@ -751,20 +803,7 @@ impl EnvRenderer {
         let (light_geometry, simplified) = light_pass_geometry(gpu, model, &geometry, options);
         let bounds = model.bounds();
         let first_layer = options.dodm.first_layer_for(bounds);
-        let full_maps = LightMaps::new(gpu, resolution, slots, first_layer)?;
-        let simplified_resolution = options.dodm.simplified_resolution(options.kappa);
-        let simplified_maps = match kinds.srbf.is_empty() || simplified_resolution == resolution {
-            true => None,
-            false => {
-                let slots = batch_size.min(maps(&kinds.srbf)) as u32;
-                Some(LightMaps::new(
-                    gpu,
-                    simplified_resolution,
-                    slots,
-                    first_layer,
-                )?)
-            }
-        };
+        let (full_maps, simplified_maps) = LightMaps::for_frame(gpu, options, kinds, first_layer)?;
         let targets = EnvViewTargets::new(gpu, width, height, options.transparency);
         let sums = self.view.accumulator(gpu, &targets);
         let view_params = FrameParams {
