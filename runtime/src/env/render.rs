@@ -410,16 +410,10 @@ fn check_inputs(
     Ok(())
 }
 
-/// The image and the DODM batch (one array layer per light slot) against the adapter's limits;
-/// the SAT, the occupancy map and the sums are checked when created.
-fn check_frame_limits(
-    gpu: &GpuContext,
-    (width, height): (u32, u32),
-    resolution: u32,
-    slots: u32,
-) -> Result<(), LimitError> {
+/// A DODM batch (one array layer per light slot) against the adapter's limits; the image is
+/// checked first, the SAT, the occupancy map and the sums when created.
+fn check_light_map_limits(gpu: &GpuContext, resolution: u32, slots: u32) -> Result<(), LimitError> {
     let limits = GpuLimits::of(gpu);
-    limits.check_image(width, height)?;
     limits.check_texture_2d("DODM", resolution, resolution, |max| {
         format!("use a DODM resolution of at most {max}")
     })?;
@@ -498,6 +492,7 @@ impl LightMaps {
         slots: u32,
         first_layer: f32,
     ) -> Result<Self, EnvRenderError> {
+        check_light_map_limits(gpu, resolution, slots)?;
         Ok(Self {
             sat: SummedAreaTables::new(gpu, resolution, slots)?,
             dodm: DodmBatch::new(gpu, resolution, slots, first_layer),
@@ -787,16 +782,7 @@ impl EnvRenderer {
             options,
             multiple,
         } = *request;
-        let batch_size = options.dodm.batch_size as usize;
-        let maps = |lights: &[EnvLight]| shadow_groups(lights).len();
-        let most_maps = [&kinds.srbf_every_strand, &kinds.srbf, &kinds.directional]
-            .map(|k| maps(k))
-            .into_iter()
-            .max()
-            .unwrap_or(0);
-        let slots = batch_size.min(most_maps) as u32;
-        let resolution = options.dodm.resolution;
-        check_frame_limits(gpu, (width, height), resolution, slots)?;
+        GpuLimits::of(gpu).check_image(width, height)?;
         let occupancy = OccupancyMap::new(gpu, options.transparency, width, height)?;
         check_sums_limits(gpu, width, height)?;
         let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;

@@ -65,17 +65,21 @@ struct SpreadDirection {
     omega: vec3<f32>,
 };
 
-fn spread_direction(slot: u32, cos_g: f32, phi: f32) -> SpreadDirection {
-    let light = env_lights[slot];
-    let sin_g = sqrt(max(0.0, 1.0 - cos_g * cos_g));
-    let side = vec2<f32>(cos(phi), sin(phi));
-    // The map's +x and +y (rows run down) in the world: its projection's first two rows.
+// The world directions of a light map's +x and +y texel axes (rows run down): its
+// projection's first two rows.
+fn map_axes(light: EnvLightGpu) -> mat2x3<f32> {
     let m = light.view_proj;
     let right = normalize(vec3<f32>(m[0].x, m[1].x, m[2].x));
     let down = -normalize(vec3<f32>(m[0].y, m[1].y, m[2].y));
+    return mat2x3<f32>(right, down);
+}
+
+fn spread_direction(light: EnvLightGpu, axes: mat2x3<f32>, cos_g: f32, phi: f32) -> SpreadDirection {
+    let sin_g = sqrt(max(0.0, 1.0 - cos_g * cos_g));
+    let side = vec2<f32>(cos(phi), sin(phi));
     var d: SpreadDirection;
     d.shift = batch.spread_shape.y * (sin_g / cos_g) * light.texels_per_unit * side;
-    d.omega = cos_g * light.direction.xyz + sin_g * (side.x * right + side.y * down);
+    d.omega = cos_g * light.direction.xyz + sin_g * (axes * side);
     return d;
 }
 
@@ -91,6 +95,7 @@ fn lobe_spread_transmittance(slot: u32, world: vec3<f32>, t: vec3<f32>, e: vec3<
     let z = clip.z * (light.far - light.near);
     let rings = batch.spread.x;
     let per_ring = batch.spread.y;
+    let axes = map_axes(light);
     var sum = 0.0;
     var weights = 0.0;
     for (var r = 0u; r < rings; r++) {
@@ -98,7 +103,7 @@ fn lobe_spread_transmittance(slot: u32, world: vec3<f32>, t: vec3<f32>, e: vec3<
         for (var j = 0u; j < per_ring; j++) {
             // Alternate rings are turned by half a step, so the directions interleave.
             let phi = TWO_PI * (f32(j) + 0.5 * f32(r & 1u)) / f32(per_ring);
-            let d = spread_direction(slot, cos_g, phi);
+            let d = spread_direction(light, axes, cos_g, phi);
             let w = spread_weight(d.omega, t, e);
             sum += w * exp(-sheared_optical_depth(slot, p, z, d.shift));
             weights += w;
