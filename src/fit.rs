@@ -125,14 +125,15 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
     }
     for s in &set.sources {
         eprintln!(
-            "compact source toward ({:.4}, {:.4}, {:.4}): power {:.4e} {:.4e} {:.4e} ({:.1}% of the map's), a directional light",
+            "compact source toward ({:.4}, {:.4}, {:.4}): power {:.4e} {:.4e} {:.4e} ({:.1}% of the map's), a directional light spread {:.2}° (rms per axis)",
             s.direction[0],
             s.direction[1],
             s.direction[2],
             s.power[0],
             s.power[1],
             s.power[2],
-            100.0 * s.power_share
+            100.0 * s.power_share,
+            s.angular_variance.sqrt().to_degrees()
         );
     }
     eprintln!(

@@ -30,6 +30,11 @@ pub struct CompactSource {
     pub power: [f64; 3],
     /// Share of the map's luminance power it holds.
     pub power_share: f64,
+    /// Per-axis variance (rad²) of the directions its power arrives from about `direction`:
+    /// half the power-weighted mean of |ω − (ω·d)d|² over the disc. ~0 for a sun a pixel or two
+    /// wide, ~r²/4 for a uniform panel of angular radius r. A renderer that draws the source as
+    /// one directional light softens its shadow by this much (`TransmittanceFilter`).
+    pub angular_variance: f64,
 }
 
 /// What counts as a compact source.
@@ -162,6 +167,8 @@ pub fn extract(map: &EnvMap, options: &SourceOptions) -> (Vec<CompactSource>, En
         if !(norm >= options.min_norm_share * squared_norm(&pixels)) || weighted.length() == 0.0 {
             break;
         }
+        let direction = weighted.normalize();
+        let spread = angular_variance(&residual, &disc, background, direction);
         for &(x, y, _) in &disc {
             let p = &mut pixels[y * width + x];
             for c in 0..3 {
@@ -169,12 +176,37 @@ pub fn extract(map: &EnvMap, options: &SourceOptions) -> (Vec<CompactSource>, En
             }
         }
         sources.push(CompactSource {
-            direction: weighted.normalize().to_array(),
+            direction: direction.to_array(),
             power,
             power_share: share,
+            angular_variance: spread,
         });
     }
     (sources, EnvMap::from_pixels(width, height, pixels))
+}
+
+/// [`CompactSource::angular_variance`] of the excess over `background` on `disc` (pixels of
+/// `map`) about `direction`.
+fn angular_variance(
+    map: &EnvMap,
+    disc: &[(usize, usize, f64)],
+    background: [f64; 3],
+    direction: DVec3,
+) -> f64 {
+    let (mut sum, mut weight) = (0.0, 0.0);
+    for &(x, y, _) in disc {
+        let p = map.pixels()[y * map.width() + x];
+        let excess: [f64; 3] = std::array::from_fn(|c| (p[c] as f64 - background[c]).max(0.0));
+        let w = (0..3).map(|c| LUMINANCE[c] * excess[c]).sum::<f64>() * map.row_solid_angle(y);
+        let d = map.direction(x, y);
+        sum += w * (d - d.dot(direction) * direction).length_squared();
+        weight += w;
+    }
+    if weight > 0.0 {
+        0.5 * sum / weight
+    } else {
+        0.0
+    }
 }
 
 /// How much more of the map's power (luminance share) the sources at the wider radius must
@@ -324,6 +356,37 @@ mod tests {
         // No wider radius, or one no wider: the narrow extraction as is.
         assert_eq!(extract_widening(&lamp, &options, None).2, 2.5);
         assert_eq!(extract_widening(&lamp, &options, Some(2.0)).2, 2.5);
+    }
+
+    /// Per-axis variance of directions within `disc` radians of a softbox's centre, weighted by
+    /// its excess radiance (`sky_with_softbox`'s profile over `lamp` radians; the ring's median
+    /// is the sky, so the excess is the profile) and solid angle: ½ E[sin²γ] by Gauss–Legendre
+    /// over γ.
+    fn softbox_variance_by_quadrature(lamp: f64, disc: f64) -> f64 {
+        use strandlight_tables::quadrature::GaussLegendre;
+        let rule = GaussLegendre::composite(16, 64, 0.0, disc);
+        let weight = |g: f64| (1.0 + 0.05 * (1.0 - (g / lamp).powi(2))) * g.sin();
+        0.5 * rule.integrate(|g| weight(g) * g.sin().powi(2)) / rule.integrate(weight)
+    }
+
+    #[test]
+    fn a_source_carries_the_spread_of_its_disc() {
+        let options = SourceOptions::default();
+        let toward = DVec3::new(0.3, 0.8, -0.52).normalize();
+        // A softbox 6° across taken at 5°: its excess fills the whole disc.
+        let lamp = sky_with_softbox(0.5, toward, 6f64.to_radians(), 200.0);
+        let (wide, _, radius) = extract_widening(&lamp, &options, Some(5.0));
+        assert_eq!(radius, 5.0);
+        let expected = softbox_variance_by_quadrature(6f64.to_radians(), 5f64.to_radians());
+        let got = wide[0].angular_variance;
+        println!("softbox: angular variance {got:.4e}, quadrature {expected:.4e}");
+        // Pixels of 0.35° on a 5° disc: its rim is a staircase.
+        assert!((got / expected - 1.0).abs() < 0.03, "{got} vs {expected}");
+        // A sun a pixel or two wide carries (almost) no spread.
+        let sun = sky_with_sun(0.5, toward, 0.25f64.to_radians(), 20000.0);
+        let spread = extract(&sun, &options).0[0].angular_variance;
+        println!("0.25° sun: angular variance {spread:.4e}");
+        assert!(spread < 0.01 * expected, "{spread}");
     }
 
     #[test]

@@ -27,6 +27,12 @@ pub struct LightSpec {
     /// Directional lights only: the direction of the shadow map whose visibility this light
     /// takes (a reference sub-texel takes its cube texel's); `None`: its own direction.
     pub shadowed_from: Option<DVec3>,
+    /// Directional lights only: per-axis variance (rad²) of the directions it stands for, which
+    /// softens its shadow (a fitted set's compact source, [`CompactSource::angular_variance`]).
+    /// 0: a point, as every reference and median-cut light is.
+    ///
+    /// [`CompactSource::angular_variance`]: crate::compact_sources::CompactSource::angular_variance
+    pub angular_variance: f64,
 }
 
 impl LightSpec {
@@ -59,12 +65,14 @@ pub fn srbf_set_lights(set: &SrbfSet) -> Vec<LightSpec> {
             lambda: Some(l.lambda),
             rgb: l.amplitude,
             shadowed_from: None,
+            angular_variance: 0.0,
         },
         LightKind::Directional => LightSpec {
             direction: l.center().normalize(),
             lambda: None,
             rgb: crate::srbf_set::power(l),
             shadowed_from: None,
+            angular_variance: 0.0,
         },
     });
     let sources = set.sources.iter().map(|s| LightSpec {
@@ -72,6 +80,7 @@ pub fn srbf_set_lights(set: &SrbfSet) -> Vec<LightSpec> {
         lambda: None,
         rgb: s.power,
         shadowed_from: None,
+        angular_variance: s.angular_variance,
     });
     lobes.chain(sources).collect()
 }
@@ -84,6 +93,7 @@ fn directional(lights: Vec<DirectionalLight>, rotate_degrees: f64) -> Vec<LightS
             lambda: None,
             rgb: l.power,
             shadowed_from: None,
+            angular_variance: 0.0,
         })
         .collect()
 }
@@ -166,6 +176,7 @@ pub fn reference_lights_shaded(
                     lambda: None,
                     rgb: l.power.map(|p| p * w),
                     shadowed_from,
+                    angular_variance: 0.0,
                 })
             });
             lights.extend(samples);

@@ -17,7 +17,9 @@ use strandlight_tables::srbf::{self, SrbfLobe};
 
 pub const FORMAT: &str = "strandlight-srbf-set";
 /// 2: compact sources (`sources`) beside the lobes; a version-1 reader would drop them silently.
-pub const FORMAT_VERSION: u32 = 2;
+/// 3: each source's angular variance (its shadow's softness); a version-2 set would render its
+/// sources as points.
+pub const FORMAT_VERSION: u32 = 3;
 /// Bandwidth that stands for a directional light (support ≈ 2.1°).
 pub const DIRECTIONAL_LAMBDA: f64 = 1.0e4;
 

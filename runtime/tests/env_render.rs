@@ -388,6 +388,105 @@ fn slab_convolution_transmittance_follows_the_cone_integral() {
     );
 }
 
+/// ∫T(ω)dω over the cone of half-angle `radius` about +z divided by its solid angle: ~2000
+/// directions stratified uniformly in solid angle (cos γ uniform on [cos r, 1], φ uniform).
+fn disc_transmittance(p: DVec3, radius: f64, rows: usize, thickness: f64) -> f64 {
+    let (n_gamma, n_phi) = (40, 50);
+    let mut visible = 0usize;
+    for i in 0..n_gamma {
+        let u = (i as f64 + 0.5) / n_gamma as f64;
+        let cos_g = 1.0 - u * (1.0 - radius.cos());
+        let sin_g = (1.0 - cos_g * cos_g).max(0.0).sqrt();
+        for j in 0..n_phi {
+            let phi = std::f64::consts::TAU * (j as f64 + 0.5) / n_phi as f64;
+            let w = DVec3::new(sin_g * phi.cos(), sin_g * phi.sin(), cos_g);
+            visible += ray_visible(p, w, rows, thickness, &NO_GAP) as usize;
+        }
+    }
+    visible as f64 / (n_gamma * n_phi) as f64
+}
+
+/// A compact source drawn as one directional light with its disc's angular variance
+/// (`EnvLight::extended`, a studio's softbox) is shadowed through the box matched to that
+/// variance: closer to the visibility averaged over its disc than the point light's single
+/// texel.
+#[test]
+fn an_extended_source_is_shadowed_as_its_disc() {
+    let gpu = gpu();
+    let (rows, thickness) = (SLAB_ROWS, SLAB_THICKNESS);
+    let SlabMaps { batch, sat } = slab_maps(&gpu, &NO_GAP);
+    let probe = TransmittanceProbe::new(&gpu);
+    // A disc 12° in radius: uniform over the cap, per-axis variance ½E[sin²γ].
+    let radius = 12f64.to_radians();
+    let c = radius.cos();
+    let variance = 0.5 * (1.0 - (1.0 + c + c * c) / 3.0);
+    let lights = [
+        EnvLight::extended(Vec3::Z, [1.0; 3], variance as f32),
+        EnvLight::directional(Vec3::Z, [1.0; 3]),
+    ];
+    let jitter: Vec<f32> = (0..8)
+        .map(|k| (k as f32 - 3.5) / 7.0 * 1.5 / PER_UNIT as f32)
+        .collect();
+    let mut sites = Vec::new();
+    for z in [0.15f32, 0.05, -0.2, -0.4] {
+        for x in [-0.52f32, -0.11, 0.23, 0.61] {
+            sites.push(Vec3::new(x, 0.3, z));
+        }
+    }
+    let points: Vec<Vec3> = sites
+        .iter()
+        .flat_map(|s| jitter.iter().map(move |&dx| *s + Vec3::X * dx))
+        .collect();
+    let binding = BatchBinding::new(
+        &gpu,
+        &probe.batch_layout,
+        &lights,
+        &batch,
+        &sat,
+        true,
+        false,
+    );
+    let transmittance = |slot: u32| -> Vec<f64> {
+        let t = probe.transmittance(&gpu, &binding, slot, &points).unwrap();
+        t.chunks(jitter.len())
+            .map(|c| c.iter().map(|&x| x as f64).sum::<f64>() / c.len() as f64)
+            .collect()
+    };
+    let (extended, point) = (transmittance(0), transmittance(1));
+    let truth: Vec<f64> = sites
+        .iter()
+        .map(|s| {
+            let t: f64 = jitter
+                .iter()
+                .map(|&dx| {
+                    disc_transmittance((*s + Vec3::X * dx).as_dvec3(), radius, rows, thickness)
+                })
+                .sum();
+            t / jitter.len() as f64
+        })
+        .collect();
+    let rel = |v: &[f64]| {
+        let e: f64 = v.iter().zip(&truth).map(|(a, t)| (a - t).powi(2)).sum();
+        (e / truth.iter().map(|t| t * t).sum::<f64>()).sqrt()
+    };
+    for (i, s) in sites.iter().enumerate().step_by(3) {
+        println!(
+            "site ({:5.2}, {:5.2}): disc integral {:.3}, extended box {:.3}, point texel {:.3}",
+            s.x, s.z, truth[i], extended[i], point[i]
+        );
+    }
+    let (e, p) = (rel(&extended), rel(&point));
+    println!(
+        "relative RMSE over {} sites vs the 12° disc integral: extended box {e:.4}, point texel {p:.4}",
+        sites.len()
+    );
+    assert!(e < TOLERANCE, "extended box: relative RMSE {e}");
+    assert!(
+        e < p,
+        "extended box {e} not better than the point's texel {p}"
+    );
+}
+
 /// Relative RMSE allowed for the convolution DODM's boxes against the cone integral. The method
 /// approximates (Ren §5): optical depth is averaged where transmittance should be, over an
 /// axis-aligned square on one effective occlusion plane, with the cumulative depth interpolated
@@ -921,10 +1020,20 @@ fn bad_inputs_are_typed_errors() {
         every_strand: true,
         ..EnvLight::directional(Vec3::Z, [1.0; 3])
     };
+    let spread_srbf = EnvLight {
+        angular_variance: 1e-3,
+        ..EnvLight::srbf(Vec3::Z, 8.0, [1.0; 3])
+    };
     for (index, lights) in [
         (0, vec![shared_srbf]),
         (1, vec![light[0], bad_from]),
         (0, vec![every_strand_sun]),
+        (0, vec![EnvLight::extended(Vec3::Z, [1.0; 3], f32::NAN)]),
+        (
+            1,
+            vec![light[0], EnvLight::extended(Vec3::Z, [1.0; 3], -1e-3)],
+        ),
+        (0, vec![spread_srbf]),
     ] {
         let e = render(&lights, &tables, &options);
         assert!(

@@ -39,7 +39,7 @@ pub fn to_env_lights(specs: &[LightSpec], up: UpAxis) -> Vec<EnvLight> {
             let rgb = s.rgb.map(|c| c as f32);
             match (s.lambda, s.shadowed_from) {
                 (Some(lambda), _) => EnvLight::srbf(direction, lambda as f32, rgb),
-                (None, None) => EnvLight::directional(direction, rgb),
+                (None, None) => EnvLight::extended(direction, rgb, s.angular_variance as f32),
                 (None, Some(from)) => EnvLight::directional_shadowed_from(
                     direction,
                     rgb,
@@ -125,6 +125,7 @@ mod tests {
             lambda: Some(32.0),
             rgb: [1.0, 2.0, 3.0],
             shadowed_from: None,
+            angular_variance: 0.0,
         }];
         let l = to_env_lights(&srbf, UpAxis::Y)[0];
         assert_eq!(l.lambda, Some(32.0));

@@ -29,6 +29,11 @@ pub struct EnvLight {
     /// "Adaptive κ"); [`mark_every_strand`] picks them. Directional lights always draw every
     /// strand.
     pub every_strand: bool,
+    /// Directional lights only: per-axis variance (rad²) of the directions the light stands
+    /// for (an extended compact source: a softbox, a sun's disc). Its visibility is averaged
+    /// over a box matched to it, as an SRBF's is over its lobe
+    /// ([`TransmittanceFilter`](crate::env::render::TransmittanceFilter)); 0 reads one texel.
+    pub angular_variance: f32,
 }
 
 impl EnvLight {
@@ -39,6 +44,7 @@ impl EnvLight {
             rgb: amplitude,
             shadowed_from: None,
             every_strand: false,
+            angular_variance: 0.0,
         }
     }
 
@@ -49,6 +55,16 @@ impl EnvLight {
             rgb: irradiance,
             shadowed_from: None,
             every_strand: false,
+            angular_variance: 0.0,
+        }
+    }
+
+    /// A directional light standing for directions spread by `variance` (rad² per axis) about
+    /// `direction`: [`EnvLight::angular_variance`].
+    pub fn extended(direction: Vec3, irradiance: [f32; 3], variance: f32) -> Self {
+        Self {
+            angular_variance: variance,
+            ..Self::directional(direction, irradiance)
         }
     }
 

@@ -262,6 +262,17 @@ fn check_light(index: usize, light: &EnvLight) -> Result<(), EnvRenderError> {
     if light.rgb.iter().any(|c| !c.is_finite()) {
         return Err(bad(format!("rgb {:?} is not finite", light.rgb)));
     }
+    if !(light.angular_variance.is_finite() && light.angular_variance >= 0.0) {
+        return Err(bad(format!(
+            "angular variance {} must be finite and non-negative",
+            light.angular_variance
+        )));
+    }
+    if light.angular_variance > 0.0 && light.lambda.is_some() {
+        return Err(bad(
+            "angular_variance is for directional lights (an SRBF's spread is its λ)".into(),
+        ));
+    }
     if light.every_strand && light.lambda.is_none() {
         return Err(bad(
             "every_strand is for SRBF lights (directional lights always draw every strand)".into(),

@@ -30,16 +30,18 @@ pub enum TransmittanceFilter {
 }
 
 impl TransmittanceFilter {
-    /// s with R = (δ/2)·s for `light`; 0 for a directional light under every filter.
+    /// s with R = (δ/2)·s for `light`. A directional light's box matches its
+    /// [`EnvLight::angular_variance`] under both SRBF filters (0 for a point: one texel).
     pub fn slope(self, light: &EnvLight) -> f32 {
         let Some(lambda) = light.lambda else {
-            return 0.0;
+            return match self {
+                Self::Centre => 0.0,
+                _ => matched_slope(light.angular_variance as f64),
+            };
         };
         match self {
             Self::PaperSupport => tan_support(light),
-            Self::MatchedVariance => {
-                ((3.0 * transverse_variance(lambda as f64)).sqrt() as f32).min(MAX_SLOPE)
-            }
+            Self::MatchedVariance => matched_slope(transverse_variance(lambda as f64)),
             Self::Centre => 0.0,
         }
     }
@@ -51,6 +53,12 @@ impl TransmittanceFilter {
             Self::Centre => "centre texel",
         }
     }
+}
+
+/// The slope whose box (per-axis variance R²/3) has the variance of directions spread by
+/// `variance` per axis, projected at δ/2.
+fn matched_slope(variance: f64) -> f32 {
+    ((3.0 * variance.max(0.0)).sqrt() as f32).min(MAX_SLOPE)
 }
 
 /// tan α of light `light`'s support (G = 10⁻³), 0 for a directional light: the slope of
@@ -121,6 +129,20 @@ mod tests {
         assert!((matched as f64 - (3.0 * transverse_variance(32.0)).sqrt()).abs() < 1e-6);
         assert!(matched < paper, "{matched} vs {paper}");
         assert_eq!(TransmittanceFilter::Centre.slope(&srbf), 0.0);
+        // An extended source's box has its variance: a 5° panel (σ² = r²/4 for small r).
+        let r = 5f32.to_radians();
+        let panel = EnvLight::extended(Vec3::Z, [1.0; 3], r * r / 4.0);
+        for f in [
+            TransmittanceFilter::PaperSupport,
+            TransmittanceFilter::MatchedVariance,
+        ] {
+            let s = f.slope(&panel);
+            assert!(
+                (s * s / 3.0 - r * r / 4.0).abs() < 1e-6 * r * r,
+                "{f:?}: {s}"
+            );
+        }
+        assert_eq!(TransmittanceFilter::Centre.slope(&panel), 0.0);
         let directional = EnvLight::directional(Vec3::Z, [1.0; 3]);
         for f in [
             TransmittanceFilter::PaperSupport,

@@ -339,6 +339,7 @@ pub fn srbf_json() -> Vec<u8> {
             direction: [0.0, 0.6, 0.8],
             power: [2.0, 1.5, 1.0],
             power_share: 0.4,
+            angular_variance: 1e-4,
         }],
         source: "fuzz.hdr".into(),
         source_sha256: "0".repeat(64),
