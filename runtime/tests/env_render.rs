@@ -1016,10 +1016,6 @@ fn bad_inputs_are_typed_errors() {
         ..EnvLight::srbf(Vec3::Z, 8.0, [1.0; 3])
     };
     let bad_from = EnvLight::directional_shadowed_from(Vec3::Z, [1.0; 3], Vec3::NAN);
-    let every_strand_sun = EnvLight {
-        every_strand: true,
-        ..EnvLight::directional(Vec3::Z, [1.0; 3])
-    };
     let spread_srbf = EnvLight {
         angular_variance: 1e-3,
         ..EnvLight::srbf(Vec3::Z, 8.0, [1.0; 3])
@@ -1027,7 +1023,6 @@ fn bad_inputs_are_typed_errors() {
     for (index, lights) in [
         (0, vec![shared_srbf]),
         (1, vec![light[0], bad_from]),
-        (0, vec![every_strand_sun]),
         (0, vec![EnvLight::extended(Vec3::Z, [1.0; 3], f32::NAN)]),
         (
             1,
@@ -1689,6 +1684,39 @@ fn srbf_and_directional_lights_in_one_frame_add_and_directional_ignores_kappa() 
         worst_kappa, 0.0,
         "a directional light's map must not depend on κ"
     );
+}
+
+/// A compact source not drawing every strand (`thin_weak_sources`) is shadowed through a κ
+/// map: at κ 1 exactly as with every strand, at κ 0.1 differently (its map is thinned) but
+/// with the same light reaching the groom on average (fibers enlarged 1/κ cover the ones left
+/// out).
+#[test]
+fn a_thinned_source_is_shadowed_through_a_kappa_map() {
+    let gpu = gpu();
+    let scene = groom_scene();
+    let sun = EnvLight::directional(Vec3::new(0.5, 0.7, 0.6), [2.0, 1.8, 1.5]);
+    let thinned = EnvLight {
+        every_strand: false,
+        ..sun
+    };
+    let render = |light: EnvLight, kappa: f32| render_groom(&gpu, &scene, &[light], kappa);
+    let at_one = worst_relative(&render(thinned, 1.0), &render(sun, 1.0));
+    let (whole, thin) = (render(sun, 0.1), render(thinned, 0.1));
+    let changed = worst_relative(&thin, &whole);
+    let mean = |p: &[[f32; 4]]| p.iter().map(|p| p[1] as f64).sum::<f64>();
+    let ratio = mean(&thin) / mean(&whole);
+    println!(
+        "thinned vs whole source: κ 1 worst relative {at_one:.2e}; κ 0.1 worst {changed:.2e}, mean light ratio {ratio:.4}"
+    );
+    assert!(
+        at_one < 1e-6,
+        "at κ 1 a thinned map draws every strand: {at_one}"
+    );
+    assert!(
+        changed > 1e-2,
+        "at κ 0.1 the thinned source's map must be thinned"
+    );
+    assert!((ratio - 1.0).abs() < TOLERANCE, "mean light ratio {ratio}");
 }
 
 /// Lobe spread's fiber weighting is a weighted mean of the directions' transmittances: where

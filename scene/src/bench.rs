@@ -28,7 +28,7 @@ use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake::bake_job;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription, Model, PlanOptions};
 use strandlight_precompute::baked_tables_check::check_asset;
-use strandlight_runtime::env::{EnvLight, ViewTransparency, mark_every_strand};
+use strandlight_runtime::env::{EnvLight, ViewTransparency, mark_every_strand, thin_weak_sources};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_runtime::passes::lobe_spread::LobeSpread;
 
@@ -366,6 +366,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         modes: plan.modes.clone(),
         kappa: plan.kappas[0],
         every_strand_share: 0.0,
+        whole_sources: false,
         timing_runs: 1,
         equal_error: false,
         baseline: plan.baseline,
@@ -490,6 +491,9 @@ fn srbf_points(
     for config in srbf_configs(plan) {
         let mut lights = strongest_lights(scene, config.lobes);
         mark_every_strand(&mut lights, config.every_strand_share);
+        if !args.whole_sources {
+            thin_weak_sources(&mut lights);
+        }
         let mut frame: EnvFrame = compare::frame(scene, args, &lights, mode);
         frame.role = FrameRole::Interactive {
             kappa: config.kappa,

@@ -28,7 +28,9 @@ use strandlight_precompute::env_lights::{
     face_resolution_for, reference_lights_shaded, srbf_set_lights,
 };
 use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_runtime::env::{EnvLight, EnvRenderOptions, mark_every_strand, shadow_groups};
+use strandlight_runtime::env::{
+    EnvLight, EnvRenderOptions, mark_every_strand, shadow_groups, thin_weak_sources,
+};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::image_out::{write_exr, write_png};
 use strandlight_runtime::passes::convolution_depth::{DodmSettings, MAX_DODM_RESOLUTION};
@@ -132,6 +134,11 @@ pub struct CompareArgs {
     /// (docs/BENCHMARKS.md, "Adaptive κ").
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0.0))]
     pub every_strand_share: f32,
+    /// Every compact source draws every strand into its light map. Default: κ thins the maps
+    /// of the sources weaker than the strongest thinned lobe, as it thins that lobe's
+    /// (docs/BENCHMARKS.md, "Weak sources thinned").
+    #[cfg_attr(any(feature = "cli", test), arg(long))]
+    pub whole_sources: bool,
     /// Renders per timing (the median is reported).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 3))]
     pub timing_runs: usize,
@@ -447,6 +454,15 @@ pub fn prepare_with_hair(
             100.0 * args.every_strand_share,
             args.kappa
         ));
+    }
+    if !args.whole_sources {
+        let thinned = thin_weak_sources(&mut srbf);
+        if thinned > 0 && args.kappa < 1.0 {
+            steps.say(format!(
+                "{thinned} compact sources weaker than the strongest lobe: κ {} thins their maps too",
+                args.kappa
+            ));
+        }
     }
     let fit_relative_l2_error = fit.set.relative_l2_error;
     Ok(CompareScene {
@@ -1008,7 +1024,7 @@ pub fn execute(
         "scene".into(),
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
-            "preset": args.preset, "baseline": args.baseline, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "preset": args.preset, "baseline": args.baseline, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "whole_sources": args.whole_sources, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
             "split_lobes": args.split_lobes, "split_ratio": args.split_ratio,
             "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,

@@ -15,7 +15,7 @@ use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_precompute::env_lights::srbf_set_lights;
 use strandlight_runtime::camera::UpAxis;
-use strandlight_runtime::env::EnvLight;
+use strandlight_runtime::env::{EnvLight, thin_weak_sources};
 
 /// What the scene is made of besides the hair.
 pub struct EnvSceneRequest<'a> {
@@ -130,7 +130,8 @@ pub fn prepare_env_scene_reporting(
         } else {
             request.scattering
         };
-    let lights = to_env_lights(&srbf_set_lights(&fit.set), request.up);
+    let mut lights = to_env_lights(&srbf_set_lights(&fit.set), request.up);
+    thin_weak_sources(&mut lights);
     Ok(EnvScene {
         fit,
         tables,

@@ -24,10 +24,11 @@ pub struct EnvLight {
     /// The reference uses it to shade a cube texel's light over finer sub-texels whose
     /// visibility is the texel's (`precompute/src/env_lights.rs`).
     pub shadowed_from: Option<Vec3>,
-    /// SRBF lights only: draw every strand into this light's map whatever the frame's κ. The
-    /// stochastic simplification's noise costs most on the few powerful lobes (docs/BENCHMARKS.md,
-    /// "Adaptive κ"); [`mark_every_strand`] picks them. Directional lights always draw every
-    /// strand.
+    /// Draw every strand into this light's map whatever the frame's κ. SRBFs default to κ's
+    /// thinning: its noise costs most on the few powerful lobes (docs/BENCHMARKS.md, "Adaptive
+    /// κ"), and [`mark_every_strand`] picks them. Directional lights default to every strand
+    /// (the reference's, the baseline's, a sun's); a frame of κ-thinned lobes also thins the
+    /// compact sources weaker than its strongest thinned lobe ([`thin_weak_sources`]).
     pub every_strand: bool,
     /// Directional lights only: per-axis variance (rad²) of the directions the light stands
     /// for (an extended compact source: a softbox, a sun's disc). Its visibility is averaged
@@ -54,7 +55,7 @@ impl EnvLight {
             lambda: None,
             rgb: irradiance,
             shadowed_from: None,
-            every_strand: false,
+            every_strand: true,
             angular_variance: 0.0,
         }
     }
@@ -81,9 +82,9 @@ impl EnvLight {
     }
 
     /// Whether stochastic simplification thins this light's map (κ < 1 draws only its window
-    /// of the strands): an SRBF not marked [`EnvLight::every_strand`].
+    /// of the strands): a light not marked [`EnvLight::every_strand`].
     pub fn is_simplified(&self) -> bool {
-        self.lambda.is_some() && !self.every_strand
+        !self.every_strand
     }
 
     /// The direction of the light pass whose map shadows this light.
@@ -137,6 +138,27 @@ pub fn mark_every_strand(lights: &mut [EnvLight], share: f32) -> usize {
         }
     }
     marked
+}
+
+/// Lets κ thin the maps of the compact sources (directional lights with their own map) that
+/// deliver less power than the strongest κ-thinned SRBF lobe: what the frame already accepts
+/// for that lobe's shadow it accepts for a weaker source's, and each such source's map then
+/// costs a thinned map's fill instead of every strand's (docs/BENCHMARKS.md, "Weak sources
+/// thinned"). Stronger sources (a sun) draw every strand. Returns how many are thinned.
+pub fn thin_weak_sources(lights: &mut [EnvLight]) -> usize {
+    let strongest_thinned = lights
+        .iter()
+        .filter(|l| l.lambda.is_some() && l.is_simplified())
+        .map(EnvLight::luminous_power)
+        .fold(0.0f32, f32::max);
+    let mut thinned = 0;
+    for light in lights.iter_mut() {
+        if light.lambda.is_none() && light.shadowed_from.is_none() {
+            light.every_strand = light.luminous_power() >= strongest_thinned;
+            thinned += usize::from(!light.every_strand);
+        }
+    }
+    thinned
 }
 
 /// Consecutive lights that share one shadow map (one DODM slot, one light pass, one
@@ -221,21 +243,42 @@ mod tests {
 
     #[test]
     fn every_strand_goes_to_the_strongest_lobes_until_the_share_is_held() {
-        // Powers 4 : 3 : 2 : 1 (same λ); the sun is directional and never marked.
+        // Powers 4 : 3 : 2 : 1 (same λ); the sun is directional: every strand, left alone.
         let sun = EnvLight::directional(Vec3::X, [100.0; 3]);
         let mut lights = vec![lobe(2.0), sun, lobe(4.0), lobe(1.0), lobe(3.0)];
         let marked =
             |lights: &[EnvLight]| -> Vec<bool> { lights.iter().map(|l| l.every_strand).collect() };
         // 40% of 10: the strongest (4) alone holds it.
         assert_eq!(mark_every_strand(&mut lights, 0.4), 1);
-        assert_eq!(marked(&lights), [false, false, true, false, false]);
+        assert_eq!(marked(&lights), [false, true, true, false, false]);
         // 50%: 4 holds 40%, so 3 joins (70%).
         assert_eq!(mark_every_strand(&mut lights, 0.5), 2);
-        assert_eq!(marked(&lights), [false, false, true, false, true]);
+        assert_eq!(marked(&lights), [false, true, true, false, true]);
         assert_eq!(mark_every_strand(&mut lights, 1.0), 4);
-        assert_eq!(marked(&lights), [true, false, true, true, true]);
+        assert_eq!(marked(&lights), [true; 5]);
         // 0 clears every earlier mark.
         assert_eq!(mark_every_strand(&mut lights, 0.0), 0);
-        assert_eq!(marked(&lights), [false; 5]);
+        assert_eq!(marked(&lights), [false, true, false, false, false]);
+    }
+
+    #[test]
+    fn sources_weaker_than_the_strongest_thinned_lobe_are_thinned() {
+        let power = lobe(1.0).luminous_power();
+        let source = |share: f32| EnvLight::directional(Vec3::X, [share * power; 3]);
+        let shared = EnvLight::directional_shadowed_from(Vec3::X, [0.01; 3], Vec3::Y);
+        let mut lights = vec![lobe(1.0), lobe(3.0), source(2.0), source(5.0), shared];
+        let every = |l: &[EnvLight]| -> Vec<bool> { l.iter().map(|l| l.every_strand).collect() };
+        // The strongest thinned lobe delivers 3: the source of 2 is thinned, the one of 5 and
+        // the light sharing another map (a reference sub-texel's) are not.
+        assert_eq!(thin_weak_sources(&mut lights), 1);
+        assert_eq!(every(&lights), [false, false, false, true, true]);
+        // With the lobe of 3 drawing every strand, the strongest thinned one delivers 1.
+        mark_every_strand(&mut lights, 0.7);
+        assert_eq!(thin_weak_sources(&mut lights), 0);
+        assert_eq!(every(&lights), [false, true, true, true, true]);
+        // Sources alone (a reference, a baseline): nothing thinned.
+        let mut alone = vec![source(0.1), source(0.2)];
+        assert_eq!(thin_weak_sources(&mut alone), 0);
+        assert!(alone.iter().all(|l| l.every_strand));
     }
 }

@@ -273,11 +273,6 @@ fn check_light(index: usize, light: &EnvLight) -> Result<(), EnvRenderError> {
             "angular_variance is for directional lights (an SRBF's spread is its λ)".into(),
         ));
     }
-    if light.every_strand && light.lambda.is_none() {
-        return Err(bad(
-            "every_strand is for SRBF lights (directional lights always draw every strand)".into(),
-        ));
-    }
     if let Some(from) = light.shadowed_from {
         if light.lambda.is_some() {
             return Err(bad(
@@ -343,13 +338,14 @@ pub struct EnvRenderer {
     view: EnvViewPass,
 }
 
-/// A frame's lights split by kind, each batched apart: SRBFs drawing every strand into their
-/// maps, SRBFs drawing κ of them (one light-pass geometry per batch), directional lights (their
-/// own table).
+/// A frame's lights split by kind, each batched apart: SRBFs and directional lights (each with
+/// its own table), each drawing every strand into their maps or κ of them (one light-pass
+/// geometry and one map size per batch).
 struct LightKinds {
     srbf_every_strand: Vec<EnvLight>,
     srbf: Vec<EnvLight>,
     directional: Vec<EnvLight>,
+    directional_thinned: Vec<EnvLight>,
 }
 
 impl LightKinds {
@@ -357,15 +353,31 @@ impl LightKinds {
         let (srbf, directional): (Vec<EnvLight>, _) =
             lights.iter().partition(|l| l.lambda.is_some());
         let (srbf_every_strand, srbf) = srbf.into_iter().partition(|l| l.every_strand);
+        let (directional, directional_thinned) =
+            directional.into_iter().partition(|l| l.every_strand);
         Self {
             srbf_every_strand,
             srbf,
             directional,
+            directional_thinned,
         }
     }
 
     fn has_srbf(&self) -> bool {
         !(self.srbf.is_empty() && self.srbf_every_strand.is_empty())
+    }
+
+    fn has_directional(&self) -> bool {
+        !(self.directional.is_empty() && self.directional_thinned.is_empty())
+    }
+
+    /// The kinds whose maps κ thins.
+    fn thinned(&self) -> [&Vec<EnvLight>; 2] {
+        [&self.srbf, &self.directional_thinned]
+    }
+
+    fn has_thinned(&self) -> bool {
+        self.thinned().iter().any(|k| !k.is_empty())
     }
 }
 
@@ -407,7 +419,7 @@ fn check_inputs(
     if kinds.has_srbf() {
         required_table(&tables.srbf, "srbf", "SRBF lights", Some(AXIS_INV_LAMBDA))?;
     }
-    if !kinds.directional.is_empty() {
+    if kinds.has_directional() {
         required_table(&tables.direct, "direct", "directional lights", None)?;
     }
     if with_multiple {
@@ -529,8 +541,9 @@ impl LightMaps {
         };
         let simplified_resolution = dodm.simplified_resolution(options.kappa);
         let full_kinds = [&kinds.srbf_every_strand, &kinds.directional];
-        if kinds.srbf.is_empty() || simplified_resolution == dodm.resolution {
-            let all = slots(&[&kinds.srbf, full_kinds[0], full_kinds[1]]);
+        let thinned = kinds.thinned();
+        if !kinds.has_thinned() || simplified_resolution == dodm.resolution {
+            let all = slots(&[full_kinds[0], full_kinds[1], thinned[0], thinned[1]]);
             return Ok((
                 Some(Self::new(gpu, dodm.resolution, all, first_layer)?),
                 None,
@@ -540,12 +553,7 @@ impl LightMaps {
             0 => None,
             n => Some(Self::new(gpu, dodm.resolution, n, first_layer)?),
         };
-        let simplified = Self::new(
-            gpu,
-            simplified_resolution,
-            slots(&[&kinds.srbf]),
-            first_layer,
-        )?;
+        let simplified = Self::new(gpu, simplified_resolution, slots(&thinned), first_layer)?;
         Ok((full, Some(simplified)))
     }
 
@@ -736,6 +744,7 @@ impl EnvRenderer {
             (&kinds.srbf_every_strand, srbf_tables.as_ref()),
             (&kinds.srbf, srbf_tables.as_ref()),
             (&kinds.directional, directional_tables.as_ref()),
+            (&kinds.directional_thinned, directional_tables.as_ref()),
         ];
         for (kind_lights, binding) in kind_tables {
             let Some(binding) = binding else { continue };
@@ -820,7 +829,7 @@ impl EnvRenderer {
             };
             (
                 bind(kinds.has_srbf(), &tables.srbf),
-                bind(!kinds.directional.is_empty(), &tables.direct),
+                bind(kinds.has_directional(), &tables.direct),
             )
         });
         Ok(FrameResources {
