@@ -44,9 +44,9 @@ pub struct FitArgs {
     #[arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().min_norm_share)]
     pub source_min_share: f64,
     /// Take the sources at this wider radius (degrees) instead where they hold ≥ 10 points
-    /// more of the map's power (extended lamps, e.g. 5 for a studio's softboxes; off by default).
-    #[arg(long, value_name = "DEGREES")]
-    pub wider_source_radius: Option<f64>,
+    /// more of the map's power (extended lamps: a studio's softboxes, a wide sun); 0: never.
+    #[arg(long, value_name = "DEGREES", default_value_t = strandlight_precompute::compact_sources::DEFAULT_WIDER_RADIUS_DEGREES)]
+    pub wider_source_radius: f64,
     /// Replace NaN/negative values by 0 and +Inf by the largest finite value instead of refusing.
     #[arg(long)]
     pub sanitize: bool,
@@ -85,7 +85,9 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
             radius_degrees: args.source_radius,
             min_norm_share: args.source_min_share,
         },
-        wider_source_radius: args.wider_source_radius,
+        wider_source_radius: strandlight_precompute::compact_sources::wider_radius(
+            args.wider_source_radius,
+        ),
         ..FitOptions::default()
     };
     let source = env.source();

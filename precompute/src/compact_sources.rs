@@ -209,6 +209,16 @@ fn angular_variance(
     }
 }
 
+/// The wider disc radius (degrees) the fit tries by default ([`extract_widening`]): a studio's
+/// softboxes and a sun 6° wide widen, the shared maps' suns and lamps do not
+/// (docs/BENCHMARKS.md, "Wider compact sources").
+pub const DEFAULT_WIDER_RADIUS_DEGREES: f64 = 5.0;
+
+/// `degrees` as a wider radius, 0 meaning none (how the command lines switch widening off).
+pub fn wider_radius(degrees: f64) -> Option<f64> {
+    (degrees != 0.0).then_some(degrees)
+}
+
 /// How much more of the map's power (luminance share) the sources at the wider radius must
 /// hold before [`extract_widening`] takes them: a sun's glow adds a few points, a softbox whose
 /// light spills past the narrow disc adds tens.

@@ -71,10 +71,11 @@ pub struct FitOptions {
     #[serde(default = "crate::compact_sources::SourceOptions::none")]
     pub sources: crate::compact_sources::SourceOptions,
     /// A wider disc radius (degrees) the sources take instead where it holds markedly more of
-    /// the map's power ([`crate::compact_sources::extract_widening`]: extended lamps). Off by
-    /// default: it was measured on the shared maps (it helps the photo studio only) but it
-    /// also widens the demo's procedural 6° sun, where it is not measured. Options saved
-    /// without the field predate it: none.
+    /// the map's power ([`crate::compact_sources::extract_widening`]: extended lamps, a wide
+    /// sun). Default [`crate::compact_sources::DEFAULT_WIDER_RADIUS_DEGREES`]: of the shared
+    /// maps only the photo studio widens, and with the demo's procedural 6° sun both are
+    /// closer to their references (docs/BENCHMARKS.md). Options saved without the field
+    /// predate it: none.
     #[serde(default)]
     pub wider_source_radius: Option<f64>,
 }
@@ -97,7 +98,7 @@ impl Default for FitOptions {
             rotate_degrees: 0.0,
             preserve_power: true,
             sources: Default::default(),
-            wider_source_radius: None,
+            wider_source_radius: Some(crate::compact_sources::DEFAULT_WIDER_RADIUS_DEGREES),
         }
     }
 }

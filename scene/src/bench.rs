@@ -349,7 +349,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
             .radius_degrees,
         source_min_share: strandlight_precompute::compact_sources::SourceOptions::default()
             .min_norm_share,
-        wider_source_radius: None,
+        wider_source_radius: strandlight_precompute::compact_sources::DEFAULT_WIDER_RADIUS_DEGREES,
         size: format!("{}x{}", plan.size.0, plan.size.1),
         json: true,
         reference_lights: None,
@@ -366,7 +366,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         modes: plan.modes.clone(),
         kappa: plan.kappas[0],
         every_strand_share: 0.0,
-        whole_sources: false,
+        thin_weak_sources: false,
         timing_runs: 1,
         equal_error: false,
         baseline: plan.baseline,
@@ -491,7 +491,7 @@ fn srbf_points(
     for config in srbf_configs(plan) {
         let mut lights = strongest_lights(scene, config.lobes);
         mark_every_strand(&mut lights, config.every_strand_share);
-        if !args.whole_sources {
+        if args.thin_weak_sources {
             thin_weak_sources(&mut lights);
         }
         let mut frame: EnvFrame = compare::frame(scene, args, &lights, mode);

@@ -24,6 +24,7 @@ use serde_json::{Value, json};
 use std::path::PathBuf;
 use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
+use strandlight_precompute::compact_sources::wider_radius;
 use strandlight_precompute::env_lights::{
     face_resolution_for, reference_lights_shaded, srbf_set_lights,
 };
@@ -64,9 +65,9 @@ pub struct CompareArgs {
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().min_norm_share))]
     pub source_min_share: f64,
     /// The fit takes its sources at this wider radius (degrees) where they hold ≥ 10 points
-    /// more of the map's power (extended lamps; off by default; docs/BENCHMARKS.md).
-    #[cfg_attr(any(feature = "cli", test), arg(long, value_name = "DEGREES"))]
-    pub wider_source_radius: Option<f64>,
+    /// more of the map's power (extended lamps, a wide sun; 0: never; docs/BENCHMARKS.md).
+    #[cfg_attr(any(feature = "cli", test), arg(long, value_name = "DEGREES", default_value_t = strandlight_precompute::compact_sources::DEFAULT_WIDER_RADIUS_DEGREES))]
+    pub wider_source_radius: f64,
     /// Image size WxH (the paper's 640x480).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value = "640x480"))]
     pub size: String,
@@ -134,11 +135,12 @@ pub struct CompareArgs {
     /// (docs/BENCHMARKS.md, "Adaptive κ").
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0.0))]
     pub every_strand_share: f32,
-    /// Every compact source draws every strand into its light map. Default: κ thins the maps
-    /// of the sources weaker than the strongest thinned lobe, as it thins that lobe's
-    /// (docs/BENCHMARKS.md, "Weak sources thinned").
+    /// κ thins the maps of the compact sources weaker than the strongest thinned lobe, as it
+    /// thins that lobe's (off by default: faster on royal esplanade at +0.002 relative RMSE,
+    /// but +0.016 to +0.028 on spruit and moonless golf, whose thinned point sources read one
+    /// texel of a thinned map; docs/BENCHMARKS.md, "Weak sources thinned").
     #[cfg_attr(any(feature = "cli", test), arg(long))]
-    pub whole_sources: bool,
+    pub thin_weak_sources: bool,
     /// Renders per timing (the median is reported).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 3))]
     pub timing_runs: usize,
@@ -242,11 +244,11 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
             args.source_radius
         );
     }
-    if let Some(r) = args.wider_source_radius
+    if let Some(r) = wider_radius(args.wider_source_radius)
         && !(r > args.source_radius && r <= 20.0)
     {
         bail!(
-            "--wider-source-radius {r}: must be wider than --source-radius ({}) and at most 20 degrees",
+            "--wider-source-radius {r}: must be wider than --source-radius ({}) and at most 20 degrees (0: never)",
             args.source_radius
         );
     }
@@ -374,7 +376,7 @@ pub fn prepare_with_hair(
         initial_lobes: args.lobes.min(FitOptions::default().initial_lobes),
         rotate_degrees: args.rotate,
         sources,
-        wider_source_radius: args.wider_source_radius,
+        wider_source_radius: wider_radius(args.wider_source_radius),
         target_relative_mse: args.fit_target,
         ..FitOptions::default()
     };
@@ -455,7 +457,7 @@ pub fn prepare_with_hair(
             args.kappa
         ));
     }
-    if !args.whole_sources {
+    if args.thin_weak_sources {
         let thinned = thin_weak_sources(&mut srbf);
         if thinned > 0 && args.kappa < 1.0 {
             steps.say(format!(
@@ -1024,7 +1026,7 @@ pub fn execute(
         "scene".into(),
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
-            "preset": args.preset, "baseline": args.baseline, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "whole_sources": args.whole_sources, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "preset": args.preset, "baseline": args.baseline, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "thin_weak_sources": args.thin_weak_sources, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
             "split_lobes": args.split_lobes, "split_ratio": args.split_ratio,
             "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,

@@ -15,7 +15,7 @@ use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_precompute::env_lights::srbf_set_lights;
 use strandlight_runtime::camera::UpAxis;
-use strandlight_runtime::env::{EnvLight, thin_weak_sources};
+use strandlight_runtime::env::EnvLight;
 
 /// What the scene is made of besides the hair.
 pub struct EnvSceneRequest<'a> {
@@ -130,8 +130,7 @@ pub fn prepare_env_scene_reporting(
         } else {
             request.scattering
         };
-    let mut lights = to_env_lights(&srbf_set_lights(&fit.set), request.up);
-    thin_weak_sources(&mut lights);
+    let lights = to_env_lights(&srbf_set_lights(&fit.set), request.up);
     Ok(EnvScene {
         fit,
         tables,

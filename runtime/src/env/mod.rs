@@ -27,8 +27,8 @@ pub struct EnvLight {
     /// Draw every strand into this light's map whatever the frame's κ. SRBFs default to κ's
     /// thinning: its noise costs most on the few powerful lobes (docs/BENCHMARKS.md, "Adaptive
     /// κ"), and [`mark_every_strand`] picks them. Directional lights default to every strand
-    /// (the reference's, the baseline's, a sun's); a frame of κ-thinned lobes also thins the
-    /// compact sources weaker than its strongest thinned lobe ([`thin_weak_sources`]).
+    /// (the reference's, the baseline's, a sun's); [`thin_weak_sources`] lets κ thin the
+    /// compact sources weaker than the frame's strongest thinned lobe (an option).
     pub every_strand: bool,
     /// Directional lights only: per-axis variance (rad²) of the directions the light stands
     /// for (an extended compact source: a softbox, a sun's disc). Its visibility is averaged
@@ -143,8 +143,10 @@ pub fn mark_every_strand(lights: &mut [EnvLight], share: f32) -> usize {
 /// Lets κ thin the maps of the compact sources (directional lights with their own map) that
 /// deliver less power than the strongest κ-thinned SRBF lobe: what the frame already accepts
 /// for that lobe's shadow it accepts for a weaker source's, and each such source's map then
-/// costs a thinned map's fill instead of every strand's (docs/BENCHMARKS.md, "Weak sources
-/// thinned"). Stronger sources (a sun) draw every strand. Returns how many are thinned.
+/// costs a thinned map's fill instead of every strand's. Stronger sources (a sun) draw every
+/// strand. Not the default: a point source reads one texel of its map, where an SRBF's box
+/// averages several, so κ's noise shows more (docs/BENCHMARKS.md, "Weak sources thinned").
+/// Returns how many are thinned.
 pub fn thin_weak_sources(lights: &mut [EnvLight]) -> usize {
     let strongest_thinned = lights
         .iter()
