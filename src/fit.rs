@@ -24,7 +24,8 @@ pub struct FitArgs {
     pub target_error: f64,
     #[arg(long, default_value_t = 16.0)]
     pub lambda_min: f64,
-    #[arg(long, default_value_t = 64.0)]
+    /// The narrowest lobe's bandwidth (default 256; the paper's is 64).
+    #[arg(long, default_value_t = strandlight_precompute::srbf_fit::DEFAULT_LAMBDA_MAX)]
     pub lambda_max: f64,
     /// Width of the prefiltered grid the fit runs on (height = width/2); λ_max ≤ width²/64.
     #[arg(long, default_value_t = 256)]

@@ -40,7 +40,17 @@ const STAGNATION_TOLERANCE: f64 = 1e-6;
 /// ... and this many rounds in a row without progress end the fit.
 const STAGNATION_ROUNDS: usize = 4;
 
-/// What the fit may do. The defaults are the paper's.
+/// The default largest bandwidth λ: the narrowest lobe, 1/√λ ≈ 3.6° rms. The paper's 64
+/// (7.2° rms) leaves the detail between those widths to no lobe; the hair's R lobe (a few degrees)
+/// sees it. Measured against the references of the eight shared maps (docs/BENCHMARKS.md,
+/// "Narrower lobes"): 256 lowers the shadowed single-scattering error on six (quarry 0.056 →
+/// 0.039, overcast 0.252 → 0.198, piz 0.344 → 0.287) and raises it on spruit and moonless
+/// golf; 128 gains about half as much. The tables' 1/λ axis follows the lobes used, at the
+/// same accuracy.
+pub const DEFAULT_LAMBDA_MAX: f64 = 256.0;
+
+/// What the fit may do. The defaults are the paper's, but for [`DEFAULT_LAMBDA_MAX`] and the
+/// compact sources.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FitOptions {
     /// Lobes placed before the first optimization (paper: 30).
@@ -50,6 +60,8 @@ pub struct FitOptions {
     /// Stop once the relative MSE Σw‖fit−map‖²/Σw‖map‖² is at or below this (paper: 0.15).
     pub target_relative_mse: f64,
     pub lambda_min: f64,
+    /// The narrowest lobe allowed (default [`DEFAULT_LAMBDA_MAX`]; the paper's 64 is
+    /// `--lambda-max 64`).
     pub lambda_max: f64,
     /// Width of the prefiltered fit grid (its height is half of it).
     pub grid_width: usize,
@@ -91,7 +103,7 @@ impl Default for FitOptions {
             max_lobes: 64,
             target_relative_mse: 0.15,
             lambda_min: 16.0,
-            lambda_max: 64.0,
+            lambda_max: DEFAULT_LAMBDA_MAX,
             grid_width: 256,
             iterations_per_round: 10,
             final_iterations: 100,

@@ -103,6 +103,7 @@ fn error_decreases_as_lobes_are_added() {
         max_lobes: 10,
         target_relative_mse: 0.0,
         grid_width: 64,
+        lambda_max: 64.0, // λ ≤ grid_width²/64
         ..FitOptions::default()
     };
     let result = fit(&map, &options, &mut |_| {}).unwrap();
@@ -158,6 +159,7 @@ fn reported_errors_equal_an_independent_recomputation_and_rotation_is_consistent
         initial_lobes: 8,
         max_lobes: 10,
         grid_width: 64,
+        lambda_max: 64.0, // λ ≤ grid_width²/64
         sources: SourceOptions::none(),
         ..FitOptions::default()
     };
@@ -197,6 +199,7 @@ fn the_result_does_not_depend_on_the_thread_count() {
         max_lobes: 9,
         target_relative_mse: 0.0,
         grid_width: 64,
+        lambda_max: 64.0, // λ ≤ grid_width²/64
         ..FitOptions::default()
     };
     let run = |threads| {
@@ -217,7 +220,7 @@ fn bad_options_and_black_maps_are_refused_by_name() {
     let e = fit(
         &map,
         &FitOptions {
-            lambda_min: 70.0,
+            lambda_min: 300.0,
             ..FitOptions::default()
         },
         &mut |_| {},
@@ -259,6 +262,7 @@ fn sets_round_trip_through_json_and_bad_files_are_refused() {
         initial_lobes: 3,
         max_lobes: 3,
         grid_width: 64,
+        lambda_max: 64.0, // λ ≤ grid_width²/64
         ..FitOptions::default()
     };
     let set = SrbfSet::fit(&source(&map), &options, &mut |_| {}).unwrap();
@@ -311,6 +315,7 @@ fn a_sun_narrower_than_any_lobe_doubles_its_power_unless_power_is_preserved() {
             max_lobes: 4,
             target_relative_mse: 0.0,
             grid_width: 64,
+            lambda_max: 64.0, // λ ≤ grid_width²/64
             preserve_power,
             // The SRBF fit itself: no compact source taken out first.
             sources: SourceOptions::none(),
@@ -355,6 +360,7 @@ fn by_default_a_sun_is_taken_out_as_a_directional_light_with_its_power() {
     let map = EnvMap::from_pixels(256, 128, px);
     let options = FitOptions {
         grid_width: 64,
+        lambda_max: 64.0, // λ ≤ grid_width²/64
         ..FitOptions::default()
     };
     let set = SrbfSet::fit(&source(&map), &options, &mut |_| {}).unwrap();

@@ -79,6 +79,7 @@ fn fits_with_a_compact_sun_are_bit_identical_across_thread_counts() {
         max_lobes: 8,
         target_relative_mse: 0.0,
         grid_width: 64,
+        lambda_max: 64.0, // λ ≤ grid_width²/64
         sources: SourceOptions::default(),
         ..FitOptions::default()
     };

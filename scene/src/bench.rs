@@ -344,6 +344,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         env: map.display().to_string(),
         lobes: plan.lobes[0],
         fit_target: FitOptions::default().target_relative_mse,
+        lambda_max: FitOptions::default().lambda_max,
         sources: strandlight_precompute::compact_sources::SourceOptions::default().max_sources,
         source_radius: strandlight_precompute::compact_sources::SourceOptions::default()
             .radius_degrees,

@@ -53,6 +53,10 @@ pub struct CompareArgs {
     /// or --lobes is reached; default: the paper's 15%).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = FitOptions::default().target_relative_mse))]
     pub fit_target: f64,
+    /// The fit's largest SRBF bandwidth λ (its narrowest lobe; the tables' 1/λ axis follows
+    /// the lobes the fit uses).
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = FitOptions::default().lambda_max))]
+    pub lambda_max: f64,
     /// Most compact bright sources (suns, lamps) the fit takes out as directional lights
     /// rendered beside the SRBFs; 0: SRBFs alone, as the paper.
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().max_sources))]
@@ -378,6 +382,7 @@ pub fn prepare_with_hair(
         sources,
         wider_source_radius: wider_radius(args.wider_source_radius),
         target_relative_mse: args.fit_target,
+        lambda_max: args.lambda_max,
         ..FitOptions::default()
     };
     let fit = steps.run(
@@ -1026,7 +1031,7 @@ pub fn execute(
         "scene".into(),
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
-            "preset": args.preset, "baseline": args.baseline, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "thin_weak_sources": args.thin_weak_sources, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "preset": args.preset, "baseline": args.baseline, "lambda_max": args.lambda_max, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "thin_weak_sources": args.thin_weak_sources, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
             "split_lobes": args.split_lobes, "split_ratio": args.split_ratio,
             "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,

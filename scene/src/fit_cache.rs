@@ -96,6 +96,7 @@ mod tests {
             initial_lobes: 1,
             max_lobes: 2,
             grid_width: 64,
+            lambda_max: 64.0, // λ ≤ grid_width²/64
             iterations_per_round: 20,
             final_iterations: 20,
             ..FitOptions::default()

@@ -134,6 +134,7 @@ fn build_scene() -> Result<Scene, String> {
         max_lobes: 24,
         target_relative_mse: 0.03,
         grid_width: 64,
+        lambda_max: 64.0, // λ ≤ grid_width²/64
         iterations_per_round: 10,
         final_iterations: 40,
         sources: SourceOptions::none(),
