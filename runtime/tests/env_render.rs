@@ -175,12 +175,17 @@ fn ray_visible(p: DVec3, w: DVec3, rows: usize, thickness: f64, gap: &Gap) -> bo
     true
 }
 
-/// ∫G(ω)T(ω)dω / ∫G dω over ~2000 directions stratified by G (cos γ by inverse CDF, φ uniform).
-fn cone_transmittance(p: DVec3, lambda: f64, rows: usize, thickness: f64, gap: &Gap) -> f64 {
+/// The mean visibility from `p` over ~2000 directions about +z: 40 strata of cos γ, each at
+/// `cos_gamma(u)` for u the stratum's centre in [0, 1] (an inverse CDF), × 50 of φ.
+fn stratified_visibility(
+    p: DVec3,
+    (rows, thickness, gap): (usize, f64, &Gap),
+    cos_gamma: impl Fn(f64) -> f64,
+) -> f64 {
     let (n_gamma, n_phi) = (40, 50);
     let mut visible = 0usize;
     for i in 0..n_gamma {
-        let cos_g = sample_cos_gamma(lambda, (i as f64 + 0.5) / n_gamma as f64);
+        let cos_g = cos_gamma((i as f64 + 0.5) / n_gamma as f64);
         let sin_g = (1.0 - cos_g * cos_g).max(0.0).sqrt();
         for j in 0..n_phi {
             let phi = std::f64::consts::TAU * (j as f64 + 0.5) / n_phi as f64;
@@ -189,6 +194,11 @@ fn cone_transmittance(p: DVec3, lambda: f64, rows: usize, thickness: f64, gap: &
         }
     }
     visible as f64 / (n_gamma * n_phi) as f64
+}
+
+/// ∫G(ω)T(ω)dω / ∫G dω, directions stratified by G (cos γ by its inverse CDF).
+fn cone_transmittance(p: DVec3, lambda: f64, rows: usize, thickness: f64, gap: &Gap) -> f64 {
+    stratified_visibility(p, (rows, thickness, gap), |u| sample_cos_gamma(lambda, u))
 }
 
 /// The slab's light maps from straight above (two slots, the same direction), drawn and summed.
@@ -388,22 +398,12 @@ fn slab_convolution_transmittance_follows_the_cone_integral() {
     );
 }
 
-/// ∫T(ω)dω over the cone of half-angle `radius` about +z divided by its solid angle: ~2000
-/// directions stratified uniformly in solid angle (cos γ uniform on [cos r, 1], φ uniform).
+/// ∫T(ω)dω over the cone of half-angle `radius` about +z divided by its solid angle (cos γ
+/// uniform on [cos r, 1]).
 fn disc_transmittance(p: DVec3, radius: f64, rows: usize, thickness: f64) -> f64 {
-    let (n_gamma, n_phi) = (40, 50);
-    let mut visible = 0usize;
-    for i in 0..n_gamma {
-        let u = (i as f64 + 0.5) / n_gamma as f64;
-        let cos_g = 1.0 - u * (1.0 - radius.cos());
-        let sin_g = (1.0 - cos_g * cos_g).max(0.0).sqrt();
-        for j in 0..n_phi {
-            let phi = std::f64::consts::TAU * (j as f64 + 0.5) / n_phi as f64;
-            let w = DVec3::new(sin_g * phi.cos(), sin_g * phi.sin(), cos_g);
-            visible += ray_visible(p, w, rows, thickness, &NO_GAP) as usize;
-        }
-    }
-    visible as f64 / (n_gamma * n_phi) as f64
+    stratified_visibility(p, (rows, thickness, &NO_GAP), |u| {
+        1.0 - u * (1.0 - radius.cos())
+    })
 }
 
 /// A compact source drawn as one directional light with its disc's angular variance
