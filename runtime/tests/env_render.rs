@@ -234,6 +234,22 @@ fn slab_maps(gpu: &GpuContext, gap: &Gap) -> SlabMaps {
     SlabMaps { batch, sat }
 }
 
+/// x offsets of the 8 points that stand for one slab site, spread across 1.5 fiber spacings: a
+/// map of 1.35 fibers per texel cannot follow the transmittance below one fiber spacing.
+fn slab_jitter() -> Vec<f32> {
+    (0..8)
+        .map(|k| (k as f32 - 3.5) / 7.0 * 1.5 / PER_UNIT as f32)
+        .collect()
+}
+
+/// Each site's points, site by site: `site + x·dx` for dx in `jitter`.
+fn jittered(sites: &[Vec3], jitter: &[f32]) -> Vec<Vec3> {
+    sites
+        .iter()
+        .flat_map(|s| jitter.iter().map(move |&dx| *s + Vec3::X * dx))
+        .collect()
+}
+
 #[test]
 fn slab_convolution_transmittance_follows_the_cone_integral() {
     let gpu = gpu();
@@ -252,9 +268,7 @@ fn slab_convolution_transmittance_follows_the_cone_integral() {
     // follow the transmittance's structure below one fiber spacing (whether the few rays near
     // the centre graze a fiber or not): every estimate and the reference are averaged over 8
     // points spread across 1.5 fiber spacings in x around each site.
-    let jitter: Vec<f32> = (0..8)
-        .map(|k| (k as f32 - 3.5) / 7.0 * 1.5 / PER_UNIT as f32)
-        .collect();
+    let jitter = slab_jitter();
     let mut sites = Vec::new();
     for z in [0.25f32, 0.15, 0.05, -0.2, -0.4] {
         for y in [0.0f32, 0.5, 0.8, 0.86] {
@@ -263,10 +277,7 @@ fn slab_convolution_transmittance_follows_the_cone_integral() {
             }
         }
     }
-    let points: Vec<Vec3> = sites
-        .iter()
-        .flat_map(|s| jitter.iter().map(move |&dx| *s + Vec3::X * dx))
-        .collect();
+    let points = jittered(&sites, &jitter);
     let filters = [
         TransmittanceFilter::PaperSupport,
         TransmittanceFilter::MatchedVariance,
@@ -424,19 +435,14 @@ fn an_extended_source_is_shadowed_as_its_disc() {
         EnvLight::extended(Vec3::Z, [1.0; 3], variance as f32),
         EnvLight::directional(Vec3::Z, [1.0; 3]),
     ];
-    let jitter: Vec<f32> = (0..8)
-        .map(|k| (k as f32 - 3.5) / 7.0 * 1.5 / PER_UNIT as f32)
-        .collect();
+    let jitter = slab_jitter();
     let mut sites = Vec::new();
     for z in [0.15f32, 0.05, -0.2, -0.4] {
         for x in [-0.52f32, -0.11, 0.23, 0.61] {
             sites.push(Vec3::new(x, 0.3, z));
         }
     }
-    let points: Vec<Vec3> = sites
-        .iter()
-        .flat_map(|s| jitter.iter().map(move |&dx| *s + Vec3::X * dx))
-        .collect();
+    let points = jittered(&sites, &jitter);
     let binding = BatchBinding::new(
         &gpu,
         &probe.batch_layout,
@@ -515,9 +521,7 @@ fn lobe_spread_follows_the_cone_integral_beside_a_slot() {
         direction: Vec3::Z,
         lights: &light,
     }];
-    let jitter: Vec<f32> = (0..8)
-        .map(|k| (k as f32 - 3.5) / 7.0 * 1.5 / PER_UNIT as f32)
-        .collect();
+    let jitter = slab_jitter();
     let mut sites = Vec::new();
     for z in [0.05f32, -0.2, -0.4] {
         for y in [0.0f32, 0.5] {
@@ -528,10 +532,7 @@ fn lobe_spread_follows_the_cone_integral_beside_a_slot() {
             }
         }
     }
-    let points: Vec<Vec3> = sites
-        .iter()
-        .flat_map(|s| jitter.iter().map(move |&dx| *s + Vec3::X * dx))
-        .collect();
+    let points = jittered(&sites, &jitter);
     let n = jitter.len();
     let site_means = |v: &[f64]| -> Vec<f64> {
         v.chunks(n)
