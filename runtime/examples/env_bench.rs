@@ -86,6 +86,7 @@ fn main() -> Result<(), BoxError> {
             resolution: 256,
             first_layer: None,
             batch_size: 16,
+            ..DodmSettings::default()
         },
         count_fragments: true,
         ..Default::default()

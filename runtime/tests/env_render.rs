@@ -697,6 +697,7 @@ fn render_unshadowed_with(
             resolution: 64,
             first_layer: None,
             batch_size: 2,
+            ..DodmSettings::default()
         },
         kappa: 1.0,
         shadowed: false,
@@ -1048,6 +1049,7 @@ fn bad_inputs_are_typed_errors() {
             resolution: 2048,
             first_layer: None,
             batch_size: slots,
+            ..DodmSettings::default()
         },
         kappa: 1.0,
         ..options
@@ -1171,6 +1173,7 @@ fn render_occluder(
             resolution: 64,
             first_layer: Some(0.05),
             batch_size,
+            ..DodmSettings::default()
         },
         kappa: 1.0,
         ..Default::default()
@@ -1555,6 +1558,7 @@ fn render_groom(
             resolution: 128,
             first_layer: None,
             batch_size: 2,
+            ..DodmSettings::default()
         },
         kappa,
         ..Default::default()
@@ -1579,6 +1583,68 @@ fn worst_relative(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
         .flat_map(|(p, q)| (0..3).map(move |c| (p[c] as f64, q[c] as f64)))
         .map(|(x, y)| (x - y).abs() / y.abs().max(1e-3))
         .fold(0.0, f64::max)
+}
+
+/// sqrt(Σ (a − b)² / Σ b²) over the pixels' RGB.
+fn relative_rms(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    let (mut diff, mut norm) = (0.0, 0.0);
+    for (p, q) in a.iter().zip(b) {
+        for c in 0..3 {
+            diff += (p[c] as f64 - q[c] as f64).powi(2);
+            norm += (q[c] as f64).powi(2);
+        }
+    }
+    (diff / norm).sqrt()
+}
+
+/// Coarser strands in the κ-simplified light pass (`DodmSettings::simplified_chord_tolerance`):
+/// chords within a hundredth of a texel leave the frame almost as it was; at the default half texel
+/// the frame moves by less than another draw of κ's strands moves it (on this small curly
+/// groom 0.7 of it; on straight.hair under venice 0.33); chords of 16 texels move it more.
+#[test]
+fn coarser_simplified_strands_change_the_frame_less_than_another_kappa_draw() {
+    let gpu = gpu();
+    let (model, camera, tables) = groom_scene();
+    let lights = groom_lobes();
+    let render = |tolerance: f32, seed: u64| {
+        let options = EnvRenderOptions {
+            dodm: DodmSettings {
+                resolution: 128,
+                batch_size: 2,
+                simplified_chord_tolerance: tolerance,
+                ..DodmSettings::default()
+            },
+            kappa: 0.1,
+            simplification_seed: seed,
+            ..Default::default()
+        };
+        render_env_frame(
+            &gpu, &model, &camera, RES, RES, &lights, &tables, &options, None,
+        )
+        .unwrap_or_else(|e| panic!("{e}"))
+        .pixels
+    };
+    let exact = render(0.0, 1);
+    let negligible = relative_rms(&render(0.01, 1), &exact);
+    let half_texel = relative_rms(&render(0.5, 1), &exact);
+    let another_draw = relative_rms(&render(0.0, 2), &exact);
+    let far_too_coarse = relative_rms(&render(16.0, 1), &exact);
+    println!(
+        "against every point drawn: 0.01-texel chords {negligible:.2e}, half-texel \
+         {half_texel:.4}, another κ draw {another_draw:.4}, 16-texel {far_too_coarse:.4}"
+    );
+    assert!(
+        negligible < 0.05 * half_texel,
+        "0.01-texel chords: {negligible} (half-texel {half_texel})"
+    );
+    assert!(
+        half_texel < another_draw,
+        "half-texel chords moved the frame by {half_texel}, another κ draw by {another_draw}"
+    );
+    assert!(
+        far_too_coarse > 1.3 * half_texel,
+        "16-texel chords should change the shadows more: {far_too_coarse} vs {half_texel}"
+    );
 }
 
 /// Adaptive κ: in a κ 0.1 frame, a lobe marked `every_strand` is shadowed exactly as at κ 1,
@@ -1735,6 +1801,7 @@ fn fiber_weighting_is_a_normalized_mean_over_the_lobe() {
                 resolution: 128,
                 first_layer: None,
                 batch_size: 2,
+                ..DodmSettings::default()
             },
             lobe_spread: spread,
             ..Default::default()

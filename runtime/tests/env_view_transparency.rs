@@ -120,6 +120,7 @@ fn render_sized(
             resolution: 64,
             first_layer: None,
             batch_size: 4,
+            ..DodmSettings::default()
         },
         kappa: 1.0,
         shadowed: false,

@@ -56,6 +56,10 @@ pub struct BenchPlan {
     /// before it existed: none.
     #[serde(default)]
     pub lobe_spread_kappas: Vec<f32>,
+    /// Chord tolerances of the simplified light pass (`compare --light-chord-tolerance`, texels)
+    /// other than the default; reports written before it existed: none.
+    #[serde(default)]
+    pub chord_tolerances: Vec<f32>,
     pub baseline_lights: Vec<usize>,
     /// Which directional-light baseline (reports written before it existed: median cut).
     #[serde(default)]
@@ -91,6 +95,7 @@ impl BenchPlan {
             dodm_sizes: vec![512, 256, 1024],
             every_strand_shares: vec![0.2, 0.4],
             lobe_spread_kappas: vec![0.1, 0.3, 1.0],
+            chord_tolerances: vec![0.0],
             baseline_lights: vec![4, 8, 16, 32, 64, 128],
             baseline: Baseline::MedianCut,
             reference_max_lights: 1536,
@@ -118,6 +123,7 @@ impl BenchPlan {
             dodm_sizes: vec![512, 256],
             every_strand_shares: vec![0.4],
             lobe_spread_kappas: vec![0.1, 1.0],
+            chord_tolerances: vec![0.0],
             baseline_lights: vec![4, 16, 64],
             baseline: Baseline::MedianCut,
             reference_max_lights: 384,
@@ -376,6 +382,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         split_lobes: 0,
         split_ratio: 3.0,
         light_map_size: plan.dodm_sizes[0],
+        light_chord_tolerance: DodmSettings::default().simplified_chord_tolerance,
         look: LookArgs {
             transparency: EnvTransparency::Opaque,
             view: ViewArgs {
@@ -427,10 +434,11 @@ struct SrbfConfig {
     dodm: u32,
     every_strand_share: f32,
     lobe_spread: bool,
+    chord_tolerance: f32,
 }
 
-/// The SRBF frames of `plan`: the default, then lobes, κ, light-map size and adaptive κ's
-/// share varied one at a time, then lobe spread at each of its κ (a series of its own: at the
+/// The SRBF frames of `plan`: the default, then lobes, κ, light-map size, adaptive κ's
+/// share and the simplified light pass's chord tolerance varied one at a time, then lobe spread at each of its κ (a series of its own: at the
 /// default κ it changes one setting, elsewhere two).
 fn srbf_configs(plan: &BenchPlan) -> Vec<SrbfConfig> {
     let (lobes, kappa, dodm) = (plan.lobes[0], plan.kappas[0], plan.dodm_sizes[0]);
@@ -441,6 +449,7 @@ fn srbf_configs(plan: &BenchPlan) -> Vec<SrbfConfig> {
         dodm,
         every_strand_share: 0.0,
         lobe_spread: false,
+        chord_tolerance: DodmSettings::default().simplified_chord_tolerance,
     };
     let changed = |label: String| SrbfConfig { label, ..default };
     let mut configs = Vec::new();
@@ -466,6 +475,12 @@ fn srbf_configs(plan: &BenchPlan) -> Vec<SrbfConfig> {
         configs.push(SrbfConfig {
             every_strand_share: share,
             ..changed(format!("adaptive κ, share {share}"))
+        });
+    }
+    for &tolerance in &plan.chord_tolerances {
+        configs.push(SrbfConfig {
+            chord_tolerance: tolerance,
+            ..changed(format!("light-pass chord tolerance {tolerance} texels"))
         });
     }
     for &k in &plan.lobe_spread_kappas {
@@ -499,7 +514,10 @@ fn srbf_points(
         frame.role = FrameRole::Interactive {
             kappa: config.kappa,
         };
-        frame.look.dodm = DodmSettings::at_resolution(config.dodm);
+        frame.look.dodm = DodmSettings {
+            simplified_chord_tolerance: config.chord_tolerance,
+            ..DodmSettings::at_resolution(config.dodm)
+        };
         frame.look.lobe_spread = config.lobe_spread.then(LobeSpread::default);
         let r = steps.run(
             &format!("{}: SRBF {}", mode.name(), config.label),
@@ -826,6 +844,7 @@ mod tests {
             assert!(!default.lobe_spread);
             let expected = plan.lobes.len() - 1 + plan.kappas.len() - 1 + plan.dodm_sizes.len() - 1
                 + plan.every_strand_shares.len()
+                + plan.chord_tolerances.len()
                 + plan.lobe_spread_kappas.len();
             assert_eq!(configs.len(), 1 + expected, "{}", plan.name);
             for c in &configs[1..] {
@@ -834,6 +853,7 @@ mod tests {
                     c.dodm != default.dodm,
                     c.every_strand_share != default.every_strand_share,
                     c.lobe_spread != default.lobe_spread,
+                    c.chord_tolerance != default.chord_tolerance,
                 ];
                 let one_other = changed.iter().filter(|&&x| x).count() == 1;
                 match c.lobe_spread {

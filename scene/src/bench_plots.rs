@@ -114,7 +114,7 @@ where
         .draw()
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
     // Labels name what was changed ("8 lobes", "κ 1", "light maps 256²", "adaptive κ, share
-    // 0.4"); the default's names every setting and joins every SRBF series.
+    // 0.4", "light-pass chord tolerance 0 texels"); the default's names every setting and joins every SRBF series.
     let series = |family: &str, label: LabelFilter| -> Vec<(f64, f64)> {
         let mut v: Vec<(f64, f64)> = measured
             .iter()
@@ -138,7 +138,7 @@ where
     chart
         .draw_series(baseline.iter().map(|&p| Circle::new(p, 4, RED.filled())))
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    let srbf_series: [(LabelFilter, RGBColor, &str); 5] = [
+    let srbf_series: [(LabelFilter, RGBColor, &str); 6] = [
         (&|l| l.ends_with(" lobes"), BLUE, "SRBF: lobe count"),
         (&|l| l.starts_with("κ"), GREEN, "SRBF: κ"),
         (
@@ -155,6 +155,11 @@ where
             &|l| l.starts_with("lobe spread"),
             RGBColor(230, 120, 0),
             "SRBF: lobe spread (κ)",
+        ),
+        (
+            &|l| l.starts_with("light-pass chord"),
+            RGBColor(120, 80, 40),
+            "SRBF: light-pass chord tolerance",
         ),
     ];
     for (matches, colour, label) in srbf_series {

@@ -182,6 +182,11 @@ pub struct CompareArgs {
     /// shadow each strand differently (docs/BENCHMARKS.md, "Light-map size").
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = DodmSettings::default().resolution))]
     pub light_map_size: u32,
+    /// How far, in texels of a κ-simplified light map, the strands its light pass draws may
+    /// stray from the hair's (points closer to a coarser strand are dropped; 0 draws every
+    /// point; docs/BENCHMARKS.md, "Coarser strands in the simplified light pass").
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = DodmSettings::default().simplified_chord_tolerance))]
+    pub light_chord_tolerance: f32,
     /// The look of all three renders.
     #[cfg_attr(any(feature = "cli", test), command(flatten))]
     pub look: LookArgs,
@@ -223,14 +228,12 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
         bail!("--timing-runs 0: at least one render per timing");
     }
     args.look.look()?;
-    DodmSettings::at_resolution(args.light_map_size)
-        .check()
-        .with_context(|| {
-            format!(
-                "--light-map-size {}: texels across a light map, 1 to {MAX_DODM_RESOLUTION}",
-                args.light_map_size
-            )
-        })?;
+    light_maps(args).check().with_context(|| {
+        format!(
+            "--light-map-size {} / --light-chord-tolerance {}: texels across a light map, 1 to {MAX_DODM_RESOLUTION}; a tolerance ≥ 0",
+            args.light_map_size, args.light_chord_tolerance
+        )
+    })?;
     if let Some(n) = args.table_resolution
         && !(2..=256).contains(&n)
     {
@@ -654,11 +657,19 @@ pub fn frame<'a>(
     }
 }
 
+/// The light maps of every frame (checked by `validate`).
+fn light_maps(args: &CompareArgs) -> DodmSettings {
+    DodmSettings {
+        simplified_chord_tolerance: args.light_chord_tolerance,
+        ..DodmSettings::at_resolution(args.light_map_size)
+    }
+}
+
 /// The renderer choices of every frame (checked by `validate`).
 fn look(args: &CompareArgs) -> EnvLook {
     EnvLook {
         shadowed: !args.unshadowed,
-        dodm: DodmSettings::at_resolution(args.light_map_size),
+        dodm: light_maps(args),
         ..args.look.look().expect("checked by validate")
     }
 }
@@ -703,7 +714,8 @@ fn reference_inputs(
         "direct_table_inputs": direct.metadata.description.inputs_key,
         "multiple_tables_inputs": REFERENCE_MULTIPLE_TABLES.iter().filter(|_| mode == ScatteringMode::Full).filter_map(|n| scene.tables.assets.get(*n)).map(|a| a.metadata.description.inputs_key.clone()).collect::<Vec<_>>(),
         "generator": env!("CARGO_PKG_VERSION"),
-        "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, transparency: look(args).transparency, dodm: look(args).dodm, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
+        // κ 1 draws every strand as it is: the simplified maps' chord tolerance is not an input.
+        "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, transparency: look(args).transparency, dodm: DodmSettings { simplified_chord_tolerance: 0.0, ..look(args).dodm }, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
     });
     // Only a finer shading cube adds a key, so brute-force references keep their cache entries.
     if let Some(m) = shading_face(args)?.filter(|&m| m > face) {
@@ -1031,7 +1043,7 @@ pub fn execute(
         "scene".into(),
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
-            "preset": args.preset, "baseline": args.baseline, "lambda_max": args.lambda_max, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "thin_weak_sources": args.thin_weak_sources, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "preset": args.preset, "baseline": args.baseline, "lambda_max": args.lambda_max, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "light_chord_tolerance": args.light_chord_tolerance, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "thin_weak_sources": args.thin_weak_sources, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
             "split_lobes": args.split_lobes, "split_ratio": args.split_ratio,
             "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,

@@ -16,7 +16,7 @@ use crate::gpu::{AdapterReport, GpuContext};
 use crate::hair::{Aabb, HairModel};
 use crate::passes::convolution_depth::{
     ConvolutionDepthPass, DodmBatch, DodmSettings, DodmSettingsError, SimplifiedSegments,
-    check_kappa,
+    check_kappa, simplification_order,
 };
 use crate::passes::env_view::{
     BatchBinding, EnvAccumulator, EnvViewPass, EnvViewTargets, FrameVisibility, TableBinding,
@@ -627,30 +627,26 @@ impl FrameResources {
     }
 }
 
-/// The geometry the SRBF light passes draw: the strands in simplification order (with that
-/// order, whose windows the passes draw) when κ < 1, else all of them.
+/// The geometry the SRBF light passes draw: when κ < 1, the strands in simplification order
+/// (with that order, whose windows the passes draw), coarsened to what a simplified map's
+/// texels hold ([`DodmSettings::simplified_chord_tolerance`]); else all of them as they are.
 fn light_pass_geometry(
     gpu: &GpuContext,
     model: &HairModel,
     geometry: &StrandGeometry,
     options: &EnvRenderOptions,
-) -> (StrandGeometry, Option<SimplifiedSegments>) {
-    if options.kappa < 1.0 {
-        let simplified = SimplifiedSegments::new(gpu, model, options.simplification_seed);
-        (
-            simplified.geometry(geometry, options.kappa),
-            Some(simplified),
-        )
-    } else {
-        let all = StrandGeometry {
-            points: geometry.points.clone(),
-            segments: geometry.segments.clone(),
-            attributes: geometry.attributes.clone(),
-            segment_count: geometry.segment_count,
-            default_thickness: geometry.default_thickness,
-        };
-        (all, None)
+) -> Result<(StrandGeometry, Option<SimplifiedSegments>), TooManyPoints> {
+    if options.kappa >= 1.0 {
+        return Ok((geometry.clone(), None));
     }
+    let order = simplification_order(model, options.simplification_seed);
+    let tolerance = options
+        .dodm
+        .simplified_chord_tolerance_world(options.kappa, model.bounds());
+    let coarse = model.decimated(tolerance, geometry.default_thickness);
+    let simplified = SimplifiedSegments::in_order(gpu, &coarse, &order);
+    let drawn = StrandGeometry::upload(gpu, &coarse)?;
+    Ok((simplified.geometry(&drawn, options.kappa), Some(simplified)))
 }
 
 /// What one frame is asked for.
@@ -806,7 +802,7 @@ impl EnvRenderer {
         let occupancy = OccupancyMap::new(gpu, options.transparency, width, height)?;
         check_sums_limits(gpu, width, height)?;
         let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;
-        let (light_geometry, simplified) = light_pass_geometry(gpu, model, &geometry, options);
+        let (light_geometry, simplified) = light_pass_geometry(gpu, model, &geometry, options)?;
         let bounds = model.bounds();
         let first_layer = options.dodm.first_layer_for(bounds);
         let (full_maps, simplified_maps) = LightMaps::for_frame(gpu, options, kinds, first_layer)?;

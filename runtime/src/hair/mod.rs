@@ -8,6 +8,7 @@
 
 mod bytes;
 mod clean;
+mod decimate;
 mod error;
 pub mod groom;
 mod model;

@@ -37,6 +37,16 @@ impl<T: Copy> Attribute<T> {
     pub fn is_per_point(&self) -> bool {
         matches!(self, Attribute::PerPoint(_))
     }
+
+    /// The attribute of a model made of the points `indices` (valid point indices) of this one.
+    pub fn at_points(&self, indices: &[usize]) -> Attribute<T> {
+        match self {
+            Attribute::Uniform(v) => Attribute::Uniform(*v),
+            Attribute::PerPoint(values) => {
+                Attribute::PerPoint(indices.iter().map(|&i| values[i]).collect())
+            }
+        }
+    }
 }
 
 /// An axis-aligned bounding box. `empty()` has min = +∞, max = −∞ so that growing it works.

@@ -39,6 +39,11 @@ pub struct DodmSettings {
     pub first_layer: Option<f32>,
     /// Lights per batch (one map each, drawn in one submit; default 16).
     pub batch_size: u32,
+    /// How far, in texels of a κ-simplified map, the strands its light pass draws may stray
+    /// from the hair's: points within it of a coarser strand are dropped
+    /// ([`HairModel::decimated`]; default 0.5, 0 draws every point). Full-resolution maps always
+    /// draw every point.
+    pub simplified_chord_tolerance: f32,
 }
 
 impl Default for DodmSettings {
@@ -47,6 +52,7 @@ impl Default for DodmSettings {
             resolution: 512,
             first_layer: None,
             batch_size: 16,
+            simplified_chord_tolerance: 0.5,
         }
     }
 }
@@ -59,6 +65,8 @@ pub enum DodmSettingsError {
     FirstLayer(f32),
     #[error("light batch size 0: must be at least 1")]
     BatchSize,
+    #[error("simplified light pass chord tolerance {0}: must be finite and ≥ 0 (texels)")]
+    ChordTolerance(f32),
     #[error("stochastic simplification fraction κ = {0}: must be in (0, 1]")]
     Kappa(f32),
 }
@@ -85,6 +93,14 @@ impl DodmSettings {
         (texel_ratio / kappa).max(1.0)
     }
 
+    /// [`Self::simplified_chord_tolerance`] in world units for a hair of `bounds`: the light
+    /// camera spans the bounds' diagonal ([`crate::camera::light_camera`]) over
+    /// [`Self::simplified_resolution`] texels.
+    pub fn simplified_chord_tolerance_world(&self, kappa: f32, bounds: Aabb) -> f32 {
+        let texel = bounds.diagonal() / self.simplified_resolution(kappa) as f32;
+        self.simplified_chord_tolerance * texel
+    }
+
     /// The default settings with `resolution`² maps and the largest batch, up to the default
     /// 16, whose summed-area tables fit one storage binding on any adapter (2048² maps: 2).
     pub fn at_resolution(resolution: u32) -> Self {
@@ -109,6 +125,10 @@ impl DodmSettings {
         }
         if self.batch_size == 0 {
             return Err(DodmSettingsError::BatchSize);
+        }
+        let tolerance = self.simplified_chord_tolerance;
+        if !(tolerance.is_finite() && tolerance >= 0.0) {
+            return Err(DodmSettingsError::ChordTolerance(tolerance));
         }
         Ok(())
     }
@@ -233,6 +253,13 @@ pub fn strand_window(segments_before: &[u32], kappa: f32, k: u32) -> Vec<Range<u
 
 impl SimplifiedSegments {
     pub fn new(gpu: &GpuContext, model: &HairModel, seed: u64) -> Self {
+        Self::in_order(gpu, model, &simplification_order(model, seed))
+    }
+
+    /// The segments of `model` with its strands in `order` (a permutation of its strands; a
+    /// coarser model of the same strands takes its original's order, so that both draw the
+    /// same strands per window).
+    pub fn in_order(gpu: &GpuContext, model: &HairModel, order: &[u32]) -> Self {
         let table = segment_table(model);
         // Segment range of each strand in the original table.
         let mut first = Vec::with_capacity(model.strand_count() + 1);
@@ -242,7 +269,7 @@ impl SimplifiedSegments {
         }
         let mut ordered = Vec::with_capacity(table.len());
         let mut segments_before = vec![0u32];
-        for s in simplification_order(model, seed) {
+        for &s in order {
             ordered.extend_from_slice(&table[first[s as usize]..first[s as usize + 1]]);
             segments_before.push(ordered.len() as u32);
         }
@@ -680,6 +707,30 @@ mod tests {
             .check()
             .is_err()
         );
+        for bad in [-0.5, f32::NAN, f32::INFINITY] {
+            let e = DodmSettings {
+                simplified_chord_tolerance: bad,
+                ..ok
+            }
+            .check()
+            .unwrap_err();
+            assert!(matches!(e, DodmSettingsError::ChordTolerance(_)), "{bad}");
+            assert!(e.to_string().contains("chord tolerance"), "{e}");
+        }
+    }
+
+    #[test]
+    fn the_chord_tolerance_is_a_fraction_of_a_simplified_texel_in_the_world() {
+        let bounds = Aabb::from_points(&[Vec3::ZERO, Vec3::new(30.0, 40.0, 0.0)]);
+        let settings = DodmSettings::default();
+        // κ 0.25: 256 texels across the light camera's 50-unit span, half of one = 50/512.
+        let world = settings.simplified_chord_tolerance_world(0.25, bounds);
+        assert!((world - 50.0 / 512.0).abs() < 1e-6, "{world}");
+        let off = DodmSettings {
+            simplified_chord_tolerance: 0.0,
+            ..settings
+        };
+        assert_eq!(off.simplified_chord_tolerance_world(0.25, bounds), 0.0);
     }
 
     /// Strands rooted along a line in a scrambled file order.
