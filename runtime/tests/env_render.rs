@@ -1585,18 +1585,6 @@ fn worst_relative(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// sqrt(Σ (a − b)² / Σ b²) over the pixels' RGB.
-fn relative_rms(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
-    let (mut diff, mut norm) = (0.0, 0.0);
-    for (p, q) in a.iter().zip(b) {
-        for c in 0..3 {
-            diff += (p[c] as f64 - q[c] as f64).powi(2);
-            norm += (q[c] as f64).powi(2);
-        }
-    }
-    (diff / norm).sqrt()
-}
-
 /// Coarser strands in the κ-simplified light pass (`DodmSettings::simplified_chord_tolerance`):
 /// chords within a hundredth of a texel leave the frame almost as it was; at the default half texel
 /// the frame moves by less than another draw of κ's strands moves it (on this small curly
@@ -1625,10 +1613,10 @@ fn coarser_simplified_strands_change_the_frame_less_than_another_kappa_draw() {
         .pixels
     };
     let exact = render(0.0, 1);
-    let negligible = relative_rms(&render(0.01, 1), &exact);
-    let half_texel = relative_rms(&render(0.5, 1), &exact);
-    let another_draw = relative_rms(&render(0.0, 2), &exact);
-    let far_too_coarse = relative_rms(&render(16.0, 1), &exact);
+    let negligible = relative_rmse(&render(0.01, 1), &exact);
+    let half_texel = relative_rmse(&render(0.5, 1), &exact);
+    let another_draw = relative_rmse(&render(0.0, 2), &exact);
+    let far_too_coarse = relative_rmse(&render(16.0, 1), &exact);
     println!(
         "against every point drawn: 0.01-texel chords {negligible:.2e}, half-texel \
          {half_texel:.4}, another κ draw {another_draw:.4}, 16-texel {far_too_coarse:.4}"

@@ -52,16 +52,9 @@ fn render(gpu: &strandlight_runtime::gpu::GpuContext, hair: &HairModel, t: Trans
     render_frame(gpu, hair, &frame, &options).unwrap_or_else(|e| panic!("{t:?}: {e}"))
 }
 
-/// ‖a − b‖ / ‖b‖ over the RGB of every pixel.
-fn relative_rmse(a: &Frame, b: &Frame) -> f64 {
-    let (mut err, mut norm) = (0.0f64, 0.0f64);
-    for (p, q) in a.pixels.iter().zip(&b.pixels) {
-        for k in 0..3 {
-            err += (p[k] as f64 - q[k] as f64).powi(2);
-            norm += (q[k] as f64).powi(2);
-        }
-    }
-    (err / norm).sqrt()
+/// [`relative_rmse`] of two frames.
+fn frame_error(a: &Frame, b: &Frame) -> f64 {
+    relative_rmse(&a.pixels, &b.pixels)
 }
 
 #[test]
@@ -94,7 +87,7 @@ fn every_technique_approaches_the_abuffer() {
         full_counts.stored, counts.stored,
         "k = 64 keeps every fragment"
     );
-    let full_error = relative_rmse(&full, &reference);
+    let full_error = frame_error(&full, &reference);
     eprintln!("K-buffer k = 64: relative RMSE {full_error:.2e} against the A-buffer");
     assert!(full_error < 2e-3, "k = 64: {full_error}");
 
@@ -113,7 +106,7 @@ fn every_technique_approaches_the_abuffer() {
         (counts.stored, 0),
         "DBK with Δ over the whole hair keeps every fragment"
     );
-    let dbk_error = relative_rmse(&whole, &reference);
+    let dbk_error = frame_error(&whole, &reference);
     eprintln!("DBK, Δ = twice the diagonal: relative RMSE {dbk_error:.2e} against the A-buffer");
     assert!(dbk_error < 2e-3, "DBK over the whole volume: {dbk_error}");
 
@@ -127,7 +120,7 @@ fn every_technique_approaches_the_abuffer() {
             counts.stored,
             "k = {k}: every fragment kept or counted"
         );
-        let error = relative_rmse(&frame, &reference);
+        let error = frame_error(&frame, &reference);
         errors.push((k, error, c.dropped));
         assert!(
             error <= previous + 1e-4,
@@ -144,16 +137,16 @@ fn every_technique_approaches_the_abuffer() {
     let mut sorted = Vec::new();
     for bins in [16, 256, 4096] {
         let frame = render(&gpu, &hair, Transparency::Sorted { bins });
-        sorted.push((bins, relative_rmse(&frame, &reference)));
+        sorted.push((bins, frame_error(&frame, &reference)));
     }
     let opaque_frame = render(&gpu, &hair, Transparency::Opaque);
-    let opaque = relative_rmse(&opaque_frame, &reference);
+    let opaque = frame_error(&opaque_frame, &reference);
     eprintln!("sorted blending (bins, relative RMSE): {sorted:?}; opaque: {opaque:.4}");
 
     // One subset is the opaque pass (same segments, same order); more approach the A-buffer.
     let one = render(&gpu, &hair, Transparency::RandomSubsets { subsets: 1 });
     // Same segments in the same order; only the subset layer's half floats differ.
-    let one_error = relative_rmse(&one, &opaque_frame);
+    let one_error = frame_error(&one, &opaque_frame);
     eprintln!("one random subset against the opaque pass: relative RMSE {one_error:.2e}");
     assert!(
         one_error < 2e-3,
@@ -163,7 +156,7 @@ fn every_technique_approaches_the_abuffer() {
         .into_iter()
         .map(|n| {
             let frame = render(&gpu, &hair, Transparency::RandomSubsets { subsets: n });
-            (n, relative_rmse(&frame, &reference))
+            (n, frame_error(&frame, &reference))
         })
         .collect();
     eprintln!("random subsets (k, relative RMSE): {subsets:?}");

@@ -12,6 +12,18 @@ pub const RES: u32 = 64;
 /// Light-map texels per world unit (2 units across 64 texels).
 pub const PER_UNIT: f64 = 32.0;
 
+/// ‖a − b‖ / ‖b‖ over the RGB of every pixel (alpha left out).
+pub fn relative_rmse(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
+    let (mut err, mut norm) = (0.0f64, 0.0f64);
+    for (p, q) in a.iter().zip(b) {
+        for k in 0..3 {
+            err += (p[k] as f64 - q[k] as f64).powi(2);
+            norm += (q[k] as f64).powi(2);
+        }
+    }
+    (err / norm).sqrt()
+}
+
 /// The software or hardware device; a test fails (with the install hint) when there is none.
 pub fn gpu() -> GpuContext {
     GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"))
