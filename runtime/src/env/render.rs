@@ -802,7 +802,10 @@ impl EnvRenderer {
         let occupancy = OccupancyMap::new(gpu, options.transparency, width, height)?;
         check_sums_limits(gpu, width, height)?;
         let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;
-        let (light_geometry, simplified) = light_pass_geometry(gpu, model, &geometry, options)?;
+        // Per hair and settings, not per light or view: setup, as the upload is.
+        let (light_geometry, simplified) = timings.time(gpu, "upload", || {
+            light_pass_geometry(gpu, model, &geometry, options)
+        })?;
         let bounds = model.bounds();
         let first_layer = options.dodm.first_layer_for(bounds);
         let (full_maps, simplified_maps) = LightMaps::for_frame(gpu, options, kinds, first_layer)?;
