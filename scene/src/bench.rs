@@ -438,8 +438,9 @@ struct SrbfConfig {
 }
 
 /// The SRBF frames of `plan`: the default, then lobes, κ, light-map size, adaptive κ's
-/// share and the simplified light pass's chord tolerance varied one at a time, then lobe spread at each of its κ (a series of its own: at the
-/// default κ it changes one setting, elsewhere two).
+/// share and the simplified light pass's chord tolerance varied one at a time, then lobe
+/// spread at each of its κ (a series of its own: at the default κ it changes one setting,
+/// elsewhere two).
 fn srbf_configs(plan: &BenchPlan) -> Vec<SrbfConfig> {
     let (lobes, kappa, dodm) = (plan.lobes[0], plan.kappas[0], plan.dodm_sizes[0]);
     let default = SrbfConfig {

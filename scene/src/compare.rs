@@ -1099,6 +1099,8 @@ mod tests {
             ("--every-strand-share", "NaN", "[0, 1]"),
             ("--light-map-size", "0", "1 to 2048"),
             ("--light-map-size", "4096", "1 to 2048"),
+            ("--light-chord-tolerance", "NaN", "a tolerance ≥ 0"),
+            ("--light-chord-tolerance", "inf", "a tolerance ≥ 0"),
         ] {
             let a = args(&["--hair", "h", "--env", "e", flag, value]).unwrap();
             let e = validate(&a).unwrap_err().to_string();
