@@ -306,11 +306,9 @@ impl SimplifiedSegments {
     /// `geometry` drawing the first κ fraction of strands in simplification order.
     pub fn geometry(&self, geometry: &StrandGeometry, kappa: f32) -> StrandGeometry {
         StrandGeometry {
-            points: geometry.points.clone(),
             segments: self.segments.clone(),
-            attributes: geometry.attributes.clone(),
             segment_count: self.segment_count(kappa),
-            default_thickness: geometry.default_thickness,
+            ..geometry.clone()
         }
     }
 }
