@@ -5,19 +5,19 @@
 mod common;
 use common::*;
 
-use glam::{DVec3, Vec3};
-use strandlight_runtime::camera::Camera;
+use glam::{DVec3, Vec2, Vec3};
+use strandlight_runtime::camera::{Camera, Projection, light_camera};
 use strandlight_runtime::env::{
     EnvFrame, EnvLight, EnvRenderOptions, EnvTables, ForwardScatteringGrid,
     ForwardScatteringSource, render_env_frame,
 };
 use strandlight_runtime::env::{LobeSpread, ShadowGroup, TransmittanceFilter};
-use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::gpu::{GpuContext, read_texture_rgba};
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::multiple::ForwardScatteringError;
 use strandlight_runtime::passes::convolution_depth::{
-    ConvolutionDepthPass, DodmBatch, DodmSettings, SimplifiedSegments,
+    ConvolutionDepthPass, DodmBatch, DodmSettings, OPTICAL_DEPTH_FORMAT, SimplifiedSegments,
 };
 use strandlight_runtime::passes::env_view::BatchBinding;
 use strandlight_runtime::passes::strand_geometry::StrandGeometry;
@@ -38,18 +38,8 @@ use strandlight_tables::table_axes::{
 /// Writes `texels` (RGBA, row-major) into layer 0 of the batch's optical-depth texture.
 fn upload_optical_depth(gpu: &GpuContext, batch: &DodmBatch, texels: &[[f32; 4]]) {
     let res = batch.resolution;
-    let format = batch.optical_depth.format();
-    let (bytes, texel_bytes): (Vec<u8>, u32) = match format {
-        wgpu::TextureFormat::Rgba32Float => (bytemuck::cast_slice(texels).to_vec(), 16),
-        _ => {
-            let h: Vec<half::f16> = texels
-                .iter()
-                .flatten()
-                .map(|&v| half::f16::from_f32(v))
-                .collect();
-            (bytemuck::cast_slice(&h).to_vec(), 8)
-        }
-    };
+    assert_eq!(batch.optical_depth.format(), OPTICAL_DEPTH_FORMAT);
+    let (bytes, texel_bytes): (Vec<u8>, u32) = (bytemuck::cast_slice(texels).to_vec(), 16);
     gpu.queue.write_texture(
         wgpu::TexelCopyTextureInfo {
             texture: &batch.optical_depth,
@@ -1289,7 +1279,7 @@ fn read_nearest_depth(gpu: &GpuContext, batch: &DodmBatch) -> Vec<f32> {
             texture: &batch.nearest_depth,
             mip_level: 0,
             origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::DepthOnly,
+            aspect: wgpu::TextureAspect::All,
         },
         wgpu::TexelCopyBufferInfo {
             buffer: &buffer,
@@ -1850,4 +1840,93 @@ fn fiber_weighting_is_a_normalized_mean_over_the_lobe() {
         weighting < box_gap,
         "weighting {weighting} vs the spread's own change {box_gap}"
     );
+}
+
+/// The light pass against the geometry it draws: three straight fibers half a texel wide (quads
+/// of one texel at α = 0.5, so τ = ln 2 per fragment), two of them on top of each other in the
+/// map 0.45 apart along the light, the third alone. Across its length every fiber covers exactly
+/// the texel whose centre lies within half a texel of its line; the nearer fiber sets the
+/// nearest depth, at the depth the light's camera gives its points; the cumulative optical
+/// depths at the boundaries 0.1, 0.3, 0.6 and ∞ behind it hold τ before δ = 0.45 and 2τ after.
+#[test]
+fn the_light_pass_covers_each_fiber_with_its_optical_depth() {
+    let gpu = gpu();
+    let res = 64u32;
+    let first_layer = 0.1f32;
+    // (y, z) of each fiber, running along x; the light is toward +z, so A is nearer than B.
+    let fibers = [(0.2f32, 0.3f32), (0.2, -0.15), (-0.4, 0.0)];
+    let points: Vec<Vec3> = fibers
+        .iter()
+        .flat_map(|&(y, z)| (0..5).map(move |k| Vec3::new(-0.8 + 0.4 * k as f32, y, z)))
+        .collect();
+    let offsets: Vec<u32> = (0..=fibers.len() as u32).map(|f| 5 * f).collect();
+    let bare = HairModel::new(points.clone(), offsets.clone(), None, None, None).unwrap();
+    let camera = light_camera(Vec3::Z, bare.bounds());
+    let texels_per_unit = match camera.projection {
+        Projection::Orthographic { half_height } => res as f32 / (2.0 * half_height),
+        Projection::Perspective { .. } => unreachable!("light cameras are orthographic"),
+    };
+    let width = Attribute::Uniform(0.5 / texels_per_unit);
+    let model = HairModel::new(points, offsets, Some(width), None, None).unwrap();
+    let geometry = StrandGeometry::upload(&gpu, &model).unwrap();
+    let mut batch = DodmBatch::new(&gpu, res, 1, first_layer);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    ConvolutionDepthPass::new(&gpu).encode(
+        &gpu,
+        &mut encoder,
+        &geometry,
+        &[Vec3::Z],
+        model.bounds(),
+        1.0,
+        1.0,
+        &mut batch,
+    );
+    gpu.queue.submit([encoder.finish()]);
+    let nearest = read_nearest_depth(&gpu, &batch);
+    let optical = read_texture_rgba(&gpu, &batch.optical_depth).unwrap();
+
+    let view_proj = camera.projection_matrix(1.0) * camera.view();
+    // A world point's texel coordinates (x right, y down) and depth in the map.
+    let project = |p: Vec3| {
+        let clip = view_proj * p.extend(1.0);
+        let t = Vec2::new(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y) * res as f32;
+        (t, clip.z / clip.w)
+    };
+    let tau = 2f32.ln();
+    let (start, _) = project(Vec3::new(-0.8, 0.0, 0.0));
+    let (end, _) = project(Vec3::new(0.8, 0.0, 0.0));
+    let columns = (start.x.min(end.x).ceil() as u32 + 1)..(start.x.max(end.x).floor() as u32 - 1);
+    assert!(columns.len() > 40, "the fibers span {columns:?}");
+    for x in columns {
+        // Where each fiber crosses this column's centre line.
+        let at = |(y, z): (f32, f32)| {
+            let world_x = -0.8 + 1.6 * (x as f32 + 0.5 - start.x) / (end.x - start.x);
+            project(Vec3::new(world_x, y, z))
+        };
+        let (pair, pair_depth) = at(fibers[0]);
+        let (alone, alone_depth) = at(fibers[2]);
+        for y in 0..res {
+            let centre = y as f32 + 0.5;
+            let i = (y * res + x) as usize;
+            let (want_depth, want) = if (centre - pair.y).abs() < 0.5 {
+                (pair_depth, [tau, tau, 2.0 * tau, 2.0 * tau])
+            } else if (centre - alone.y).abs() < 0.5 {
+                (alone_depth, [tau; 4])
+            } else {
+                (1.0, [0.0; 4])
+            };
+            assert!(
+                (nearest[i] - want_depth).abs() < 1e-4,
+                "texel ({x}, {y}): nearest depth {} instead of {want_depth}",
+                nearest[i]
+            );
+            for k in 0..4 {
+                assert!(
+                    (optical[i][k] - want[k]).abs() < 1e-3,
+                    "texel ({x}, {y}): optical depth {:?} instead of {want:?}",
+                    optical[i]
+                );
+            }
+        }
+    }
 }

@@ -495,6 +495,8 @@ struct FrameResources {
     /// Group 0 of every view and visibility pass.
     strands: wgpu::BindGroup,
     coverage_view: wgpu::TextureView,
+    /// [`EnvViewTargets::nearest_position`] and `nearest_tangent`.
+    nearest_views: [wgpu::TextureView; 2],
     depth_view: wgpu::TextureView,
     /// The single-scattering tables of the SRBF and the directional lights (None: no such
     /// lights), each bound with the multiple-scattering table.
@@ -591,6 +593,7 @@ impl FrameResources {
         FrameVisibility {
             map: &self.occupancy,
             coverage: &self.coverage_view,
+            nearest: [&self.nearest_views[0], &self.nearest_views[1]],
             transparency: options.transparency,
             width: self.sums.width,
             height: self.sums.height,
@@ -834,6 +837,8 @@ impl EnvRenderer {
         Ok(FrameResources {
             strands: self.view.strands(gpu, &geometry, &view_params),
             coverage_view: targets.coverage.create_view(&Default::default()),
+            nearest_views: [&targets.nearest_position, &targets.nearest_tangent]
+                .map(|t| t.create_view(&Default::default())),
             depth_view: targets.depth.create_view(&Default::default()),
             geometry,
             light_geometry,
@@ -870,6 +875,7 @@ impl EnvRenderer {
                 &view.group,
                 &frame.depth_view,
                 &frame.coverage_view,
+                [&frame.nearest_views[0], &frame.nearest_views[1]],
                 &frame.occupancy,
                 frame.geometry.segment_count,
             );

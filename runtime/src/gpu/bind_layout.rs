@@ -97,6 +97,24 @@ pub fn depth_texture_entry(
     )
 }
 
+/// A 2D storage texture of `format` at `binding`, written (never read) by the shader.
+pub fn storage_texture_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+    format: wgpu::TextureFormat,
+) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::StorageTexture {
+            access: wgpu::StorageTextureAccess::WriteOnly,
+            format,
+            view_dimension: wgpu::TextureViewDimension::D2,
+        },
+        count: None,
+    }
+}
+
 /// A bind group of `resources` at bindings 0, 1, 2, … in order.
 pub fn bind_group(
     device: &wgpu::Device,

@@ -1,9 +1,10 @@
 //! The light pass of the convolution optical depth map (Ren 2010 §5): for a batch of lights, per
-//! light an orthographic camera along its direction around the hair ([`light_camera`]), a depth
-//! prepass (nearest fiber z₀ per texel, one `Depth32Float` array layer per light slot), then an
-//! additive pass into an RGBA float array layer holding the cumulative optical depths at the
-//! boundaries z_k = k(k+1)d/2, k = 1..3, behind z₀ and everything in the fourth channel
-//! (`convolution_depth.wgsl`). All lights of a batch are encoded into one command encoder.
+//! light an orthographic camera along its direction around the hair ([`light_camera`]), the
+//! nearest fiber z₀ per texel (one `R32Float` array layer per light slot), then the cumulative
+//! optical depths at the boundaries z_k = k(k+1)d/2, k = 1..3, behind z₀ and everything in the
+//! fourth channel (an `Rgba32Float` array layer). The strands' quads are rasterized in compute
+//! (`convolution_depth.wgsl`): one invocation per segment visits the texel centres its two
+//! triangles cover. All lights of a batch are encoded into one command encoder.
 //! Inputs: [`StrandGeometry`] (possibly the simplified segment order of
 //! [`SimplifiedSegments`]), light directions, hair bounds, [`DodmSettings`].
 //! Output: [`DodmBatch`] (textures + the lights' cameras), read by `summed_area` and the view pass.
@@ -13,14 +14,14 @@ use std::ops::Range;
 use strandlight_tables::hard_case_sweep::SweepRng;
 use wgpu::util::DeviceExt;
 
-use super::attachments::{cleared_color, cleared_depth};
 use super::frame_params::{FrameParams, KajiyaKay};
-use super::render_target::DEPTH_FORMAT;
 use super::strand_geometry::{StrandGeometry, segment_table};
-use super::strand_quads::{strand_bind_group_layout, strand_bind_group_scaled};
+use super::strand_quads::{strand_bind_group_layout_for, strand_bind_group_scaled};
 use crate::camera::{Camera, Projection, light_camera};
 use crate::gpu::GpuContext;
-use crate::gpu::bind_layout::{depth_texture_entry, uniform_entry};
+use crate::gpu::bind_layout::{
+    bind_group, pipeline_layout, storage_entry, storage_texture_entry, uniform_entry,
+};
 use crate::gpu::texture::texture_2d;
 use crate::hair::{Aabb, HairModel};
 
@@ -320,6 +321,10 @@ struct DodmUniform {
     far: f32,
     first_layer: f32,
     tau_scale: f32,
+    resolution: u32,
+    segment_count: u32,
+    window_count: u32,
+    row_length: u32,
 }
 
 /// The maps of one batch: layer `slot` of each array belongs to light `slot`.
@@ -328,11 +333,17 @@ pub struct DodmBatch {
     pub slots: u32,
     pub first_layer: f32,
     pub cameras: Vec<Camera>,
-    /// Nearest fiber depth z₀ (0..1 between the camera's near and far planes).
+    /// Nearest fiber depth z₀ (0..1 between the camera's near and far planes; 1 where nothing
+    /// is drawn), `R32Float`.
     pub nearest_depth: wgpu::Texture,
-    /// Cumulative optical depths at the four boundaries.
+    /// Cumulative optical depths at the four boundaries, `Rgba32Float`.
     pub optical_depth: wgpu::Texture,
 }
+
+/// The formats of [`DodmBatch`]'s maps: written by the light pass's compute resolve, so
+/// storage formats of every WebGPU adapter.
+pub const NEAREST_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+pub const OPTICAL_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 impl DodmBatch {
     pub fn new(gpu: &GpuContext, resolution: u32, slots: u32, first_layer: f32) -> Self {
@@ -341,24 +352,21 @@ impl DodmBatch {
             height: resolution,
             depth_or_array_layers: slots.max(1),
         };
-        let texture = |label, format, usage| texture_2d(gpu, label, size, format, usage);
-        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let texture = |label, format| {
+            // COPY_SRC: tests read the maps back; COPY_DST: tests write optical depths.
+            let usage = wgpu::TextureUsages::STORAGE_BINDING
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST;
+            texture_2d(gpu, label, size, format, usage)
+        };
         Self {
             resolution,
             slots,
             first_layer,
             cameras: Vec::new(),
-            // COPY_SRC: tests read the coverage back.
-            nearest_depth: texture(
-                "dodm nearest depth",
-                DEPTH_FORMAT,
-                usage | wgpu::TextureUsages::COPY_SRC,
-            ),
-            optical_depth: texture(
-                "dodm optical depth",
-                gpu.hdr_format(),
-                usage | wgpu::TextureUsages::COPY_SRC | wgpu::TextureUsages::COPY_DST,
-            ),
+            nearest_depth: texture("dodm nearest depth", NEAREST_DEPTH_FORMAT),
+            optical_depth: texture("dodm optical depth", OPTICAL_DEPTH_FORMAT),
         }
     }
 
@@ -390,26 +398,36 @@ impl DodmBatch {
         }
     }
 
+    /// The maps, and the light pass's scratch of one slot (4 + 16 bytes a texel).
     pub fn memory(&self) -> Vec<(String, u64)> {
-        let texels = self.resolution as u64 * self.resolution as u64 * self.slots.max(1) as u64;
-        let texel = self
-            .optical_depth
-            .format()
-            .block_copy_size(None)
-            .unwrap_or(16) as u64;
+        let map = self.resolution as u64 * self.resolution as u64;
+        let texels = map * self.slots.max(1) as u64;
         vec![
             ("dodm nearest depth".into(), texels * 4),
-            ("dodm optical depth".into(), texels * texel),
+            ("dodm optical depth".into(), texels * 16),
+            (
+                "dodm light-pass scratch".into(),
+                map * SCRATCH_BYTES_PER_TEXEL,
+            ),
         ]
     }
 }
 
-/// The two pipelines of the light pass, built once.
+/// The light pass's scratch per texel: the nearest depth and four optical depths, u32 each.
+const SCRATCH_BYTES_PER_TEXEL: u64 = 4 + 16;
+
+/// Workgroups of the splat kernels (`@workgroup_size(64)`) in x before a row wraps to y: within
+/// every adapter's 65535 workgroups per dimension.
+const SPLAT_ROW_WORKGROUPS: u32 = 32768;
+
+/// The light pass's three kernels and their layouts, built once.
 pub struct ConvolutionDepthPass {
-    depth_pipeline: wgpu::RenderPipeline,
-    layer_pipeline: wgpu::RenderPipeline,
+    nearest: wgpu::ComputePipeline,
+    layers: wgpu::ComputePipeline,
+    resolve: wgpu::ComputePipeline,
     strand_layout: wgpu::BindGroupLayout,
-    dodm_layout: wgpu::BindGroupLayout,
+    splat_layout: wgpu::BindGroupLayout,
+    output_layout: wgpu::BindGroupLayout,
 }
 
 impl ConvolutionDepthPass {
@@ -425,84 +443,50 @@ impl ConvolutionDepthPass {
                 .into(),
             ),
         });
-        let strand_layout = strand_bind_group_layout(device);
-        let dodm_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("dodm"),
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let strand_layout = strand_bind_group_layout_for(device, compute);
+        let splat_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dodm splat"),
             entries: &[
-                depth_texture_entry(0, wgpu::ShaderStages::FRAGMENT),
-                uniform_entry(1, wgpu::ShaderStages::FRAGMENT),
+                uniform_entry(0, compute),
+                storage_entry(1, compute, true),
+                storage_entry(2, compute, false),
+                storage_entry(3, compute, false),
             ],
         });
-        let layout = |label, groups: &[Option<&wgpu::BindGroupLayout>]| {
-            device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-                label: Some(label),
-                bind_group_layouts: groups,
-                immediate_size: 0,
+        let output_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("dodm maps"),
+            entries: &[
+                storage_texture_entry(0, compute, NEAREST_DEPTH_FORMAT),
+                storage_texture_entry(1, compute, OPTICAL_DEPTH_FORMAT),
+            ],
+        });
+        let layout = pipeline_layout(
+            device,
+            "dodm light pass",
+            &[
+                Some(&strand_layout),
+                Some(&splat_layout),
+                Some(&output_layout),
+            ],
+        );
+        let kernel = |entry: &str| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&layout),
+                module: &shader,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
             })
         };
-        let depth_layout = layout("dodm depth", &[Some(&strand_layout)]);
-        let layer_layout = layout("dodm layers", &[Some(&strand_layout), Some(&dodm_layout)]);
-        let vertex = wgpu::VertexState {
-            module: &shader,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        };
-        let primitive = wgpu::PrimitiveState {
-            topology: wgpu::PrimitiveTopology::TriangleList,
-            cull_mode: None,
-            ..Default::default()
-        };
-        let depth_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("dodm depth"),
-            layout: Some(&depth_layout),
-            vertex: vertex.clone(),
-            fragment: None,
-            primitive,
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        });
-        let additive = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let layer_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("dodm layers"),
-            layout: Some(&layer_layout),
-            vertex,
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_dodm"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: gpu.hdr_format(),
-                    blend: Some(wgpu::BlendState {
-                        color: additive,
-                        alpha: additive,
-                    }),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            primitive,
-            depth_stencil: None,
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        });
         Self {
-            depth_pipeline,
-            layer_pipeline,
+            nearest: kernel("splat_nearest"),
+            layers: kernel("splat_layers"),
+            resolve: kernel("resolve"),
             strand_layout,
-            dodm_layout,
+            splat_layout,
+            output_layout,
         }
     }
 
@@ -538,6 +522,8 @@ impl ConvolutionDepthPass {
 
     /// [`Self::encode`] drawing, for light `i`, only the segments in `windows[i]` (ranges of
     /// `geometry`'s segment table: [`SimplifiedSegments::window`]); `scales` = [τ, width].
+    /// Per light: the nearest depths, then the optical depths, splatted into a scratch shared by
+    /// the batch's lights, then resolved into the light's layer of the maps.
     #[allow(clippy::too_many_arguments)]
     pub fn encode_windows(
         &self,
@@ -557,8 +543,12 @@ impl ConvolutionDepthPass {
             .iter()
             .map(|&l| light_camera(l, bounds))
             .collect();
+        let scratch = LightPassScratch::new(gpu, res);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("dodm light pass"),
+            timestamp_writes: gpu.compute_timestamps(),
+        });
         for (slot, camera) in batch.cameras.iter().enumerate() {
-            let slot = slot as u32;
             let frame = FrameParams {
                 camera: *camera,
                 width: res,
@@ -569,6 +559,17 @@ impl ConvolutionDepthPass {
             };
             let strands =
                 strand_bind_group_scaled(gpu, &self.strand_layout, geometry, &frame, width_scale);
+            let ranges: Vec<[u32; 2]> = windows[slot]
+                .iter()
+                .filter(|r| !r.is_empty())
+                .map(|r| [r.start, r.end - r.start])
+                .collect();
+            let segment_count: u32 = ranges.iter().map(|r| r[1]).sum();
+            let workgroups = segment_count.div_ceil(64);
+            let grid = [
+                workgroups.min(SPLAT_ROW_WORKGROUPS),
+                workgroups.div_ceil(SPLAT_ROW_WORKGROUPS),
+            ];
             let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("dodm params"),
                 contents: bytemuck::bytes_of(&DodmUniform {
@@ -576,56 +577,81 @@ impl ConvolutionDepthPass {
                     far: camera.far,
                     first_layer: batch.first_layer,
                     tau_scale,
+                    resolution: res,
+                    segment_count,
+                    window_count: ranges.len() as u32,
+                    row_length: grid[0] * 64,
                 }),
                 usage: wgpu::BufferUsages::UNIFORM,
             });
-            let depth_view = DodmBatch::layer_view(&batch.nearest_depth, slot);
-            let optical_view = DodmBatch::layer_view(&batch.optical_depth, slot);
-            let dodm_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("dodm"),
-                layout: &self.dodm_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: wgpu::BindingResource::TextureView(&depth_view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: uniform.as_entire_binding(),
-                    },
-                ],
+            // A storage binding may not be empty.
+            let window_list: &[[u32; 2]] = if ranges.is_empty() {
+                &[[0, 0]]
+            } else {
+                &ranges
+            };
+            let window_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("dodm windows"),
+                contents: bytemuck::cast_slice(window_list),
+                usage: wgpu::BufferUsages::STORAGE,
             });
-            {
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("dodm depth"),
-                    color_attachments: &[],
-                    depth_stencil_attachment: cleared_depth(&depth_view, true),
-                    timestamp_writes: gpu.render_timestamps(),
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&self.depth_pipeline);
-                pass.set_bind_group(0, &strands, &[]);
-                for range in &windows[slot as usize] {
-                    pass.draw(0..6, range.clone());
+            let splat = bind_group(
+                device,
+                "dodm splat",
+                &self.splat_layout,
+                &[
+                    uniform.as_entire_binding(),
+                    window_buffer.as_entire_binding(),
+                    scratch.nearest.as_entire_binding(),
+                    scratch.layers.as_entire_binding(),
+                ],
+            );
+            let nearest_view = DodmBatch::layer_view(&batch.nearest_depth, slot as u32);
+            let optical_view = DodmBatch::layer_view(&batch.optical_depth, slot as u32);
+            let output = bind_group(
+                device,
+                "dodm maps",
+                &self.output_layout,
+                &[
+                    wgpu::BindingResource::TextureView(&nearest_view),
+                    wgpu::BindingResource::TextureView(&optical_view),
+                ],
+            );
+            pass.set_bind_group(0, &strands, &[]);
+            pass.set_bind_group(1, &splat, &[]);
+            pass.set_bind_group(2, &output, &[]);
+            if segment_count > 0 {
+                for kernel in [&self.nearest, &self.layers] {
+                    pass.set_pipeline(kernel);
+                    pass.dispatch_workgroups(grid[0], grid[1], 1);
                 }
             }
-            {
-                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("dodm layers"),
-                    color_attachments: &[cleared_color(&optical_view)],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: gpu.render_timestamps(),
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&self.layer_pipeline);
-                pass.set_bind_group(0, &strands, &[]);
-                pass.set_bind_group(1, &dodm_group, &[]);
-                for range in &windows[slot as usize] {
-                    pass.draw(0..6, range.clone());
-                }
-            }
+            pass.set_pipeline(&self.resolve);
+            pass.dispatch_workgroups(res.div_ceil(8), res.div_ceil(8), 1);
+        }
+    }
+}
+
+/// One map's splat targets, zeroed at creation and by each resolve.
+struct LightPassScratch {
+    nearest: wgpu::Buffer,
+    layers: wgpu::Buffer,
+}
+
+impl LightPassScratch {
+    fn new(gpu: &GpuContext, resolution: u32) -> Self {
+        let texels = resolution as u64 * resolution as u64;
+        let buffer = |label, bytes| {
+            gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            })
+        };
+        Self {
+            nearest: buffer("dodm nearest scratch", texels * 4),
+            layers: buffer("dodm layers scratch", texels * 16),
         }
     }
 }

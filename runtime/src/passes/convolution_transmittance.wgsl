@@ -57,7 +57,7 @@ struct BatchParams {
 
 @group(1) @binding(0) var<uniform> batch: BatchParams;
 @group(1) @binding(1) var<storage, read> env_lights: array<EnvLightGpu>;
-@group(1) @binding(2) var dodm_depth: texture_depth_2d_array;
+@group(1) @binding(2) var dodm_depth: texture_2d_array<f32>;
 @group(1) @binding(3) var<storage, read> sat: array<vec4<u32>>;
 @group(1) @binding(4) var<storage, read> shading_samples: array<ShadingSample>;
 
@@ -126,7 +126,7 @@ fn nearest_depth_around(slot: u32, texel: vec2<i32>) -> f32 {
     for (var dy = -EMPTY_TEXEL_SEARCH; dy <= EMPTY_TEXEL_SEARCH; dy++) {
         for (var dx = -EMPTY_TEXEL_SEARCH; dx <= EMPTY_TEXEL_SEARCH; dx++) {
             let t = clamp(texel + vec2<i32>(dx, dy), vec2<i32>(0), vec2<i32>(last));
-            z0 = min(z0, textureLoad(dodm_depth, t, i32(slot), 0));
+            z0 = min(z0, textureLoad(dodm_depth, t, i32(slot), 0).r);
         }
     }
     return z0;
@@ -143,7 +143,7 @@ fn effective_transmittance(slot: u32, world: vec3<f32>, t: vec3<f32>, e: vec3<f3
     if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }
     let res = f32(batch.resolution);
     let texel = min(vec2<i32>(uv * res), vec2<i32>(i32(batch.resolution) - 1));
-    var z0 = textureLoad(dodm_depth, texel, i32(slot), 0);
+    var z0 = textureLoad(dodm_depth, texel, i32(slot), 0).r;
     if (z0 >= 1.0) {
         // Nothing drawn on this texel: the point's own fiber fell in a gap of the map (left out
         // by the simplification, or thinner than a texel). A one-texel box (directional light)

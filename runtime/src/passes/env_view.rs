@@ -1,6 +1,7 @@
-//! The env-lit view pass (Ren 2010 §3.1, §5–6): the hair rasterized from the camera with the
-//! strand pass's quads; each fragment the frame's visibility lets through ([`ViewTransparency`],
-//! built once per frame by [`ViewVisibilityPass`]) loops over a batch's lights and sums
+//! The env-lit view pass (Ren 2010 §3.1, §5–6): each fiber the frame's visibility lets through
+//! ([`ViewTransparency`], built once per frame by [`ViewVisibilityPass`]: the nearest fiber of
+//! each pixel, shaded by a full-screen pass, or every fragment of the strands rasterized again
+//! through the occupancy map) loops over a batch's lights and sums
 //! T̃ × table lookup × light weight (single scattering) and, with a forward-scattering grid,
 //! power × T_f × I_G (multiple scattering) into two targets (`env_view.wgsl`). A small compute
 //! pass adds each batch's images into running float sums (`env_accumulate.wgsl`).
@@ -12,7 +13,7 @@ use glam::Vec3;
 use strandlight_tables::table::{AxisGpu, Table};
 use wgpu::util::DeviceExt;
 
-use super::attachments::{cleared_color, prepassed_depth};
+use super::attachments::cleared_color;
 use super::convolution_depth::DodmBatch;
 use super::frame_params::FrameParams;
 use super::lobe_spread::{LobeSpread, spread_uniform};
@@ -25,7 +26,7 @@ use super::view_visibility::{OccupancyMap, ViewTransparency, ViewVisibilityPass}
 use crate::env::{EnvLight, ForwardScatteringGrid, ShadowGroup};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{
-    float_texture_entry, pipeline_layout, storage_entry, texture_entry, uniform_entry,
+    float_array_texture_entry, float_texture_entry, pipeline_layout, storage_entry, uniform_entry,
 };
 use crate::gpu::texture::texture_2d;
 
@@ -95,12 +96,7 @@ pub fn transmittance_bind_group_layout(
         entries: &[
             uniform_entry(0, visibility),
             storage_entry(1, visibility, true),
-            texture_entry(
-                2,
-                visibility,
-                wgpu::TextureSampleType::Depth,
-                wgpu::TextureViewDimension::D2Array,
-            ),
+            float_array_texture_entry(2, visibility),
             storage_entry(3, visibility, true),
             storage_entry(4, visibility, true),
         ],
@@ -414,6 +410,8 @@ pub struct FrameVisibility<'a> {
     pub map: &'a OccupancyMap,
     /// [`EnvViewTargets::coverage`].
     pub coverage: &'a wgpu::TextureView,
+    /// [`EnvViewTargets::nearest_position`] and [`EnvViewTargets::nearest_tangent`].
+    pub nearest: [&'a wgpu::TextureView; 2],
     pub transparency: ViewTransparency,
     pub width: u32,
     pub height: u32,
@@ -482,6 +480,14 @@ impl ViewBinding {
                     binding: 3,
                     resource: wgpu::BindingResource::TextureView(visibility.coverage),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(visibility.nearest[0]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(visibility.nearest[1]),
+                },
             ],
         });
         Self {
@@ -491,15 +497,22 @@ impl ViewBinding {
     }
 }
 
-/// Two HDR targets (single, multiple) and a depth buffer for one batch's view pass, and the
-/// frame's coverage (red: Σ −ln(1 − α) of a pixel's fragments; the opaque view's alpha; 1×1 and
-/// unused for the transparent view).
+/// Two HDR targets (single, multiple) for one batch's view pass, and what the opaque view reads
+/// of the frame's visibility: the depth prepass, the coverage (red: Σ −ln(1 − α) of a pixel's
+/// fragments; the opaque view's alpha) and the nearest fiber's position (w: 1 on hair) and
+/// tangent, f32 so that the deferred view shades the very point the rasterizer interpolated
+/// (the three are 1×1 and unused for the transparent view).
 pub struct EnvViewTargets {
     pub single: wgpu::Texture,
     pub multiple: wgpu::Texture,
     pub depth: wgpu::Texture,
     pub coverage: wgpu::Texture,
+    pub nearest_position: wgpu::Texture,
+    pub nearest_tangent: wgpu::Texture,
 }
+
+/// The format of [`EnvViewTargets::nearest_position`] and `nearest_tangent`.
+pub const NEAREST_SURFACE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 impl EnvViewTargets {
     pub fn new(gpu: &GpuContext, width: u32, height: u32, transparency: ViewTransparency) -> Self {
@@ -512,6 +525,17 @@ impl EnvViewTargets {
         let color = wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
+        let opaque_only = match transparency {
+            ViewTransparency::Opaque => size,
+            ViewTransparency::Occupancy { .. } => wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+        };
+        let read_by_view =
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let visibility = |label, format| texture_2d(gpu, label, opaque_only, format, read_by_view);
         Self {
             single: texture("env single", gpu.hdr_format(), color),
             multiple: texture("env multiple", gpu.hdr_format(), color),
@@ -520,20 +544,9 @@ impl EnvViewTargets {
                 DEPTH_FORMAT,
                 wgpu::TextureUsages::RENDER_ATTACHMENT,
             ),
-            coverage: texture_2d(
-                gpu,
-                "env coverage",
-                match transparency {
-                    ViewTransparency::Opaque => size,
-                    ViewTransparency::Occupancy { .. } => wgpu::Extent3d {
-                        width: 1,
-                        height: 1,
-                        depth_or_array_layers: 1,
-                    },
-                },
-                gpu.hdr_format(),
-                wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            ),
+            coverage: visibility("env coverage", gpu.hdr_format()),
+            nearest_position: visibility("env nearest position", NEAREST_SURFACE_FORMAT),
+            nearest_tangent: visibility("env nearest tangent", NEAREST_SURFACE_FORMAT),
         }
     }
 
@@ -548,6 +561,8 @@ impl EnvViewTargets {
             ("env multiple target".into(), bytes(&self.multiple)),
             ("env depth".into(), bytes(&self.depth)),
             ("env coverage".into(), bytes(&self.coverage)),
+            ("env nearest position".into(), bytes(&self.nearest_position)),
+            ("env nearest tangent".into(), bytes(&self.nearest_tangent)),
         ]
     }
 }
@@ -618,14 +633,16 @@ impl EnvViewLayouts {
                     storage_entry(1, fragment, true),
                     storage_entry(2, fragment, false),
                     float_texture_entry(3, fragment),
+                    float_texture_entry(4, fragment),
+                    float_texture_entry(5, fragment),
                 ],
             ),
         }
     }
 }
 
-/// The view and visibility passes share one module, so that both rasterize bit-identical
-/// depths (the opaque view's Equal depth test relies on it).
+/// The view and visibility passes share one module, so that they rasterize bit-identical
+/// depths (the fragment count's Equal depth test after the prepass relies on it).
 fn env_view_shader(device: &wgpu::Device) -> wgpu::ShaderModule {
     let source = [
         include_str!("strand_quads.wgsl"),
@@ -643,12 +660,13 @@ fn env_view_shader(device: &wgpu::Device) -> wgpu::ShaderModule {
     })
 }
 
-/// A view pipeline writing the single and multiple targets from fragment entry `entry`.
+/// A view pipeline writing the single and multiple targets from vertex entry `vertex` and
+/// fragment entry `entry`.
 fn view_pipeline(
     gpu: &GpuContext,
     layout: &wgpu::PipelineLayout,
     shader: &wgpu::ShaderModule,
-    (label, entry): (&str, &str),
+    (label, vertex, entry): (&str, &str, &str),
     blend: Option<wgpu::BlendComponent>,
     depth: Option<wgpu::DepthStencilState>,
 ) -> wgpu::RenderPipeline {
@@ -663,7 +681,7 @@ fn view_pipeline(
             layout: Some(layout),
             vertex: wgpu::VertexState {
                 module: shader,
-                entry_point: Some("vs_main"),
+                entry_point: Some(vertex),
                 compilation_options: Default::default(),
                 buffers: &[],
             },
@@ -741,34 +759,26 @@ impl EnvViewPass {
             &strands_only,
             gpu.hdr_format(),
         );
-        // After the depth prepass only the nearest fragments are at an Equal depth; nothing
-        // writes depth, so early depth testing rejects the rest before the fragment shader.
-        let nearest_only = wgpu::DepthStencilState {
-            format: DEPTH_FORMAT,
-            depth_write_enabled: Some(false),
-            depth_compare: Some(wgpu::CompareFunction::Equal),
-            stencil: Default::default(),
-            bias: Default::default(),
-        };
         let additive = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,
             dst_factor: wgpu::BlendFactor::One,
             operation: wgpu::BlendOperation::Add,
         };
-        // Fragments tied at the nearest depth (segment joints) replace, not add to, each other.
+        // The depth prepass left each pixel's nearest fiber in two textures: the opaque view
+        // shades those pixels, rasterizing no strand per batch.
         let opaque = view_pipeline(
             gpu,
             &layout,
             &shader,
-            ("env view (opaque)", "fs_env_opaque"),
+            ("env view (opaque)", "vs_fullscreen", "fs_env_deferred"),
             None,
-            Some(nearest_only),
+            None,
         );
         let transparent = view_pipeline(
             gpu,
             &layout,
             &shader,
-            ("env view (occupancy)", "fs_env_transparent"),
+            ("env view (occupancy)", "vs_main", "fs_env_transparent"),
             Some(additive),
             None,
         );
@@ -852,8 +862,9 @@ impl EnvViewPass {
         strand_bind_group(gpu, &self.strand_layout, geometry, frame)
     }
 
-    /// Encodes one batch: the view pass into `targets` (reading the depth prepass of the frame
-    /// when opaque), then its addition into `sums`.
+    /// Encodes one batch: the view pass into `targets` (opaque: a full-screen pass over the
+    /// nearest fibers the frame's depth prepass left; occupancy: the strands rasterized again),
+    /// then its addition into `sums`.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -870,16 +881,15 @@ impl EnvViewPass {
     ) {
         let single = targets.single.create_view(&Default::default());
         let multiple = targets.multiple.create_view(&Default::default());
-        let depth = targets.depth.create_view(&Default::default());
-        let (pipeline, depth_attachment) = match transparency {
-            ViewTransparency::Opaque => (&self.opaque, prepassed_depth(&depth)),
-            ViewTransparency::Occupancy { .. } => (&self.transparent, None),
+        let (pipeline, vertices, instances) = match transparency {
+            ViewTransparency::Opaque => (&self.opaque, 3, 1),
+            ViewTransparency::Occupancy { .. } => (&self.transparent, 6, geometry.segment_count),
         };
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("env view"),
                 color_attachments: &[cleared_color(&single), cleared_color(&multiple)],
-                depth_stencil_attachment: depth_attachment,
+                depth_stencil_attachment: None,
                 timestamp_writes: gpu.render_timestamps(),
                 occlusion_query_set: None,
                 multiview_mask: None,
@@ -889,7 +899,7 @@ impl EnvViewPass {
             pass.set_bind_group(1, &batch.group, &[]);
             pass.set_bind_group(2, &tables.group, &[]);
             pass.set_bind_group(3, &view.group, &[]);
-            pass.draw(0..6, 0..geometry.segment_count);
+            pass.draw(0..vertices, 0..instances);
         }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("env accumulate"),

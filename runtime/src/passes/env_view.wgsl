@@ -9,10 +9,11 @@
 // irradiance. Tables are strandlight `Table`s (row-major, channels innermost, RGB) uploaded as-is
 // and interpolated quadrilinearly exactly like `Table::lookup`.
 //
-// Two fragment entry points, one per view transparency (view_visibility.rs):
-//   fs_env_opaque:      after a depth prepass, only the nearest fragments pass the depth test
-//                       (Equal); the nearest fiber's radiance stands for the pixel's, weighted
-//                       by the coverage of all its fibers, 1 − exp(−Σ τ).
+// Two entry points, one per view transparency (view_visibility.rs):
+//   fs_env_deferred:    a full-screen pass over the nearest fiber of each pixel, which the depth
+//                       prepass left in two textures (position, tangent); its radiance stands
+//                       for the pixel's, weighted by the coverage of all its fibers,
+//                       1 − exp(−Σ τ). No strand is rasterized again per batch of lights.
 //   fs_env_transparent: every fragment is weighted by coverage × its visibility through the
 //                       fragments in front (the occupancy map) and added; fragments that can no
 //                       longer contribute stop before any light is evaluated (early termination).
@@ -61,6 +62,10 @@ struct ViewParams {
 @group(3) @binding(2) var<storage, read_write> occupancy_map: array<atomic<u32>>;
 // Red: the optical depth Σ −ln(1 − α) of all the pixel's fragments (opaque view).
 @group(3) @binding(3) var coverage: texture_2d<f32>;
+// The nearest fiber of each pixel (opaque view, fs_nearest_surface): xyz its world position,
+// w 1 where the pixel holds hair; and its (unnormalized) tangent.
+@group(3) @binding(4) var nearest_position: texture_2d<f32>;
+@group(3) @binding(5) var nearest_tangent: texture_2d<f32>;
 
 struct TableCell {
     lower: u32,
@@ -182,20 +187,20 @@ struct EnvOut {
     @location(1) multiple: vec4<f32>,
 };
 
-// Single and multiple scattering of one fragment under the batch's lights, times `weight`
-// (pre-multiplied; the weight is also the alpha written).
-fn shade(in: VertexOut, weight: f32) -> EnvOut {
-    let t = normalize(in.tangent);
+// Single and multiple scattering of the fiber at `world` along `tangent` under the batch's lights,
+// times `weight` (pre-multiplied; the weight is also the alpha written).
+fn shade(world: vec3<f32>, tangent: vec3<f32>, weight: f32) -> EnvOut {
+    let t = normalize(tangent);
     var e = frame.toward_eye.xyz;
-    if (frame.eye.w > 0.5) { e = normalize(frame.eye.xyz - in.world); }
+    if (frame.eye.w > 0.5) { e = normalize(frame.eye.xyz - world); }
     var single = vec3<f32>(0.0);
     var multiple = vec3<f32>(0.0);
     let with_grid = (batch.flags & FLAG_GRID) != 0u;
     for (var slot = 0u; slot < batch.light_count; slot++) {
         let light = env_lights[slot];
-        let visible = effective_transmittance(slot, in.world, t, e);
+        let visible = effective_transmittance(slot, world, t, e);
         var g = vec4<f32>(0.0);
-        if (with_grid) { g = forward_scattering(slot, in.world); }
+        if (with_grid) { g = forward_scattering(slot, world); }
         for (var s = light.first_sample; s < light.first_sample + light.sample_count; s++) {
             let sample = shading_samples[s];
             let f = fiber_frame(t, sample.direction.xyz, e);
@@ -213,16 +218,25 @@ fn shade(in: VertexOut, weight: f32) -> EnvOut {
     return out;
 }
 
-// No side effects here: the depth test may then run before the shader.
+// One triangle covering the viewport.
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) vertex: u32) -> @builtin(position) vec4<f32> {
+    let uv = vec2<f32>(f32((vertex << 1u) & 2u), f32(vertex & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+
 @fragment
-fn fs_env_opaque(in: VertexOut) -> EnvOut {
-    let tau = textureLoad(coverage, vec2<i32>(in.clip.xy), 0).r;
-    return shade(in, 1.0 - exp(-tau));
+fn fs_env_deferred(@builtin(position) pixel: vec4<f32>) -> EnvOut {
+    let p = vec2<i32>(pixel.xy);
+    let nearest = textureLoad(nearest_position, p, 0);
+    if (nearest.w == 0.0) { discard; }
+    let tau = textureLoad(coverage, p, 0).r;
+    return shade(nearest.xyz, textureLoad(nearest_tangent, p, 0).xyz, 1.0 - exp(-tau));
 }
 
 @fragment
 fn fs_env_transparent(in: VertexOut) -> EnvOut {
     let seen = occupancy_visibility(in);
     if (seen < view.visibility_cutoff) { discard; }
-    return shade(in, in.alpha * seen);
+    return shade(in.world, in.tangent, in.alpha * seen);
 }

@@ -20,7 +20,7 @@ fn srbf_quantile(q: f32, inv_lambda: f32) -> f32 {
 // (world units behind the map's near plane; the column's front z0 from its nearest depth).
 fn column_optical_depth(slot: u32, texel: vec2<i32>, z: f32, near_offset: f32, far_offset: f32) -> f32 {
     let light = env_lights[slot];
-    let z0 = textureLoad(dodm_depth, texel, i32(slot), 0) * (light.far - light.near);
+    let z0 = textureLoad(dodm_depth, texel, i32(slot), 0).r * (light.far - light.near);
     if (z0 >= z - near_offset) { return 0.0; }
     var l = box_mean(slot, texel, 0);
     if ((batch.flags & FLAG_SAT_TRANSMITTANCE) != 0u) {

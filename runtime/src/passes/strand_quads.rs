@@ -13,7 +13,15 @@ use crate::lights::{GpuLight, Light};
 /// Group 0 of every pass that draws strand quads (`strand_quads.wgsl`): frame uniform, points,
 /// segments, point attributes, lights.
 pub fn strand_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
+    strand_bind_group_layout_for(device, wgpu::ShaderStages::VERTEX_FRAGMENT)
+}
+
+/// [`strand_bind_group_layout`] for the shader `stages` that read it (a compute pass that
+/// rasterizes the quads itself: the light pass).
+pub fn strand_bind_group_layout_for(
+    device: &wgpu::Device,
+    stages: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayout {
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("strands"),
         entries: &[

@@ -1,7 +1,10 @@
 // Strands as camera-facing quads expanded from segments (wgpu lines are one pixel wide): the
 // vertex stage shared by the passes that draw strands (prepended to their fragment shaders).
 //
-// One instance per segment, six vertices (two triangles) per instance. A quad is
+// Six vertices (two triangles) per segment, drawn either as one instance per segment
+// (`draw(0..6, segments)`) or as one instance of six vertices per segment (`draw(6·first ..
+// 6·end, 0..1)`: on lavapipe, whose vertex stage runs each instance on its own, 15% faster for
+// the whole hair). A quad is
 // max(width, 1) pixels wide; a fiber thinner than a pixel keeps the one-pixel quad and carries
 // its coverage width/1px in alpha (Svoboda §1.2.3), so the alpha summed across the strand equals
 // its width in pixels.
@@ -53,8 +56,9 @@ struct Light {
 @group(0) @binding(4) var<storage, read> lights: array<Light>;
 
 struct VertexOut {
-    // Invariant: the env view's depth prepass and its Equal-depth shading pass are different
-    // pipelines over this vertex stage and must produce bit-identical depths.
+    // Invariant: the env view's depth prepass and the fragment count's Equal-depth pass
+    // (view_visibility.rs) are different pipelines over this vertex stage and must produce
+    // bit-identical depths.
     @builtin(position) @invariant clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) tangent: vec3<f32>,
@@ -74,9 +78,21 @@ fn corner(k: u32) -> vec2<f32> {
     return vec2<f32>(ends[k], sides[k]);
 }
 
-// Corner `vertex` of segment `segment`'s quad: the body of every strand vertex entry point (the
-// sorted pass draws segments in another order than their instance index).
-fn strand_vertex(vertex: u32, segment: u32) -> VertexOut {
+// A segment as every pass sees it: its end points, their tangents and clip positions, and the
+// screen-space normal its quad is widened along.
+struct SegmentFrame {
+    index: u32,
+    p0: vec3<f32>,
+    p1: vec3<f32>,
+    t0: vec3<f32>,
+    t1: vec3<f32>,
+    clip0: vec4<f32>,
+    clip1: vec4<f32>,
+    // Unit perpendicular of the segment on screen (isotropic pixels).
+    normal: vec2<f32>,
+};
+
+fn segment_frame(segment: u32) -> SegmentFrame {
     let packed = segments[segment];
     let i0 = packed & 0x3fffffffu;
     let is_first = (packed & 0x40000000u) != 0u;
@@ -89,11 +105,6 @@ fn strand_vertex(vertex: u32, segment: u32) -> VertexOut {
     if (!is_first) { before = point(i0 - 1u); }
     var after = p1;
     if (!is_last) { after = point(i0 + 2u); }
-    let t0 = normalize(p1 - before);
-    let t1 = normalize(after - p0);
-
-    let c = corner(vertex);
-    let at_end = c.x > 0.5;
     let clip0 = frame.view_proj * vec4<f32>(p0, 1.0);
     let clip1 = frame.view_proj * vec4<f32>(p1, 1.0);
     // Screen direction in pixels (isotropic), and its perpendicular.
@@ -103,17 +114,23 @@ fn strand_vertex(vertex: u32, segment: u32) -> VertexOut {
     var d = s1 - s0;
     if (dot(d, d) < 1e-12) { d = vec2<f32>(1.0, 0.0); }
     d = normalize(d);
-    let normal = vec2<f32>(-d.y, d.x);
+    return SegmentFrame(
+        i0, p0, p1, normalize(p1 - before), normalize(after - p0), clip0, clip1,
+        vec2<f32>(-d.y, d.x),
+    );
+}
 
-    var index = i0;
-    var clip = clip0;
-    var world = p0;
-    var tangent = t0;
+// Corner (end `at_end`, side `side` = ±1) of the quad of segment `f`.
+fn quad_corner_of(f: SegmentFrame, at_end: bool, side: f32) -> VertexOut {
+    var index = f.index;
+    var clip = f.clip0;
+    var world = f.p0;
+    var tangent = f.t0;
     if (at_end) {
-        index = i0 + 1u;
-        clip = clip1;
-        world = p1;
-        tangent = t1;
+        index = f.index + 1u;
+        clip = f.clip1;
+        world = f.p1;
+        tangent = f.t1;
     }
     let attr = attributes[index];
     var width_px = attr.thickness * frame.focal_px / clip.w;
@@ -130,7 +147,8 @@ fn strand_vertex(vertex: u32, segment: u32) -> VertexOut {
         alpha = 1.0 - exp(-tau * quad_px / scaled_quad_px);
         quad_px = scaled_quad_px;
     }
-    let offset_px = normal * (c.y * 0.5 * quad_px);
+    let half_viewport = 0.5 * frame.viewport;
+    let offset_px = f.normal * (side * 0.5 * quad_px);
     clip = vec4<f32>(clip.xy + offset_px / half_viewport * clip.w, clip.zw);
 
     var out: VertexOut;
@@ -142,7 +160,14 @@ fn strand_vertex(vertex: u32, segment: u32) -> VertexOut {
     return out;
 }
 
+// Corner `vertex` of segment `segment`'s quad: the body of every strand vertex entry point (the
+// sorted pass draws segments in another order than their instance index).
+fn strand_vertex(vertex: u32, segment: u32) -> VertexOut {
+    let c = corner(vertex);
+    return quad_corner_of(segment_frame(segment), c.x > 0.5, c.y);
+}
+
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment: u32) -> VertexOut {
-    return strand_vertex(vertex, segment);
+    return strand_vertex(vertex % 6u, segment + vertex / 6u);
 }

@@ -1,9 +1,11 @@
 //! What the env view pass sees of each pixel's fibers (Ren 2010 §8, "Transparency"): built once
 //! per frame, before the light batches, and read by every batch's view pass, so that the costly
 //! per-fragment loop over lights runs only for fragments that reach the image.
-//! * [`ViewTransparency::Opaque`]: a depth prepass and a coverage pass (Σ −ln(1 − α) of each
-//!   pixel's fragments); the view pass then shades only the fragments at each pixel's nearest
-//!   depth (depth test Equal) and weights the nearest fiber's radiance by the coverage of all.
+//! * [`ViewTransparency::Opaque`]: a depth prepass that leaves each pixel's nearest fiber
+//!   (position and tangent) in two textures, and a coverage pass (Σ −ln(1 − α) of each pixel's
+//!   fragments); each batch's view pass then shades those fibers in one full-screen pass,
+//!   weighting the nearest fiber's radiance by the coverage of all. The strands are rasterized
+//!   twice per frame, not once per batch.
 //! * [`ViewTransparency::Occupancy`]: the occupancy and slab maps of Sintorn & Assarsson 2009
 //!   (`occupancy_map.wgsl`, `view_visibility.wgsl`): two passes record each pixel's depth range,
 //!   which of its 128 depth slices hold fragments and the optical depth per slab of 32 slices;
@@ -12,9 +14,11 @@
 //!   the cutoff (the paper's early opacity culling).
 //!
 //! Inputs: the strands' bind group and the view group (group 3, holding the [`OccupancyMap`]).
-//! Outputs: the view's depth and coverage textures (opaque) or the occupancy map (occupancy).
+//! Outputs: the view's depth, nearest-fiber and coverage textures (opaque) or the occupancy map
+//! (occupancy).
 
 use super::attachments::{cleared_color, cleared_depth, prepassed_depth};
+use super::env_view::NEAREST_SURFACE_FORMAT;
 use super::render_target::{DEPTH_FORMAT, RenderTarget};
 use crate::gpu::GpuContext;
 use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels};
@@ -157,7 +161,14 @@ impl ViewVisibilityPass {
             }),
             write_mask: wgpu::ColorWrites::ALL,
         })];
-        // A fragment entry point writes the additive float target; `depth`: the depth test and
+        // Replaced, not blended: with the depth test Less the last write is the nearest.
+        let nearest_target = Some(wgpu::ColorTargetState {
+            format: NEAREST_SURFACE_FORMAT,
+            blend: None,
+            write_mask: wgpu::ColorWrites::ALL,
+        });
+        let nearest_targets = [nearest_target.clone(), nearest_target];
+        // A fragment entry point writes the additive float target (or the nearest surface); `depth`: the depth test and
         // whether it writes, None without a depth attachment.
         let pipeline = |label: &str,
                         layout: &wgpu::PipelineLayout,
@@ -165,6 +176,7 @@ impl ViewVisibilityPass {
                         depth: Option<(wgpu::CompareFunction, bool)>| {
             let targets: &[Option<wgpu::ColorTargetState>] = match fragment {
                 Some(f) if f.starts_with("fs_count") || f == "fs_coverage" => &float_target,
+                Some("fs_nearest_surface") => &nearest_targets,
                 _ => &[],
             };
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -203,7 +215,12 @@ impl ViewVisibilityPass {
         let reading =
             |label, entry, compare| pipeline(label, layout, Some(entry), Some((compare, false)));
         Self {
-            depth_prepass: pipeline("view depth prepass", strands_only, None, Some((Less, true))),
+            depth_prepass: pipeline(
+                "view depth prepass",
+                strands_only,
+                Some("fs_nearest_surface"),
+                Some((Less, true)),
+            ),
             coverage: pipeline("view coverage", strands_only, Some("fs_coverage"), None),
             range: reading("occupancy depth range", "fs_occupancy_range", Always),
             slices: reading("occupancy slices", "fs_occupancy_slices", Always),
@@ -213,9 +230,10 @@ impl ViewVisibilityPass {
         }
     }
 
-    /// Encodes the frame's build: the depth prepass into `depth` and the coverage into
-    /// `coverage` (opaque, both kept for the view passes), or the occupancy map zeroed and its
-    /// two passes. `view` must bind `map`.
+    /// Encodes the frame's build: the depth prepass into `depth` with each pixel's nearest fiber
+    /// into `nearest` (position, tangent), and the coverage into `coverage` (opaque, all kept
+    /// for the view passes), or the occupancy map zeroed and its two passes. `view` must bind
+    /// `map`.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -226,22 +244,29 @@ impl ViewVisibilityPass {
         view: &wgpu::BindGroup,
         depth: &wgpu::TextureView,
         coverage: &wgpu::TextureView,
+        nearest: [&wgpu::TextureView; 2],
         map: &OccupancyMap,
         segments: u32,
     ) {
-        // (label, colour target, with the depth attachment, pipeline, binds group 3).
+        // (label, colour targets, with the depth attachment, pipeline, binds group 3).
         let passes: Vec<(
             &str,
-            Option<&wgpu::TextureView>,
+            Vec<&wgpu::TextureView>,
             bool,
             &wgpu::RenderPipeline,
             bool,
         )> = match transparency {
             ViewTransparency::Opaque => vec![
-                ("view depth prepass", None, true, &self.depth_prepass, false),
+                (
+                    "view depth prepass",
+                    nearest.to_vec(),
+                    true,
+                    &self.depth_prepass,
+                    false,
+                ),
                 (
                     "view coverage",
-                    Some(coverage),
+                    vec![coverage],
                     false,
                     &self.coverage,
                     false,
@@ -250,16 +275,13 @@ impl ViewVisibilityPass {
             ViewTransparency::Occupancy { .. } => {
                 encoder.clear_buffer(&map.buffer, 0, None);
                 vec![
-                    ("occupancy depth range", None, true, &self.range, true),
-                    ("occupancy slices", None, true, &self.slices, true),
+                    ("occupancy depth range", vec![], true, &self.range, true),
+                    ("occupancy slices", vec![], true, &self.slices, true),
                 ]
             }
         };
-        for (label, color, with_depth, pipeline, bind_view) in passes {
-            let color_attachments = match color {
-                Some(c) => vec![cleared_color(c)],
-                None => vec![],
-            };
+        for (label, colors, with_depth, pipeline, bind_view) in passes {
+            let color_attachments: Vec<_> = colors.into_iter().map(cleared_color).collect();
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(label),
                 color_attachments: &color_attachments,
@@ -277,7 +299,7 @@ impl ViewVisibilityPass {
             if bind_view {
                 pass.set_bind_group(3, view, &[]);
             }
-            pass.draw(0..6, 0..segments);
+            pass.draw(0..6 * segments, 0..1);
         }
     }
 
@@ -315,7 +337,7 @@ impl ViewVisibilityPass {
             pass.set_bind_group(3, view, &[]);
             for pipeline in [&self.count_rasterized, shaded] {
                 pass.set_pipeline(pipeline);
-                pass.draw(0..6, 0..segments);
+                pass.draw(0..6 * segments, 0..1);
             }
         }
         gpu.queue.submit([encoder.finish()]);

@@ -9,6 +9,18 @@ fn fs_coverage(in: VertexOut) -> @location(0) vec4<f32> {
     return vec4<f32>(-log(max(1.0 - in.alpha, 1e-6)), 0.0, 0.0, 0.0);
 }
 
+// Opaque view, the depth prepass: the nearest fragment of each pixel (depth test Less, so the
+// last write is the nearest) leaves its position and tangent for the deferred view pass.
+struct NearestSurface {
+    @location(0) position: vec4<f32>,
+    @location(1) tangent: vec4<f32>,
+};
+
+@fragment
+fn fs_nearest_surface(in: VertexOut) -> NearestSurface {
+    return NearestSurface(vec4<f32>(in.world, 1.0), vec4<f32>(in.tangent, 0.0));
+}
+
 // Pass 1: the nearest and farthest view depth of each pixel's fragments.
 @fragment
 fn fs_occupancy_range(in: VertexOut) {
