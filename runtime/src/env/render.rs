@@ -646,6 +646,10 @@ fn light_pass_geometry(
     let tolerance = options
         .dodm
         .simplified_chord_tolerance_world(options.kappa, model.bounds());
+    if tolerance == 0.0 {
+        let simplified = SimplifiedSegments::in_order(gpu, model, &order);
+        return Ok((simplified.geometry(geometry, options.kappa), Some(simplified)));
+    }
     let coarse = model.decimated(tolerance, geometry.default_thickness);
     let simplified = SimplifiedSegments::in_order(gpu, &coarse, &order);
     let drawn = StrandGeometry::upload(gpu, &coarse)?;

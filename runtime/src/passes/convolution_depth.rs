@@ -42,8 +42,10 @@ pub struct DodmSettings {
     pub batch_size: u32,
     /// How far, in texels of a κ-simplified map, the strands its light pass draws may stray
     /// from the hair's: points within it of a coarser strand are dropped
-    /// ([`HairModel::decimated`]; default 0.5, 0 draws every point). Full-resolution maps always
-    /// draw every point.
+    /// ([`HairModel::decimated`]; default 0, every point drawn: since the light pass rasterizes
+    /// in compute its cost follows the texels covered, which coarser strands do not reduce, and
+    /// 0.5 measured slower and less accurate on every map, docs/BENCHMARKS.md, "The light pass in
+    /// compute"). Full-resolution maps always draw every point.
     pub simplified_chord_tolerance: f32,
 }
 
@@ -53,7 +55,7 @@ impl Default for DodmSettings {
             resolution: 512,
             first_layer: None,
             batch_size: 16,
-            simplified_chord_tolerance: 0.5,
+            simplified_chord_tolerance: 0.0,
         }
     }
 }
@@ -746,7 +748,10 @@ mod tests {
     #[test]
     fn the_chord_tolerance_is_a_fraction_of_a_simplified_texel_in_the_world() {
         let bounds = Aabb::from_points(&[Vec3::ZERO, Vec3::new(30.0, 40.0, 0.0)]);
-        let settings = DodmSettings::default();
+        let settings = DodmSettings {
+            simplified_chord_tolerance: 0.5,
+            ..DodmSettings::default()
+        };
         // κ 0.25: 256 texels across the light camera's 50-unit span, half of one = 50/512.
         let world = settings.simplified_chord_tolerance_world(0.25, bounds);
         assert!((world - 50.0 / 512.0).abs() < 1e-6, "{world}");
