@@ -107,7 +107,7 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
     let args = regenerate_args(report);
     let _ = writeln!(
         out,
-        "{BEGIN}\n## Speed against error (`strandlight bench{args}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. Regenerate with `cargo run --release -- bench{args}` (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and the opaque view; errors are over the reference's hair pixels (compact sources exact, the rest one light per cube texel; the reference climbs N = 96, 384, … until N and 4N lights agree within 1% relative RMSE, or stops at {} lights: each map below says whether it converged); ms are frame times on this machine's adapter, one run each (lavapipe: ratios only).\n",
+        "{BEGIN}\n## Speed against error (`strandlight bench{args}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. Regenerate with `cargo run --release -- bench{args}` (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and the opaque view; errors are over the reference's hair pixels (compact sources exact, the rest one light per cube texel; the reference climbs N = 96, 384, … until N and 4N lights agree within 1% relative RMSE, or stops at {} lights: each map below says whether it converged); ms are frame times on this machine's adapter, {} (lavapipe: ratios only).\n",
         report.date,
         report.git_revision,
         report.machine,
@@ -116,6 +116,10 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
         plan.size.0,
         plan.size.1,
         plan.reference_max_lights,
+        match plan.timing_runs {
+            1 => "one run each".to_string(),
+            n => format!("the median of {n} runs each (the reference one run)"),
+        },
     );
     if !report.skipped.is_empty() {
         let _ = writeln!(out, "Skipped: {}.\n", report.skipped.join("; "));
