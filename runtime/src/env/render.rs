@@ -648,7 +648,10 @@ fn light_pass_geometry(
         .simplified_chord_tolerance_world(options.kappa, model.bounds());
     if tolerance == 0.0 {
         let simplified = SimplifiedSegments::in_order(gpu, model, &order);
-        return Ok((simplified.geometry(geometry, options.kappa), Some(simplified)));
+        return Ok((
+            simplified.geometry(geometry, options.kappa),
+            Some(simplified),
+        ));
     }
     let coarse = model.decimated(tolerance, geometry.default_thickness);
     let simplified = SimplifiedSegments::in_order(gpu, &coarse, &order);
