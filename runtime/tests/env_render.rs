@@ -1263,6 +1263,29 @@ fn lights_sharing_a_shadow_map_take_its_visibility_and_their_own_shading() {
     }
 }
 
+/// One `res`² light map of every strand of `model`, its light toward +z, encoded into `encoder`.
+fn light_map_toward_z(
+    gpu: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    model: &HairModel,
+    res: u32,
+    first_layer: f32,
+) -> DodmBatch {
+    let geometry = StrandGeometry::upload(gpu, model).unwrap();
+    let mut batch = DodmBatch::new(gpu, res, 1, first_layer);
+    ConvolutionDepthPass::new(gpu).encode(
+        gpu,
+        encoder,
+        &geometry,
+        &[Vec3::Z],
+        model.bounds(),
+        1.0,
+        1.0,
+        &mut batch,
+    );
+    batch
+}
+
 /// Layer 0 of a batch's nearest-depth map, row-major from the top.
 fn read_nearest_depth(gpu: &GpuContext, batch: &DodmBatch) -> Vec<f32> {
     let res = batch.resolution;
@@ -1422,21 +1445,10 @@ fn empty_texel_points_read_the_box_around_them() {
     let thickness = 0.2 / PER_UNIT;
     let lambda = 32.0f32;
     let model = slab(rows, thickness as f32);
-    let geometry = StrandGeometry::upload(&gpu, &model).unwrap();
     let res = RES;
-    let mut batch = DodmBatch::new(&gpu, res, 1, 0.045);
     let sat = SummedAreaTables::new(&gpu, res, 1).unwrap();
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    ConvolutionDepthPass::new(&gpu).encode(
-        &gpu,
-        &mut encoder,
-        &geometry,
-        &[Vec3::Z],
-        model.bounds(),
-        1.0,
-        1.0,
-        &mut batch,
-    );
+    let batch = light_map_toward_z(&gpu, &mut encoder, &model, res, 0.045);
     SummedAreaPass::new(&gpu).encode(&gpu, &mut encoder, &batch.optical_depth, &sat);
     gpu.queue.submit([encoder.finish()]);
     let depth = read_nearest_depth(&gpu, &batch);
@@ -1868,19 +1880,8 @@ fn the_light_pass_covers_each_fiber_with_its_optical_depth() {
     };
     let width = Attribute::Uniform(0.5 / texels_per_unit);
     let model = HairModel::new(points, offsets, Some(width), None, None).unwrap();
-    let geometry = StrandGeometry::upload(&gpu, &model).unwrap();
-    let mut batch = DodmBatch::new(&gpu, res, 1, first_layer);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    ConvolutionDepthPass::new(&gpu).encode(
-        &gpu,
-        &mut encoder,
-        &geometry,
-        &[Vec3::Z],
-        model.bounds(),
-        1.0,
-        1.0,
-        &mut batch,
-    );
+    let batch = light_map_toward_z(&gpu, &mut encoder, &model, res, first_layer);
     gpu.queue.submit([encoder.finish()]);
     let nearest = read_nearest_depth(&gpu, &batch);
     let optical = read_texture_rgba(&gpu, &batch.optical_depth).unwrap();
