@@ -1,6 +1,6 @@
 // Deep opacity depth map (DODM) of Ren 2010 §5 (eq. 10), appended to strand_quads.wgsl: one
 // light's orthographic map, rasterized in compute. Each invocation takes one segment's quad
-// (the two triangles `strand_vertex` gives every pass that draws strands) and visits the texel
+// (the two triangles `quad_corner_of` gives every pass that draws strands) and visits the texel
 // centres it covers, interpolating depth and alpha in the covering triangle as the fixed-function
 // rasterizer does. Texel quads are a few texels in size: a hardware rasterizer is fast at them,
 // lavapipe's spends ~1 µs per triangle, which made this pass most of an env-lit frame on a CPU.
@@ -10,11 +10,11 @@
 // 2. splat_layers: CUMULATIVE optical depths l(z_k) from z0 to the layer boundaries
 //    z_k = k(k+1)d/2 (k = 1, 2, 3) behind z0, the fourth channel everything (z_4 = ∞): a
 //    fragment at relative depth δ counts towards every boundary with z_k > δ. It adds its τ
-//    to its own layer only, one atomic, and the resolve sums the layers front to back. τ = −ln(1 − α) per
-//    fragment as in deep_opacity.wgsl, scaled by 1/κ when only a κ fraction of the strands is
-//    drawn (stochastic simplification, §7; the vertex stage has then also widened the fibers by
-//    1/κ, spreading each one's optical depth, so the map keeps the coverage of those left out).
-//    WGSL has no float atomics: the depths are summed in fixed point.
+//    to its own layer only, one atomic, and the resolve sums the layers front to back.
+//    τ = −ln(1 − α) per fragment as in deep_opacity.wgsl, scaled by 1/κ when only a κ fraction
+//    of the strands is drawn (stochastic simplification, §7; the quads are then also widened by
+//    1/κ, spreading each fiber's optical depth, so the map keeps the coverage of those left
+//    out). WGSL has no float atomics: the depths are summed in fixed point.
 // 3. resolve: the scratch into the slot's layer of the two textures the view pass and the
 //    summed-area tables read, zeroing the scratch for the next light.
 
