@@ -97,7 +97,10 @@ impl BenchPlan {
         Self {
             name: "full".into(),
             maps: ALL_MAPS.iter().map(|m| m.to_string()).collect(),
-            size: (320, 240),
+            // Every env-lit figure in docs/BENCHMARKS.md is at this size: on lavapipe on two
+            // cores a 1536-light single-scattering reference takes 3-4 min at it, four times
+            // that at 320×240, and the whole plan would not fit a working day.
+            size: (160, 120),
             modes: vec![ScatteringMode::Single, ScatteringMode::Full],
             fit_lobes: vec![8, 16, 32, 49, 64],
             table_nodes: vec![8, 16, 24, 32],
@@ -297,28 +300,39 @@ pub struct BenchReport {
     pub env_lit: Vec<EnvLitResult>,
     /// Maps the plan named that were not found, with why.
     pub skipped: Vec<String>,
+    /// Where this report merges several runs ([`BenchReport::merged`]): each run's `bench`
+    /// arguments, to say how to measure it again. Empty for one run.
+    #[serde(default)]
+    pub runs: Vec<String>,
 }
 
 impl BenchReport {
-    /// One report of runs that measured the same plan on different maps (a long sweep split
-    /// into one run per map): maps, fits and env-lit results in the order given, the first
-    /// run's table sweep, the runs' dates and revisions named, their seconds summed.
+    /// One report of runs that measured the same plan on different maps or modes, each with
+    /// the reference budget its maps need (a long sweep split into runs: a cached 6144-light
+    /// reference for one map, 1536 for the rest). Maps, modes, fits and env-lit results in the
+    /// order given (a map's fit sweep from its first run), the first run's table sweep, the
+    /// largest reference budget, the runs' dates, revisions and arguments named, their seconds
+    /// summed.
     pub fn merged(reports: Vec<BenchReport>) -> anyhow::Result<BenchReport> {
         let mut reports = reports.into_iter();
         let mut merged = reports.next().context("no report to merge")?;
         // Dates are "YYYY-MM-DD HH:MM UTC": their order as text is their order in time.
         let (mut first_date, mut last_date) = (merged.date.clone(), merged.date.clone());
         let mut revisions = vec![merged.git_revision.clone()];
-        let plan_without_maps = |p: &BenchPlan| BenchPlan {
+        merged.runs = vec![crate::bench_report::regenerate_args(&merged)];
+        // What a run may change of the plan it shares with the others.
+        let shared_part = |p: &BenchPlan| BenchPlan {
             maps: Vec::new(),
+            modes: Vec::new(),
+            reference_max_lights: 0,
             ..p.clone()
         };
         for report in reports {
-            if plan_without_maps(&report.plan) != plan_without_maps(&merged.plan) {
+            if shared_part(&report.plan) != shared_part(&merged.plan) {
                 anyhow::bail!(
-                    "the reports measured different plans (apart from the maps): {:?} and {:?}",
-                    plan_without_maps(&merged.plan),
-                    plan_without_maps(&report.plan)
+                    "the reports measured different plans (apart from maps, modes and reference budget): {:?} and {:?}",
+                    shared_part(&merged.plan),
+                    shared_part(&report.plan)
                 );
             }
             if (&report.machine, &report.adapter) != (&merged.machine, &merged.adapter) {
@@ -330,16 +344,42 @@ impl BenchReport {
                     report.adapter
                 );
             }
-            if let Some(map) = report
-                .plan
-                .maps
-                .iter()
-                .find(|m| merged.plan.maps.contains(m))
-            {
-                anyhow::bail!("{map} is in more than one report");
+            if let Some(r) = report.env_lit.iter().find(|r| {
+                merged
+                    .env_lit
+                    .iter()
+                    .any(|m| (&m.map, &m.mode) == (&r.map, &r.mode))
+            }) {
+                anyhow::bail!(
+                    "{} ({} scattering) is in more than one report",
+                    r.map,
+                    r.mode
+                );
             }
-            merged.plan.maps.extend(report.plan.maps);
-            merged.fits.extend(report.fits);
+            merged
+                .runs
+                .push(crate::bench_report::regenerate_args(&report));
+            let had_fits = |map: &String| merged.fits.iter().any(|f| &f.map == map);
+            let new_fits: Vec<FitPoint> = report
+                .fits
+                .into_iter()
+                .filter(|f| !had_fits(&f.map))
+                .collect();
+            merged.fits.extend(new_fits);
+            for map in report.plan.maps {
+                if !merged.plan.maps.contains(&map) {
+                    merged.plan.maps.push(map);
+                }
+            }
+            for mode in report.plan.modes {
+                if !merged.plan.modes.contains(&mode) {
+                    merged.plan.modes.push(mode);
+                }
+            }
+            merged.plan.reference_max_lights = merged
+                .plan
+                .reference_max_lights
+                .max(report.plan.reference_max_lights);
             merged.env_lit.extend(report.env_lit);
             merged.skipped.extend(report.skipped);
             merged.seconds += report.seconds;
@@ -348,6 +388,9 @@ impl BenchReport {
             }
             first_date = first_date.min(report.date.clone());
             last_date = last_date.max(report.date);
+        }
+        if merged.runs.len() == 1 {
+            merged.runs.clear();
         }
         if last_date != first_date {
             merged.date = format!("{first_date} to {last_date}");
@@ -747,6 +790,7 @@ pub fn run(plan: &BenchPlan, paths: &BenchPaths, steps: &mut Steps) -> anyhow::R
         tables: tables(plan, &paths.scratch, steps)?,
         env_lit: Vec::new(),
         skipped: Vec::new(),
+        runs: Vec::new(),
     };
     for map in &plan.maps {
         let path = paths.data.join("envmaps").join(map);
@@ -805,17 +849,53 @@ mod tests {
         let mut plan = BenchPlan::quick();
         plan.maps = vec![map.into()];
         BenchReport {
+            env_lit: vec![result(map, "single")],
+            fits: vec![fit(map, 8)],
             plan,
             machine: "m".into(),
             adapter: "a".into(),
             date: date.into(),
             git_revision: revision.into(),
             seconds: 10.0,
-            fits: Vec::new(),
             tables: Vec::new(),
-            env_lit: Vec::new(),
             skipped: Vec::new(),
+            runs: Vec::new(),
         }
+    }
+
+    fn result(map: &str, mode: &str) -> EnvLitResult {
+        EnvLitResult {
+            map: map.into(),
+            mode: mode.into(),
+            reference_lights: 96,
+            reference_ms: 1.0,
+            reference_converged: Some(true),
+            reference_ladder: Vec::new(),
+            points: Vec::new(),
+            speedup_equal_rmse: None,
+            speedup_equal_flip: None,
+        }
+    }
+
+    fn fit(map: &str, max_lobes: usize) -> FitPoint {
+        FitPoint {
+            map: map.into(),
+            max_lobes,
+            lobes: max_lobes,
+            sources: 0,
+            relative_l2_error: 0.1,
+            seconds: 1.0,
+        }
+    }
+
+    /// The same map measured in full scattering by a run with its own reference budget.
+    fn full_scattering_run(map: &str, reference_max_lights: usize) -> BenchReport {
+        let mut run = report(map, "d4", "r3");
+        run.plan.modes = vec![ScatteringMode::Full];
+        run.plan.reference_max_lights = reference_max_lights;
+        run.env_lit = vec![result(map, "full")];
+        run.fits = vec![fit(map, 8), fit(map, 32)];
+        run
     }
 
     #[test]
@@ -830,12 +910,39 @@ mod tests {
         assert_eq!(merged.date, "d1 to d3");
         assert_eq!(merged.git_revision, "r1, r2");
         assert_eq!(merged.seconds, 30.0);
+        assert_eq!(merged.runs.len(), 3);
+        assert!(
+            merged
+                .runs
+                .iter()
+                .all(|r| r.starts_with(" --quick --maps "))
+        );
     }
 
     #[test]
-    fn reports_of_different_plans_machines_or_the_same_map_do_not_merge() {
+    fn a_run_of_another_mode_and_reference_budget_joins_its_map() {
+        let merged = BenchReport::merged(vec![
+            report("a.hdr", "d1", "r1"),
+            full_scattering_run("a.hdr", 6144),
+        ])
+        .unwrap();
+        assert_eq!(merged.plan.maps, ["a.hdr"]);
+        assert_eq!(
+            merged.plan.modes,
+            [ScatteringMode::Single, ScatteringMode::Full]
+        );
+        assert_eq!(merged.plan.reference_max_lights, 6144);
+        let modes: Vec<&str> = merged.env_lit.iter().map(|r| r.mode.as_str()).collect();
+        assert_eq!(modes, ["single", "full"]);
+        // The map's fit sweep once, from its first run.
+        assert_eq!(merged.fits.len(), 1);
+        assert!(merged.runs[1].contains("--modes full --reference-max-lights 6144"));
+    }
+
+    #[test]
+    fn reports_of_different_plans_machines_or_the_same_map_and_mode_do_not_merge() {
         let mut other_plan = report("b.hdr", "d", "r");
-        other_plan.plan.reference_max_lights = 1536;
+        other_plan.plan.size = (320, 240);
         let mut other_machine = report("b.hdr", "d", "r");
         other_machine.adapter = "b".into();
         for (second, says) in [

@@ -75,7 +75,7 @@ fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str, baseline: &str
 
 /// The command line that reruns `report`'s plan: the plan's name and each flag whose value the
 /// run changed from that plan's.
-fn regenerate_args(report: &BenchReport) -> String {
+pub(crate) fn regenerate_args(report: &BenchReport) -> String {
     let plan = &report.plan;
     let base = plan.base();
     let list = |v: &[usize]| v.iter().map(usize::to_string).collect::<Vec<_>>().join(",");
@@ -105,9 +105,33 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
     let mut out = String::new();
     let plan = &report.plan;
     let args = regenerate_args(report);
+    let regenerate = match report.runs.is_empty() {
+        true => format!("Regenerate with `cargo run --release -- bench{args}`"),
+        false => format!(
+            "Measured in {} runs, {}, merged into this page by `bench --from-report {plot_dir}/runs/*.json`",
+            report.runs.len(),
+            report
+                .runs
+                .iter()
+                .map(|run| format!("`bench{run}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
+    let heading_args = match report.runs.is_empty() {
+        true => args.as_str(),
+        false => "",
+    };
+    let budget = match report.runs.is_empty() {
+        true => format!("or stops at {} lights", plan.reference_max_lights),
+        false => format!(
+            "or stops at its run's budget (at most {} lights)",
+            plan.reference_max_lights
+        ),
+    };
     let _ = writeln!(
         out,
-        "{BEGIN}\n## Speed against error (`strandlight bench{args}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. Regenerate with `cargo run --release -- bench{args}` (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and the opaque view; errors are over the reference's hair pixels (compact sources exact, the rest one light per cube texel; the reference climbs N = 96, 384, … until N and 4N lights agree within 1% relative RMSE, or stops at {} lights: each map below says whether it converged); ms are frame times on this machine's adapter, {} (lavapipe: ratios only).\n",
+        "{BEGIN}\n## Speed against error (`strandlight bench{heading_args}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and the opaque view; errors are over the reference's hair pixels (compact sources exact, the rest one light per cube texel; the reference climbs N = 96, 384, … until N and 4N lights agree within 1% relative RMSE, {budget}: each map below says whether it converged); ms are frame times on this machine's adapter, {} (lavapipe: ratios only).\n",
         report.date,
         report.git_revision,
         report.machine,
@@ -115,7 +139,6 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
         report.seconds,
         plan.size.0,
         plan.size.1,
-        plan.reference_max_lights,
         match plan.timing_runs {
             1 => "one run each".to_string(),
             n => format!("the median of {n} runs each (the reference one run)"),
@@ -210,6 +233,7 @@ mod tests {
             tables: Vec::new(),
             env_lit: Vec::new(),
             skipped: Vec::new(),
+            runs: Vec::new(),
         }
     }
 
@@ -249,6 +273,22 @@ mod tests {
         );
         let page = section(&report_of(every_map), "bench");
         assert!(page.contains(&format!("`cargo run --release -- bench{args}`")));
+    }
+
+    #[test]
+    fn a_merged_page_names_every_run_instead_of_one_command() {
+        let mut merged = report_of(BenchPlan::full());
+        merged.runs = vec![
+            " --modes single".into(),
+            " --maps quarry_01_1k.hdr --modes single --reference-max-lights 6144".into(),
+        ];
+        let page = section(&merged, "bench");
+        assert!(page.contains("Measured in 2 runs, `bench --modes single`, `bench --maps quarry_01_1k.hdr --modes single --reference-max-lights 6144`"), "{page}");
+        assert!(
+            page.contains("`bench --from-report bench/runs/*.json`"),
+            "{page}"
+        );
+        assert!(!page.contains("Regenerate with"), "{page}");
     }
 
     #[test]
