@@ -54,7 +54,8 @@ pub struct BenchArgs {
     pub cache: PathBuf,
     /// Measure nothing: write the plots and the page again from report JSONs earlier runs
     /// wrote (after a change to how they are drawn, without the hour of measuring). Several
-    /// reports of the same plan on different maps (a sweep run map by map) make one page.
+    /// reports of the same plan on different maps or modes (a sweep run map by map, each with
+    /// the reference budget its map needs) make one page.
     #[arg(long, value_name = "REPORT_JSON", num_args = 1.., conflicts_with_all = ["quick", "maps", "data", "modes", "reference_max_lights", "baseline_lights", "baseline"])]
     pub from_report: Vec<PathBuf>,
 }

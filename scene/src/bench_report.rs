@@ -32,6 +32,66 @@ fn ladder_rungs(r: &EnvLitResult) -> Vec<String> {
         .collect()
 }
 
+/// The goals every map's SRBF default is held to: relative RMSE against the converged reference
+/// per scattering mode, and the speed-up over the reference and over the baseline at equal error.
+const SINGLE_ERROR_GOAL: f64 = 0.05;
+const FULL_ERROR_GOAL: f64 = 0.08;
+const SPEEDUP_GOAL: f64 = 10.0;
+
+fn mark(met: bool) -> &'static str {
+    if met { " ✓" } else { "" }
+}
+
+/// An equal-error speed-up's cell and whether it meets the goal; where the baseline never got as
+/// accurate, its lower bound ("> x", met when even the bound is).
+fn speedup_goal_cell(s: Option<f64>, r: &EnvLitResult) -> String {
+    match (s, r.speedup_lower_bound()) {
+        (Some(s), _) => format!("{s:.1}×{}", mark(s >= SPEEDUP_GOAL)),
+        (None, Some((_, bound))) => format!("> {bound:.1}×{}", mark(bound >= SPEEDUP_GOAL)),
+        (None, None) => "–".into(),
+    }
+}
+
+/// One row per map and mode: the SRBF default against the goals, so where each map stands is
+/// read before its sweep.
+fn goals_table(out: &mut String, report: &BenchReport) {
+    let _ = writeln!(
+        out,
+        "### Where each map stands\n\nThe SRBF default against the goals: relative RMSE ≤ {SINGLE_ERROR_GOAL} (single scattering) or ≤ {FULL_ERROR_GOAL} (full) against the converged reference, at ≥ {SPEEDUP_GOAL}× the reference's speed and ≥ {SPEEDUP_GOAL}× {}'s at equal error; ✓ marks a goal met. Against a reference that did not converge the error is an estimate, off by up to its last rung.\n\n| map | mode | reference lights | ms | relative RMSE | HDR-FLIP | × reference | × {} at equal rel. RMSE | × at equal HDR-FLIP |\n|---|---|---|---:|---:|---:|---:|---:|---:|",
+        report.plan.baseline.name(),
+        report.plan.baseline.name()
+    );
+    for r in &report.env_lit {
+        let Some(default) = r.points.first() else {
+            continue;
+        };
+        let goal = match r.mode.as_str() {
+            "full" => FULL_ERROR_GOAL,
+            _ => SINGLE_ERROR_GOAL,
+        };
+        let reference = match r.reference_converged {
+            Some(true) => format!("{} (converged)", r.reference_lights),
+            Some(false) => format!("{} (not converged)", r.reference_lights),
+            None => r.reference_lights.to_string(),
+        };
+        let over_reference = r.reference_ms / default.ms;
+        let _ = writeln!(
+            out,
+            "| {} | {} | {reference} | {:.0} | {:.4}{} | {:.4} | {over_reference:.0}×{} | {} | {} |",
+            r.map,
+            r.mode,
+            default.ms,
+            default.relative_rmse,
+            mark(default.relative_rmse <= goal && r.reference_converged == Some(true)),
+            default.hdr_flip,
+            mark(over_reference >= SPEEDUP_GOAL),
+            speedup_goal_cell(r.speedup_equal_rmse, r),
+            speedup_goal_cell(r.speedup_equal_flip, r),
+        );
+    }
+    out.push('\n');
+}
+
 fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str, baseline: &str) {
     let _ = writeln!(
         out,
@@ -108,7 +168,7 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
     let regenerate = match report.runs.is_empty() {
         true => format!("Regenerate with `cargo run --release -- bench{args}`"),
         false => format!(
-            "Measured in {} runs, {}, merged into this page by `bench --from-report {plot_dir}/runs/*.json`",
+            "Measured in {} runs, {}, merged into this page by `bench --from-report` with their reports ([`{plot_dir}/runs/`]({plot_dir}/runs/))",
             report.runs.len(),
             report
                 .runs
@@ -147,6 +207,7 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
     if !report.skipped.is_empty() {
         let _ = writeln!(out, "Skipped: {}.\n", report.skipped.join("; "));
     }
+    goals_table(&mut out, report);
     out.push_str("### SRBF fit: error and time against the lobe count\n\n| map | most lobes | lobes | compact sources | relative L2 error (without sources) | fit s |\n|---|---:|---:|---:|---:|---:|\n");
     for f in &report.fits {
         let _ = writeln!(
@@ -204,7 +265,7 @@ pub fn splice(page: &str, section: &str) -> anyhow::Result<String> {
 mod tests {
     use super::*;
     use crate::baseline::Baseline;
-    use crate::bench::{BenchPlan, PlanChanges};
+    use crate::bench::{BenchPlan, PlanChanges, Point};
     use crate::scene_tables::ScatteringMode;
 
     #[test]
@@ -275,6 +336,55 @@ mod tests {
         assert!(page.contains(&format!("`cargo run --release -- bench{args}`")));
     }
 
+    fn frame(family: &str, ms: f64, relative_rmse: f64) -> Point {
+        Point {
+            family: family.into(),
+            label: String::new(),
+            lights: 64,
+            ms,
+            relative_rmse,
+            hdr_flip: 0.2,
+        }
+    }
+
+    #[test]
+    fn the_goals_table_marks_only_the_goals_met() {
+        let met = EnvLitResult {
+            map: "quarry".into(),
+            mode: "single".into(),
+            reference_lights: 6145,
+            reference_ms: 1000.0,
+            reference_converged: Some(true),
+            reference_ladder: Vec::new(),
+            points: vec![frame("srbf", 10.0, 0.04), frame("median cut", 50.0, 0.3)],
+            speedup_equal_rmse: Some(12.0),
+            speedup_equal_flip: None,
+        };
+        // Below the full-scattering goal, but against a reference that did not converge.
+        let unconverged = EnvLitResult {
+            map: "golf".into(),
+            mode: "full".into(),
+            reference_converged: Some(false),
+            reference_ms: 50.0,
+            speedup_equal_rmse: Some(9.9),
+            ..met.clone()
+        };
+        let mut report = report_of(BenchPlan::full());
+        report.env_lit = vec![met, unconverged];
+        let mut table = String::new();
+        goals_table(&mut table, &report);
+        assert!(
+            table.contains("| quarry | single | 6145 (converged) | 10 | 0.0400 ✓ | 0.2000 | 100× ✓ | 12.0× ✓ | > 5.0× |"),
+            "{table}"
+        );
+        assert!(
+            table.contains(
+                "| golf | full | 6145 (not converged) | 10 | 0.0400 | 0.2000 | 5× | 9.9× | > 5.0× |"
+            ),
+            "{table}"
+        );
+    }
+
     #[test]
     fn a_merged_page_names_every_run_instead_of_one_command() {
         let mut merged = report_of(BenchPlan::full());
@@ -285,7 +395,9 @@ mod tests {
         let page = section(&merged, "bench");
         assert!(page.contains("Measured in 2 runs, `bench --modes single`, `bench --maps quarry_01_1k.hdr --modes single --reference-max-lights 6144`"), "{page}");
         assert!(
-            page.contains("`bench --from-report bench/runs/*.json`"),
+            page.contains(
+                "`bench --from-report` with their reports ([`bench/runs/`](bench/runs/))"
+            ),
             "{page}"
         );
         assert!(!page.contains("Regenerate with"), "{page}");
