@@ -319,7 +319,7 @@ impl BenchReport {
         // Dates are "YYYY-MM-DD HH:MM UTC": their order as text is their order in time.
         let (mut first_date, mut last_date) = (merged.date.clone(), merged.date.clone());
         let mut revisions = vec![merged.git_revision.clone()];
-        merged.runs = vec![crate::bench_report::regenerate_args(&merged)];
+        merged.runs = runs_of(&merged);
         // What a run may change of the plan it shares with the others.
         let shared_part = |p: &BenchPlan| BenchPlan {
             maps: Vec::new(),
@@ -356,9 +356,7 @@ impl BenchReport {
                     r.mode
                 );
             }
-            merged
-                .runs
-                .push(crate::bench_report::regenerate_args(&report));
+            merged.runs.extend(runs_of(&report));
             let had_fits = |map: &String| merged.fits.iter().any(|f| &f.map == map);
             let new_fits: Vec<FitPoint> = report
                 .fits
@@ -397,6 +395,14 @@ impl BenchReport {
         }
         merged.git_revision = revisions.join(", ");
         Ok(merged)
+    }
+}
+
+/// The `bench` arguments of the runs `report` holds: its own, or those it was merged from.
+fn runs_of(report: &BenchReport) -> Vec<String> {
+    match report.runs.is_empty() {
+        true => vec![crate::bench_report::regenerate_args(report)],
+        false => report.runs.clone(),
     }
 }
 
@@ -937,6 +943,9 @@ mod tests {
         // The map's fit sweep once, from its first run.
         assert_eq!(merged.fits.len(), 1);
         assert!(merged.runs[1].contains("--modes full --reference-max-lights 6144"));
+        // Merged again with a third run, the first two runs are still named.
+        let again = BenchReport::merged(vec![merged, report("b.hdr", "d5", "r3")]).unwrap();
+        assert_eq!(again.runs.len(), 3);
     }
 
     #[test]
