@@ -2,6 +2,7 @@
 //! [`BEGIN`] and [`END`], replaced whole on every run; the rest of the page is left alone).
 
 use crate::bench::{BenchReport, EnvLitResult};
+use crate::scene_tables::ScatteringMode;
 use anyhow::bail;
 use std::fmt::Write;
 
@@ -42,8 +43,8 @@ fn mark(met: bool) -> &'static str {
     if met { " ✓" } else { "" }
 }
 
-/// An equal-error speed-up's cell and whether it meets the goal; where the baseline never got as
-/// accurate, its lower bound ("> x", met when even the bound is).
+/// An equal-error speed-up's cell, marked where it meets the goal; where the baseline never got
+/// as accurate, its lower bound ("> x", marked when even the bound meets it).
 fn speedup_goal_cell(s: Option<f64>, r: &EnvLitResult) -> String {
     match (s, r.speedup_lower_bound()) {
         (Some(s), _) => format!("{s:.1}×{}", mark(s >= SPEEDUP_GOAL)),
@@ -65,9 +66,9 @@ fn goals_table(out: &mut String, report: &BenchReport) {
         let Some(default) = r.points.first() else {
             continue;
         };
-        let goal = match r.mode.as_str() {
-            "full" => FULL_ERROR_GOAL,
-            _ => SINGLE_ERROR_GOAL,
+        let goal = match r.mode == ScatteringMode::Full.name() {
+            true => FULL_ERROR_GOAL,
+            false => SINGLE_ERROR_GOAL,
         };
         let reference = match r.reference_converged {
             Some(true) => format!("{} (converged)", r.reference_lights),
@@ -165,28 +166,29 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
     let mut out = String::new();
     let plan = &report.plan;
     let args = regenerate_args(report);
-    let regenerate = match report.runs.is_empty() {
-        true => format!("Regenerate with `cargo run --release -- bench{args}`"),
-        false => format!(
-            "Measured in {} runs, {}, merged into this page by `bench --from-report` with their reports ([`{plot_dir}/runs/`]({plot_dir}/runs/))",
-            report.runs.len(),
-            report
-                .runs
-                .iter()
-                .map(|run| format!("`bench{run}`"))
-                .collect::<Vec<_>>()
-                .join(", ")
+    // One run reruns with its own arguments; a merged page names each run instead.
+    let (heading_args, regenerate, budget) = match report.runs.is_empty() {
+        true => (
+            args.as_str(),
+            format!("Regenerate with `cargo run --release -- bench{args}`"),
+            format!("or stops at {} lights", plan.reference_max_lights),
         ),
-    };
-    let heading_args = match report.runs.is_empty() {
-        true => args.as_str(),
-        false => "",
-    };
-    let budget = match report.runs.is_empty() {
-        true => format!("or stops at {} lights", plan.reference_max_lights),
-        false => format!(
-            "or stops at its run's budget (at most {} lights)",
-            plan.reference_max_lights
+        false => (
+            "",
+            format!(
+                "Measured in {} runs, {}, merged into this page by `bench --from-report` with their reports ([`{plot_dir}/runs/`]({plot_dir}/runs/))",
+                report.runs.len(),
+                report
+                    .runs
+                    .iter()
+                    .map(|run| format!("`bench{run}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+            format!(
+                "or stops at its run's budget (at most {} lights)",
+                plan.reference_max_lights
+            ),
         ),
     };
     let _ = writeln!(
@@ -266,7 +268,6 @@ mod tests {
     use super::*;
     use crate::baseline::Baseline;
     use crate::bench::{BenchPlan, PlanChanges, Point};
-    use crate::scene_tables::ScatteringMode;
 
     #[test]
     fn the_generated_section_is_replaced_and_the_rest_kept() {
