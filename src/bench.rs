@@ -49,6 +49,11 @@ pub struct BenchArgs {
     /// median-cut-sources: the compact sources exactly, median cut over the rest).
     #[arg(long, value_enum)]
     pub baseline: Option<Baseline>,
+    /// Measure only where each map's error comes from (fit, tables, one visibility per lobe,
+    /// κ, multiple scattering), no sweep: minutes per map with the references cached. Its
+    /// report merges (`--from-report`) beside the sweeps' reports of the same maps.
+    #[arg(long)]
+    pub decomposition_only: bool,
     /// Cache folder (fits, tables, reference images), shared with `compare`.
     #[arg(long, default_value = "out/cache")]
     pub cache: PathBuf,
@@ -56,7 +61,7 @@ pub struct BenchArgs {
     /// wrote (after a change to how they are drawn, without the hour of measuring). Several
     /// reports of the same plan on different maps or modes (a sweep run map by map, each with
     /// the reference budget its map needs) make one page.
-    #[arg(long, value_name = "REPORT_JSON", num_args = 1.., conflicts_with_all = ["quick", "maps", "data", "modes", "reference_max_lights", "baseline_lights", "baseline"])]
+    #[arg(long, value_name = "REPORT_JSON", num_args = 1.., conflicts_with_all = ["quick", "maps", "data", "modes", "reference_max_lights", "baseline_lights", "baseline", "decomposition_only"])]
     pub from_report: Vec<PathBuf>,
 }
 
@@ -151,6 +156,7 @@ fn measure(args: &BenchArgs) -> anyhow::Result<Option<BenchReport>> {
         reference_max_lights: args.reference_max_lights,
         baseline_lights: args.baseline_lights.clone(),
         baseline: args.baseline,
+        decomposition_only: args.decomposition_only,
     })?;
     let mut steps = Steps::new(false);
     let paths = BenchPaths {

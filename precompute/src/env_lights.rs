@@ -221,6 +221,52 @@ fn tent_samples(texel: CubeTexel, n: usize, m: usize) -> impl Iterator<Item = (C
     })
 }
 
+/// The brute-force reference of a fitted set's own lighting, `fit` being
+/// [`srbf_set_lights`]'s lights: its compact sources as exact point lights (no softened
+/// shadow: the map's reference takes its sources as points too), then its lobes' radiance,
+/// sampled on a `width × height` equirectangular map, one light per texel of a
+/// `face_resolution` cube ([`cube_face_lights`]).
+///
+/// Why: rendered against the map's reference ([`reference_lights`]) at the same cube, it
+/// measures what the fit alone changes in the image, and the SRBF frame against it what the
+/// convolution tables and the renderer change: `strandlight bench`'s error decomposition.
+pub fn fitted_reference_lights(
+    fit: &[LightSpec],
+    width: usize,
+    height: usize,
+    face_resolution: usize,
+) -> Result<Vec<LightSpec>, CubeLightsError> {
+    let lobes: Vec<(DVec3, f64, [f64; 3])> = fit
+        .iter()
+        .filter_map(|l| {
+            l.lambda
+                .map(|lambda| (l.direction.normalize(), lambda, l.rgb))
+        })
+        .collect();
+    let radiance = EnvMap::from_fn(width, height, |w| {
+        lobes
+            .iter()
+            .fold([0.0; 3], |sum, &(center, lambda, amplitude)| {
+                let g = srbf::kernel(w.dot(center), lambda);
+                std::array::from_fn(|c| sum[c] + amplitude[c] * g)
+            })
+    });
+    let sources = fit
+        .iter()
+        .filter(|l| l.lambda.is_none())
+        .map(|l| LightSpec {
+            shadowed_from: None,
+            angular_variance: 0.0,
+            ..*l
+        });
+    let mut lights: Vec<LightSpec> = sources.collect();
+    lights.extend(directional(
+        cube_face_lights(&radiance, face_resolution)?,
+        0.0,
+    ));
+    Ok(lights)
+}
+
 /// The equal-cost baseline: `count` median-cut directional lights (Debevec 2005).
 pub fn median_cut_lights(map: &EnvMap, count: usize, rotate_degrees: f64) -> Vec<LightSpec> {
     directional(median_cut(map, count.max(1)), rotate_degrees)
@@ -284,6 +330,51 @@ mod tests {
             }
         }
         sum
+    }
+
+    /// The fitted set's reference holds what the set delivers: each lobe's closed-form
+    /// ∫ G dω times its amplitude plus each source's power, the sources kept exactly where
+    /// they are and as points.
+    #[test]
+    fn the_fitted_reference_holds_the_fits_power_and_its_sources_exactly() {
+        let lobe = |d: DVec3, lambda: f64, rgb: [f64; 3]| LightSpec {
+            direction: d.normalize(),
+            lambda: Some(lambda),
+            rgb,
+            shadowed_from: None,
+            angular_variance: 0.0,
+        };
+        let sun = LightSpec {
+            direction: DVec3::new(0.3, 0.8, -0.2).normalize(),
+            lambda: None,
+            rgb: [5.0, 4.0, 3.0],
+            shadowed_from: None,
+            angular_variance: 1e-3,
+        };
+        let fit = [
+            lobe(DVec3::new(0.0, 1.0, 0.0), 3.0, [1.0, 1.5, 2.0]),
+            lobe(DVec3::new(1.0, -0.2, 0.4), 120.0, [8.0, 6.0, 1.0]),
+            sun,
+        ];
+        let lights = fitted_reference_lights(&fit, 1024, 512, 16).unwrap();
+        assert_eq!(lights.len(), 1 + 6 * 16 * 16);
+        assert_eq!(lights[0].direction, sun.direction);
+        assert_eq!(lights[0].rgb, sun.rgb);
+        assert_eq!(
+            lights[0].angular_variance, 0.0,
+            "the reference's sources are points"
+        );
+        let want: [f64; 3] = std::array::from_fn(|c| {
+            sun.rgb[c]
+                + [1.0, 1.5, 2.0][c] * srbf::integral(3.0)
+                + [8.0, 6.0, 1.0][c] * srbf::integral(120.0)
+        });
+        let gap = relative_gap(total_power(&lights), want);
+        assert!(
+            gap < 2e-3,
+            "power {:?} against {want:?}: {gap}",
+            total_power(&lights)
+        );
     }
 
     fn relative_gap(a: [f64; 3], b: [f64; 3]) -> f64 {

@@ -15,6 +15,9 @@ use crate::baseline::Baseline;
 use crate::compare::{self, CompareArgs, CompareScene};
 use crate::env_frame::{EnvFrame, FrameRole, render_lights};
 use crate::environment::load_env;
+use crate::error_decomposition::{
+    self, DecompositionInputs, ErrorDecomposition, UNSHADOWED_REFERENCE_MAX_LIGHTS,
+};
 use crate::fit_cache::fit_cached;
 use crate::hdr_flip::hdr_flip;
 use crate::image_metrics::{Image, relative_rmse};
@@ -70,6 +73,11 @@ pub struct BenchPlan {
     /// Reports written before it existed: 1.
     #[serde(default = "one_run")]
     pub timing_runs: usize,
+    /// Measure only the error decomposition (`bench --decomposition-only`): no fit, table or
+    /// env-lit sweep, so a page measured before the decomposition existed can gain it from a
+    /// short run merged beside its own. Reports written before it existed: false.
+    #[serde(default)]
+    pub decomposition_only: bool,
 }
 
 fn one_run() -> usize {
@@ -115,6 +123,7 @@ impl BenchPlan {
             baseline: Baseline::MedianCut,
             reference_max_lights: 1536,
             timing_runs: TIMING_RUNS,
+            decomposition_only: false,
         }
     }
 
@@ -144,6 +153,7 @@ impl BenchPlan {
             baseline: Baseline::MedianCut,
             reference_max_lights: 384,
             timing_runs: TIMING_RUNS,
+            decomposition_only: false,
         }
     }
 }
@@ -158,6 +168,7 @@ pub struct PlanChanges {
     pub reference_max_lights: Option<usize>,
     pub baseline_lights: Vec<usize>,
     pub baseline: Option<Baseline>,
+    pub decomposition_only: bool,
 }
 
 /// The most median-cut lights a bench frame may ask for (a light map each; the largest
@@ -205,6 +216,7 @@ impl BenchPlan {
         if let Some(baseline) = changes.baseline {
             self.baseline = baseline;
         }
+        self.decomposition_only |= changes.decomposition_only;
         let probe = compare_args(
             &self,
             Path::new("map"),
@@ -298,6 +310,10 @@ pub struct BenchReport {
     pub fits: Vec<FitPoint>,
     pub tables: Vec<TablePoint>,
     pub env_lit: Vec<EnvLitResult>,
+    /// Per map and mode, where the SRBF default's error comes from. Reports written before it
+    /// existed: none.
+    #[serde(default)]
+    pub decompositions: Vec<ErrorDecomposition>,
     /// Maps the plan named that were not found, with why.
     pub skipped: Vec<String>,
     /// Where this report merges several runs ([`BenchReport::merged`]): each run's `bench`
@@ -325,6 +341,7 @@ impl BenchReport {
             maps: Vec::new(),
             modes: Vec::new(),
             reference_max_lights: 0,
+            decomposition_only: false,
             ..p.clone()
         };
         for report in reports {
@@ -356,6 +373,18 @@ impl BenchReport {
                     r.mode
                 );
             }
+            if let Some(d) = report.decompositions.iter().find(|d| {
+                merged
+                    .decompositions
+                    .iter()
+                    .any(|m| (&m.map, &m.mode) == (&d.map, &d.mode))
+            }) {
+                anyhow::bail!(
+                    "the error decomposition of {} ({} scattering) is in more than one report",
+                    d.map,
+                    d.mode
+                );
+            }
             merged.runs.extend(runs_of(&report));
             let had_fits = |map: &String| merged.fits.iter().any(|f| &f.map == map);
             let new_fits: Vec<FitPoint> = report
@@ -379,6 +408,8 @@ impl BenchReport {
                 .reference_max_lights
                 .max(report.plan.reference_max_lights);
             merged.env_lit.extend(report.env_lit);
+            merged.decompositions.extend(report.decompositions);
+            merged.plan.decomposition_only &= report.plan.decomposition_only;
             merged.skipped.extend(report.skipped);
             merged.seconds += report.seconds;
             if !revisions.contains(&report.git_revision) {
@@ -617,6 +648,12 @@ fn curve_ms_at(points: &[&Point], error: f64, metric: impl Fn(&Point) -> f64) ->
     })
 }
 
+/// One map's env-lit results and error decompositions (each mode).
+struct MapResults {
+    env_lit: Vec<EnvLitResult>,
+    decompositions: Vec<ErrorDecomposition>,
+}
+
 fn env_lit(
     plan: &BenchPlan,
     map: &Path,
@@ -624,7 +661,7 @@ fn env_lit(
     cache: &Path,
     scratch: &Path,
     steps: &mut Steps,
-) -> anyhow::Result<Vec<EnvLitResult>> {
+) -> anyhow::Result<MapResults> {
     let args = compare_args(plan, map, cache, scratch);
     let scene = compare::prepare_with_hair(&args, hair.0.clone(), hair.1.clone(), steps)?;
     // The first frame compiles the driver's shader variants: not a frame's cost.
@@ -632,8 +669,40 @@ fn env_lit(
     render_lights(&compare::frame(&scene, &args, &lights, plan.modes[0]))?;
     let name = map_stem(map);
     let mut out = Vec::new();
+    let mut decompositions = Vec::new();
+    let unshadowed_args = CompareArgs {
+        unshadowed: true,
+        reference_max_lights: UNSHADOWED_REFERENCE_MAX_LIGHTS,
+        ..compare_args(plan, map, cache, scratch)
+    };
+    let inputs = DecompositionInputs {
+        render: &render_lights,
+        scene: &scene,
+        args: &args,
+        unshadowed_args: &unshadowed_args,
+        lights: &lights,
+        kappa: plan.kappas[0],
+    };
     for &mode in &plan.modes {
         let reference = compare::reference(&render_lights, &scene, &args, mode, steps)?;
+        decompositions.push(match mode {
+            ScatteringMode::Single => {
+                error_decomposition::single_scattering(&name, &inputs, &reference, steps)?
+            }
+            ScatteringMode::Full => {
+                let single = compare::reference(
+                    &render_lights,
+                    &scene,
+                    &args,
+                    ScatteringMode::Single,
+                    steps,
+                )?;
+                error_decomposition::full_scattering(&name, &inputs, &single, &reference, steps)?
+            }
+        });
+        if plan.decomposition_only {
+            continue;
+        }
         let image = &reference.chosen.image;
         let mut points = srbf_points(plan, &scene, &args, mode, image, steps)?;
         let family = plan.baseline.name();
@@ -679,7 +748,10 @@ fn env_lit(
             points,
         });
     }
-    Ok(out)
+    Ok(MapResults {
+        env_lit: out,
+        decompositions,
+    })
 }
 
 /// A map's file name without its extension, as the report names it.
@@ -793,8 +865,12 @@ pub fn run(plan: &BenchPlan, paths: &BenchPaths, steps: &mut Steps) -> anyhow::R
         git_revision: command_output("git", &["describe", "--always", "--dirty", "--abbrev=7"]),
         seconds: 0.0,
         fits: Vec::new(),
-        tables: tables(plan, &paths.scratch, steps)?,
+        tables: match plan.decomposition_only {
+            true => Vec::new(),
+            false => tables(plan, &paths.scratch, steps)?,
+        },
         env_lit: Vec::new(),
+        decompositions: Vec::new(),
         skipped: Vec::new(),
         runs: Vec::new(),
     };
@@ -804,11 +880,13 @@ pub fn run(plan: &BenchPlan, paths: &BenchPaths, steps: &mut Steps) -> anyhow::R
             report.skipped.push(format!("{}: absent", path.display()));
             continue;
         }
-        report.fits.extend(fits(plan, &path, &paths.cache, steps)?);
+        if !plan.decomposition_only {
+            report.fits.extend(fits(plan, &path, &paths.cache, steps)?);
+        }
         let scratch = paths.scratch.join(map);
-        report
-            .env_lit
-            .extend(env_lit(plan, &path, &hair, &paths.cache, &scratch, steps)?);
+        let results = env_lit(plan, &path, &hair, &paths.cache, &scratch, steps)?;
+        report.env_lit.extend(results.env_lit);
+        report.decompositions.extend(results.decompositions);
     }
     report.seconds = start.elapsed().as_secs_f64();
     Ok(report)
@@ -864,9 +942,33 @@ mod tests {
             git_revision: revision.into(),
             seconds: 10.0,
             tables: Vec::new(),
+            decompositions: Vec::new(),
             skipped: Vec::new(),
             runs: Vec::new(),
         }
+    }
+
+    fn decomposition(map: &str, mode: &str) -> ErrorDecomposition {
+        ErrorDecomposition {
+            map: map.into(),
+            mode: mode.into(),
+            reference_lights: 1536,
+            reference_converged: Some(false),
+            unshadowed_reference_lights: None,
+            unshadowed_converged: None,
+            steps: Vec::new(),
+        }
+    }
+
+    /// A short run that measured only the error decomposition of a map the sweeps measured.
+    fn decomposition_run(map: &str) -> BenchReport {
+        let mut run = report(map, "d9", "r9");
+        run.plan.decomposition_only = true;
+        run.plan.modes = vec![ScatteringMode::Single, ScatteringMode::Full];
+        run.env_lit = Vec::new();
+        run.fits = Vec::new();
+        run.decompositions = vec![decomposition(map, "single"), decomposition(map, "full")];
+        run
     }
 
     fn result(map: &str, mode: &str) -> EnvLitResult {
@@ -946,6 +1048,30 @@ mod tests {
         // Merged again with a third run, the first two runs are still named.
         let again = BenchReport::merged(vec![merged, report("b.hdr", "d5", "r3")]).unwrap();
         assert_eq!(again.runs.len(), 3);
+    }
+
+    #[test]
+    fn a_decomposition_only_run_joins_the_sweeps_of_its_map_once() {
+        let merged = BenchReport::merged(vec![
+            report("a.hdr", "d1", "r1"),
+            full_scattering_run("a.hdr", 1536),
+            decomposition_run("a.hdr"),
+        ])
+        .unwrap();
+        let modes: Vec<&str> = merged.env_lit.iter().map(|r| r.mode.as_str()).collect();
+        assert_eq!(modes, ["single", "full"], "the sweeps are kept");
+        assert_eq!(merged.decompositions.len(), 2);
+        assert!(!merged.plan.decomposition_only, "the page holds sweeps");
+        assert!(
+            merged.runs[2].ends_with("--decomposition-only"),
+            "{:?}",
+            merged.runs
+        );
+        let error = BenchReport::merged(vec![merged, decomposition_run("a.hdr")]).unwrap_err();
+        assert!(
+            error.to_string().contains("error decomposition of a.hdr"),
+            "{error}"
+        );
     }
 
     #[test]

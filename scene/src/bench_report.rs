@@ -2,6 +2,7 @@
 //! [`BEGIN`] and [`END`], replaced whole on every run; the rest of the page is left alone).
 
 use crate::bench::{BenchReport, EnvLitResult};
+use crate::error_decomposition::{self as decomposition, DecompositionStep, ErrorDecomposition};
 use crate::scene_tables::ScatteringMode;
 use anyhow::bail;
 use std::fmt::Write;
@@ -93,6 +94,90 @@ fn goals_table(out: &mut String, report: &BenchReport) {
     out.push('\n');
 }
 
+/// A decomposition step's cell: relative RMSE, and HDR-FLIP where the step is a picture.
+fn step_cell(step: Option<&DecompositionStep>) -> String {
+    match step {
+        Some(DecompositionStep {
+            relative_rmse,
+            hdr_flip: Some(flip),
+            ..
+        }) => format!("{relative_rmse:.4} / {flip:.4}"),
+        Some(s) => format!("{:.4}", s.relative_rmse),
+        None => "–".into(),
+    }
+}
+
+fn reference_cell(lights: usize, converged: Option<bool>) -> String {
+    match converged {
+        Some(true) => format!("{lights} (converged)"),
+        Some(false) => format!("{lights} (not converged)"),
+        None => lights.to_string(),
+    }
+}
+
+/// Per map, where the SRBF default's error comes from: each approximation of the method added
+/// in turn ([`decomposition`]).
+fn decomposition_tables(out: &mut String, report: &BenchReport) {
+    if report.decompositions.is_empty() {
+        return;
+    }
+    let of_mode = |mode: ScatteringMode| {
+        report
+            .decompositions
+            .iter()
+            .filter(move |d| d.mode == mode.name())
+    };
+    let _ = writeln!(
+        out,
+        "### Where the error comes from
+
+Each approximation of the method added in turn, the image measured against the reference it should match at that point (relative RMSE / HDR-FLIP over the hair). Unshadowed (T = 1, no light maps): the fit (the brute-force render of the fitted lighting, its sources exact and its lobes one light per cube texel, against that of the map), the tables (the SRBF frame against the render of the fitted lighting) and both (the SRBF frame against the map's render); their references climb to {} lights. Shadowed, against the map's reference: every strand in every light map (κ 1: what is left is the one visibility per lobe), then the default κ.
+
+| map | reference lights (unshadowed: map, fit) | fit | tables | fit and tables | + one visibility per lobe (κ 1) | + κ (the default) |
+|---|---|---:|---:|---:|---:|---:|",
+        decomposition::UNSHADOWED_REFERENCE_MAX_LIGHTS
+    );
+    for d in of_mode(ScatteringMode::Single) {
+        let unshadowed = match (d.unshadowed_reference_lights, d.unshadowed_converged) {
+            (Some((map, fit)), Some(true)) => format!("{map}, {fit}, converged"),
+            (Some((map, fit)), _) => format!("{map}, {fit}, not converged"),
+            (None, _) => "–".into(),
+        };
+        let _ = writeln!(
+            out,
+            "| {} | {} ({unshadowed}) | {} | {} | {} | {} | {} |",
+            d.map,
+            reference_cell(d.reference_lights, d.reference_converged),
+            step_cell(d.step(decomposition::FIT)),
+            step_cell(d.step(decomposition::TABLES)),
+            step_cell(d.step(decomposition::UNSHADOWED)),
+            step_cell(d.step(decomposition::EVERY_STRAND)),
+            step_cell(d.step(decomposition::DEFAULT_KAPPA)),
+        );
+    }
+    let full: Vec<&ErrorDecomposition> = of_mode(ScatteringMode::Full).collect();
+    if !full.is_empty() {
+        out.push_str("
+Full scattering, the SRBF default: the error of its single- and of its multiple-scattering part against the references' (full minus single scattering), each over the full reference's norm, so that they add as vectors to the full frame's error.
+
+| map | reference lights | single-scattering part | multiple-scattering part | full |
+|---|---|---:|---:|---:|
+");
+    }
+    for d in full {
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {} |",
+            d.map,
+            reference_cell(d.reference_lights, d.reference_converged),
+            step_cell(d.step(decomposition::SINGLE_PART)),
+            step_cell(d.step(decomposition::MULTIPLE_PART)),
+            step_cell(d.step(decomposition::FULL)),
+        );
+    }
+    out.push('\n');
+}
+
 fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str, baseline: &str) {
     let _ = writeln!(
         out,
@@ -158,6 +243,9 @@ pub(crate) fn regenerate_args(report: &BenchReport) -> String {
         let flag = serde_json::to_value(plan.baseline).expect("a unit enum serializes");
         args += &format!(" --baseline {}", flag.as_str().unwrap_or_default());
     }
+    if plan.decomposition_only {
+        args += " --decomposition-only";
+    }
     args
 }
 
@@ -210,6 +298,7 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
         let _ = writeln!(out, "Skipped: {}.\n", report.skipped.join("; "));
     }
     goals_table(&mut out, report);
+    decomposition_tables(&mut out, report);
     out.push_str("### SRBF fit: error and time against the lobe count\n\n| map | most lobes | lobes | compact sources | relative L2 error (without sources) | fit s |\n|---|---:|---:|---:|---:|---:|\n");
     for f in &report.fits {
         let _ = writeln!(
@@ -294,6 +383,7 @@ mod tests {
             fits: Vec::new(),
             tables: Vec::new(),
             env_lit: Vec::new(),
+            decompositions: Vec::new(),
             skipped: Vec::new(),
             runs: Vec::new(),
         }
@@ -404,6 +494,59 @@ mod tests {
         assert!(!page.contains("Regenerate with"), "{page}");
     }
 
+    fn step(label: &str, relative_rmse: f64, hdr_flip: Option<f64>) -> DecompositionStep {
+        DecompositionStep {
+            label: label.into(),
+            relative_rmse,
+            hdr_flip,
+        }
+    }
+
+    /// Each step lands in its own column whatever order it was measured in; a part of an image
+    /// shows no HDR-FLIP; a page measured before decompositions existed shows no table.
+    #[test]
+    fn each_decomposition_step_is_shown_in_its_column() {
+        use decomposition::*;
+        let mut report = report_of(BenchPlan::full());
+        assert!(!section(&report, "bench").contains("Where the error comes from"));
+        report.decompositions = vec![
+            ErrorDecomposition {
+                map: "m".into(),
+                mode: "single".into(),
+                reference_lights: 1536,
+                reference_converged: Some(false),
+                unshadowed_reference_lights: Some((6144, 1536)),
+                unshadowed_converged: Some(true),
+                steps: vec![
+                    step(DEFAULT_KAPPA, 0.5, Some(0.55)),
+                    step(FIT, 0.1, Some(0.11)),
+                    step(EVERY_STRAND, 0.4, Some(0.44)),
+                    step(TABLES, 0.2, Some(0.22)),
+                    step(UNSHADOWED, 0.3, Some(0.33)),
+                ],
+            },
+            ErrorDecomposition {
+                map: "m".into(),
+                mode: "full".into(),
+                reference_lights: 6145,
+                reference_converged: Some(true),
+                unshadowed_reference_lights: None,
+                unshadowed_converged: None,
+                steps: vec![
+                    step(MULTIPLE_PART, 0.07, None),
+                    step(SINGLE_PART, 0.06, None),
+                    step(FULL, 0.08, Some(0.09)),
+                ],
+            },
+        ];
+        let page = section(&report, "bench");
+        assert!(page.contains("| m | 1536 (not converged) (6144, 1536, converged) | 0.1000 / 0.1100 | 0.2000 / 0.2200 | 0.3000 / 0.3300 | 0.4000 / 0.4400 | 0.5000 / 0.5500 |"), "{page}");
+        assert!(
+            page.contains("| m | 6145 (converged) | 0.0600 | 0.0700 | 0.0800 / 0.0900 |"),
+            "{page}"
+        );
+    }
+
     #[test]
     fn the_regenerate_command_repeats_every_changed_flag_and_only_those() {
         let changes = PlanChanges {
@@ -412,12 +555,13 @@ mod tests {
             reference_max_lights: Some(6144),
             baseline_lights: vec![256, 16, 64, 16],
             baseline: Some(Baseline::MedianCutSources),
+            decomposition_only: true,
         };
         let plan = BenchPlan::quick().changed(&changes).unwrap();
         assert_eq!(plan.baseline_lights, [16, 64, 256]);
         assert_eq!(
             regenerate_args(&report_of(plan)),
-            " --quick --maps quarry_01_1k.hdr --modes full --reference-max-lights 6144 --baseline-lights 16,64,256 --baseline median-cut-sources"
+            " --quick --maps quarry_01_1k.hdr --modes full --reference-max-lights 6144 --baseline-lights 16,64,256 --baseline median-cut-sources --decomposition-only"
         );
         let unchanged = PlanChanges {
             modes: BenchPlan::full().modes,

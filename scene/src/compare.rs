@@ -26,7 +26,8 @@ use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_precompute::compact_sources::wider_radius;
 use strandlight_precompute::env_lights::{
-    face_resolution_for, reference_lights_shaded, srbf_set_lights,
+    LightSpec, face_resolution_for, fitted_reference_lights, reference_lights_shaded,
+    srbf_set_lights,
 };
 use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::{
@@ -213,6 +214,20 @@ pub struct CompareScene {
     pub fit_relative_l2_error: f64,
     /// The compact sources the fit took out (rendered as directional lights in the SRBF frame).
     pub compact_sources: Vec<strandlight_precompute::compact_sources::CompactSource>,
+    /// The fitted set's lights in the map's frame (what `srbf` holds in the world's), for a
+    /// reference of the fit's own lighting ([`ReferenceLighting::Fit`]).
+    pub fit_lights: Vec<LightSpec>,
+}
+
+/// What a brute-force reference lights the hair with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ReferenceLighting {
+    /// The map: every error figure is against it.
+    Map,
+    /// The fit's own lighting ([`fitted_reference_lights`]): against the map's reference it
+    /// measures the fit alone, and the SRBF frame against it the tables and the renderer
+    /// (`bench`'s error decomposition). Shaded at the texel lights only.
+    Fit,
 }
 
 /// The flags' values checked together, before any work (for callers that build the args).
@@ -456,7 +471,8 @@ pub fn prepare_with_hair(
     )?;
     let up = UpAxis::detect(&hair);
     let camera = Camera::framing_front(hair.bounds(), width as f32 / height as f32, false, up);
-    let mut srbf = to_env_lights(&srbf_set_lights(&set), up);
+    let fit_lights = srbf_set_lights(&set);
+    let mut srbf = to_env_lights(&fit_lights, up);
     let marked = mark_every_strand(&mut srbf, args.every_strand_share);
     if marked > 0 {
         steps.say(format!(
@@ -491,6 +507,7 @@ pub fn prepare_with_hair(
         fiber,
         fit_relative_l2_error,
         compact_sources: fit.set.sources.clone(),
+        fit_lights,
     })
 }
 
@@ -526,7 +543,14 @@ impl CompareScene {
         face: usize,
         shading_face: Option<usize>,
         rotate: f64,
+        lighting: ReferenceLighting,
     ) -> anyhow::Result<Vec<EnvLight>> {
+        if lighting == ReferenceLighting::Fit {
+            // The fit's lobes are already turned by the rotation the scene was fitted with.
+            let (w, h) = (self.map.width(), self.map.height());
+            let specs = fitted_reference_lights(&self.fit_lights, w, h, face)?;
+            return Ok(to_env_lights(&specs, self.up));
+        }
         let shading = shading_face.unwrap_or(face).max(face);
         let specs =
             reference_lights_shaded(&self.map, face, shading, rotate, &self.reference_sources)
@@ -697,6 +721,7 @@ fn reference_inputs(
     face: usize,
     lights: usize,
     mode: ScatteringMode,
+    lighting: ReferenceLighting,
 ) -> anyhow::Result<Value> {
     let direct = scene.tables.get(args.shading.direct_table(mode))?;
     let mut inputs = json!({
@@ -717,6 +742,13 @@ fn reference_inputs(
         // κ 1 draws every strand as it is: the simplified maps' chord tolerance is not an input.
         "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, transparency: look(args).transparency, dodm: DodmSettings { simplified_chord_tolerance: 0.0, ..look(args).dodm }, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
     });
+    // Only the fit's lighting adds a key, so the map's references keep their cache entries.
+    if lighting == ReferenceLighting::Fit {
+        inputs["reference_lighting"] = json!({
+            "fit_lights": sha256_hex(format!("{:?}", scene.fit_lights).as_bytes()),
+            "placement": "fit's sources exact, its lobes' radiance sampled on the map's grid, texel lights at texel centres",
+        });
+    }
     // Only a finer shading cube adds a key, so brute-force references keep their cache entries.
     if let Some(m) = shading_face(args)?.filter(|&m| m > face) {
         inputs["reference_shading"] = json!(format!(
@@ -831,6 +863,16 @@ fn run_mode(
     })
 }
 
+/// What the steps call a reference of `lighting` under `args`.
+fn reference_name(lighting: ReferenceLighting, args: &CompareArgs) -> &'static str {
+    match (lighting, args.unshadowed) {
+        (ReferenceLighting::Map, false) => "reference",
+        (ReferenceLighting::Map, true) => "unshadowed reference",
+        (ReferenceLighting::Fit, false) => "reference of the fit",
+        (ReferenceLighting::Fit, true) => "unshadowed reference of the fit",
+    }
+}
+
 /// The reference of `mode` with 6·face² lights, from the cache or rendered (and cached).
 fn reference_with_face(
     render: Renderer,
@@ -838,15 +880,17 @@ fn reference_with_face(
     args: &CompareArgs,
     mode: ScatteringMode,
     face: usize,
+    lighting: ReferenceLighting,
     steps: &mut Steps,
 ) -> anyhow::Result<ReferenceImage> {
-    let lights = scene.reference_set(face, shading_face(args)?, args.rotate)?;
+    let lights = scene.reference_set(face, shading_face(args)?, args.rotate, lighting)?;
     // What a reference costs is its shadow maps: one per compact source and per texel.
     let maps = shadow_groups(&lights).len();
     let cache = ReferenceCache::new(args.cache.join("reference"));
-    let inputs = reference_inputs(scene, args, face, maps, mode)?;
+    let inputs = reference_inputs(scene, args, face, maps, mode, lighting)?;
+    let what = reference_name(lighting, args);
     steps.run(
-        &format!("{}: reference, {maps} lights", mode.name()),
+        &format!("{}: {what}, {maps} lights", mode.name()),
         || match cache.load(&inputs) {
             Some((image, record)) => Ok(ReferenceImage {
                 image,
@@ -887,10 +931,22 @@ pub fn reference(
     mode: ScatteringMode,
     steps: &mut Steps,
 ) -> anyhow::Result<Reference> {
+    reference_of(render, scene, args, mode, ReferenceLighting::Map, steps)
+}
+
+/// [`reference`] lit by `lighting`.
+pub fn reference_of(
+    render: Renderer,
+    scene: &CompareScene,
+    args: &CompareArgs,
+    mode: ScatteringMode,
+    lighting: ReferenceLighting,
+    steps: &mut Steps,
+) -> anyhow::Result<Reference> {
     let most_face = match validate(args)? {
         ReferenceChoice::Fixed(face) => {
             return Ok(Reference {
-                chosen: reference_with_face(render, scene, args, mode, face, steps)?,
+                chosen: reference_with_face(render, scene, args, mode, face, lighting, steps)?,
                 ladder: Vec::new(),
                 converged: None,
             });
@@ -898,15 +954,16 @@ pub fn reference(
         ReferenceChoice::Converged { most_face } => most_face,
     };
     let mut face = FIRST_CONVERGENCE_FACE;
-    let mut coarse = reference_with_face(render, scene, args, mode, face, steps)?;
+    let mut coarse = reference_with_face(render, scene, args, mode, face, lighting, steps)?;
     let mut ladder = Vec::new();
     loop {
-        let fine = reference_with_face(render, scene, args, mode, 2 * face, steps)?;
+        let fine = reference_with_face(render, scene, args, mode, 2 * face, lighting, steps)?;
         let difference = relative_rmse(&coarse.image, &fine.image)?;
         ladder.push((coarse.record.lights, coarse.record.milliseconds, difference));
         steps.say(format!(
-            "{}: reference with {} lights against {}: relative RMSE {difference:.4} (tolerance {})",
+            "{}: {} with {} lights against {}: relative RMSE {difference:.4} (tolerance {})",
             mode.name(),
+            reference_name(lighting, args),
             coarse.record.lights,
             fine.record.lights,
             args.reference_tolerance

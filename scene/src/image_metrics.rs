@@ -72,6 +72,19 @@ pub enum CompareError {
 }
 
 impl Image {
+    /// `self − other` in RGB, `self`'s alpha kept (one part of an additive image: full minus
+    /// single scattering). Sizes must match.
+    pub fn minus(&self, other: &Image) -> Result<Image, CompareError> {
+        other.check_against("the subtracted image", self)?;
+        let pixels = self
+            .pixels
+            .iter()
+            .zip(&other.pixels)
+            .map(|(a, b)| [a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3]])
+            .collect();
+        Ok(Image::new(self.width, self.height, pixels))
+    }
+
     pub fn new(width: u32, height: u32, pixels: Vec<[f32; 4]>) -> Self {
         assert_eq!(
             pixels.len(),
@@ -121,18 +134,37 @@ fn is_hair(p: &[f32; 4]) -> bool {
 
 /// √(Σ‖a − r‖² / Σ‖r‖²) over RGB of the pixels where the reference has hair.
 pub fn relative_rmse(approx: &Image, reference: &Image) -> Result<f64, CompareError> {
-    check_finite("the reference", reference)?;
-    approx.check_against("the image", reference)?;
+    relative_rmse_of_part(approx, reference, reference)
+}
+
+/// The error of one additive part of an image relative to the whole:
+/// √(Σ‖a − r‖² / Σ‖w‖²) over RGB of the pixels where `whole` has hair, `a` approximating the
+/// part `r` of the reference `whole` (the multiple-scattering part of a full image: full
+/// minus single scattering). The parts' errors add as vectors to the whole's.
+pub fn relative_rmse_of_part(
+    approx_part: &Image,
+    reference_part: &Image,
+    whole: &Image,
+) -> Result<f64, CompareError> {
+    check_finite("the reference", whole)?;
+    check_finite("the reference's part", reference_part)?;
+    reference_part.check_against("the reference's part", whole)?;
+    approx_part.check_against("the image", whole)?;
     let (mut num, mut den, mut hair) = (0.0f64, 0.0f64, 0usize);
-    for (a, r) in approx.pixels.iter().zip(&reference.pixels) {
-        if !is_hair(r) {
+    for ((a, r), w) in approx_part
+        .pixels
+        .iter()
+        .zip(&reference_part.pixels)
+        .zip(&whole.pixels)
+    {
+        if !is_hair(w) {
             continue;
         }
         hair += 1;
         for c in 0..3 {
             let d = a[c] as f64 - r[c] as f64;
             num += d * d;
-            den += (r[c] as f64).powi(2);
+            den += (w[c] as f64).powi(2);
         }
     }
     if hair == 0 {
@@ -318,6 +350,39 @@ mod tests {
             [50.0, 50.0, 50.0, 1.0],
         ]);
         (approx, reference)
+    }
+
+    /// A full image split into single and multiple scattering: each part's error is measured
+    /// over the whole's norm and hair, and the parts' errors add as vectors to the whole's.
+    #[test]
+    fn the_parts_errors_are_relative_to_the_whole_and_add_up_to_it() {
+        let (approx, reference) = worked_pair();
+        // The reference's single-scattering part; the rest of it is multiple scattering.
+        let single_reference = image(vec![[0.5, 0.0, 0.0, 1.0], [0.0, 1.0, 0.0, 0.5], [0.0; 4]]);
+        // The image's single part is off by 0.1 in pixel 0 only, so its multiple part carries
+        // the rest of its error: 0.2 in pixel 1 (and pixel 2, which has no hair).
+        let single_approx = image(vec![[0.6, 0.0, 0.0, 1.0], [0.0, 1.0, 0.0, 0.5], [9.0; 4]]);
+        let single = relative_rmse_of_part(&single_approx, &single_reference, &reference).unwrap();
+        // √(0.01 / 5)
+        assert!((single - (0.01f64 / 5.0).sqrt()).abs() < 1e-7, "{single}");
+        let multiple_approx = approx.minus(&single_approx).unwrap();
+        let multiple_reference = reference.minus(&single_reference).unwrap();
+        let multiple =
+            relative_rmse_of_part(&multiple_approx, &multiple_reference, &reference).unwrap();
+        // √(0.04 / 5)
+        assert!(
+            (multiple - (0.04f64 / 5.0).sqrt()).abs() < 1e-7,
+            "{multiple}"
+        );
+        let whole = relative_rmse(&approx, &reference).unwrap();
+        assert!(
+            (single.hypot(multiple) - whole).abs() < 1e-7,
+            "{single} ⊕ {multiple} ≠ {whole}"
+        );
+        assert!(
+            approx.minus(&image(vec![[0.0; 4]])).is_err(),
+            "sizes must match"
+        );
     }
 
     #[test]

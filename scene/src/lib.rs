@@ -17,6 +17,7 @@ pub mod env_frame;
 pub mod env_scene;
 pub mod environment;
 pub mod equal_time;
+pub mod error_decomposition;
 pub mod error_metric;
 pub mod fit_cache;
 pub mod frame_render;
