@@ -441,10 +441,15 @@ pub fn prepare_with_hair(
         .map(BakeResolution::reduced)
         .unwrap_or_default();
     let wanted = wanted_tables(args.shading, &args.modes, !set.lobes.is_empty(), true);
+    // A resolution of its own gets a folder of its own: runs of other resolutions would
+    // otherwise rebake over each other's tables.
+    let resolution_suffix = args
+        .table_resolution
+        .map_or(String::new(), |n| format!("-n{n}"));
     let table_dir = args
         .cache
         .join("tables")
-        .join(format!("{}-{:?}", args.preset, args.shading).to_lowercase());
+        .join(format!("{}-{:?}{resolution_suffix}", args.preset, args.shading).to_lowercase());
     let tables = steps.run(
         "bake",
         || {

@@ -141,9 +141,11 @@ pub fn bake_scene_tables(
         .map(|s| (s.name.clone(), s.reason.clone()))
         .collect();
     let mut expected: BTreeMap<String, Value> = BTreeMap::new();
+    let mut keys: BTreeMap<String, String> = BTreeMap::new();
     let mut baked = Vec::new();
     for job in plan.jobs.into_iter().filter(|j| wanted.contains(&j.name)) {
         expected.insert(job.name.to_string(), job.fiber_parameters.clone());
+        keys.insert(job.name.to_string(), job.inputs_key());
         let t = bake_job(job, dir, Storage::F32)?;
         if let Some(reason) = &t.replaced_damaged {
             eprintln!(
@@ -156,8 +158,7 @@ pub fn bake_scene_tables(
     }
     let mut assets = BTreeMap::new();
     for t in &baked {
-        let asset = read_asset(&t.path)?;
-        expect_parameters(&asset, &expected[&t.name])?;
+        let asset = load_baked(t, &keys[&t.name], &expected[&t.name])?;
         assets.insert(t.name.clone(), asset);
     }
     Ok(SceneTables {
@@ -165,6 +166,21 @@ pub fn bake_scene_tables(
         baked,
         skipped,
     })
+}
+
+/// The table `t` as baked or found with inputs `key`, its fiber `parameters` checked. Another
+/// process baking other settings (a λ range, a resolution) into the same folder may have
+/// replaced the file since: that is an error, never a table of other settings.
+fn load_baked(t: &BakedTable, key: &str, parameters: &Value) -> anyhow::Result<TableAsset> {
+    let asset = read_asset(&t.path)?;
+    expect_parameters(&asset, parameters)?;
+    if asset.metadata.description.inputs_key.as_deref() != Some(key) {
+        bail!(
+            "{}: the table was replaced after it was baked, by one of other settings (another run baking into the same folder at the same time?); run again, or give each run its own --cache",
+            t.path.display()
+        );
+    }
+    Ok(asset)
 }
 
 /// λ range of an SRBF set with a 10% margin (the bake's 1/λ axis spans only this). A set of
@@ -194,6 +210,43 @@ pub fn lambda_range_of_set(set: &SrbfSet) -> anyhow::Result<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Two runs baking other λ ranges into one folder: the first run's table, replaced on disk
+    /// by the second's, is refused when loaded instead of shading with the wrong λ axis.
+    #[test]
+    fn a_table_replaced_after_its_bake_is_refused() {
+        let dir = std::env::temp_dir().join(format!(
+            "strandlight-scene-tables-replaced-{}",
+            std::process::id()
+        ));
+        let _ = std::fs::remove_dir_all(&dir);
+        let fiber = FiberDescription::preset("blonde").unwrap();
+        let name = EnvShading::Marschner.srbf_table(ScatteringMode::Single);
+        let bake = |range| {
+            bake_scene_tables(
+                &fiber,
+                EnvShading::Marschner,
+                BakeResolution::reduced(4),
+                range,
+                &[name],
+                &dir,
+                &mut |_| {},
+            )
+            .unwrap()
+        };
+        let first = bake((20.0, 40.0));
+        let asset = first.get(name).unwrap();
+        let key = asset.metadata.description.inputs_key.clone().unwrap();
+        let parameters = asset.metadata.description.fiber_parameters.clone();
+        let baked = &first.baked[0];
+        load_baked(baked, &key, &parameters).expect("the file as baked loads");
+        bake((30.0, 60.0));
+        let error = load_baked(baked, &key, &parameters)
+            .unwrap_err()
+            .to_string();
+        assert!(error.contains("replaced after it was baked"), "{error}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn tables_for_each_mode_exist_in_the_plan() {

@@ -445,6 +445,34 @@ fn check_light_map_limits(gpu: &GpuContext, resolution: u32, slots: u32) -> Resu
     })
 }
 
+/// The tables a frame binds whole, against the adapter's storage-binding limit: a table baked
+/// with too many nodes (64 per direction axis is 400 MB) is refused by name, not by the driver.
+fn check_table_limits(
+    gpu: &GpuContext,
+    tables: &EnvTables,
+    kinds: &LightKinds,
+    with_multiple: bool,
+) -> Result<(), LimitError> {
+    let limits = GpuLimits::of(gpu);
+    let bound = [
+        ("env table `srbf`", kinds.has_srbf(), &tables.srbf),
+        (
+            "env table `direct`",
+            kinds.has_directional(),
+            &tables.direct,
+        ),
+        ("env table `multiple`", with_multiple, &tables.multiple),
+    ];
+    for (what, needed, table) in bound {
+        if let Some(t) = table.as_ref().filter(|_| needed) {
+            limits.check_storage_buffer(what, t.as_bytes().len() as u64, |max| {
+                format!("bake it with fewer nodes per axis, to at most {max} bytes")
+            })?;
+        }
+    }
+    Ok(())
+}
+
 /// The frame's running sums (two RGBA f32 images) and the pass that adds into them.
 fn check_sums_limits(gpu: &GpuContext, width: u32, height: u32) -> Result<(), LimitError> {
     let limits = GpuLimits::of(gpu);
@@ -829,6 +857,7 @@ impl EnvRenderer {
             shading: KajiyaKay::default(),
             width_override_px: options.width_override_px,
         };
+        check_table_limits(gpu, tables, kinds, multiple.is_some())?;
         let (srbf_tables, directional_tables) = timings.time(gpu, "table upload", || {
             let multiple_table = multiple.and(tables.multiple.as_ref());
             let bind = |needed: bool, t: &Option<Table>| {
