@@ -464,7 +464,12 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         rotate: 0.0,
         sanitize: false,
         table_resolution: None,
-        modes: plan.modes.clone(),
+        // The tables every mode measured needs, and single scattering's for full scattering's
+        // decomposition, which compares the single-scattering parts.
+        modes: [ScatteringMode::Single, ScatteringMode::Full]
+            .into_iter()
+            .filter(|m| *m == ScatteringMode::Single || plan.modes.contains(m))
+            .collect(),
         kappa: plan.kappas[0],
         every_strand_share: 0.0,
         thin_weak_sources: false,
