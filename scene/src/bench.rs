@@ -16,7 +16,7 @@ use crate::compare::{self, CompareArgs, CompareScene};
 use crate::env_frame::{EnvFrame, FrameRole, render_lights};
 use crate::environment::load_env;
 use crate::error_decomposition::{
-    self, DecompositionInputs, ErrorDecomposition, UNSHADOWED_REFERENCE_MAX_LIGHTS,
+    self, DecompositionInputs, ErrorDecomposition, unshadowed_max_lights,
 };
 use crate::fit_cache::fit_cached;
 use crate::hdr_flip::hdr_flip;
@@ -677,7 +677,7 @@ fn env_lit(
     let mut decompositions = Vec::new();
     let unshadowed_args = CompareArgs {
         unshadowed: true,
-        reference_max_lights: UNSHADOWED_REFERENCE_MAX_LIGHTS,
+        reference_max_lights: unshadowed_max_lights(plan.reference_max_lights),
         ..compare_args(plan, map, cache, scratch)
     };
     let inputs = DecompositionInputs {

@@ -135,7 +135,7 @@ Each approximation of the method added in turn, the image measured against the r
 
 | map | reference lights (unshadowed: map, fit) | fit | tables | fit and tables | + one visibility per lobe (κ 1) | + κ (the default) |
 |---|---|---:|---:|---:|---:|---:|",
-        decomposition::UNSHADOWED_REFERENCE_MAX_LIGHTS
+        decomposition::unshadowed_max_lights(report.plan.reference_max_lights)
     );
     for d in of_mode(ScatteringMode::Single) {
         let unshadowed = match (d.unshadowed_reference_lights, d.unshadowed_converged) {

@@ -13,8 +13,8 @@
 //! - full scattering: the error of the single- and the multiple-scattering part, each over the
 //!   full reference's norm (they add as vectors to the full frame's error), and the whole.
 //!
-//! The unshadowed references are cheap (no light passes), so they climb to
-//! [`UNSHADOWED_REFERENCE_MAX_LIGHTS`] and usually converge; the shadowed ones are the
+//! The unshadowed references are cheap (no light passes), so they climb further than the
+//! shadowed ones ([`unshadowed_max_lights`]) and usually converge; the shadowed ones are the
 //! run's.
 
 use crate::compare::{self, CompareArgs, CompareScene, Reference, ReferenceLighting};
@@ -29,6 +29,13 @@ use strandlight_runtime::env::EnvLight;
 /// The most lights an unshadowed reference climbs to (6·64²): one costs about a minute on
 /// lavapipe at 160×120, its shading alone being what converges.
 pub const UNSHADOWED_REFERENCE_MAX_LIGHTS: usize = 24576;
+
+/// The unshadowed references' budget beside a shadowed budget of `shadowed_max_lights`: two
+/// rungs (16×) past it, at most [`UNSHADOWED_REFERENCE_MAX_LIGHTS`] (`bench --quick`'s 384
+/// gives 6144; the full plan's 1536 and above give 24576). Always 6n² when the input is.
+pub fn unshadowed_max_lights(shadowed_max_lights: usize) -> usize {
+    (16 * shadowed_max_lights).min(UNSHADOWED_REFERENCE_MAX_LIGHTS)
+}
 
 /// One approximation added: the image's error against the reference it should match.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -208,5 +215,20 @@ impl ErrorDecomposition {
     /// The step of `label`, where measured.
     pub fn step(&self, label: &str) -> Option<&DecompositionStep> {
         self.steps.iter().find(|s| s.label == label)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use strandlight_precompute::env_lights::face_resolution_for;
+
+    #[test]
+    fn the_unshadowed_budget_is_a_cube_two_rungs_past_the_shadowed_one() {
+        for (shadowed, want) in [(384, 6144), (1536, 24576), (6144, 24576)] {
+            let got = unshadowed_max_lights(shadowed);
+            assert_eq!(got, want, "beside {shadowed}");
+            assert!(face_resolution_for(got).is_some(), "{got} is 6n²");
+        }
     }
 }
