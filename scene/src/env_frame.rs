@@ -151,7 +151,7 @@ fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
 /// Forward-scattering settings of `role`.
 pub fn forward_settings(role: FrameRole) -> ForwardScatteringSettings {
     match role {
-        FrameRole::Interactive { .. } => ForwardScatteringSettings::default(),
+        FrameRole::Interactive { .. } => ForwardScatteringSettings::interactive(),
         FrameRole::Reference => ForwardScatteringSettings::dense_reference(),
     }
 }
@@ -168,16 +168,23 @@ fn forward_scattering<'g>(
         &frame.tables.get("attenuation_ratio")?.table,
         &frame.tables.get("srbf_spread")?.table,
     )?;
-    let cpu = CpuForwardScattering::new(frame.hair, tables, forward_settings(frame.role))?;
+    let settings = forward_settings(frame.role);
+    let cpu = CpuForwardScattering::new(frame.hair, tables, settings)?;
+    // The GPU marches from every sample: the same grid without the CPU's light sweep.
+    let on_gpu = |cpu: CpuForwardScattering| {
+        let march = ForwardScatteringSettings {
+            light_sweep: false,
+            ..settings
+        };
+        GpuForwardScattering::new(gpu, cpu.with_settings(march)?)
+    };
     Ok(match frame.look.forward_scattering {
         _ if frame.role == FrameRole::Reference => Box::new(cpu),
         ForwardDevice::Cpu => Box::new(cpu),
-        ForwardDevice::Gpu => {
-            Box::new(GpuForwardScattering::new(gpu, cpu).context("--forward-scattering gpu")?)
-        }
+        ForwardDevice::Gpu => Box::new(on_gpu(cpu).context("--forward-scattering gpu")?),
         ForwardDevice::Auto if gpu.report.is_software => Box::new(cpu),
         // A volume beyond the adapter's limits is still rendered, by rayon.
-        ForwardDevice::Auto => match GpuForwardScattering::new(gpu, cpu.clone()) {
+        ForwardDevice::Auto => match on_gpu(cpu.clone()) {
             Ok(on_gpu) => Box::new(on_gpu),
             Err(_) => Box::new(cpu),
         },

@@ -57,6 +57,21 @@ impl Default for ForwardScatteringSettings {
 }
 
 impl ForwardScatteringSettings {
+    /// The interactive frame's setting on the CPU: samples every second voxel corner (Ren's
+    /// 4 left the multiple-scattering part of a full frame 0.027–0.099 off the dense
+    /// reference's on the eight shared maps, 15% dark on royal esplanade), computed by light
+    /// sweeps, which at this density cost what Ren's coarse march did (0.93–1.0× the full
+    /// frame on lavapipe, 0.76× on photo studio). Measured in docs/BENCHMARKS.md, "The
+    /// forward-scattering grid". The GPU march cannot sweep: it runs this with
+    /// `light_sweep` off.
+    pub fn interactive() -> Self {
+        Self {
+            coarse_factor: 2,
+            light_sweep: true,
+            ..Self::default()
+        }
+    }
+
     /// The reference renderer's setting: samples at every voxel corner, quarter-voxel steps,
     /// computed by light sweeps (see the convergence study in the example).
     pub fn dense_reference() -> Self {
@@ -201,6 +216,26 @@ impl CpuForwardScattering {
             sample_grid,
             positions,
         }
+    }
+
+    /// The same voxelized hair sampled under other `settings` (the GPU's march beside the CPU's
+    /// sweep); their voxels must be the ones it was voxelized with.
+    pub fn with_settings(
+        self,
+        settings: ForwardScatteringSettings,
+    ) -> Result<Self, ForwardScatteringError> {
+        settings.validate()?;
+        if settings.voxels != self.settings.voxels {
+            return Err(ForwardScatteringError::InvalidSetting {
+                parameter: "voxels",
+                value: format!("{:?}", settings.voxels),
+                problem: format!(
+                    "the hair was voxelized with {:?}; voxelize it again instead",
+                    self.settings.voxels
+                ),
+            });
+        }
+        Ok(Self::from_volume(self.volume, self.tables, settings))
     }
 
     pub fn volume(&self) -> &HairVolume {

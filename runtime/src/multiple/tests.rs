@@ -510,6 +510,59 @@ fn bad_settings_are_typed_errors() {
     }
 }
 
+/// The GPU's march beside the CPU's sweep: the same voxels resampled under other settings give
+/// what a fresh voxelization under them gives; other voxels are refused.
+#[test]
+fn a_voxelized_hair_resampled_under_other_settings_matches_a_fresh_one() {
+    let model = tangled_hair(&mut Rng(7), 40, 12, 0.1, 0.01);
+    let sweep = ForwardScatteringSettings {
+        light_sweep: true,
+        ..settings(24, 2, 0.5)
+    };
+    let march = ForwardScatteringSettings {
+        light_sweep: false,
+        coarse_factor: 2,
+        ..sweep
+    };
+    let cpu = CpuForwardScattering::new(&model, tables(), sweep).unwrap();
+    let resampled = cpu.clone().with_settings(march).unwrap();
+    let fresh = CpuForwardScattering::new(&model, tables(), march).unwrap();
+    assert_eq!(resampled.settings(), fresh.settings());
+    assert_eq!(
+        resampled.sample_grid().positions(),
+        fresh.sample_grid().positions()
+    );
+    let light = EnvLight::srbf(Vec3::new(0.3, 0.9, 0.2), 40.0, [1.0; 3]);
+    let probes: Vec<Vec3> = fresh
+        .sample_grid()
+        .positions()
+        .into_iter()
+        .step_by(7)
+        .collect();
+    assert_eq!(
+        resampled.values_at(&light, &probes),
+        fresh.values_at(&light, &probes)
+    );
+    let other_voxels = ForwardScatteringSettings {
+        voxels: VoxelSettings {
+            voxels_longest_side: 32,
+            default_diameter: None,
+        },
+        ..march
+    };
+    let err = cpu.with_settings(other_voxels).unwrap_err();
+    assert!(
+        matches!(
+            err,
+            ForwardScatteringError::InvalidSetting {
+                parameter: "voxels",
+                ..
+            }
+        ),
+        "{err}"
+    );
+}
+
 #[test]
 fn light_sweep_matches_the_slab_closed_form() {
     let d = 0.15f32;
