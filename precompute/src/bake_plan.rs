@@ -149,9 +149,10 @@ impl From<ConvolutionSettingsSerde> for ConvolutionSettings {
 
 /// Nodes of the convolution tables' u·ω_o axis: the R lobe is as narrow in θ_o as the fiber's
 /// longitudinal width, and the convolution with an SRBF widens it only over ω_i, so the view
-/// axis needs three times the paper's 32 nodes (measured by `bench`'s error decomposition,
-/// unshadowed against a 6144-light reference of the same map: venice 0.045 → 0.011 at 64 →
-/// 0.008 at 96, quarry 0.021 → 0.013; 128 gains nothing more).
+/// axis needs three times the paper's 32 nodes (the SRBF frame's unshadowed error, fit and
+/// tables together, against a 6144-light reference of the same map: venice 0.045 → 0.011 at
+/// 64 → 0.008 at 96, quarry 0.021 → 0.013; 128 gains nothing more; docs/BENCHMARKS.md,
+/// "Where the error comes from, map by map").
 pub const CONVOLUTION_VIEW_NODES: usize = 96;
 /// Nodes of the convolution tables' 1/λ axis: it spans only the fitted set's bandwidths, over
 /// which the convolution varies slowly (64 → 8 nodes left both maps above unchanged; 16 keeps

@@ -60,10 +60,10 @@ impl ForwardScatteringSettings {
     /// The interactive frame's setting on the CPU: samples every second voxel corner (Ren's
     /// 4 left the multiple-scattering part of a full frame 0.027–0.099 off the dense
     /// reference's on the eight shared maps, 15% dark on royal esplanade), computed by light
-    /// sweeps, which at this density cost what Ren's coarse march did (0.93–1.0× the full
-    /// frame on lavapipe, 0.76× on photo studio). Measured in docs/BENCHMARKS.md, "The
-    /// forward-scattering grid". The GPU march cannot sweep: it runs this with
-    /// `light_sweep` off.
+    /// sweeps, which at this density cost what Ren's coarse march did (0.92–0.99× the full
+    /// frame on lavapipe, 0.76× on photo studio). Measured in docs/BENCHMARKS.md, "Where the
+    /// error comes from, map by map" (its forward-scattering grid part). The GPU march cannot
+    /// sweep: it runs this grid with `light_sweep` off.
     pub fn interactive() -> Self {
         Self {
             coarse_factor: 2,
