@@ -361,28 +361,18 @@ impl BenchReport {
                     report.adapter
                 );
             }
-            if let Some(r) = report.env_lit.iter().find(|r| {
-                merged
-                    .env_lit
-                    .iter()
-                    .any(|m| (&m.map, &m.mode) == (&r.map, &r.mode))
-            }) {
-                anyhow::bail!(
-                    "{} ({} scattering) is in more than one report",
-                    r.map,
-                    r.mode
-                );
+            let env_lit_key = |r: &EnvLitResult| (r.map.clone(), r.mode.clone());
+            if let Some((map, mode)) = repeated_key(&merged.env_lit, &report.env_lit, env_lit_key) {
+                anyhow::bail!("{map} ({mode} scattering) is in more than one report");
             }
-            if let Some(d) = report.decompositions.iter().find(|d| {
-                merged
-                    .decompositions
-                    .iter()
-                    .any(|m| (&m.map, &m.mode) == (&d.map, &d.mode))
-            }) {
+            let decomposition_key = |d: &ErrorDecomposition| (d.map.clone(), d.mode.clone());
+            if let Some((map, mode)) = repeated_key(
+                &merged.decompositions,
+                &report.decompositions,
+                decomposition_key,
+            ) {
                 anyhow::bail!(
-                    "the error decomposition of {} ({} scattering) is in more than one report",
-                    d.map,
-                    d.mode
+                    "the error decomposition of {map} ({mode} scattering) is in more than one report"
                 );
             }
             merged.runs.extend(runs_of(&report));
@@ -427,6 +417,17 @@ impl BenchReport {
         merged.git_revision = revisions.join(", ");
         Ok(merged)
     }
+}
+
+/// The first (map, mode) of `new` that `merged` already holds.
+fn repeated_key<T>(
+    merged: &[T],
+    new: &[T],
+    key: impl Fn(&T) -> (String, String),
+) -> Option<(String, String)> {
+    new.iter()
+        .map(&key)
+        .find(|k| merged.iter().any(|m| &key(m) == k))
 }
 
 /// The `bench` arguments of the runs `report` holds: its own, or those it was merged from.

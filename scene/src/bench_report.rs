@@ -115,6 +115,12 @@ fn reference_cell(lights: usize, converged: Option<bool>) -> String {
     }
 }
 
+/// One map's row: its name, the reference cell and one cell per step, in `steps`' order.
+fn decomposition_row(out: &mut String, d: &ErrorDecomposition, reference: &str, steps: &[&str]) {
+    let cells: Vec<String> = steps.iter().map(|l| step_cell(d.step(l))).collect();
+    let _ = writeln!(out, "| {} | {reference} | {} |", d.map, cells.join(" | "));
+}
+
 /// Per map, where the SRBF default's error comes from: each approximation of the method added
 /// in turn ([`decomposition`]).
 fn decomposition_tables(out: &mut String, report: &BenchReport) {
@@ -143,17 +149,15 @@ Each approximation of the method added in turn, the image measured against the r
             (Some((map, fit)), _) => format!("{map}, {fit}, not converged"),
             (None, _) => "–".into(),
         };
-        let _ = writeln!(
-            out,
-            "| {} | {} ({unshadowed}) | {} | {} | {} | {} | {} |",
-            d.map,
-            reference_cell(d.reference_lights, d.reference_converged),
-            step_cell(d.step(decomposition::FIT)),
-            step_cell(d.step(decomposition::TABLES)),
-            step_cell(d.step(decomposition::UNSHADOWED)),
-            step_cell(d.step(decomposition::EVERY_STRAND)),
-            step_cell(d.step(decomposition::DEFAULT_KAPPA)),
-        );
+        let reference = reference_cell(d.reference_lights, d.reference_converged);
+        let steps = [
+            decomposition::FIT,
+            decomposition::TABLES,
+            decomposition::UNSHADOWED,
+            decomposition::EVERY_STRAND,
+            decomposition::DEFAULT_KAPPA,
+        ];
+        decomposition_row(out, d, &format!("{reference} ({unshadowed})"), &steps);
     }
     let full: Vec<&ErrorDecomposition> = of_mode(ScatteringMode::Full).collect();
     if !full.is_empty() {
@@ -165,15 +169,13 @@ Full scattering, the SRBF default: the error of its single- and of its multiple-
 ");
     }
     for d in full {
-        let _ = writeln!(
-            out,
-            "| {} | {} | {} | {} | {} |",
-            d.map,
-            reference_cell(d.reference_lights, d.reference_converged),
-            step_cell(d.step(decomposition::SINGLE_PART)),
-            step_cell(d.step(decomposition::MULTIPLE_PART)),
-            step_cell(d.step(decomposition::FULL)),
-        );
+        let reference = reference_cell(d.reference_lights, d.reference_converged);
+        let steps = [
+            decomposition::SINGLE_PART,
+            decomposition::MULTIPLE_PART,
+            decomposition::FULL,
+        ];
+        decomposition_row(out, d, &reference, &steps);
     }
     out.push('\n');
 }
