@@ -1,7 +1,8 @@
 //! `strandlight image-error TEST.exr REF.exr`: the errors `compare` reports (relative RMSE and
 //! HDR-FLIP over the reference's hair pixels), between any two of its EXR images — e.g. a
 //! 384-light reference against a 1536-light one, to show how far a reduced reference is from
-//! converged.
+//! converged. A second line splits the error into what one brightness scale removes (a bias) and
+//! what it leaves (a pattern), and says how the brightest tenth of the hair compares.
 
 use std::path::PathBuf;
 
@@ -9,7 +10,7 @@ use anyhow::Context;
 use clap::Args;
 
 use strandlight_scene::hdr_flip::{error_map_magma, hdr_flip};
-use strandlight_scene::image_metrics::{mean_ratio, relative_rmse};
+use strandlight_scene::image_metrics::{error_split, mean_ratio, relative_rmse};
 use strandlight_scene::reference_cache::read_rgba_exr;
 
 #[derive(Args, Debug)]
@@ -45,6 +46,14 @@ pub fn run(args: ImageErrorArgs) -> anyhow::Result<()> {
         flip.start_exposure,
         flip.stop_exposure,
         pair()
+    );
+    let split = error_split(&test, &reference).with_context(pair)?;
+    println!(
+        "bias and pattern: the best single scale {:.4} leaves relative RMSE {:.4}; the brightest tenth of the hair is {:.4}× the reference's and holds {:.0}% of the squared error",
+        split.best_scale,
+        split.relative_rmse_after_scale,
+        split.brightest_tenth_ratio,
+        100.0 * split.brightest_tenth_share
     );
     if let Some(path) = &args.flip_map {
         let (w, h) = (reference.width, reference.height);

@@ -199,6 +199,80 @@ pub fn mean_ratio(approx: &Image, reference: &Image) -> Result<f64, CompareError
     Ok(sum_a / sum_r)
 }
 
+/// How an image's error over the hair splits between a brightness bias and a pattern, and
+/// where the bias sits: a bias is a modelling error a correction can target, a pattern is
+/// per-pixel scatter (shadow detail placed differently, noise).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ErrorSplit {
+    /// The one factor s that brings the image closest to the reference: the s minimizing
+    /// Σ‖s·a − r‖², s = Σ a·r / Σ a·a over RGB of the hair pixels.
+    pub best_scale: f64,
+    /// The relative RMSE of s·a: the error no brightness correction removes.
+    pub relative_rmse_after_scale: f64,
+    /// Σa / Σr over the brightest tenth of the reference's hair pixels (by their RGB sum; at
+    /// least one pixel): the lit fibers, which weigh most in a relative RMSE.
+    pub brightest_tenth_ratio: f64,
+    /// That tenth's share of Σ‖a − r‖² (0 when the images agree).
+    pub brightest_tenth_share: f64,
+}
+
+/// The [`ErrorSplit`] of `approx` against `reference` over the reference's hair pixels.
+pub fn error_split(approx: &Image, reference: &Image) -> Result<ErrorSplit, CompareError> {
+    check_finite("the reference", reference)?;
+    approx.check_against("the image", reference)?;
+    let hair: Vec<(&[f32; 4], &[f32; 4])> = approx
+        .pixels
+        .iter()
+        .zip(&reference.pixels)
+        .filter(|(_, r)| is_hair(r))
+        .collect();
+    if hair.is_empty() {
+        return Err(CompareError::NoHair);
+    }
+    let rgb_sum = |p: &[f32; 4]| (0..3).map(|c| p[c] as f64).sum::<f64>();
+    let squared_error = |(a, r): &(&[f32; 4], &[f32; 4])| {
+        (0..3)
+            .map(|c| (a[c] as f64 - r[c] as f64).powi(2))
+            .sum::<f64>()
+    };
+    let (mut ar, mut aa, mut rr) = (0.0f64, 0.0f64, 0.0f64);
+    for (a, r) in &hair {
+        for c in 0..3 {
+            let (a, r) = (a[c] as f64, r[c] as f64);
+            ar += a * r;
+            aa += a * a;
+            rr += r * r;
+        }
+    }
+    if rr == 0.0 {
+        return Err(CompareError::BlackReference);
+    }
+    // A black image has no brightness to correct: its best scale is taken as 1.
+    let s = if aa > 0.0 { ar / aa } else { 1.0 };
+    // Σ‖s·a − r‖² = s²·Σa² − 2s·Σa·r + Σr², never below 0 but for rounding.
+    let after = ((s * s * aa - 2.0 * s * ar + rr).max(0.0) / rr).sqrt();
+    let mut by_brightness = hair.clone();
+    by_brightness.sort_by(|x, y| rgb_sum(y.1).total_cmp(&rgb_sum(x.1)));
+    let tenth = &by_brightness[..hair.len().div_ceil(10)];
+    let tenth_sums = tenth
+        .iter()
+        .fold((0.0, 0.0), |(a, r), p| (a + rgb_sum(p.0), r + rgb_sum(p.1)));
+    let total_error: f64 = hair.iter().map(squared_error).sum();
+    let tenth_error: f64 = tenth.iter().map(squared_error).sum();
+    Ok(ErrorSplit {
+        best_scale: s,
+        relative_rmse_after_scale: after,
+        brightest_tenth_ratio: match tenth_sums.1 {
+            0.0 => 1.0,
+            r => tenth_sums.0 / r,
+        },
+        brightest_tenth_share: match total_error {
+            0.0 => 0.0,
+            e => tenth_error / e,
+        },
+    })
+}
+
 /// [`VIRIDIS`] at t ∈ [0, 1] (clamped), linearly interpolated between its samples.
 pub fn colormap(t: f64) -> [u8; 3] {
     let t = if t.is_finite() {
@@ -407,6 +481,62 @@ mod tests {
         let black = image(vec![[0.0, 0.0, 0.0, 1.0]; 3]);
         assert!(matches!(
             mean_ratio(&black, &black),
+            Err(CompareError::BlackReference)
+        ));
+    }
+
+    #[test]
+    fn error_split_by_hand() {
+        // Worked pair: Σa·r = 1.1 + 4 = 5.1, Σa² = 1.21 + 4 + 0.04 = 5.25, s = 5.1/5.25;
+        // Σ‖s·a − r‖² = s²·5.25 − 2s·5.1 + 5 = 5 − 5.1²/5.25.
+        let (approx, reference) = worked_pair();
+        let split = error_split(&approx, &reference).unwrap();
+        let s = 5.1 / 5.25;
+        assert!((split.best_scale - s).abs() < 1e-6, "{split:?}");
+        let after = ((5.0 - 5.1 * 5.1 / 5.25) / 5.0f64).sqrt();
+        assert!(
+            (split.relative_rmse_after_scale - after).abs() < 1e-6,
+            "{split:?}"
+        );
+        // Two hair pixels: the brightest tenth is the one pixel of RGB sum 2, measured 2.2; its
+        // error 0.2² (the blue) is 0.04 of Σ‖a − r‖² = 0.01 + 0.04.
+        assert!(
+            (split.brightest_tenth_ratio - 1.1).abs() < 1e-6,
+            "{split:?}"
+        );
+        assert!(
+            (split.brightest_tenth_share - 0.8).abs() < 1e-6,
+            "{split:?}"
+        );
+
+        // A pure bias (the image twice the reference) is all scale: nothing left after it.
+        let doubled = image(
+            reference
+                .pixels
+                .iter()
+                .map(|p| [2.0 * p[0], 2.0 * p[1], 2.0 * p[2], p[3]])
+                .collect(),
+        );
+        let split = error_split(&doubled, &reference).unwrap();
+        assert!((split.best_scale - 0.5).abs() < 1e-12);
+        assert!(split.relative_rmse_after_scale < 1e-7, "{split:?}");
+        assert!((split.brightest_tenth_ratio - 2.0).abs() < 1e-12);
+
+        // A pure pattern (the two hair pixels' light swapped) keeps the mean; the scale does
+        // not remove it.
+        let swapped = image(vec![[0.0, 2.0, 0.0, 1.0], [1.0, 0.0, 0.0, 0.5], [0.0; 4]]);
+        let split = error_split(&swapped, &reference).unwrap();
+        assert!(split.relative_rmse_after_scale > 0.99, "{split:?}");
+        assert_eq!(split.brightest_tenth_ratio, 0.5);
+        assert_eq!(
+            error_split(&reference, &reference)
+                .unwrap()
+                .brightest_tenth_share,
+            0.0
+        );
+        let black = image(vec![[0.0, 0.0, 0.0, 1.0]; 3]);
+        assert!(matches!(
+            error_split(&black, &black),
             Err(CompareError::BlackReference)
         ));
     }

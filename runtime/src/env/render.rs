@@ -340,7 +340,10 @@ pub struct EnvRenderer {
 
 /// A frame's lights split by kind, each batched apart: SRBFs and directional lights (each with
 /// its own table), each drawing every strand into their maps or κ of them (one light-pass
-/// geometry and one map size per batch).
+/// geometry and one map size per batch). κ-thinned SRBFs are ranked by power, strongest first:
+/// a thinned light's strand subset follows its place among them
+/// ([`FrameResources::next_windows`]), so the frame must not depend on the order its caller
+/// lists the lobes in (the fit, `compare`, `bench` and the viewer list them differently).
 struct LightKinds {
     srbf_every_strand: Vec<EnvLight>,
     srbf: Vec<EnvLight>,
@@ -352,7 +355,10 @@ impl LightKinds {
     fn of(lights: &[EnvLight]) -> Self {
         let (srbf, directional): (Vec<EnvLight>, _) =
             lights.iter().partition(|l| l.lambda.is_some());
-        let (srbf_every_strand, srbf) = srbf.into_iter().partition(|l| l.every_strand);
+        let (srbf_every_strand, mut srbf): (_, Vec<EnvLight>) =
+            srbf.into_iter().partition(|l| l.every_strand);
+        // Stable, so lights of equal power keep the caller's order.
+        srbf.sort_by(|a, b| b.luminous_power().total_cmp(&a.luminous_power()));
         let (directional, directional_thinned) =
             directional.into_iter().partition(|l| l.every_strand);
         Self {
