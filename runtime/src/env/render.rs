@@ -343,7 +343,7 @@ pub struct EnvRenderer {
 /// geometry and one map size per batch). κ-thinned SRBFs are ranked by power, strongest first:
 /// a thinned light's strand subset follows its place among them
 /// ([`FrameResources::next_windows`]), so the frame must not depend on the order its caller
-/// lists the lobes in (the fit, `compare`, `bench` and the viewer list them differently).
+/// lists the lobes in (`compare` lists them in fit order, `bench` by power).
 struct LightKinds {
     srbf_every_strand: Vec<EnvLight>,
     srbf: Vec<EnvLight>,
