@@ -1718,7 +1718,8 @@ fn a_lobe_drawing_every_strand_is_shadowed_as_at_kappa_one() {
 /// Each simplified light draws its own window of strands: at κ ½ a lobe split into two halves
 /// is shadowed by the two complementary subsets (a different image from the one lobe with one
 /// subset), while at κ 1 the split changes nothing. And the frame is the sum of its lights'
-/// windows in order: the second half's part equals the lobe rendered as a frame's second light.
+/// windows by power rank: the second half's part equals the lobe rendered as a frame's second
+/// light, behind a brighter one.
 #[test]
 fn each_simplified_light_draws_its_own_subset_of_strands() {
     let gpu = gpu();
@@ -1728,6 +1729,12 @@ fn each_simplified_light_draws_its_own_subset_of_strands() {
         rgb: lobe.rgb.map(|c| 0.5 * c),
         ..lobe
     };
+    // Ten times its lobe's power: `other` ranks first, so `lobe` takes the second window.
+    let other = EnvLight {
+        rgb: other.rgb.map(|c| 10.0 * c),
+        ..other
+    };
+    assert!(other.luminous_power() > lobe.luminous_power());
     let render = |lights: &[EnvLight], kappa: f32| render_groom(&gpu, &scene, lights, kappa);
     let split_full = worst_relative(&render(&[half, half], 1.0), &render(&[lobe], 1.0));
     let (split, whole) = (render(&[half, half], 0.5), render(&[lobe], 0.5));
