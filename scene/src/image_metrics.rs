@@ -220,7 +220,7 @@ pub struct ErrorSplit {
 pub fn error_split(approx: &Image, reference: &Image) -> Result<ErrorSplit, CompareError> {
     check_finite("the reference", reference)?;
     approx.check_against("the image", reference)?;
-    let hair: Vec<(&[f32; 4], &[f32; 4])> = approx
+    let mut hair: Vec<(&[f32; 4], &[f32; 4])> = approx
         .pixels
         .iter()
         .zip(&reference.pixels)
@@ -230,11 +230,6 @@ pub fn error_split(approx: &Image, reference: &Image) -> Result<ErrorSplit, Comp
         return Err(CompareError::NoHair);
     }
     let rgb_sum = |p: &[f32; 4]| (0..3).map(|c| p[c] as f64).sum::<f64>();
-    let squared_error = |(a, r): &(&[f32; 4], &[f32; 4])| {
-        (0..3)
-            .map(|c| (a[c] as f64 - r[c] as f64).powi(2))
-            .sum::<f64>()
-    };
     let (mut ar, mut aa, mut rr) = (0.0f64, 0.0f64, 0.0f64);
     for (a, r) in &hair {
         for c in 0..3 {
@@ -249,16 +244,20 @@ pub fn error_split(approx: &Image, reference: &Image) -> Result<ErrorSplit, Comp
     }
     // A black image has no brightness to correct: its best scale is taken as 1.
     let s = if aa > 0.0 { ar / aa } else { 1.0 };
-    // Σ‖s·a − r‖² = s²·Σa² − 2s·Σa·r + Σr², never below 0 but for rounding.
-    let after = ((s * s * aa - 2.0 * s * ar + rr).max(0.0) / rr).sqrt();
-    let mut by_brightness = hair.clone();
-    by_brightness.sort_by(|x, y| rgb_sum(y.1).total_cmp(&rgb_sum(x.1)));
-    let tenth = &by_brightness[..hair.len().div_ceil(10)];
+    // Σ‖s·a − r‖² = s²·Σa² − 2s·Σa·r + Σr² (s = 1: the error itself), never below 0 but for
+    // rounding.
+    let squared_error_at = |s: f64| (s * s * aa - 2.0 * s * ar + rr).max(0.0);
+    let after = (squared_error_at(s) / rr).sqrt();
+    let total_error = squared_error_at(1.0);
+    hair.sort_by(|x, y| rgb_sum(y.1).total_cmp(&rgb_sum(x.1)));
+    let tenth = &hair[..hair.len().div_ceil(10)];
     let tenth_sums = tenth
         .iter()
         .fold((0.0, 0.0), |(a, r), p| (a + rgb_sum(p.0), r + rgb_sum(p.1)));
-    let total_error: f64 = hair.iter().map(squared_error).sum();
-    let tenth_error: f64 = tenth.iter().map(squared_error).sum();
+    let tenth_error: f64 = tenth
+        .iter()
+        .flat_map(|(a, r)| (0..3).map(move |c| (a[c] as f64 - r[c] as f64).powi(2)))
+        .sum();
     Ok(ErrorSplit {
         best_scale: s,
         relative_rmse_after_scale: after,
