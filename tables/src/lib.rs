@@ -21,6 +21,7 @@ pub mod kajiya_kay;
 pub mod longitudinal;
 pub mod marschner;
 pub mod model_sweeps;
+pub mod outside_tools;
 pub mod quadrature;
 pub mod scattering;
 pub mod shared_data;
