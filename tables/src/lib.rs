@@ -13,6 +13,7 @@ pub mod artist;
 pub mod asset;
 pub mod atomic_write;
 pub mod checksum;
+pub mod chiang;
 pub mod dual_scattering;
 pub mod dual_scattering_hard_cases;
 pub mod error;
