@@ -1,8 +1,12 @@
 //! What to bake for a fiber: the table jobs of each model (Ren 2010 §4, §6; Hunz §3.3.4), and
 //! the decision to skip multiple scattering for hair too dark to need it.
+//!
+//! Multiple scattering (`fiber_averages`, `multiple`) comes from one model: Marschner when it
+//! is baked, else Chiang, else the artist model's normalized copy.
 
 use crate::attenuation_ratio::attenuation_ratio_table;
 use crate::bake::{BuildError, TableJob};
+use crate::chiang_luts::{bake_chiang_lut_m, bake_chiang_lut_n};
 use crate::convolution::{ConvolutionGrid, ConvolutionSettings, convolve_grid};
 use crate::convolution_table::{ConvolutionResolution, bake_convolution_table};
 use crate::direct_table::{DirectResolution, bake_direct_table};
@@ -17,6 +21,7 @@ use std::path::Path;
 use std::sync::Arc;
 use strandlight_tables::FiberAngles;
 use strandlight_tables::artist::{ArtistModel, ArtistParams, Normalization};
+use strandlight_tables::chiang::{Chiang, ChiangParams};
 use strandlight_tables::dual_scattering::{
     DualScatteringAverages, DualScatteringBcsdf, DualScatteringConfig, LobeDecomposition,
 };
@@ -29,13 +34,16 @@ use strandlight_tables::table_axes::{AXIS_QUANTITY, AXIS_SIN_THETA};
 use thiserror::Error;
 
 /// Everything about a fiber that any table depends on. A TOML file with any subset of these
-/// sections (`[marschner]`, `[kajiya_kay]`, `[artist]`, `[dual_scattering]`); the rest default.
+/// sections (`[marschner]`, `[kajiya_kay]`, `[artist]`, `[chiang]`, `[dual_scattering]`); the
+/// rest default.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(default, deny_unknown_fields)]
 pub struct FiberDescription {
     pub marschner: MarschnerParams,
     pub kajiya_kay: KajiyaKayParams,
     pub artist: ArtistParams,
+    /// Chiang et al. 2016 under Mitsuba's parameter names (the path tracer's fiber).
+    pub chiang: ChiangParams,
     pub dual_scattering: DualScatteringConfig,
 }
 
@@ -56,14 +64,18 @@ pub enum FiberError {
 }
 
 impl FiberDescription {
-    /// The defaults with the Marschner absorption of a named melanin preset.
+    /// The defaults with the melanin of a named preset: Marschner's absorption and Chiang's
+    /// concentrations.
     pub fn preset(name: &str) -> Result<Self, FiberError> {
-        let marschner = MarschnerParams::with_preset(name).map_err(|source| FiberError::Param {
+        let preset_error = |source| FiberError::Param {
             context: "--preset".into(),
             source,
-        })?;
+        };
+        let marschner = MarschnerParams::with_preset(name).map_err(preset_error)?;
+        let chiang = ChiangParams::with_preset(name).map_err(preset_error)?;
         Ok(Self {
             marschner,
+            chiang,
             ..Self::default()
         })
     }
@@ -95,6 +107,7 @@ impl FiberDescription {
             .validate()
             .map_err(param_error("[kajiya_kay]"))?;
         self.artist.validate().map_err(param_error("[artist]"))?;
+        self.chiang.validate().map_err(param_error("[chiang]"))?;
         self.dual_scattering
             .validate()
             .map_err(param_error("[dual_scattering]"))?;
@@ -109,6 +122,8 @@ pub enum Model {
     Marschner,
     KajiyaKay,
     Artist,
+    /// Chiang et al. 2016 (serde `"chiang"`).
+    Chiang,
 }
 
 /// Node counts of every table.
@@ -401,6 +416,20 @@ pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan,
         ));
     }
 
+    if options.models.contains(&Model::Chiang) {
+        let source = push_chiang(&mut jobs, fiber, &options.resolution, settings)?;
+        if multiple_source.is_none() {
+            let (single, averages, params) = source;
+            push_fiber_averages(
+                &mut jobs,
+                averages.clone(),
+                params.clone(),
+                options.resolution.fiber_average_thetas,
+            );
+            multiple_source = Some((single, averages, params, "chiang"));
+        }
+    }
+
     if options.models.contains(&Model::KajiyaKay) {
         push_kajiya_kay(&mut jobs, fiber, &options.resolution, settings)?;
     }
@@ -504,6 +533,101 @@ pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan,
         skipped,
         multiple_scattering_share: share,
     })
+}
+
+/// The Chiang jobs, parallel to Marschner's: `chiang` (I of S), `chiang_full` (S + d_b S_back
+/// with the averages of Chiang's lobe decomposition), the two direct tables and the
+/// point-light textures `chiang_lut_m`, `chiang_lut_n` ([`crate::chiang_luts`]). Returns the
+/// model, its dual-scattering averages and their parameters, for the caller to use as the
+/// multiple-scattering source.
+#[allow(clippy::type_complexity)]
+fn push_chiang(
+    jobs: &mut Vec<TableJob>,
+    fiber: &FiberDescription,
+    res: &BakeResolution,
+    settings: ConvolutionSettings,
+) -> Result<
+    (
+        Arc<dyn ScatteringFunction>,
+        DualScatteringAverages,
+        serde_json::Value,
+    ),
+    FiberError,
+> {
+    let c = Arc::new(Chiang::new(fiber.chiang.clone()).map_err(param_error("[chiang]"))?);
+    // Build the model's N̄ grid once, before the jobs share it.
+    c.prepare();
+    let params = json!({ "chiang": fiber.chiang });
+    let conv_settings = json!({ "resolution": res.convolution, "settings": res.settings });
+    let (s, r) = (c.clone(), res.clone());
+    jobs.push(TableJob {
+        name: "chiang",
+        quantity: "I_C: ∫ G(ω_i; ξ, λ) S(ω_i, ω_o) cos θ_i dω_i, Chiang et al. 2016 single scattering averaged over the fiber's width, RGB".into(),
+        scattering_function: "chiang".into(),
+        fiber_parameters: params.clone(),
+        settings: conv_settings.clone(),
+        build: Box::new(move || Ok(bake_convolution_table(&|a: &FiberAngles| s.eval(a), &r.convolution, &settings)?)),
+    });
+    let averages =
+        DualScatteringAverages::new(c.as_ref() as &dyn LobeDecomposition, fiber.dual_scattering)
+            .map_err(param_error("[chiang] dual-scattering averages"))?;
+    let full_params = json!({ "chiang": fiber.chiang, "dual_scattering": fiber.dual_scattering });
+    let bcsdf = Arc::new(DualScatteringBcsdf {
+        single: (*c).clone(),
+        averages: averages.clone(),
+    });
+    let (b, r) = (bcsdf.clone(), res.clone());
+    jobs.push(TableJob {
+        name: "chiang_full",
+        quantity: "I_C with d_b·S_back: ∫ G (S + d_b S_back) cos θ_i dω_i (Ren §7), RGB".into(),
+        scattering_function: "chiang+dual-scattering-back".into(),
+        fiber_parameters: full_params.clone(),
+        settings: conv_settings,
+        build: Box::new(move || {
+            Ok(bake_convolution_table(
+                &|a: &FiberAngles| b.eval(a),
+                &r.convolution,
+                &settings,
+            )?)
+        }),
+    });
+    push_direct(
+        jobs,
+        "chiang_direct",
+        "S(ω_i, ω_o)·cos θ_i of Chiang et al. 2016 for a directional light, RGB",
+        "chiang",
+        params.clone(),
+        res,
+        c.clone(),
+    );
+    push_direct(
+        jobs,
+        "chiang_full_direct",
+        "(S + d_b S_back)·cos θ_i of Chiang et al. 2016 for a directional light (Ren §7), RGB",
+        "chiang+dual-scattering-back",
+        full_params.clone(),
+        res,
+        bcsdf,
+    );
+    let (cm, cn) = (c.clone(), c.clone());
+    let luts = res.luts;
+    jobs.push(TableJob {
+        name: "chiang_lut_m",
+        quantity: "Chiang M texture: M_R, M_TT, M_TRT, M_residual over (sin θ_i, sin θ_o); S·cos θ_i = Σ_p M_p N̄_p".into(),
+        scattering_function: "chiang".into(),
+        fiber_parameters: params.clone(),
+        settings: json!({ "luts": luts }),
+        build: Box::new(move || bake_chiang_lut_m(&cm, &luts).map_err(boxed)),
+    });
+    jobs.push(TableJob {
+        name: "chiang_lut_n",
+        quantity: "Chiang N texture: N̄_R, N̄_TT, N̄_TRT, N̄_residual over (cos φ, sin θ_o), RGB; S·cos θ_i = Σ_p M_p N̄_p".into(),
+        scattering_function: "chiang".into(),
+        fiber_parameters: params,
+        settings: json!({ "luts": luts }),
+        build: Box::new(move || bake_chiang_lut_n(&cn, &luts).map_err(boxed)),
+    });
+    Ok((c as Arc<dyn ScatteringFunction>, averages, full_params))
 }
 
 /// A direct table of `model` (see [`crate::direct_table`]): same fiber parameters as the
@@ -722,6 +846,89 @@ mod tests {
     }
 
     #[test]
+    fn chiang_jobs_parallel_marschners_and_skip_multiple_scattering_for_dark_hair() {
+        let options = PlanOptions {
+            models: vec![Model::Chiang],
+            resolution: BakeResolution::reduced(4),
+            ..Default::default()
+        };
+        let blonde = plan(&FiberDescription::preset("blonde").unwrap(), &options).unwrap();
+        let names: Vec<&str> = blonde.jobs.iter().map(|j| j.name).collect();
+        for want in [
+            "chiang",
+            "chiang_full",
+            "chiang_direct",
+            "chiang_full_direct",
+            "chiang_lut_m",
+            "chiang_lut_n",
+            "fiber_averages",
+            "multiple",
+            "attenuation_ratio",
+            "srbf_spread",
+        ] {
+            assert!(names.contains(&want), "{want} missing from {names:?}");
+        }
+        let averages = blonde
+            .jobs
+            .iter()
+            .find(|j| j.name == "fiber_averages")
+            .unwrap();
+        assert!(averages.fiber_parameters.get("chiang").is_some());
+        for preset in ["dark", "brown", "red", "blonde", "white"] {
+            let p = plan(&FiberDescription::preset(preset).unwrap(), &options).unwrap();
+            println!(
+                "chiang multiple-scattering share {preset}: {:.4}",
+                p.multiple_scattering_share.unwrap()
+            );
+        }
+        let dark = plan(&FiberDescription::preset("dark").unwrap(), &options).unwrap();
+        assert!(dark.skipped.iter().any(|s| s.name == "multiple"));
+        let d = dark.multiple_scattering_share.unwrap();
+        assert!(d > 0.03 && d < DEFAULT_MULTIPLE_THRESHOLD, "{d}");
+        let b = blonde.multiple_scattering_share.unwrap();
+        assert!(b > DEFAULT_MULTIPLE_THRESHOLD && b < 1.0, "{b}");
+    }
+
+    #[test]
+    fn marschner_stays_the_multiple_scattering_source_beside_chiang() {
+        let options = PlanOptions {
+            models: vec![Model::Chiang, Model::Marschner, Model::Artist],
+            resolution: BakeResolution::reduced(4),
+            ..Default::default()
+        };
+        let p = plan(&FiberDescription::preset("blonde").unwrap(), &options).unwrap();
+        let averages: Vec<_> = p
+            .jobs
+            .iter()
+            .filter(|j| j.name == "fiber_averages")
+            .collect();
+        assert_eq!(averages.len(), 1);
+        assert!(averages[0].fiber_parameters.get("marschner").is_some());
+        let multiple = p.jobs.iter().find(|j| j.name == "multiple").unwrap();
+        assert!(multiple.scattering_function.starts_with("marschner"));
+        // Every table name is unique.
+        let mut names: Vec<&str> = p.jobs.iter().map(|j| j.name).collect();
+        names.sort_unstable();
+        let before = names.len();
+        names.dedup();
+        assert_eq!(names.len(), before);
+    }
+
+    #[test]
+    fn presets_set_the_chiang_melanin_and_model_names_round_trip() {
+        let dark = FiberDescription::preset("dark").unwrap();
+        assert_eq!((dark.chiang.eumelanin, dark.chiang.pheomelanin), (8.0, 0.0));
+        let red = FiberDescription::preset("red").unwrap();
+        assert_eq!((red.chiang.eumelanin, red.chiang.pheomelanin), (0.3, 2.0));
+        assert_eq!(red.marschner.sigma_a, red.chiang.absorption().unwrap());
+        assert_eq!(serde_json::to_string(&Model::Chiang).unwrap(), "\"chiang\"");
+        assert_eq!(
+            serde_json::from_str::<Model>("\"chiang\"").unwrap(),
+            Model::Chiang
+        );
+    }
+
+    #[test]
     fn fiber_files_report_the_file_and_the_parameter() {
         let dir = std::env::temp_dir().join(format!("strandlight-fiber-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
@@ -743,6 +950,24 @@ mod tests {
         .unwrap();
         let ok = FiberDescription::from_toml_file(&path).unwrap();
         assert_eq!(ok.marschner.eta, 1.6);
+        std::fs::write(&path, "[chiang]\nlongitudinal_roughness = 1.5\n").unwrap();
+        let err = FiberDescription::from_toml_file(&path)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("[chiang]") && err.contains("longitudinal_roughness"),
+            "{err}"
+        );
+        std::fs::write(
+            &path,
+            "[chiang]\neumelanin = 0.5\nscale_tilt_degrees = 3.0\n",
+        )
+        .unwrap();
+        let ok = FiberDescription::from_toml_file(&path).unwrap();
+        assert_eq!(
+            (ok.chiang.eumelanin, ok.chiang.scale_tilt_degrees),
+            (0.5, 3.0)
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

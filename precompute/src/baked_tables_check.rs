@@ -7,6 +7,7 @@ use crate::attenuation_ratio::attenuation_ratio;
 use crate::convolution::convolve_reference;
 use crate::direct_table::direct_value;
 use crate::multiple_scattering_table::multiple_scattering_reference;
+use crate::point_light_luts::AzimuthAxis;
 use crate::srbf_spread::srbf_longitudinal_variance;
 use crate::table_accuracy::{TableAccuracy, stratified_points, summarize};
 use rayon::prelude::*;
@@ -15,6 +16,9 @@ use std::sync::Arc;
 use strandlight_tables::FiberAngles;
 use strandlight_tables::artist::{ArtistModel, ArtistParams, Normalization};
 use strandlight_tables::asset::TableAsset;
+use strandlight_tables::chiang::{
+    AzimuthalResolution, Chiang, ChiangParams, LOBES, MIN_LOGISTIC_SCALE,
+};
 use strandlight_tables::dual_scattering::{
     DualScatteringAverages, DualScatteringConfig, LobeDecomposition, backscatter_series,
     fiber_averages_direct,
@@ -86,7 +90,7 @@ fn check_asset_with(
     let table = &asset.table;
     let axes = table.axes();
     let (reference, points): (Reference, Vec<Vec<f64>>) = match name.as_str() {
-        "marschner" | "marschner_full" | "artist" => {
+        "marschner" | "marschner_full" | "artist" | "chiang" | "chiang_full" => {
             let s = scattering_from(&name, params).map_err(bad)?;
             let (lmin, lmax) = (1.0 / axes[3].max, 1.0 / axes[3].min);
             let pts = stratified_points(samples, lmin, lmax, seed)
@@ -106,7 +110,11 @@ fn check_asset_with(
             });
             (r, pts)
         }
-        "marschner_direct" | "marschner_full_direct" | "artist_direct" => {
+        "marschner_direct"
+        | "marschner_full_direct"
+        | "artist_direct"
+        | "chiang_direct"
+        | "chiang_full_direct" => {
             let s = scattering_from(name.trim_end_matches("_direct"), params).map_err(bad)?;
             // The convolution tables' stratification (grazing ends, Δφ strata), at the one
             // 1/λ node; the reference evaluates the model itself in f64.
@@ -206,6 +214,14 @@ fn check_asset_with(
         "lut_m" | "lut_n" => {
             let m = Arc::new(marschner_from(params).map_err(bad)?);
             let is_m = name == "lut_m";
+            let azimuth = if is_m {
+                AzimuthAxis::CosPhi
+            } else {
+                AzimuthAxis::of_table(table).map_err(|source| CheckError::Lookup {
+                    path: path.clone(),
+                    source,
+                })?
+            };
             let r: Reference = Arc::new(move |x: &[f64]| {
                 let lobe = |q: f64| [Lobe::R, Lobe::TT, Lobe::TRT][(q.round() as usize).min(2)];
                 if is_m {
@@ -216,12 +232,29 @@ fn check_asset_with(
                         vec![m.longitudinal(lobe(x[2]), ti, to)]
                     }
                 } else {
-                    m.azimuthal(
-                        lobe(x[2]),
-                        x[1].clamp(0.0, 1.0).acos(),
-                        x[0].clamp(-1.0, 1.0).acos(),
-                    )
-                    .to_vec()
+                    m.azimuthal(lobe(x[2]), x[1].clamp(0.0, 1.0).acos(), azimuth.phi(x[0]))
+                        .to_vec()
+                }
+            });
+            (r, random_points(table, samples, seed))
+        }
+        "chiang_lut_m" | "chiang_lut_n" => {
+            let m = Arc::new(chiang_from(params).map_err(bad)?);
+            let is_m = name == "chiang_lut_m";
+            let azimuth = if is_m {
+                AzimuthAxis::CosPhi
+            } else {
+                AzimuthAxis::of_table(table).map_err(|source| CheckError::Lookup {
+                    path: path.clone(),
+                    source,
+                })?
+            };
+            let r: Reference = Arc::new(move |x: &[f64]| {
+                let p = (x[2].round() as usize).min(LOBES - 1);
+                if is_m {
+                    vec![m.longitudinal(p, x[0].asin(), x[1].asin())]
+                } else {
+                    m.azimuthal_exact(x[1].clamp(-1.0, 1.0).asin(), azimuth.phi(x[0]))[p].to_vec()
                 }
             });
             (r, random_points(table, samples, seed))
@@ -336,6 +369,10 @@ fn compare(
             | "marschner_direct"
             | "marschner_full_direct"
             | "artist_direct"
+            | "chiang"
+            | "chiang_full"
+            | "chiang_direct"
+            | "chiang_full_direct"
     );
     Ok(summarize(name, table, table_max, &rows, directional))
 }
@@ -358,11 +395,22 @@ fn artist_from(params: &Value) -> Result<ArtistModel, String> {
     ArtistModel::new(section::<ArtistParams>(params, "artist")?).map_err(|e| e.to_string())
 }
 
+/// The Chiang fiber of the stored parameters, with its N̄ grid twice as fine as a bake's on
+/// both axes (≈ 8× less interpolation error), so that the reference does not share the
+/// bake's N̄ grid.
+fn chiang_from(params: &Value) -> Result<Chiang, String> {
+    let p = section::<ChiangParams>(params, "chiang")?;
+    let s = p.logistic_scale().max(MIN_LOGISTIC_SCALE);
+    Chiang::with_resolution(p, AzimuthalResolution::for_scale(s).refined(2))
+        .map_err(|e| e.to_string())
+}
+
 /// The function a convolution table integrates.
 fn scattering_from(name: &str, params: &Value) -> Result<Arc<dyn ScatteringFunction>, String> {
     Ok(match name {
         "marschner" => Arc::new(marschner_from(params)?),
         "artist" => Arc::new(artist_from(params)?),
+        "chiang" => Arc::new(chiang_from(params)?),
         _ => bcsdf_from(params)?,
     })
 }
@@ -371,6 +419,8 @@ fn scattering_from(name: &str, params: &Value) -> Result<Arc<dyn ScatteringFunct
 fn lobes_from(params: &Value) -> Result<Arc<dyn LobesAndScattering>, String> {
     if params.get("marschner").is_some() {
         Ok(Arc::new(marschner_from(params)?))
+    } else if params.get("chiang").is_some() {
+        Ok(Arc::new(chiang_from(params)?))
     } else {
         Ok(Arc::new(
             artist_from(params)?.normalized(Normalization::PeakPerChannel),

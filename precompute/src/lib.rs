@@ -10,6 +10,7 @@
 //! [`convolution_table`] (I_M, I_A, I_d, I_s as tables), [`direct_table`] (S·cos θ_i for
 //! directional lights, on the same axes), [`multiple_scattering_table`] (I_G),
 //! [`attenuation_ratio`], [`srbf_spread`], [`point_light_luts`] (Hunz Algorithm 2),
+//! [`chiang_luts`] (the same for the Chiang fiber),
 //! [`bake_plan`] (which tables a fiber needs), [`bake`] (assets and the cache),
 //! [`table_accuracy`] (the accuracy measure: stratified off-grid points against f64 integration) and [`baked_tables_check`] (every baked asset against its f64 reference).
 
@@ -17,6 +18,7 @@ pub mod attenuation_ratio;
 pub mod bake;
 pub mod bake_plan;
 pub mod baked_tables_check;
+pub mod chiang_luts;
 pub mod compact_sources;
 pub mod convolution;
 pub mod convolution_table;

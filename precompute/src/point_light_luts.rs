@@ -115,7 +115,7 @@ impl AzimuthAxis {
             })
     }
 
-    fn axis(self, count: usize) -> Axis {
+    pub(crate) fn axis(self, count: usize) -> Axis {
         match self {
             AzimuthAxis::CosPhi => Axis::uniform(self.name(), -1.0, 1.0, count),
             AzimuthAxis::CosHalfPhi => Axis::uniform(self.name(), 0.0, 1.0, count),
@@ -456,6 +456,18 @@ pub fn stratified_points(
     max_inclination: f64,
     seed: u64,
 ) -> Vec<FiberAngles> {
+    let lobes = Lobe::ALL.map(|l| model.shift_width(l));
+    stratified_points_for_lobes(lobes, count, max_inclination, seed)
+}
+
+/// [`stratified_points`] for any model with lobes R, TT, TRT of longitudinal shift α_p and
+/// width β_p in θ_h (radians, in that order).
+pub fn stratified_points_for_lobes(
+    lobes: [(f64, f64); 3],
+    count: usize,
+    max_inclination: f64,
+    seed: u64,
+) -> Vec<FiberAngles> {
     let limit = max_inclination.clamp(0.0, PI / 2.0);
     let band = limit.min(10f64.to_radians());
     let mut rng = SplitMix64(seed);
@@ -465,7 +477,7 @@ pub fn stratified_points(
             let stratum = ((k / 4) as f64 + rng.unit()) / per_kind as f64;
             let lobe = Lobe::ALL[(k / 4) % 3];
             let ridge = |rng: &mut SplitMix64, theta_other: f64| {
-                let (alpha, beta) = model.shift_width(lobe);
+                let (alpha, beta) = lobes[lobe.index()];
                 let theta_h = alpha + 2.0 * beta * (2.0 * rng.unit() - 1.0);
                 (2.0 * theta_h - theta_other).clamp(-limit, limit)
             };
