@@ -73,11 +73,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let t = Instant::now();
             let acc = check_asset(&read_asset(&baked.path)?, points, 1)?;
             print!(
-                " | check {:.1} s, {points} points: max {:.3e} rms {:.3e} (of the table's max) max rel(>1%) {:.3e}",
+                " | check {:.1} s, {points} points: max {:.3e} rms {:.3e} (of the table's max) max rel(>1%) {:.3e}, worst at {:.3?}",
                 t.elapsed().as_secs_f64(),
                 acc.max_abs_error,
                 acc.rms_abs_error,
-                acc.max_rel_error
+                acc.max_rel_error,
+                acc.worst_point
             );
         }
         println!();

@@ -68,8 +68,14 @@
 //! at the lobe's centre, where θ_i = 2α_p − θ_o), with
 //! `J_p(θ_o) = ∫ g(β_p², θ_h − α_p) cos²θ_i / cos²θ_d dθ_i` (≈ 2 for narrow lobes, less for
 //! wide ones cut off at the poles), so that for every view the decomposition's
-//! `∫ S cos θ_i dω_i` equals the exact model's lobe by lobe up to the variation of N̄_p across
-//! the lobe's width (measured in the tests). The shape in θ is only the Gaussian's.
+//! `∫ S cos θ_i dω_i` equals the exact model's lobe by lobe, up to the variation of N̄_p and
+//! J_p across a lobe's width. Measured (tests): within 0.1% for views within 35° of the normal
+//! plane, 1.5% at 57°; toward grazing views the Gaussians, cut off at the poles where d'Eon's
+//! term wraps around them, lose up to 18% (brown fiber at 74°). The shape in θ is only the
+//! Gaussian's. The exact model is not reciprocal, so its energy per *light* direction (what
+//! dual scattering's ā_f + ā_b measure) differs from the per-view energy it conserves: a white
+//! fiber lit at 86° sends out 1.34 of the light; the decomposition, nearly reciprocal by
+//! construction, does not reproduce that excess.
 
 pub mod azimuthal;
 pub mod params;
