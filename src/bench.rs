@@ -11,7 +11,7 @@ use clap::Args;
 use strandlight_scene::baseline::Baseline;
 use strandlight_scene::bench::{BenchPaths, BenchPlan, BenchReport, PlanChanges, run as run_bench};
 use strandlight_scene::bench_plots::{Metric, plot};
-use strandlight_scene::bench_report::{section, splice};
+use strandlight_scene::bench_report::{section, splice, splice_truth, truth_section};
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 use strandlight_tables::atomic_write::write_atomically;
@@ -22,6 +22,11 @@ pub struct BenchArgs {
     /// One map, single scattering, 160×120, a reference of at most 384 lights: a few minutes.
     #[arg(long)]
     pub quick: bool,
+    /// Every map in both modes against the path-traced ground truth (Mitsuba 3, which must be
+    /// installed: `pip install mitsuba`) with the Chiang fiber: the SRBF default, the median-cut
+    /// front and the DOM reference; rewrites the section docs/BENCHMARKS.md opens with.
+    #[arg(long, conflicts_with = "quick")]
+    pub truth: bool,
     /// The shared data folder (default: $STRANDLIGHT_SHARED_DATA or ../shared/data).
     #[arg(long)]
     pub data: Option<PathBuf>,
@@ -61,7 +66,7 @@ pub struct BenchArgs {
     /// wrote (after a change to how they are drawn, without the hour of measuring). Several
     /// reports of the same plan on different maps or modes (a sweep run map by map, each with
     /// the reference budget its map needs) make one page.
-    #[arg(long, value_name = "REPORT_JSON", num_args = 1.., conflicts_with_all = ["quick", "maps", "data", "modes", "reference_max_lights", "baseline_lights", "baseline", "decomposition_only"])]
+    #[arg(long, value_name = "REPORT_JSON", num_args = 1.., conflicts_with_all = ["quick", "truth", "maps", "data", "modes", "reference_max_lights", "baseline_lights", "baseline", "decomposition_only"])]
     pub from_report: Vec<PathBuf>,
 }
 
@@ -82,10 +87,10 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     };
     let quick = report.plan.is_quick();
     let out = args.out.clone().unwrap_or_else(|| {
-        PathBuf::from(if quick {
-            "out/bench-quick"
-        } else {
-            "docs/bench"
+        PathBuf::from(match report.plan.name.as_str() {
+            "quick" => "out/bench-quick",
+            "truth" => "docs/bench-truth",
+            _ => "docs/bench",
         })
     });
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
@@ -95,7 +100,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     })
     .with_context(|| format!("writing {}", json.display()))?;
     for r in &report.env_lit {
-        for metric in [Metric::RelativeRmse, Metric::HdrFlip] {
+        for metric in Metric::of_result(r) {
             let stem = format!("{}-{}-{}", r.map, r.mode, metric.file_tag());
             let [png, _] = plot(&out, &stem, r, metric)?;
             println!("wrote {} (and .svg)", png.display());
@@ -115,8 +120,11 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             &out,
             args.benchmarks.parent().unwrap_or(&PathBuf::from(".")),
         );
-        let updated = splice(&page, &section(&report, &relative))
-            .with_context(|| args.benchmarks.display().to_string())?;
+        let updated = match report.plan.is_truth() {
+            true => splice_truth(&page, &truth_section(&report, &relative)),
+            false => splice(&page, &section(&report, &relative)),
+        }
+        .with_context(|| args.benchmarks.display().to_string())?;
         write_atomically(&args.benchmarks, |w| {
             std::io::Write::write_all(w, updated.as_bytes())
         })
@@ -145,10 +153,10 @@ fn measure(args: &BenchArgs) -> anyhow::Result<Option<BenchReport>> {
         );
         return Ok(None);
     }
-    let base = if args.quick {
-        BenchPlan::quick()
-    } else {
-        BenchPlan::full()
+    let base = match (args.quick, args.truth) {
+        (true, _) => BenchPlan::quick(),
+        (_, true) => BenchPlan::truth(),
+        _ => BenchPlan::full(),
     };
     let plan = base.changed(&PlanChanges {
         maps: args.maps.clone(),

@@ -9,6 +9,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 
+use strandlight_scene::ground_truth::{read_truth_sidecar, without_noise};
 use strandlight_scene::hdr_flip::{error_map_magma, hdr_flip};
 use strandlight_scene::image_metrics::{error_split, mean_ratio, relative_rmse};
 use strandlight_scene::reference_cache::read_rgba_exr;
@@ -55,6 +56,21 @@ pub fn run(args: ImageErrorArgs) -> anyhow::Result<()> {
         split.brightest_tenth_ratio,
         100.0 * split.brightest_tenth_share
     );
+    if let Some(truth) = read_truth_sidecar(&args.reference) {
+        println!(
+            "the reference is a path-traced ground truth ({}, {} spp, depth {}{}) with noise {:.4}: without it, relative RMSE {:.4}",
+            truth.renderer,
+            truth.spp,
+            truth.max_depth,
+            if truth.converged {
+                ""
+            } else {
+                ", not converged"
+            },
+            truth.noise,
+            without_noise(error, truth.noise)
+        );
+    }
     if let Some(path) = &args.flip_map {
         let (w, h) = (reference.width, reference.height);
         strandlight_runtime::image_out::write_png_rgb8(

@@ -11,6 +11,7 @@ mod render;
 mod summary;
 mod sweep_cmd;
 mod tables_cmd;
+mod truth;
 mod view;
 
 use clap::{Parser, Subcommand};
@@ -48,6 +49,9 @@ enum Command {
     /// Speed against error on the shared data: fit, tables and env-lit frames against the
     /// converged reference, with plots; rewrites docs/BENCHMARKS.md's generated section.
     Bench(bench::BenchArgs),
+    /// The path-traced ground truth of a scene (Mitsuba 3, the Chiang fiber), cached for
+    /// `compare` and `bench`; `--export DIR` writes the scene's Mitsuba files instead.
+    Truth(truth::TruthArgs),
     /// The markdown table of docs/BENCHMARKS.md from `compare --json` reports.
     CompareTable(compare_table::CompareTableArgs),
     /// Relative RMSE and HDR-FLIP between two EXR images over the reference's hair pixels.
@@ -76,5 +80,6 @@ fn main() -> anyhow::Result<()> {
         Command::ImageError(args) => image_error::run(args),
         Command::Demo(args) => demo::run(args),
         Command::View(args) => view::run(args),
+        Command::Truth(args) => truth::run(args),
     }
 }

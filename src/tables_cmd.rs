@@ -21,6 +21,8 @@ pub enum ModelArg {
     Marschner,
     KajiyaKay,
     Artist,
+    /// Chiang et al. 2016 (pbrt-v4, Mitsuba 3, Cycles): the path-traced ground truth's fiber.
+    Chiang,
     All,
 }
 
@@ -109,7 +111,13 @@ pub fn bake(args: BakeArgs) -> anyhow::Result<()> {
         ModelArg::Marschner => vec![Model::Marschner],
         ModelArg::KajiyaKay => vec![Model::KajiyaKay],
         ModelArg::Artist => vec![Model::Artist],
-        ModelArg::All => vec![Model::Marschner, Model::KajiyaKay, Model::Artist],
+        ModelArg::Chiang => vec![Model::Chiang],
+        ModelArg::All => vec![
+            Model::Marschner,
+            Model::KajiyaKay,
+            Model::Artist,
+            Model::Chiang,
+        ],
     };
     let mut resolution = match args.resolution {
         Some(n) if !(2..=256).contains(&n) => {

@@ -12,10 +12,10 @@ use std::process::Command;
 use strandlight_scene::image_metrics::relative_rmse;
 use strandlight_scene::reference_cache::read_rgba_exr;
 use strandlight_tables::artist::ArtistParams;
+use strandlight_tables::outside_tools::{missing_tool, program_exists};
 
 fn xvfb_run() -> Option<&'static str> {
-    let found = Command::new("xvfb-run").arg("--help").output().is_ok();
-    found.then_some("xvfb-run")
+    program_exists("xvfb-run").then_some("xvfb-run")
 }
 
 fn strandlight(dir: &Path) -> Command {
@@ -79,7 +79,7 @@ fn window_against_screenshot(window: &Path, shot: &Path, rect: [f64; 4]) -> f64 
 #[test]
 fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays() {
     let Some(xvfb) = xvfb_run() else {
-        println!("skipped: xvfb-run is not installed (apt-get install -y xvfb)");
+        missing_tool("xvfb-run", "apt-get install -y xvfb");
         return;
     };
     let dir = std::env::temp_dir().join(format!("strandlight-view-{}", std::process::id()));

@@ -19,6 +19,7 @@ use crate::error_decomposition::{
     self, DecompositionInputs, ErrorDecomposition, unshadowed_max_lights,
 };
 use crate::fit_cache::fit_cached;
+use crate::ground_truth::{GroundTruth, TruthUse};
 use crate::hdr_flip::hdr_flip;
 use crate::image_metrics::{Image, relative_rmse};
 use crate::look::{BoxAverageArg, EnvTransparency, ForwardDevice, LookArgs, ViewArgs};
@@ -78,10 +79,37 @@ pub struct BenchPlan {
     /// short run merged beside its own. Reports written before it existed: false.
     #[serde(default)]
     pub decomposition_only: bool,
+    /// The fiber model of every frame (reports written before it existed: Marschner).
+    #[serde(default = "marschner")]
+    pub shading: EnvShading,
+    /// Also measure every frame against the path-traced ground truth (Mitsuba 3; the Chiang
+    /// fiber only), rendering what the cache lacks. Reports written before it existed: false.
+    #[serde(default)]
+    pub ground_truth: bool,
+    /// Most samples per pixel of a ground-truth image, single and full scattering (a full
+    /// scattering sample costs ~4.5× a single one on straight.hair).
+    #[serde(default = "truth_max_spp")]
+    pub truth_max_spp: [u32; 2],
+    /// Measure where each map's error comes from (against the DOM reference). Reports written
+    /// before it existed: true.
+    #[serde(default = "yes")]
+    pub decomposition: bool,
 }
 
 fn one_run() -> usize {
     1
+}
+
+fn marschner() -> EnvShading {
+    EnvShading::Marschner
+}
+
+fn truth_max_spp() -> [u32; 2] {
+    [16384, 4096]
+}
+
+fn yes() -> bool {
+    true
 }
 
 /// Timed runs per frame in both plans ([`BenchPlan::timing_runs`]).
@@ -124,6 +152,47 @@ impl BenchPlan {
             reference_max_lights: 1536,
             timing_runs: TIMING_RUNS,
             decomposition_only: false,
+            shading: EnvShading::Marschner,
+            ground_truth: false,
+            truth_max_spp: truth_max_spp(),
+            decomposition: true,
+        }
+    }
+
+    /// Every map in both modes against the path-traced ground truth with the Chiang fiber (the
+    /// model Mitsuba, pbrt and Cycles render): the SRBF default, the median-cut front and the
+    /// DOM reference, each measured against both yardsticks. No parameter sweep, fit or table
+    /// study, no decomposition: what the page opens with.
+    pub fn truth() -> Self {
+        Self {
+            name: "truth".into(),
+            fit_lobes: Vec::new(),
+            table_nodes: Vec::new(),
+            table_check_points: 0,
+            lobes: vec![64],
+            kappas: vec![0.1],
+            dodm_sizes: vec![512],
+            every_strand_shares: Vec::new(),
+            lobe_spread_kappas: Vec::new(),
+            chord_tolerances: Vec::new(),
+            baseline_lights: vec![4, 8, 16, 32, 64, 128, 256],
+            shading: EnvShading::Chiang,
+            ground_truth: true,
+            decomposition: false,
+            ..Self::full()
+        }
+    }
+
+    /// Whether this is the ground-truth plan (its page section opens docs/BENCHMARKS.md).
+    pub fn is_truth(&self) -> bool {
+        self.name == "truth"
+    }
+
+    /// Most samples per pixel of `mode`'s ground truth.
+    pub fn truth_max_spp_of(&self, mode: ScatteringMode) -> u32 {
+        match mode {
+            ScatteringMode::Single => self.truth_max_spp[0],
+            ScatteringMode::Full => self.truth_max_spp[1],
         }
     }
 
@@ -154,6 +223,10 @@ impl BenchPlan {
             reference_max_lights: 384,
             timing_runs: TIMING_RUNS,
             decomposition_only: false,
+            shading: EnvShading::Marschner,
+            ground_truth: false,
+            truth_max_spp: truth_max_spp(),
+            decomposition: true,
         }
     }
 }
@@ -178,9 +251,10 @@ const MOST_BASELINE_LIGHTS: usize = 6144;
 impl BenchPlan {
     /// The plan this one was changed from: the quick or the full one.
     pub fn base(&self) -> Self {
-        match self.is_quick() {
-            true => Self::quick(),
-            false => Self::full(),
+        match self.name.as_str() {
+            "quick" => Self::quick(),
+            "truth" => Self::truth(),
+            _ => Self::full(),
         }
     }
 
@@ -239,6 +313,35 @@ pub struct Point {
     pub ms: f64,
     pub relative_rmse: f64,
     pub hdr_flip: f64,
+    /// The same frame against the path-traced ground truth, where the plan has one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truth: Option<TruthError>,
+}
+
+/// A frame's error against the path-traced ground truth.
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
+pub struct TruthError {
+    pub relative_rmse: f64,
+    /// With the ground truth's own noise removed in quadrature.
+    pub relative_rmse_noise_corrected: f64,
+    pub hdr_flip: f64,
+}
+
+/// How one map and mode's ground truth was made.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct TruthSummary {
+    pub renderer: String,
+    pub spp: u32,
+    pub max_depth: u32,
+    /// Mitsuba's time for the kept image (its two renders), seconds.
+    pub seconds: f64,
+    pub converged: bool,
+    /// Relative RMSE of the kept image's noise (from its last N-vs-4N rung).
+    pub noise: f64,
+    /// (spp N, relative RMSE of N against 4N).
+    pub ladder: Vec<(u32, f64)>,
+    /// (depth D, relative RMSE of D against 2D), full scattering.
+    pub depth_ladder: Vec<(u32, f64)>,
 }
 
 impl Point {
@@ -263,6 +366,14 @@ pub struct EnvLitResult {
     /// median-cut curve interpolated log-log (None where the curve never gets that accurate).
     pub speedup_equal_rmse: Option<f64>,
     pub speedup_equal_flip: Option<f64>,
+    /// The path-traced ground truth, where the plan has one.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub truth: Option<TruthSummary>,
+    /// The equal-error speed-ups over median cut, both measured against the ground truth.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speedup_equal_rmse_truth: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speedup_equal_flip_truth: Option<f64>,
 }
 
 impl EnvLitResult {
@@ -458,7 +569,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         reference_tolerance: 0.01,
         reference_max_lights: plan.reference_max_lights,
         reference_shading_lights: 0,
-        shading: EnvShading::Marschner,
+        shading: plan.shading,
         preset: "brown".into(),
         out: out.to_path_buf(),
         cache: cache.to_path_buf(),
@@ -492,6 +603,11 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
                 ..ViewArgs::default()
             },
         },
+        ground_truth: match plan.ground_truth {
+            true => TruthUse::Render,
+            false => TruthUse::Off,
+        },
+        truth_max_spp: plan.truth_max_spp[0],
     }
 }
 
@@ -508,22 +624,57 @@ fn strongest_lights(scene: &CompareScene, n: usize) -> Vec<EnvLight> {
     lights
 }
 
+/// The yardsticks a frame is measured against: the DOM reference, and the ground truth where
+/// the plan has one.
+#[derive(Clone, Copy)]
+struct Yardsticks<'a> {
+    reference: &'a Image,
+    truth: Option<&'a GroundTruth>,
+}
+
 fn measure(
     family: &str,
     label: String,
     lights: usize,
     ms: f64,
     image: &Image,
-    reference: &Image,
+    against: Yardsticks,
 ) -> anyhow::Result<Point> {
     Ok(Point {
         family: family.into(),
         label,
         lights,
         ms,
-        relative_rmse: relative_rmse(image, reference)?,
-        hdr_flip: hdr_flip(image, reference)?.mean_over_hair,
+        relative_rmse: relative_rmse(image, against.reference)?,
+        hdr_flip: hdr_flip(image, against.reference)?.mean_over_hair,
+        truth: against.truth.map(|t| truth_error(image, t)).transpose()?,
     })
+}
+
+fn truth_error(image: &Image, truth: &GroundTruth) -> anyhow::Result<TruthError> {
+    let e = relative_rmse(image, &truth.image)?;
+    Ok(TruthError {
+        relative_rmse: e,
+        relative_rmse_noise_corrected: truth.noise_corrected(e),
+        hdr_flip: hdr_flip(image, &truth.image)?.mean_over_hair,
+    })
+}
+
+fn truth_summary(t: &GroundTruth) -> TruthSummary {
+    TruthSummary {
+        renderer: format!("Mitsuba {} (scalar_rgb, path, hair BSDF)", t.mitsuba),
+        spp: t.spp,
+        max_depth: t.max_depth,
+        seconds: t.seconds,
+        converged: t.converged,
+        noise: t.noise,
+        ladder: t
+            .ladder
+            .iter()
+            .map(|r| (r.spp, r.difference_to_4x))
+            .collect(),
+        depth_ladder: t.depth_ladder.clone(),
+    }
 }
 
 /// One SRBF frame of the sweep: the defaults with one setting changed.
@@ -601,7 +752,7 @@ fn srbf_points(
     scene: &CompareScene,
     args: &CompareArgs,
     mode: ScatteringMode,
-    reference: &Image,
+    against: Yardsticks,
     steps: &mut Steps,
 ) -> anyhow::Result<Vec<Point>> {
     let mut points = Vec::new();
@@ -631,7 +782,7 @@ fn srbf_points(
             lights.len(),
             r.milliseconds,
             &r.image,
-            reference,
+            against,
         )?);
     }
     Ok(points)
@@ -639,7 +790,7 @@ fn srbf_points(
 
 /// ms of the median-cut curve at `error` (log-log interpolation between the two measured
 /// counts around it), None when no measured count is that accurate.
-fn curve_ms_at(points: &[&Point], error: f64, metric: impl Fn(&Point) -> f64) -> Option<f64> {
+fn curve_ms_at(points: &[&Point], error: f64, metric: &dyn Fn(&Point) -> f64) -> Option<f64> {
     let mut curve: Vec<(f64, f64)> = points.iter().map(|p| (metric(p), p.ms)).collect();
     curve.sort_by(|a, b| b.0.total_cmp(&a.0)); // error falling
     if curve.first().is_some_and(|c| c.0 <= error) {
@@ -691,26 +842,39 @@ fn env_lit(
     };
     for &mode in &plan.modes {
         let reference = compare::reference(&render_lights, &scene, &args, mode, steps)?;
-        decompositions.push(match mode {
-            ScatteringMode::Single => {
-                error_decomposition::single_scattering(&name, &inputs, &reference, steps)?
-            }
-            ScatteringMode::Full => {
-                let single = compare::reference(
-                    &render_lights,
-                    &scene,
-                    &args,
-                    ScatteringMode::Single,
-                    steps,
-                )?;
-                error_decomposition::full_scattering(&name, &inputs, &single, &reference, steps)?
-            }
-        });
+        if plan.decomposition {
+            decompositions.push(match mode {
+                ScatteringMode::Single => {
+                    error_decomposition::single_scattering(&name, &inputs, &reference, steps)?
+                }
+                ScatteringMode::Full => {
+                    let single = compare::reference(
+                        &render_lights,
+                        &scene,
+                        &args,
+                        ScatteringMode::Single,
+                        steps,
+                    )?;
+                    error_decomposition::full_scattering(
+                        &name, &inputs, &single, &reference, steps,
+                    )?
+                }
+            });
+        }
         if plan.decomposition_only {
             continue;
         }
+        let truth_args = CompareArgs {
+            truth_max_spp: plan.truth_max_spp_of(mode),
+            ..compare_args(plan, map, cache, scratch)
+        };
+        let truth = compare::truth_of(&scene, &truth_args, mode, steps)?;
         let image = &reference.chosen.image;
-        let mut points = srbf_points(plan, &scene, &args, mode, image, steps)?;
+        let against = Yardsticks {
+            reference: image,
+            truth: truth.as_ref(),
+        };
+        let mut points = srbf_points(plan, &scene, &args, mode, against, steps)?;
         let family = plan.baseline.name();
         for &n in &plan.baseline_lights {
             let r = steps.run(
@@ -725,7 +889,7 @@ fn env_lit(
                 count,
                 r.milliseconds,
                 &r.image,
-                image,
+                against,
             )?);
         }
         let record = &reference.chosen.record;
@@ -736,11 +900,21 @@ fn env_lit(
             ms: record.milliseconds,
             relative_rmse: 0.0,
             hdr_flip: 0.0,
+            truth: truth.as_ref().map(|t| truth_error(image, t)).transpose()?,
         });
         let default = points[0].clone();
         let baseline: Vec<&Point> = points.iter().filter(|p| p.is_baseline()).collect();
-        let speedup = |metric: fn(&Point) -> f64| {
+        let speedup = |metric: &dyn Fn(&Point) -> f64| {
             curve_ms_at(&baseline, metric(&default), metric).map(|ms| ms / default.ms)
+        };
+        let truth_metric =
+            |f: fn(&TruthError) -> f64| move |p: &Point| p.truth.as_ref().map_or(f64::NAN, f);
+        let (truth_rmse, truth_flip) = match &truth {
+            Some(_) => (
+                speedup(&truth_metric(|t| t.relative_rmse)),
+                speedup(&truth_metric(|t| t.hdr_flip)),
+            ),
+            None => (None, None),
         };
         out.push(EnvLitResult {
             map: name.clone(),
@@ -749,8 +923,11 @@ fn env_lit(
             reference_ms: record.milliseconds,
             reference_converged: reference.converged,
             reference_ladder: reference.ladder.iter().map(|&(n, _, d)| (n, d)).collect(),
-            speedup_equal_rmse: speedup(|p| p.relative_rmse),
-            speedup_equal_flip: speedup(|p| p.hdr_flip),
+            speedup_equal_rmse: speedup(&|p| p.relative_rmse),
+            speedup_equal_flip: speedup(&|p| p.hdr_flip),
+            truth: truth.as_ref().map(truth_summary),
+            speedup_equal_rmse_truth: truth_rmse,
+            speedup_equal_flip_truth: truth_flip,
             points,
         });
     }
@@ -932,6 +1109,7 @@ mod tests {
             ms,
             relative_rmse: error,
             hdr_flip: error,
+            truth: None,
         }
     }
 
@@ -988,6 +1166,9 @@ mod tests {
             points: Vec::new(),
             speedup_equal_rmse: None,
             speedup_equal_flip: None,
+            truth: None,
+            speedup_equal_rmse_truth: None,
+            speedup_equal_flip_truth: None,
         }
     }
 
@@ -1148,8 +1329,8 @@ mod tests {
         let refs: Vec<&Point> = curve.iter().collect();
         let err = |p: &Point| p.relative_rmse;
         // Error ∝ 1/ms here: 0.2 lies halfway (in log) between 10 and 40 ms.
-        assert!((curve_ms_at(&refs, 0.2, err).unwrap() - 20.0).abs() < 1e-9);
-        assert_eq!(curve_ms_at(&refs, 0.5, err), Some(10.0));
-        assert_eq!(curve_ms_at(&refs, 0.01, err), None);
+        assert!((curve_ms_at(&refs, 0.2, &err).unwrap() - 20.0).abs() < 1e-9);
+        assert_eq!(curve_ms_at(&refs, 0.5, &err), Some(10.0));
+        assert_eq!(curve_ms_at(&refs, 0.01, &err), None);
     }
 }

@@ -33,20 +33,36 @@ fn register_font() {
 pub enum Metric {
     RelativeRmse,
     HdrFlip,
+    /// Against the path-traced ground truth (where the report has one).
+    TruthRelativeRmse,
+    TruthHdrFlip,
 }
 
 impl Metric {
+    /// Every metric a result can be drawn with: against the ground truth only where it has one.
+    pub fn of_result(r: &EnvLitResult) -> Vec<Metric> {
+        let mut metrics = vec![Metric::RelativeRmse, Metric::HdrFlip];
+        if r.truth.is_some() {
+            metrics.extend([Metric::TruthRelativeRmse, Metric::TruthHdrFlip]);
+        }
+        metrics
+    }
+
     fn of(self, p: &Point) -> f64 {
         match self {
             Metric::RelativeRmse => p.relative_rmse,
             Metric::HdrFlip => p.hdr_flip,
+            Metric::TruthRelativeRmse => p.truth.map_or(f64::NAN, |t| t.relative_rmse),
+            Metric::TruthHdrFlip => p.truth.map_or(f64::NAN, |t| t.hdr_flip),
         }
     }
 
     fn name(self) -> &'static str {
         match self {
-            Metric::RelativeRmse => "relative RMSE",
-            Metric::HdrFlip => "HDR-FLIP (mean over hair)",
+            Metric::RelativeRmse => "relative RMSE vs the DOM reference",
+            Metric::HdrFlip => "HDR-FLIP vs the DOM reference",
+            Metric::TruthRelativeRmse => "relative RMSE vs the path-traced truth",
+            Metric::TruthHdrFlip => "HDR-FLIP vs the path-traced truth",
         }
     }
 
@@ -54,13 +70,22 @@ impl Metric {
         match self {
             Metric::RelativeRmse => "rmse",
             Metric::HdrFlip => "flip",
+            Metric::TruthRelativeRmse => "truth-rmse",
+            Metric::TruthHdrFlip => "truth-flip",
         }
+    }
+
+    /// Whether the DOM reference has an error of its own under this metric.
+    fn against_truth(self) -> bool {
+        matches!(self, Metric::TruthRelativeRmse | Metric::TruthHdrFlip)
     }
 
     fn speedup(self, r: &EnvLitResult) -> Option<f64> {
         match self {
             Metric::RelativeRmse => r.speedup_equal_rmse,
             Metric::HdrFlip => r.speedup_equal_flip,
+            Metric::TruthRelativeRmse => r.speedup_equal_rmse_truth,
+            Metric::TruthHdrFlip => r.speedup_equal_flip_truth,
         }
     }
 }
@@ -86,7 +111,15 @@ where
         lo_ms = lo_ms.min(p.ms);
         hi_ms = hi_ms.max(p.ms);
     }
-    for p in &measured {
+    let reference = r.points.iter().find(|p| p.family == "reference");
+    let reference_point = reference
+        .filter(|_| metric.against_truth())
+        .map(|p| (p.ms, metric.of(p).max(1e-4)));
+    for p in measured
+        .iter()
+        .copied()
+        .chain(reference.filter(|_| metric.against_truth()))
+    {
         let e = metric.of(p).max(1e-4);
         lo_e = lo_e.min(e);
         hi_e = hi_e.max(e);
@@ -197,7 +230,17 @@ where
             .label(note)
             .legend(|(x, y)| Cross::new((x + 9, y), 6, BLACK.stroke_width(2)));
     }
-    if let Some(reference) = r.points.iter().find(|p| p.family == "reference") {
+    if let (Some(reference), Some(at)) = (reference, reference_point) {
+        // Against the ground truth the DOM reference has an error of its own: a point.
+        chart
+            .draw_series([Rectangle::new(
+                [(at.0 / 1.08, at.1 / 1.08), (at.0 * 1.08, at.1 * 1.08)],
+                BLACK.filled(),
+            )])
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?
+            .label(format!("DOM reference, {} lights", reference.lights))
+            .legend(|(x, y)| Rectangle::new([(x + 5, y - 4), (x + 13, y + 4)], BLACK.filled()));
+    } else if let Some(reference) = reference {
         // The reference has no error of its own: drawn as a vertical line at its cost.
         chart
             .draw_series(LineSeries::new(

@@ -9,6 +9,9 @@ use std::fmt::Write;
 
 pub const BEGIN: &str = "<!-- strandlight bench: generated section, begin -->";
 pub const END: &str = "<!-- strandlight bench: generated section, end -->";
+/// The markers of the ground-truth plan's section (`bench --truth`), which opens the page.
+pub const TRUTH_BEGIN: &str = "<!-- strandlight bench --truth: generated section, begin -->";
+pub const TRUTH_END: &str = "<!-- strandlight bench --truth: generated section, end -->";
 
 fn optional_speedup(s: Option<f64>, r: &EnvLitResult, baseline: &str) -> String {
     match (s, r.speedup_lower_bound()) {
@@ -227,7 +230,11 @@ pub(crate) fn regenerate_args(report: &BenchReport) -> String {
     let plan = &report.plan;
     let base = plan.base();
     let list = |v: &[usize]| v.iter().map(usize::to_string).collect::<Vec<_>>().join(",");
-    let mut args = String::from(if plan.is_quick() { " --quick" } else { "" });
+    let mut args = String::from(match plan.name.as_str() {
+        "quick" => " --quick",
+        "truth" => " --truth",
+        _ => "",
+    });
     if plan.maps != base.maps {
         args += &format!(" --maps {}", plan.maps.join(","));
     }
@@ -337,21 +344,191 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
 
 /// `page` with its generated section replaced by `section` (appended when it has none).
 pub fn splice(page: &str, section: &str) -> anyhow::Result<String> {
-    match (page.find(BEGIN), page.find(END)) {
+    splice_between(page, section, BEGIN, END, Placement::End)
+}
+
+/// `page` with the ground-truth section replaced by `section` (placed after the page's first
+/// paragraph when it has none: the page opens with it).
+pub fn splice_truth(page: &str, section: &str) -> anyhow::Result<String> {
+    splice_between(page, section, TRUTH_BEGIN, TRUTH_END, Placement::Top)
+}
+
+/// Where a section goes on a page that has none yet.
+enum Placement {
+    End,
+    /// After the title and the paragraph under it.
+    Top,
+}
+
+fn splice_between(
+    page: &str,
+    section: &str,
+    begin: &str,
+    end: &str,
+    placement: Placement,
+) -> anyhow::Result<String> {
+    match (page.find(begin), page.find(end)) {
         (Some(b), Some(e)) if b < e => {
-            let after = e + END.len();
+            let after = e + end.len();
             let tail = page[after..].strip_prefix('\n').unwrap_or(&page[after..]);
             Ok(format!("{}{}{}", &page[..b], section, tail))
         }
-        (None, None) => Ok(format!(
-            "{}\n{}",
-            page.trim_end_matches('\n').to_owned() + "\n",
-            section
-        )),
+        (None, None) => Ok(match placement {
+            Placement::End => format!(
+                "{}\n{}",
+                page.trim_end_matches('\n').to_owned() + "\n",
+                section
+            ),
+            Placement::Top => {
+                // The end of the first paragraph after the title (or of the page).
+                let body = page.find("\n\n").map_or(page.len(), |t| t + 2);
+                let cut = page[body..]
+                    .find("\n\n")
+                    .map_or(page.len(), |p| body + p + 2);
+                format!("{}{}\n{}", &page[..cut], section, &page[cut..])
+            }
+        }),
         _ => bail!(
-            "the page's generated-section markers are damaged (one missing or out of order): fix them by hand"
+            "the page's generated-section markers ({begin}) are damaged (one missing or out of order): fix them by hand"
         ),
     }
+}
+
+/// The ground-truth plan's section: per map and mode the SRBF default, the DOM reference and
+/// the median-cut front, each against the path-traced ground truth, with the equal-error
+/// speed-ups measured against it and the path tracer's time beside the frame's.
+pub fn truth_section(report: &BenchReport, plot_dir: &str) -> String {
+    let mut out = String::new();
+    let plan = &report.plan;
+    let regenerate = match report.runs.is_empty() {
+        true => format!(
+            "Regenerate with `cargo run --release -- bench{}`",
+            regenerate_args(report)
+        ),
+        false => format!(
+            "Measured in {} runs ({}), merged by `bench --from-report`",
+            report.runs.len(),
+            report
+                .runs
+                .iter()
+                .map(|run| format!("`bench{run}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
+    let _ = writeln!(
+        out,
+        "{TRUTH_BEGIN}\n## Against the path-traced ground truth (`strandlight bench --truth`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data` and Mitsuba 3: `pip install mitsuba`).\n\n**What is measured.** straight.hair under each shared map at {}×{} (default front camera), shaded with the `brown` Chiang fiber (Chiang et al. 2016: eumelanin 1.3, longitudinal and azimuthal roughness 0.3, IOR 1.55, scale tilt 2°). Fibers are opaque cylinders of the file's width in both renderers: straight.hair's transparency field (0.36) is ignored. **The ground truth** is Mitsuba 3's path tracer with its own `hair` BSDF (the same model, written by others), `bsplinecurve` fibers through the strands' points and the map as its `envmap`, hidden from the camera: single scattering at `max_depth` 2, full scattering at the first depth D where 2D moves the image by < 1%. Its samples climb ×4 from 1024 per pixel until N and 4N agree within 1% or the budget ({} spp single, {} full) is reached; the kept image averages both, and its noise (relative RMSE, from the last N-vs-4N difference) is given. **Errors** are relative RMSE over the truth's hair pixels, raw and with the truth's noise removed in quadrature (\"n.c.\"), and HDR-FLIP. The **DOM reference** is the project's own converged reference (the map as directional lights, each shadowed by a deep opacity map): its error against the truth is what it shares with the method and so cannot show. **× median cut** is the SRBF default's speed-up over median cut at equal error, both measured against the truth (log-log interpolated along median cut's measured front). ms are frame times on this machine's adapter (lavapipe: ratios only); Mitsuba's seconds are its render time on the same 2 cores.\n",
+        report.date,
+        report.git_revision,
+        report.machine,
+        report.adapter,
+        report.seconds,
+        plan.size.0,
+        plan.size.1,
+        plan.truth_max_spp[0],
+        plan.truth_max_spp[1],
+    );
+    out.push_str("| map | mode | SRBF ms | SRBF vs truth: rel. RMSE (n.c.) / HDR-FLIP | DOM reference vs truth | × median cut at equal rel. RMSE | at equal HDR-FLIP | truth: spp, depth, noise | Mitsuba s |\n|---|---|---:|---|---|---:|---:|---|---:|\n");
+    for r in &report.env_lit {
+        let (Some(truth), Some(default)) = (&r.truth, r.points.first()) else {
+            continue;
+        };
+        let reference = r.points.iter().find(|p| p.family == "reference");
+        let cell = |p: Option<&crate::bench::Point>| match p.and_then(|p| p.truth) {
+            Some(t) => format!(
+                "{:.4} ({:.4}) / {:.4}",
+                t.relative_rmse, t.relative_rmse_noise_corrected, t.hdr_flip
+            ),
+            None => "–".into(),
+        };
+        let speedup = |s: Option<f64>| s.map_or("–".to_string(), |s| format!("{s:.1}×"));
+        let _ = writeln!(
+            out,
+            "| {} | {} | {:.0} | {} | {} ({} lights) | {} | {} | {}, {}, {:.4}{} | {:.0} |",
+            r.map,
+            r.mode,
+            default.ms,
+            cell(Some(default)),
+            cell(reference),
+            r.reference_lights,
+            speedup(r.speedup_equal_rmse_truth),
+            speedup(r.speedup_equal_flip_truth),
+            truth.spp,
+            truth.max_depth,
+            truth.noise,
+            if truth.converged {
+                ""
+            } else {
+                " (not converged)"
+            },
+            truth.seconds,
+        );
+    }
+    out.push_str("\n\"–\" under × median cut: median cut's measured front never got as accurate as the SRBF default.\n");
+    for r in &report.env_lit {
+        let Some(truth) = &r.truth else { continue };
+        let _ = writeln!(
+            out,
+            "\n#### {} — {} scattering\n\nGround truth: {} spp (ladder {}){}, noise {:.4}; DOM reference {} lights{}.\n\n| frame | lights | ms | vs truth: rel. RMSE | n.c. | HDR-FLIP | vs DOM reference: rel. RMSE | HDR-FLIP |\n|---|---:|---:|---:|---:|---:|---:|---:|",
+            r.map,
+            r.mode,
+            truth.spp,
+            truth
+                .ladder
+                .iter()
+                .map(|(n, d)| format!("{n} vs {}: {d:.4}", 4 * n))
+                .collect::<Vec<_>>()
+                .join("; "),
+            match truth.depth_ladder.is_empty() {
+                true => String::new(),
+                false => format!(
+                    ", depth {} (depth search {})",
+                    truth.max_depth,
+                    truth
+                        .depth_ladder
+                        .iter()
+                        .map(|(d, e)| format!("{d} vs {}: {e:.4}", 2 * d))
+                        .collect::<Vec<_>>()
+                        .join("; ")
+                ),
+            },
+            truth.noise,
+            r.reference_lights,
+            match r.reference_converged {
+                Some(true) => ", converged",
+                Some(false) => ", not converged",
+                None => "",
+            }
+        );
+        for p in &r.points {
+            let t = p.truth.unwrap_or(crate::bench::TruthError {
+                relative_rmse: f64::NAN,
+                relative_rmse_noise_corrected: f64::NAN,
+                hdr_flip: f64::NAN,
+            });
+            let _ = writeln!(
+                out,
+                "| {} {} | {} | {:.0} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} |",
+                p.family,
+                p.label,
+                p.lights,
+                p.ms,
+                t.relative_rmse,
+                t.relative_rmse_noise_corrected,
+                t.hdr_flip,
+                p.relative_rmse,
+                p.hdr_flip
+            );
+        }
+        let stem = format!("{plot_dir}/{}-{}", r.map, r.mode);
+        let _ = writeln!(
+            out,
+            "\n![error against ms, relative RMSE vs the truth]({stem}-truth-rmse.png) ![error against ms, HDR-FLIP vs the truth]({stem}-truth-flip.png)"
+        );
+    }
+    let _ = writeln!(out, "\n{TRUTH_END}");
+    out
 }
 
 #[cfg(test)]
@@ -405,6 +582,9 @@ mod tests {
             points: Vec::new(),
             speedup_equal_rmse: None,
             speedup_equal_flip: None,
+            truth: None,
+            speedup_equal_rmse_truth: None,
+            speedup_equal_flip_truth: None,
         };
         assert_eq!(
             ladder_rungs(&r),
@@ -437,6 +617,7 @@ mod tests {
             ms,
             relative_rmse,
             hdr_flip: 0.2,
+            truth: None,
         }
     }
 
@@ -452,6 +633,9 @@ mod tests {
             points: vec![frame("srbf", 10.0, 0.04), frame("median cut", 50.0, 0.3)],
             speedup_equal_rmse: Some(12.0),
             speedup_equal_flip: None,
+            truth: None,
+            speedup_equal_rmse_truth: None,
+            speedup_equal_flip_truth: None,
         };
         // Below the full-scattering goal, but against a reference that did not converge.
         let unconverged = EnvLitResult {

@@ -9,6 +9,8 @@ use crate::environment::load_env;
 use crate::equal_time::{EqualTimeSearch, equal_error_lights, equal_time_lights};
 use crate::error_metric::ErrorMetric;
 use crate::fit_cache::fit_cached;
+use crate::ground_truth::mitsuba_scene::MitsubaScene;
+use crate::ground_truth::{GroundTruth, TruthInputs, TruthSettings, TruthUse, ground_truth};
 use crate::hair_input::{load_hair, parse_size};
 use crate::hdr_flip::{HdrFlip, error_map_magma, hdr_flip};
 use crate::image_metrics::{Image, error_legend, relative_rmse, write_side_by_side};
@@ -191,6 +193,18 @@ pub struct CompareArgs {
     /// The look of all three renders.
     #[cfg_attr(any(feature = "cli", test), command(flatten))]
     pub look: LookArgs,
+    /// The path-traced ground truth (Mitsuba 3; the Chiang fiber only, which is Mitsuba's
+    /// `hair`): `cached` measures every frame against it where `strandlight truth` or an
+    /// earlier run rendered it, `render` renders what is missing (minutes), `off` never.
+    #[cfg_attr(
+        any(feature = "cli", test),
+        arg(long, value_enum, default_value = "cached")
+    )]
+    pub ground_truth: TruthUse,
+    /// Most samples per pixel of one ground-truth image (its ladder climbs ×4 from 1024 until
+    /// N and 4N agree within --reference-tolerance or the next rung would pass this).
+    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = TruthSettings::default().max_spp))]
+    pub truth_max_spp: u32,
 }
 
 /// Everything fixed before the first render.
@@ -380,6 +394,7 @@ pub fn prepare_with_hair(
     steps: &mut Steps,
 ) -> anyhow::Result<CompareScene> {
     validate(args)?;
+    let (hair, hair_sha256) = fibers_for(args.shading, hair, hair_sha256);
     let (width, height) = parse_size(&args.size)?;
     let fiber = FiberDescription::preset(&args.preset)
         .with_context(|| format!("--preset {:?}", args.preset))?;
@@ -474,8 +489,7 @@ pub fn prepare_with_hair(
             )
         },
     )?;
-    let up = UpAxis::detect(&hair);
-    let camera = Camera::framing_front(hair.bounds(), width as f32 / height as f32, false, up);
+    let (up, camera) = front_camera(&hair, (width, height));
     let fit_lights = srbf_set_lights(&set);
     let mut srbf = to_env_lights(&fit_lights, up);
     let marked = mark_every_strand(&mut srbf, args.every_strand_share);
@@ -514,6 +528,26 @@ pub fn prepare_with_hair(
         compact_sources: fit.set.sources.clone(),
         fit_lights,
     })
+}
+
+/// The hair as `shading` renders it, and the hash that identifies it in the caches: the Chiang
+/// fiber is the path tracer's, whose fibers are opaque cylinders, so a file's transparency is
+/// dropped for it (and the hash says so).
+pub fn fibers_for(shading: EnvShading, hair: HairModel, sha256: String) -> (HairModel, String) {
+    match hair.transparency() {
+        Some(_) if shading.physical_fibers() => (
+            hair.without_transparency(),
+            format!("{sha256}+opaque fibers"),
+        ),
+        _ => (hair, sha256),
+    }
+}
+
+/// The hair's up axis and the default camera that frames it from the front at `size`.
+pub fn front_camera(hair: &HairModel, size: (u32, u32)) -> (UpAxis, Camera) {
+    let up = UpAxis::detect(hair);
+    let aspect = size.0 as f32 / size.1 as f32;
+    (up, Camera::framing_front(hair.bounds(), aspect, false, up))
 }
 
 /// The function that renders a frame: [`render_lights`] in the program, a stand-in in tests.
@@ -591,6 +625,8 @@ struct ModeResult {
     baseline_lights: usize,
     baseline_search: Vec<(usize, f64)>,
     equal_error: Option<EqualErrorResult>,
+    /// The path-traced ground truth, where the fiber has one and it is cached or rendered.
+    truth: Option<GroundTruth>,
 }
 
 /// The equal-error baseline: the count found and (lights, ms, relative RMSE) of every render.
@@ -631,23 +667,23 @@ pub fn render_baseline(
     timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)
 }
 
-/// Median-cut baselines of growing size until one is as accurate as `target_error`.
+/// Median-cut baselines of growing size (up to `most` lights) until one is as accurate as
+/// `target_error` against `yardstick` (the ground truth where there is one, else the reference).
+#[allow(clippy::too_many_arguments)]
 fn equal_error_baseline(
     render: Renderer,
     scene: &CompareScene,
     args: &CompareArgs,
     mode: ScatteringMode,
-    reference: &ReferenceImage,
+    yardstick: &Image,
+    most: usize,
     target_error: f64,
     start: usize,
 ) -> anyhow::Result<EqualErrorResult> {
     let mut renders = Vec::new();
-    let most = reference.record.lights.max(16);
-    let found = equal_error_lights(target_error, start, most, 0.1, 10, |n| {
+    let found = equal_error_lights(target_error, start, most.max(16), 0.1, 10, |n| {
         let r = render_baseline(render, scene, args, mode, n)?;
-        let error = args
-            .equal_error_metric
-            .measure(&r.image, &reference.image)?;
+        let error = args.equal_error_metric.measure(&r.image, yardstick)?;
         // A search near the reference's light count renders for many minutes: say each step
         // (stderr, so `--json` keeps stdout for the JSON).
         eprintln!(
@@ -664,6 +700,56 @@ fn equal_error_baseline(
         at_bound: found.at_bound,
         renders,
     })
+}
+
+/// The ground-truth settings of `args`.
+pub fn truth_settings(args: &CompareArgs) -> TruthSettings {
+    TruthSettings {
+        max_spp: args.truth_max_spp,
+        tolerance: args.reference_tolerance,
+        ..TruthSettings::default()
+    }
+}
+
+/// Mitsuba's `hair` parameters of the scene's fiber, where the shading model is the one the
+/// path tracer has (Chiang et al. 2016); None for the others, which the DOM reference measures.
+pub fn truth_fiber(scene: &CompareScene, args: &CompareArgs) -> Option<Value> {
+    (args.shading == EnvShading::Chiang)
+        .then(|| serde_json::to_value(&scene.fiber.chiang).expect("fiber parameters serialize"))
+}
+
+/// The path-traced ground truth of `mode` (cached, rendered or none: `--ground-truth`).
+pub fn truth_of(
+    scene: &CompareScene,
+    args: &CompareArgs,
+    mode: ScatteringMode,
+    steps: &mut Steps,
+) -> anyhow::Result<Option<GroundTruth>> {
+    let Some(fiber) = truth_fiber(scene, args) else {
+        return Ok(None);
+    };
+    let inputs = TruthInputs {
+        scene: MitsubaScene {
+            hair: &scene.hair,
+            up: scene.up,
+            camera: scene.camera,
+            size: scene.size,
+            map: Some(&scene.map),
+            rotate_degrees: args.rotate,
+            directional: &[],
+            fiber: &fiber,
+        },
+        hair_sha256: &scene.hair_sha256,
+        map_sha256: &scene.map_sha256,
+    };
+    ground_truth(
+        &inputs,
+        mode,
+        &truth_settings(args),
+        args.ground_truth,
+        &args.cache,
+        steps,
+    )
 }
 
 pub fn frame<'a>(
@@ -789,6 +875,7 @@ fn run_mode(
         },
     )?;
     let reference = reference(render, scene, args, mode, steps)?;
+    let truth = truth_of(scene, args, mode, steps)?;
     let reference_lights = reference.chosen.record.lights;
     let search = EqualTimeSearch {
         max_lights: reference_lights.max(16),
@@ -826,9 +913,11 @@ fn run_mode(
         Some(r) => r,
         None => render_baseline(render, scene, args, mode, found.lights)?,
     };
+    // The equal-error search measures against the best yardstick there is.
+    let yardstick = truth.as_ref().map_or(&reference.chosen.image, |t| &t.image);
     let equal_error = if args.equal_error {
         let metric = args.equal_error_metric;
-        let target = metric.measure(&srbf.image, &reference.chosen.image)?;
+        let target = metric.measure(&srbf.image, yardstick)?;
         Some(steps.run(
             &format!("{m}: equal-error baseline"),
             || {
@@ -837,7 +926,8 @@ fn run_mode(
                     scene,
                     args,
                     mode,
-                    &reference.chosen,
+                    yardstick,
+                    reference_lights,
                     target,
                     found.lights,
                 )
@@ -865,6 +955,7 @@ fn run_mode(
         baseline_lights: baseline_set(scene, args, found.lights).len(),
         baseline_search: found.measurements,
         equal_error,
+        truth,
     })
 }
 
@@ -1089,9 +1180,22 @@ pub fn execute(
                 "speedup_vs_reference": reference_ms / r.srbf.milliseconds,
                 "images": written,
         });
+        if let Some(truth) = &r.truth {
+            let stem = args.out.join(format!("{}-truth", mode.name()));
+            crate::ground_truth::write_truth_image(truth, &stem, &description)?;
+            entry["ground_truth"] = truth_json(
+                truth,
+                &[
+                    ("srbf", &r.srbf.image),
+                    ("baseline", &r.baseline.image),
+                    ("reference", &reference.image),
+                ],
+            )?;
+            steps.say(truth_line(mode, truth, &entry["ground_truth"]));
+        }
         if let Some(e) = &r.equal_error {
             let (lights, ms, error) = e.chosen();
-            entry["baseline_equal_error"] = json!({ "lights": lights, "ms": ms, "metric": args.equal_error_metric, "error": error, "at_bound": e.at_bound, "renders": e.renders });
+            entry["baseline_equal_error"] = json!({ "lights": lights, "ms": ms, "metric": args.equal_error_metric, "yardstick": if r.truth.is_some() { "ground truth" } else { "reference" }, "error": error, "at_bound": e.at_bound, "renders": e.renders });
             entry["speedup_at_equal_error"] = json!(ms / r.srbf.milliseconds);
         }
         report.insert(mode.name().into(), entry);
@@ -1123,6 +1227,60 @@ pub fn execute(
         ),
     );
     Ok(Value::Object(report))
+}
+
+/// The ground truth's record and each frame's error against it (raw, and with the truth's
+/// own noise removed in quadrature).
+fn truth_json(truth: &GroundTruth, frames: &[(&str, &Image)]) -> anyhow::Result<Value> {
+    let mut v = json!({
+        "renderer": format!("Mitsuba {} (scalar_rgb, path, hair BSDF)", truth.mitsuba),
+        "spp": truth.spp,
+        "max_depth": truth.max_depth,
+        "seconds": truth.seconds,
+        "converged": truth.converged,
+        "noise": truth.noise,
+        "ladder": truth.ladder,
+        "depth_ladder": truth.depth_ladder,
+        "fibers": "opaque cylinders of the file's width (its transparency field ignored)",
+    });
+    for (name, image) in frames {
+        let e = relative_rmse(image, &truth.image)?;
+        v[*name] = json!({
+            "relative_rmse": e,
+            "relative_rmse_noise_corrected": truth.noise_corrected(e),
+            "hdr_flip": hdr_flip(image, &truth.image)?.mean_over_hair,
+        });
+    }
+    Ok(v)
+}
+
+fn truth_line(mode: ScatteringMode, truth: &GroundTruth, figures: &Value) -> String {
+    let part = |name: &str| {
+        format!(
+            "{name} rel. RMSE {:.4} ({:.4} without the truth's noise) HDR-FLIP {:.4}",
+            figures[name]["relative_rmse"].as_f64().unwrap_or(f64::NAN),
+            figures[name]["relative_rmse_noise_corrected"]
+                .as_f64()
+                .unwrap_or(f64::NAN),
+            figures[name]["hdr_flip"].as_f64().unwrap_or(f64::NAN),
+        )
+    };
+    format!(
+        "{:<6} against the path-traced ground truth ({} spp, depth {}, noise {:.4}{}, Mitsuba {:.1} s): {} | {} | {}",
+        mode.name(),
+        truth.spp,
+        truth.max_depth,
+        truth.noise,
+        if truth.converged {
+            ""
+        } else {
+            ", not converged"
+        },
+        truth.seconds,
+        part("srbf"),
+        part("baseline"),
+        part("reference")
+    )
 }
 
 #[cfg(test)]

@@ -389,13 +389,14 @@ impl FrameSettings {
         }
     }
 
-    /// The env renderer's fiber model (it reads one RGB 4D table: Marschner or artist).
+    /// The env renderer's fiber model (it reads one RGB 4D table: Marschner, Chiang or artist).
     pub fn env_shading(&self) -> anyhow::Result<EnvShading> {
         match self.shading() {
             Shading::Marschner => Ok(EnvShading::Marschner),
+            Shading::Chiang => Ok(EnvShading::Chiang),
             Shading::Artist => Ok(EnvShading::Artist),
             Shading::KajiyaKay => bail!(
-                "--shading kajiya-kay with --env: the env renderer reads one RGB 4D table (Marschner I_M or the artist I_A); use --shading marschner or artist"
+                "--shading kajiya-kay with --env: the env renderer reads one RGB 4D table (Marschner I_M, Chiang's or the artist I_A); use --shading marschner, chiang or artist"
             ),
         }
     }

@@ -22,6 +22,7 @@ pub mod error_metric;
 pub mod fit_cache;
 pub mod frame_render;
 pub mod frame_settings;
+pub mod ground_truth;
 pub mod hair_input;
 pub mod hdr_flip;
 pub mod image_metrics;

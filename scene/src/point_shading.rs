@@ -1,13 +1,15 @@
-//! The fiber model of a point-lit frame, built from a user's choice: Kajiya-Kay, Marschner
-//! through its lookup textures (baked here: the runtime does not link the tabulation code), or
-//! the artist-friendly model with controls from a JSON file.
+//! The fiber model of a point-lit frame, built from a user's choice: Kajiya-Kay, Marschner or
+//! Chiang through their lookup textures (baked here: the runtime does not link the tabulation
+//! code), or the artist-friendly model with controls from a JSON file.
 
 use anyhow::Context;
 use std::path::Path;
+use strandlight_precompute::chiang_luts::{bake_chiang_lut_m, bake_chiang_lut_n};
 use strandlight_precompute::point_light_luts::{LutResolution, bake_lut_m, bake_lut_n};
-use strandlight_runtime::passes::fiber_shading::{MarschnerLuts, ShadingModel};
+use strandlight_runtime::passes::fiber_shading::{ChiangLuts, MarschnerLuts, ShadingModel};
 use strandlight_runtime::passes::frame_params::KajiyaKay;
 use strandlight_tables::artist::{ArtistModel, ArtistParams};
+use strandlight_tables::chiang::{Chiang, ChiangParams};
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -17,14 +19,17 @@ pub enum Shading {
     KajiyaKay,
     Marschner,
     Artist,
+    /// Chiang et al. 2016, the model of pbrt-v4, Mitsuba 3 and Cycles' Principled Hair (and of
+    /// the path-traced ground truth).
+    Chiang,
 }
 
 /// What a point-lit frame's fiber model is made from.
 pub struct PointShadingRequest<'a> {
     pub shading: Shading,
-    /// Melanin preset of the Marschner fiber.
+    /// Melanin preset of the Marschner or Chiang fiber.
     pub preset: &'a str,
-    /// Nodes per axis of the Marschner lookup textures.
+    /// Nodes per axis of the Marschner or Chiang lookup textures.
     pub lut_size: usize,
     /// Artist controls; None: the built-in defaults.
     pub artist: Option<ArtistParams>,
@@ -41,6 +46,7 @@ pub fn point_shading_model(
             format!("Kajiya-Kay {:?}", KajiyaKay::default()),
         )),
         Shading::Marschner => marschner_luts(request.preset, request.lut_size),
+        Shading::Chiang => chiang_luts(request.preset, request.lut_size),
         Shading::Artist => artist(request.artist),
     }
 }
@@ -59,6 +65,22 @@ fn marschner_luts(preset: &str, lut_size: usize) -> anyhow::Result<(ShadingModel
     );
     Ok((
         ShadingModel::MarschnerLut(MarschnerLuts::new(lut_m, lut_n)?),
+        description,
+    ))
+}
+
+fn chiang_luts(preset: &str, lut_size: usize) -> anyhow::Result<(ShadingModel, String)> {
+    let params =
+        ChiangParams::with_preset(preset).with_context(|| format!("--preset {preset:?}"))?;
+    let model = Chiang::new(params)?;
+    let resolution = LutResolution::square(lut_size);
+    let lut_m =
+        bake_chiang_lut_m(&model, &resolution).with_context(|| format!("--lut-size {lut_size}"))?;
+    let lut_n =
+        bake_chiang_lut_n(&model, &resolution).with_context(|| format!("--lut-size {lut_size}"))?;
+    let description = format!("Chiang 2016 (preset {preset}) through {lut_size}² lookup tables");
+    Ok((
+        ShadingModel::ChiangLut(ChiangLuts::new(lut_m, lut_n)?),
         description,
     ))
 }
@@ -113,6 +135,13 @@ mod tests {
             point_shading_model(&request(Shading::Artist)).unwrap().0,
             ShadingModel::Artist(_)
         ));
+        match point_shading_model(&request(Shading::Chiang)).unwrap().0 {
+            ShadingModel::ChiangLut(luts) => {
+                assert_eq!(luts.lut_m().shape(), vec![16, 16, 4]);
+                assert_eq!(luts.lut_n().shape(), vec![16, 16, 4]);
+            }
+            other => panic!("{}", other.name()),
+        }
         let e = point_shading_model(&PointShadingRequest {
             preset: "purple",
             ..request(Shading::Marschner)

@@ -6,6 +6,7 @@
 use crate::image_metrics::Image;
 use crate::sealed_file::{Unsealed, read_sealed, seal, write_sealed};
 use anyhow::Context;
+use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -22,6 +23,23 @@ pub struct ReferenceRecord {
     pub lights: usize,
     /// Frame time of the reference render.
     pub milliseconds: f64,
+}
+
+/// A record a cache entry is found by: it names every input of its image.
+pub trait CachedRecord: Serialize + DeserializeOwned {
+    /// Everything the image depends on; the entry's key is its hash.
+    fn inputs(&self) -> &Value;
+    /// What the image is, written into the EXR's comment.
+    fn description() -> &'static str;
+}
+
+impl CachedRecord for ReferenceRecord {
+    fn inputs(&self) -> &Value {
+        &self.inputs
+    }
+    fn description() -> &'static str {
+        "strandlight brute-force reference"
+    }
 }
 
 pub struct ReferenceCache {
@@ -46,10 +64,10 @@ impl ReferenceCache {
     }
 
     /// The cached image for `inputs`, or None (absent, damaged or recorded for other inputs).
-    pub fn load(&self, inputs: &Value) -> Option<(Image, ReferenceRecord)> {
+    pub fn load<R: CachedRecord>(&self, inputs: &Value) -> Option<(Image, R)> {
         let (exr_path, json_path) = self.paths(inputs);
-        let record: ReferenceRecord = serde_json::from_slice(&intact(&json_path)?).ok()?;
-        if &record.inputs != inputs {
+        let record: R = serde_json::from_slice(&intact(&json_path)?).ok()?;
+        if record.inputs() != inputs {
             return None;
         }
         intact(&exr_path)?;
@@ -63,16 +81,16 @@ impl ReferenceCache {
     }
 
     /// Stores the image (EXR first, then the JSON that makes it a hit), each sealed.
-    pub fn store(&self, image: &Image, record: &ReferenceRecord) -> anyhow::Result<PathBuf> {
+    pub fn store<R: CachedRecord>(&self, image: &Image, record: &R) -> anyhow::Result<PathBuf> {
         std::fs::create_dir_all(&self.dir)
             .with_context(|| format!("cannot create the cache folder {}", self.dir.display()))?;
-        let (exr_path, json_path) = self.paths(&record.inputs);
+        let (exr_path, json_path) = self.paths(record.inputs());
         write_exr(
             &exr_path,
             image.width,
             image.height,
             &image.pixels,
-            "strandlight brute-force reference",
+            R::description(),
         )?;
         seal(&exr_path).with_context(|| format!("sealing {}", exr_path.display()))?;
         let json = serde_json::to_vec_pretty(record)?;
@@ -139,19 +157,21 @@ mod tests {
                 .map(|i| [i as f32, 0.5, -1.0, 0.25 * i as f32])
                 .collect(),
         );
-        assert!(cache.load(&inputs).is_none());
+        assert!(cache.load::<ReferenceRecord>(&inputs).is_none());
         let record = ReferenceRecord {
             inputs: inputs.clone(),
             lights: 6144,
             milliseconds: 1234.5,
         };
         cache.store(&image, &record).unwrap();
-        let (back, rec) = cache.load(&inputs).unwrap();
+        let (back, rec) = cache.load::<ReferenceRecord>(&inputs).unwrap();
         assert_eq!(back, image, "f32 EXR round trip is exact");
         assert_eq!(rec, record);
         assert!(
             cache
-                .load(&json!({ "hair_sha256": "ab", "size": [3, 2], "lights": 96 }))
+                .load::<ReferenceRecord>(
+                    &json!({ "hair_sha256": "ab", "size": [3, 2], "lights": 96 })
+                )
                 .is_none()
         );
         // A damaged image or record is a miss, not a crash and not a wrong picture: every single
@@ -166,7 +186,7 @@ mod tests {
             std::fs::write(&exr_path, &flipped).unwrap();
             decoder_accepted += usize::from(read_rgba_exr(&exr_path).is_ok());
             assert!(
-                cache.load(&inputs).is_none(),
+                cache.load::<ReferenceRecord>(&inputs).is_none(),
                 "a reference image flipped at byte {at} was served"
             );
         }
@@ -180,15 +200,15 @@ mod tests {
             "no flip gets past the decoder alone: the seal is untested"
         );
         std::fs::write(&exr_path, &original).unwrap();
-        assert!(cache.load(&inputs).is_some());
+        assert!(cache.load::<ReferenceRecord>(&inputs).is_some());
         let json = std::fs::read(&json_path).unwrap();
         std::fs::write(&json_path, &json[..json.len() - 3]).unwrap();
         assert!(
-            cache.load(&inputs).is_none(),
+            cache.load::<ReferenceRecord>(&inputs).is_none(),
             "a truncated record was served"
         );
         std::fs::write(&exr_path, b"not an exr").unwrap();
-        assert!(cache.load(&inputs).is_none());
+        assert!(cache.load::<ReferenceRecord>(&inputs).is_none());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -19,6 +19,9 @@ use strandlight_tables::asset::{Storage, TableAsset, expect_parameters, read_ass
 pub enum EnvShading {
     Marschner,
     Artist,
+    /// Chiang et al. 2016 (pbrt-v4, Mitsuba 3 and Cycles' Principled Hair): the model the
+    /// path-traced ground truth renders.
+    Chiang,
 }
 
 /// Single scattering only, or with multiple scattering (Ren §3.2).
@@ -44,7 +47,14 @@ impl EnvShading {
         match self {
             EnvShading::Marschner => Model::Marschner,
             EnvShading::Artist => Model::Artist,
+            EnvShading::Chiang => Model::Chiang,
         }
+    }
+
+    /// Whether fibers are physical, opaque cylinders (a file's transparency ignored), as the
+    /// path tracer renders them.
+    pub fn physical_fibers(self) -> bool {
+        self == EnvShading::Chiang
     }
 
     /// The convolution table of SRBF lights in `mode` (the artist model has no d_b·S_back
@@ -53,6 +63,8 @@ impl EnvShading {
         match (self, mode) {
             (EnvShading::Marschner, ScatteringMode::Single) => "marschner",
             (EnvShading::Marschner, ScatteringMode::Full) => "marschner_full",
+            (EnvShading::Chiang, ScatteringMode::Single) => "chiang",
+            (EnvShading::Chiang, ScatteringMode::Full) => "chiang_full",
             (EnvShading::Artist, _) => "artist",
         }
     }
@@ -62,6 +74,8 @@ impl EnvShading {
         match (self, mode) {
             (EnvShading::Marschner, ScatteringMode::Single) => "marschner_direct",
             (EnvShading::Marschner, ScatteringMode::Full) => "marschner_full_direct",
+            (EnvShading::Chiang, ScatteringMode::Single) => "chiang_direct",
+            (EnvShading::Chiang, ScatteringMode::Full) => "chiang_full_direct",
             (EnvShading::Artist, _) => "artist_direct",
         }
     }

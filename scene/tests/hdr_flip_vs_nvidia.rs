@@ -8,6 +8,7 @@ use std::path::Path;
 use std::process::Command;
 use strandlight_scene::hdr_flip::{PIXELS_PER_DEGREE, hdr_flip};
 use strandlight_scene::image_metrics::{HAIR_ALPHA, Image};
+use strandlight_tables::outside_tools::{python, require_python_modules};
 
 const NVIDIA_HDR_FLIP: &str = r#"
 import sys, numpy as np, flip_evaluator as flip
@@ -17,14 +18,6 @@ error, mean, _ = flip.evaluate(load(sys.argv[7]), load(sys.argv[8]), "HDR", appl
     parameters={"ppd": ppd, "startExposure": start, "stopExposure": stop, "numExposures": n, "tonemapper": "ACES"})
 np.asarray(error, dtype='<f4').reshape(h, w).tofile(sys.argv[9])
 "#;
-
-fn nvidia_available() -> bool {
-    Command::new("python3")
-        .args(["-c", "import flip_evaluator, numpy"])
-        .output()
-        .map(|o| o.status.success())
-        .unwrap_or(false)
-}
 
 fn write_rgb(path: &Path, image: &Image) {
     let bytes: Vec<u8> = image
@@ -66,10 +59,7 @@ fn fibers(highlight_row: f32, noise: f32, seed: u32) -> Image {
 
 #[test]
 fn our_hdr_flip_matches_nvidias_float_implementation() {
-    if !nvidia_available() {
-        eprintln!(
-            "skipped: python3 with NVIDIA's flip-evaluator and numpy is not installed (pip install flip-evaluator)"
-        );
+    if !require_python_modules(&["flip_evaluator", "numpy"], "pip install flip-evaluator") {
         return;
     }
     let dir = std::env::temp_dir().join(format!("strandlight-flip-{}", std::process::id()));
@@ -97,7 +87,7 @@ fn our_hdr_flip_matches_nvidias_float_implementation() {
     for (name, test) in &cases {
         let ours = hdr_flip(test, &reference).unwrap();
         write_rgb(&test_path, test);
-        let status = Command::new("python3")
+        let status = Command::new(python())
             .args(["-c", NVIDIA_HDR_FLIP])
             .arg(reference.width.to_string())
             .arg(reference.height.to_string())

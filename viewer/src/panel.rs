@@ -119,7 +119,12 @@ impl Panel {
         egui::ComboBox::from_label("fiber model")
             .selected_text(format!("{shading:?}"))
             .show_ui(ui, |ui| {
-                for m in [Shading::KajiyaKay, Shading::Marschner, Shading::Artist] {
+                for m in [
+                    Shading::KajiyaKay,
+                    Shading::Marschner,
+                    Shading::Chiang,
+                    Shading::Artist,
+                ] {
                     let allowed = !(m == Shading::KajiyaKay
                         && matches!(s.lighting, Lighting::Environment(_)));
                     ui.add_enabled_ui(allowed, |ui| {

@@ -70,8 +70,8 @@ pub struct ViewState {
 pub enum TablesKey {
     Lights {
         shading: Shading,
-        /// Only Marschner's lookup textures depend on these.
-        marschner_luts: Option<(String, usize)>,
+        /// Only the lookup textures (Marschner's, Chiang's) depend on these.
+        lookup_tables: Option<(String, usize)>,
     },
     Environment {
         map: String,
@@ -87,7 +87,7 @@ pub fn tables_key(settings: &FrameSettings) -> TablesKey {
     match &settings.lighting {
         Lighting::Lights(point) => TablesKey::Lights {
             shading,
-            marschner_luts: (shading == Shading::Marschner)
+            lookup_tables: matches!(shading, Shading::Marschner | Shading::Chiang)
                 .then(|| (settings.preset.clone(), point.lut_size)),
         },
         Lighting::Environment(env) => TablesKey::Environment {

@@ -217,6 +217,14 @@ impl HairModel {
         self.color.as_ref()
     }
 
+    /// The same strands with every fiber opaque: a file's transparency is a rendering hint for
+    /// non-physical shaders, while a physically based fiber (and a path tracer's cylinder)
+    /// passes light only by scattering it.
+    pub fn without_transparency(mut self) -> Self {
+        self.transparency = None;
+        self
+    }
+
     pub fn bounds(&self) -> Aabb {
         self.bounds
     }

@@ -1,107 +1,13 @@
-// Marschner through the two point-light lookup tables (Hunz 2016 Algorithm 2), as the fiber model
-// of strands.wgsl:
+// Marschner through its two point-light lookup tables (fiber_lut.wgsl; Hunz 2016 Algorithm 2),
+// as the fiber model of strands.wgsl:
 //   S = Σ_p M_p(sin θ_i, sin θ_o) · N_p(cos φ, cos θ_d) / max(cos²θ_d, 1e-8),
-// cos θ_d being the M table's fourth quantity. The tables are strandlight `Table`s uploaded
-// as-is (storage buffers, row-major, channels innermost) and interpolated here bilinearly over
-// their two continuous axes, exactly as `Table::lookup` does on the CPU; the quantity / lobe
-// axis is indexed, not interpolated.
-
-struct LutAxis {
-    min: f32,
-    inv_range: f32,
-    last_index: f32,
-    inv_exponent: f32,
-    // 0: x itself; 1: asin(x); 2: −acos(x).
-    warp: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-};
-
-struct MarschnerLutParams {
-    // M: sin θ_i, sin θ_o. N: azimuth (cos φ or cos(φ/2)), cos θ_d.
-    m_axes: array<LutAxis, 2>,
-    n_axes: array<LutAxis, 2>,
-    // Element strides of the three axes (x, y, z) of each table.
-    m_strides: vec4<u32>,
-    n_strides: vec4<u32>,
-    // 1 when N's azimuth axis is cos(φ/2).
-    half_phi: u32,
-    min_cos2_theta_d: f32,
-    _pad0: u32,
-    _pad1: u32,
-};
-
-@group(2) @binding(0) var<uniform> lut: MarschnerLutParams;
-@group(2) @binding(1) var<storage, read> lut_m: array<f32>;
-@group(2) @binding(2) var<storage, read> lut_n: array<f32>;
-
-// The lower node of the cell holding x and the upper node's weight (`Axis::cell`).
-struct LutCell {
-    lower: u32,
-    upper_weight: f32,
-};
-
-fn lut_cell(a: LutAxis, x: f32) -> LutCell {
-    if (a.last_index < 1.0) { return LutCell(0u, 0.0); }
-    var w = x;
-    if (a.warp == 1u) { w = asin(clamp(x, -1.0, 1.0)); }
-    if (a.warp == 2u) { w = -acos(clamp(x, -1.0, 1.0)); }
-    var t = clamp((w - a.min) * a.inv_range, 0.0, 1.0);
-    if (a.inv_exponent != 1.0) { t = pow(t, a.inv_exponent); }
-    let f = t * a.last_index;
-    let lower = min(floor(f), a.last_index - 1.0);
-    return LutCell(u32(lower), f - lower);
-}
-
-// Bilinear weights and the four element offsets of one cell of a two-axis slice.
-struct Bilinear {
-    base: u32,
-    step_x: u32,
-    step_y: u32,
-    wx: f32,
-    wy: f32,
-};
-
-fn bilinear(ax: LutAxis, ay: LutAxis, strides: vec4<u32>, x: f32, y: f32) -> Bilinear {
-    let cx = lut_cell(ax, x);
-    let cy = lut_cell(ay, y);
-    var sx = strides.x;
-    var sy = strides.y;
-    if (ax.last_index < 1.0) { sx = 0u; }
-    if (ay.last_index < 1.0) { sy = 0u; }
-    return Bilinear(cx.lower * strides.x + cy.lower * strides.y, sx, sy, cx.upper_weight, cy.upper_weight);
-}
-
-fn m_value(b: Bilinear, quantity: u32) -> f32 {
-    let o = b.base + quantity * lut.m_strides.z;
-    let v00 = lut_m[o];
-    let v10 = lut_m[o + b.step_x];
-    let v01 = lut_m[o + b.step_y];
-    let v11 = lut_m[o + b.step_x + b.step_y];
-    return mix(mix(v00, v10, b.wx), mix(v01, v11, b.wx), b.wy);
-}
-
-fn n_texel(o: u32) -> vec3<f32> {
-    return vec3<f32>(lut_n[o], lut_n[o + 1u], lut_n[o + 2u]);
-}
-
-fn n_value(b: Bilinear, lobe: u32) -> vec3<f32> {
-    let o = b.base + lobe * lut.n_strides.z;
-    let v00 = n_texel(o);
-    let v10 = n_texel(o + b.step_x);
-    let v01 = n_texel(o + b.step_y);
-    let v11 = n_texel(o + b.step_x + b.step_y);
-    return mix(mix(v00, v10, b.wx), mix(v01, v11, b.wx), b.wy);
-}
+// cos θ_d being the M table's fourth quantity.
 
 // S (1/sr, RGB) at a fiber frame.
 fn marschner_lut_s(f: FiberFrame) -> vec3<f32> {
     let bm = bilinear(lut.m_axes[0], lut.m_axes[1], lut.m_strides, f.sin_theta_i, f.sin_theta_o);
     let cos_d = clamp(m_value(bm, 3u), 0.0, 1.0);
-    var azimuth = f.cos_phi;
-    if (lut.half_phi == 1u) { azimuth = sqrt(clamp(0.5 + 0.5 * f.cos_phi, 0.0, 1.0)); }
-    let bn = bilinear(lut.n_axes[0], lut.n_axes[1], lut.n_strides, azimuth, cos_d);
+    let bn = bilinear(lut.n_axes[0], lut.n_axes[1], lut.n_strides, lut_azimuth(f.cos_phi), cos_d);
     var s = vec3<f32>(0.0);
     for (var p = 0u; p < 3u; p++) {
         s += m_value(bm, p) * n_value(bn, p);

@@ -5,6 +5,8 @@
 //! * [`ShadingModel::MarschnerLut`] — Marschner through the two point-light lookup tables of
 //!   Hunz 2016 Algorithm 2, baked elsewhere (`strandlight_precompute::point_light_luts`; the
 //!   runtime never links tabulation code) and uploaded as-is.
+//! * [`ShadingModel::ChiangLut`] — Chiang et al. 2016 through the same kind of table pair
+//!   (`S·cos θ_i = Σ_p M_p(sin θ_i, sin θ_o) N̄_p(cos φ, sin θ_o)`, four lobes with the residual).
 //! * [`ShadingModel::Artist`] — Sadeghi et al. 2010 in closed form.
 //!
 //! Every model returns, per light, `E · S · cos θ_i` (Kajiya-Kay: `E · KK`, whose diffuse
@@ -35,6 +37,7 @@ pub enum ShadingModel {
     #[default]
     KajiyaKay,
     MarschnerLut(MarschnerLuts),
+    ChiangLut(ChiangLuts),
     Artist(ArtistModel),
 }
 
@@ -43,6 +46,7 @@ impl ShadingModel {
         match self {
             ShadingModel::KajiyaKay => "kajiya-kay",
             ShadingModel::MarschnerLut(_) => "marschner (lookup tables)",
+            ShadingModel::ChiangLut(_) => "chiang (lookup tables)",
             ShadingModel::Artist(_) => "artist",
         }
     }
@@ -53,7 +57,13 @@ impl ShadingModel {
             ShadingModel::KajiyaKay => include_str!("fiber_kajiya_kay.wgsl"),
             ShadingModel::MarschnerLut(_) => concat!(
                 include_str!("fiber_frame.wgsl"),
+                include_str!("fiber_lut.wgsl"),
                 include_str!("fiber_marschner_lut.wgsl")
+            ),
+            ShadingModel::ChiangLut(_) => concat!(
+                include_str!("fiber_frame.wgsl"),
+                include_str!("fiber_lut.wgsl"),
+                include_str!("fiber_chiang_lut.wgsl")
             ),
             ShadingModel::Artist(_) => concat!(
                 include_str!("fiber_frame.wgsl"),
@@ -72,15 +82,43 @@ pub enum LutLayoutError {
     },
 }
 
+/// A longitudinal M table and an azimuthal N table as `fiber_lut.wgsl` reads them.
+#[derive(Clone, Debug, PartialEq)]
+struct LutPair {
+    lut_m: Table,
+    lut_n: Table,
+    /// N's azimuth axis is cos(φ/2) rather than cos φ.
+    half_phi: bool,
+}
+
+impl LutPair {
+    fn uniform(&self) -> LutUniform {
+        let m = self.lut_m.gpu_axes();
+        let n = self.lut_n.gpu_axes();
+        LutUniform {
+            m_axes: [m[0], m[1]],
+            n_axes: [n[0], n[1]],
+            m_strides: strides(&self.lut_m),
+            n_strides: strides(&self.lut_n),
+            half_phi: self.half_phi as u32,
+            min_cos2_theta_d: MIN_COS2_THETA_D,
+            _pad: [0; 2],
+        }
+    }
+}
+
 /// The M table (axes `sin_theta_i`, `sin_theta_o`, `quantity` with 4 nodes M_R, M_TT, M_TRT,
 /// cos θ_d; 1 channel) and the N table (axes `cos_phi` or `cos_half_phi`, `cos_theta_d`, `lobe`
 /// with 3 nodes; 3 channels), checked for that layout.
 #[derive(Clone, Debug, PartialEq)]
-pub struct MarschnerLuts {
-    lut_m: Table,
-    lut_n: Table,
-    half_phi: bool,
-}
+pub struct MarschnerLuts(LutPair);
+
+/// Chiang's M table (axes `sin_theta_i`, `sin_theta_o`, `quantity` with 4 nodes: M_p of the
+/// lobes R, TT, TRT with the scale tilt and of the residual; 1 channel) and N table (axes
+/// `cos_phi` or `cos_half_phi`, `sin_theta_o`, `lobe` with 4 nodes: N̄_p = ½∫A_p N_p dh of the
+/// same lobes; 3 channels), checked for that layout.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChiangLuts(LutPair);
 
 fn check_layout(
     table_name: &'static str,
@@ -145,33 +183,56 @@ impl MarschnerLuts {
             3,
         )?;
         let half_phi = lut_n.axes()[0].name == AXIS_COS_HALF_PHI;
-        Ok(Self {
+        Ok(Self(LutPair {
             lut_m,
             lut_n,
             half_phi,
-        })
+        }))
     }
 
     pub fn lut_m(&self) -> &Table {
-        &self.lut_m
+        &self.0.lut_m
     }
 
     pub fn lut_n(&self) -> &Table {
-        &self.lut_n
+        &self.0.lut_n
+    }
+}
+
+impl ChiangLuts {
+    pub fn new(lut_m: Table, lut_n: Table) -> Result<Self, LutLayoutError> {
+        check_layout(
+            "chiang_lut_m",
+            &lut_m,
+            [&[AXIS_SIN_THETA_I], &[AXIS_SIN_THETA_O], &[AXIS_QUANTITY]],
+            4,
+            1,
+        )?;
+        check_layout(
+            "chiang_lut_n",
+            &lut_n,
+            [
+                &[AXIS_COS_PHI, AXIS_COS_HALF_PHI],
+                &[AXIS_SIN_THETA_O],
+                &[AXIS_LOBE],
+            ],
+            4,
+            3,
+        )?;
+        let half_phi = lut_n.axes()[0].name == AXIS_COS_HALF_PHI;
+        Ok(Self(LutPair {
+            lut_m,
+            lut_n,
+            half_phi,
+        }))
     }
 
-    fn uniform(&self) -> MarschnerLutUniform {
-        let m = self.lut_m.gpu_axes();
-        let n = self.lut_n.gpu_axes();
-        MarschnerLutUniform {
-            m_axes: [m[0], m[1]],
-            n_axes: [n[0], n[1]],
-            m_strides: strides(&self.lut_m),
-            n_strides: strides(&self.lut_n),
-            half_phi: self.half_phi as u32,
-            min_cos2_theta_d: MIN_COS2_THETA_D,
-            _pad: [0; 2],
-        }
+    pub fn lut_m(&self) -> &Table {
+        &self.0.lut_m
+    }
+
+    pub fn lut_n(&self) -> &Table {
+        &self.0.lut_n
     }
 }
 
@@ -189,7 +250,7 @@ fn strides(table: &Table) -> [u32; 4] {
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct MarschnerLutUniform {
+struct LutUniform {
     m_axes: [AxisGpu; 2],
     n_axes: [AxisGpu; 2],
     m_strides: [u32; 4],
@@ -264,7 +325,8 @@ impl ModelBinding {
         };
         let (entries, buffers): (Vec<_>, Vec<wgpu::Buffer>) = match model {
             ShadingModel::KajiyaKay => return None,
-            ShadingModel::MarschnerLut(luts) => (
+            ShadingModel::MarschnerLut(MarschnerLuts(luts))
+            | ShadingModel::ChiangLut(ChiangLuts(luts)) => (
                 vec![
                     uniform_entry(0, fragment),
                     storage_entry(1, fragment, true),
@@ -272,20 +334,12 @@ impl ModelBinding {
                 ],
                 vec![
                     buffer(
-                        "marschner lut params",
+                        "lut params",
                         bytemuck::bytes_of(&luts.uniform()),
                         wgpu::BufferUsages::UNIFORM,
                     ),
-                    buffer(
-                        "marschner lut_m",
-                        luts.lut_m.as_bytes(),
-                        wgpu::BufferUsages::STORAGE,
-                    ),
-                    buffer(
-                        "marschner lut_n",
-                        luts.lut_n.as_bytes(),
-                        wgpu::BufferUsages::STORAGE,
-                    ),
+                    buffer("lut_m", luts.lut_m.as_bytes(), wgpu::BufferUsages::STORAGE),
+                    buffer("lut_n", luts.lut_n.as_bytes(), wgpu::BufferUsages::STORAGE),
                 ],
             ),
             ShadingModel::Artist(model) => (
@@ -334,7 +388,7 @@ mod tests {
             3,
         );
         let luts = MarschnerLuts::new(m.clone(), n.clone()).unwrap();
-        assert!(luts.half_phi);
+        assert!(luts.0.half_phi);
         // The stride of each axis is the offset between neighbouring nodes.
         assert_eq!(
             strides(&n),

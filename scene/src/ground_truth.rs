@@ -1,0 +1,551 @@
+//! The path-traced ground truth: the scene rendered by a renderer nobody here wrote, Mitsuba 3,
+//! with its `hair` BSDF (Chiang et al. 2016, as in pbrt-v4 and Cycles), its `envmap` emitter and
+//! its `path` integrator. Fibers are opaque tubes (`bsplinecurve` through the strand's points) of the file's width: light
+//! passes a fiber only by scattering through it, whatever transparency the file asks for.
+//!
+//! Single scattering is `max_depth` 2 (direct light through opaque fibers). Full scattering is
+//! traced to the first depth D (of 8, 16, 32, …) whose image moves by less than the tolerance
+//! when the depth doubles, both rendered with the same seed so that the difference is the deeper
+//! bounces, not noise. Samples follow the rule of the other references: N samples per pixel
+//! are converged when independent N and 4N images differ by at most the tolerance (relative RMSE
+//! over the hair); the kept image averages the two (5N samples), and the ladder stops at a
+//! budget, where the image is reported as not converged with its noise estimated from the last
+//! difference. Every image is cached by content like the DOM reference.
+
+pub mod mitsuba_scene;
+
+use crate::image_metrics::{Image, relative_rmse};
+use crate::reference_cache::{CachedRecord, ReferenceCache, read_rgba_exr};
+use crate::scene_tables::ScatteringMode;
+use crate::steps::Steps;
+use anyhow::{Context, bail};
+use mitsuba_scene::{MitsubaRun, MitsubaScene, write_scene};
+use serde::{Deserialize, Serialize};
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+use strandlight_tables::checksum::sha256_hex;
+use strandlight_tables::outside_tools::{PYTHON_VAR, python};
+
+/// What to install when Mitsuba is missing.
+pub const INSTALL_HINT: &str = "pip install mitsuba (or set STRANDLIGHT_PYTHON to a Python that has it; `.ci/run` installs it)";
+
+/// The exit status of `mitsuba_render.py` when `import mitsuba` fails.
+const NO_MITSUBA_STATUS: i32 = 3;
+
+/// How hard the ground truth works (see the module documentation).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TruthSettings {
+    /// Samples per pixel of the first rung.
+    pub first_spp: u32,
+    /// Most samples per pixel of one image (the ladder stops there).
+    pub max_spp: u32,
+    /// Relative RMSE between N and 4N (and between depths D and 2D) that counts as converged.
+    pub tolerance: f64,
+    /// First depth tried for full scattering, and the most.
+    pub first_depth: u32,
+    pub most_depth: u32,
+    /// Samples per pixel of the depth search.
+    pub depth_spp: u32,
+}
+
+impl Default for TruthSettings {
+    fn default() -> Self {
+        Self {
+            first_spp: 1024,
+            max_spp: 16384,
+            tolerance: 0.01,
+            first_depth: 8,
+            most_depth: 64,
+            depth_spp: 256,
+        }
+    }
+}
+
+/// What is stored beside a ground-truth image.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TruthRecord {
+    /// Everything the image depends on.
+    pub inputs: Value,
+    /// Mitsuba's render time, seconds (scene loading excluded).
+    pub seconds: f64,
+    /// `mitsuba.__version__`.
+    pub mitsuba: String,
+}
+
+impl CachedRecord for TruthRecord {
+    fn inputs(&self) -> &Value {
+        &self.inputs
+    }
+    fn description() -> &'static str {
+        "strandlight path-traced ground truth (Mitsuba 3)"
+    }
+}
+
+/// (depth D, relative RMSE of the image at D against 2D) per step of the depth search.
+pub type DepthLadder = Vec<(u32, f64)>;
+
+/// One rung of the sample ladder.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SampleRung {
+    pub spp: u32,
+    pub seconds: f64,
+    /// Relative RMSE against the independent image of 4× the samples.
+    pub difference_to_4x: f64,
+}
+
+/// The ground truth of one scene and mode.
+#[derive(Debug, Clone)]
+pub struct GroundTruth {
+    pub image: Image,
+    /// Samples per pixel of the kept image (N + 4N of the last rung).
+    pub spp: u32,
+    pub max_depth: u32,
+    /// Mitsuba's time for the kept image's two renders, seconds.
+    pub seconds: f64,
+    pub ladder: Vec<SampleRung>,
+    /// The depth search (empty for single scattering).
+    pub depth_ladder: DepthLadder,
+    pub converged: bool,
+    /// The kept image's noise, relative RMSE against the noiseless image: the last rung's
+    /// difference d between independent N and 4N images is √(σ²_N + σ²_N/4) = σ_N·√1.25, and
+    /// their average holds 5N samples: σ_N/√5 = d/2.5.
+    pub noise: f64,
+    pub mitsuba: String,
+}
+
+impl GroundTruth {
+    /// The error of `image` against the noiseless truth, estimated by removing this image's
+    /// noise in quadrature (their errors are independent): √max(0, e² − noise²).
+    pub fn noise_corrected(&self, measured: f64) -> f64 {
+        without_noise(measured, self.noise)
+    }
+}
+
+/// A relative RMSE measured against a noisy yardstick, with the yardstick's own noise (relative
+/// RMSE) removed in quadrature: the two errors are independent, so their squares add.
+pub fn without_noise(measured: f64, noise: f64) -> f64 {
+    (measured * measured - noise * noise).max(0.0).sqrt()
+}
+
+/// The scene and what identifies it in the cache.
+pub struct TruthInputs<'a> {
+    pub scene: MitsubaScene<'a>,
+    pub hair_sha256: &'a str,
+    pub map_sha256: &'a str,
+}
+
+impl TruthInputs<'_> {
+    fn key(&self, run: MitsubaRun) -> Value {
+        json!({
+            "renderer": "mitsuba3 scalar_rgb path, hair BSDF, bsplinecurve through the strand points, envmap (hidden from the camera), box filter",
+            "hair_sha256": self.hair_sha256,
+            "map_sha256": self.map_sha256,
+            "rotate": self.scene.rotate_degrees,
+            "directional": self.scene.directional,
+            "up": format!("{:?}", self.scene.up),
+            "camera": format!("{:?}", self.scene.camera),
+            "size": [self.scene.size.0, self.scene.size.1],
+            "fiber": self.scene.fiber,
+            "run": run,
+            "script_sha256": sha256_hex(mitsuba_scene::RENDER_SCRIPT.as_bytes()),
+        })
+    }
+}
+
+/// Whether a ground truth may be rendered or only read from the cache.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum TruthUse {
+    /// Never: the DOM reference is the only yardstick.
+    Off,
+    /// Where an earlier run cached every image it needs (`strandlight truth` renders them).
+    Cached,
+    /// Render what the cache lacks (minutes per image).
+    Render,
+}
+
+/// One image from `cache`, or rendered by Mitsuba in a fresh folder under `work` when `render`
+/// allows (None when it does not and the cache lacks it). The bool says it was cached.
+pub fn render_cached(
+    inputs: &TruthInputs,
+    run: MitsubaRun,
+    cache: &ReferenceCache,
+    work: &Path,
+    render: bool,
+) -> anyhow::Result<Option<(Image, TruthRecord, bool)>> {
+    let key = inputs.key(run);
+    if let Some((image, record)) = cache.load::<TruthRecord>(&key) {
+        return Ok(Some((image, record, true)));
+    }
+    if !render {
+        return Ok(None);
+    }
+    let dir = work.join(format!("mitsuba-{}", &ReferenceCache::key(&key)[..16]));
+    let output = dir.join("render.exr");
+    let scene_json = write_scene(&inputs.scene, run, &dir, &output)?;
+    let (seconds, mitsuba) = run_mitsuba(&scene_json, run)?;
+    let image = read_rgba_exr(&output)?;
+    let record = TruthRecord {
+        inputs: key,
+        seconds,
+        mitsuba,
+    };
+    cache.store(&image, &record)?;
+    std::fs::remove_dir_all(&dir).ok();
+    Ok(Some((image, record, false)))
+}
+
+/// Runs `mitsuba_render.py` on a scene file, printing a progress line every 10 s while it
+/// works (a first ground truth takes minutes). Returns (render seconds, Mitsuba's version).
+pub fn run_mitsuba(scene_json: &Path, run: MitsubaRun) -> anyhow::Result<(f64, String)> {
+    let dir = scene_json.parent().unwrap_or(Path::new("."));
+    let script = dir.join(mitsuba_scene::RENDER_SCRIPT_NAME);
+    let interpreter = python();
+    let mut child = Command::new(&interpreter)
+        .arg(&script)
+        .arg(scene_json)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .with_context(|| {
+            format!("cannot start {interpreter} for Mitsuba 3 ({INSTALL_HINT}; {PYTHON_VAR} names another interpreter)")
+        })?;
+    let start = Instant::now();
+    let mut last_said = start;
+    let status = loop {
+        if let Some(status) = child.try_wait()? {
+            break status;
+        }
+        std::thread::sleep(Duration::from_millis(200));
+        if last_said.elapsed() >= Duration::from_secs(10) {
+            eprintln!(
+                "  ground truth: Mitsuba renders {} spp at depth {}, {:.0} s so far",
+                run.spp,
+                run.max_depth,
+                start.elapsed().as_secs_f64()
+            );
+            last_said = Instant::now();
+        }
+    };
+    let out = child.wait_with_output()?;
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if status.code() == Some(NO_MITSUBA_STATUS) {
+        bail!("Mitsuba 3 is not installed for {interpreter}: {INSTALL_HINT}");
+    }
+    if !status.success() {
+        bail!(
+            "Mitsuba failed on {} ({status}):\n{}",
+            scene_json.display(),
+            stderr.trim()
+        );
+    }
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout.lines().last().unwrap_or_default();
+    let report: Value = serde_json::from_str(line)
+        .with_context(|| format!("Mitsuba's report on {}: {line:?}", scene_json.display()))?;
+    Ok((
+        report["seconds"].as_f64().unwrap_or(f64::NAN),
+        report["mitsuba"].as_str().unwrap_or("?").to_string(),
+    ))
+}
+
+/// The ground truth of `mode`: the depth search (full scattering), then the sample ladder.
+/// None when `truth` is [`TruthUse::Cached`] and an image it needs was never rendered.
+pub fn ground_truth(
+    inputs: &TruthInputs,
+    mode: ScatteringMode,
+    settings: &TruthSettings,
+    truth: TruthUse,
+    cache_dir: &Path,
+    steps: &mut Steps,
+) -> anyhow::Result<Option<GroundTruth>> {
+    validate(settings)?;
+    if truth == TruthUse::Off {
+        return Ok(None);
+    }
+    let may_render = truth == TruthUse::Render;
+    let cache = ReferenceCache::new(cache_dir.join("truth"));
+    let work = cache_dir.join("truth-work");
+    let m = mode.name();
+    let (max_depth, depth_ladder) = match mode {
+        ScatteringMode::Single => (2, Vec::new()),
+        ScatteringMode::Full => {
+            let found = steps.run(
+                &format!("{m}: truth depth"),
+                || depth_search(inputs, settings, &cache, &work, may_render),
+                |found: &Option<(u32, DepthLadder)>| match found {
+                    None => "not cached".into(),
+                    Some((d, ladder)) => {
+                        let moves: Vec<String> = ladder
+                            .iter()
+                            .map(|(d, e)| format!("{d}→{}: {e:.4}", 2 * d))
+                            .collect();
+                        format!("max_depth {d} ({})", moves.join(", "))
+                    }
+                },
+            )?;
+            match found {
+                Some(found) => found,
+                None => return Ok(None),
+            }
+        }
+    };
+    let mut ladder = Vec::new();
+    let mut spp = settings.first_spp;
+    let render = |spp: u32, steps: &mut Steps| {
+        // Each rung its own seed (its sample count), so that every image is independent of
+        // the others: N against 4N then measures noise, not a shared sample sequence.
+        let run = MitsubaRun {
+            max_depth,
+            spp,
+            seed: spp,
+        };
+        steps.run(
+            &format!("{m}: truth {spp} spp"),
+            || render_cached(inputs, run, &cache, &work, may_render),
+            |r: &Option<(Image, TruthRecord, bool)>| match r {
+                None => "not cached".into(),
+                Some((_, r, cached)) => format!(
+                    "Mitsuba {:.1} s{}",
+                    r.seconds,
+                    if *cached { " (cached)" } else { "" }
+                ),
+            },
+        )
+    };
+    let Some(mut coarse) = render(spp, steps)? else {
+        return Ok(None);
+    };
+    loop {
+        let Some(fine) = render(4 * spp, steps)? else {
+            return Ok(None);
+        };
+        let difference = relative_rmse(&coarse.0, &fine.0)?;
+        ladder.push(SampleRung {
+            spp,
+            seconds: coarse.1.seconds,
+            difference_to_4x: difference,
+        });
+        steps.say(format!(
+            "{m}: ground truth {spp} against {} spp: relative RMSE {difference:.4} (tolerance {})",
+            4 * spp,
+            settings.tolerance
+        ));
+        let converged = difference <= settings.tolerance;
+        if converged || 16 * spp > settings.max_spp {
+            return Ok(Some(GroundTruth {
+                image: average(&coarse.0, 1.0, &fine.0, 4.0),
+                spp: 5 * spp,
+                max_depth,
+                seconds: coarse.1.seconds + fine.1.seconds,
+                ladder,
+                depth_ladder,
+                converged,
+                noise: difference / 2.5,
+                mitsuba: fine.1.mitsuba,
+            }));
+        }
+        spp *= 4;
+        coarse = fine;
+    }
+}
+
+/// The first depth D whose image, rendered again at 2D with the same seed, moves by at most
+/// the tolerance; the most depth if none does. None: not cached and not allowed to render.
+fn depth_search(
+    inputs: &TruthInputs,
+    settings: &TruthSettings,
+    cache: &ReferenceCache,
+    work: &Path,
+    may_render: bool,
+) -> anyhow::Result<Option<(u32, DepthLadder)>> {
+    let image = |max_depth| {
+        let run = MitsubaRun {
+            max_depth,
+            spp: settings.depth_spp,
+            seed: 7,
+        };
+        render_cached(inputs, run, cache, work, may_render).map(|r| r.map(|r| r.0))
+    };
+    let mut ladder = Vec::new();
+    let mut depth = settings.first_depth;
+    let Some(mut shallow) = image(depth)? else {
+        return Ok(None);
+    };
+    while depth < settings.most_depth {
+        let Some(deep) = image(2 * depth)? else {
+            return Ok(None);
+        };
+        let moved = relative_rmse(&shallow, &deep)?;
+        ladder.push((depth, moved));
+        if moved <= settings.tolerance {
+            return Ok(Some((depth, ladder)));
+        }
+        depth *= 2;
+        shallow = deep;
+    }
+    Ok(Some((settings.most_depth, ladder)))
+}
+
+fn validate(s: &TruthSettings) -> anyhow::Result<()> {
+    if s.first_spp == 0 || s.max_spp < s.first_spp || s.depth_spp == 0 {
+        bail!(
+            "ground-truth samples: first {} and most {} per pixel must be ≥ 1 and ordered",
+            s.first_spp,
+            s.max_spp
+        );
+    }
+    if !(s.tolerance > 0.0 && s.tolerance < 1.0) {
+        bail!(
+            "ground-truth tolerance {}: use a relative RMSE in (0, 1)",
+            s.tolerance
+        );
+    }
+    if s.first_depth < 3 || s.most_depth < s.first_depth {
+        bail!(
+            "ground-truth depths: first {} (≥ 3: more than direct light) and most {} must be ordered",
+            s.first_depth,
+            s.most_depth
+        );
+    }
+    Ok(())
+}
+
+/// The weighted mean of two images (weights by their sample counts); alpha likewise.
+fn average(a: &Image, wa: f32, b: &Image, wb: f32) -> Image {
+    let w = wa + wb;
+    let pixels = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .map(|(p, q)| std::array::from_fn(|c| (wa * p[c] + wb * q[c]) / w))
+        .collect();
+    Image::new(a.width, a.height, pixels)
+}
+
+/// Writes a scene's Mitsuba files to `dir` (curves, map, script, `scene.json` for `run`) for
+/// a user who wants the offline render: `python3 DIR/mitsuba_render.py DIR/scene.json`.
+pub fn export(inputs: &TruthInputs, run: MitsubaRun, dir: &Path) -> anyhow::Result<PathBuf> {
+    write_scene(&inputs.scene, run, dir, &dir.join("render.exr"))
+}
+
+/// What `strandlight truth` renders (or exports): the scene exactly as `compare` sets it up,
+/// so that `compare`, `image-error` and `bench` find the cached images.
+pub struct TruthRequest {
+    pub hair: PathBuf,
+    pub env: String,
+    pub sanitize: bool,
+    pub size: (u32, u32),
+    pub rotate_degrees: f64,
+    pub preset: String,
+    pub modes: Vec<ScatteringMode>,
+    pub settings: TruthSettings,
+    pub cache: PathBuf,
+}
+
+/// A loaded [`TruthRequest`]: the hair (opaque fibers), map, camera and fiber.
+pub struct TruthScene {
+    pub hair: strandlight_runtime::hair::HairModel,
+    pub hair_sha256: String,
+    pub map: strandlight_precompute::EnvMap,
+    pub map_sha256: String,
+    pub up: strandlight_runtime::camera::UpAxis,
+    pub camera: strandlight_runtime::camera::Camera,
+    pub fiber: Value,
+}
+
+impl TruthScene {
+    pub fn load(request: &TruthRequest) -> anyhow::Result<Self> {
+        use crate::compare::{fibers_for, front_camera};
+        use crate::scene_tables::EnvShading;
+        let bytes = std::fs::read(&request.hair)
+            .with_context(|| format!("--hair {}", request.hair.display()))?;
+        let (hair, _) = crate::hair_input::load_hair(Some(&request.hair))?;
+        let (hair, hair_sha256) = fibers_for(EnvShading::Chiang, hair, sha256_hex(&bytes));
+        let env = crate::environment::load_env(&request.env, request.sanitize)?;
+        let (up, camera) = front_camera(&hair, request.size);
+        let fiber = strandlight_precompute::bake_plan::FiberDescription::preset(&request.preset)
+            .with_context(|| format!("--preset {:?}", request.preset))?;
+        Ok(Self {
+            hair,
+            hair_sha256,
+            map: env.map,
+            map_sha256: env.sha256,
+            up,
+            camera,
+            fiber: serde_json::to_value(&fiber.chiang)?,
+        })
+    }
+
+    pub fn inputs(&self, size: (u32, u32), rotate_degrees: f64) -> TruthInputs<'_> {
+        TruthInputs {
+            scene: MitsubaScene {
+                hair: &self.hair,
+                up: self.up,
+                camera: self.camera,
+                size,
+                map: Some(&self.map),
+                rotate_degrees,
+                directional: &[],
+                fiber: &self.fiber,
+            },
+            hair_sha256: &self.hair_sha256,
+            map_sha256: &self.map_sha256,
+        }
+    }
+}
+
+/// What is written beside a ground-truth image (`STEM.json` beside `STEM.exr`), so that a tool
+/// reading the image later (`image-error`) knows its noise.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TruthSidecar {
+    pub renderer: String,
+    pub spp: u32,
+    pub max_depth: u32,
+    pub converged: bool,
+    /// Relative RMSE of the image's own noise.
+    pub noise: f64,
+    pub seconds: f64,
+}
+
+/// Writes `STEM.exr` (linear), `STEM.png` and the sidecar `STEM.json`; returns the EXR's path.
+pub fn write_truth_image(
+    truth: &GroundTruth,
+    stem: &Path,
+    description: &str,
+) -> anyhow::Result<PathBuf> {
+    use strandlight_runtime::image_out::{write_exr, write_png};
+    let (w, h) = (truth.image.width, truth.image.height);
+    let exr = stem.with_extension("exr");
+    write_exr(&exr, w, h, &truth.image.pixels, description)?;
+    write_png(
+        &stem.with_extension("png"),
+        w,
+        h,
+        &truth.image.pixels,
+        description,
+    )?;
+    let sidecar = TruthSidecar {
+        renderer: format!("Mitsuba {} (scalar_rgb, path, hair BSDF)", truth.mitsuba),
+        spp: truth.spp,
+        max_depth: truth.max_depth,
+        converged: truth.converged,
+        noise: truth.noise,
+        seconds: truth.seconds,
+    };
+    let json = stem.with_extension("json");
+    strandlight_tables::atomic_write::write_atomically(&json, |out| {
+        std::io::Write::write_all(out, serde_json::to_string_pretty(&sidecar)?.as_bytes())
+    })
+    .with_context(|| format!("cannot write {}", json.display()))?;
+    Ok(exr)
+}
+
+/// The sidecar of a ground-truth EXR, None when the image has none (it is not a ground truth).
+pub fn read_truth_sidecar(exr: &Path) -> Option<TruthSidecar> {
+    let text = std::fs::read_to_string(exr.with_extension("json")).ok()?;
+    serde_json::from_str(&text).ok()
+}
