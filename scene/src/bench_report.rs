@@ -258,6 +258,16 @@ pub(crate) fn regenerate_args(report: &BenchReport) -> String {
     args
 }
 
+/// The commands of a merged report's runs, as the page names them.
+fn run_commands(report: &BenchReport) -> String {
+    report
+        .runs
+        .iter()
+        .map(|run| format!("`bench{run}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
 /// The generated section, `plot_dir` relative to the Markdown file (e.g. `bench`).
 pub fn section(report: &BenchReport, plot_dir: &str) -> String {
     let mut out = String::new();
@@ -275,12 +285,7 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
             format!(
                 "Measured in {} runs, {}, merged into this page by `bench --from-report` with their reports ([`{plot_dir}/runs/`]({plot_dir}/runs/))",
                 report.runs.len(),
-                report
-                    .runs
-                    .iter()
-                    .map(|run| format!("`bench{run}`"))
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                run_commands(report)
             ),
             format!(
                 "or stops at its run's budget (at most {} lights)",
@@ -406,14 +411,9 @@ pub fn truth_section(report: &BenchReport, plot_dir: &str) -> String {
             regenerate_args(report)
         ),
         false => format!(
-            "Measured in {} runs ({}), merged by `bench --from-report`",
+            "Measured in {} runs, {}, merged into this page by `bench --from-report` with their reports ([`{plot_dir}/runs/`]({plot_dir}/runs/))",
             report.runs.len(),
-            report
-                .runs
-                .iter()
-                .map(|run| format!("`bench{run}`"))
-                .collect::<Vec<_>>()
-                .join(", ")
+            run_commands(report)
         ),
     };
     let _ = writeln!(

@@ -29,7 +29,8 @@ use strandlight_tables::checksum::sha256_hex;
 use strandlight_tables::outside_tools::{PYTHON_VAR, python};
 
 /// What to install when Mitsuba is missing.
-pub const INSTALL_HINT: &str = "pip install mitsuba (or set STRANDLIGHT_PYTHON to a Python that has it; `.ci/run` installs it)";
+pub const INSTALL_HINT: &str =
+    "pip install mitsuba, or set STRANDLIGHT_PYTHON to a Python that has it";
 
 /// The exit status of `mitsuba_render.py` when `import mitsuba` fails.
 const NO_MITSUBA_STATUS: i32 = 3;
@@ -198,21 +199,42 @@ pub fn render_cached(
     Ok(Some((image, record, false)))
 }
 
-/// Runs `mitsuba_render.py` on a scene file, printing a progress line every 10 s while it
-/// works (a first ground truth takes minutes). Returns (render seconds, Mitsuba's version).
+/// Runs `mitsuba_render.py` on a scene file with `$STRANDLIGHT_PYTHON` (or `python3`),
+/// printing a progress line every 10 s while it works (a first ground truth takes minutes).
+/// Returns (render seconds, Mitsuba's version).
 pub fn run_mitsuba(scene_json: &Path, run: MitsubaRun) -> anyhow::Result<(f64, String)> {
+    run_mitsuba_with(&python(), scene_json, run)
+}
+
+/// [`run_mitsuba`] with the interpreter named.
+pub fn run_mitsuba_with(
+    interpreter: &str,
+    scene_json: &Path,
+    run: MitsubaRun,
+) -> anyhow::Result<(f64, String)> {
     let dir = scene_json.parent().unwrap_or(Path::new("."));
     let script = dir.join(mitsuba_scene::RENDER_SCRIPT_NAME);
-    let interpreter = python();
-    let mut child = Command::new(&interpreter)
+    let mut child = Command::new(interpreter)
         .arg(&script)
         .arg(scene_json)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .with_context(|| {
-            format!("cannot start {interpreter} for Mitsuba 3 ({INSTALL_HINT}; {PYTHON_VAR} names another interpreter)")
+            format!("cannot start {interpreter}, the Python that runs Mitsuba 3 (${PYTHON_VAR}, default python3): {INSTALL_HINT}")
         })?;
+    // Drained while the child runs: a full pipe would stall it.
+    let drain = |pipe: Option<Box<dyn std::io::Read + Send>>| {
+        std::thread::spawn(move || {
+            let mut text = String::new();
+            if let Some(mut pipe) = pipe {
+                let _ = pipe.read_to_string(&mut text);
+            }
+            text
+        })
+    };
+    let stdout = drain(child.stdout.take().map(|p| Box::new(p) as _));
+    let stderr = drain(child.stderr.take().map(|p| Box::new(p) as _));
     let start = Instant::now();
     let mut last_said = start;
     let status = loop {
@@ -230,8 +252,8 @@ pub fn run_mitsuba(scene_json: &Path, run: MitsubaRun) -> anyhow::Result<(f64, S
             last_said = Instant::now();
         }
     };
-    let out = child.wait_with_output()?;
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stdout = stdout.join().unwrap_or_default();
+    let stderr = stderr.join().unwrap_or_default();
     if status.code() == Some(NO_MITSUBA_STATUS) {
         bail!("Mitsuba 3 is not installed for {interpreter}: {INSTALL_HINT}");
     }
@@ -242,7 +264,6 @@ pub fn run_mitsuba(scene_json: &Path, run: MitsubaRun) -> anyhow::Result<(f64, S
             stderr.trim()
         );
     }
-    let stdout = String::from_utf8_lossy(&out.stdout);
     let line = stdout.lines().last().unwrap_or_default();
     let report: Value = serde_json::from_str(line)
         .with_context(|| format!("Mitsuba's report on {}: {line:?}", scene_json.display()))?;
@@ -548,4 +569,156 @@ pub fn write_truth_image(
 pub fn read_truth_sidecar(exr: &Path) -> Option<TruthSidecar> {
     let text = std::fs::read_to_string(exr.with_extension("json")).ok()?;
     serde_json::from_str(&text).ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compare::front_camera;
+    use strandlight_runtime::hair::{GroomParams, generate_groom};
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("strandlight-gt-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn run() -> MitsubaRun {
+        MitsubaRun {
+            max_depth: 2,
+            spp: 1,
+            seed: 0,
+        }
+    }
+
+    /// The runner reports a missing interpreter, a Python without Mitsuba (the script's exit
+    /// status 3) and a failed render with what the child printed, never a silent result.
+    #[test]
+    fn a_missing_python_mitsuba_or_failed_render_is_a_clear_error() {
+        let dir = scratch("runner");
+        let scene = dir.join("scene.json");
+        std::fs::write(&scene, "{}").unwrap();
+        let e = run_mitsuba_with("/nonexistent/python3", &scene, run()).unwrap_err();
+        assert!(format!("{e:#}").contains("pip install mitsuba"), "{e:#}");
+        if !strandlight_tables::outside_tools::program_exists(&python()) {
+            return;
+        }
+        let script = dir.join(mitsuba_scene::RENDER_SCRIPT_NAME);
+        std::fs::write(&script, "import sys\nsys.exit(3)\n").unwrap();
+        let e = run_mitsuba_with(&python(), &scene, run()).unwrap_err();
+        assert!(
+            format!("{e:#}").contains("not installed")
+                && format!("{e:#}").contains("pip install mitsuba"),
+            "{e:#}"
+        );
+        std::fs::write(
+            &script,
+            "import sys\nsys.stderr.write('bad curve file\\n')\nsys.exit(1)\n",
+        )
+        .unwrap();
+        let e = format!(
+            "{:#}",
+            run_mitsuba_with(&python(), &scene, run()).unwrap_err()
+        );
+        assert!(
+            e.contains("Mitsuba failed on") && e.contains("bad curve file"),
+            "{e}"
+        );
+        std::fs::write(&script, "print('not json')\n").unwrap();
+        let e = format!(
+            "{:#}",
+            run_mitsuba_with(&python(), &scene, run()).unwrap_err()
+        );
+        assert!(e.contains("Mitsuba's report"), "{e}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    /// The sample ladder against a cache filled with images whose error is known: an image of
+    /// N spp is 1 + 8/N everywhere, so N and 4N differ by 6/(N + 2) relative.
+    #[test]
+    fn the_ladder_stops_at_the_first_converged_rung_or_the_budget() {
+        let dir = scratch("ladder");
+        let hair = generate_groom(&GroomParams {
+            strand_count: 20,
+            clump_count: 4,
+            ..GroomParams::default()
+        })
+        .unwrap();
+        let (up, camera) = front_camera(&hair, (8, 6));
+        let fiber = serde_json::json!({ "eumelanin": 1.3 });
+        let inputs = TruthInputs {
+            scene: MitsubaScene {
+                hair: &hair,
+                up,
+                camera,
+                size: (8, 6),
+                map: None,
+                rotate_degrees: 0.0,
+                directional: &[],
+                fiber: &fiber,
+            },
+            hair_sha256: "h",
+            map_sha256: "m",
+        };
+        let cache = ReferenceCache::new(dir.join("truth"));
+        let value = |spp: u32| 1.0 + 8.0 / spp as f32;
+        let store = |spp: u32| {
+            let run = MitsubaRun {
+                max_depth: 2,
+                spp,
+                seed: spp,
+            };
+            let image = Image::new(8, 6, vec![[value(spp), value(spp), value(spp), 1.0]; 48]);
+            let record = TruthRecord {
+                inputs: inputs.key(run),
+                seconds: spp as f64 / 1000.0,
+                mitsuba: "test".into(),
+            };
+            cache.store(&image, &record).unwrap();
+        };
+        let settings = |tolerance| TruthSettings {
+            tolerance,
+            max_spp: 16384,
+            ..TruthSettings::default()
+        };
+        let truth = |tolerance, using| {
+            ground_truth(
+                &inputs,
+                ScatteringMode::Single,
+                &settings(tolerance),
+                using,
+                &dir,
+                &mut Steps::new(true),
+            )
+            .unwrap()
+        };
+        store(1024);
+        assert!(
+            truth(0.01, TruthUse::Cached).is_none(),
+            "the 4096 rung is missing"
+        );
+        assert!(truth(0.01, TruthUse::Off).is_none());
+        store(4096);
+        store(16384);
+        let d = |n: f64| (8.0 / n - 2.0 / n) / (1.0 + 2.0 / n);
+        // 1024 against 4096 differ by 0.0058: converged at 1%.
+        let t = truth(0.01, TruthUse::Cached).unwrap();
+        assert!(t.converged && t.spp == 5 * 1024 && t.max_depth == 2);
+        assert!((t.noise - d(1024.0) / 2.5).abs() < 1e-6, "{}", t.noise);
+        let mean = (value(1024) + 4.0 * value(4096)) / 5.0;
+        assert!((t.image.pixels[0][0] - mean).abs() < 1e-6);
+        // At 0.1% the ladder climbs to 4096 against 16384 (0.0015), and the budget stops it.
+        let t = truth(0.001, TruthUse::Cached).unwrap();
+        assert!(
+            !t.converged && t.spp == 5 * 4096,
+            "{} {}",
+            t.converged,
+            t.spp
+        );
+        assert_eq!(t.ladder.len(), 2);
+        assert!((t.ladder[1].difference_to_4x - d(4096.0)).abs() < 1e-6);
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }

@@ -98,6 +98,27 @@ fn ours(
     render_lights(&frame).unwrap().image
 }
 
+/// The Mitsuba scene of `hair` at the default front camera, lit by `map` and `directional`.
+fn mitsuba_scene<'a>(
+    hair: &'a HairModel,
+    size: (u32, u32),
+    map: Option<&'a EnvMap>,
+    directional: &'a [([f64; 3], [f64; 3])],
+    fiber: &'a serde_json::Value,
+) -> MitsubaScene<'a> {
+    let (up, camera) = front_camera(hair, size);
+    MitsubaScene {
+        hair,
+        up,
+        camera,
+        size,
+        map,
+        rotate_degrees: 0.0,
+        directional,
+        fiber,
+    }
+}
+
 /// Mitsuba's image of the same scene (direct light only).
 fn theirs(scene: MitsubaScene, spp: u32, dir: &Path) -> Image {
     // Each test's cache is its own scratch folder; the map (or its absence) must be in the key.
@@ -184,21 +205,12 @@ fn the_silhouettes_match() {
     let (tables, fiber) = chiang(&dir);
     let size = (64, 48);
     for (name, hair) in [("groom", small_groom()), ("letter F", letter_f())] {
-        let (up, camera) = front_camera(&hair, size);
+        let (up, _) = front_camera(&hair, size);
         let toward = (up.toward_front().as_dvec3() + up.vector().as_dvec3()).normalize();
         let light = EnvLight::directional(toward.as_vec3(), [3.0; 3]);
         let a = ours(&hair, size, &[light], &tables, true);
         let b = theirs(
-            MitsubaScene {
-                hair: &hair,
-                up,
-                camera,
-                size,
-                map: None,
-                rotate_degrees: 0.0,
-                directional: &[(toward.to_array(), [3.0; 3])],
-                fiber: &fiber,
-            },
+            mitsuba_scene(&hair, size, None, &[(toward.to_array(), [3.0; 3])], &fiber),
             64,
             &dir,
         );
@@ -264,7 +276,7 @@ fn one_bright_texel_lights_the_same_side() {
     let (tables, fiber) = chiang(&dir);
     let hair = small_groom();
     let size = (64, 48);
-    let (up, camera) = front_camera(&hair, size);
+    let (up, _) = front_camera(&hair, size);
     let (w, h) = (64usize, 32usize);
     // Texels of the map's frame: the map's centre (−Z) is behind the hair, seen from the front.
     for (name, x, y) in [
@@ -282,16 +294,7 @@ fn one_bright_texel_lights_the_same_side() {
         let light = EnvLight::directional(toward.as_vec3(), [power as f32; 3]);
         let a = ours(&hair, size, &[light], &tables, true);
         let b = theirs(
-            MitsubaScene {
-                hair: &hair,
-                up,
-                camera,
-                size,
-                map: Some(&map),
-                rotate_degrees: 0.0,
-                directional: &[],
-                fiber: &fiber,
-            },
+            mitsuba_scene(&hair, size, Some(&map), &[], &fiber),
             256,
             &dir,
         );
@@ -337,8 +340,7 @@ fn one_fiber_under_one_directional_light() {
     )
     .unwrap();
     let size = (64, 48);
-    let (up, camera) = front_camera(&hair, size);
-    assert_eq!(up, UpAxis::Y);
+    assert_eq!(front_camera(&hair, size).0, UpAxis::Y);
     let mut worst: f64 = 0.0;
     for toward in [
         DVec3::new(0.4, 0.3, 1.0),
@@ -349,16 +351,13 @@ fn one_fiber_under_one_directional_light() {
         let light = EnvLight::directional(toward.as_vec3(), [2.0, 1.5, 1.0]);
         let a = ours(&hair, size, &[light], &tables, false);
         let b = theirs(
-            MitsubaScene {
-                hair: &hair,
-                up,
-                camera,
+            mitsuba_scene(
+                &hair,
                 size,
-                map: None,
-                rotate_degrees: 0.0,
-                directional: &[(toward.to_array(), [2.0, 1.5, 1.0])],
-                fiber: &fiber,
-            },
+                None,
+                &[(toward.to_array(), [2.0, 1.5, 1.0])],
+                &fiber,
+            ),
             8192,
             &dir,
         );

@@ -162,32 +162,47 @@ fn check_layout(
     Ok(())
 }
 
-impl MarschnerLuts {
-    pub fn new(lut_m: Table, lut_n: Table) -> Result<Self, LutLayoutError> {
+impl LutPair {
+    /// The pair checked for the layout `fiber_lut.wgsl` reads: M over (`sin_theta_i`,
+    /// `sin_theta_o`, 4 quantities), 1 channel; N over (`cos_phi` or `cos_half_phi`,
+    /// `n_second_axis`, `lobes` lobes), RGB.
+    fn checked(
+        names: [&'static str; 2],
+        lut_m: Table,
+        lut_n: Table,
+        n_second_axis: &'static str,
+        lobes: usize,
+    ) -> Result<Self, LutLayoutError> {
         check_layout(
-            "lut_m",
+            names[0],
             &lut_m,
             [&[AXIS_SIN_THETA_I], &[AXIS_SIN_THETA_O], &[AXIS_QUANTITY]],
             4,
             1,
         )?;
         check_layout(
-            "lut_n",
+            names[1],
             &lut_n,
             [
                 &[AXIS_COS_PHI, AXIS_COS_HALF_PHI],
-                &[AXIS_COS_THETA_D],
+                &[n_second_axis],
                 &[AXIS_LOBE],
             ],
-            3,
+            lobes,
             3,
         )?;
         let half_phi = lut_n.axes()[0].name == AXIS_COS_HALF_PHI;
-        Ok(Self(LutPair {
+        Ok(Self {
             lut_m,
             lut_n,
             half_phi,
-        }))
+        })
+    }
+}
+
+impl MarschnerLuts {
+    pub fn new(lut_m: Table, lut_n: Table) -> Result<Self, LutLayoutError> {
+        LutPair::checked(["lut_m", "lut_n"], lut_m, lut_n, AXIS_COS_THETA_D, 3).map(Self)
     }
 
     pub fn lut_m(&self) -> &Table {
@@ -201,30 +216,14 @@ impl MarschnerLuts {
 
 impl ChiangLuts {
     pub fn new(lut_m: Table, lut_n: Table) -> Result<Self, LutLayoutError> {
-        check_layout(
-            "chiang_lut_m",
-            &lut_m,
-            [&[AXIS_SIN_THETA_I], &[AXIS_SIN_THETA_O], &[AXIS_QUANTITY]],
-            4,
-            1,
-        )?;
-        check_layout(
-            "chiang_lut_n",
-            &lut_n,
-            [
-                &[AXIS_COS_PHI, AXIS_COS_HALF_PHI],
-                &[AXIS_SIN_THETA_O],
-                &[AXIS_LOBE],
-            ],
-            4,
-            3,
-        )?;
-        let half_phi = lut_n.axes()[0].name == AXIS_COS_HALF_PHI;
-        Ok(Self(LutPair {
+        LutPair::checked(
+            ["chiang_lut_m", "chiang_lut_n"],
             lut_m,
             lut_n,
-            half_phi,
-        }))
+            AXIS_SIN_THETA_O,
+            4,
+        )
+        .map(Self)
     }
 
     pub fn lut_m(&self) -> &Table {
