@@ -274,7 +274,8 @@ pub fn run_mitsuba_with(
 }
 
 /// The ground truth of `mode`: the depth search (full scattering), then the sample ladder.
-/// None when `truth` is [`TruthUse::Cached`] and an image it needs was never rendered.
+/// None when `truth` is [`TruthUse::Cached`] and the cache lacks the first N-against-4N pair;
+/// with the first pair cached, the last cached pair below the budget.
 pub fn ground_truth(
     inputs: &TruthInputs,
     mode: ScatteringMode,
@@ -340,9 +341,12 @@ pub fn ground_truth(
     let Some(mut coarse) = render(spp, steps)? else {
         return Ok(None);
     };
+    // With the cache only, the last pair it holds is the truth: a finer rung that a run with a
+    // larger budget would render does not hide what a smaller budget already measured.
+    let mut last_pair = None;
     loop {
         let Some(fine) = render(4 * spp, steps)? else {
-            return Ok(None);
+            return Ok(last_pair);
         };
         let difference = relative_rmse(&coarse.0, &fine.0)?;
         ladder.push(SampleRung {
@@ -356,19 +360,21 @@ pub fn ground_truth(
             settings.tolerance
         ));
         let converged = difference <= settings.tolerance;
+        let truth = GroundTruth {
+            image: average(&coarse.0, 1.0, &fine.0, 4.0),
+            spp: 5 * spp,
+            max_depth,
+            seconds: coarse.1.seconds + fine.1.seconds,
+            ladder: ladder.clone(),
+            depth_ladder: depth_ladder.clone(),
+            converged,
+            noise: difference / 2.5,
+            mitsuba: fine.1.mitsuba.clone(),
+        };
         if converged || 16 * spp > settings.max_spp {
-            return Ok(Some(GroundTruth {
-                image: average(&coarse.0, 1.0, &fine.0, 4.0),
-                spp: 5 * spp,
-                max_depth,
-                seconds: coarse.1.seconds + fine.1.seconds,
-                ladder,
-                depth_ladder,
-                converged,
-                noise: difference / 2.5,
-                mitsuba: fine.1.mitsuba,
-            }));
+            return Ok(Some(truth));
         }
+        last_pair = Some(truth);
         spp *= 4;
         coarse = fine;
     }
@@ -701,6 +707,10 @@ mod tests {
         );
         assert!(truth(0.01, TruthUse::Off).is_none());
         store(4096);
+        // The cache holds 1024 and 4096 only: at 0.1% the pair it holds is the truth, not
+        // converged.
+        let t = truth(0.001, TruthUse::Cached).unwrap();
+        assert!(!t.converged && t.spp == 5 * 1024 && t.ladder.len() == 1);
         store(16384);
         let d = |n: f64| (8.0 / n - 2.0 / n) / (1.0 + 2.0 / n);
         // 1024 against 4096 differ by 0.0058: converged at 1%.
