@@ -218,40 +218,7 @@ pub fn check_chiang_luts(
             ))
         })
         .collect::<Result<_, TableError>>()?;
-    let reference_max = pairs
-        .iter()
-        .flat_map(|(_, r)| r.iter().copied())
-        .fold(0.0f64, f64::max);
-    let scale = if reference_max > 0.0 {
-        reference_max
-    } else {
-        1.0
-    };
-    let (mut max_abs, mut sum_sq, mut max_rel) = (0.0f64, 0.0f64, 0.0f64);
-    let mut worst_point = [0.0; 3];
-    for ((got, want), a) in pairs.iter().zip(points) {
-        for c in 0..3 {
-            let e = (got[c] - want[c]).abs();
-            if e > max_abs || e.is_nan() {
-                max_abs = e;
-                worst_point = [a.theta_i, a.theta_o, a.phi];
-            }
-            sum_sq += e * e;
-            if want[c] > 0.01 * reference_max {
-                max_rel = max_rel.max(e / want[c]);
-            }
-        }
-    }
-    let values = (3 * points.len()).max(1) as f64;
-    Ok(LutAccuracy {
-        name: name.to_string(),
-        max_abs_error: max_abs / scale,
-        rms_abs_error: (sum_sq / values).sqrt() / scale,
-        max_rel_error: max_rel,
-        samples: points.len(),
-        reference_max,
-        worst_point,
-    })
+    Ok(LutAccuracy::of_pairs(name, &pairs, points))
 }
 
 #[cfg(test)]
