@@ -650,6 +650,7 @@ fn env_view_shader(device: &wgpu::Device) -> wgpu::ShaderModule {
         include_str!("convolution_transmittance.wgsl"),
         include_str!("lobe_spread.wgsl"),
         include_str!("occupancy_map.wgsl"),
+        include_str!("table_axis.wgsl"),
         include_str!("env_view.wgsl"),
         include_str!("view_visibility.wgsl"),
     ]

@@ -18,18 +18,6 @@
 //                       fragments in front (the occupancy map) and added; fragments that can no
 //                       longer contribute stop before any light is evaluated (early termination).
 
-struct TableAxis {
-    min: f32,
-    inv_range: f32,
-    last_index: f32,
-    inv_exponent: f32,
-    // 0: x itself; 1: asin(x); 2: −acos(x).
-    warp: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-};
-
 struct TableLayout {
     axes: array<TableAxis, 4>,
     // Element strides of the four axes.
@@ -66,24 +54,6 @@ struct ViewParams {
 // w 1 where the pixel holds hair; and its (unnormalized) tangent.
 @group(3) @binding(4) var nearest_position: texture_2d<f32>;
 @group(3) @binding(5) var nearest_tangent: texture_2d<f32>;
-
-struct TableCell {
-    lower: u32,
-    upper_weight: f32,
-};
-
-// `Axis::cell`: the lower node of the cell holding x and the upper node's weight.
-fn table_cell(a: TableAxis, x: f32) -> TableCell {
-    if (a.last_index < 1.0) { return TableCell(0u, 0.0); }
-    var w = x;
-    if (a.warp == 1u) { w = asin(clamp(x, -1.0, 1.0)); }
-    if (a.warp == 2u) { w = -acos(clamp(x, -1.0, 1.0)); }
-    var t = clamp((w - a.min) * a.inv_range, 0.0, 1.0);
-    if (a.inv_exponent != 1.0) { t = pow(t, a.inv_exponent); }
-    let f = t * a.last_index;
-    let lower = min(floor(f), a.last_index - 1.0);
-    return TableCell(u32(lower), f - lower);
-}
 
 // The 16 corners of a 4D cell: base offset, per-axis steps (0 on one-node axes), weights.
 struct Cell4 {

@@ -6,23 +6,11 @@
 // interpolated. The model's own file (fiber_marschner_lut.wgsl, fiber_chiang_lut.wgsl) says
 // how S is assembled from them.
 
-struct LutAxis {
-    min: f32,
-    inv_range: f32,
-    last_index: f32,
-    inv_exponent: f32,
-    // 0: x itself; 1: asin(x); 2: −acos(x).
-    warp: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-};
-
 struct LutParams {
     // M: sin θ_i, sin θ_o. N: azimuth (cos φ or cos(φ/2)), then cos θ_d (Marschner) or sin θ_o
     // (Chiang).
-    m_axes: array<LutAxis, 2>,
-    n_axes: array<LutAxis, 2>,
+    m_axes: array<TableAxis, 2>,
+    n_axes: array<TableAxis, 2>,
     // Element strides of the three axes (x, y, z) of each table.
     m_strides: vec4<u32>,
     n_strides: vec4<u32>,
@@ -38,24 +26,6 @@ struct LutParams {
 @group(2) @binding(1) var<storage, read> lut_m: array<f32>;
 @group(2) @binding(2) var<storage, read> lut_n: array<f32>;
 
-// The lower node of the cell holding x and the upper node's weight (`Axis::cell`).
-struct LutCell {
-    lower: u32,
-    upper_weight: f32,
-};
-
-fn lut_cell(a: LutAxis, x: f32) -> LutCell {
-    if (a.last_index < 1.0) { return LutCell(0u, 0.0); }
-    var w = x;
-    if (a.warp == 1u) { w = asin(clamp(x, -1.0, 1.0)); }
-    if (a.warp == 2u) { w = -acos(clamp(x, -1.0, 1.0)); }
-    var t = clamp((w - a.min) * a.inv_range, 0.0, 1.0);
-    if (a.inv_exponent != 1.0) { t = pow(t, a.inv_exponent); }
-    let f = t * a.last_index;
-    let lower = min(floor(f), a.last_index - 1.0);
-    return LutCell(u32(lower), f - lower);
-}
-
 // Bilinear weights and the four element offsets of one cell of a two-axis slice.
 struct Bilinear {
     base: u32,
@@ -65,9 +35,9 @@ struct Bilinear {
     wy: f32,
 };
 
-fn bilinear(ax: LutAxis, ay: LutAxis, strides: vec4<u32>, x: f32, y: f32) -> Bilinear {
-    let cx = lut_cell(ax, x);
-    let cy = lut_cell(ay, y);
+fn bilinear(ax: TableAxis, ay: TableAxis, strides: vec4<u32>, x: f32, y: f32) -> Bilinear {
+    let cx = table_cell(ax, x);
+    let cy = table_cell(ay, y);
     var sx = strides.x;
     var sy = strides.y;
     if (ax.last_index < 1.0) { sx = 0u; }

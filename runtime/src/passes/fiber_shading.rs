@@ -57,11 +57,13 @@ impl ShadingModel {
             ShadingModel::KajiyaKay => include_str!("fiber_kajiya_kay.wgsl"),
             ShadingModel::MarschnerLut(_) => concat!(
                 include_str!("fiber_frame.wgsl"),
+                include_str!("table_axis.wgsl"),
                 include_str!("fiber_lut.wgsl"),
                 include_str!("fiber_marschner_lut.wgsl")
             ),
             ShadingModel::ChiangLut(_) => concat!(
                 include_str!("fiber_frame.wgsl"),
+                include_str!("table_axis.wgsl"),
                 include_str!("fiber_lut.wgsl"),
                 include_str!("fiber_chiang_lut.wgsl")
             ),
