@@ -346,6 +346,13 @@ pub fn ground_truth(
     let mut last_pair = None;
     loop {
         let Some(fine) = render(4 * spp, steps)? else {
+            if last_pair.is_some() {
+                steps.say(format!(
+                    "{m}: the cache holds no {} spp image: the truth is its {} against {spp} spp pair",
+                    4 * spp,
+                    spp / 4
+                ));
+            }
             return Ok(last_pair);
         };
         let difference = relative_rmse(&coarse.0, &fine.0)?;
