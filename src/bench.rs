@@ -11,7 +11,9 @@ use clap::Args;
 use strandlight_scene::baseline::Baseline;
 use strandlight_scene::bench::{BenchPaths, BenchPlan, BenchReport, PlanChanges, run as run_bench};
 use strandlight_scene::bench_plots::{Metric, plot};
-use strandlight_scene::bench_report::{section, splice, splice_truth, truth_section};
+use strandlight_scene::bench_report::{
+    details, section, splice, splice_truth, truth_details, truth_section,
+};
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 use strandlight_tables::atomic_write::write_atomically;
@@ -106,6 +108,16 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
             println!("wrote {} (and .svg)", png.display());
         }
     }
+    let details_page = out.join("DETAILS.md");
+    let details_text = match report.plan.is_truth() {
+        true => truth_details(&report, "."),
+        false => details(&report, "."),
+    };
+    write_atomically(&details_page, |w| {
+        std::io::Write::write_all(w, details_text.as_bytes())
+    })
+    .with_context(|| format!("writing {}", details_page.display()))?;
+    println!("wrote {}", details_page.display());
     if quick {
         let page = out.join("REPORT.md");
         write_atomically(&page, |w| {
