@@ -9,3 +9,4 @@ pub mod lights;
 pub mod multiple;
 pub mod passes;
 pub mod render;
+pub mod visibility;

@@ -170,6 +170,11 @@ pub struct HairVolume {
     pub deviation: Vec<f32>,
     /// Fiber length per voxel (model units), kept for tests and statistics.
     pub fiber_length: Vec<f32>,
+    /// The length-weighted second moment E[t tᵀ] of the fiber tangents (xx, yy, zz, xy, xz,
+    /// yz; zero in empty voxels): a ray along ω meets the voxel's fibers with
+    /// E[(t·ω)²] = ωᵀ E[t tᵀ] ω, so light along the fibers passes where light across them is
+    /// stopped (`crate::visibility`).
+    pub tangent_moment: Vec<[f32; 6]>,
 }
 
 /// Per-voxel sums: length, length × diameter, structure tensor (xx, yy, zz, xy, xz, yz),
@@ -255,11 +260,11 @@ impl HairVolume {
     fn from_sums(grid: VoxelGrid, sums: &[VoxelSums], nu_max: f64) -> Self {
         let deviation_model = DirectionDeviation::new(nu_max, 257);
         let volume = (grid.voxel_size as f64).powi(3);
-        let per_voxel: Vec<(f32, Vec3, f32, f32)> = sums
+        let per_voxel: Vec<(f32, Vec3, f32, f32, [f32; 6])> = sums
             .par_iter()
             .map(|s| {
                 if !(s.length > 0.0) {
-                    return (0.0, Vec3::Z, 0.0, 0.0);
+                    return (0.0, Vec3::Z, 0.0, 0.0, [0.0; 6]);
                 }
                 let m = s.tensor.map(|v| v / s.length);
                 let signed = DVec3::from_array(s.signed);
@@ -276,6 +281,7 @@ impl HairVolume {
                     dir.as_vec3(),
                     nu as f32,
                     s.length as f32,
+                    m.map(|v| v as f32),
                 )
             })
             .collect();
@@ -285,12 +291,14 @@ impl HairVolume {
             mean_direction: Vec::with_capacity(sums.len()),
             deviation: Vec::with_capacity(sums.len()),
             fiber_length: Vec::with_capacity(sums.len()),
+            tangent_moment: Vec::with_capacity(sums.len()),
         };
-        for (s, d, nu, l) in per_voxel {
+        for (s, d, nu, l, m) in per_voxel {
             out.sigma_perp.push(s);
             out.mean_direction.push(d);
             out.deviation.push(nu);
             out.fiber_length.push(l);
+            out.tangent_moment.push(m);
         }
         out
     }
