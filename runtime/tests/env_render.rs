@@ -1981,3 +1981,140 @@ fn the_light_pass_covers_each_fiber_with_its_optical_depth() {
         }
     }
 }
+
+/// SH coefficients of V(ω) = 0.55 + 0.25 z − 0.2 x (bands 0 and 1).
+fn band_one_visibility() -> [f32; 16] {
+    let y00 = 0.282_094_8;
+    let y1 = 0.488_602_5;
+    let mut c = [0.0; 16];
+    c[0] = 0.55 / y00;
+    c[2] = 0.25 / y1; // z
+    c[3] = -0.2 / y1; // x
+    c
+}
+
+/// With the visibility volume, each SRBF lobe is the unshadowed lobe times the volume's
+/// lobe-weighted visibility (computed here on the CPU with the same SH and band ratios), and no
+/// light pass is drawn for it.
+#[test]
+fn a_visibility_volume_scales_each_lobe_by_its_lobe_weighted_visibility() {
+    use strandlight_runtime::env::EnvRenderer;
+    use strandlight_runtime::visibility::{
+        LobeVisibility, VisibilityVolume, VisibilityVolumeSettings, lobe_visibility,
+    };
+    let gpu = gpu();
+    let (model, camera, tables) = groom_scene();
+    let lobes = groom_lobes();
+    let renderer = EnvRenderer::new(&gpu);
+    let settings = VisibilityVolumeSettings::default();
+    let c = band_one_visibility();
+    let bounds = model.bounds();
+    let volume = VisibilityVolume::uniform(bounds.min - 1.0, 0.5, [4, 4, 4], c);
+    renderer.use_visibility_volume(&gpu, &model, settings, &volume);
+    let render = |lights: &[EnvLight], options: &EnvRenderOptions| {
+        renderer
+            .render(
+                &gpu, &model, &camera, RES, RES, lights, &tables, options, None,
+            )
+            .unwrap_or_else(|e| panic!("{e}"))
+    };
+    let unshadowed = EnvRenderOptions {
+        shadowed: false,
+        ..Default::default()
+    };
+    let with_volume = EnvRenderOptions {
+        lobe_visibility: LobeVisibility::Volume(settings),
+        ..Default::default()
+    };
+    let frame = render(&lobes, &with_volume);
+    assert!(
+        frame.stats.timings.iter().all(|t| t.pass != "light pass"),
+        "SRBF lobes that read the volume draw no light map: {:?}",
+        frame.stats.timings
+    );
+    let parts: Vec<(f32, Vec<[f32; 4]>)> = lobes
+        .iter()
+        .map(|l| {
+            let v = lobe_visibility(&c, l.direction, l.lambda.unwrap());
+            (v, render(&[*l], &unshadowed).pixels)
+        })
+        .collect();
+    println!(
+        "lobe visibilities {:?}",
+        parts.iter().map(|p| p.0).collect::<Vec<_>>()
+    );
+    assert!(
+        (parts[0].0 - parts[1].0).abs() > 0.1,
+        "the lobes must differ"
+    );
+    let expected: Vec<[f32; 4]> = (0..frame.pixels.len())
+        .map(|i| {
+            let mut p = [0.0; 4];
+            for (v, image) in &parts {
+                for ch in 0..3 {
+                    p[ch] += v * image[i][ch];
+                }
+            }
+            p
+        })
+        .collect();
+    let lit = expected.iter().filter(|p| p[0] > 1e-4).count();
+    assert!(lit > 100, "the lobes must light the groom ({lit} pixels)");
+    let worst = worst_relative(&frame.pixels, &expected);
+    assert!(
+        worst < 1e-4,
+        "GPU vs CPU lobe visibility: worst relative {worst}"
+    );
+}
+
+/// A volume built from the groom shadows it: darker than unshadowed, and the light it takes
+/// away is of the order the light maps take (the two estimators differ, the ground truth judges
+/// them: docs/BENCHMARKS.md).
+#[test]
+fn a_built_visibility_volume_shadows_the_groom_about_as_its_light_maps_do() {
+    use strandlight_runtime::visibility::{LobeVisibility, VisibilityVolumeSettings};
+    let gpu = gpu();
+    let (_, _, tables) = groom_scene();
+    // Dense enough to shadow itself.
+    let model = generate_groom(&GroomParams {
+        strand_count: 4000,
+        ..Default::default()
+    })
+    .unwrap();
+    let camera = Camera::framing(model.bounds(), 1.0, false);
+    let lobes = groom_lobes();
+    let mean = |options: EnvRenderOptions| -> f64 {
+        let frame = render_env_frame(
+            &gpu, &model, &camera, RES, RES, &lobes, &tables, &options, None,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        frame
+            .pixels
+            .iter()
+            .map(|p| p[0] as f64 + p[1] as f64 + p[2] as f64)
+            .sum::<f64>()
+    };
+    let free = mean(EnvRenderOptions {
+        shadowed: false,
+        ..Default::default()
+    });
+    let maps = mean(EnvRenderOptions {
+        kappa: 1.0,
+        ..Default::default()
+    });
+    let volume = mean(EnvRenderOptions {
+        lobe_visibility: LobeVisibility::Volume(VisibilityVolumeSettings {
+            voxels_longest_side: 32,
+            directions: 64,
+        }),
+        ..Default::default()
+    });
+    println!("unshadowed {free:.3}, light maps {maps:.3}, volume {volume:.3}");
+    assert!(
+        volume < 0.99 * free,
+        "the volume must shadow: {volume} vs {free}"
+    );
+    // The light lost to shadow, by each estimator: the same order of magnitude.
+    let ratio = (free - volume) / (free - maps);
+    assert!((0.25..4.0).contains(&ratio), "shadow volume/maps {ratio}");
+}

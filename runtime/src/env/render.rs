@@ -20,7 +20,7 @@ use crate::passes::convolution_depth::{
 };
 use crate::passes::env_view::{
     BatchBinding, EnvAccumulator, EnvViewPass, EnvViewTargets, FrameVisibility, TableBinding,
-    ViewBinding,
+    ViewBinding, VolumeBuffers,
 };
 use crate::passes::frame_params::{FrameParams, KajiyaKay};
 pub use crate::passes::lobe_spread::LobeSpread;
@@ -32,6 +32,10 @@ pub use crate::passes::transmittance_filter::TransmittanceFilter;
 use crate::passes::view_visibility::OccupancyMap;
 pub use crate::passes::view_visibility::{FragmentCounts, OccupancyError, ViewTransparency};
 use crate::render::PassTiming;
+use crate::visibility::{
+    LobeVisibility, VisibilityVolume, VisibilityVolumeError, VisibilityVolumeSettings,
+};
+use std::sync::{Arc, Mutex};
 
 /// The tables a frame shades with. Each is an RGB [`Table`] with axes (u·ξ, u·ω_o, cos Δφ, w):
 /// * `srbf`: the convolution table I (I_M, `marschner_full` or the artist I_A), w = 1/λ;
@@ -149,6 +153,9 @@ pub struct EnvRenderOptions {
     /// the lobe's own light map ([`LobeSpread`]); `None` (default): Ren's one box-filtered
     /// visibility per lobe.
     pub lobe_spread: Option<LobeSpread>,
+    /// Where SRBF lobes' visibility comes from: their light maps (Ren's) or the groom's
+    /// visibility volume integrated over each lobe.
+    pub lobe_visibility: LobeVisibility,
 }
 
 impl std::fmt::Debug for EnvRenderOptions {
@@ -165,6 +172,9 @@ impl std::fmt::Debug for EnvRenderOptions {
             .field("width_override_px", &self.width_override_px);
         if let Some(spread) = &self.lobe_spread {
             s.field("lobe_spread", spread);
+        }
+        if self.lobe_visibility != LobeVisibility::LightMaps {
+            s.field("lobe_visibility", &self.lobe_visibility);
         }
         s.finish()
     }
@@ -183,6 +193,7 @@ impl Default for EnvRenderOptions {
             box_average: BoxAverage::default(),
             width_override_px: None,
             lobe_spread: None,
+            lobe_visibility: LobeVisibility::LightMaps,
         }
     }
 }
@@ -211,6 +222,10 @@ pub enum EnvRenderError {
     Gpu(String),
     #[error(transparent)]
     LobeSpread(#[from] LobeSpreadError),
+    #[error(transparent)]
+    VisibilityVolume(#[from] VisibilityVolumeError),
+    #[error("lobe spread and the visibility volume both set SRBF lobes' visibility: choose one")]
+    TwoLobeVisibilities,
 }
 
 #[derive(Clone, Debug)]
@@ -336,6 +351,30 @@ pub struct EnvRenderer {
     depth: ConvolutionDepthPass,
     sat: SummedAreaPass,
     view: EnvViewPass,
+    /// The last groom's visibility volume on the GPU, kept while frames ask for the same hair
+    /// and settings (a static groom pays its build once).
+    volume: Mutex<Option<CachedVolume>>,
+}
+
+/// A visibility volume uploaded for one groom and settings.
+struct CachedVolume {
+    key: (u64, VisibilityVolumeSettings),
+    buffers: Arc<VolumeBuffers>,
+}
+
+/// A fingerprint of the hair a visibility volume was built from: its points, strands and
+/// thicknesses (what the march sees).
+fn hair_fingerprint(model: &HairModel) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    model.points_bytes().hash(&mut h);
+    model.strand_offsets_bytes().hash(&mut h);
+    if let Some(t) = model.thickness() {
+        t.per_point_values(model.point_count())
+            .iter()
+            .for_each(|v| v.to_bits().hash(&mut h));
+    }
+    h.finish()
 }
 
 /// A frame's lights split by kind, each batched apart: SRBFs and directional lights (each with
@@ -421,6 +460,12 @@ fn check_inputs(
     options.transparency.check()?;
     if let Some(spread) = &options.lobe_spread {
         spread.validate()?;
+    }
+    if let Some(volume) = options.lobe_visibility.volume() {
+        volume.validate()?;
+        if options.lobe_spread.is_some() {
+            return Err(EnvRenderError::TwoLobeVisibilities);
+        }
     }
     if kinds.has_srbf() {
         required_table(&tables.srbf, "srbf", "SRBF lights", Some(AXIS_INV_LAMBDA))?;
@@ -536,6 +581,8 @@ struct FrameResources {
     /// lights), each bound with the multiple-scattering table.
     srbf_tables: Option<TableBinding>,
     directional_tables: Option<TableBinding>,
+    /// The groom's visibility volume (or its placeholder under Ren's light maps).
+    volume: Arc<VolumeBuffers>,
 }
 
 /// One resolution's light maps: the batch's DODM and its summed-area tables.
@@ -625,6 +672,7 @@ impl FrameResources {
     /// The visibility input of group 3 for this frame.
     fn visibility(&self, options: &EnvRenderOptions) -> FrameVisibility<'_> {
         FrameVisibility {
+            volume: &self.volume,
             map: &self.occupancy,
             coverage: &self.coverage_view,
             nearest: [&self.nearest_views[0], &self.nearest_views[1]],
@@ -660,6 +708,7 @@ impl FrameResources {
         memory.extend(self.targets.memory());
         memory.push(self.occupancy.memory());
         memory.push(("env sums".into(), self.sums.sums.size()));
+        memory.push(("visibility volume".into(), self.volume.bytes));
         memory
     }
 }
@@ -710,7 +759,60 @@ impl EnvRenderer {
             depth: ConvolutionDepthPass::new(gpu),
             sat: SummedAreaPass::new(gpu),
             view: EnvViewPass::new(gpu),
+            volume: Mutex::new(None),
         }
+    }
+
+    /// Makes `volume` the visibility volume of `model` under `settings` (instead of building
+    /// it): a volume computed elsewhere, or a hand-made one in tests.
+    pub fn use_visibility_volume(
+        &self,
+        gpu: &GpuContext,
+        model: &HairModel,
+        settings: VisibilityVolumeSettings,
+        volume: &VisibilityVolume,
+    ) {
+        *self.volume.lock().unwrap_or_else(|e| e.into_inner()) = Some(CachedVolume {
+            key: (hair_fingerprint(model), settings),
+            buffers: Arc::new(VolumeBuffers::new(gpu, Some(volume))),
+        });
+    }
+
+    /// The frame's volume buffers: the cached volume where the hair and settings match, else
+    /// built (timed as "visibility volume", a static groom's setup), or the placeholder.
+    fn volume_buffers(
+        &self,
+        gpu: &GpuContext,
+        model: &HairModel,
+        options: &EnvRenderOptions,
+        timings: &mut Timings,
+    ) -> Result<Arc<VolumeBuffers>, EnvRenderError> {
+        let Some(settings) = options
+            .lobe_visibility
+            .volume()
+            .filter(|_| options.shadowed)
+        else {
+            return Ok(Arc::new(VolumeBuffers::new(gpu, None)));
+        };
+        let key = (hair_fingerprint(model), *settings);
+        let mut cache = self.volume.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(cached) = cache.as_ref().filter(|c| c.key == key) {
+            return Ok(cached.buffers.clone());
+        }
+        let volume = timings.time(gpu, "visibility volume", || {
+            VisibilityVolume::build(model, settings)
+        })?;
+        GpuLimits::of(gpu).check_storage_buffer(
+            "visibility volume",
+            volume.bytes().len() as u64,
+            |max| format!("use fewer voxels along the longest side (at most {max} bytes)"),
+        )?;
+        let buffers = Arc::new(VolumeBuffers::new(gpu, Some(&volume)));
+        *cache = Some(CachedVolume {
+            key,
+            buffers: buffers.clone(),
+        });
+        Ok(buffers)
     }
 
     /// Renders `model` seen by `camera` into `width`×`height` under `lights` (SRBFs shaded with
@@ -864,6 +966,7 @@ impl EnvRenderer {
             width_override_px: options.width_override_px,
         };
         check_table_limits(gpu, tables, kinds, multiple.is_some())?;
+        let volume = self.volume_buffers(gpu, model, options, timings)?;
         let (srbf_tables, directional_tables) = timings.time(gpu, "table upload", || {
             let multiple_table = multiple.and(tables.multiple.as_ref());
             let bind = |needed: bool, t: &Option<Table>| {
@@ -894,6 +997,7 @@ impl EnvRenderer {
             sums,
             srbf_tables,
             directional_tables,
+            volume,
         })
     }
 
@@ -966,8 +1070,11 @@ impl EnvRenderer {
             }
             None => None,
         };
-        // Unshadowed frames never read the light maps: skip drawing them.
-        if options.shadowed {
+        // Unshadowed frames never read the light maps, nor do SRBF lobes that read the
+        // visibility volume: skip drawing them.
+        let srbf_from_volume = options.lobe_visibility.volume().is_some()
+            && batch.first_light().is_some_and(|l| l.lambda.is_some());
+        if options.shadowed && !srbf_from_volume {
             self.encode_light_maps(gpu, frame, batch, options, timings);
         }
         let simplified = batch.is_simplified();

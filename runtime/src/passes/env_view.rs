@@ -29,6 +29,7 @@ use crate::gpu::bind_layout::{
     float_array_texture_entry, float_texture_entry, pipeline_layout, storage_entry, uniform_entry,
 };
 use crate::gpu::texture::texture_2d;
+use crate::visibility::VisibilityVolume;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -177,9 +178,9 @@ impl BatchBinding {
             .iter()
             .enumerate()
             .map(|(slot, group)| {
-                // An unshadowed frame drew no light maps, so there is no camera to read.
-                let map = shadowed.then(|| {
-                    let camera = dodm.cameras[slot];
+                // An unshadowed frame, or SRBF lobes that read the visibility volume, drew no
+                // light maps, so there is no camera to read.
+                let map = dodm.cameras.get(slot).filter(|_| shadowed).map(|&camera| {
                     let view_proj = camera.projection_matrix(1.0) * camera.view();
                     (
                         view_proj,
@@ -405,8 +406,69 @@ pub struct ViewBinding {
     pub bytes: u64,
 }
 
+/// The visibility volume as group 3 reads it (bindings 6 and 7, `visibility_volume.wgsl`): the
+/// SH coefficients of T(ω) at a grid's vertices, or a placeholder that leaves SRBF lobes to
+/// their light maps. Uploaded once per groom.
+pub struct VolumeBuffers {
+    params: wgpu::Buffer,
+    coefficients: wgpu::Buffer,
+    /// Bytes of the coefficients (0 for the placeholder).
+    pub bytes: u64,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct VolumeUniform {
+    origin: [f32; 4],
+    dims: [u32; 4],
+    spacing: [f32; 4],
+}
+
+impl VolumeBuffers {
+    pub fn new(gpu: &GpuContext, volume: Option<&VisibilityVolume>) -> Self {
+        let device = &gpu.device;
+        let (uniform, coefficients, bytes) = match volume {
+            Some(v) => (
+                VolumeUniform {
+                    origin: v.origin.extend(1.0).into(),
+                    dims: [v.dims[0], v.dims[1], v.dims[2], 0],
+                    spacing: [v.spacing, 0.0, 0.0, 0.0],
+                },
+                v.bytes(),
+                v.bytes().len() as u64,
+            ),
+            None => (
+                VolumeUniform {
+                    origin: [0.0; 4],
+                    dims: [1, 1, 1, 0],
+                    spacing: [1.0, 0.0, 0.0, 0.0],
+                },
+                &[0u8; 64][..],
+                0,
+            ),
+        };
+        Self {
+            params: init_buffer(
+                device,
+                "visibility volume params",
+                bytemuck::bytes_of(&uniform),
+                wgpu::BufferUsages::UNIFORM,
+            ),
+            coefficients: init_buffer(
+                device,
+                "visibility volume",
+                coefficients,
+                wgpu::BufferUsages::STORAGE,
+            ),
+            bytes,
+        }
+    }
+}
+
 /// What group 3 is built from besides the grid.
 pub struct FrameVisibility<'a> {
+    /// SRBF lobes' visibility volume, or its placeholder.
+    pub volume: &'a VolumeBuffers,
     pub map: &'a OccupancyMap,
     /// [`EnvViewTargets::coverage`].
     pub coverage: &'a wgpu::TextureView,
@@ -487,6 +549,14 @@ impl ViewBinding {
                 wgpu::BindGroupEntry {
                     binding: 5,
                     resource: wgpu::BindingResource::TextureView(visibility.nearest[1]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: visibility.volume.params.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: visibility.volume.coefficients.as_entire_binding(),
                 },
             ],
         });
@@ -635,6 +705,8 @@ impl EnvViewLayouts {
                     float_texture_entry(3, fragment),
                     float_texture_entry(4, fragment),
                     float_texture_entry(5, fragment),
+                    uniform_entry(6, fragment),
+                    storage_entry(7, fragment, true),
                 ],
             ),
         }
@@ -652,6 +724,7 @@ fn env_view_shader(device: &wgpu::Device) -> wgpu::ShaderModule {
         include_str!("occupancy_map.wgsl"),
         include_str!("table_axis.wgsl"),
         include_str!("env_view.wgsl"),
+        include_str!("visibility_volume.wgsl"),
         include_str!("view_visibility.wgsl"),
     ]
     .concat();

@@ -166,9 +166,19 @@ fn shade(world: vec3<f32>, tangent: vec3<f32>, weight: f32) -> EnvOut {
     var single = vec3<f32>(0.0);
     var multiple = vec3<f32>(0.0);
     let with_grid = (batch.flags & FLAG_GRID) != 0u;
+    // SRBF lobes integrate the visibility volume's T over the lobe instead of reading their
+    // light maps (visibility_volume.wgsl); directional lights keep their maps.
+    let with_volume = volume_enabled() && (batch.flags & FLAG_UNSHADOWED) == 0u;
+    var sh: Sh16;
+    if (with_volume) { sh = volume_coefficients(world); }
     for (var slot = 0u; slot < batch.light_count; slot++) {
         let light = env_lights[slot];
-        let visible = effective_transmittance(slot, world, t, e);
+        var visible: f32;
+        if (with_volume && light.direction.w > 0.0) {
+            visible = volume_lobe_visibility(sh, light.direction.xyz, light.direction.w);
+        } else {
+            visible = effective_transmittance(slot, world, t, e);
+        }
         var g = vec4<f32>(0.0);
         if (with_grid) { g = forward_scattering(slot, world); }
         for (var s = light.first_sample; s < light.first_sample + light.sample_count; s++) {

@@ -14,3 +14,24 @@ pub mod volume;
 
 pub use spherical_harmonics::{SH_COEFFICIENTS, lobe_visibility, srbf_band_ratios};
 pub use volume::{VisibilityVolume, VisibilityVolumeError, VisibilityVolumeSettings};
+
+/// Where an SRBF lobe's visibility comes from.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum LobeVisibility {
+    /// Ren 2010: each lobe's own convolution optical depth map, read at the lobe's centre and
+    /// box-filtered (one light pass per lobe).
+    #[default]
+    LightMaps,
+    /// The groom's [`VisibilityVolume`], integrated over each lobe (no light pass for SRBF
+    /// lobes; built once per groom and kept while the hair does not move).
+    Volume(VisibilityVolumeSettings),
+}
+
+impl LobeVisibility {
+    pub fn volume(&self) -> Option<&VisibilityVolumeSettings> {
+        match self {
+            Self::LightMaps => None,
+            Self::Volume(settings) => Some(settings),
+        }
+    }
+}

@@ -138,7 +138,9 @@ mod tests {
 
     #[test]
     fn band_ratios_match_f64_integration_from_wide_to_narrow_lobes() {
-        for lambda in [0.01, 0.3, 0.499, 0.5, 0.999, 1.0, 2.5, 10.0, 19.9, 20.1, 150.0, 2000.0] {
+        for lambda in [
+            0.01, 0.3, 0.499, 0.5, 0.999, 1.0, 2.5, 10.0, 19.9, 20.1, 150.0, 2000.0,
+        ] {
             let exact: Vec<f64> = (0..4)
                 .map(|l| band_integral(lambda, l) / band_integral(lambda, 0))
                 .collect();
@@ -188,14 +190,20 @@ mod tests {
             }
             let brute = num / den;
             let sh = lobe_visibility(&c, xi, lambda) as f64;
-            assert!((sh - brute).abs() < 2e-3, "ξ {xi} λ {lambda}: {sh} vs {brute}");
+            assert!(
+                (sh - brute).abs() < 2e-3,
+                "ξ {xi} λ {lambda}: {sh} vs {brute}"
+            );
         }
     }
 
     #[test]
     fn the_window_lifts_a_hemisphere_step_at_its_pole_to_one() {
         let dirs = fibonacci_directions(100_000);
-        let step = project(&dirs, dirs.iter().map(|d| if d.z > 0.0 { 1.0 } else { 0.0 }));
+        let step = project(
+            &dirs,
+            dirs.iter().map(|d| if d.z > 0.0 { 1.0 } else { 0.0 }),
+        );
         let at_pole = |c: &[f32; SH_COEFFICIENTS]| -> f32 {
             c.iter().zip(sh_basis(Vec3::Z)).map(|(c, y)| c * y).sum()
         };

@@ -224,7 +224,11 @@ impl VisibilityVolume {
 
 fn unflatten(v: usize, dims: [u32; 3]) -> [u32; 3] {
     let (nx, ny) = (dims[0] as usize, dims[1] as usize);
-    [(v % nx) as u32, ((v / nx) % ny) as u32, (v / (nx * ny)) as u32]
+    [
+        (v % nx) as u32,
+        ((v / nx) % ny) as u32,
+        (v / (nx * ny)) as u32,
+    ]
 }
 
 fn flatten([i, j, k]: [u32; 3], dims: [u32; 3]) -> usize {
@@ -336,7 +340,10 @@ mod tests {
         let step = 0.5 * size;
         let p = Vec3::splat(1.0); // the cube's centre: 1.0 to every face
         let across = march(&extinction, &hair.grid, p, Vec3::Z, step);
-        assert!((across - (-sigma * 1.0f32).exp()).abs() < 1e-5, "across {across}");
+        assert!(
+            (across - (-sigma * 1.0f32).exp()).abs() < 1e-5,
+            "across {across}"
+        );
         let along = march(&extinction, &hair.grid, p, Vec3::X, step);
         assert_eq!(along, 1.0);
         // 30° off the fibers in the x–z plane: the path to the x face is 1/cos 30°, and σ·sin 30°.
@@ -345,10 +352,14 @@ mod tests {
         let aslant = march(&extinction, &hair.grid, p, w, step);
         let expected = (-sigma * a.sin() / a.cos()).exp();
         // The last midpoint step may overhang the border by up to half a step.
-        assert!((aslant.ln() - expected.ln()).abs() < sigma * a.sin() * step, "aslant {aslant} vs {expected}");
+        assert!(
+            (aslant.ln() - expected.ln()).abs() < sigma * a.sin() * step,
+            "aslant {aslant} vs {expected}"
+        );
         // Fibers in every direction (E[t tᵀ] = I/3): √(2/3) of σ_t⊥.
         let mut iso = extinction;
-        iso.moment = vec![[1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 0.0, 0.0, 0.0]; hair.grid.voxel_count()];
+        iso.moment =
+            vec![[1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 0.0, 0.0, 0.0]; hair.grid.voxel_count()];
         let t = march(&iso, &hair.grid, p, Vec3::Y, step);
         assert!((t - (-sigma * (2.0f32 / 3.0).sqrt()).exp()).abs() < 1e-5);
     }
@@ -365,7 +376,11 @@ mod tests {
         };
         let p = Vec3::splat(1.0);
         let dirs = fibonacci_directions(20_000);
-        for (xi, lambda) in [(Vec3::Z, 2.0f32), (Vec3::X, 2.0), (Vec3::new(1.0, 1.0, 0.3), 1.0)] {
+        for (xi, lambda) in [
+            (Vec3::Z, 2.0f32),
+            (Vec3::X, 2.0),
+            (Vec3::new(1.0, 1.0, 0.3), 1.0),
+        ] {
             let xi = xi.normalize();
             let (mut num, mut den) = (0.0f64, 0.0f64);
             for &d in &dirs {
@@ -376,7 +391,10 @@ mod tests {
             let brute = (num / den) as f32;
             let sh = volume.lobe_visibility(p, xi, lambda);
             // Bands 0–3 of a smooth T through a wide lobe.
-            assert!((sh - brute).abs() < 0.03, "ξ {xi} λ {lambda}: SH {sh} vs march {brute}");
+            assert!(
+                (sh - brute).abs() < 0.03,
+                "ξ {xi} λ {lambda}: SH {sh} vs march {brute}"
+            );
         }
     }
 
@@ -399,7 +417,10 @@ mod tests {
         let outside = v.lobe_visibility(Vec3::new(1.0, 0.725, 20.0), Vec3::Z, 50.0);
         assert!(across < 0.3, "across {across}");
         assert!(along > 1.5 * across, "along {along} vs across {across}");
-        assert!(outside > 0.9, "beyond the grid the top face's vertex holds: {outside}");
+        assert!(
+            outside > 0.9,
+            "beyond the grid the top face's vertex holds: {outside}"
+        );
     }
 
     #[test]
