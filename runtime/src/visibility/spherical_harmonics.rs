@@ -66,7 +66,7 @@ pub fn srbf_band_ratios(lambda: f32) -> [f32; 4] {
 /// sky above a fiber on the hair's surface reconstructs to 0.81 at its pole from bands 0–3, so
 /// the fibers a lobe lights most would read a fifth too dark. Damping the higher bands by these
 /// factors brings the pole to 1.04 (clamped to 1) at the price of a slightly softer horizon.
-pub const RINGING_WINDOW: [f32; 4] = [1.0, 0.900_316_3, 0.636_619_8, 0.300_105_1];
+pub const RINGING_WINDOW: [f32; 4] = [1.0, 0.900_316_3, std::f32::consts::FRAC_2_PI, 0.300_105_1];
 
 /// `c` with each band scaled by [`RINGING_WINDOW`].
 pub fn windowed(c: &[f32; SH_COEFFICIENTS]) -> [f32; SH_COEFFICIENTS] {

@@ -303,10 +303,7 @@ mod tests {
             None,
             None,
         )
-        .map(|m| {
-            assert_eq!(m.strand_count(), strands);
-            m
-        })
+        .inspect(|m| assert_eq!(m.strand_count(), strands))
         .expect("a valid slab")
     }
 
