@@ -38,7 +38,6 @@ pub mod radiance_hdr;
 pub mod srbf_fit;
 pub mod srbf_objective;
 pub mod srbf_set;
-pub mod srbf_split;
 pub mod srbf_spread;
 pub mod table_accuracy;
 

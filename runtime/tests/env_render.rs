@@ -7,11 +7,11 @@ use common::*;
 
 use glam::{DVec3, Vec2, Vec3};
 use strandlight_runtime::camera::{Camera, Projection, light_camera};
+use strandlight_runtime::env::TransmittanceFilter;
 use strandlight_runtime::env::{
     EnvFrame, EnvLight, EnvRenderOptions, EnvTables, ForwardScatteringGrid,
     ForwardScatteringSource, render_env_frame,
 };
-use strandlight_runtime::env::{LobeSpread, ShadowGroup, TransmittanceFilter};
 use strandlight_runtime::gpu::{GpuContext, read_texture_rgba};
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::hair::{Attribute, HairModel};
@@ -125,11 +125,9 @@ fn summed_area_box_sums_are_exact_at_the_largest_map() {
     );
 }
 
-/// Texel columns without fibers: none (the plain slab), or [`GAP`].
+/// Texel columns without fibers (`common::slab_with_gap`): none, the plain slab.
 type Gap = std::ops::Range<u32>;
 const NO_GAP: Gap = 0..0;
-/// The slot of `slab_with_gap` in the lobe-spread test: x from −0.25 to 0.25.
-const GAP: Gap = 24..40;
 
 /// Fiber centres of slab row `r` (see `common::slab_with_gap`).
 fn row_fibers(r: usize, gap: &Gap) -> (f64, Vec<f64>) {
@@ -493,118 +491,6 @@ fn an_extended_source_is_shadowed_as_its_disc() {
 /// 0.123 (the exact ray at the centre direction alone scores 0.197); 0.15 bounds both boxes with
 /// some room, and each must beat the centre texel.
 const TOLERANCE: f64 = 0.15;
-
-/// The slab with a slot cut through it, lit by an SRBF from straight above: points below the
-/// slot's edges see part of the lobe through the slot and part through the fibers. Ren's box
-/// averages around the point's own texel, with a radius that grows only with the depth behind
-/// that texel's first fiber, so a point under the slot (nothing in front of it) is fully lit
-/// up to the edge; the lobe's spread over its directions shadows it from the side. Both against
-/// the cone integral of the exact ray visibility.
-#[test]
-fn lobe_spread_follows_the_cone_integral_beside_a_slot() {
-    let gpu = gpu();
-    let lambda = 32.0f32;
-    let SlabMaps { batch, sat } = slab_maps(&gpu, &GAP);
-    let probe = TransmittanceProbe::new(&gpu);
-    let light = [EnvLight::srbf(Vec3::Z, lambda, [1.0; 3])];
-    let groups = [ShadowGroup {
-        direction: Vec3::Z,
-        lights: &light,
-    }];
-    let jitter = slab_jitter();
-    let mut sites = Vec::new();
-    for z in [0.05f32, -0.2, -0.4] {
-        for y in [0.0f32, 0.5] {
-            for x in [
-                -0.4f32, -0.32, -0.27, -0.22, -0.17, -0.1, 0.0, 0.12, 0.19, 0.24, 0.3,
-            ] {
-                sites.push(Vec3::new(x, y, z));
-            }
-        }
-    }
-    let points = jittered(&sites, &jitter);
-    let n = jitter.len();
-    let site_means = |v: &[f64]| -> Vec<f64> {
-        v.chunks(n)
-            .map(|c| c.iter().sum::<f64>() / n as f64)
-            .collect()
-    };
-    let estimate = |spread: Option<LobeSpread>| {
-        let binding = BatchBinding::with_groups(
-            &gpu,
-            &probe.batch_layout,
-            &groups,
-            &batch,
-            &sat,
-            true,
-            false,
-            TransmittanceFilter::default(),
-            spread,
-        );
-        let t = probe.transmittance(&gpu, &binding, 0, &points).unwrap();
-        site_means(&t.iter().map(|&x| x as f64).collect::<Vec<_>>())
-    };
-    let truth = site_means(
-        &points
-            .iter()
-            .map(|p| {
-                cone_transmittance(p.as_dvec3(), lambda as f64, SLAB_ROWS, SLAB_THICKNESS, &GAP)
-            })
-            .collect::<Vec<_>>(),
-    );
-    // The slab is 0.3 deep, within the map's last layer boundary (0.45): nothing to lose by
-    // marching the full tilt, which is what the geometry asks for; two rings of four
-    // directions in 8 steps (the default's one ring of six in 4 scores 0.036 here).
-    let full_tilt = LobeSpread {
-        rings: 2,
-        per_ring: 4,
-        steps: 8,
-        cone_scale: 1.0,
-        ..LobeSpread::default()
-    };
-    let candidates = [
-        ("matched box", estimate(None)),
-        ("lobe spread, full tilt", estimate(Some(full_tilt))),
-        (
-            "lobe spread, default",
-            estimate(Some(LobeSpread::default())),
-        ),
-    ];
-    let norm: f64 = truth.iter().map(|t| t * t).sum();
-    let rel: Vec<f64> = candidates
-        .iter()
-        .map(|(_, v)| {
-            let e: f64 = v.iter().zip(&truth).map(|(a, b)| (a - b).powi(2)).sum();
-            (e / norm).sqrt()
-        })
-        .collect();
-    for (i, p) in sites.iter().enumerate().filter(|(i, _)| i % 3 == 0) {
-        println!(
-            "site ({:5.2}, {:4.2}, {:5.2}): cone integral {:.3}, matched box {:.3}, spread full tilt {:.3}, spread default {:.3}",
-            p.x, p.y, p.z, truth[i], candidates[0].1[i], candidates[1].1[i], candidates[2].1[i]
-        );
-    }
-    for ((name, _), r) in candidates.iter().zip(&rel) {
-        println!(
-            "{name}: relative RMSE {r:.4} over {} sites vs the cone integral",
-            sites.len()
-        );
-    }
-    assert!(rel[1] < SPREAD_TOLERANCE, "full-tilt spread: {}", rel[1]);
-    assert!(
-        rel[1] < 0.75 * rel[0],
-        "full-tilt spread {} does not follow the cone better than the box {}",
-        rel[1],
-        rel[0]
-    );
-    // The default's narrower tilt (cone scale 0.3) is calibrated on hair whose depth the map
-    // lumps beyond its last layer boundary; on this slab, resolved to its depth, it spreads too
-    // little and is printed above, not held to the box (docs/BENCHMARKS.md, "Lobe spread").
-}
-
-/// Relative RMSE allowed for the full-tilt lobe spread beside the slot (eight directions of a
-/// λ = 32 lobe, each marched in eight steps through a map of ~1 fiber per texel).
-const SPREAD_TOLERANCE: f64 = 0.15;
 
 /// A 4-axis RGB table shaped like the convolution tables, filled with a smooth non-polynomial
 /// function so interpolation weights and strides all matter.
@@ -1824,84 +1710,6 @@ fn a_thinned_source_is_shadowed_through_a_kappa_map() {
         "at κ 0.1 the thinned source's map must be thinned"
     );
     assert!((ratio - 1.0).abs() < TOLERANCE, "mean light ratio {ratio}");
-}
-
-/// Lobe spread's fiber weighting is a weighted mean of the directions' transmittances: where
-/// every direction marches the same columns (a vanishing tilt) the weights cancel and the frame
-/// is the unweighted one; at the default tilt they change it, by less than the spread itself
-/// changes Ren's box.
-#[test]
-fn fiber_weighting_is_a_normalized_mean_over_the_lobe() {
-    let gpu = gpu();
-    let scene = groom_scene();
-    let (model, camera, tables) = &scene;
-    let render = |spread: Option<LobeSpread>| {
-        let options = EnvRenderOptions {
-            dodm: DodmSettings {
-                resolution: 128,
-                first_layer: None,
-                batch_size: 2,
-                ..DodmSettings::default()
-            },
-            lobe_spread: spread,
-            ..Default::default()
-        };
-        render_env_frame(
-            &gpu,
-            model,
-            camera,
-            RES,
-            RES,
-            &groom_lobes(),
-            tables,
-            &options,
-            None,
-        )
-        .unwrap_or_else(|e| panic!("{e}"))
-        .pixels
-    };
-    let spread = |cone_scale: f32, fiber_weighted: bool| {
-        Some(LobeSpread {
-            cone_scale,
-            fiber_weighted,
-            ..LobeSpread::default()
-        })
-    };
-    let lit = |a: &[[f32; 4]]| a.iter().filter(|p| p[0] > 1e-4).count();
-    // Mean |a − b| / b over the lit pixels' RGB: a point on a texel's edge may cross into the
-    // next column under any tilt, so the worst pixel says little here.
-    let mean_relative = |a: &[[f32; 4]], b: &[[f32; 4]]| {
-        let pairs: Vec<f64> = a
-            .iter()
-            .zip(b)
-            .filter(|(_, q)| q[0] > 1e-4)
-            .flat_map(|(p, q)| (0..3).map(move |c| ((p[c] - q[c]) / q[c].max(1e-4)).abs() as f64))
-            .collect();
-        pairs.iter().sum::<f64>() / pairs.len().max(1) as f64
-    };
-    let flat = [render(spread(1e-4, false)), render(spread(1e-4, true))];
-    let flat_gap = mean_relative(&flat[1], &flat[0]);
-    let tilted = [render(spread(0.3, false)), render(spread(0.3, true))];
-    let weighting = mean_relative(&tilted[1], &tilted[0]);
-    let box_gap = mean_relative(&tilted[0], &render(None));
-    println!(
-        "{} lit pixels; no tilt: weighted vs unweighted {flat_gap:.2e}; tilt 0.3: {weighting:.2e} (spread vs box: {box_gap:.2e})",
-        lit(&flat[0])
-    );
-    assert!(lit(&flat[0]) > 100, "the groom is lit");
-    assert!(tilted[1].iter().flatten().all(|v| v.is_finite()));
-    assert!(
-        flat_gap < 0.1 * weighting,
-        "weights do not cancel: {flat_gap} vs {weighting}"
-    );
-    assert!(
-        weighting > 1e-5,
-        "the weights change nothing at the default tilt"
-    );
-    assert!(
-        weighting < box_gap,
-        "weighting {weighting} vs the spread's own change {box_gap}"
-    );
 }
 
 /// The light pass against the geometry it draws: three straight fibers half a texel wide (quads

@@ -22,7 +22,9 @@ use crate::fit_cache::fit_cached;
 use crate::ground_truth::{GroundTruth, TruthUse};
 use crate::hdr_flip::hdr_flip;
 use crate::image_metrics::{Image, relative_rmse};
-use crate::look::{BoxAverageArg, EnvTransparency, ForwardDevice, LookArgs, ViewArgs};
+use crate::look::{
+    BoxAverageArg, EnvTransparency, ForwardDevice, LobeVisibilityArg, LookArgs, ViewArgs,
+};
 use crate::scene_tables::{EnvShading, ScatteringMode};
 use crate::steps::Steps;
 use anyhow::Context;
@@ -34,7 +36,6 @@ use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription, Model,
 use strandlight_precompute::baked_tables_check::check_asset;
 use strandlight_runtime::env::{EnvLight, ViewTransparency, mark_every_strand, thin_weak_sources};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
-use strandlight_runtime::passes::lobe_spread::LobeSpread;
 
 /// What one run measures.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -56,10 +57,11 @@ pub struct BenchPlan {
     /// every strand (`compare --every-strand-share`); reports written before it existed: none.
     #[serde(default)]
     pub every_strand_shares: Vec<f32>,
-    /// Lobe spread (`compare --lobe-spread`, default settings) at these κ; reports written
-    /// before it existed: none.
+    /// Also an SRBF frame whose lobes take their visibility from the groom's visibility volume
+    /// (`--lobe-visibility volume`) instead of their light maps; reports written before it
+    /// existed: none.
     #[serde(default)]
-    pub lobe_spread_kappas: Vec<f32>,
+    pub visibility_volume: bool,
     /// Chord tolerances of the simplified light pass (`compare --light-chord-tolerance`, texels)
     /// other than the default; reports written before it existed: none.
     #[serde(default)]
@@ -144,7 +146,7 @@ impl BenchPlan {
             kappas: vec![0.1, 0.3, 1.0],
             dodm_sizes: vec![512, 256, 1024],
             every_strand_shares: vec![0.2, 0.4],
-            lobe_spread_kappas: vec![0.1, 0.3, 1.0],
+            visibility_volume: true,
             chord_tolerances: vec![0.5],
             baseline_lights: vec![4, 8, 16, 32, 64, 128],
             baseline: Baseline::MedianCut,
@@ -172,7 +174,7 @@ impl BenchPlan {
             kappas: vec![0.1],
             dodm_sizes: vec![512],
             every_strand_shares: Vec::new(),
-            lobe_spread_kappas: Vec::new(),
+            visibility_volume: true,
             chord_tolerances: Vec::new(),
             shading: EnvShading::Chiang,
             ground_truth: true,
@@ -217,7 +219,7 @@ impl BenchPlan {
             kappas: vec![0.1, 1.0],
             dodm_sizes: vec![512, 256],
             every_strand_shares: vec![0.4],
-            lobe_spread_kappas: vec![0.1, 1.0],
+            visibility_volume: true,
             chord_tolerances: vec![0.5],
             baseline_lights: vec![4, 16, 64],
             baseline: Baseline::MedianCut,
@@ -591,13 +593,15 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         baseline: plan.baseline,
         equal_error_metric: crate::error_metric::ErrorMetric::RelativeRmse,
         unshadowed: false,
-        split_lobes: 0,
-        split_ratio: 3.0,
         light_map_size: plan.dodm_sizes[0],
         light_chord_tolerance: DodmSettings::default().simplified_chord_tolerance,
         look: LookArgs {
             transparency: EnvTransparency::Opaque,
             view: ViewArgs {
+                // The sweep varies the light maps' settings (κ, size, adaptive κ, chord
+                // tolerance) around Ren's light-map frame; the visibility volume, the product's
+                // default, is its own frame ([`BenchPlan::visibility_volume`]).
+                lobe_visibility: LobeVisibilityArg::LightMaps,
                 visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF,
                 box_average: BoxAverageArg::OpticalDepth,
                 forward_scattering: ForwardDevice::Auto,
@@ -685,7 +689,8 @@ struct SrbfConfig {
     kappa: f32,
     dodm: u32,
     every_strand_share: f32,
-    lobe_spread: bool,
+    /// Lobes read the visibility volume, not their light maps.
+    volume: bool,
     chord_tolerance: f32,
 }
 
@@ -701,7 +706,7 @@ fn srbf_configs(plan: &BenchPlan) -> Vec<SrbfConfig> {
         kappa,
         dodm,
         every_strand_share: 0.0,
-        lobe_spread: false,
+        volume: false,
         chord_tolerance: DodmSettings::default().simplified_chord_tolerance,
     };
     let changed = |label: String| SrbfConfig { label, ..default };
@@ -736,11 +741,10 @@ fn srbf_configs(plan: &BenchPlan) -> Vec<SrbfConfig> {
             ..changed(format!("light-pass chord tolerance {tolerance} texels"))
         });
     }
-    for &k in &plan.lobe_spread_kappas {
+    if plan.visibility_volume {
         configs.push(SrbfConfig {
-            kappa: k,
-            lobe_spread: true,
-            ..changed(format!("lobe spread, κ {k}"))
+            volume: true,
+            ..changed("visibility volume".into())
         });
     }
     configs.insert(0, default);
@@ -771,7 +775,9 @@ fn srbf_points(
             simplified_chord_tolerance: config.chord_tolerance,
             ..DodmSettings::at_resolution(config.dodm)
         };
-        frame.look.lobe_spread = config.lobe_spread.then(LobeSpread::default);
+        if config.volume {
+            frame.look.lobe_visibility = LobeVisibilityArg::Volume.settings();
+        }
         let r = steps.run(
             &format!("{}: SRBF {}", mode.name(), config.label),
             || compare::timed_render(&render_lights, &frame, args.timing_runs),
@@ -1286,37 +1292,27 @@ mod tests {
             let default = &configs[0];
             assert!(default.label.starts_with("default"));
             assert_eq!(default.every_strand_share, 0.0);
-            assert!(!default.lobe_spread);
             let expected = plan.lobes.len() - 1 + plan.kappas.len() - 1 + plan.dodm_sizes.len() - 1
                 + plan.every_strand_shares.len()
                 + plan.chord_tolerances.len()
-                + plan.lobe_spread_kappas.len();
+                + usize::from(plan.visibility_volume);
             assert_eq!(configs.len(), 1 + expected, "{}", plan.name);
+            assert!(!default.volume);
             for c in &configs[1..] {
                 let changed = [
                     c.lobes != default.lobes,
                     c.dodm != default.dodm,
                     c.every_strand_share != default.every_strand_share,
-                    c.lobe_spread != default.lobe_spread,
+                    c.volume != default.volume,
                     c.chord_tolerance != default.chord_tolerance,
                 ];
                 let one_other = changed.iter().filter(|&&x| x).count() == 1;
-                match c.lobe_spread {
-                    // The spread series: spread on, κ free, nothing else changed.
-                    true => assert!(one_other, "{}", c.label),
-                    false => assert!(
-                        one_other != (c.kappa != default.kappa),
-                        "{}: one setting changed",
-                        c.label
-                    ),
-                }
+                assert!(
+                    one_other != (c.kappa != default.kappa),
+                    "{}: one setting changed",
+                    c.label
+                );
             }
-            let spread_kappas: Vec<f32> = configs
-                .iter()
-                .filter(|c| c.lobe_spread)
-                .map(|c| c.kappa)
-                .collect();
-            assert_eq!(spread_kappas, plan.lobe_spread_kappas, "{}", plan.name);
         }
     }
 

@@ -171,7 +171,7 @@ where
     chart
         .draw_series(baseline.iter().map(|&p| Circle::new(p, 4, RED.filled())))
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    let srbf_series: [(LabelFilter, RGBColor, &str); 6] = [
+    let srbf_series: [(LabelFilter, RGBColor, &str); 7] = [
         (&|l| l.ends_with(" lobes"), BLUE, "SRBF: lobe count"),
         (&|l| l.starts_with("κ"), GREEN, "SRBF: κ"),
         (
@@ -187,7 +187,12 @@ where
         (
             &|l| l.starts_with("lobe spread"),
             RGBColor(230, 120, 0),
-            "SRBF: lobe spread (κ)",
+            "SRBF: lobe spread (κ; removed, in earlier reports)",
+        ),
+        (
+            &|l| l == "visibility volume",
+            RGBColor(0, 150, 110),
+            "SRBF: visibility volume",
         ),
         (
             &|l| l.starts_with("light-pass chord"),

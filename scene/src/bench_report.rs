@@ -351,7 +351,7 @@ pub fn details(report: &BenchReport, plot_dir: &str) -> String {
     );
     let _ = writeln!(
         out,
-        "\n## Env-lit frames: error against milliseconds\n\nThe SRBF default and one parameter varied at a time (lobes kept: the most powerful; κ: Ren's stochastic simplification; light-map size; adaptive κ; the chord tolerance of the simplified light pass in texels: coarser strands, where 0 draws every point), lobe spread (`--lobe-spread`, its default settings) at several κ, the {} baseline at several light counts, and the reference.",
+        "\n## Env-lit frames: error against milliseconds\n\nThe SRBF default and one parameter varied at a time (lobes kept: the most powerful; κ: Ren's stochastic simplification; light-map size; adaptive κ; the chord tolerance of the simplified light pass in texels: coarser strands, where 0 draws every point), the visibility volume (`--lobe-visibility volume`: each lobe's visibility integrated over it from the groom's SH visibility volume, no light pass per lobe; lobe spread at several κ in reports written before it was removed), the {} baseline at several light counts, and the reference.",
         plan.baseline.name()
     );
     for r in &report.env_lit {

@@ -173,13 +173,6 @@ pub struct CompareArgs {
     /// left is the lighting (fit, median cut) and table error without the shadowing error.
     #[cfg_attr(any(feature = "cli", test), arg(long))]
     pub unshadowed: bool,
-    /// Split every SRBF lobe into a centre and this many ring sub-lobes (0: off), each an SRBF
-    /// light with its own shadow map (precompute/src/srbf_split.rs).
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0))]
-    pub split_lobes: usize,
-    /// Bandwidth of the sub-lobes relative to their lobe's, with --split-lobes.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 3.0))]
-    pub split_ratio: f64,
     /// Texels across every light map (DODM) of all three renders, the reference's included:
     /// the reference converges in its light count at this size, and light maps of another size
     /// shadow each strand differently (docs/BENCHMARKS.md, "Light-map size").
@@ -430,26 +423,7 @@ pub fn prepare_with_hair(
             )
         },
     )?;
-    if args.split_lobes != 0 && !(3..=12).contains(&args.split_lobes) {
-        bail!(
-            "--split-lobes {}: use 0 (off) or a ring of 3 to 12",
-            args.split_lobes
-        );
-    }
-    if !(args.split_ratio >= 1.0 && args.split_ratio <= 16.0) {
-        bail!("--split-ratio {}: use 1 to 16", args.split_ratio);
-    }
-    let (set, split_error) =
-        strandlight_precompute::srbf_split::split_set(&fit.set, args.split_lobes, args.split_ratio);
-    if args.split_lobes > 0 {
-        steps.say(format!(
-            "split {} lobes into {} (ring {}, bandwidth × {}): worst relative L2 error of a split {split_error:.4}",
-            fit.set.lobes.len(),
-            set.lobes.len(),
-            args.split_lobes,
-            args.split_ratio
-        ));
-    }
+    let set = fit.set.clone();
     let lambda_range = lambda_range_of_set(&set)?;
     let resolution = args
         .table_resolution
@@ -1210,8 +1184,7 @@ pub fn execute(
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
             "preset": args.preset, "baseline": args.baseline, "lambda_max": args.lambda_max, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "light_chord_tolerance": args.light_chord_tolerance, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "thin_weak_sources": args.thin_weak_sources, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
-            "split_lobes": args.split_lobes, "split_ratio": args.split_ratio,
-            "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "forward_scattering": args.look.view.forward_scattering,
+            "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "lobe_visibility": args.look.view.lobe_visibility, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,
             "compact_sources": scene.compact_sources,
         }),

@@ -3,10 +3,9 @@
 //! The `cli` feature lets the command line parse these settings directly.
 
 use anyhow::Context;
-use strandlight_runtime::env::{
-    BoxAverage, DEFAULT_SIMPLIFICATION_SEED, LobeSpread, ViewTransparency,
-};
+use strandlight_runtime::env::{BoxAverage, DEFAULT_SIMPLIFICATION_SEED, ViewTransparency};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
+use strandlight_runtime::visibility::{LobeVisibility, VisibilityVolumeSettings};
 
 /// What the view shows of each pixel's fibers (Ren §8).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -30,6 +29,31 @@ pub enum ForwardDevice {
     Auto,
     Cpu,
     Gpu,
+}
+
+/// Where SRBF lobes' visibility comes from (the CLI's names for [`LobeVisibility`]).
+/// The default is the volume: faster on 15 of the 16 map × mode frames and as close to the
+/// path-traced truth (docs/BENCHMARKS.md, "Lobe visibility"); light maps stay on the front where
+/// they are a little more accurate for their time (quarry, esplanade, venice, piz).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
+#[serde(rename_all = "kebab-case")]
+pub enum LobeVisibilityArg {
+    /// Ren 2010: each lobe's own convolution optical depth map, read at its centre.
+    LightMaps,
+    /// The groom's visibility volume (SH of the transmittance, marched once per groom),
+    /// integrated over each lobe: no light pass per lobe.
+    #[default]
+    Volume,
+}
+
+impl LobeVisibilityArg {
+    pub fn settings(self) -> LobeVisibility {
+        match self {
+            Self::LightMaps => LobeVisibility::LightMaps,
+            Self::Volume => LobeVisibility::Volume(VisibilityVolumeSettings::default()),
+        }
+    }
 }
 
 /// What the effective transmittance's box averages (the CLI's names for [`BoxAverage`]).
@@ -64,6 +88,14 @@ pub struct LookArgs {
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::Args))]
 pub struct ViewArgs {
+    /// Where SRBF lobes' visibility comes from: their light maps (Ren 2010) or the groom's
+    /// visibility volume integrated over each lobe (docs/BENCHMARKS.md, "Lobe visibility").
+    #[cfg_attr(
+        any(feature = "cli", test),
+        arg(long, value_enum, default_value = "volume")
+    )]
+    #[serde(default = "light_maps")]
+    pub lobe_visibility: LobeVisibilityArg,
     /// With occupancy: fragments seen less than this fraction are not shaded (early termination).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = ViewTransparency::DEFAULT_CUTOFF))]
     pub visibility_cutoff: f32,
@@ -86,71 +118,11 @@ pub struct ViewArgs {
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = DEFAULT_SIMPLIFICATION_SEED))]
     #[serde(default = "default_simplification_seed")]
     pub simplification_seed: u64,
-    /// Spread each SRBF light's visibility over its lobe: the mean over directions of the lobe,
-    /// each traced through the light's own map, instead of one filtered visibility per lobe
-    /// (docs/BENCHMARKS.md, "Lobe spread").
-    #[cfg_attr(any(feature = "cli", test), arg(long))]
-    #[serde(default)]
-    pub lobe_spread: bool,
-    /// Lobe spread: rings of directions.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = LobeSpread::default().rings))]
-    #[serde(default = "spread_defaults::rings")]
-    pub lobe_spread_rings: u32,
-    /// Lobe spread: directions per ring.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = LobeSpread::default().per_ring))]
-    #[serde(default = "spread_defaults::per_ring")]
-    pub lobe_spread_per_ring: u32,
-    /// Lobe spread: steps of each direction's march.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = LobeSpread::default().steps))]
-    #[serde(default = "spread_defaults::steps")]
-    pub lobe_spread_steps: u32,
-    /// Lobe spread: depth marched before the point, in the light map's first layers.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = LobeSpread::default().reach_layers))]
-    #[serde(default = "spread_defaults::reach")]
-    pub lobe_spread_reach: f32,
-    /// Lobe spread: tilt of the marched lines, times tan γ.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = LobeSpread::default().cone_scale))]
-    #[serde(default = "spread_defaults::cone_scale")]
-    pub lobe_spread_cone_scale: f32,
-    /// Lobe spread: weigh each direction by the fiber's response to it (the lobe times the
-    /// fiber, not the lobe alone).
-    #[cfg_attr(any(feature = "cli", test), arg(long))]
-    #[serde(default)]
-    pub lobe_spread_fiber_weighted: bool,
 }
 
-/// Serde defaults of the lobe-spread arguments (reports written before they existed).
-mod spread_defaults {
-    use super::LobeSpread;
-    pub fn rings() -> u32 {
-        LobeSpread::default().rings
-    }
-    pub fn per_ring() -> u32 {
-        LobeSpread::default().per_ring
-    }
-    pub fn steps() -> u32 {
-        LobeSpread::default().steps
-    }
-    pub fn reach() -> f32 {
-        LobeSpread::default().reach_layers
-    }
-    pub fn cone_scale() -> f32 {
-        LobeSpread::default().cone_scale
-    }
-}
-
-impl ViewArgs {
-    /// The lobe spread these arguments ask for (None when off).
-    pub fn lobe_spread(&self) -> Option<LobeSpread> {
-        self.lobe_spread.then_some(LobeSpread {
-            rings: self.lobe_spread_rings,
-            per_ring: self.lobe_spread_per_ring,
-            steps: self.lobe_spread_steps,
-            reach_layers: self.lobe_spread_reach,
-            cone_scale: self.lobe_spread_cone_scale,
-            fiber_weighted: self.lobe_spread_fiber_weighted,
-        })
-    }
+/// Reports and screenshots written before the visibility volume existed used light maps.
+fn light_maps() -> LobeVisibilityArg {
+    LobeVisibilityArg::LightMaps
 }
 
 fn default_simplification_seed() -> u64 {
@@ -160,17 +132,11 @@ fn default_simplification_seed() -> u64 {
 impl Default for ViewArgs {
     fn default() -> Self {
         Self {
+            lobe_visibility: LobeVisibilityArg::default(),
             visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF,
             box_average: BoxAverageArg::OpticalDepth,
             forward_scattering: ForwardDevice::Auto,
             simplification_seed: DEFAULT_SIMPLIFICATION_SEED,
-            lobe_spread: false,
-            lobe_spread_rings: spread_defaults::rings(),
-            lobe_spread_per_ring: spread_defaults::per_ring(),
-            lobe_spread_steps: spread_defaults::steps(),
-            lobe_spread_reach: spread_defaults::reach(),
-            lobe_spread_cone_scale: spread_defaults::cone_scale(),
-            lobe_spread_fiber_weighted: false,
         }
     }
 }
@@ -197,10 +163,6 @@ impl LookArgs {
         transparency
             .check()
             .with_context(|| format!("--visibility-cutoff {}", view.visibility_cutoff))?;
-        let lobe_spread = view.lobe_spread();
-        if let Some(spread) = &lobe_spread {
-            spread.validate().context("--lobe-spread")?;
-        }
         let box_average = match view.box_average {
             BoxAverageArg::OpticalDepth => BoxAverage::OpticalDepth,
             BoxAverageArg::Transmittance => BoxAverage::Transmittance,
@@ -214,7 +176,7 @@ impl LookArgs {
             dodm: DodmSettings::default(),
             simplification_seed: view.simplification_seed,
             simplified_lights_before: 0,
-            lobe_spread,
+            lobe_visibility: view.lobe_visibility.settings(),
         })
     }
 }
@@ -238,6 +200,6 @@ pub struct EnvLook {
     /// parts before this one, so that each light draws the strands it draws in the whole
     /// frame (`EnvRenderer::render_part`). 0 for a whole frame.
     pub simplified_lights_before: u32,
-    /// SRBF visibility spread over the lobe ([`ViewArgs::lobe_spread`]).
-    pub lobe_spread: Option<LobeSpread>,
+    /// Where SRBF lobes' visibility comes from ([`ViewArgs::lobe_visibility`]).
+    pub lobe_visibility: LobeVisibility,
 }

@@ -10,7 +10,7 @@ use strandlight_runtime::passes::deep_opacity::MAX_LAYERS;
 use strandlight_scene::frame_settings::{
     EnvLighting, Lighting, PointLighting, Shadows, Transparency,
 };
-use strandlight_scene::look::{BoxAverageArg, EnvTransparency};
+use strandlight_scene::look::{BoxAverageArg, EnvTransparency, LobeVisibilityArg};
 use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_tables::artist::ArtistParams;
@@ -226,6 +226,19 @@ fn env_controls(ui: &mut egui::Ui, e: &mut EnvLighting, lobes: &mut usize, total
             &mut e.view.box_average,
             BoxAverageArg::Transmittance,
             "transmittance",
+        );
+    });
+    ui.horizontal(|ui| {
+        ui.label("lobe visibility");
+        ui.radio_value(
+            &mut e.view.lobe_visibility,
+            LobeVisibilityArg::LightMaps,
+            "light maps",
+        );
+        ui.radio_value(
+            &mut e.view.lobe_visibility,
+            LobeVisibilityArg::Volume,
+            "volume",
         );
     });
 }

@@ -231,8 +231,8 @@ use crate::multiple::ForwardScatteringError;
 pub mod render;
 pub use render::{
     BoxAverage, DEFAULT_SIMPLIFICATION_SEED, EnvFrame, EnvRenderError, EnvRenderOptions,
-    EnvRenderStats, EnvRenderer, EnvTableError, EnvTables, FragmentCounts, LobeSpread,
-    OccupancyError, TransmittanceFilter, ViewTransparency, render_env_frame,
+    EnvRenderStats, EnvRenderer, EnvTableError, EnvTables, FragmentCounts, OccupancyError,
+    TransmittanceFilter, ViewTransparency, render_env_frame,
 };
 
 #[cfg(test)]

@@ -23,8 +23,6 @@ use crate::passes::env_view::{
     ViewBinding, VolumeBuffers,
 };
 use crate::passes::frame_params::{FrameParams, KajiyaKay};
-pub use crate::passes::lobe_spread::LobeSpread;
-use crate::passes::lobe_spread::LobeSpreadError;
 use crate::passes::strand_geometry::{StrandGeometry, TooManyPoints};
 pub use crate::passes::summed_area::BoxAverage;
 use crate::passes::summed_area::{SummedAreaPass, SummedAreaTables};
@@ -149,10 +147,6 @@ pub struct EnvRenderOptions {
     /// View pass only: every fiber this many pixels wide instead of its projected thickness (as
     /// `FrameParams::width_override_px`); the light pass always uses the file's thickness.
     pub width_override_px: Option<f32>,
-    /// SRBF lights' visibility averaged over directions of their lobes, each marched through
-    /// the lobe's own light map ([`LobeSpread`]); `None` (default): Ren's one box-filtered
-    /// visibility per lobe.
-    pub lobe_spread: Option<LobeSpread>,
     /// Where SRBF lobes' visibility comes from: their light maps (Ren's) or the groom's
     /// visibility volume integrated over each lobe.
     pub lobe_visibility: LobeVisibility,
@@ -170,9 +164,6 @@ impl std::fmt::Debug for EnvRenderOptions {
             .field("transmittance_filter", &self.transmittance_filter)
             .field("box_average", &self.box_average)
             .field("width_override_px", &self.width_override_px);
-        if let Some(spread) = &self.lobe_spread {
-            s.field("lobe_spread", spread);
-        }
         if self.lobe_visibility != LobeVisibility::LightMaps {
             s.field("lobe_visibility", &self.lobe_visibility);
         }
@@ -192,7 +183,6 @@ impl Default for EnvRenderOptions {
             transmittance_filter: TransmittanceFilter::default(),
             box_average: BoxAverage::default(),
             width_override_px: None,
-            lobe_spread: None,
             lobe_visibility: LobeVisibility::LightMaps,
         }
     }
@@ -221,11 +211,7 @@ pub enum EnvRenderError {
     #[error("the GPU reported an error: {0}")]
     Gpu(String),
     #[error(transparent)]
-    LobeSpread(#[from] LobeSpreadError),
-    #[error(transparent)]
     VisibilityVolume(#[from] VisibilityVolumeError),
-    #[error("lobe spread and the visibility volume both set SRBF lobes' visibility: choose one")]
-    TwoLobeVisibilities,
 }
 
 #[derive(Clone, Debug)]
@@ -458,14 +444,8 @@ fn check_inputs(
     options.dodm.check()?;
     check_kappa(options.kappa)?;
     options.transparency.check()?;
-    if let Some(spread) = &options.lobe_spread {
-        spread.validate()?;
-    }
     if let Some(volume) = options.lobe_visibility.volume() {
         volume.validate()?;
-        if options.lobe_spread.is_some() {
-            return Err(EnvRenderError::TwoLobeVisibilities);
-        }
     }
     if kinds.has_srbf() {
         required_table(&tables.srbf, "srbf", "SRBF lights", Some(AXIS_INV_LAMBDA))?;
@@ -1089,7 +1069,6 @@ impl EnvRenderer {
                 options.shadowed,
                 grid.is_some(),
                 options.transmittance_filter,
-                options.lobe_spread,
             );
             let visibility = frame.visibility(options);
             let view = ViewBinding::new(gpu, &self.view.view_layout, grid.as_ref(), &visibility);

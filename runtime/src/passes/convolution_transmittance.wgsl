@@ -9,8 +9,7 @@
 // texels, blended between the two nearest texel boxes) averages each boundary's optical depth
 // through the SAT; l(δ) interpolates linearly between (0, 0) and the boundaries (z_k, l̄_k); T̃ = exp(−l).
 // Directional lights (tan α = 0) read the single texel: a plain per-light deep opacity map.
-// With lobe spread on (lobe_spread.wgsl, appended after this file), SRBF lights take its
-// visibility instead of the box's.
+// With the visibility volume (visibility_volume.wgsl), SRBF lights do not come here.
 
 struct EnvLightGpu {
     view_proj: mat4x4<f32>,
@@ -48,11 +47,6 @@ struct BatchParams {
     // Bit 0: skip shadowing (T̃ = 1). Bit 1: a forward-scattering grid is bound. Bit 2: the
     // SATs hold transmittance (BoxAverage::Transmittance), not optical depth.
     flags: u32,
-    // Lobe spread (lobe_spread.wgsl): rings, directions per ring, steps, fiber weighting (all 0
-    // when off).
-    spread: vec4<u32>,
-    // Lobe spread: reach in first layers, cone scale.
-    spread_shape: vec4<f32>,
 };
 
 @group(1) @binding(0) var<uniform> batch: BatchParams;
@@ -132,12 +126,9 @@ fn nearest_depth_around(slot: u32, texel: vec2<i32>) -> f32 {
     return z0;
 }
 
-fn effective_transmittance(slot: u32, world: vec3<f32>, t: vec3<f32>, e: vec3<f32>) -> f32 {
+fn effective_transmittance(slot: u32, world: vec3<f32>) -> f32 {
     if ((batch.flags & FLAG_UNSHADOWED) != 0u) { return 1.0; }
     let light = env_lights[slot];
-    if (lobe_spread_enabled() && light.direction.w > 0.0) {
-        return lobe_spread_transmittance(slot, world, t, e);
-    }
     let clip = light.view_proj * vec4<f32>(world, 1.0);
     let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
     if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }

@@ -16,7 +16,6 @@ use wgpu::util::DeviceExt;
 use super::attachments::cleared_color;
 use super::convolution_depth::DodmBatch;
 use super::frame_params::FrameParams;
-use super::lobe_spread::{LobeSpread, spread_uniform};
 use super::render_target::DEPTH_FORMAT;
 use super::strand_geometry::StrandGeometry;
 use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
@@ -77,10 +76,6 @@ struct BatchUniform {
     resolution: u32,
     max_half_size: u32,
     flags: u32,
-    /// [`spread_uniform`]: rings, per ring, steps, fiber weighting (0 when off).
-    spread: [u32; 4],
-    /// [`spread_uniform`]: reach in first layers, cone scale.
-    spread_shape: [f32; 4],
 }
 
 const FLAG_UNSHADOWED: u32 = 1;
@@ -152,14 +147,11 @@ impl BatchBinding {
                 lights: one,
             })
             .collect();
-        Self::with_groups(
-            gpu, layout, &groups, dodm, sat, shadowed, with_grid, filter, None,
-        )
+        Self::with_groups(gpu, layout, &groups, dodm, sat, shadowed, with_grid, filter)
     }
 
     /// `groups[slot]` shaded with the visibility of DODM slot `slot`; `shadowed = false`
-    /// forces T̃ = 1. SRBF lights take the box of `filter`, or with `spread` the mean over
-    /// their lobe's directions ([`LobeSpread`]).
+    /// forces T̃ = 1. SRBF lights take the box of `filter`.
     #[allow(clippy::too_many_arguments)]
     pub fn with_groups(
         gpu: &GpuContext,
@@ -170,7 +162,6 @@ impl BatchBinding {
         shadowed: bool,
         with_grid: bool,
         filter: TransmittanceFilter,
-        spread: Option<LobeSpread>,
     ) -> Self {
         let device = &gpu.device;
         let mut samples: Vec<ShadingSampleGpu> = Vec::new();
@@ -222,7 +213,6 @@ impl BatchBinding {
             } else {
                 0
             };
-        let (spread_counts, spread_shape) = spread_uniform(spread);
         let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("env batch"),
             contents: bytemuck::bytes_of(&BatchUniform {
@@ -230,8 +220,6 @@ impl BatchBinding {
                 resolution: dodm.resolution,
                 max_half_size: MAX_BOX_HALF_SIZE,
                 flags,
-                spread: spread_counts,
-                spread_shape,
             }),
             usage: wgpu::BufferUsages::UNIFORM,
         });
@@ -720,7 +708,6 @@ fn env_view_shader(device: &wgpu::Device) -> wgpu::ShaderModule {
         include_str!("strand_quads.wgsl"),
         include_str!("fiber_frame.wgsl"),
         include_str!("convolution_transmittance.wgsl"),
-        include_str!("lobe_spread.wgsl"),
         include_str!("occupancy_map.wgsl"),
         include_str!("table_axis.wgsl"),
         include_str!("env_view.wgsl"),

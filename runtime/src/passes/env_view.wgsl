@@ -142,33 +142,31 @@ fn forward_scattering(slot: u32, world: vec3<f32>) -> vec4<f32> {
     return acc;
 }
 
-// Lobe spread's weight of direction ω (lobe_spread.wgsl): with fiber weighting, the fiber's
-// response to ω, read from the single table at its narrowest width (the 1/λ axis clamps 0 to
-// its first node), so the lobe's visibility is the mean of V over G·S rather than over G.
-fn spread_weight(omega: vec3<f32>, t: vec3<f32>, e: vec3<f32>) -> f32 {
-    if (batch.spread.w == 0u) { return 1.0; }
-    let f = fiber_frame(t, omega, e);
-    let s = single_lookup(vec4<f32>(f.sin_theta_i, f.sin_theta_o, f.cos_phi, 0.0));
-    return max(s.r + s.g + s.b, 0.0);
-}
-
 struct EnvOut {
     @location(0) single: vec4<f32>,
     @location(1) multiple: vec4<f32>,
 };
 
-// Single and multiple scattering of the fiber at `world` along `tangent` under the batch's lights,
-// times `weight` (pre-multiplied; the weight is also the alpha written).
+fn toward_eye(world: vec3<f32>) -> vec3<f32> {
+    if (frame.eye.w > 0.5) { return normalize(frame.eye.xyz - world); }
+    return frame.toward_eye.xyz;
+}
+
+// SRBF lobes integrate the visibility volume's T over the lobe instead of reading their light
+// maps (visibility_volume.wgsl); directional lights keep their maps.
+fn shades_from_volume() -> bool {
+    return volume_enabled() && (batch.flags & FLAG_UNSHADOWED) == 0u;
+}
+
+// Single and multiple scattering of the fiber at `world` along `tangent` under the batch's
+// lights, times `weight` (pre-multiplied; the weight is also the alpha written).
 fn shade(world: vec3<f32>, tangent: vec3<f32>, weight: f32) -> EnvOut {
     let t = normalize(tangent);
-    var e = frame.toward_eye.xyz;
-    if (frame.eye.w > 0.5) { e = normalize(frame.eye.xyz - world); }
+    let e = toward_eye(world);
     var single = vec3<f32>(0.0);
     var multiple = vec3<f32>(0.0);
     let with_grid = (batch.flags & FLAG_GRID) != 0u;
-    // SRBF lobes integrate the visibility volume's T over the lobe instead of reading their
-    // light maps (visibility_volume.wgsl); directional lights keep their maps.
-    let with_volume = volume_enabled() && (batch.flags & FLAG_UNSHADOWED) == 0u;
+    let with_volume = shades_from_volume();
     var sh: Sh16;
     if (with_volume) { sh = volume_coefficients(world); }
     for (var slot = 0u; slot < batch.light_count; slot++) {
@@ -177,7 +175,7 @@ fn shade(world: vec3<f32>, tangent: vec3<f32>, weight: f32) -> EnvOut {
         if (with_volume && light.direction.w > 0.0) {
             visible = volume_lobe_visibility(sh, light.direction.xyz, light.direction.w);
         } else {
-            visible = effective_transmittance(slot, world, t, e);
+            visible = effective_transmittance(slot, world);
         }
         var g = vec4<f32>(0.0);
         if (with_grid) { g = forward_scattering(slot, world); }

@@ -8,7 +8,6 @@ pub mod env_view;
 pub mod fiber_shading;
 pub mod frame_params;
 pub mod kbuffer;
-pub mod lobe_spread;
 pub mod random_subsets;
 pub mod render_target;
 pub mod shadow_slots;

@@ -48,7 +48,6 @@ impl TransmittanceProbe {
         let device = &gpu.device;
         let source = [
             include_str!("convolution_transmittance.wgsl"),
-            include_str!("lobe_spread.wgsl"),
             include_str!("transmittance_probe.wgsl"),
         ]
         .concat();

@@ -29,7 +29,7 @@ fn spread_weight(omega: vec3<f32>, t: vec3<f32>, e: vec3<f32>) -> f32 {
 fn probe_transmittance(@builtin(global_invocation_id) id: vec3<u32>) {
     if (id.x >= arrayLength(&probe_points)) { return; }
     let p = probe_points[id.x].position;
-    probe_transmittance_out[id.x] = effective_transmittance(u32(p.w), p.xyz, vec3<f32>(0.0), vec3<f32>(0.0));
+    probe_transmittance_out[id.x] = effective_transmittance(u32(p.w), p.xyz);
 }
 
 @compute @workgroup_size(64)
