@@ -565,6 +565,9 @@ struct FrameResources {
     volume: Arc<VolumeBuffers>,
 }
 
+/// Texels across the light maps bound, unread, by SRBF batches that read the visibility volume.
+const PLACEHOLDER_MAP_RESOLUTION: u32 = 8;
+
 /// One resolution's light maps: the batch's DODM and its summed-area tables.
 struct LightMaps {
     dodm: DodmBatch,
@@ -593,6 +596,26 @@ impl LightMaps {
         kinds: &LightKinds,
         first_layer: f32,
     ) -> Result<(Option<Self>, Option<Self>), EnvRenderError> {
+        if options.shadowed && options.lobe_visibility.volume().is_some() && kinds.has_srbf() {
+            // SRBF lobes read the visibility volume: only the compact sources draw maps, and
+            // SRBF batches bind a small placeholder that nothing reads.
+            let sources = LightKinds {
+                srbf_every_strand: Vec::new(),
+                srbf: Vec::new(),
+                directional: kinds.directional.clone(),
+                directional_thinned: kinds.directional_thinned.clone(),
+            };
+            let placeholder = || Self::new(gpu, PLACEHOLDER_MAP_RESOLUTION, 1, first_layer);
+            if !sources.has_directional() {
+                return Ok((Some(placeholder()?), None));
+            }
+            let (full, simplified) = Self::for_frame(gpu, options, &sources, first_layer)?;
+            let full = match full {
+                Some(maps) => maps,
+                None => placeholder()?,
+            };
+            return Ok((Some(full), simplified));
+        }
         let dodm = &options.dodm;
         let slots = |lights: &[&Vec<EnvLight>]| {
             let most = lights
