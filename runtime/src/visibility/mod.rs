@@ -15,7 +15,9 @@ pub mod volume;
 pub use spherical_harmonics::{SH_COEFFICIENTS, lobe_visibility, srbf_band_ratios};
 pub use volume::{VisibilityVolume, VisibilityVolumeError, VisibilityVolumeSettings};
 
-/// Where an SRBF lobe's visibility comes from.
+/// Where an SRBF lobe's visibility comes from. The runtime defaults to Ren's light maps, the
+/// method as published; the product's settings (`scene::look`, so the CLI and the viewer) default
+/// to the volume, which measured faster at the same error (docs/BENCHMARKS.md, "Lobe visibility").
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub enum LobeVisibility {
     /// Ren 2010: each lobe's own convolution optical depth map, read at the lobe's centre and
