@@ -203,3 +203,42 @@ pub struct EnvLook {
     /// Where SRBF lobes' visibility comes from ([`ViewArgs::lobe_visibility`]).
     pub lobe_visibility: LobeVisibility,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        look: LookArgs,
+    }
+
+    #[test]
+    fn the_volume_is_the_default_and_light_maps_are_one_flag_away() {
+        let default = Cli::parse_from(["x"]).look.look().unwrap();
+        assert_eq!(
+            default.lobe_visibility,
+            LobeVisibility::Volume(VisibilityVolumeSettings::default())
+        );
+        let maps = Cli::parse_from(["x", "--lobe-visibility", "light-maps"])
+            .look
+            .look()
+            .unwrap();
+        assert_eq!(maps.lobe_visibility, LobeVisibility::LightMaps);
+        assert!(Cli::try_parse_from(["x", "--lobe-visibility", "cone"]).is_err());
+    }
+
+    #[test]
+    fn settings_saved_before_the_volume_read_back_as_light_maps() {
+        let mut saved = serde_json::to_value(ViewArgs::default()).unwrap();
+        saved.as_object_mut().unwrap().remove("lobe_visibility");
+        let old: ViewArgs = serde_json::from_value(saved).unwrap();
+        assert_eq!(old.lobe_visibility, LobeVisibilityArg::LightMaps);
+        assert_eq!(
+            ViewArgs::default().lobe_visibility,
+            LobeVisibilityArg::Volume
+        );
+    }
+}
