@@ -95,25 +95,18 @@ pub fn unoccluded_coefficients() -> [f32; SH_COEFFICIENTS] {
 /// Optical depth beyond which a march stops (T < 10⁻⁵).
 const OPAQUE_DEPTH: f32 = 11.5;
 
-/// Per voxel what a ray needs: σ_t⊥ and E[t tᵀ].
-struct Extinction {
-    sigma_perp: Vec<f32>,
-    moment: Vec<[f32; 6]>,
-}
-
-impl Extinction {
-    fn along(&self, voxel: usize, w: Vec3) -> f32 {
-        let s = self.sigma_perp[voxel];
-        if s == 0.0 {
-            return 0.0;
-        }
-        let m = &self.moment[voxel];
-        let along = w.x * w.x * m[0]
-            + w.y * w.y * m[1]
-            + w.z * w.z * m[2]
-            + 2.0 * (w.x * w.y * m[3] + w.x * w.z * m[4] + w.y * w.z * m[5]);
-        s * (1.0 - along).max(0.0).sqrt()
+/// The extinction of `voxel` along the unit vector `w`: σ_t⊥ · √(1 − wᵀ E[t tᵀ] w).
+fn extinction_along(hair: &HairVolume, voxel: usize, w: Vec3) -> f32 {
+    let s = hair.sigma_perp[voxel];
+    if s == 0.0 {
+        return 0.0;
     }
+    let m = &hair.tangent_moment[voxel];
+    let along = w.x * w.x * m[0]
+        + w.y * w.y * m[1]
+        + w.z * w.z * m[2]
+        + 2.0 * (w.x * w.y * m[3] + w.x * w.z * m[4] + w.y * w.z * m[5]);
+    s * (1.0 - along).max(0.0).sqrt()
 }
 
 impl VisibilityVolume {
@@ -144,10 +137,6 @@ impl VisibilityVolume {
     fn from_hair_volume(hair: &HairVolume, directions: usize) -> Self {
         let grid = hair.grid;
         let dims = grid.dims.map(|d| d + 1);
-        let extinction = Extinction {
-            sigma_perp: hair.sigma_perp.clone(),
-            moment: hair.tangent_moment.clone(),
-        };
         let lattice = fibonacci_directions(directions);
         let vertex_count = dims.iter().map(|&d| d as usize).product::<usize>();
         let step = 0.5 * grid.voxel_size;
@@ -159,9 +148,7 @@ impl VisibilityVolume {
                     return unoccluded_coefficients();
                 }
                 let p = grid.origin + Vec3::new(i as f32, j as f32, k as f32) * grid.voxel_size;
-                let t = lattice
-                    .iter()
-                    .map(|&w| march(&extinction, &grid, p, w, step));
+                let t = lattice.iter().map(|&w| march(hair, p, w, step));
                 project(&lattice, t)
             })
             .collect();
@@ -252,13 +239,8 @@ fn touches_fiber(hair: &HairVolume, v: [u32; 3]) -> bool {
 }
 
 /// exp(−∫σ(w) ds) from `p` along `w` to the grid's border (midpoint rule, steps of `step`).
-fn march(
-    extinction: &Extinction,
-    grid: &crate::multiple::VoxelGrid,
-    p: Vec3,
-    w: Vec3,
-    step: f32,
-) -> f32 {
+fn march(hair: &HairVolume, p: Vec3, w: Vec3, step: f32) -> f32 {
+    let grid = &hair.grid;
     let Some((t0, t1)) = grid.ray_interval(p, w) else {
         return 1.0;
     };
@@ -266,7 +248,7 @@ fn march(
     let mut t = t0 + 0.5 * step;
     while t < t1 {
         if let Some(voxel) = grid.voxel_of(p + t * w) {
-            depth += extinction.along(voxel, w) * step;
+            depth += extinction_along(hair, voxel, w) * step;
             if depth > OPAQUE_DEPTH {
                 return 0.0;
             }
@@ -330,23 +312,19 @@ mod tests {
     fn a_march_follows_the_closed_form_across_and_aslant_and_passes_along_the_fibers() {
         let (n, size, sigma) = (20, 0.1, 1.5);
         let hair = uniform_fibers_along_x(n, size, sigma);
-        let extinction = Extinction {
-            sigma_perp: hair.sigma_perp.clone(),
-            moment: hair.tangent_moment.clone(),
-        };
         let step = 0.5 * size;
         let p = Vec3::splat(1.0); // the cube's centre: 1.0 to every face
-        let across = march(&extinction, &hair.grid, p, Vec3::Z, step);
+        let across = march(&hair, p, Vec3::Z, step);
         assert!(
             (across - (-sigma * 1.0f32).exp()).abs() < 1e-5,
             "across {across}"
         );
-        let along = march(&extinction, &hair.grid, p, Vec3::X, step);
+        let along = march(&hair, p, Vec3::X, step);
         assert_eq!(along, 1.0);
         // 30° off the fibers in the x–z plane: the path to the x face is 1/cos 30°, and σ·sin 30°.
         let a = 30f32.to_radians();
         let w = Vec3::new(a.cos(), 0.0, a.sin());
-        let aslant = march(&extinction, &hair.grid, p, w, step);
+        let aslant = march(&hair, p, w, step);
         let expected = (-sigma * a.sin() / a.cos()).exp();
         // The last midpoint step may overhang the border by up to half a step.
         assert!(
@@ -354,10 +332,10 @@ mod tests {
             "aslant {aslant} vs {expected}"
         );
         // Fibers in every direction (E[t tᵀ] = I/3): √(2/3) of σ_t⊥.
-        let mut iso = extinction;
-        iso.moment =
+        let mut iso = hair.clone();
+        iso.tangent_moment =
             vec![[1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 0.0, 0.0, 0.0]; hair.grid.voxel_count()];
-        let t = march(&iso, &hair.grid, p, Vec3::Y, step);
+        let t = march(&iso, p, Vec3::Y, step);
         assert!((t - (-sigma * (2.0f32 / 3.0).sqrt()).exp()).abs() < 1e-5);
     }
 
@@ -367,10 +345,6 @@ mod tests {
         // lobe-weighted mean of the marched T (brute force over 20 000 directions).
         let hair = uniform_fibers_along_x(16, 0.125, 1.2);
         let volume = VisibilityVolume::from_hair_volume(&hair, 512);
-        let extinction = Extinction {
-            sigma_perp: hair.sigma_perp.clone(),
-            moment: hair.tangent_moment.clone(),
-        };
         let p = Vec3::splat(1.0);
         let dirs = fibonacci_directions(20_000);
         for (xi, lambda) in [
@@ -382,7 +356,7 @@ mod tests {
             let (mut num, mut den) = (0.0f64, 0.0f64);
             for &d in &dirs {
                 let g = ((lambda * (d.dot(xi) - 1.0)) as f64).exp();
-                num += g * march(&extinction, &hair.grid, p, d, 0.0625) as f64;
+                num += g * march(&hair, p, d, 0.0625) as f64;
                 den += g;
             }
             let brute = (num / den) as f32;
