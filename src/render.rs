@@ -383,7 +383,6 @@ fn run_env(args: &RenderArgs, settings: &FrameSettings, env: &EnvLighting) -> an
             "mode": mode.name(),
             "frame_ms": rendered.milliseconds,
             "transparency": look_args.transparency,
-            "box_average": look_args.view.box_average,
             "forward_scattering": look_args.view.forward_scattering,
             "visibility_cutoff": look_args.view.visibility_cutoff,
             "memory_per_batch_bytes": rendered.memory_per_batch.iter().map(|(n, b)| (n.clone(), serde_json::json!(b))).collect::<serde_json::Map<_, _>>(),

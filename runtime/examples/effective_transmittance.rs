@@ -8,8 +8,7 @@
 //! (stratified in cos γ by its inverse CDF and in φ), each of irradiance 1/N, every strand drawn
 //! in the light pass (κ = 1); each directional light reads its map's single texel, so the
 //! reference averages exact per-direction deep opacity maps. Estimates: the one SRBF light with
-//! each [`TransmittanceFilter`] (and the default one averaging transmittance instead of optical
-//! depth, [`BoxAverage`]), at κ = 1 and κ = 0.1. Error: relative RMSE over hair pixels
+//! each [`TransmittanceFilter`], at κ = 1 and κ = 0.1. Error: relative RMSE over hair pixels
 //! (reference alpha > 0.01), sqrt(Σ(a − r)² / Σr²), on the red channel (all three are equal).
 //!
 //! Run: `cargo run --release -p strandlight-runtime --example effective_transmittance --
@@ -24,7 +23,7 @@ use std::time::Instant;
 use glam::Vec3;
 use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::{
-    BoxAverage, EnvFrame, EnvLight, EnvRenderOptions, EnvRenderer, EnvTables, TransmittanceFilter,
+    EnvFrame, EnvLight, EnvRenderOptions, EnvRenderer, EnvTables, TransmittanceFilter,
 };
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
@@ -229,26 +228,9 @@ fn main() -> Result<(), BoxError> {
         ),
     ];
     let filters = [
-        (
-            TransmittanceFilter::PaperSupport,
-            BoxAverage::OpticalDepth,
-            "paper",
-        ),
-        (
-            TransmittanceFilter::MatchedVariance,
-            BoxAverage::OpticalDepth,
-            "matched",
-        ),
-        (
-            TransmittanceFilter::Centre,
-            BoxAverage::OpticalDepth,
-            "centre",
-        ),
-        (
-            TransmittanceFilter::MatchedVariance,
-            BoxAverage::Transmittance,
-            "matched_t",
-        ),
+        (TransmittanceFilter::PaperSupport, "paper"),
+        (TransmittanceFilter::MatchedVariance, "matched"),
+        (TransmittanceFilter::Centre, "centre"),
     ];
     println!(
         "{hair_name}: {} strands, {} segments; {width}×{height}; DODM {}²; reference: {} directional lights from G; {}",
@@ -293,11 +275,10 @@ fn main() -> Result<(), BoxError> {
                 [(1.0 / integral(lambda as f64)) as f32; 3],
             )];
             for kappa in [1.0f32, 0.1] {
-                for &(filter, box_average, tag) in &filters {
+                for &(filter, tag) in &filters {
                     let options = EnvRenderOptions {
                         kappa,
                         transmittance_filter: filter,
-                        box_average,
                         ..EnvRenderOptions::default()
                     };
                     let estimate = renderer.render(
@@ -306,11 +287,7 @@ fn main() -> Result<(), BoxError> {
                     let rmse = relative_rmse(&estimate.pixels, &reference.pixels);
                     row += &format!(" {rmse:.4} ({:.0} ms) |", frame_ms(&estimate));
                     if kappa == 1.0 {
-                        write(
-                            tag,
-                            &estimate,
-                            &format!("{}, averaging {}", filter.name(), box_average.name()),
-                        )?;
+                        write(tag, &estimate, filter.name())?;
                     }
                 }
             }
@@ -320,9 +297,9 @@ fn main() -> Result<(), BoxError> {
     }
     println!();
     println!(
-        "| light | λ | reference ms | paper κ=1 | matched κ=1 | centre κ=1 | matched, transmittance average κ=1 | paper κ=0.1 | matched κ=0.1 | centre κ=0.1 | matched, transmittance average κ=0.1 |"
+        "| light | λ | reference ms | paper κ=1 | matched κ=1 | centre κ=1 | paper κ=0.1 | matched κ=0.1 | centre κ=0.1 |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|");
     for row in &rows {
         println!("{row}");
     }

@@ -86,7 +86,6 @@ fn main() -> Result<(), BoxError> {
             resolution: 256,
             first_layer: None,
             batch_size: 16,
-            ..DodmSettings::default()
         },
         count_fragments: true,
         ..Default::default()

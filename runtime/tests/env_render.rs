@@ -22,7 +22,7 @@ use strandlight_runtime::passes::convolution_depth::{
 use strandlight_runtime::passes::env_view::BatchBinding;
 use strandlight_runtime::passes::strand_geometry::StrandGeometry;
 use strandlight_runtime::passes::summed_area::{
-    BoxAverage, MAX_BOX_HALF_SIZE, SummedAreaPass, SummedAreaTables, quantize_optical_depth,
+    MAX_BOX_HALF_SIZE, SummedAreaPass, SummedAreaTables, quantize_optical_depth,
 };
 use strandlight_runtime::passes::transmittance_probe::{ProbeBox, TransmittanceProbe};
 use strandlight_tables::angles::FiberAngles;
@@ -304,26 +304,6 @@ fn slab_convolution_transmittance_follows_the_cone_integral() {
             .transmittance(&gpu, &default_binding, 1, &points)
             .unwrap(),
     );
-    // The same default box averaging the transmittance instead of the optical depth.
-    let mut transmittance_sat = SummedAreaTables::new(&gpu, SLAB_RESOLUTION, 2).unwrap();
-    transmittance_sat.average = BoxAverage::Transmittance;
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    SummedAreaPass::new(&gpu).encode(&gpu, &mut encoder, &batch.optical_depth, &transmittance_sat);
-    gpu.queue.submit([encoder.finish()]);
-    let transmittance_binding = BatchBinding::new(
-        &gpu,
-        &probe.batch_layout,
-        &lights,
-        &batch,
-        &transmittance_sat,
-        true,
-        false,
-    );
-    let transmittance_average = to64(
-        &probe
-            .transmittance(&gpu, &transmittance_binding, 0, &points)
-            .unwrap(),
-    );
     let truth: Vec<f64> = points
         .iter()
         .map(|p| cone_transmittance(p.as_dvec3(), lambda as f64, rows, thickness, &NO_GAP))
@@ -332,14 +312,13 @@ fn slab_convolution_transmittance_follows_the_cone_integral() {
         .iter()
         .map(|p| ray_visible(p.as_dvec3(), DVec3::Z, rows, thickness, &NO_GAP) as u8 as f64)
         .collect();
-    let mut errors = vec![0.0; filters.len() + 3];
+    let mut errors = vec![0.0; filters.len() + 2];
     let mut norm = 0.0;
     for (i, p) in sites.iter().enumerate() {
         let t = site_mean(&truth, i);
         let mut values: Vec<f64> = estimates.iter().map(|e| site_mean(e, i)).collect();
         values.push(site_mean(&centre_map, i));
         values.push(site_mean(&centre_ray, i));
-        values.push(site_mean(&transmittance_average, i));
         for (e, v) in errors.iter_mut().zip(&values) {
             *e += (v - t).powi(2);
         }
@@ -354,26 +333,13 @@ fn slab_convolution_transmittance_follows_the_cone_integral() {
     let rel: Vec<f64> = errors.iter().map(|e| (e / norm).sqrt()).collect();
     println!(
         "relative RMSE over {} sites vs the cone integral (2000 directions, λ = {lambda}): paper support box {:.4}, \
-         matched-variance box {:.4}, centre texel {:.4}, directional deep opacity map {:.4}, exact centre-direction ray {:.4}, \
-         matched-variance box averaging transmittance {:.4}",
+         matched-variance box {:.4}, centre texel {:.4}, directional deep opacity map {:.4}, exact centre-direction ray {:.4}",
         sites.len(),
         rel[0],
         rel[1],
         rel[2],
         rel[3],
-        rel[4],
-        rel[5]
-    );
-    assert!(
-        rel[5] < TOLERANCE,
-        "transmittance average: relative RMSE {}",
-        rel[5]
-    );
-    assert!(
-        rel[5] < rel[2],
-        "transmittance average {} not better than the centre texel {}",
-        rel[5],
-        rel[2]
+        rel[4]
     );
     // The centre filter is the directional light's single texel.
     assert!((rel[2] - rel[3]).abs() < 1e-6, "{} vs {}", rel[2], rel[3]);
@@ -573,7 +539,6 @@ fn render_unshadowed_with(
             resolution: 64,
             first_layer: None,
             batch_size: 2,
-            ..DodmSettings::default()
         },
         kappa: 1.0,
         shadowed: false,
@@ -925,7 +890,6 @@ fn bad_inputs_are_typed_errors() {
             resolution: 2048,
             first_layer: None,
             batch_size: slots,
-            ..DodmSettings::default()
         },
         kappa: 1.0,
         ..options
@@ -1049,7 +1013,6 @@ fn render_occluder(
             resolution: 64,
             first_layer: Some(0.05),
             batch_size,
-            ..DodmSettings::default()
         },
         kappa: 1.0,
         ..Default::default()
@@ -1446,7 +1409,6 @@ fn render_groom(
             resolution: 128,
             first_layer: None,
             batch_size: 2,
-            ..DodmSettings::default()
         },
         kappa,
         ..Default::default()
@@ -1471,56 +1433,6 @@ fn worst_relative(a: &[[f32; 4]], b: &[[f32; 4]]) -> f64 {
         .flat_map(|(p, q)| (0..3).map(move |c| (p[c] as f64, q[c] as f64)))
         .map(|(x, y)| (x - y).abs() / y.abs().max(1e-3))
         .fold(0.0, f64::max)
-}
-
-/// Coarser strands in the κ-simplified light pass (`DodmSettings::simplified_chord_tolerance`):
-/// chords within a hundredth of a texel leave the frame almost as it was; at the default half texel
-/// the frame moves by less than another draw of κ's strands moves it (on this small curly
-/// groom 0.7 of it; on straight.hair under venice 0.33); chords of 16 texels move it more.
-#[test]
-fn coarser_simplified_strands_change_the_frame_less_than_another_kappa_draw() {
-    let gpu = gpu();
-    let (model, camera, tables) = groom_scene();
-    let lights = groom_lobes();
-    let render = |tolerance: f32, seed: u64| {
-        let options = EnvRenderOptions {
-            dodm: DodmSettings {
-                resolution: 128,
-                batch_size: 2,
-                simplified_chord_tolerance: tolerance,
-                ..DodmSettings::default()
-            },
-            kappa: 0.1,
-            simplification_seed: seed,
-            ..Default::default()
-        };
-        render_env_frame(
-            &gpu, &model, &camera, RES, RES, &lights, &tables, &options, None,
-        )
-        .unwrap_or_else(|e| panic!("{e}"))
-        .pixels
-    };
-    let exact = render(0.0, 1);
-    let negligible = relative_rmse(&render(0.01, 1), &exact);
-    let half_texel = relative_rmse(&render(0.5, 1), &exact);
-    let another_draw = relative_rmse(&render(0.0, 2), &exact);
-    let far_too_coarse = relative_rmse(&render(16.0, 1), &exact);
-    println!(
-        "against every point drawn: 0.01-texel chords {negligible:.2e}, half-texel \
-         {half_texel:.4}, another κ draw {another_draw:.4}, 16-texel {far_too_coarse:.4}"
-    );
-    assert!(
-        negligible < 0.05 * half_texel,
-        "0.01-texel chords: {negligible} (half-texel {half_texel})"
-    );
-    assert!(
-        half_texel < another_draw,
-        "half-texel chords moved the frame by {half_texel}, another κ draw by {another_draw}"
-    );
-    assert!(
-        far_too_coarse > 1.3 * half_texel,
-        "16-texel chords should change the shadows more: {far_too_coarse} vs {half_texel}"
-    );
 }
 
 /// A κ-thinned SRBF's strand subset follows its rank by power, not its place in the caller's
@@ -1679,7 +1591,7 @@ fn srbf_and_directional_lights_in_one_frame_add_and_directional_ignores_kappa() 
     );
 }
 
-/// A compact source not drawing every strand (`thin_weak_sources`) is shadowed through a κ
+/// A compact source not drawing every strand (`EnvLight::every_strand` false) is shadowed through a κ
 /// map: at κ 1 exactly as with every strand, at κ 0.1 differently (its map is thinned) but
 /// with the same light reaching the groom on average (fibers enlarged 1/κ cover the ones left
 /// out).

@@ -120,7 +120,6 @@ fn render_sized(
             resolution: 64,
             first_layer: None,
             batch_size: 4,
-            ..DodmSettings::default()
         },
         kappa: 1.0,
         shadowed: false,

@@ -159,7 +159,6 @@ fn a_light_batch_past_the_texture_array_limit_is_refused() {
             resolution: 8,
             first_layer: None,
             batch_size: layers + 1,
-            ..DodmSettings::default()
         },
         ..Default::default()
     };

@@ -22,9 +22,7 @@ use crate::fit_cache::fit_cached;
 use crate::ground_truth::{GroundTruth, TruthUse};
 use crate::hdr_flip::hdr_flip;
 use crate::image_metrics::{Image, relative_rmse};
-use crate::look::{
-    BoxAverageArg, EnvTransparency, ForwardDevice, LobeVisibilityArg, LookArgs, ViewArgs,
-};
+use crate::look::{EnvTransparency, ForwardDevice, LobeVisibilityArg, LookArgs, ViewArgs};
 use crate::scene_tables::{EnvShading, ScatteringMode};
 use crate::steps::Steps;
 use anyhow::Context;
@@ -34,7 +32,7 @@ use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake::bake_job;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription, Model, PlanOptions};
 use strandlight_precompute::baked_tables_check::check_asset;
-use strandlight_runtime::env::{EnvLight, ViewTransparency, mark_every_strand, thin_weak_sources};
+use strandlight_runtime::env::{EnvLight, ViewTransparency};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 
 /// What one run measures.
@@ -53,19 +51,6 @@ pub struct BenchPlan {
     pub lobes: Vec<usize>,
     pub kappas: Vec<f32>,
     pub dodm_sizes: Vec<u32>,
-    /// Adaptive κ: frames whose strongest lobes holding this share of the lobes' power draw
-    /// every strand (`compare --every-strand-share`); reports written before it existed: none.
-    #[serde(default)]
-    pub every_strand_shares: Vec<f32>,
-    /// Also an SRBF frame whose lobes take their visibility from the groom's visibility volume
-    /// (`--lobe-visibility volume`) instead of their light maps; reports written before it
-    /// existed: none.
-    #[serde(default)]
-    pub visibility_volume: bool,
-    /// Chord tolerances of the simplified light pass (`compare --light-chord-tolerance`, texels)
-    /// other than the default; reports written before it existed: none.
-    #[serde(default)]
-    pub chord_tolerances: Vec<f32>,
     pub baseline_lights: Vec<usize>,
     /// Which directional-light baseline (reports written before it existed: median cut).
     #[serde(default)]
@@ -145,9 +130,6 @@ impl BenchPlan {
             lobes: vec![64, 8, 16, 32, 49],
             kappas: vec![0.1, 0.3, 1.0],
             dodm_sizes: vec![512, 256, 1024],
-            every_strand_shares: vec![0.2, 0.4],
-            visibility_volume: true,
-            chord_tolerances: vec![0.5],
             baseline_lights: vec![4, 8, 16, 32, 64, 128],
             baseline: Baseline::MedianCut,
             reference_max_lights: 1536,
@@ -173,9 +155,6 @@ impl BenchPlan {
             lobes: vec![64],
             kappas: vec![0.1],
             dodm_sizes: vec![512],
-            every_strand_shares: Vec::new(),
-            visibility_volume: true,
-            chord_tolerances: Vec::new(),
             shading: EnvShading::Chiang,
             ground_truth: true,
             // The truth's noise at 4096 (the kept image holds 5120 spp) is ~3% relative RMSE,
@@ -218,9 +197,6 @@ impl BenchPlan {
             lobes: vec![64, 8, 32],
             kappas: vec![0.1, 1.0],
             dodm_sizes: vec![512, 256],
-            every_strand_shares: vec![0.4],
-            visibility_volume: true,
-            chord_tolerances: vec![0.5],
             baseline_lights: vec![4, 16, 64],
             baseline: Baseline::MedianCut,
             reference_max_lights: 384,
@@ -479,7 +455,14 @@ impl BenchReport {
             if let Some((map, mode)) = repeated_key(&merged.env_lit, &report.env_lit, env_lit_key) {
                 anyhow::bail!("{map} ({mode} scattering) is in more than one report");
             }
-            let decomposition_key = |d: &ErrorDecomposition| (d.map.clone(), d.mode.clone());
+            let decomposition_key = |d: &ErrorDecomposition| {
+                let against = if d.against_truth {
+                    ", against the truth"
+                } else {
+                    ""
+                };
+                (d.map.clone(), format!("{}{against}", d.mode))
+            };
             if let Some((map, mode)) = repeated_key(
                 &merged.decompositions,
                 &report.decompositions,
@@ -587,23 +570,20 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
             .collect(),
         kappa: plan.kappas[0],
         every_strand_share: 0.0,
-        thin_weak_sources: false,
         timing_runs: plan.timing_runs,
         equal_error: false,
         baseline: plan.baseline,
         equal_error_metric: crate::error_metric::ErrorMetric::RelativeRmse,
         unshadowed: false,
         light_map_size: plan.dodm_sizes[0],
-        light_chord_tolerance: DodmSettings::default().simplified_chord_tolerance,
         look: LookArgs {
             transparency: EnvTransparency::Opaque,
             view: ViewArgs {
-                // The sweep varies the light maps' settings (κ, size, adaptive κ, chord
-                // tolerance) around Ren's light-map frame; the visibility volume, the product's
-                // default, is its own frame ([`BenchPlan::visibility_volume`]).
+                // Every SRBF frame of the sweep sets its own ([`srbf_configs`]); the error
+                // decomposition against the DOM reference takes Ren's light maps apart (one
+                // visibility per lobe, κ), so they are what these arguments leave in place.
                 lobe_visibility: LobeVisibilityArg::LightMaps,
                 visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF,
-                box_average: BoxAverageArg::OpticalDepth,
                 forward_scattering: ForwardDevice::Auto,
                 ..ViewArgs::default()
             },
@@ -683,71 +663,62 @@ fn truth_summary(t: &GroundTruth) -> TruthSummary {
 }
 
 /// One SRBF frame of the sweep: the defaults with one setting changed.
+#[derive(Clone)]
 struct SrbfConfig {
     label: String,
     lobes: usize,
     kappa: f32,
     dodm: u32,
-    every_strand_share: f32,
-    /// Lobes read the visibility volume, not their light maps.
-    volume: bool,
-    chord_tolerance: f32,
+    lobe_visibility: LobeVisibilityArg,
 }
 
-/// The SRBF frames of `plan`: the default, then lobes, κ, light-map size, adaptive κ's
-/// share and the simplified light pass's chord tolerance varied one at a time, then lobe
-/// spread at each of its κ (a series of its own: at the default κ it changes one setting,
-/// elsewhere two).
+/// The label of Ren 2010's frame: lobes shadowed by their own light maps at the plan's first κ
+/// and size, the base of the κ and light-map-size series.
+fn light_maps_label(kappa: f32, dodm: u32) -> String {
+    format!("light maps (κ {kappa}, {dodm}²)")
+}
+
+/// The SRBF frames of `plan`: the product's default (lobes shadowed by the visibility volume),
+/// with the lobe count varied; then Ren 2010's light maps, with κ and the light-map size
+/// varied one at a time (κ thins only light maps, so it has no frame of the volume's). Compact
+/// sources draw maps of the plan's first size in every frame.
 fn srbf_configs(plan: &BenchPlan) -> Vec<SrbfConfig> {
     let (lobes, kappa, dodm) = (plan.lobes[0], plan.kappas[0], plan.dodm_sizes[0]);
     let default = SrbfConfig {
-        label: format!("default ({lobes} lobes, κ {kappa}, {dodm}²)"),
+        label: format!("default ({lobes} lobes, visibility volume)"),
         lobes,
         kappa,
         dodm,
-        every_strand_share: 0.0,
-        volume: false,
-        chord_tolerance: DodmSettings::default().simplified_chord_tolerance,
+        lobe_visibility: LobeVisibilityArg::Volume,
     };
-    let changed = |label: String| SrbfConfig { label, ..default };
-    let mut configs = Vec::new();
+    let light_maps = SrbfConfig {
+        label: light_maps_label(kappa, dodm),
+        lobe_visibility: LobeVisibilityArg::LightMaps,
+        ..default.clone()
+    };
+    let mut configs = vec![default.clone()];
     for &n in &plan.lobes[1..] {
         configs.push(SrbfConfig {
+            label: format!("{n} lobes"),
             lobes: n,
-            ..changed(format!("{n} lobes"))
+            ..default.clone()
         });
     }
+    configs.push(light_maps.clone());
     for &k in &plan.kappas[1..] {
         configs.push(SrbfConfig {
+            label: format!("light maps, κ {k}"),
             kappa: k,
-            ..changed(format!("κ {k}"))
+            ..light_maps.clone()
         });
     }
     for &d in &plan.dodm_sizes[1..] {
         configs.push(SrbfConfig {
+            label: format!("light maps {d}²"),
             dodm: d,
-            ..changed(format!("light maps {d}²"))
+            ..light_maps.clone()
         });
     }
-    for &share in &plan.every_strand_shares {
-        configs.push(SrbfConfig {
-            every_strand_share: share,
-            ..changed(format!("adaptive κ, share {share}"))
-        });
-    }
-    for &tolerance in &plan.chord_tolerances {
-        configs.push(SrbfConfig {
-            chord_tolerance: tolerance,
-            ..changed(format!("light-pass chord tolerance {tolerance} texels"))
-        });
-    }
-    if plan.visibility_volume {
-        configs.push(SrbfConfig {
-            volume: true,
-            ..changed("visibility volume".into())
-        });
-    }
-    configs.insert(0, default);
     configs
 }
 
@@ -762,22 +733,13 @@ fn srbf_points(
 ) -> anyhow::Result<Vec<Point>> {
     let mut points = Vec::new();
     for config in srbf_configs(plan) {
-        let mut lights = strongest_lights(scene, config.lobes);
-        mark_every_strand(&mut lights, config.every_strand_share);
-        if args.thin_weak_sources {
-            thin_weak_sources(&mut lights);
-        }
+        let lights = strongest_lights(scene, config.lobes);
         let mut frame: EnvFrame = compare::frame(scene, args, &lights, mode);
         frame.role = FrameRole::Interactive {
             kappa: config.kappa,
         };
-        frame.look.dodm = DodmSettings {
-            simplified_chord_tolerance: config.chord_tolerance,
-            ..DodmSettings::at_resolution(config.dodm)
-        };
-        if config.volume {
-            frame.look.lobe_visibility = LobeVisibilityArg::Volume.settings();
-        }
+        frame.look.dodm = DodmSettings::at_resolution(config.dodm);
+        frame.look.lobe_visibility = config.lobe_visibility.settings();
         let r = steps.run(
             &format!("{}: SRBF {}", mode.name(), config.label),
             || compare::timed_render(&render_lights, &frame, args.timing_runs),
@@ -847,6 +809,7 @@ fn env_lit(
         lights: &lights,
         kappa: plan.kappas[0],
     };
+    let mut single_truth = None;
     for &mode in &plan.modes {
         let reference = compare::reference(&render_lights, &scene, &args, mode, steps)?;
         if plan.decomposition {
@@ -876,6 +839,17 @@ fn env_lit(
             ..compare_args(plan, map, cache, scratch)
         };
         let truth = compare::truth_of(&scene, &truth_args, mode, steps)?;
+        if let Some(truth) = &truth {
+            decompositions.push(against_truth(
+                &name,
+                mode,
+                &inputs,
+                &reference,
+                truth,
+                &mut single_truth,
+                steps,
+            )?);
+        }
         let image = &reference.chosen.image;
         let against = Yardsticks {
             reference: image,
@@ -942,6 +916,37 @@ fn env_lit(
         env_lit: out,
         decompositions,
     })
+}
+
+/// The decomposition of `reference`'s mode against its ground truth `truth`. Full scattering's
+/// needs the single-scattering truth too: `single_truth` holds it once measured (rendered
+/// here when the plan has no single-scattering mode before full).
+fn against_truth(
+    name: &str,
+    mode: ScatteringMode,
+    inputs: &DecompositionInputs,
+    reference: &compare::Reference,
+    truth: &GroundTruth,
+    single_truth: &mut Option<GroundTruth>,
+    steps: &mut Steps,
+) -> anyhow::Result<ErrorDecomposition> {
+    if mode == ScatteringMode::Single {
+        *single_truth = Some(truth.clone());
+        return error_decomposition::single_scattering_against_truth(
+            name, inputs, reference, truth, steps,
+        );
+    }
+    if single_truth.is_none() {
+        // The plan's single-scattering budget: `compare_args` sets it.
+        *single_truth =
+            compare::truth_of(inputs.scene, inputs.args, ScatteringMode::Single, steps)?;
+    }
+    let single = single_truth.as_ref().context(
+        "the single-scattering ground truth, which full scattering's decomposition needs",
+    )?;
+    error_decomposition::full_scattering_against_truth(
+        name, inputs, reference, single, truth, steps,
+    )
 }
 
 /// A map's file name without its extension, as the report names it.
@@ -1147,6 +1152,7 @@ mod tests {
             reference_converged: Some(false),
             unshadowed_reference_lights: None,
             unshadowed_converged: None,
+            against_truth: false,
             steps: Vec::new(),
         }
     }
@@ -1291,27 +1297,32 @@ mod tests {
             let configs = srbf_configs(&plan);
             let default = &configs[0];
             assert!(default.label.starts_with("default"));
-            assert_eq!(default.every_strand_share, 0.0);
-            let expected = plan.lobes.len() - 1 + plan.kappas.len() - 1 + plan.dodm_sizes.len() - 1
-                + plan.every_strand_shares.len()
-                + plan.chord_tolerances.len()
-                + usize::from(plan.visibility_volume);
+            assert_eq!(default.lobe_visibility, LobeVisibilityArg::default());
+            let expected = plan.lobes.len() + plan.kappas.len() + plan.dodm_sizes.len() - 2;
             assert_eq!(configs.len(), 1 + expected, "{}", plan.name);
-            assert!(!default.volume);
+            let light_maps = configs
+                .iter()
+                .find(|c| c.label == light_maps_label(plan.kappas[0], plan.dodm_sizes[0]))
+                .expect("Ren's light-map frame");
+            let changed = |c: &SrbfConfig, base: &SrbfConfig| {
+                [
+                    c.lobes != base.lobes,
+                    c.kappa != base.kappa,
+                    c.dodm != base.dodm,
+                    c.lobe_visibility != base.lobe_visibility,
+                ]
+                .iter()
+                .filter(|&&x| x)
+                .count()
+            };
+            assert_eq!(changed(light_maps, default), 1);
             for c in &configs[1..] {
-                let changed = [
-                    c.lobes != default.lobes,
-                    c.dodm != default.dodm,
-                    c.every_strand_share != default.every_strand_share,
-                    c.volume != default.volume,
-                    c.chord_tolerance != default.chord_tolerance,
-                ];
-                let one_other = changed.iter().filter(|&&x| x).count() == 1;
-                assert!(
-                    one_other != (c.kappa != default.kappa),
-                    "{}: one setting changed",
-                    c.label
-                );
+                let base = match c.lobe_visibility {
+                    LobeVisibilityArg::Volume => default,
+                    LobeVisibilityArg::LightMaps if c.label == light_maps.label => default,
+                    LobeVisibilityArg::LightMaps => light_maps,
+                };
+                assert_eq!(changed(c, base), 1, "{}: one setting changed", c.label);
             }
         }
     }

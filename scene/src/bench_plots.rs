@@ -146,8 +146,10 @@ where
         .label_style(("sans-serif", 13))
         .draw()
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    // Labels name what was changed ("8 lobes", "κ 1", "light maps 256²", "adaptive κ, share
-    // 0.4", "light-pass chord tolerance 0 texels"); the default's names every setting and joins every SRBF series.
+    // Labels name what was changed ("8 lobes", "light maps, κ 1", "light maps 256²"); each
+    // series is joined to the frame it varies: the default, or for the κ and size series Ren's
+    // light-map frame ("light maps (κ 0.1, 512²)") where the report has one. Reports written
+    // before the volume was the default label κ frames "κ 1", and vary the default.
     let series = |family: &str, label: LabelFilter| -> Vec<(f64, f64)> {
         let mut v: Vec<(f64, f64)> = measured
             .iter()
@@ -171,23 +173,23 @@ where
     chart
         .draw_series(baseline.iter().map(|&p| Circle::new(p, 4, RED.filled())))
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    let srbf_series: [(LabelFilter, RGBColor, &str); 7] = [
+    let is_light_map_base: LabelFilter = &|l| l.starts_with("light maps (");
+    let srbf_series: [(LabelFilter, RGBColor, &str); 8] = [
         (&|l| l.ends_with(" lobes"), BLUE, "SRBF: lobe count"),
-        (&|l| l.starts_with("κ"), GREEN, "SRBF: κ"),
         (
-            &|l| l.starts_with("light maps"),
+            is_light_map_base,
+            RGBColor(90, 90, 90),
+            "SRBF: light maps (Ren 2010)",
+        ),
+        (
+            &|l| l.starts_with("κ") || l.starts_with("light maps, κ"),
+            GREEN,
+            "SRBF light maps: κ",
+        ),
+        (
+            &|l| l.starts_with("light maps ") && l.ends_with('²'),
             MAGENTA,
-            "SRBF: light-map size",
-        ),
-        (
-            &|l| l.starts_with("adaptive"),
-            CYAN,
-            "SRBF: adaptive κ share",
-        ),
-        (
-            &|l| l.starts_with("lobe spread"),
-            RGBColor(230, 120, 0),
-            "SRBF: lobe spread (κ; removed, in earlier reports)",
+            "SRBF light maps: size",
         ),
         (
             &|l| l == "visibility volume",
@@ -195,17 +197,32 @@ where
             "SRBF: visibility volume",
         ),
         (
+            &|l| l.starts_with("adaptive"),
+            CYAN,
+            "SRBF: adaptive κ share (removed, in earlier reports)",
+        ),
+        (
+            &|l| l.starts_with("lobe spread"),
+            RGBColor(230, 120, 0),
+            "SRBF: lobe spread (κ; removed, in earlier reports)",
+        ),
+        (
             &|l| l.starts_with("light-pass chord"),
             RGBColor(120, 80, 40),
-            "SRBF: light-pass chord tolerance",
+            "SRBF: light-pass chord tolerance (removed, in earlier reports)",
         ),
     ];
+    let light_map_base = series("srbf", is_light_map_base);
     for (matches, colour, label) in srbf_series {
         let mut points = series("srbf", matches);
         if points.is_empty() {
             continue; // not in this plan (or a report written before it)
         }
-        points.extend(series("srbf", &|l| l.starts_with("default")));
+        let varies_light_maps = label.starts_with("SRBF light maps") && !light_map_base.is_empty();
+        match varies_light_maps {
+            true => points.extend(&light_map_base),
+            false => points.extend(series("srbf", &|l| l.starts_with("default"))),
+        }
         points.sort_by(|a, b| a.0.total_cmp(&b.0));
         let style = colour.stroke_width(1);
         chart

@@ -103,6 +103,12 @@ fn step_cell(step: Option<&DecompositionStep>) -> String {
         Some(DecompositionStep {
             relative_rmse,
             hdr_flip: Some(flip),
+            relative_rmse_noise_corrected: Some(corrected),
+            ..
+        }) => format!("{relative_rmse:.4} ({corrected:.4}) / {flip:.4}"),
+        Some(DecompositionStep {
+            relative_rmse,
+            hdr_flip: Some(flip),
             ..
         }) => format!("{relative_rmse:.4} / {flip:.4}"),
         Some(s) => format!("{:.4}", s.relative_rmse),
@@ -127,14 +133,14 @@ fn decomposition_row(out: &mut String, d: &ErrorDecomposition, reference: &str, 
 /// Per map, where the SRBF default's error comes from: each approximation of the method added
 /// in turn ([`decomposition`]).
 fn decomposition_tables(out: &mut String, report: &BenchReport) {
-    if report.decompositions.is_empty() {
+    if !report.decompositions.iter().any(|d| !d.against_truth) {
         return;
     }
     let of_mode = |mode: ScatteringMode| {
         report
             .decompositions
             .iter()
-            .filter(move |d| d.mode == mode.name())
+            .filter(move |d| d.mode == mode.name() && !d.against_truth)
     };
     let _ = writeln!(
         out,
@@ -181,6 +187,57 @@ Full scattering, the SRBF default: the error of its single- and of its multiple-
         decomposition_row(out, d, &reference, &steps);
     }
     out.push('\n');
+}
+
+/// Per map, each approximation's frame against the ground truth ([`decomposition`]'s
+/// `…_against_truth`).
+fn truth_decomposition_tables(out: &mut String, report: &BenchReport) {
+    let of_mode = |mode: ScatteringMode| -> Vec<&ErrorDecomposition> {
+        report
+            .decompositions
+            .iter()
+            .filter(|d| d.mode == mode.name() && d.against_truth)
+            .collect()
+    };
+    let (single, full) = (
+        of_mode(ScatteringMode::Single),
+        of_mode(ScatteringMode::Full),
+    );
+    if single.is_empty() && full.is_empty() {
+        return;
+    }
+    let _ = writeln!(
+        out,
+        "\n### Where the error comes from, against the truth\n\nEach frame against the ground truth (relative RMSE (n.c.) / HDR-FLIP over the hair), one approximation changed from the frame on its left: the DOM reference of the map's lights; the DOM reference of the fit's lights (the fit: its lobes one light per cube texel, its compact sources exact; the same light count); Ren 2010's SRBF frame with every strand in every lobe's light map (κ 1: the tables and one visibility per lobe); at the default κ; the visibility volume in place of the light maps (the product's default); and, on maps with compact sources, the default with their light maps {}× finer ({}² against {}²: what the compact sources' shadow resolution costs). The truth has no unshadowed image, so the tables are not measured apart here (\"Where the error comes from\" under \"Speed against error\" measures them against the DOM reference).\n\n| map | DOM reference: map | DOM reference: fit | SRBF light maps, κ 1 | + κ (Ren 2010) | volume (default) | compact sources' maps ×{} |\n|---|---|---|---|---|---|---|",
+        decomposition::SHARP_SOURCE_MAP_SCALE,
+        decomposition::SHARP_SOURCE_MAP_SCALE * report.plan.dodm_sizes[0],
+        report.plan.dodm_sizes[0],
+        decomposition::SHARP_SOURCE_MAP_SCALE,
+    );
+    let single_steps = [
+        decomposition::TRUTH_MAP_LIGHTS,
+        decomposition::TRUTH_FIT_LIGHTS,
+        decomposition::TRUTH_EVERY_STRAND,
+        decomposition::TRUTH_LIGHT_MAPS,
+        decomposition::TRUTH_VOLUME,
+        decomposition::TRUTH_SHARP_SOURCES,
+    ];
+    for d in single {
+        let cells: Vec<String> = single_steps.iter().map(|l| step_cell(d.step(l))).collect();
+        let _ = writeln!(out, "| {} | {} |", d.map, cells.join(" | "));
+    }
+    if !full.is_empty() {
+        out.push_str("\nFull scattering, the default frame: its single- and multiple-scattering parts against the truth's (the full truth less the single-scattering truth), each over the full truth's norm (they add as vectors to the full frame's error), and the whole.\n\n| map | single-scattering part | multiple-scattering part | full (n.c.) / HDR-FLIP |\n|---|---:|---:|---|\n");
+    }
+    for d in full {
+        let steps = [
+            decomposition::SINGLE_PART,
+            decomposition::MULTIPLE_PART,
+            decomposition::FULL,
+        ];
+        let cells: Vec<String> = steps.iter().map(|l| step_cell(d.step(l))).collect();
+        let _ = writeln!(out, "| {} | {} |", d.map, cells.join(" | "));
+    }
 }
 
 fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str, baseline: &str) {
@@ -351,7 +408,7 @@ pub fn details(report: &BenchReport, plot_dir: &str) -> String {
     );
     let _ = writeln!(
         out,
-        "\n## Env-lit frames: error against milliseconds\n\nThe SRBF default and one parameter varied at a time (lobes kept: the most powerful; κ: Ren's stochastic simplification; light-map size; adaptive κ; the chord tolerance of the simplified light pass in texels: coarser strands, where 0 draws every point), the visibility volume (`--lobe-visibility volume`: each lobe's visibility integrated over it from the groom's SH visibility volume, no light pass per lobe; lobe spread at several κ in reports written before it was removed), the {} baseline at several light counts, and the reference.",
+        "\n## Env-lit frames: error against milliseconds\n\nThe SRBF default (each lobe's visibility integrated over it from the groom's SH visibility volume, no light pass per lobe) with the lobe count varied (the most powerful kept); Ren 2010's light maps (`--lobe-visibility light-maps`) with κ (Ren's stochastic simplification) and the light-map size varied one at a time; the {} baseline at several light counts; and the reference. Reports written before the volume became the default vary Ren's frame as \"the default\", and some hold frames since removed (adaptive κ, the light pass's chord tolerance, lobe spread).",
         plan.baseline.name()
     );
     for r in &report.env_lit {
@@ -485,6 +542,7 @@ pub fn truth_section(report: &BenchReport, plot_dir: &str) -> String {
         );
     }
     out.push_str("\n\"> x×\" under × median cut: median cut's measured front (up to its costliest frame, x times the SRBF default's time) never got as accurate as the SRBF default against the truth.\n");
+    truth_decomposition_tables(&mut out, report);
     let _ = writeln!(
         out,
         "\nEvery frame of every map, with its plots: [{plot_dir}/DETAILS.md]({plot_dir}/DETAILS.md)."
@@ -789,6 +847,7 @@ mod tests {
         DecompositionStep {
             label: label.into(),
             relative_rmse,
+            relative_rmse_noise_corrected: None,
             hdr_flip,
         }
     }
@@ -808,6 +867,7 @@ mod tests {
                 reference_converged: Some(false),
                 unshadowed_reference_lights: Some((6144, 1536)),
                 unshadowed_converged: Some(true),
+                against_truth: false,
                 steps: vec![
                     step(DEFAULT_KAPPA, 0.5, Some(0.55)),
                     step(FIT, 0.1, Some(0.11)),
@@ -823,6 +883,7 @@ mod tests {
                 reference_converged: Some(true),
                 unshadowed_reference_lights: None,
                 unshadowed_converged: None,
+                against_truth: false,
                 steps: vec![
                     step(MULTIPLE_PART, 0.07, None),
                     step(SINGLE_PART, 0.06, None),
@@ -836,6 +897,57 @@ mod tests {
             page.contains("| m | 6145 (converged) | 0.0600 | 0.0700 | 0.0800 / 0.0900 |"),
             "{page}"
         );
+    }
+
+    /// Against the truth: each frame in its column with its noise-corrected error, a map
+    /// without compact sources shows none for their step, and the truth's table is not the
+    /// DOM reference's (nor the other way round).
+    #[test]
+    fn each_step_against_the_truth_is_shown_in_its_column() {
+        use decomposition::*;
+        let mut report = report_of(BenchPlan::truth());
+        let truth_step = |label: &str, e: f64| DecompositionStep {
+            relative_rmse_noise_corrected: Some(e - 0.001),
+            ..step(label, e, Some(e + 0.1))
+        };
+        let of = |mode: &str, steps| ErrorDecomposition {
+            map: "m".into(),
+            mode: mode.into(),
+            reference_lights: 1536,
+            reference_converged: Some(false),
+            unshadowed_reference_lights: None,
+            unshadowed_converged: None,
+            against_truth: true,
+            steps,
+        };
+        report.decompositions = vec![
+            of(
+                "single",
+                vec![
+                    truth_step(TRUTH_VOLUME, 0.35),
+                    truth_step(TRUTH_MAP_LIGHTS, 0.31),
+                    truth_step(TRUTH_LIGHT_MAPS, 0.34),
+                    truth_step(TRUTH_FIT_LIGHTS, 0.32),
+                    truth_step(TRUTH_EVERY_STRAND, 0.33),
+                ],
+            ),
+            of(
+                "full",
+                vec![
+                    step(SINGLE_PART, 0.2, None),
+                    truth_step(FULL, 0.3),
+                    step(MULTIPLE_PART, 0.1, None),
+                ],
+            ),
+        ];
+        let page = truth_section(&report, "bench-truth");
+        assert!(page.contains("| m | 0.3100 (0.3090) / 0.4100 | 0.3200 (0.3190) / 0.4200 | 0.3300 (0.3290) / 0.4300 | 0.3400 (0.3390) / 0.4400 | 0.3500 (0.3490) / 0.4500 | – |"), "{page}");
+        assert!(
+            page.contains("| m | 0.2000 | 0.1000 | 0.3000 (0.2990) / 0.4000 |"),
+            "{page}"
+        );
+        assert!(page.contains("4× finer (2048² against 512²"), "{page}");
+        assert!(!section(&report, "bench").contains("Where the error comes from"));
     }
 
     #[test]

@@ -32,15 +32,13 @@ use strandlight_precompute::env_lights::{
     srbf_set_lights,
 };
 use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_runtime::env::{
-    EnvLight, EnvRenderOptions, mark_every_strand, shadow_groups, thin_weak_sources,
-};
+use strandlight_runtime::env::{EnvLight, EnvRenderOptions, mark_every_strand, shadow_groups};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::image_out::{write_exr, write_png};
 use strandlight_runtime::passes::convolution_depth::{DodmSettings, MAX_DODM_RESOLUTION};
 use strandlight_tables::checksum::sha256_hex;
 
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::Args))]
 pub struct CompareArgs {
     /// Hair file (.hair, .tfx, .data, .ply).
@@ -136,18 +134,13 @@ pub struct CompareArgs {
     /// into the light maps (1 = all). The reference and the baseline always draw all.
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0.1))]
     pub kappa: f32,
-    /// Adaptive κ: the most powerful SRBF lobes holding this share of the lobes' power draw
-    /// every strand into their light maps, the rest κ (0: κ for every lobe, as the paper; 1:
-    /// every lobe at κ 1). κ's noise costs most on the few strong, narrow lobes
-    /// (docs/BENCHMARKS.md, "Adaptive κ").
+    /// Adaptive κ, with `--lobe-visibility light-maps`: the most powerful SRBF lobes holding
+    /// this share of the lobes' power draw every strand into their light maps, the rest κ (0:
+    /// κ for every lobe, as the paper). On the front of venice only: 0.5 takes single
+    /// scattering from 0.378 to 0.369 against the truth for 3.8× the frame (docs/BENCHMARKS.md,
+    /// "Options judged against the truth").
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0.0))]
     pub every_strand_share: f32,
-    /// κ thins the maps of the compact sources weaker than the strongest thinned lobe, as it
-    /// thins that lobe's (off by default: faster on royal esplanade at +0.002 relative RMSE,
-    /// but +0.016 to +0.028 on spruit and moonless golf, whose thinned point sources read one
-    /// texel of a thinned map; docs/BENCHMARKS.md, "Weak sources thinned").
-    #[cfg_attr(any(feature = "cli", test), arg(long))]
-    pub thin_weak_sources: bool,
     /// Renders per timing (the median is reported).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 3))]
     pub timing_runs: usize,
@@ -178,11 +171,6 @@ pub struct CompareArgs {
     /// shadow each strand differently (docs/BENCHMARKS.md, "Light-map size").
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = DodmSettings::default().resolution))]
     pub light_map_size: u32,
-    /// How far, in texels of a κ-simplified light map, the strands its light pass draws may
-    /// stray from the hair's (points closer to a coarser strand are dropped; 0 draws every
-    /// point; docs/BENCHMARKS.md, "Coarser strands in the simplified light pass").
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = DodmSettings::default().simplified_chord_tolerance))]
-    pub light_chord_tolerance: f32,
     /// The look of all three renders.
     #[cfg_attr(any(feature = "cli", test), command(flatten))]
     pub look: LookArgs,
@@ -194,8 +182,9 @@ pub struct CompareArgs {
         arg(long, value_enum, default_value = "cached")
     )]
     pub ground_truth: TruthUse,
-    /// Most samples per pixel of one ground-truth image (its ladder climbs ×4 from 1024 until
-    /// N and 4N agree within --reference-tolerance or the next rung would pass this).
+    /// Most samples per pixel of one ground-truth image (its ladder climbs ×4 from 1024, or from
+    /// a quarter of this when that is less, until N and 4N agree within --reference-tolerance or
+    /// the next rung would pass this; at 640×480, 256 costs what 4096 costs at 160×120).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = TruthSettings::default().max_spp))]
     pub truth_max_spp: u32,
 }
@@ -252,20 +241,14 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
     args.look.look()?;
     light_maps(args).check().with_context(|| {
         format!(
-            "--light-map-size {} / --light-chord-tolerance {}: texels across a light map, 1 to {MAX_DODM_RESOLUTION}; a tolerance ≥ 0",
-            args.light_map_size, args.light_chord_tolerance
+            "--light-map-size {}: texels across a light map, 1 to {MAX_DODM_RESOLUTION}",
+            args.light_map_size
         )
     })?;
     if let Some(n) = args.table_resolution
         && !(2..=256).contains(&n)
     {
         bail!("--table-resolution {n}: use 2 to 256 nodes per direction axis");
-    }
-    if !(0.0..=1.0).contains(&args.every_strand_share) {
-        bail!(
-            "--every-strand-share {}: a share of the lobes' power, in [0, 1]",
-            args.every_strand_share
-        );
     }
     if !(args.source_radius > 0.0 && args.source_radius <= 20.0) {
         bail!(
@@ -293,6 +276,14 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
             args.reference_tolerance
         );
     }
+    if !(0.0..=1.0).contains(&args.every_strand_share) {
+        bail!(
+            "--every-strand-share {}: a share of the lobes' power, in [0, 1]",
+            args.every_strand_share
+        );
+    }
+    crate::ground_truth::validate(&truth_settings(args))
+        .map_err(|e| anyhow::anyhow!("--truth-max-spp {}: {e}", args.truth_max_spp))?;
     let check = |flag: &str, count: usize| {
         face_resolution_for(count).with_context(|| {
             format!("{flag} {count}: must be 6n² for a cube of n×n texels per face (e.g. 6, 24, 96, 384, 1536, 6144)")
@@ -473,15 +464,6 @@ pub fn prepare_with_hair(
             100.0 * args.every_strand_share,
             args.kappa
         ));
-    }
-    if args.thin_weak_sources {
-        let thinned = thin_weak_sources(&mut srbf);
-        if thinned > 0 && args.kappa < 1.0 {
-            steps.say(format!(
-                "{thinned} compact sources weaker than the strongest lobe: κ {} thins their maps too",
-                args.kappa
-            ));
-        }
     }
     let fit_relative_l2_error = fit.set.relative_l2_error;
     Ok(CompareScene {
@@ -678,11 +660,7 @@ fn equal_error_baseline(
 
 /// The ground-truth settings of `args`.
 pub fn truth_settings(args: &CompareArgs) -> TruthSettings {
-    TruthSettings {
-        max_spp: args.truth_max_spp,
-        tolerance: args.reference_tolerance,
-        ..TruthSettings::default()
-    }
+    TruthSettings::with_budget(args.truth_max_spp, args.reference_tolerance)
 }
 
 /// Mitsuba's `hair` parameters of the scene's fiber, where the shading model is the one the
@@ -748,10 +726,7 @@ pub fn frame<'a>(
 
 /// The light maps of every frame (checked by `validate`).
 fn light_maps(args: &CompareArgs) -> DodmSettings {
-    DodmSettings {
-        simplified_chord_tolerance: args.light_chord_tolerance,
-        ..DodmSettings::at_resolution(args.light_map_size)
-    }
+    DodmSettings::at_resolution(args.light_map_size)
 }
 
 /// The renderer choices of every frame (checked by `validate`).
@@ -804,8 +779,7 @@ fn reference_inputs(
         "direct_table_inputs": direct.metadata.description.inputs_key,
         "multiple_tables_inputs": REFERENCE_MULTIPLE_TABLES.iter().filter(|_| mode == ScatteringMode::Full).filter_map(|n| scene.tables.assets.get(*n)).map(|a| a.metadata.description.inputs_key.clone()).collect::<Vec<_>>(),
         "generator": env!("CARGO_PKG_VERSION"),
-        // κ 1 draws every strand as it is: the simplified maps' chord tolerance is not an input.
-        "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, transparency: look(args).transparency, dodm: DodmSettings { simplified_chord_tolerance: 0.0, ..look(args).dodm }, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
+        "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, transparency: look(args).transparency, dodm: look(args).dodm, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
     });
     // Only the fit's lighting adds a key, so the map's references keep their cache entries.
     if lighting == ReferenceLighting::Fit {
@@ -1183,8 +1157,8 @@ pub fn execute(
         "scene".into(),
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
-            "preset": args.preset, "baseline": args.baseline, "lambda_max": args.lambda_max, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "light_chord_tolerance": args.light_chord_tolerance, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "thin_weak_sources": args.thin_weak_sources, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
-            "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "box_average": args.look.view.box_average, "lobe_visibility": args.look.view.lobe_visibility, "forward_scattering": args.look.view.forward_scattering,
+            "preset": args.preset, "baseline": args.baseline, "lambda_max": args.lambda_max, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "lobe_visibility": args.look.view.lobe_visibility, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,
             "compact_sources": scene.compact_sources,
         }),
@@ -1288,12 +1262,11 @@ mod tests {
             ("--reference-max-lights", "100", "6n²"),
             ("--reference-max-lights", "96", "allow at least 384"),
             ("--reference-tolerance", "0", "(0, 1)"),
-            ("--every-strand-share", "1.5", "[0, 1]"),
-            ("--every-strand-share", "NaN", "[0, 1]"),
             ("--light-map-size", "0", "1 to 2048"),
             ("--light-map-size", "4096", "1 to 2048"),
-            ("--light-chord-tolerance", "NaN", "a tolerance ≥ 0"),
-            ("--light-chord-tolerance", "inf", "a tolerance ≥ 0"),
+            ("--truth-max-spp", "3", "at least 4"),
+            ("--every-strand-share", "1.5", "[0, 1]"),
+            ("--every-strand-share", "NaN", "[0, 1]"),
         ] {
             let a = args(&["--hair", "h", "--env", "e", flag, value]).unwrap();
             let e = validate(&a).unwrap_err().to_string();

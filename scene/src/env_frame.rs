@@ -143,7 +143,6 @@ fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
         kappa,
         shadowed: look.shadowed,
         transparency: look.transparency,
-        box_average: look.box_average,
         count_fragments: look.count_fragments,
         dodm: look.dodm,
         simplification_seed: look.simplification_seed,

@@ -16,15 +16,25 @@
 //! The unshadowed references are cheap (no light passes), so they climb further than the
 //! shadowed ones ([`unshadowed_max_lights`]) and usually converge; the shadowed ones are the
 //! run's.
+//!
+//! Against the path-traced ground truth (issue #38) each frame is measured against the truth
+//! itself, so the steps show how each approximation moves the error that a reader of the
+//! picture sees, the DOM reference's own included ([`single_scattering_against_truth`],
+//! [`full_scattering_against_truth`]). The truth has no unshadowed image, so the fit is taken
+//! as the DOM reference of the fit's lights, and the tables are not apart from the one
+//! visibility per lobe there.
 
 use crate::compare::{self, CompareArgs, CompareScene, Reference, ReferenceLighting};
 use crate::env_frame::{EnvFrame, FrameRole, RenderedEnv};
+use crate::ground_truth::GroundTruth;
 use crate::hdr_flip::hdr_flip;
 use crate::image_metrics::{Image, relative_rmse, relative_rmse_of_part};
+use crate::look::LobeVisibilityArg;
 use crate::scene_tables::ScatteringMode;
 use crate::steps::Steps;
 use serde::{Deserialize, Serialize};
 use strandlight_runtime::env::EnvLight;
+use strandlight_runtime::passes::convolution_depth::DodmSettings;
 
 /// The most lights an unshadowed reference climbs to (6·64²): one costs about a minute on
 /// lavapipe at 160×120, its shading alone being what converges.
@@ -42,6 +52,10 @@ pub fn unshadowed_max_lights(shadowed_max_lights: usize) -> usize {
 pub struct DecompositionStep {
     pub label: String,
     pub relative_rmse: f64,
+    /// Against the ground truth: the relative RMSE with the truth's noise removed in
+    /// quadrature. None against a DOM reference, and for a part of an image.
+    #[serde(default)]
+    pub relative_rmse_noise_corrected: Option<f64>,
     /// None for a part of an image (its HDR-FLIP has no meaning: it is not a picture).
     pub hdr_flip: Option<f64>,
 }
@@ -58,6 +72,10 @@ pub struct ErrorDecomposition {
     /// both converged.
     pub unshadowed_reference_lights: Option<(usize, usize)>,
     pub unshadowed_converged: Option<bool>,
+    /// Every step measured against the path-traced ground truth, not the DOM reference.
+    /// Reports written before it existed: false.
+    #[serde(default)]
+    pub against_truth: bool,
     pub steps: Vec<DecompositionStep>,
 }
 
@@ -70,6 +88,16 @@ pub const DEFAULT_KAPPA: &str = "+ κ (the default)";
 pub const SINGLE_PART: &str = "single-scattering part";
 pub const MULTIPLE_PART: &str = "multiple-scattering part";
 pub const FULL: &str = "full (the default)";
+/// Single-scattering steps against the ground truth.
+pub const TRUTH_MAP_LIGHTS: &str = "DOM reference (the map's lights)";
+pub const TRUTH_FIT_LIGHTS: &str = "DOM reference of the fit's lights";
+pub const TRUTH_EVERY_STRAND: &str = "SRBF: tables, one light map per lobe (κ 1)";
+pub const TRUTH_LIGHT_MAPS: &str = "+ κ (Ren 2010)";
+pub const TRUTH_VOLUME: &str = "visibility volume instead (the default)";
+pub const TRUTH_SHARP_SOURCES: &str = "the default, compact sources' maps at 4× size";
+/// How many times the default light-map size the compact sources' maps get in
+/// [`TRUTH_SHARP_SOURCES`]: what their shadows' resolution costs against the truth.
+pub const SHARP_SOURCE_MAP_SCALE: u32 = 4;
 
 /// What a decomposition renders with: the scene, the run's compare settings (`args`) and the
 /// same with `unshadowed` set, the SRBF default's lights and κ.
@@ -93,12 +121,42 @@ impl DecompositionInputs<'_> {
     ) -> anyhow::Result<Image> {
         let mut frame: EnvFrame = compare::frame(self.scene, args, self.lights, mode);
         frame.role = FrameRole::Interactive { kappa };
+        self.render_srbf(&frame, mode, label, steps)
+    }
+
+    /// The product's default frame (lobes read the visibility volume), with compact sources'
+    /// light maps of `dodm`.
+    fn srbf_volume(
+        &self,
+        mode: ScatteringMode,
+        dodm: DodmSettings,
+        label: &str,
+        steps: &mut Steps,
+    ) -> anyhow::Result<Image> {
+        let mut frame: EnvFrame = compare::frame(self.scene, self.args, self.lights, mode);
+        frame.role = FrameRole::Interactive { kappa: self.kappa };
+        frame.look.lobe_visibility = LobeVisibilityArg::Volume.settings();
+        frame.look.dodm = dodm;
+        self.render_srbf(&frame, mode, label, steps)
+    }
+
+    fn render_srbf(
+        &self,
+        frame: &EnvFrame,
+        mode: ScatteringMode,
+        label: &str,
+        steps: &mut Steps,
+    ) -> anyhow::Result<Image> {
         let r = steps.run(
             &format!("{}: decomposition, SRBF {label}", mode.name()),
-            || (self.render)(&frame),
+            || (self.render)(frame),
             |r: &RenderedEnv| format!("{:.0} ms", r.milliseconds),
         )?;
         Ok(r.image)
+    }
+
+    fn has_compact_sources(&self) -> bool {
+        self.lights.iter().any(|l| l.lambda.is_none())
     }
 }
 
@@ -106,7 +164,38 @@ fn step(label: &str, image: &Image, reference: &Image) -> anyhow::Result<Decompo
     Ok(DecompositionStep {
         label: label.into(),
         relative_rmse: relative_rmse(image, reference)?,
+        relative_rmse_noise_corrected: None,
         hdr_flip: Some(hdr_flip(image, reference)?.mean_over_hair),
+    })
+}
+
+fn truth_step(
+    label: &str,
+    image: &Image,
+    truth: &GroundTruth,
+) -> anyhow::Result<DecompositionStep> {
+    let e = relative_rmse(image, &truth.image)?;
+    Ok(DecompositionStep {
+        label: label.into(),
+        relative_rmse: e,
+        relative_rmse_noise_corrected: Some(truth.noise_corrected(e)),
+        hdr_flip: Some(hdr_flip(image, &truth.image)?.mean_over_hair),
+    })
+}
+
+/// A part of an image (single or multiple scattering) against the same part of `yardstick`,
+/// over the whole `norm` image: the parts' errors add as vectors to the whole's.
+fn part_step(
+    label: &str,
+    part: &Image,
+    yardstick: &Image,
+    norm: &Image,
+) -> anyhow::Result<DecompositionStep> {
+    Ok(DecompositionStep {
+        label: label.into(),
+        relative_rmse: relative_rmse_of_part(part, yardstick, norm)?,
+        relative_rmse_noise_corrected: None,
+        hdr_flip: None,
     })
 }
 
@@ -149,6 +238,7 @@ pub fn single_scattering(
             .converged
             .zip(fit_unshadowed.converged)
             .map(|(a, b)| a && b),
+        against_truth: false,
         steps: vec![
             step(FIT, fit_u, map_u)?,
             step(TABLES, &srbf_unshadowed, fit_u)?,
@@ -183,11 +273,6 @@ pub fn full_scattering(
         steps,
     )?;
     let (r_single, r_full) = (&single.chosen.image, &full.chosen.image);
-    let multiple_part = relative_rmse_of_part(
-        &srbf_full.minus(&srbf_single)?,
-        &r_full.minus(r_single)?,
-        r_full,
-    )?;
     Ok(ErrorDecomposition {
         map: map.into(),
         mode: ScatteringMode::Full.name().into(),
@@ -195,18 +280,106 @@ pub fn full_scattering(
         reference_converged: full.converged,
         unshadowed_reference_lights: None,
         unshadowed_converged: None,
+        against_truth: false,
         steps: vec![
-            DecompositionStep {
-                label: SINGLE_PART.into(),
-                relative_rmse: relative_rmse_of_part(&srbf_single, r_single, r_full)?,
-                hdr_flip: None,
-            },
-            DecompositionStep {
-                label: MULTIPLE_PART.into(),
-                relative_rmse: multiple_part,
-                hdr_flip: None,
-            },
+            part_step(SINGLE_PART, &srbf_single, r_single, r_full)?,
+            part_step(
+                MULTIPLE_PART,
+                &srbf_full.minus(&srbf_single)?,
+                &r_full.minus(r_single)?,
+                r_full,
+            )?,
             step(FULL, &srbf_full, r_full)?,
+        ],
+    })
+}
+
+/// Single scattering against the ground truth: the DOM reference of the map and of the fit's
+/// lights (at the map reference's light count), Ren's SRBF frame at κ 1 and at the default κ,
+/// the visibility volume in its place (the default), and, where the map has compact sources,
+/// the default with their light maps [`SHARP_SOURCE_MAP_SCALE`] times finer.
+pub fn single_scattering_against_truth(
+    map: &str,
+    inputs: &DecompositionInputs,
+    reference: &Reference,
+    truth: &GroundTruth,
+    steps: &mut Steps,
+) -> anyhow::Result<ErrorDecomposition> {
+    let mode = ScatteringMode::Single;
+    let lights = reference.chosen.record.lights;
+    let fit_args = CompareArgs {
+        reference_lights: Some(lights),
+        ..inputs.args.clone()
+    };
+    let fit = compare::reference_of(
+        inputs.render,
+        inputs.scene,
+        &fit_args,
+        mode,
+        ReferenceLighting::Fit,
+        steps,
+    )?;
+    let every_strand = inputs.srbf(inputs.args, mode, 1.0, "light maps, κ 1", steps)?;
+    let light_maps = inputs.srbf(inputs.args, mode, inputs.kappa, "light maps", steps)?;
+    let size = inputs.args.light_map_size;
+    let volume = inputs.srbf_volume(mode, DodmSettings::at_resolution(size), "volume", steps)?;
+    let mut measured = vec![
+        truth_step(TRUTH_MAP_LIGHTS, &reference.chosen.image, truth)?,
+        truth_step(TRUTH_FIT_LIGHTS, &fit.chosen.image, truth)?,
+        truth_step(TRUTH_EVERY_STRAND, &every_strand, truth)?,
+        truth_step(TRUTH_LIGHT_MAPS, &light_maps, truth)?,
+        truth_step(TRUTH_VOLUME, &volume, truth)?,
+    ];
+    if inputs.has_compact_sources() {
+        let sharp = DodmSettings::at_resolution(SHARP_SOURCE_MAP_SCALE * size);
+        let label = format!("volume, compact sources' maps {}²", sharp.resolution);
+        let image = inputs.srbf_volume(mode, sharp, &label, steps)?;
+        measured.push(truth_step(TRUTH_SHARP_SOURCES, &image, truth)?);
+    }
+    Ok(ErrorDecomposition {
+        map: map.into(),
+        mode: mode.name().into(),
+        reference_lights: lights,
+        reference_converged: reference.converged,
+        unshadowed_reference_lights: None,
+        unshadowed_converged: None,
+        against_truth: true,
+        steps: measured,
+    })
+}
+
+/// Full scattering against the ground truth: the default frame's single- and multiple-
+/// scattering parts against the truth's (its full image less its single-scattering image),
+/// each over the full truth's norm, and the whole.
+pub fn full_scattering_against_truth(
+    map: &str,
+    inputs: &DecompositionInputs,
+    reference: &Reference,
+    single: &GroundTruth,
+    full: &GroundTruth,
+    steps: &mut Steps,
+) -> anyhow::Result<ErrorDecomposition> {
+    let dodm = DodmSettings::at_resolution(inputs.args.light_map_size);
+    let srbf_single = inputs.srbf_volume(ScatteringMode::Single, dodm, "volume", steps)?;
+    let srbf_full = inputs.srbf_volume(ScatteringMode::Full, dodm, "volume", steps)?;
+    let (t_single, t_full) = (&single.image, &full.image);
+    Ok(ErrorDecomposition {
+        map: map.into(),
+        mode: ScatteringMode::Full.name().into(),
+        reference_lights: reference.chosen.record.lights,
+        reference_converged: reference.converged,
+        unshadowed_reference_lights: None,
+        unshadowed_converged: None,
+        against_truth: true,
+        steps: vec![
+            part_step(SINGLE_PART, &srbf_single, t_single, t_full)?,
+            part_step(
+                MULTIPLE_PART,
+                &srbf_full.minus(&srbf_single)?,
+                &t_full.minus(t_single)?,
+                t_full,
+            )?,
+            truth_step(FULL, &srbf_full, full)?,
         ],
     })
 }

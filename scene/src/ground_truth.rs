@@ -64,6 +64,22 @@ impl Default for TruthSettings {
     }
 }
 
+impl TruthSettings {
+    /// The default ladder under a budget of `max_spp` samples per pixel: its first rung and the
+    /// depth search are at most a quarter of the budget, so that even a small budget (a large
+    /// image's) renders an N and 4N pair and so measures its own noise.
+    pub fn with_budget(max_spp: u32, tolerance: f64) -> Self {
+        let default = Self::default();
+        Self {
+            first_spp: default.first_spp.min(max_spp / 4),
+            depth_spp: default.depth_spp.min(max_spp / 4).max(1),
+            max_spp,
+            tolerance,
+            ..default
+        }
+    }
+}
+
 /// What is stored beside a ground-truth image.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TruthRecord {
@@ -424,7 +440,13 @@ fn depth_search(
     Ok(Some((settings.most_depth, ladder)))
 }
 
-fn validate(s: &TruthSettings) -> anyhow::Result<()> {
+pub(crate) fn validate(s: &TruthSettings) -> anyhow::Result<()> {
+    if s.max_spp < 4 {
+        bail!(
+            "ground-truth budget {} samples per pixel: its noise is measured from an N and 4N pair, so use at least 4",
+            s.max_spp
+        );
+    }
     if s.first_spp == 0 || s.max_spp < s.first_spp || s.depth_spp == 0 {
         bail!(
             "ground-truth samples: first {} and most {} per pixel must be ≥ 1 and ordered",
@@ -736,6 +758,23 @@ mod tests {
         );
         assert_eq!(t.ladder.len(), 2);
         assert!((t.ladder[1].difference_to_4x - d(4096.0)).abs() < 1e-6);
+        // A budget of 1024 (a large image's) still renders a pair: 256 against 1024.
+        store(256);
+        let small = TruthSettings::with_budget(1024, 0.001);
+        let t = ground_truth(
+            &inputs,
+            ScatteringMode::Single,
+            &small,
+            TruthUse::Cached,
+            &dir,
+            &mut Steps::new(true),
+        )
+        .unwrap()
+        .unwrap();
+        assert!(!t.converged && t.spp == 5 * 256 && t.ladder.len() == 1);
+        assert!((t.noise - d(256.0) / 2.5).abs() < 1e-6, "{}", t.noise);
+        let e = validate(&TruthSettings::with_budget(3, 0.01)).unwrap_err();
+        assert!(format!("{e}").contains("at least 4"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -1,9 +1,10 @@
 //! How an environment-lit frame looks besides its scene and lights: the view's transparency,
-//! the transmittance's box average, and where multiple scattering's shadow paths are marched.
+//! where the lobes' visibility comes from, and where multiple scattering's shadow paths are
+//! marched.
 //! The `cli` feature lets the command line parse these settings directly.
 
 use anyhow::Context;
-use strandlight_runtime::env::{BoxAverage, DEFAULT_SIMPLIFICATION_SEED, ViewTransparency};
+use strandlight_runtime::env::{DEFAULT_SIMPLIFICATION_SEED, ViewTransparency};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_runtime::visibility::{LobeVisibility, VisibilityVolumeSettings};
 
@@ -56,17 +57,6 @@ impl LobeVisibilityArg {
     }
 }
 
-/// What the effective transmittance's box averages (the CLI's names for [`BoxAverage`]).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
-#[serde(rename_all = "kebab-case")]
-pub enum BoxAverageArg {
-    /// Ren 2010: exp(−mean optical depth).
-    OpticalDepth,
-    /// The mean of exp(−optical depth).
-    Transmittance,
-}
-
 /// The renderer choices of the env-lit commands.
 #[derive(Debug, Clone, Copy)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::Args))]
@@ -99,12 +89,6 @@ pub struct ViewArgs {
     /// With occupancy: fragments seen less than this fraction are not shaded (early termination).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = ViewTransparency::DEFAULT_CUTOFF))]
     pub visibility_cutoff: f32,
-    /// What the SRBF transmittance's box averages over the convolution optical depth map.
-    #[cfg_attr(
-        any(feature = "cli", test),
-        arg(long, value_enum, default_value = "optical-depth")
-    )]
-    pub box_average: BoxAverageArg,
     /// Where multiple scattering's shadow paths are marched (the brute-force reference's dense
     /// grid always uses the CPU light sweep).
     #[cfg_attr(
@@ -134,7 +118,6 @@ impl Default for ViewArgs {
         Self {
             lobe_visibility: LobeVisibilityArg::default(),
             visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF,
-            box_average: BoxAverageArg::OpticalDepth,
             forward_scattering: ForwardDevice::Auto,
             simplification_seed: DEFAULT_SIMPLIFICATION_SEED,
         }
@@ -163,14 +146,9 @@ impl LookArgs {
         transparency
             .check()
             .with_context(|| format!("--visibility-cutoff {}", view.visibility_cutoff))?;
-        let box_average = match view.box_average {
-            BoxAverageArg::OpticalDepth => BoxAverage::OpticalDepth,
-            BoxAverageArg::Transmittance => BoxAverage::Transmittance,
-        };
         Ok(EnvLook {
             shadowed: true,
             transparency,
-            box_average,
             count_fragments: false,
             forward_scattering: view.forward_scattering,
             dodm: DodmSettings::default(),
@@ -188,7 +166,6 @@ pub struct EnvLook {
     /// the lighting and table error alone).
     pub shadowed: bool,
     pub transparency: ViewTransparency,
-    pub box_average: BoxAverage,
     /// Count the fragments rasterized and shaded (two extra passes, outside the frame time).
     pub count_fragments: bool,
     pub forward_scattering: ForwardDevice,

@@ -10,7 +10,7 @@ use strandlight_runtime::passes::deep_opacity::MAX_LAYERS;
 use strandlight_scene::frame_settings::{
     EnvLighting, Lighting, PointLighting, Shadows, Transparency,
 };
-use strandlight_scene::look::{BoxAverageArg, EnvTransparency, LobeVisibilityArg};
+use strandlight_scene::look::{EnvTransparency, LobeVisibilityArg};
 use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_tables::artist::ArtistParams;
@@ -214,19 +214,6 @@ fn env_controls(ui: &mut egui::Ui, e: &mut EnvLighting, lobes: &mut usize, total
     ui.horizontal(|ui| {
         ui.radio_value(&mut e.transparency, EnvTransparency::Opaque, "opaque");
         ui.radio_value(&mut e.transparency, EnvTransparency::Occupancy, "occupancy");
-    });
-    ui.horizontal(|ui| {
-        ui.label("box average");
-        ui.radio_value(
-            &mut e.view.box_average,
-            BoxAverageArg::OpticalDepth,
-            "optical depth",
-        );
-        ui.radio_value(
-            &mut e.view.box_average,
-            BoxAverageArg::Transmittance,
-            "transmittance",
-        );
     });
     ui.horizontal(|ui| {
         ui.label("lobe visibility");

@@ -25,10 +25,9 @@ pub struct EnvLight {
     /// visibility is the texel's (`precompute/src/env_lights.rs`).
     pub shadowed_from: Option<Vec3>,
     /// Draw every strand into this light's map whatever the frame's κ. SRBFs default to κ's
-    /// thinning: its noise costs most on the few powerful lobes (docs/BENCHMARKS.md, "Adaptive
-    /// κ"), and [`mark_every_strand`] picks them. Directional lights default to every strand
-    /// (the reference's, the baseline's, a sun's); [`thin_weak_sources`] lets κ thin the
-    /// compact sources weaker than the frame's strongest thinned lobe (an option).
+    /// thinning (Ren §7): its noise costs most on the few powerful lobes, and
+    /// [`mark_every_strand`] picks them (adaptive κ). Directional lights (the reference's, the
+    /// baseline's, a sun's) draw every strand.
     pub every_strand: bool,
     /// Directional lights only: per-axis variance (rad²) of the directions the light stands
     /// for (an extended compact source: a softbox, a sun's disc). Its visibility is averaged
@@ -140,29 +139,6 @@ pub fn mark_every_strand(lights: &mut [EnvLight], share: f32) -> usize {
     marked
 }
 
-/// Lets κ thin the maps of the compact sources (directional lights with their own map) that
-/// deliver less power than the strongest κ-thinned SRBF lobe: what the frame already accepts
-/// for that lobe's shadow it accepts for a weaker source's, and each such source's map then
-/// costs a thinned map's fill instead of every strand's. Stronger sources (a sun) draw every
-/// strand. Not the default: a point source reads one texel of its map, where an SRBF's box
-/// averages several, so κ's noise shows more (docs/BENCHMARKS.md, "Weak sources thinned").
-/// Returns how many are thinned.
-pub fn thin_weak_sources(lights: &mut [EnvLight]) -> usize {
-    let strongest_thinned = lights
-        .iter()
-        .filter(|l| l.lambda.is_some() && l.is_simplified())
-        .map(EnvLight::luminous_power)
-        .fold(0.0f32, f32::max);
-    let mut thinned = 0;
-    for light in lights.iter_mut() {
-        if light.lambda.is_none() && light.shadowed_from.is_none() {
-            light.every_strand = light.luminous_power() >= strongest_thinned;
-            thinned += usize::from(!light.every_strand);
-        }
-    }
-    thinned
-}
-
 /// Consecutive lights that share one shadow map (one DODM slot, one light pass, one
 /// forward-scattering grid block): a run of directional lights with the same
 /// [`EnvLight::shadowed_from`], or any other light alone.
@@ -230,9 +206,9 @@ use crate::multiple::ForwardScatteringError;
 
 pub mod render;
 pub use render::{
-    BoxAverage, DEFAULT_SIMPLIFICATION_SEED, EnvFrame, EnvRenderError, EnvRenderOptions,
-    EnvRenderStats, EnvRenderer, EnvTableError, EnvTables, FragmentCounts, OccupancyError,
-    TransmittanceFilter, ViewTransparency, render_env_frame,
+    DEFAULT_SIMPLIFICATION_SEED, EnvFrame, EnvRenderError, EnvRenderOptions, EnvRenderStats,
+    EnvRenderer, EnvTableError, EnvTables, FragmentCounts, OccupancyError, TransmittanceFilter,
+    ViewTransparency, render_env_frame,
 };
 
 #[cfg(test)]
@@ -261,26 +237,5 @@ mod tests {
         // 0 clears every earlier mark.
         assert_eq!(mark_every_strand(&mut lights, 0.0), 0);
         assert_eq!(marked(&lights), [false, true, false, false, false]);
-    }
-
-    #[test]
-    fn sources_weaker_than_the_strongest_thinned_lobe_are_thinned() {
-        let power = lobe(1.0).luminous_power();
-        let source = |share: f32| EnvLight::directional(Vec3::X, [share * power; 3]);
-        let shared = EnvLight::directional_shadowed_from(Vec3::X, [0.01; 3], Vec3::Y);
-        let mut lights = vec![lobe(1.0), lobe(3.0), source(2.0), source(5.0), shared];
-        let every = |l: &[EnvLight]| -> Vec<bool> { l.iter().map(|l| l.every_strand).collect() };
-        // The strongest thinned lobe delivers 3: the source of 2 is thinned, the one of 5 and
-        // the light sharing another map (a reference sub-texel's) are not.
-        assert_eq!(thin_weak_sources(&mut lights), 1);
-        assert_eq!(every(&lights), [false, false, false, true, true]);
-        // With the lobe of 3 drawing every strand, the strongest thinned one delivers 1.
-        mark_every_strand(&mut lights, 0.7);
-        assert_eq!(thin_weak_sources(&mut lights), 0);
-        assert_eq!(every(&lights), [false, true, true, true, true]);
-        // Sources alone (a reference, a baseline): nothing thinned.
-        let mut alone = vec![source(0.1), source(0.2)];
-        assert_eq!(thin_weak_sources(&mut alone), 0);
-        assert!(alone.iter().all(|l| l.every_strand));
     }
 }

@@ -24,7 +24,6 @@ use crate::passes::env_view::{
 };
 use crate::passes::frame_params::{FrameParams, KajiyaKay};
 use crate::passes::strand_geometry::{StrandGeometry, TooManyPoints};
-pub use crate::passes::summed_area::BoxAverage;
 use crate::passes::summed_area::{SummedAreaPass, SummedAreaTables};
 pub use crate::passes::transmittance_filter::TransmittanceFilter;
 use crate::passes::view_visibility::OccupancyMap;
@@ -141,9 +140,6 @@ pub struct EnvRenderOptions {
     /// The averaging box of the effective transmittance (default
     /// [`TransmittanceFilter::MatchedVariance`], the best measured: docs/BENCHMARKS.md).
     pub transmittance_filter: TransmittanceFilter,
-    /// What that box averages for SRBF lights (directional lights read one texel, where both
-    /// agree): Ren's optical depth or the transmittance (docs/BENCHMARKS.md).
-    pub box_average: BoxAverage,
     /// View pass only: every fiber this many pixels wide instead of its projected thickness (as
     /// `FrameParams::width_override_px`); the light pass always uses the file's thickness.
     pub width_override_px: Option<f32>,
@@ -162,7 +158,6 @@ impl std::fmt::Debug for EnvRenderOptions {
             .field("count_fragments", &self.count_fragments)
             .field("shadowed", &self.shadowed)
             .field("transmittance_filter", &self.transmittance_filter)
-            .field("box_average", &self.box_average)
             .field("width_override_px", &self.width_override_px);
         if self.lobe_visibility != LobeVisibility::LightMaps {
             s.field("lobe_visibility", &self.lobe_visibility);
@@ -181,7 +176,6 @@ impl Default for EnvRenderOptions {
             count_fragments: false,
             shadowed: true,
             transmittance_filter: TransmittanceFilter::default(),
-            box_average: BoxAverage::default(),
             width_override_px: None,
             lobe_visibility: LobeVisibility::LightMaps,
         }
@@ -717,32 +711,22 @@ impl FrameResources {
 }
 
 /// The geometry the SRBF light passes draw: when κ < 1, the strands in simplification order
-/// (with that order, whose windows the passes draw), coarsened to what a simplified map's
-/// texels hold ([`DodmSettings::simplified_chord_tolerance`]); else all of them as they are.
+/// (with that order, whose windows the passes draw); else all of them as they are.
 fn light_pass_geometry(
     gpu: &GpuContext,
     model: &HairModel,
     geometry: &StrandGeometry,
     options: &EnvRenderOptions,
-) -> Result<(StrandGeometry, Option<SimplifiedSegments>), TooManyPoints> {
+) -> (StrandGeometry, Option<SimplifiedSegments>) {
     if options.kappa >= 1.0 {
-        return Ok((geometry.clone(), None));
+        return (geometry.clone(), None);
     }
     let order = simplification_order(model, options.simplification_seed);
-    let tolerance = options
-        .dodm
-        .simplified_chord_tolerance_world(options.kappa, model.bounds());
-    if tolerance == 0.0 {
-        let simplified = SimplifiedSegments::in_order(gpu, model, &order);
-        return Ok((
-            simplified.geometry(geometry, options.kappa),
-            Some(simplified),
-        ));
-    }
-    let coarse = model.decimated(tolerance, geometry.default_thickness);
-    let simplified = SimplifiedSegments::in_order(gpu, &coarse, &order);
-    let drawn = StrandGeometry::upload(gpu, &coarse)?;
-    Ok((simplified.geometry(&drawn, options.kappa), Some(simplified)))
+    let simplified = SimplifiedSegments::in_order(gpu, model, &order);
+    (
+        simplified.geometry(geometry, options.kappa),
+        Some(simplified),
+    )
 }
 
 /// What one frame is asked for.
@@ -954,7 +938,7 @@ impl EnvRenderer {
         // Per hair and settings, not per light or view: setup, as the upload is.
         let (light_geometry, simplified) = timings.time(gpu, "upload", || {
             light_pass_geometry(gpu, model, &geometry, options)
-        })?;
+        });
         let bounds = model.bounds();
         let first_layer = options.dodm.first_layer_for(bounds);
         let (full_maps, simplified_maps) = LightMaps::for_frame(gpu, options, kinds, first_layer)?;
@@ -1123,7 +1107,6 @@ impl EnvRenderer {
         options: &EnvRenderOptions,
         timings: &mut Timings,
     ) {
-        let srbf_kind = batch.first_light().is_some_and(|l| l.lambda.is_some());
         let simplified = batch.is_simplified();
         let directions: Vec<_> = batch.groups.iter().map(|g| g.direction).collect();
         let windows = match simplified {
@@ -1163,10 +1146,6 @@ impl EnvRenderer {
             );
             gpu.queue.submit([encoder.finish()]);
         });
-        maps.sat.average = match srbf_kind {
-            true => options.box_average,
-            false => BoxAverage::OpticalDepth,
-        };
         timings.time(gpu, "summed-area tables", || {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             self.sat

@@ -8,7 +8,6 @@
 
 mod bytes;
 mod clean;
-mod decimate;
 mod error;
 pub mod groom;
 mod model;

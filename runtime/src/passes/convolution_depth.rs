@@ -40,13 +40,6 @@ pub struct DodmSettings {
     pub first_layer: Option<f32>,
     /// Lights per batch (one map each, drawn in one submit; default 16).
     pub batch_size: u32,
-    /// How far, in texels of a κ-simplified map, the strands its light pass draws may stray
-    /// from the hair's: points within it of a coarser strand are dropped
-    /// ([`HairModel::decimated`]; default 0, every point drawn: since the light pass rasterizes
-    /// in compute its cost follows the texels covered, which coarser strands do not reduce, and
-    /// 0.5 measured slower and less accurate on every map, docs/BENCHMARKS.md, "The light pass in
-    /// compute"). Full-resolution maps always draw every point.
-    pub simplified_chord_tolerance: f32,
 }
 
 impl Default for DodmSettings {
@@ -55,7 +48,6 @@ impl Default for DodmSettings {
             resolution: 512,
             first_layer: None,
             batch_size: 16,
-            simplified_chord_tolerance: 0.0,
         }
     }
 }
@@ -68,8 +60,6 @@ pub enum DodmSettingsError {
     FirstLayer(f32),
     #[error("light batch size 0: must be at least 1")]
     BatchSize,
-    #[error("simplified light pass chord tolerance {0}: must be finite and ≥ 0 (texels)")]
-    ChordTolerance(f32),
     #[error("stochastic simplification fraction κ = {0}: must be in (0, 1]")]
     Kappa(f32),
 }
@@ -96,14 +86,6 @@ impl DodmSettings {
         (texel_ratio / kappa).max(1.0)
     }
 
-    /// [`Self::simplified_chord_tolerance`] in world units for a hair of `bounds`: the light
-    /// camera spans the bounds' diagonal ([`crate::camera::light_camera`]) over
-    /// [`Self::simplified_resolution`] texels.
-    pub fn simplified_chord_tolerance_world(&self, kappa: f32, bounds: Aabb) -> f32 {
-        let texel = bounds.diagonal() / self.simplified_resolution(kappa) as f32;
-        self.simplified_chord_tolerance * texel
-    }
-
     /// The default settings with `resolution`² maps and the largest batch, up to the default
     /// 16, whose summed-area tables fit one storage binding on any adapter (2048² maps: 2).
     pub fn at_resolution(resolution: u32) -> Self {
@@ -128,10 +110,6 @@ impl DodmSettings {
         }
         if self.batch_size == 0 {
             return Err(DodmSettingsError::BatchSize);
-        }
-        let tolerance = self.simplified_chord_tolerance;
-        if !(tolerance.is_finite() && tolerance >= 0.0) {
-            return Err(DodmSettingsError::ChordTolerance(tolerance));
         }
         Ok(())
     }
@@ -733,33 +711,6 @@ mod tests {
             .check()
             .is_err()
         );
-        for bad in [-0.5, f32::NAN, f32::INFINITY] {
-            let e = DodmSettings {
-                simplified_chord_tolerance: bad,
-                ..ok
-            }
-            .check()
-            .unwrap_err();
-            assert!(matches!(e, DodmSettingsError::ChordTolerance(_)), "{bad}");
-            assert!(e.to_string().contains("chord tolerance"), "{e}");
-        }
-    }
-
-    #[test]
-    fn the_chord_tolerance_is_a_fraction_of_a_simplified_texel_in_the_world() {
-        let bounds = Aabb::from_points(&[Vec3::ZERO, Vec3::new(30.0, 40.0, 0.0)]);
-        let settings = DodmSettings {
-            simplified_chord_tolerance: 0.5,
-            ..DodmSettings::default()
-        };
-        // κ 0.25: 256 texels across the light camera's 50-unit span, half of one = 50/512.
-        let world = settings.simplified_chord_tolerance_world(0.25, bounds);
-        assert!((world - 50.0 / 512.0).abs() < 1e-6, "{world}");
-        let off = DodmSettings {
-            simplified_chord_tolerance: 0.0,
-            ..settings
-        };
-        assert_eq!(off.simplified_chord_tolerance_world(0.25, bounds), 0.0);
     }
 
     /// Strands rooted along a line in a scrambled file order.

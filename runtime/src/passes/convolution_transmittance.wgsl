@@ -44,8 +44,7 @@ struct BatchParams {
     light_count: u32,
     resolution: u32,
     max_half_size: u32,
-    // Bit 0: skip shadowing (T̃ = 1). Bit 1: a forward-scattering grid is bound. Bit 2: the
-    // SATs hold transmittance (BoxAverage::Transmittance), not optical depth.
+    // Bit 0: skip shadowing (T̃ = 1). Bit 1: a forward-scattering grid is bound.
     flags: u32,
 };
 
@@ -56,10 +55,8 @@ struct BatchParams {
 @group(1) @binding(4) var<storage, read> shading_samples: array<ShadingSample>;
 
 const SAT_FIXED_POINT_SCALE: f32 = 256.0;
-const SAT_TRANSMITTANCE_SCALE: f32 = 4096.0;
 const FLAG_UNSHADOWED: u32 = 1u;
 const FLAG_GRID: u32 = 2u;
-const FLAG_SAT_TRANSMITTANCE: u32 = 4u;
 
 fn sat_at(slot: u32, x: i32, y: i32) -> vec4<u32> {
     if (x < 0 || y < 0) { return vec4<u32>(0u); }
@@ -100,14 +97,13 @@ fn layered_optical_depth(l: vec4<f32>, delta: f32, d: f32) -> f32 {
     return l.w;
 }
 
-// Mean of the quantized cumulative depths (or transmittances) over the square of half-size h
-// texels around `texel`.
+// Mean of the quantized cumulative depths over the square of half-size h texels around
+// `texel`: Ren 2010's convolution optical depth (exp(−mean τ), not the mean of exp(−τ), which
+// measured farther from both references: docs/history, "Transmittance SATs").
 fn box_mean(slot: u32, texel: vec2<i32>, h: i32) -> vec4<f32> {
     let lo = texel - vec2<i32>(h);
     let hi = texel + vec2<i32>(h);
-    var scale = SAT_FIXED_POINT_SCALE;
-    if ((batch.flags & FLAG_SAT_TRANSMITTANCE) != 0u) { scale = SAT_TRANSMITTANCE_SCALE; }
-    return vec4<f32>(sat_box_sum(slot, lo, hi)) / (box_area(lo, hi) * scale);
+    return vec4<f32>(sat_box_sum(slot, lo, hi)) / (box_area(lo, hi) * SAT_FIXED_POINT_SCALE);
 }
 
 // Texels searched around an empty texel for the hair's front (5 × 5).
@@ -153,11 +149,6 @@ fn effective_transmittance(slot: u32, world: vec3<f32>) -> f32 {
     var mean = box_mean(slot, texel, h0);
     if (f > 0.0 && h0 < i32(batch.max_half_size)) {
         mean = mix(mean, box_mean(slot, texel, h0 + 1), f);
-    }
-    if ((batch.flags & FLAG_SAT_TRANSMITTANCE) != 0u) {
-        // Mean transmittances at the boundaries → their optical depths, so that the layers
-        // interpolate geometrically in transmittance.
-        mean = -log(max(mean, vec4<f32>(1.0 / SAT_TRANSMITTANCE_SCALE)));
     }
     return exp(-layered_optical_depth(mean, delta, light.first_layer));
 }

@@ -19,7 +19,7 @@ use super::frame_params::FrameParams;
 use super::render_target::DEPTH_FORMAT;
 use super::strand_geometry::StrandGeometry;
 use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
-use super::summed_area::{BoxAverage, MAX_BOX_HALF_SIZE, SummedAreaTables};
+use super::summed_area::{MAX_BOX_HALF_SIZE, SummedAreaTables};
 use super::transmittance_filter::TransmittanceFilter;
 use super::view_visibility::{OccupancyMap, ViewTransparency, ViewVisibilityPass};
 use crate::env::{EnvLight, ForwardScatteringGrid, ShadowGroup};
@@ -80,7 +80,6 @@ struct BatchUniform {
 
 const FLAG_UNSHADOWED: u32 = 1;
 const FLAG_GRID: u32 = 2;
-const FLAG_SAT_TRANSMITTANCE: u32 = 4;
 
 /// Group 1 of the view pass and the probe (`convolution_transmittance.wgsl`).
 pub fn transmittance_bind_group_layout(
@@ -206,13 +205,8 @@ impl BatchBinding {
         if gpu_lights.is_empty() {
             gpu_lights.push(bytemuck::Zeroable::zeroed());
         }
-        let flags = if shadowed { 0 } else { FLAG_UNSHADOWED }
-            | if with_grid { FLAG_GRID } else { 0 }
-            | if sat.average == BoxAverage::Transmittance {
-                FLAG_SAT_TRANSMITTANCE
-            } else {
-                0
-            };
+        let flags =
+            if shadowed { 0 } else { FLAG_UNSHADOWED } | if with_grid { FLAG_GRID } else { 0 };
         let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("env batch"),
             contents: bytemuck::bytes_of(&BatchUniform {

@@ -7,8 +7,6 @@
 //! box of at most 2²⁰ texels sums below 2³² and its S(a) − S(b) − S(c) + S(d) is exact modulo 2³²
 //! however far the corners lie from the origin: boxes are limited to
 //! 2·[`MAX_BOX_HALF_SIZE`] + 1 = 1023 texels a side (1023² < 2²⁰).
-//! With [`BoxAverage::Transmittance`] each texel's exp(−τ) is stored instead, rounded to
-//! 1/[`TRANSMITTANCE_SCALE`] = 1/4096 (at most 2¹² units a texel again, so the same box limit).
 //! Inputs: the optical-depth array texture of a [`DodmBatch`]. Output: [`SummedAreaTables`].
 
 use wgpu::util::DeviceExt;
@@ -19,7 +17,6 @@ use crate::gpu::bind_layout::{storage_entry, texture_entry, uniform_entry};
 use crate::gpu::limits::{GpuLimits, LimitError};
 
 pub const FIXED_POINT_SCALE: f32 = 256.0;
-pub const TRANSMITTANCE_SCALE: f32 = 4096.0;
 pub const MAX_TEXEL_TAU: f32 = 16.0;
 /// Boxes are at most 2·511 + 1 texels a side (see the module notes).
 pub const MAX_BOX_HALF_SIZE: u32 = 511;
@@ -56,37 +53,12 @@ pub fn sat_bytes(gpu: &GpuContext, resolution: u32, slots: u32) -> Result<u64, L
     Ok(bytes)
 }
 
-/// What the averaging box of the effective transmittance averages.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum BoxAverage {
-    /// Ren 2010's convolution optical depth: T̃ = exp(−mean l). By Jensen's inequality this is
-    /// below the mean transmittance wherever l varies over the box (a lobe that straddles the
-    /// edge of the hair), so lit outer fibers come out dark.
-    #[default]
-    OpticalDepth,
-    /// T̃ = mean exp(−l) at each layer boundary, interpolated geometrically in depth between
-    /// them: the average of the transmittance over the directions the box stands for. Stored
-    /// in steps of 1/4096, so T̃ never falls below 1/4096: a fully shadowed point still gets
-    /// 2.4·10⁻⁴ of the light (the optical-depth average reaches e⁻¹⁶).
-    Transmittance,
-}
-
-impl BoxAverage {
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::OpticalDepth => "optical depth (Ren 2010)",
-            Self::Transmittance => "transmittance",
-        }
-    }
-}
-
 /// The SATs of one batch: `vec4<u32>` per texel per slot, `[(slot·res + y)·res + x]`, of the
-/// quantity `average` names (what the next encode stores and the view pass reads).
+/// quantized optical depths.
 pub struct SummedAreaTables {
     pub buffer: wgpu::Buffer,
     pub resolution: u32,
     pub slots: u32,
-    pub average: BoxAverage,
 }
 
 impl SummedAreaTables {
@@ -102,7 +74,6 @@ impl SummedAreaTables {
             buffer,
             resolution,
             slots,
-            average: BoxAverage::OpticalDepth,
         })
     }
 
@@ -116,8 +87,7 @@ impl SummedAreaTables {
 struct SatUniform {
     resolution: u32,
     slots: u32,
-    transmittance: u32,
-    _pad: u32,
+    _pad: [u32; 2],
 }
 
 /// The two compute pipelines, built once.
@@ -185,8 +155,7 @@ impl SummedAreaPass {
             contents: bytemuck::bytes_of(&SatUniform {
                 resolution: tables.resolution,
                 slots: tables.slots,
-                transmittance: (tables.average == BoxAverage::Transmittance) as u32,
-                _pad: 0,
+                _pad: [0; 2],
             }),
             usage: wgpu::BufferUsages::UNIFORM,
         });

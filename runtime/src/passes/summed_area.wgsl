@@ -9,8 +9,7 @@
 struct SatParams {
     resolution: u32,
     slots: u32,
-    // 1: store each texel's transmittance exp(−τ) (BoxAverage::Transmittance).
-    transmittance: u32,
+    _pad0: u32,
     _pad1: u32,
 };
 
@@ -20,13 +19,9 @@ struct SatParams {
 
 const FIXED_POINT_SCALE: f32 = 256.0;
 const MAX_TEXEL_TAU: f32 = 16.0;
-const TRANSMITTANCE_SCALE: f32 = 4096.0;
 
 fn quantize(tau: vec4<f32>) -> vec4<u32> {
     let t = clamp(tau, vec4<f32>(0.0), vec4<f32>(MAX_TEXEL_TAU));
-    if (sat_params.transmittance != 0u) {
-        return vec4<u32>(round(exp(-t) * TRANSMITTANCE_SCALE));
-    }
     return vec4<u32>(round(t * FIXED_POINT_SCALE));
 }
 
