@@ -8,10 +8,10 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 
-use strandlight_scene::baseline::Baseline;
-use strandlight_scene::bench::{BenchPaths, BenchPlan, BenchReport, PlanChanges, run as run_bench};
-use strandlight_scene::bench_plots::{Metric, plot};
-use strandlight_scene::bench_report::{
+use strandlight_eval::baseline::Baseline;
+use strandlight_eval::bench::{BenchPaths, BenchPlan, BenchReport, PlanChanges, run as run_bench};
+use strandlight_eval::bench_plots::{Metric, plot};
+use strandlight_eval::bench_report::{
     details, section, splice, splice_truth, truth_details, truth_section,
 };
 use strandlight_scene::scene_tables::ScatteringMode;

@@ -1,7 +1,7 @@
 //! `strandlight compare`: SRBF lights vs the brute-force reference vs the equal-time median-cut
-//! baseline ([`strandlight_scene::compare`]); prints the report as JSON with `--json`.
+//! baseline ([`strandlight_eval::compare`]); prints the report as JSON with `--json`.
 
-use strandlight_scene::compare::{CompareArgs, execute, prepare};
+use strandlight_eval::compare::{CompareArgs, execute, prepare};
 use strandlight_scene::env_frame::render_lights;
 use strandlight_scene::steps::Steps;
 

@@ -1,5 +1,5 @@
 //! `strandlight compare-table`: the markdown table of docs/BENCHMARKS.md from `compare --json`
-//! reports (built by `strandlight_scene::compare_table`).
+//! reports (built by `strandlight_eval::compare_table`).
 
 use clap::Args;
 use std::path::PathBuf;
@@ -14,7 +14,7 @@ pub struct CompareTableArgs {
 pub fn run(args: CompareTableArgs) -> anyhow::Result<()> {
     println!(
         "{}",
-        strandlight_scene::compare_table::markdown_table(&args.reports)?
+        strandlight_eval::compare_table::markdown_table(&args.reports)?
     );
     Ok(())
 }

@@ -9,10 +9,10 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 
-use strandlight_scene::ground_truth::{read_truth_sidecar, without_noise};
-use strandlight_scene::hdr_flip::{error_map_magma, hdr_flip};
+use strandlight_eval::ground_truth::{read_truth_sidecar, without_noise};
+use strandlight_eval::hdr_flip::{error_map_magma, hdr_flip};
+use strandlight_eval::reference_cache::read_rgba_exr;
 use strandlight_scene::image_metrics::{error_split, mean_ratio, relative_rmse};
-use strandlight_scene::reference_cache::read_rgba_exr;
 
 #[derive(Args, Debug)]
 pub struct ImageErrorArgs {

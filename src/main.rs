@@ -45,7 +45,7 @@ enum Command {
     Render(render::RenderArgs),
     /// SRBF lights vs the brute-force cube-texel reference and the equal-time median-cut
     /// baseline (Ren 2010 §8): frame times, relative RMSE over hair pixels, images side by side.
-    Compare(strandlight_scene::compare::CompareArgs),
+    Compare(strandlight_eval::compare::CompareArgs),
     /// Speed against error on the shared data: fit, tables and env-lit frames against the
     /// converged reference, with plots; rewrites docs/BENCHMARKS.md's generated section.
     Bench(bench::BenchArgs),

@@ -1,6 +1,6 @@
-//! `strandlight summary`: prints [`strandlight_scene::summary`] as text or JSON.
+//! `strandlight summary`: prints [`strandlight_eval::summary`] as text or JSON.
 
-use strandlight_scene::summary::{self, AlbedoRow, ModelSummary, PresetSummary, Summary};
+use strandlight_eval::summary::{self, AlbedoRow, ModelSummary, PresetSummary, Summary};
 use strandlight_tables::Rgb;
 
 #[derive(clap::Args, Default)]

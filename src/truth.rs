@@ -5,8 +5,8 @@
 use anyhow::Context;
 use clap::Args;
 use std::path::PathBuf;
-use strandlight_scene::ground_truth::mitsuba_scene::MitsubaRun;
-use strandlight_scene::ground_truth::{
+use strandlight_eval::ground_truth::mitsuba_scene::MitsubaRun;
+use strandlight_eval::ground_truth::{
     TruthRequest, TruthScene, TruthSettings, TruthUse, export, ground_truth, write_truth_image,
 };
 use strandlight_scene::hair_input::parse_size;

@@ -9,8 +9,8 @@
 use serde_json::{Value, json};
 use std::path::Path;
 use std::process::Command;
+use strandlight_eval::reference_cache::read_rgba_exr;
 use strandlight_scene::image_metrics::relative_rmse;
-use strandlight_scene::reference_cache::read_rgba_exr;
 use strandlight_tables::artist::ArtistParams;
 use strandlight_tables::outside_tools::{missing_tool, program_exists};
 

@@ -25,16 +25,16 @@
 //! visibility per lobe there.
 
 use crate::compare::{self, CompareArgs, CompareScene, Reference, ReferenceLighting};
-use crate::env_frame::{EnvFrame, FrameRole, RenderedEnv};
 use crate::ground_truth::GroundTruth;
 use crate::hdr_flip::hdr_flip;
-use crate::image_metrics::{Image, relative_rmse, relative_rmse_of_part};
-use crate::look::LobeVisibilityArg;
-use crate::scene_tables::ScatteringMode;
-use crate::steps::Steps;
 use serde::{Deserialize, Serialize};
 use strandlight_runtime::env::EnvLight;
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
+use strandlight_scene::env_frame::{EnvFrame, FrameRole, RenderedEnv};
+use strandlight_scene::image_metrics::{Image, relative_rmse, relative_rmse_of_part};
+use strandlight_scene::look::LobeVisibilityArg;
+use strandlight_scene::scene_tables::ScatteringMode;
+use strandlight_scene::steps::Steps;
 
 /// The most lights an unshadowed reference climbs to (6·64²): one costs about a minute on
 /// lavapipe at 160×120, its shading alone being what converges.

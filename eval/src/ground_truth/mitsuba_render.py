@@ -1,6 +1,6 @@
 """Renders one strandlight scene in Mitsuba 3: the path-traced ground truth.
 
-Called by strandlight (scene/src/ground_truth.rs) as `python3 mitsuba_render.py SCENE.json`.
+Called by strandlight (eval/src/ground_truth.rs) as `python3 mitsuba_render.py SCENE.json`.
 SCENE.json names every input; nothing here chooses a setting. The film is linear RGBA: RGB is
 the hair's radiance times its pixel coverage over black (emitters seen directly are hidden), A is
 the coverage, the same convention as strandlight's frames. Prints one JSON line with the time.

@@ -20,7 +20,7 @@
 //!   LDR-FLIP (NVIDIA's HDR path stays in float). `tests/tests/hdr_flip_vs_nvidia.rs` measures
 //!   what that costs against NVIDIA's own HDR-FLIP (the `flip-evaluator` package).
 
-use crate::image_metrics::{CompareError, HAIR_ALPHA, Image};
+use strandlight_scene::image_metrics::{CompareError, HAIR_ALPHA, Image};
 
 /// Pixels per degree of visual angle: FLIP's default, a 0.7 m wide 4K monitor seen from 0.7 m.
 pub const PIXELS_PER_DEGREE: f32 = nv_flip::DEFAULT_PIXELS_PER_DEGREE;
@@ -103,7 +103,7 @@ fn exposed_srgb8(image: &Image, exposure: f32) -> Vec<u8> {
 /// from the reference's hair pixels.
 pub fn hdr_flip(test: &Image, reference: &Image) -> Result<HdrFlip, CompareError> {
     // The same checks (size, finite values, some hair, not black) as the relative RMSE.
-    crate::image_metrics::relative_rmse(test, reference)?;
+    strandlight_scene::image_metrics::relative_rmse(test, reference)?;
     let hair: Vec<bool> = reference.pixels.iter().map(|p| p[3] > HAIR_ALPHA).collect();
     let luminances: Vec<f32> = reference
         .pixels

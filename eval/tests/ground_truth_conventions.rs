@@ -11,20 +11,20 @@
 
 use glam::{DVec3, Vec3};
 use std::path::{Path, PathBuf};
+use strandlight_eval::compare::front_camera;
+use strandlight_eval::ground_truth::mitsuba_scene::{MitsubaRun, MitsubaScene};
+use strandlight_eval::ground_truth::{INSTALL_HINT, TruthInputs, render_cached};
+use strandlight_eval::reference_cache::ReferenceCache;
 use strandlight_precompute::EnvMap;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_precompute::envmap::pixel_direction;
 use strandlight_runtime::camera::UpAxis;
 use strandlight_runtime::env::EnvLight;
 use strandlight_runtime::hair::{Attribute, GroomParams, HairModel, generate_groom};
-use strandlight_scene::compare::front_camera;
 use strandlight_scene::env_frame::{EnvFrame, FrameRole, env_adapter, render_lights};
 use strandlight_scene::environment::map_pixels_sha256;
-use strandlight_scene::ground_truth::mitsuba_scene::{MitsubaRun, MitsubaScene};
-use strandlight_scene::ground_truth::{INSTALL_HINT, TruthInputs, render_cached};
 use strandlight_scene::image_metrics::{HAIR_ALPHA, Image};
 use strandlight_scene::look::{EnvLook, LookArgs};
-use strandlight_scene::reference_cache::ReferenceCache;
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode, SceneTables, bake_scene_tables};
 use strandlight_scene::world_lights::env_to_world;
 use strandlight_tables::outside_tools::require_python_modules;

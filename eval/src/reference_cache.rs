@@ -3,14 +3,14 @@
 //! written atomically and sealed by a SHA-256 sidecar. A hit needs both files intact and the
 //! same inputs recorded in the JSON; a damaged entry is reported and rendered again.
 
-use crate::image_metrics::Image;
-use crate::sealed_file::{Unsealed, read_sealed, seal, write_sealed};
 use anyhow::Context;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use strandlight_runtime::image_out::write_exr;
+use strandlight_scene::image_metrics::Image;
+use strandlight_scene::sealed_file::{Unsealed, read_sealed, seal, write_sealed};
 use strandlight_tables::checksum::sha256_hex;
 
 /// What is stored beside the image.
@@ -115,7 +115,7 @@ fn intact(path: &Path) -> Option<Vec<u8>> {
 }
 
 /// A linear RGBA EXR as written by `strandlight_runtime::image_out::write_exr`.
-pub fn read_rgba_exr(path: &Path) -> anyhow::Result<crate::image_metrics::Image> {
+pub fn read_rgba_exr(path: &Path) -> anyhow::Result<strandlight_scene::image_metrics::Image> {
     use exr::prelude::*;
     let image = read_first_rgba_layer_from_file(
         path,
@@ -132,7 +132,7 @@ pub fn read_rgba_exr(path: &Path) -> anyhow::Result<crate::image_metrics::Image>
     .with_context(|| format!("{}: not a readable RGBA EXR", path.display()))?;
     let size = image.layer_data.size;
     let (_, pixels) = image.layer_data.channel_data.pixels;
-    Ok(crate::image_metrics::Image::new(
+    Ok(strandlight_scene::image_metrics::Image::new(
         size.width() as u32,
         size.height() as u32,
         pixels,

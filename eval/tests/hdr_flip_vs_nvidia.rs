@@ -1,4 +1,4 @@
-//! Our HDR-FLIP (`strandlight_scene::hdr_flip`: NVIDIA's LDR-FLIP through `nv-flip`, with the
+//! Our HDR-FLIP (`strandlight_eval::hdr_flip`: NVIDIA's LDR-FLIP through `nv-flip`, with the
 //! exposure bracket written here and 8-bit tone-mapped exposures) against NVIDIA's own HDR-FLIP,
 //! the `flip-evaluator` Python package (v1.7, float throughout), on the same image pairs with the
 //! same exposure bracket. Skips with a message where python3 or the package is missing
@@ -6,7 +6,7 @@
 
 use std::path::Path;
 use std::process::Command;
-use strandlight_scene::hdr_flip::{PIXELS_PER_DEGREE, hdr_flip};
+use strandlight_eval::hdr_flip::{PIXELS_PER_DEGREE, hdr_flip};
 use strandlight_scene::image_metrics::{HAIR_ALPHA, Image};
 use strandlight_tables::outside_tools::{python, require_python_modules};
 

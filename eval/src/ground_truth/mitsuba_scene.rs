@@ -16,9 +16,8 @@
 //! at azimuth 2π(u − ½) from −Z, Mitsuba's `envmap` at 2πu: the same picture half a turn apart
 //! about +Y, so Mitsuba's local frame is strandlight's turned by π about +Y
 //! ([`MITSUBA_MAP_FROM_OURS`]). Then the map is turned by the scene's rotation about +Y and
-//! carried into the hair's world ([`crate::world_lights::env_to_world`]).
+//! carried into the hair's world ([`strandlight_scene::world_lights::env_to_world`]).
 
-use crate::world_lights::env_to_world;
 use anyhow::Context;
 use glam::{DMat3, DVec3};
 use serde::Serialize;
@@ -30,6 +29,7 @@ use strandlight_runtime::camera::{Camera, Projection, UpAxis};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::image_out::write_exr;
 use strandlight_runtime::passes::strand_geometry::default_thickness;
+use strandlight_scene::world_lights::env_to_world;
 use strandlight_tables::atomic_write::write_atomically;
 
 /// The script that renders a scene file (written beside it).

@@ -3,9 +3,9 @@
 
 use crate::bench::{BenchReport, EnvLitResult};
 use crate::error_decomposition::{self as decomposition, DecompositionStep, ErrorDecomposition};
-use crate::scene_tables::ScatteringMode;
 use anyhow::bail;
 use std::fmt::Write;
+use strandlight_scene::scene_tables::ScatteringMode;
 
 pub const BEGIN: &str = "<!-- strandlight bench: generated section, begin -->";
 pub const END: &str = "<!-- strandlight bench: generated section, end -->";

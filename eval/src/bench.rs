@@ -13,18 +13,11 @@
 
 use crate::baseline::Baseline;
 use crate::compare::{self, CompareArgs, CompareScene};
-use crate::env_frame::{EnvFrame, FrameRole, render_lights};
-use crate::environment::load_env;
 use crate::error_decomposition::{
     self, DecompositionInputs, ErrorDecomposition, unshadowed_max_lights,
 };
-use crate::fit_cache::fit_cached;
 use crate::ground_truth::{GroundTruth, TruthUse};
 use crate::hdr_flip::hdr_flip;
-use crate::image_metrics::{Image, relative_rmse};
-use crate::look::{EnvTransparency, ForwardDevice, LobeVisibilityArg, LookArgs, ViewArgs};
-use crate::scene_tables::{EnvShading, ScatteringMode};
-use crate::steps::Steps;
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -34,6 +27,15 @@ use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription, Model,
 use strandlight_precompute::baked_tables_check::check_asset;
 use strandlight_runtime::env::{EnvLight, ViewTransparency};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
+use strandlight_scene::env_frame::{EnvFrame, FrameRole, render_lights};
+use strandlight_scene::environment::load_env;
+use strandlight_scene::fit_cache::fit_cached;
+use strandlight_scene::image_metrics::{Image, relative_rmse};
+use strandlight_scene::look::{
+    EnvTransparency, ForwardDevice, LobeVisibilityArg, LookArgs, ViewArgs,
+};
+use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
+use strandlight_scene::steps::Steps;
 
 /// What one run measures.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -1048,12 +1050,12 @@ pub fn run(plan: &BenchPlan, paths: &BenchPaths, steps: &mut Steps) -> anyhow::R
     let hair_path = paths.data.join("hair/straight.hair");
     let bytes =
         std::fs::read(&hair_path).with_context(|| format!("reading {}", hair_path.display()))?;
-    let (model, _) = crate::hair_input::load_hair(Some(&hair_path))?;
+    let (model, _) = strandlight_scene::hair_input::load_hair(Some(&hair_path))?;
     let hair = (model, strandlight_tables::checksum::sha256_hex(&bytes));
     let mut report = BenchReport {
         plan: plan.clone(),
         machine: machine(),
-        adapter: crate::env_frame::env_adapter()?,
+        adapter: strandlight_scene::env_frame::env_adapter()?,
         date: command_output("date", &["-u", "+%Y-%m-%d %H:%M UTC"]),
         // "-dirty" when the tree has uncommitted changes: the revision alone would not say
         // what was measured.

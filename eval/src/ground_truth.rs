@@ -14,10 +14,7 @@
 
 pub mod mitsuba_scene;
 
-use crate::image_metrics::{Image, relative_rmse};
 use crate::reference_cache::{CachedRecord, ReferenceCache, read_rgba_exr};
-use crate::scene_tables::ScatteringMode;
-use crate::steps::Steps;
 use anyhow::{Context, bail};
 use mitsuba_scene::{MitsubaRun, MitsubaScene, write_scene};
 use serde::{Deserialize, Serialize};
@@ -25,6 +22,9 @@ use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+use strandlight_scene::image_metrics::{Image, relative_rmse};
+use strandlight_scene::scene_tables::ScatteringMode;
+use strandlight_scene::steps::Steps;
 use strandlight_tables::checksum::sha256_hex;
 use strandlight_tables::outside_tools::{PYTHON_VAR, python};
 
@@ -516,12 +516,12 @@ pub struct TruthScene {
 impl TruthScene {
     pub fn load(request: &TruthRequest) -> anyhow::Result<Self> {
         use crate::compare::{fibers_for, front_camera};
-        use crate::scene_tables::EnvShading;
+        use strandlight_scene::scene_tables::EnvShading;
         let bytes = std::fs::read(&request.hair)
             .with_context(|| format!("--hair {}", request.hair.display()))?;
-        let (hair, _) = crate::hair_input::load_hair(Some(&request.hair))?;
+        let (hair, _) = strandlight_scene::hair_input::load_hair(Some(&request.hair))?;
         let (hair, hair_sha256) = fibers_for(EnvShading::Chiang, hair, sha256_hex(&bytes));
-        let env = crate::environment::load_env(&request.env, request.sanitize)?;
+        let env = strandlight_scene::environment::load_env(&request.env, request.sanitize)?;
         let (up, camera) = front_camera(&hair, request.size);
         let fiber = strandlight_precompute::bake_plan::FiberDescription::preset(&request.preset)
             .with_context(|| format!("--preset {:?}", request.preset))?;

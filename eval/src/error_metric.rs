@@ -2,8 +2,8 @@
 //! the method's accuracy targets are stated in) or HDR-FLIP (what a viewer sees).
 
 use crate::hdr_flip::hdr_flip;
-use crate::image_metrics::{CompareError, Image, relative_rmse};
 use serde::{Deserialize, Serialize};
+use strandlight_scene::image_metrics::{CompareError, Image, relative_rmse};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]

@@ -4,23 +4,12 @@
 //! against the reference over hair pixels, and the speed ratios; the images side by side.
 
 use crate::baseline::Baseline;
-use crate::env_frame::{EnvFrame, FrameRole, RenderedEnv, fit_summary, forward_settings};
-use crate::environment::load_env;
 use crate::equal_time::{EqualTimeSearch, equal_error_lights, equal_time_lights};
 use crate::error_metric::ErrorMetric;
-use crate::fit_cache::fit_cached;
 use crate::ground_truth::mitsuba_scene::MitsubaScene;
 use crate::ground_truth::{GroundTruth, TruthInputs, TruthSettings, TruthUse, ground_truth};
-use crate::hair_input::{load_hair, parse_size};
 use crate::hdr_flip::{HdrFlip, error_map_magma, hdr_flip};
-use crate::image_metrics::{Image, error_legend, relative_rmse, write_side_by_side};
-use crate::look::{EnvLook, LookArgs};
 use crate::reference_cache::{ReferenceCache, ReferenceRecord};
-use crate::scene_tables::{
-    EnvShading, ScatteringMode, SceneTables, bake_scene_tables, lambda_range_of_set, wanted_tables,
-};
-use crate::steps::Steps;
-use crate::world_lights::to_env_lights;
 use anyhow::{Context, bail};
 use serde_json::{Value, json};
 use std::path::PathBuf;
@@ -36,6 +25,19 @@ use strandlight_runtime::env::{EnvLight, EnvRenderOptions, mark_every_strand, sh
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::image_out::{write_exr, write_png};
 use strandlight_runtime::passes::convolution_depth::{DodmSettings, MAX_DODM_RESOLUTION};
+use strandlight_scene::env_frame::{
+    EnvFrame, FrameRole, RenderedEnv, fit_summary, forward_settings,
+};
+use strandlight_scene::environment::load_env;
+use strandlight_scene::fit_cache::fit_cached;
+use strandlight_scene::hair_input::{load_hair, parse_size};
+use strandlight_scene::image_metrics::{Image, error_legend, relative_rmse, write_side_by_side};
+use strandlight_scene::look::{EnvLook, LookArgs};
+use strandlight_scene::scene_tables::{
+    EnvShading, ScatteringMode, SceneTables, bake_scene_tables, lambda_range_of_set, wanted_tables,
+};
+use strandlight_scene::steps::Steps;
+use strandlight_scene::world_lights::to_env_lights;
 use strandlight_tables::checksum::sha256_hex;
 
 #[derive(Debug, Clone)]
