@@ -25,7 +25,8 @@ use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake::bake_job;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription, Model, PlanOptions};
 use strandlight_precompute::baked_tables_check::check_asset;
-use strandlight_runtime::env::{EnvLight, ViewTransparency};
+use strandlight_runtime::env::ViewTransparency;
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_scene::env_frame::{EnvFrame, FrameRole, render_lights};
 use strandlight_scene::environment::load_env;
@@ -116,6 +117,40 @@ const ALL_MAPS: [&str; 8] = [
 ];
 
 impl BenchPlan {
+    /// The `bench` arguments that rerun this plan: its name and each flag whose value the run
+    /// changed from that plan's.
+    pub fn regenerate_args(&self) -> String {
+        let plan = self;
+        let base = plan.base();
+        let list = |v: &[usize]| v.iter().map(usize::to_string).collect::<Vec<_>>().join(",");
+        let mut args = String::from(match plan.name.as_str() {
+            "quick" => " --quick",
+            "truth" => " --truth",
+            _ => "",
+        });
+        if plan.maps != base.maps {
+            args += &format!(" --maps {}", plan.maps.join(","));
+        }
+        if plan.modes != base.modes {
+            let modes: Vec<_> = plan.modes.iter().map(|m| m.name()).collect();
+            args += &format!(" --modes {}", modes.join(","));
+        }
+        if plan.reference_max_lights != base.reference_max_lights {
+            args += &format!(" --reference-max-lights {}", plan.reference_max_lights);
+        }
+        if plan.baseline_lights != base.baseline_lights {
+            args += &format!(" --baseline-lights {}", list(&plan.baseline_lights));
+        }
+        if plan.baseline != base.baseline {
+            let flag = serde_json::to_value(plan.baseline).expect("a unit enum serializes");
+            args += &format!(" --baseline {}", flag.as_str().unwrap_or_default());
+        }
+        if plan.decomposition_only {
+            args += " --decomposition-only";
+        }
+        args
+    }
+
     /// The whole report: every map, both modes, the sweeps.
     pub fn full() -> Self {
         Self {
@@ -532,7 +567,7 @@ fn repeated_key<T>(
 /// The `bench` arguments of the runs `report` holds: its own, or those it was merged from.
 fn runs_of(report: &BenchReport) -> Vec<String> {
     match report.runs.is_empty() {
-        true => vec![crate::bench_report::regenerate_args(report)],
+        true => vec![report.plan.regenerate_args()],
         false => report.runs.clone(),
     }
 }

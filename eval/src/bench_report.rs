@@ -281,40 +281,6 @@ fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str, baseline: &str
     );
 }
 
-/// The command line that reruns `report`'s plan: the plan's name and each flag whose value the
-/// run changed from that plan's.
-pub(crate) fn regenerate_args(report: &BenchReport) -> String {
-    let plan = &report.plan;
-    let base = plan.base();
-    let list = |v: &[usize]| v.iter().map(usize::to_string).collect::<Vec<_>>().join(",");
-    let mut args = String::from(match plan.name.as_str() {
-        "quick" => " --quick",
-        "truth" => " --truth",
-        _ => "",
-    });
-    if plan.maps != base.maps {
-        args += &format!(" --maps {}", plan.maps.join(","));
-    }
-    if plan.modes != base.modes {
-        let modes: Vec<_> = plan.modes.iter().map(|m| m.name()).collect();
-        args += &format!(" --modes {}", modes.join(","));
-    }
-    if plan.reference_max_lights != base.reference_max_lights {
-        args += &format!(" --reference-max-lights {}", plan.reference_max_lights);
-    }
-    if plan.baseline_lights != base.baseline_lights {
-        args += &format!(" --baseline-lights {}", list(&plan.baseline_lights));
-    }
-    if plan.baseline != base.baseline {
-        let flag = serde_json::to_value(plan.baseline).expect("a unit enum serializes");
-        args += &format!(" --baseline {}", flag.as_str().unwrap_or_default());
-    }
-    if plan.decomposition_only {
-        args += " --decomposition-only";
-    }
-    args
-}
-
 /// The commands of a merged report's runs, as the page names them.
 fn run_commands(report: &BenchReport) -> String {
     report
@@ -329,7 +295,7 @@ fn run_commands(report: &BenchReport) -> String {
 pub fn section(report: &BenchReport, plot_dir: &str) -> String {
     let mut out = String::new();
     let plan = &report.plan;
-    let args = regenerate_args(report);
+    let args = report.plan.regenerate_args();
     // One run reruns with its own arguments; a merged page names each run instead.
     let (heading_args, regenerate, budget) = match report.runs.is_empty() {
         true => (
@@ -479,7 +445,7 @@ pub fn truth_section(report: &BenchReport, plot_dir: &str) -> String {
     let regenerate = match report.runs.is_empty() {
         true => format!(
             "Regenerate with `cargo run --release -- bench{}`",
-            regenerate_args(report)
+            report.plan.regenerate_args()
         ),
         false => format!(
             "Measured in {} runs, {}, merged into this page by `bench --from-report` with their reports ([`{plot_dir}/runs/`]({plot_dir}/runs/))",
@@ -760,11 +726,11 @@ mod tests {
 
     #[test]
     fn the_regenerate_command_names_maps_only_when_the_run_chose_them() {
-        assert_eq!(regenerate_args(&report_of(BenchPlan::quick())), " --quick");
-        assert_eq!(regenerate_args(&report_of(BenchPlan::full())), "");
+        assert_eq!(BenchPlan::quick().regenerate_args(), " --quick");
+        assert_eq!(BenchPlan::full().regenerate_args(), "");
         let mut every_map = BenchPlan::quick();
         every_map.maps = BenchPlan::full().maps;
-        let args = regenerate_args(&report_of(every_map.clone()));
+        let args = every_map.regenerate_args();
         assert!(
             args.starts_with(" --quick --maps hdr_overcast_soil_puresky_1k.hdr,quarry_01_1k.hdr,")
         );
@@ -963,7 +929,7 @@ mod tests {
         let plan = BenchPlan::quick().changed(&changes).unwrap();
         assert_eq!(plan.baseline_lights, [16, 64, 256]);
         assert_eq!(
-            regenerate_args(&report_of(plan)),
+            plan.regenerate_args(),
             " --quick --maps quarry_01_1k.hdr --modes full --reference-max-lights 6144 --baseline-lights 16,64,256 --baseline median-cut-sources --decomposition-only"
         );
         let unchanged = PlanChanges {
@@ -973,7 +939,7 @@ mod tests {
             ..PlanChanges::default()
         };
         let plan = BenchPlan::full().changed(&unchanged).unwrap();
-        assert_eq!(regenerate_args(&report_of(plan)), "");
+        assert_eq!(plan.regenerate_args(), "");
     }
 
     #[test]

@@ -21,16 +21,18 @@ use strandlight_precompute::env_lights::{
     srbf_set_lights,
 };
 use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_runtime::env::{EnvLight, EnvRenderOptions, mark_every_strand, shadow_groups};
+use strandlight_runtime::env::EnvRenderOptions;
+use strandlight_runtime::env_light::{EnvLight, mark_every_strand, shadow_groups};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::image_out::{write_exr, write_png};
 use strandlight_runtime::passes::convolution_depth::{DodmSettings, MAX_DODM_RESOLUTION};
+use strandlight_scene::camera_choice::front_camera;
 use strandlight_scene::env_frame::{
     EnvFrame, FrameRole, RenderedEnv, fit_summary, forward_settings,
 };
 use strandlight_scene::environment::load_env;
 use strandlight_scene::fit_cache::fit_cached;
-use strandlight_scene::hair_input::{load_hair, parse_size};
+use strandlight_scene::hair_input::{fibers_for, load_hair, parse_size};
 use strandlight_scene::image_metrics::{Image, error_legend, relative_rmse, write_side_by_side};
 use strandlight_scene::look::{EnvLook, LookArgs};
 use strandlight_scene::scene_tables::{
@@ -486,26 +488,6 @@ pub fn prepare_with_hair(
         compact_sources: fit.set.sources.clone(),
         fit_lights,
     })
-}
-
-/// The hair as `shading` renders it, and the hash that identifies it in the caches: the Chiang
-/// fiber is the path tracer's, whose fibers are opaque cylinders, so a file's transparency is
-/// dropped for it (and the hash says so).
-pub fn fibers_for(shading: EnvShading, hair: HairModel, sha256: String) -> (HairModel, String) {
-    match hair.transparency() {
-        Some(_) if shading.physical_fibers() => (
-            hair.without_transparency(),
-            format!("{sha256}+opaque fibers"),
-        ),
-        _ => (hair, sha256),
-    }
-}
-
-/// The hair's up axis and the default camera that frames it from the front at `size`.
-pub fn front_camera(hair: &HairModel, size: (u32, u32)) -> (UpAxis, Camera) {
-    let up = UpAxis::detect(hair);
-    let aspect = size.0 as f32 / size.1 as f32;
-    (up, Camera::framing_front(hair.bounds(), aspect, false, up))
 }
 
 /// The function that renders a frame: [`render_lights`] in the program, a stand-in in tests.

@@ -28,7 +28,7 @@ use crate::compare::{self, CompareArgs, CompareScene, Reference, ReferenceLighti
 use crate::ground_truth::GroundTruth;
 use crate::hdr_flip::hdr_flip;
 use serde::{Deserialize, Serialize};
-use strandlight_runtime::env::EnvLight;
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_scene::env_frame::{EnvFrame, FrameRole, RenderedEnv};
 use strandlight_scene::image_metrics::{Image, relative_rmse, relative_rmse_of_part};

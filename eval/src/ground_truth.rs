@@ -515,7 +515,8 @@ pub struct TruthScene {
 
 impl TruthScene {
     pub fn load(request: &TruthRequest) -> anyhow::Result<Self> {
-        use crate::compare::{fibers_for, front_camera};
+        use strandlight_scene::camera_choice::front_camera;
+        use strandlight_scene::hair_input::fibers_for;
         use strandlight_scene::scene_tables::EnvShading;
         let bytes = std::fs::read(&request.hair)
             .with_context(|| format!("--hair {}", request.hair.display()))?;
@@ -609,8 +610,8 @@ pub fn read_truth_sidecar(exr: &Path) -> Option<TruthSidecar> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::compare::front_camera;
     use strandlight_runtime::hair::{GroomParams, generate_groom};
+    use strandlight_scene::camera_choice::front_camera;
 
     fn scratch(name: &str) -> PathBuf {
         let dir =

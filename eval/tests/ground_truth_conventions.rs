@@ -11,7 +11,6 @@
 
 use glam::{DVec3, Vec3};
 use std::path::{Path, PathBuf};
-use strandlight_eval::compare::front_camera;
 use strandlight_eval::ground_truth::mitsuba_scene::{MitsubaRun, MitsubaScene};
 use strandlight_eval::ground_truth::{INSTALL_HINT, TruthInputs, render_cached};
 use strandlight_eval::reference_cache::ReferenceCache;
@@ -19,8 +18,9 @@ use strandlight_precompute::EnvMap;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_precompute::envmap::pixel_direction;
 use strandlight_runtime::camera::UpAxis;
-use strandlight_runtime::env::EnvLight;
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::hair::{Attribute, GroomParams, HairModel, generate_groom};
+use strandlight_scene::camera_choice::front_camera;
 use strandlight_scene::env_frame::{EnvFrame, FrameRole, env_adapter, render_lights};
 use strandlight_scene::environment::map_pixels_sha256;
 use strandlight_scene::image_metrics::{HAIR_ALPHA, Image};

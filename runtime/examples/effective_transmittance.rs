@@ -23,8 +23,9 @@ use std::time::Instant;
 use glam::Vec3;
 use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::{
-    EnvFrame, EnvLight, EnvRenderOptions, EnvRenderer, EnvTables, TransmittanceFilter,
+    EnvFrame, EnvRenderOptions, EnvRenderer, EnvTables, TransmittanceFilter,
 };
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::hair::{self, HairModel};

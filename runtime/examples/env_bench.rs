@@ -12,9 +12,8 @@
 
 use glam::Vec3;
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env::{
-    EnvLight, EnvRenderOptions, EnvRenderer, EnvTables, ViewTransparency,
-};
+use strandlight_runtime::env::{EnvRenderOptions, EnvRenderer, EnvTables, ViewTransparency};
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;

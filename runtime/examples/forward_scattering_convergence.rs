@@ -12,9 +12,10 @@ use std::time::Instant;
 use glam::Vec3;
 use strandlight_precompute::attenuation_ratio::attenuation_ratio_table;
 use strandlight_precompute::srbf_spread::srbf_spread_table;
-use strandlight_runtime::env::{EnvLight, ForwardScatteringSource};
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
+use strandlight_runtime::multiple::ForwardScatteringSource;
 use strandlight_runtime::multiple::shadow_paths::LightMedium;
 use strandlight_runtime::multiple::{
     CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering,

@@ -2,6 +2,7 @@
 
 pub mod camera;
 pub mod env;
+pub mod env_light;
 pub mod gpu;
 pub mod hair;
 pub mod image_out;

@@ -8,14 +8,13 @@ use common::*;
 use glam::{DVec3, Vec2, Vec3};
 use strandlight_runtime::camera::{Camera, Projection, light_camera};
 use strandlight_runtime::env::TransmittanceFilter;
-use strandlight_runtime::env::{
-    EnvFrame, EnvLight, EnvRenderOptions, EnvTables, ForwardScatteringGrid,
-    ForwardScatteringSource, render_env_frame,
-};
+use strandlight_runtime::env::{EnvFrame, EnvRenderOptions, EnvTables, render_env_frame};
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::{GpuContext, read_texture_rgba};
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::multiple::ForwardScatteringError;
+use strandlight_runtime::multiple::{ForwardScatteringGrid, ForwardScatteringSource};
 use strandlight_runtime::passes::convolution_depth::{
     ConvolutionDepthPass, DodmBatch, DodmSettings, OPTICAL_DEPTH_FORMAT, SimplifiedSegments,
 };

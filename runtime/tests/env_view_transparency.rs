@@ -7,9 +7,10 @@ use common::*;
 
 use glam::{DVec3, Vec3};
 use strandlight_runtime::env::{
-    EnvLight, EnvRenderError, EnvRenderOptions, EnvTables, FragmentCounts, OccupancyError,
-    ViewTransparency, render_env_frame,
+    EnvRenderError, EnvRenderOptions, EnvTables, FragmentCounts, OccupancyError, ViewTransparency,
+    render_env_frame,
 };
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_tables::table::{Axis, Table};

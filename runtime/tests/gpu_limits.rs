@@ -8,9 +8,8 @@ use common::*;
 
 use glam::Vec3;
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env::{
-    EnvLight, EnvRenderError, EnvRenderOptions, EnvTables, render_env_frame,
-};
+use strandlight_runtime::env::{EnvRenderError, EnvRenderOptions, EnvTables, render_env_frame};
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::LimitError;
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::abuffer::{ABufferError, ABufferPass, ListMode};

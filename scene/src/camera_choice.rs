@@ -57,3 +57,10 @@ impl CameraChoice {
         })
     }
 }
+
+/// The hair's up axis and the default camera that frames it from the front at `size`.
+pub fn front_camera(hair: &HairModel, size: (u32, u32)) -> (UpAxis, Camera) {
+    let up = UpAxis::detect(hair);
+    let aspect = size.0 as f32 / size.1 as f32;
+    (up, Camera::framing_front(hair.bounds(), aspect, false, up))
+}

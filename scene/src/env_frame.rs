@@ -9,11 +9,12 @@ use std::sync::OnceLock;
 use strandlight_precompute::srbf_set::SrbfSet;
 use strandlight_runtime::camera::Camera;
 use strandlight_runtime::env::{
-    EnvLight, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables, ForwardScatteringSource,
-    FragmentCounts,
+    EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables, FragmentCounts,
 };
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
+use strandlight_runtime::multiple::ForwardScatteringSource;
 use strandlight_runtime::multiple::{
     CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering,
 };

@@ -15,7 +15,7 @@ use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_precompute::env_lights::srbf_set_lights;
 use strandlight_runtime::camera::UpAxis;
-use strandlight_runtime::env::EnvLight;
+use strandlight_runtime::env_light::EnvLight;
 
 /// What the scene is made of besides the hair.
 pub struct EnvSceneRequest<'a> {

@@ -19,7 +19,7 @@ use glam::{Quat, Vec3};
 use std::path::Path;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_runtime::env::EnvLight;
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};

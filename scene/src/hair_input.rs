@@ -1,6 +1,7 @@
 //! A scene's hair and image size as a user names them: a hair file (or the procedural groom when
 //! none is given) and `WxH`.
 
+use crate::scene_tables::EnvShading;
 use anyhow::{Context, bail};
 use std::path::Path;
 use strandlight_runtime::hair::{self, GroomParams, HairModel};
@@ -36,4 +37,17 @@ pub fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
         Ok(v)
     };
     Ok((parse(w)?, parse(h)?))
+}
+
+/// The hair as `shading` renders it, and the hash that identifies it in the caches: the Chiang
+/// fiber is the path tracer's, whose fibers are opaque cylinders, so a file's transparency is
+/// dropped for it (and the hash says so).
+pub fn fibers_for(shading: EnvShading, hair: HairModel, sha256: String) -> (HairModel, String) {
+    match hair.transparency() {
+        Some(_) if shading.physical_fibers() => (
+            hair.without_transparency(),
+            format!("{sha256}+opaque fibers"),
+        ),
+        _ => (hair, sha256),
+    }
 }

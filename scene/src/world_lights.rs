@@ -10,7 +10,7 @@
 use glam::{DVec3, Vec3};
 use strandlight_precompute::env_lights::LightSpec;
 use strandlight_runtime::camera::UpAxis;
-use strandlight_runtime::env::EnvLight;
+use strandlight_runtime::env_light::EnvLight;
 
 /// A direction of the map's frame in the world of a hair file with `up`. A rotation
 /// (determinant +1): the identity for Y-up; for Z-up (x, y, z) ↦ (−x, z, y).

@@ -27,11 +27,11 @@ use strandlight_precompute::env_lights::{
 use strandlight_precompute::srbf_set::{Source, SrbfSet};
 use strandlight_precompute::{FitOptions, procedural_env};
 use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_runtime::env::{
-    EnvLight, EnvRenderOptions, EnvRenderer, EnvTables, ForwardScatteringSource,
-};
+use strandlight_runtime::env::{EnvRenderOptions, EnvRenderer, EnvTables};
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::{GroomParams, HairModel, generate_groom};
+use strandlight_runtime::multiple::ForwardScatteringSource;
 use strandlight_runtime::multiple::{
     CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering,
     VoxelSettings,

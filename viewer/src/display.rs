@@ -3,7 +3,7 @@
 //! ([`PNG_TONEMAP`](strandlight_runtime::image_out::PNG_TONEMAP)) so the window and a screenshot
 //! show the same thing.
 
-use crate::worker::LinearImage;
+use crate::frame::LinearImage;
 use glam::{Quat, Vec4};
 use strandlight_precompute::envmap::EnvMap;
 use strandlight_runtime::camera::{Camera, UpAxis};

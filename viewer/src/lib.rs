@@ -5,6 +5,7 @@
 
 mod app;
 pub mod display;
+pub mod frame;
 pub mod orbit;
 mod panel;
 pub mod progressive;

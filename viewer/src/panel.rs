@@ -2,8 +2,9 @@
 //! and the overlay on the image (adapter, frame time per pass, GPU memory, lights and batches).
 //! Each group says what its changes cost ([`Recompute::label`]).
 
+use crate::frame::{FrameStats, Stage};
 use crate::recompute::{Recompute, ViewState};
-use crate::worker::{FrameStats, Stage, Status};
+use crate::worker::Status;
 use egui_file_dialog::FileDialog;
 use std::path::PathBuf;
 use strandlight_runtime::passes::deep_opacity::MAX_LAYERS;

@@ -3,9 +3,10 @@
 //! gives that frame; before the last batch the window shows the running sum scaled by the share
 //! of the lights' power it holds (lights are drawn most powerful first).
 
-use crate::worker::{FrameStats, LinearImage, Stage};
+use crate::frame::{FrameStats, LinearImage, Stage};
 use std::sync::Arc;
-use strandlight_runtime::env::{EnvLight, ViewTransparency};
+use strandlight_runtime::env::ViewTransparency;
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_scene::look::EnvLook;
 
 /// The preview draws this many of the most powerful lights.

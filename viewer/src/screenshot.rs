@@ -3,8 +3,8 @@
 //! settings also go into both images' metadata. The whole window, panel included, is captured
 //! beside them when the window next paints (`window_capture`).
 
+use crate::frame::LinearImage;
 use crate::recompute::Display;
-use crate::worker::LinearImage;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 use strandlight_runtime::image_out::{write_exr, write_png};

@@ -3,12 +3,13 @@
 //! the renderer.
 
 use crate::display::{auto_exposure_stops, background, composite, to_rgba8};
+use crate::frame::{LinearImage, Stage};
 use crate::orbit::Orbit;
 use crate::panel::{Panel, PanelOutcome};
 use crate::recompute::{Display, Recompute, ViewState, recompute};
 use crate::screenshot::{ScreenshotFiles, save};
 use crate::script::{Action, WaitFor, merge_patch};
-use crate::worker::{LinearImage, Shown, Stage, Status, Worker};
+use crate::worker::{Shown, Status, Worker};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};

@@ -12,9 +12,9 @@ use std::sync::mpsc::{Receiver, TryRecvError, channel};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env::EnvLight;
+use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
-use strandlight_runtime::render::{PassTiming, TIMING_METHOD};
+use strandlight_runtime::render::TIMING_METHOD;
 use strandlight_scene::env_frame::{env_adapter, render_lights};
 use strandlight_scene::env_scene::PrepareProgress;
 use strandlight_scene::frame_render::{
@@ -28,42 +28,8 @@ use strandlight_scene::look::EnvLook;
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 
+use crate::frame::{FrameStats, LinearImage, Stage};
 use crate::recompute::{TablesKey, tables_key};
-
-/// A frame in linear, pre-multiplied RGBA.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LinearImage {
-    pub width: u32,
-    pub height: u32,
-    pub pixels: Vec<[f32; 4]>,
-}
-
-/// How far the shown image is.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Stage {
-    Preview,
-    /// `done` of `total` light batches summed.
-    Refining {
-        done: usize,
-        total: usize,
-    },
-    Converged,
-}
-
-/// What the overlay reports of the shown image.
-#[derive(Clone, Debug, Default)]
-pub struct FrameStats {
-    /// Time per pass, summed over the batches so far.
-    pub passes: Vec<PassTiming>,
-    /// GPU memory per resource while one batch renders, bytes.
-    pub memory: Vec<(String, u64)>,
-    /// Lights drawn (SRBF lobes and directional sources, or point lights).
-    pub lights: usize,
-    /// Render calls (light batches) so far.
-    pub batches: usize,
-    pub adapter: String,
-    pub timing_method: String,
-}
 
 /// The worker's latest image of a request.
 #[derive(Clone)]

@@ -4,7 +4,8 @@
 
 use std::time::{Duration, Instant};
 use strandlight_scene::frame_settings::{FrameSettings, Lighting, PointLighting};
-use strandlight_viewer::worker::{Stage, Worker};
+use strandlight_viewer::frame::Stage;
+use strandlight_viewer::worker::Worker;
 
 fn wait_for(worker: &Worker, what: &str, done: impl Fn(&Worker) -> bool) {
     let start = Instant::now();

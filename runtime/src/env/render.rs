@@ -8,12 +8,13 @@ use strandlight_tables::table_axes::{
     AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_SIGMA_F, AXIS_U_DOT_WO, AXIS_U_DOT_XI,
 };
 
-use super::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource, ShadowGroup, shadow_groups};
 use crate::camera::Camera;
+use crate::env_light::{EnvLight, ShadowGroup, shadow_groups};
 use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels, fit_within};
 use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::gpu::{AdapterReport, GpuContext};
 use crate::hair::{Aabb, HairModel};
+use crate::multiple::{ForwardScatteringGrid, ForwardScatteringSource};
 use crate::passes::convolution_depth::{
     ConvolutionDepthPass, DodmBatch, DodmSettings, DodmSettingsError, SimplifiedSegments,
     check_kappa, simplification_order,

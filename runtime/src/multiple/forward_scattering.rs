@@ -15,7 +15,7 @@ use super::light_sweep::LightSweep;
 use super::shadow_paths::{
     LightMedium, MarchSettings, SampleAccumulator, light_direction, sample_value,
 };
-use crate::env::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource};
+use crate::env_light::EnvLight;
 use crate::hair::HairModel;
 
 /// Everything that sets the grid's accuracy and cost.
@@ -357,4 +357,30 @@ pub fn interpolate_grid(grid: &ForwardScatteringGrid, light: usize, p: Vec3) -> 
         }
     }
     Some(out)
+}
+
+/// The forward-scattering attenuation T_f (RGB) and spread σ̄_f (radians, the standard
+/// deviation of the incident inclination) of Ren §6, sampled on a regular grid over the hair
+/// per light, as the view pass reads them: `values[light][z][y][x] = [T_r, T_g, T_b, σ̄_f]`,
+/// trilinearly interpolated between grid vertices, clamped at the border.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ForwardScatteringGrid {
+    /// World position of vertex (0, 0, 0).
+    pub origin: Vec3,
+    /// World distance between neighbouring vertices along x, y, z.
+    pub spacing: Vec3,
+    /// Vertices along x, y, z.
+    pub dims: [u32; 3],
+    /// One block of dims.x·dims.y·dims.z values per light, in the order of the lights asked for.
+    pub values: Vec<[f32; 4]>,
+}
+
+/// Computes [`ForwardScatteringGrid`]s for batches of lights (the multiple-scattering module
+/// implements it on the CPU and on the GPU; a frame asks once per batch).
+pub trait ForwardScatteringSource {
+    /// The grid (with values for every light in `lights`, in order).
+    fn grid(&self, lights: &[EnvLight]) -> Result<ForwardScatteringGrid, ForwardScatteringError>;
+
+    /// Where the march runs ("CPU", "GPU"): names the pass in the frame's timings.
+    fn device(&self) -> &'static str;
 }

@@ -14,9 +14,10 @@ use wgpu::util::DeviceExt;
 use super::fiber_tables::ForwardScatteringError;
 use super::forward_scattering::CpuForwardScattering;
 use super::shadow_paths::{LightMedium, light_direction};
-use crate::env::{EnvLight, ForwardScatteringGrid, ForwardScatteringSource};
+use crate::env_light::EnvLight;
 use crate::gpu::bind_layout::{storage_entry, uniform_entry};
 use crate::gpu::{GpuContext, GpuLimits, read_buffer};
+use crate::multiple::{ForwardScatteringGrid, ForwardScatteringSource};
 
 const WORKGROUP_SIZE: u32 = 64;
 /// Two vec4 per voxel per light (see the shader's layout).

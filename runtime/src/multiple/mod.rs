@@ -24,7 +24,8 @@ mod tests;
 
 pub use fiber_tables::{ForwardScatteringError, ForwardScatteringTables};
 pub use forward_scattering::{
-    CpuForwardScattering, ForwardScatteringSettings, SampleGrid, interpolate_grid,
+    CpuForwardScattering, ForwardScatteringGrid, ForwardScatteringSettings,
+    ForwardScatteringSource, SampleGrid, interpolate_grid,
 };
 pub use gpu_shadow_paths::GpuForwardScattering;
 pub use hair_volume::{HairVolume, VoxelGrid, VoxelSettings};

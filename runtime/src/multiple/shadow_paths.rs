@@ -33,7 +33,7 @@ use rayon::prelude::*;
 
 use super::fiber_tables::{ForwardEvent, ForwardScatteringTables};
 use super::hair_volume::HairVolume;
-use crate::env::EnvLight;
+use crate::env_light::EnvLight;
 
 /// What the march needs per voxel for one light: extinction along ξ and the event there.
 pub struct LightMedium {

@@ -8,8 +8,9 @@ use strandlight_tables::table_axes::{
 };
 
 use super::*;
-use crate::env::{EnvLight, ForwardScatteringSource};
+use crate::env_light::EnvLight;
 use crate::hair::{Attribute, HairModel};
+use crate::multiple::ForwardScatteringSource;
 
 const A_F: [f64; 3] = [0.9, 0.6, 0.3];
 const BETA2_F: f64 = 0.01;

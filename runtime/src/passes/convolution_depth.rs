@@ -64,9 +64,6 @@ pub enum DodmSettingsError {
     Kappa(f32),
 }
 
-/// WebGPU's default `max_storage_buffer_binding_size` (128 MiB): what every adapter grants.
-const PORTABLE_STORAGE_BINDING_BYTES: u64 = 128 << 20;
-
 impl DodmSettings {
     /// Texels across the maps of κ-simplified lights: `resolution` × √κ (at least 16, at most
     /// `resolution`). A simplified map holds κ of the strands, each widened to cover the ones
@@ -84,19 +81,6 @@ impl DodmSettings {
     pub fn simplified_enlargement(&self, kappa: f32) -> f32 {
         let texel_ratio = self.simplified_resolution(kappa) as f32 / self.resolution as f32;
         (texel_ratio / kappa).max(1.0)
-    }
-
-    /// The default settings with `resolution`² maps and the largest batch, up to the default
-    /// 16, whose summed-area tables fit one storage binding on any adapter (2048² maps: 2).
-    pub fn at_resolution(resolution: u32) -> Self {
-        let per_slot = (resolution as u64).pow(2) * super::summed_area::SAT_TEXEL_BYTES;
-        let default = Self::default();
-        let fits = (PORTABLE_STORAGE_BINDING_BYTES / per_slot.max(1)).max(1);
-        Self {
-            resolution,
-            batch_size: fits.min(default.batch_size as u64) as u32,
-            ..default
-        }
     }
 
     pub fn check(&self) -> Result<(), DodmSettingsError> {
@@ -664,17 +648,6 @@ mod tests {
         let tiny = DodmSettings::at_resolution(8);
         assert_eq!(tiny.simplified_resolution(0.1), 8);
         assert!((tiny.simplified_enlargement(0.9) - 1.0 / 0.9).abs() < 1e-6);
-    }
-
-    #[test]
-    fn a_resolution_gets_the_largest_batch_that_fits_a_portable_binding() {
-        assert_eq!(DodmSettings::at_resolution(512), DodmSettings::default());
-        for (resolution, batch) in [(256, 16), (1024, 8), (2048, 2)] {
-            let s = DodmSettings::at_resolution(resolution);
-            assert_eq!((s.resolution, s.batch_size), (resolution, batch));
-            let bytes = (resolution as u64).pow(2) * 16 * batch as u64;
-            assert!(bytes <= 128 << 20 && bytes * 2 > 128 << 20 || batch == 16);
-        }
     }
 
     #[test]

@@ -21,13 +21,16 @@ use super::strand_geometry::StrandGeometry;
 use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
 use super::summed_area::{MAX_BOX_HALF_SIZE, SummedAreaTables};
 use super::transmittance_filter::TransmittanceFilter;
-use super::view_visibility::{OccupancyMap, ViewTransparency, ViewVisibilityPass};
-use crate::env::{EnvLight, ForwardScatteringGrid, ShadowGroup};
+use super::view_visibility::{
+    NEAREST_SURFACE_FORMAT, OccupancyMap, ViewTransparency, ViewVisibilityPass,
+};
+use crate::env_light::{EnvLight, ShadowGroup};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{
     float_array_texture_entry, float_texture_entry, pipeline_layout, storage_entry, uniform_entry,
 };
 use crate::gpu::texture::texture_2d;
+use crate::multiple::ForwardScatteringGrid;
 use crate::visibility::VisibilityVolume;
 
 #[repr(C)]
@@ -562,9 +565,6 @@ pub struct EnvViewTargets {
     pub nearest_position: wgpu::Texture,
     pub nearest_tangent: wgpu::Texture,
 }
-
-/// The format of [`EnvViewTargets::nearest_position`] and `nearest_tangent`.
-pub const NEAREST_SURFACE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 impl EnvViewTargets {
     pub fn new(gpu: &GpuContext, width: u32, height: u32, transparency: ViewTransparency) -> Self {

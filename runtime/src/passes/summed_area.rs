@@ -11,7 +11,7 @@
 
 use wgpu::util::DeviceExt;
 
-use super::convolution_depth::DodmBatch;
+use super::convolution_depth::{DodmBatch, DodmSettings};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{storage_entry, texture_entry, uniform_entry};
 use crate::gpu::limits::{GpuLimits, LimitError};
@@ -191,6 +191,25 @@ impl SummedAreaPass {
     }
 }
 
+/// WebGPU's default `max_storage_buffer_binding_size` (128 MiB): what every adapter grants.
+const PORTABLE_STORAGE_BINDING_BYTES: u64 = 128 << 20;
+
+/// The batch a light-map size allows is set by the SAT: its tables must fit one storage binding.
+impl DodmSettings {
+    /// The default settings with `resolution`² maps and the largest batch, up to the default
+    /// 16, whose summed-area tables fit one storage binding on any adapter (2048² maps: 2).
+    pub fn at_resolution(resolution: u32) -> Self {
+        let per_slot = (resolution as u64).pow(2) * SAT_TEXEL_BYTES;
+        let default = Self::default();
+        let fits = (PORTABLE_STORAGE_BINDING_BYTES / per_slot.max(1)).max(1);
+        Self {
+            resolution,
+            batch_size: fits.min(default.batch_size as u64) as u32,
+            ..default
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -204,5 +223,16 @@ mod tests {
         assert!(side * side * quantize_optical_depth(MAX_TEXEL_TAU) as u64 <= u32::MAX as u64);
         // One more texel a side would overflow.
         assert!((side + 2) * (side + 2) * 4096 > u32::MAX as u64);
+    }
+
+    #[test]
+    fn a_resolution_gets_the_largest_batch_that_fits_a_portable_binding() {
+        assert_eq!(DodmSettings::at_resolution(512), DodmSettings::default());
+        for (resolution, batch) in [(256, 16), (1024, 8), (2048, 2)] {
+            let s = DodmSettings::at_resolution(resolution);
+            assert_eq!((s.resolution, s.batch_size), (resolution, batch));
+            let bytes = (resolution as u64).pow(2) * 16 * batch as u64;
+            assert!(bytes <= 128 << 20 && bytes * 2 > 128 << 20 || batch == 16);
+        }
     }
 }

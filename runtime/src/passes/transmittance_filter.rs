@@ -6,7 +6,7 @@
 
 use strandlight_tables::srbf::support_angle;
 
-use crate::env::EnvLight;
+use crate::env_light::EnvLight;
 
 /// The largest slope used, for every filter (an SRBF wider than ~89°, λ < ~7, is limited by the
 /// box size anyway).

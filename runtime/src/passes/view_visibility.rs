@@ -18,11 +18,14 @@
 //! (occupancy).
 
 use super::attachments::{cleared_color, cleared_depth, prepassed_depth};
-use super::env_view::NEAREST_SURFACE_FORMAT;
 use super::render_target::{DEPTH_FORMAT, RenderTarget};
 use crate::gpu::GpuContext;
 use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels};
 use crate::gpu::readback::{ReadbackError, read_texture_rgba};
+
+/// The format of the view's nearest-surface targets (`EnvViewTargets::nearest_position` and
+/// `nearest_tangent`), which this pass writes and the shading pass reads.
+pub const NEAREST_SURFACE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 /// How the env view pass weighs the fragments of a pixel.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -1,0 +1,202 @@
+//! The lights of an environment-lit frame: SRBF lobes (with a bandwidth λ) and directional
+//! lights (the fit's compact sources, the reference's and median cut's samples), and how they
+//! group into shadow batches. Every pass that shades or shadows them imports them from here.
+
+use glam::Vec3;
+
+/// One light of an environment.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EnvLight {
+    /// Unit vector toward the light (the SRBF centre ξ).
+    pub direction: Vec3,
+    /// SRBF bandwidth λ; `None` for a directional light.
+    pub lambda: Option<f32>,
+    /// SRBF amplitude L_j (radiance) for an SRBF; for a directional light its irradiance at
+    /// normal incidence (the radiance it stands for × the solid angle it covers).
+    pub rgb: [f32; 3],
+    /// Directional lights only: the direction of the shadow map this light's visibility is read
+    /// from, shared by every light of one run of consecutive lights with the same value (one
+    /// light pass for the run; see [`ShadowGroup`]). `None`: its own map, along `direction`.
+    /// The reference uses it to shade a cube texel's light over finer sub-texels whose
+    /// visibility is the texel's (`precompute/src/env_lights.rs`).
+    pub shadowed_from: Option<Vec3>,
+    /// Draw every strand into this light's map whatever the frame's κ. SRBFs default to κ's
+    /// thinning (Ren §7): its noise costs most on the few powerful lobes, and
+    /// [`mark_every_strand`] picks them (adaptive κ). Directional lights (the reference's, the
+    /// baseline's, a sun's) draw every strand.
+    pub every_strand: bool,
+    /// Directional lights only: per-axis variance (rad²) of the directions the light stands
+    /// for (an extended compact source: a softbox, a sun's disc). Its visibility is averaged
+    /// over a box matched to it, as an SRBF's is over its lobe
+    /// ([`TransmittanceFilter`](crate::env::render::TransmittanceFilter)); 0 reads one texel.
+    pub angular_variance: f32,
+}
+
+impl EnvLight {
+    pub fn srbf(direction: Vec3, lambda: f32, amplitude: [f32; 3]) -> Self {
+        Self {
+            direction: direction.normalize(),
+            lambda: Some(lambda),
+            rgb: amplitude,
+            shadowed_from: None,
+            every_strand: false,
+            angular_variance: 0.0,
+        }
+    }
+
+    pub fn directional(direction: Vec3, irradiance: [f32; 3]) -> Self {
+        Self {
+            direction: direction.normalize(),
+            lambda: None,
+            rgb: irradiance,
+            shadowed_from: None,
+            every_strand: true,
+            angular_variance: 0.0,
+        }
+    }
+
+    /// A directional light standing for directions spread by `variance` (rad² per axis) about
+    /// `direction`: [`EnvLight::angular_variance`].
+    pub fn extended(direction: Vec3, irradiance: [f32; 3], variance: f32) -> Self {
+        Self {
+            angular_variance: variance,
+            ..Self::directional(direction, irradiance)
+        }
+    }
+
+    /// A directional light whose visibility is that of the shadow map along `shadowed_from`.
+    pub fn directional_shadowed_from(
+        direction: Vec3,
+        irradiance: [f32; 3],
+        shadowed_from: Vec3,
+    ) -> Self {
+        Self {
+            shadowed_from: Some(shadowed_from.normalize()),
+            ..Self::directional(direction, irradiance)
+        }
+    }
+
+    /// Whether stochastic simplification thins this light's map (κ < 1 draws only its window
+    /// of the strands): a light not marked [`EnvLight::every_strand`].
+    pub fn is_simplified(&self) -> bool {
+        !self.every_strand
+    }
+
+    /// The direction of the light pass whose map shadows this light.
+    pub fn shadow_direction(&self) -> Vec3 {
+        self.shadowed_from.unwrap_or(self.direction)
+    }
+
+    /// [`EnvLight::power`]'s luminance (Rec. 709 weights): how lights are ranked by strength.
+    pub fn luminous_power(&self) -> f32 {
+        let [r, g, b] = self.power();
+        0.2126 * r + 0.7152 * g + 0.0722 * b
+    }
+
+    /// What the light delivers to a fiber facing it, before shadowing: for an SRBF its
+    /// amplitude × ∫G dω = L_j · 2π/λ · (1 − e^{−2λ}); for a directional light its irradiance.
+    /// The multiple-scattering term (normalized spread function ψ_f) is weighted by this.
+    pub fn power(&self) -> [f32; 3] {
+        match self.lambda {
+            None => self.rgb,
+            Some(lambda) => {
+                let l = lambda as f64;
+                let integral = 2.0 * std::f64::consts::PI / l * -(-2.0 * l).exp_m1();
+                self.rgb.map(|c| (c as f64 * integral) as f32)
+            }
+        }
+    }
+}
+
+/// Marks the most powerful SRBF lights holding at least `share` of the SRBF lights' luminous
+/// power as [`EnvLight::every_strand`] (and clears the mark on the rest): adaptive κ, the
+/// simplification kept for the many weak lobes where its noise costs little. `share` ≤ 0 marks
+/// none, ≥ 1 all. Returns how many were marked.
+pub fn mark_every_strand(lights: &mut [EnvLight], share: f32) -> usize {
+    let mut order: Vec<usize> = (0..lights.len())
+        .filter(|&i| lights[i].lambda.is_some())
+        .collect();
+    order.sort_by(|&a, &b| {
+        lights[b]
+            .luminous_power()
+            .total_cmp(&lights[a].luminous_power())
+    });
+    let total: f32 = order.iter().map(|&i| lights[i].luminous_power()).sum();
+    let mut held = 0.0;
+    let mut marked = 0;
+    for i in order {
+        let mark = share > 0.0 && (held < share * total || share >= 1.0);
+        lights[i].every_strand = mark;
+        if mark {
+            held += lights[i].luminous_power();
+            marked += 1;
+        }
+    }
+    marked
+}
+
+/// Consecutive lights that share one shadow map (one DODM slot, one light pass, one
+/// forward-scattering grid block): a run of directional lights with the same
+/// [`EnvLight::shadowed_from`], or any other light alone.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowGroup<'a> {
+    /// The light pass's direction.
+    pub direction: Vec3,
+    /// The lights shaded with its visibility (at least one).
+    pub lights: &'a [EnvLight],
+}
+
+impl ShadowGroup<'_> {
+    /// One light standing for the group where only the map's direction matters (the light
+    /// pass, the forward-scattering march): the first light moved to the map's direction.
+    pub fn representative(&self) -> EnvLight {
+        EnvLight {
+            direction: self.direction,
+            shadowed_from: None,
+            ..self.lights[0]
+        }
+    }
+}
+
+/// `lights` cut into [`ShadowGroup`]s, in order.
+pub fn shadow_groups(lights: &[EnvLight]) -> Vec<ShadowGroup<'_>> {
+    let shares = |a: &EnvLight, b: &EnvLight| {
+        a.lambda.is_none() && a.shadowed_from.is_some() && a.shadowed_from == b.shadowed_from
+    };
+    lights
+        .chunk_by(shares)
+        .map(|run| ShadowGroup {
+            direction: run[0].shadow_direction(),
+            lights: run,
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lobe(amplitude: f32) -> EnvLight {
+        EnvLight::srbf(Vec3::Z, 10.0, [amplitude; 3])
+    }
+
+    #[test]
+    fn every_strand_goes_to_the_strongest_lobes_until_the_share_is_held() {
+        // Powers 4 : 3 : 2 : 1 (same λ); the sun is directional: every strand, left alone.
+        let sun = EnvLight::directional(Vec3::X, [100.0; 3]);
+        let mut lights = vec![lobe(2.0), sun, lobe(4.0), lobe(1.0), lobe(3.0)];
+        let marked =
+            |lights: &[EnvLight]| -> Vec<bool> { lights.iter().map(|l| l.every_strand).collect() };
+        // 40% of 10: the strongest (4) alone holds it.
+        assert_eq!(mark_every_strand(&mut lights, 0.4), 1);
+        assert_eq!(marked(&lights), [false, true, true, false, false]);
+        // 50%: 4 holds 40%, so 3 joins (70%).
+        assert_eq!(mark_every_strand(&mut lights, 0.5), 2);
+        assert_eq!(marked(&lights), [false, true, true, false, true]);
+        assert_eq!(mark_every_strand(&mut lights, 1.0), 4);
+        assert_eq!(marked(&lights), [true; 5]);
+        // 0 clears every earlier mark.
+        assert_eq!(mark_every_strand(&mut lights, 0.0), 0);
+        assert_eq!(marked(&lights), [false, true, false, false, false]);
+    }
+}

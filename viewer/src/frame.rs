@@ -1,0 +1,40 @@
+//! A rendered frame as the window shows it: the linear image, how far its refinement is, and
+//! what it cost. The render thread produces it, progressive refinement sums it, the window and
+//! screenshots read it.
+
+use strandlight_runtime::render::PassTiming;
+
+/// A frame in linear, pre-multiplied RGBA.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinearImage {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<[f32; 4]>,
+}
+
+/// How far the shown image is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stage {
+    Preview,
+    /// `done` of `total` light batches summed.
+    Refining {
+        done: usize,
+        total: usize,
+    },
+    Converged,
+}
+
+/// What the overlay reports of the shown image.
+#[derive(Clone, Debug, Default)]
+pub struct FrameStats {
+    /// Time per pass, summed over the batches so far.
+    pub passes: Vec<PassTiming>,
+    /// GPU memory per resource while one batch renders, bytes.
+    pub memory: Vec<(String, u64)>,
+    /// Lights drawn (SRBF lobes and directional sources, or point lights).
+    pub lights: usize,
+    /// Render calls (light batches) so far.
+    pub batches: usize,
+    pub adapter: String,
+    pub timing_method: String,
+}
