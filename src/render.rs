@@ -1,8 +1,9 @@
-//! `strandlight render`: one headless frame of a hair model under point lights, written as a
-//! linear EXR and a tonemapped PNG, with timings and GPU memory on request.
+//! `strandlight render env|lights|replay`: one headless frame of a hair model under an
+//! environment map or point lights, written as a linear EXR and a tonemapped PNG, with timings
+//! and GPU memory on request.
 
 use anyhow::bail;
-use clap::Args;
+use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
@@ -17,99 +18,47 @@ use strandlight_scene::frame_settings::{
     Transparency,
 };
 use strandlight_scene::hair_input::parse_size;
-use strandlight_scene::look::{EnvLook, EnvTransparency};
+use strandlight_scene::look::{EnvLook, LookArgs};
 use strandlight_scene::point_shading::{Shading, read_artist_params};
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 
+/// `render env`, `render lights` or `render replay`: each lighting has its own flags, so no
+/// flag belongs to two renderers.
 #[derive(Args, Debug)]
 pub struct RenderArgs {
+    #[command(subcommand)]
+    what: RenderWhat,
+}
+
+#[derive(Subcommand, Debug)]
+enum RenderWhat {
+    /// Under an environment map: SRBF fit and tables (both cached under out/cache), Ren 2010's
+    /// env-lit frame.
+    Env(EnvArgs),
+    /// Under directional, point or spot lights, with the theses' shadow and transparency
+    /// techniques.
+    Lights(LightsArgs),
+    /// Exactly the settings of a JSON file: the sidecar of a viewer screenshot.
+    Replay(ReplayArgs),
+}
+
+/// What every frame needs: the hair, its fiber, the image and the camera.
+#[derive(Args, Debug)]
+#[command(next_help_heading = "Scene")]
+struct SceneArgs {
     /// Hair file (.hair, .tfx, .data, .ply); the procedural groom when omitted.
     #[arg(long)]
     hair: Option<PathBuf>,
-    /// Repeatable: directional:X,Y,Z[:I] (toward the light), point:X,Y,Z[:I],
-    /// spot:X,Y,Z:DX,DY,DZ:HALF_ANGLE_DEGREES[:I].
-    #[arg(long = "light", default_value = DEFAULT_LIGHT)]
-    lights: Vec<String>,
-    /// Fiber model (default: kajiya-kay for point lights, marschner with --env).
+    /// Fiber model (default: kajiya-kay under lights, marschner under an environment).
     #[arg(long, value_enum)]
     shading: Option<Shading>,
-    /// Light the hair with an environment instead: a .hdr/.exr map or procedural:NAME, fitted
-    /// with SRBFs (cached) and rendered by Ren 2010's method (marschner or artist shading).
-    #[arg(long, value_name = "MAP")]
-    pub env: Option<String>,
-    /// With --env: single scattering, or full (single + multiple; skipped for dark hair).
-    #[arg(long, value_enum, default_value = "full")]
-    pub scattering: ScatteringMode,
-    /// With --env: fraction of the strands drawn into the light maps (Ren §7; 1 = all).
-    #[arg(long, default_value_t = 0.1)]
-    pub kappa: f32,
-    /// With --env: only the N most powerful SRBF lobes (a fit's compact sources are kept).
-    #[arg(long)]
-    lobes: Option<usize>,
-    /// With --env: the environment turned about the hair's up axis, degrees (the fitted lobes
-    /// are rotated exactly; nothing is refitted).
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    env_rotation: f32,
-    /// With --env: convolution optical depth map resolution (square).
-    #[arg(long, default_value_t = 512)]
-    dodm_size: u32,
-    /// Melanin preset of the Marschner fiber (--shading marschner): dark, brown, blonde, ...
+    /// Melanin preset of the Marschner and Chiang fibers: dark, brown, blonde, ...
     #[arg(long, default_value = "brown")]
     preset: String,
-    /// Nodes per axis of the Marschner lookup tables, baked at startup.
-    #[arg(long, default_value_t = 128)]
-    lut_size: usize,
     /// JSON file of artist-model controls (--shading artist; default: the built-in light brown).
     #[arg(long)]
     artist_params: Option<PathBuf>,
-    #[arg(long, value_enum, default_value = "none")]
-    shadows: Shadows,
-    #[arg(long, value_enum, default_value = "none")]
-    transparency: Transparency,
-    /// With --env: the env-lit renderer's view choices.
-    #[command(flatten)]
-    env_view: strandlight_scene::look::ViewArgs,
-    /// Deep opacity map layers (1..=32), with --shadows dom.
-    #[arg(long, default_value_t = 4)]
-    dom_layers: u32,
-    /// Layer spacing in world units (default: 1% of the hair's bounding-box diagonal).
-    #[arg(long)]
-    dom_spacing: Option<f32>,
-    /// Opacity shadow map slices across the hair's depth range (1..=32), with --shadows osm.
-    #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_OSM_SLICES)]
-    osm_slices: u32,
-    /// Light map resolution (square) of every --shadows technique.
-    #[arg(long, default_value_t = 512)]
-    dom_size: u32,
-    /// Percentage-closer filter of every light map, texels per side (odd, 1..=9).
-    #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_PCF_KERNEL)]
-    pcf: u32,
-    /// Shadow map and ADSM depth bias along the light, world units (default: two map texels).
-    #[arg(long)]
-    shadow_bias: Option<f32>,
-    /// ADSM: opacity of one fiber, in (0, 1).
-    #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_ADSM_ALPHA)]
-    adsm_alpha: f32,
-    /// ADSM: world units between fibers along the light (default: 1% of the hair's diagonal).
-    #[arg(long)]
-    adsm_spacing: Option<f32>,
-    /// Sorted blending (--transparency sorted): depth bins of the counting sort.
-    #[arg(long, default_value_t = strandlight_runtime::passes::sorted_blend::DEFAULT_SORT_BINS)]
-    sort_bins: u32,
-    /// K-buffer (--transparency kbuffer): fragments kept per pixel, nearest first.
-    #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_KBUFFER_K)]
-    kbuffer_k: u32,
-    /// Random subsets (--transparency subsets): how many (1..=16).
-    #[arg(long, default_value_t = strandlight_runtime::passes::random_subsets::DEFAULT_SUBSETS)]
-    subsets: u32,
-    /// A-buffer/DBK node pool in nodes per pixel (clamped to the adapter's limit). Default:
-    /// sized to exactly the fragments the technique stores, counted by a first build.
-    #[arg(long)]
-    abuffer_nodes_per_pixel: Option<u32>,
-    /// DBK layer depth Δ in world units (default: 5% of the hair's bounding-box diagonal).
-    #[arg(long)]
-    dbk_delta: Option<f32>,
     /// Image size WxH in pixels.
     #[arg(long, default_value = "512x512")]
     size: String,
@@ -126,16 +75,125 @@ pub struct RenderArgs {
     /// Every fiber this many pixels wide (default: the file's thickness, projected).
     #[arg(long)]
     fiber_width_px: Option<f32>,
-    /// Render exactly the settings of this JSON file (the sidecar of a viewer screenshot)
-    /// instead of the flags above; --out and --json still apply.
-    #[arg(long, value_name = "SETTINGS_JSON")]
-    replay: Option<PathBuf>,
+}
+
+/// Where the frame goes.
+#[derive(Args, Debug)]
+#[command(next_help_heading = "Output")]
+struct OutputArgs {
     /// Output stem: writes STEM.exr (linear) and STEM.png (tonemapped).
     #[arg(long, default_value = "render")]
     out: PathBuf,
     /// Print adapter, per-pass milliseconds and GPU memory as JSON.
     #[arg(long)]
     json: bool,
+}
+
+#[derive(Args, Debug)]
+struct EnvArgs {
+    /// A .hdr/.exr map or procedural:NAME, fitted with SRBFs (cached).
+    #[arg(long, value_name = "MAP")]
+    env: String,
+    /// Single scattering, or full (single + multiple; skipped for dark hair).
+    #[arg(long, value_enum, default_value = "full")]
+    scattering: ScatteringMode,
+    /// Fraction of the strands drawn into the light maps (Ren §7; 1 = all).
+    #[arg(long, default_value_t = 0.1)]
+    kappa: f32,
+    /// Only the N most powerful SRBF lobes (a fit's compact sources are kept); default: all.
+    #[arg(long, value_name = "N")]
+    strongest_lobes: Option<usize>,
+    /// The environment turned about the hair's up axis, degrees (the fitted lobes are rotated
+    /// exactly; nothing is refitted).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    rotate: f32,
+    /// Side of each light's convolution optical depth map, texels.
+    #[arg(long, default_value_t = 512)]
+    light_map_size: u32,
+    #[command(flatten)]
+    look: LookArgs,
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    output: OutputArgs,
+}
+
+#[derive(Args, Debug)]
+struct LightsArgs {
+    /// Repeatable: directional:X,Y,Z[:I] (toward the light), point:X,Y,Z[:I],
+    /// spot:X,Y,Z:DX,DY,DZ:HALF_ANGLE_DEGREES[:I].
+    #[arg(long = "light", default_value = DEFAULT_LIGHT)]
+    lights: Vec<String>,
+    /// Nodes per axis of the Marschner and Chiang lookup tables, baked at startup.
+    #[arg(long, default_value_t = 128)]
+    lut_size: usize,
+    #[command(flatten)]
+    shadows: ShadowArgs,
+    #[command(flatten)]
+    transparency: TransparencyArgs,
+    #[command(flatten)]
+    scene: SceneArgs,
+    #[command(flatten)]
+    output: OutputArgs,
+}
+
+/// The shadow technique of `render lights` and its parameters.
+#[derive(Args, Debug)]
+#[command(next_help_heading = "Shadows")]
+struct ShadowArgs {
+    #[arg(long, value_enum, default_value = "none")]
+    shadows: Shadows,
+    /// Side of every shadow technique's light map, texels.
+    #[arg(long, default_value_t = 512)]
+    light_map_size: u32,
+    /// Percentage-closer filter of every light map, texels per side (odd, 1..=9).
+    #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_PCF_KERNEL)]
+    pcf: u32,
+    /// Depth layers of the layered light maps: deep opacity map layers with --shadows dom
+    /// (1..=32, default 4), opacity shadow map slices with --shadows osm (1..=32, default 16).
+    #[arg(long, value_name = "N")]
+    layers: Option<u32>,
+    /// Deep opacity layer spacing in world units (default: 1% of the hair's bounding-box
+    /// diagonal).
+    #[arg(long)]
+    dom_spacing: Option<f32>,
+    /// Shadow map and ADSM depth bias along the light, world units (default: two map texels).
+    #[arg(long)]
+    shadow_bias: Option<f32>,
+    /// ADSM: opacity of one fiber, in (0, 1).
+    #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_ADSM_ALPHA)]
+    adsm_alpha: f32,
+    /// ADSM: world units between fibers along the light (default: 1% of the hair's diagonal).
+    #[arg(long)]
+    adsm_spacing: Option<f32>,
+}
+
+/// The transparency technique of `render lights` and its parameters. Its finer settings (the
+/// sorted blend's depth bins, the A-buffer's node pool, sized exactly by default) are read from
+/// a settings file: `render replay`.
+#[derive(Args, Debug)]
+#[command(next_help_heading = "Transparency")]
+struct TransparencyArgs {
+    #[arg(long, value_enum, default_value = "none")]
+    transparency: Transparency,
+    /// K-buffer (--transparency kbuffer): fragments kept per pixel, nearest first.
+    #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_KBUFFER_K)]
+    kbuffer_k: u32,
+    /// Random subsets (--transparency subsets): how many (1..=16).
+    #[arg(long, default_value_t = strandlight_runtime::passes::random_subsets::DEFAULT_SUBSETS)]
+    subsets: u32,
+    /// DBK layer depth Δ in world units (default: 5% of the hair's bounding-box diagonal).
+    #[arg(long)]
+    dbk_delta: Option<f32>,
+}
+
+#[derive(Args, Debug)]
+struct ReplayArgs {
+    /// The settings JSON (a viewer screenshot's sidecar, or one written by hand).
+    #[arg(value_name = "SETTINGS_JSON")]
+    settings: PathBuf,
+    #[command(flatten)]
+    output: OutputArgs,
 }
 
 /// `render.exr` → `render`: the stem may be given with either extension.
@@ -158,97 +216,92 @@ fn parse_vec3(flag: &str, text: &str) -> anyhow::Result<[f32; 3]> {
 }
 
 /// The camera `--camera`, `--up` and `--eye` ask for.
-fn camera_choice(args: &RenderArgs) -> anyhow::Result<CameraChoice> {
-    let eye = args
+fn camera_choice(scene: &SceneArgs) -> anyhow::Result<CameraChoice> {
+    let eye = scene
         .eye
         .as_deref()
         .map(|text| parse_vec3("--eye", text))
         .transpose()?;
     Ok(CameraChoice {
-        kind: args.camera,
-        up: args.up,
+        kind: scene.camera,
+        up: scene.up,
         eye,
     })
 }
 
-/// The frame the flags describe.
-fn settings_from_args(args: &RenderArgs) -> anyhow::Result<FrameSettings> {
-    let (width, height) = parse_size(&args.size)?;
-    let lighting = match &args.env {
-        Some(map) => {
-            if !matches!(
-                args.transparency,
-                Transparency::None | Transparency::Occupancy
-            ) || args.shadows != Shadows::None
-            {
-                bail!(
-                    "--env shadows every SRBF light with its convolution optical depth map and renders opaque (none) or through an occupancy map (occupancy); --shadows and --transparency sorted/abuffer/kbuffer/dbk/subsets apply to point lights only"
-                );
-            }
-            Lighting::Environment(EnvLighting {
-                scattering: args.scattering,
-                kappa: args.kappa,
-                lobes: args.lobes,
-                rotation_deg: args.env_rotation,
-                dodm_size: args.dodm_size,
-                transparency: match args.transparency {
-                    Transparency::Occupancy => EnvTransparency::Occupancy,
-                    _ => EnvTransparency::Opaque,
-                },
-                view: args.env_view,
-                ..EnvLighting::new(map.clone())
-            })
-        }
-        None => Lighting::Lights(PointLighting {
-            lights: args.lights.clone(),
-            shadows: args.shadows,
-            transparency: args.transparency,
-            dom_layers: args.dom_layers,
-            osm_slices: args.osm_slices,
-            pcf_kernel: args.pcf,
-            sort_bins: args.sort_bins,
-            kbuffer_k: args.kbuffer_k,
-            subsets: args.subsets,
-            shadow_bias: args.shadow_bias,
-            adsm_alpha: args.adsm_alpha,
-            adsm_spacing: args.adsm_spacing,
-            dom_spacing: args.dom_spacing,
-            dom_size: args.dom_size,
-            abuffer_nodes_per_pixel: args.abuffer_nodes_per_pixel,
-            dbk_delta: args.dbk_delta,
-            lut_size: args.lut_size,
-        }),
-    };
+/// The frame `scene`'s flags describe, lit by `lighting`.
+fn frame_settings(scene: &SceneArgs, lighting: Lighting) -> anyhow::Result<FrameSettings> {
+    let (width, height) = parse_size(&scene.size)?;
     Ok(FrameSettings {
-        hair: args.hair.clone(),
+        hair: scene.hair.clone(),
         size: [width, height],
-        camera: CameraSettings::Framed(camera_choice(args)?),
-        shading: args.shading,
-        preset: args.preset.clone(),
-        artist: args
+        camera: CameraSettings::Framed(camera_choice(scene)?),
+        shading: scene.shading,
+        preset: scene.preset.clone(),
+        artist: scene
             .artist_params
             .as_deref()
             .map(read_artist_params)
             .transpose()?,
-        fiber_width_px: args.fiber_width_px,
+        fiber_width_px: scene.fiber_width_px,
         lighting,
     })
 }
 
+fn env_lighting(args: &EnvArgs) -> Lighting {
+    Lighting::Environment(EnvLighting {
+        scattering: args.scattering,
+        kappa: args.kappa,
+        lobes: args.strongest_lobes,
+        rotation_deg: args.rotate,
+        dodm_size: args.light_map_size,
+        transparency: args.look.transparency,
+        view: args.look.view,
+        ..EnvLighting::new(args.env.clone())
+    })
+}
+
+fn point_lighting(args: &LightsArgs) -> Lighting {
+    let (shadows, transparency) = (&args.shadows, &args.transparency);
+    let defaults = PointLighting::default();
+    Lighting::Lights(PointLighting {
+        lights: args.lights.clone(),
+        shadows: shadows.shadows,
+        transparency: transparency.transparency,
+        dom_layers: shadows.layers.unwrap_or(defaults.dom_layers),
+        osm_slices: shadows.layers.unwrap_or(defaults.osm_slices),
+        pcf_kernel: shadows.pcf,
+        kbuffer_k: transparency.kbuffer_k,
+        subsets: transparency.subsets,
+        shadow_bias: shadows.shadow_bias,
+        adsm_alpha: shadows.adsm_alpha,
+        adsm_spacing: shadows.adsm_spacing,
+        dom_spacing: shadows.dom_spacing,
+        dom_size: shadows.light_map_size,
+        dbk_delta: transparency.dbk_delta,
+        lut_size: args.lut_size,
+        ..defaults
+    })
+}
+
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
-    let settings = match &args.replay {
-        Some(path) => FrameSettings::read(path)?,
-        None => settings_from_args(&args)?,
+    let (settings, output) = match &args.what {
+        RenderWhat::Env(env) => (frame_settings(&env.scene, env_lighting(env))?, &env.output),
+        RenderWhat::Lights(lights) => (
+            frame_settings(&lights.scene, point_lighting(lights))?,
+            &lights.output,
+        ),
+        RenderWhat::Replay(replay) => (FrameSettings::read(&replay.settings)?, &replay.output),
     };
     settings.check()?;
     match &settings.lighting {
-        Lighting::Lights(point) => run_point(&args, &settings, point),
-        Lighting::Environment(env) => run_env(&args, &settings, env),
+        Lighting::Lights(point) => run_point(output, &settings, point),
+        Lighting::Environment(env) => run_env(output, &settings, env),
     }
 }
 
 fn run_point(
-    args: &RenderArgs,
+    args: &OutputArgs,
     settings: &FrameSettings,
     point: &PointLighting,
 ) -> anyhow::Result<()> {
@@ -323,8 +376,8 @@ fn run_point(
     Ok(())
 }
 
-/// `render --env MAP`: the SRBF path alone (fit and tables cached under out/cache).
-fn run_env(args: &RenderArgs, settings: &FrameSettings, env: &EnvLighting) -> anyhow::Result<()> {
+/// `render env`: the SRBF path alone (fit and tables cached under out/cache).
+fn run_env(args: &OutputArgs, settings: &FrameSettings, env: &EnvLighting) -> anyhow::Result<()> {
     let look = EnvLook {
         count_fragments: args.json,
         ..env_look(env)?

@@ -19,7 +19,7 @@ pub struct ViewArgs {
     /// Environment map (.hdr/.exr or procedural:NAME); the demo's sun and sky by default.
     #[arg(long, value_name = "MAP")]
     env: Option<String>,
-    /// Point-light mode instead: repeatable, as `render --light`.
+    /// Point-light mode instead: repeatable, as `render lights --light`.
     #[arg(long = "light")]
     lights: Vec<String>,
     /// Fiber model (default: marschner under an environment, kajiya-kay under lights).
@@ -37,7 +37,7 @@ pub struct ViewArgs {
     replay: Option<PathBuf>,
     /// Fit and table cache (shared with `render`).
     #[arg(long, default_value = "out/cache")]
-    cache_dir: PathBuf,
+    cache: PathBuf,
     /// Drive the window with this JSON list of steps (see viewer/src/script.rs), then exit.
     #[arg(long)]
     script: Option<PathBuf>,
@@ -90,7 +90,7 @@ fn settings(args: &ViewArgs) -> anyhow::Result<FrameSettings> {
 pub fn run(args: ViewArgs) -> anyhow::Result<()> {
     strandlight_viewer::run(strandlight_viewer::ViewOptions {
         settings: settings(&args)?,
-        cache_dir: args.cache_dir,
+        cache_dir: args.cache,
         script: args.script,
         screenshot: args.screenshot,
         frames: args.frames,

@@ -106,7 +106,7 @@ fn render_past_the_texture_limit_fails_cleanly_without_output() {
     std::fs::create_dir_all(&dir).expect("a temporary directory");
     let stem = dir.join("huge");
     let out = Command::new(env!("CARGO_BIN_EXE_strandlight"))
-        .args(["render", "--size", "100000x100000", "--out"])
+        .args(["render", "lights", "--size", "100000x100000", "--out"])
         .arg(&stem)
         .output()
         .expect("the strandlight binary runs");

@@ -4,7 +4,7 @@
 //! - the window kept presenting frames while the rebake ran (no gap near the bake's length);
 //! - the screenshot is not blank, and its sidecar holds the orbited camera and the new control;
 //! - the capture of the whole window shows the screenshot's picture where the image sits;
-//! - `render --replay` of the sidecar reproduces the screenshot's linear EXR.
+//! - `render replay` of the sidecar reproduces the screenshot's linear EXR.
 
 use serde_json::{Value, json};
 use std::path::Path;
@@ -181,7 +181,7 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
     assert_eq!(sidecar["artist"]["r"]["intensity"], json!(1.5));
 
     let replay = strandlight(&dir)
-        .args(["render", "--replay", "shot.json", "--out", "replay"])
+        .args(["render", "replay", "shot.json", "--out", "replay"])
         .output()
         .unwrap();
     assert!(

@@ -577,8 +577,8 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
     CompareArgs {
         hair: PathBuf::new(),
         env: map.display().to_string(),
-        lobes: plan.lobes[0],
-        fit_target: FitOptions::default().target_relative_mse,
+        max_lobes: plan.lobes[0],
+        target_error: FitOptions::default().target_relative_mse,
         lambda_max: FitOptions::default().lambda_max,
         sources: strandlight_precompute::compact_sources::SourceOptions::default().max_sources,
         source_radius: strandlight_precompute::compact_sources::SourceOptions::default()

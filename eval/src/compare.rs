@@ -53,11 +53,11 @@ pub struct CompareArgs {
     pub env: String,
     /// Most SRBF lobes the fit may use.
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 64))]
-    pub lobes: usize,
+    pub max_lobes: usize,
     /// The fit's target relative MSE Σw‖fit−map‖²/Σw‖map‖² (lobes are added until it is met
-    /// or --lobes is reached; default: the paper's 15%).
+    /// or --max-lobes is reached; default: the paper's 15%).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = FitOptions::default().target_relative_mse))]
-    pub fit_target: f64,
+    pub target_error: f64,
     /// The fit's largest SRBF bandwidth λ (its narrowest lobe; the tables' 1/λ axis follows
     /// the lobes the fit uses).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = FitOptions::default().lambda_max))]
@@ -236,8 +236,8 @@ pub(crate) fn check_args(args: &CompareArgs) -> anyhow::Result<()> {
 }
 
 fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
-    if args.lobes == 0 {
-        bail!("--lobes 0: at least one SRBF lobe is needed");
+    if args.max_lobes == 0 {
+        bail!("--max-lobes 0: at least one SRBF lobe is needed");
     }
     if args.timing_runs == 0 {
         bail!("--timing-runs 0: at least one render per timing");
@@ -397,12 +397,12 @@ pub fn prepare_with_hair(
         min_norm_share: args.source_min_share,
     };
     let options = FitOptions {
-        max_lobes: args.lobes,
-        initial_lobes: args.lobes.min(FitOptions::default().initial_lobes),
+        max_lobes: args.max_lobes,
+        initial_lobes: args.max_lobes.min(FitOptions::default().initial_lobes),
         rotate_degrees: args.rotate,
         sources,
         wider_source_radius: wider_radius(args.wider_source_radius),
-        target_relative_mse: args.fit_target,
+        target_relative_mse: args.target_error,
         lambda_max: args.lambda_max,
         ..FitOptions::default()
     };
@@ -1233,7 +1233,7 @@ mod tests {
     fn arguments_parse_with_the_issue_defaults_and_bad_values_are_named() {
         let a = args(&["--hair", "h.hair", "--env", "procedural:studio"]).unwrap();
         assert_eq!(
-            (a.lobes, a.size.as_str(), a.reference_lights, a.shading),
+            (a.max_lobes, a.size.as_str(), a.reference_lights, a.shading),
             (64, "640x480", None, EnvShading::Marschner)
         );
         assert_eq!(
@@ -1389,7 +1389,7 @@ mod tests {
                 "groom",
                 "--env",
                 "procedural:studio",
-                "--lobes",
+                "--max-lobes",
                 "8",
                 "--size",
                 "16x12",
@@ -1443,7 +1443,7 @@ mod tests {
             "groom",
             "--env",
             "procedural:studio",
-            "--lobes",
+            "--max-lobes",
             "8",
             "--size",
             "32x24",

@@ -1,6 +1,6 @@
 //! Everything that decides one rendered picture, as one serializable value: what `render` builds
 //! from its flags, what the viewer edits live and writes beside every screenshot, and what
-//! `render --replay` reads back to reproduce that screenshot.
+//! `render replay` reads back to reproduce that screenshot.
 
 use crate::camera_choice::{CameraChoice, UpChoice};
 use crate::look::{EnvTransparency, LookArgs, ViewArgs};
@@ -396,7 +396,7 @@ impl FrameSettings {
             Shading::Chiang => Ok(EnvShading::Chiang),
             Shading::Artist => Ok(EnvShading::Artist),
             Shading::KajiyaKay => bail!(
-                "--shading kajiya-kay with --env: the env renderer reads one RGB 4D table (Marschner I_M, Chiang's or the artist I_A); use --shading marschner, chiang or artist"
+                "--shading kajiya-kay under an environment: the env renderer reads one RGB 4D table (Marschner I_M, Chiang's or the artist I_A); use --shading marschner, chiang or artist"
             ),
         }
     }
@@ -432,7 +432,7 @@ impl PointLighting {
     fn check(&self) -> anyhow::Result<()> {
         if self.transparency == Transparency::Occupancy {
             bail!(
-                "--transparency occupancy is the view of --env (environment lighting); with point lights use none, sorted, abuffer, kbuffer, dbk or subsets"
+                "--transparency occupancy is the view of `render env` (environment lighting); with point lights use none, sorted, abuffer, kbuffer, dbk or subsets"
             );
         }
         if self.lights.is_empty() {
@@ -464,17 +464,14 @@ impl EnvLighting {
             bail!("--kappa {}: must lie in (0, 1]", self.kappa);
         }
         if self.lobes == Some(0) {
-            bail!("--lobes 0: use at least one SRBF lobe (or leave it out for all)");
+            bail!("--strongest-lobes 0: use at least one SRBF lobe (or leave it out for all)");
         }
         if !self.rotation_deg.is_finite() {
-            bail!(
-                "--env-rotation {}: must be a finite angle",
-                self.rotation_deg
-            );
+            bail!("--rotate {}: must be a finite angle", self.rotation_deg);
         }
         if !(16..=MAX_DODM_RESOLUTION).contains(&self.dodm_size) {
             bail!(
-                "--dodm-size {}: must lie in 16..={MAX_DODM_RESOLUTION} texels",
+                "--light-map-size {}: must lie in 16..={MAX_DODM_RESOLUTION} texels",
                 self.dodm_size
             );
         }
@@ -525,9 +522,9 @@ mod tests {
             format!("{:#}", s.check().unwrap_err())
         };
         assert!(env(&|e| e.kappa = 0.0).contains("--kappa"));
-        assert!(env(&|e| e.lobes = Some(0)).contains("--lobes"));
-        assert!(env(&|e| e.dodm_size = 4).contains("--dodm-size"));
-        assert!(env(&|e| e.rotation_deg = f32::NAN).contains("--env-rotation"));
+        assert!(env(&|e| e.lobes = Some(0)).contains("--strongest-lobes"));
+        assert!(env(&|e| e.dodm_size = 4).contains("--light-map-size"));
+        assert!(env(&|e| e.rotation_deg = f32::NAN).contains("--rotate"));
         let mut s = FrameSettings::new(Lighting::Lights(PointLighting::default()), [8, 8]);
         s.shading = Some(Shading::KajiyaKay);
         s.check().unwrap();

@@ -1,5 +1,5 @@
 //! A screenshot: the window's picture as PNG, the linear frame as EXR (what `render` writes), and
-//! the frame's settings as a JSON sidecar that `strandlight render --replay` renders again. The
+//! the frame's settings as a JSON sidecar that `strandlight render replay` renders again. The
 //! settings also go into both images' metadata. The whole window, panel included, is captured
 //! beside them when the window next paints (`window_capture`).
 
@@ -55,7 +55,7 @@ pub fn save(
     let compact = serde_json::to_string(settings)?;
     let look = format!(
         "strandlight view screenshot; exposure {exposure_stops:+.2} stops ({}), background {}; \
-         replay: strandlight render --replay {}; settings {compact}",
+         replay: strandlight render replay {}; settings {compact}",
         if display.exposure_stops.is_none() {
             "auto"
         } else {

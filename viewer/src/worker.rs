@@ -482,7 +482,7 @@ impl WorkerState {
 }
 
 /// The lights of `lights` whose maps κ thins (SRBFs not drawing every strand): a batch's
-/// windows continue from there, so the batches sum to `render --replay`'s one-call frame.
+/// windows continue from there, so the batches sum to `render replay`'s one-call frame.
 fn simplified_lights(lights: &[EnvLight]) -> u32 {
     lights.iter().filter(|l| l.is_simplified()).count() as u32
 }
