@@ -12,7 +12,7 @@ for m in venice_sunset_1k.hdr moonless_golf_1k.hdr spruit_sunrise_1k.hdr; do
     # shellcheck disable=SC2086 # the flags are words
     ./target/release/strandlight compare --hair ../shared/data/hair/straight.hair \
       --env "../shared/data/envmaps/$m" --shading chiang --ground-truth render --truth-max-spp 4096 \
-      --reference-lights 96 --modes single --size 160x120 --timing-runs 3 \
+      --reference-lights 96 --modes single --size 160x120 \
       $flags --json --out "$out/out-$m-$name" > "$out/$m-$name.json"
   done <<'V'
 volume --lobe-visibility volume

@@ -12,7 +12,7 @@
 //! and `compare` measure the same thing.
 
 use crate::baseline::Baseline;
-use crate::compare::{self, CompareArgs, CompareScene};
+use crate::compare::{self, CompareScene, CompareSettings};
 use crate::error_decomposition::{
     self, DecompositionInputs, ErrorDecomposition, unshadowed_max_lights,
 };
@@ -25,16 +25,13 @@ use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake::bake_job;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription, Model, PlanOptions};
 use strandlight_precompute::baked_tables_check::check_asset;
-use strandlight_runtime::env::ViewTransparency;
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_scene::env_frame::{EnvFrame, FrameRole, render_lights};
 use strandlight_scene::environment::load_env;
 use strandlight_scene::fit_cache::fit_cached;
 use strandlight_scene::image_metrics::{Image, relative_rmse};
-use strandlight_scene::look::{
-    EnvTransparency, ForwardDevice, LobeVisibilityArg, LookArgs, ViewArgs,
-};
+use strandlight_scene::look::{EnvTransparency, LobeVisibilityArg, LookArgs, ViewArgs};
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
 use strandlight_scene::steps::Steps;
 
@@ -573,32 +570,16 @@ fn runs_of(report: &BenchReport) -> Vec<String> {
 }
 
 /// The compare settings a bench scene of `map` is built with.
-fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> CompareArgs {
-    CompareArgs {
-        hair: PathBuf::new(),
+fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> CompareSettings {
+    CompareSettings {
         env: map.display().to_string(),
         max_lobes: plan.lobes[0],
-        target_error: FitOptions::default().target_relative_mse,
-        lambda_max: FitOptions::default().lambda_max,
-        sources: strandlight_precompute::compact_sources::SourceOptions::default().max_sources,
-        source_radius: strandlight_precompute::compact_sources::SourceOptions::default()
-            .radius_degrees,
-        source_min_share: strandlight_precompute::compact_sources::SourceOptions::default()
-            .min_norm_share,
-        wider_source_radius: strandlight_precompute::compact_sources::DEFAULT_WIDER_RADIUS_DEGREES,
         size: format!("{}x{}", plan.size.0, plan.size.1),
         json: true,
-        reference_lights: None,
-        reference_tolerance: 0.01,
         reference_max_lights: plan.reference_max_lights,
-        reference_shading_lights: 0,
         shading: plan.shading,
-        preset: "brown".into(),
         out: out.to_path_buf(),
         cache: cache.to_path_buf(),
-        rotate: 0.0,
-        sanitize: false,
-        table_resolution: None,
         // The tables every mode measured needs, and single scattering's for full scattering's
         // decomposition, which compares the single-scattering parts.
         modes: [ScatteringMode::Single, ScatteringMode::Full]
@@ -606,12 +587,8 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
             .filter(|m| *m == ScatteringMode::Single || plan.modes.contains(m))
             .collect(),
         kappa: plan.kappas[0],
-        every_strand_share: 0.0,
         timing_runs: plan.timing_runs,
-        equal_error: false,
         baseline: plan.baseline,
-        equal_error_metric: crate::error_metric::ErrorMetric::RelativeRmse,
-        unshadowed: false,
         light_map_size: plan.dodm_sizes[0],
         look: LookArgs {
             transparency: EnvTransparency::Opaque,
@@ -620,8 +597,6 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
                 // decomposition against the DOM reference takes Ren's light maps apart (one
                 // visibility per lobe, κ), so they are what these arguments leave in place.
                 lobe_visibility: LobeVisibilityArg::LightMaps,
-                visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF,
-                forward_scattering: ForwardDevice::Auto,
                 ..ViewArgs::default()
             },
         },
@@ -630,6 +605,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
             false => TruthUse::Off,
         },
         truth_max_spp: plan.truth_max_spp[0],
+        ..CompareSettings::default()
     }
 }
 
@@ -763,7 +739,7 @@ fn srbf_configs(plan: &BenchPlan) -> Vec<SrbfConfig> {
 fn srbf_points(
     plan: &BenchPlan,
     scene: &CompareScene,
-    args: &CompareArgs,
+    args: &CompareSettings,
     mode: ScatteringMode,
     against: Yardsticks,
     steps: &mut Steps,
@@ -833,7 +809,7 @@ fn env_lit(
     let name = map_stem(map);
     let mut out = Vec::new();
     let mut decompositions = Vec::new();
-    let unshadowed_args = CompareArgs {
+    let unshadowed_args = CompareSettings {
         unshadowed: true,
         reference_max_lights: unshadowed_max_lights(plan.reference_max_lights),
         ..compare_args(plan, map, cache, scratch)
@@ -871,7 +847,7 @@ fn env_lit(
         if plan.decomposition_only {
             continue;
         }
-        let truth_args = CompareArgs {
+        let truth_args = CompareSettings {
             truth_max_spp: plan.truth_max_spp_of(mode),
             ..compare_args(plan, map, cache, scratch)
         };

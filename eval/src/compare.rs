@@ -11,6 +11,7 @@ use crate::ground_truth::{GroundTruth, TruthInputs, TruthSettings, TruthUse, gro
 use crate::hdr_flip::{HdrFlip, error_map_magma, hdr_flip};
 use crate::reference_cache::{ReferenceCache, ReferenceRecord};
 use anyhow::{Context, bail};
+use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 use std::path::PathBuf;
 use strandlight_precompute::FitOptions;
@@ -42,155 +43,154 @@ use strandlight_scene::steps::Steps;
 use strandlight_scene::world_lights::to_env_lights;
 use strandlight_tables::checksum::sha256_hex;
 
-#[derive(Debug, Clone)]
-#[cfg_attr(any(feature = "cli", test), derive(clap::Args))]
-pub struct CompareArgs {
+/// Everything one comparison is set by: a plain value that the command line builds, `bench`
+/// and the tests build directly, and every `compare --json` report records, so
+/// `compare --settings REPORT.json` measures the same thing again. The help of `compare`
+/// documents the fields it exposes as flags; the others (the fit's knobs, the reference's
+/// convergence, diagnostics) are set in a settings file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CompareSettings {
     /// Hair file (.hair, .tfx, .data, .ply).
-    #[cfg_attr(any(feature = "cli", test), arg(long))]
     pub hair: PathBuf,
     /// Environment: a Radiance .hdr / OpenEXR equirectangular map, or procedural:NAME.
-    #[cfg_attr(any(feature = "cli", test), arg(long))]
     pub env: String,
     /// Most SRBF lobes the fit may use.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 64))]
     pub max_lobes: usize,
     /// The fit's target relative MSE Σw‖fit−map‖²/Σw‖map‖² (lobes are added until it is met
-    /// or --max-lobes is reached; default: the paper's 15%).
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = FitOptions::default().target_relative_mse))]
+    /// or max_lobes is reached; default: the paper's 15%).
     pub target_error: f64,
     /// The fit's largest SRBF bandwidth λ (its narrowest lobe; the tables' 1/λ axis follows
     /// the lobes the fit uses).
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = FitOptions::default().lambda_max))]
     pub lambda_max: f64,
     /// Most compact bright sources (suns, lamps) the fit takes out as directional lights
     /// rendered beside the SRBFs; 0: SRBFs alone, as the paper.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().max_sources))]
     pub sources: usize,
     /// Angular radius of a compact source's disc, degrees (the fit's; the reference always
     /// takes the default sources out, so its cache holds across fit settings).
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().radius_degrees))]
     pub source_radius: f64,
     /// Least share of the remaining map's squared norm a compact source must hold (the fit's).
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().min_norm_share))]
     pub source_min_share: f64,
     /// The fit takes its sources at this wider radius (degrees) where they hold ≥ 10 points
     /// more of the map's power (extended lamps, a wide sun; 0: never; docs/BENCHMARKS.md).
-    #[cfg_attr(any(feature = "cli", test), arg(long, value_name = "DEGREES", default_value_t = strandlight_precompute::compact_sources::DEFAULT_WIDER_RADIUS_DEGREES))]
     pub wider_source_radius: f64,
     /// Image size WxH (the paper's 640x480).
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value = "640x480"))]
     pub size: String,
     /// Print one JSON object on stdout (progress goes to stderr).
-    #[cfg_attr(any(feature = "cli", test), arg(long))]
     pub json: bool,
     /// Lights of the brute-force reference, 6n² for n×n texels per cube face (6144 = the
     /// paper's 32×32×6; 1536, 384, 96 for quick runs). Default: converged, the first N of 96,
     /// 384, 1536, … whose image and that of 4N lights differ by at most
-    /// --reference-tolerance; the 4N image is the reference.
-    #[cfg_attr(any(feature = "cli", test), arg(long))]
+    /// `reference_tolerance`; the 4N image is the reference.
     pub reference_lights: Option<usize>,
     /// Relative RMSE between the N- and 4N-light references that counts as converged.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0.01))]
     pub reference_tolerance: f64,
     /// Most lights a converged reference may use (6n²); reached unconverged, the report says so.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 6144))]
     pub reference_max_lights: usize,
     /// The reference's shading cube, 6m² texels (m a multiple of every reference cube's n;
     /// 0, the default: every light shaded at its texel's centre, Ren 2010's brute force). The
     /// map is then shaded at this cube's texels, their visibility interpolated between the
     /// reference cube's shadow maps (precompute/src/env_lights.rs): the light passes stay the
     /// reference's, the shading costs more (docs/BENCHMARKS.md, "Shading the reference finer").
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0))]
     pub reference_shading_lights: usize,
-    #[cfg_attr(
-        any(feature = "cli", test),
-        arg(long, value_enum, default_value = "marschner")
-    )]
     pub shading: EnvShading,
     /// Melanin preset of the fiber: white, blonde, red, auburn, brown, dark.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value = "brown"))]
     pub preset: String,
     /// Folder for the images.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value = "out/compare"))]
     pub out: PathBuf,
     /// Cache folder (fits, tables, reference images).
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value = "out/cache"))]
     pub cache: PathBuf,
     /// Rotate the environment about its up axis by this many degrees.
-    #[cfg_attr(
-        any(feature = "cli", test),
-        arg(long, default_value_t = 0.0, allow_negative_numbers = true)
-    )]
     pub rotate: f64,
     /// Replace NaN/negative map values by 0 and +Inf by the largest finite value.
-    #[cfg_attr(any(feature = "cli", test), arg(long))]
     pub sanitize: bool,
     /// Nodes per direction axis of the tables (default: the paper's resolution).
-    #[cfg_attr(any(feature = "cli", test), arg(long, value_name = "N"))]
     pub table_resolution: Option<usize>,
     /// Which modes to compare: single scattering, full (single + multiple), or both.
-    #[cfg_attr(
-        any(feature = "cli", test),
-        arg(long, value_enum, value_delimiter = ',', default_value = "single,full")
-    )]
     pub modes: Vec<ScatteringMode>,
     /// Stochastic simplification of the SRBF light pass (Ren §7): the fraction of strands drawn
     /// into the light maps (1 = all). The reference and the baseline always draw all.
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0.1))]
     pub kappa: f32,
     /// Adaptive κ, with `--lobe-visibility light-maps`: the most powerful SRBF lobes holding
     /// this share of the lobes' power draw every strand into their light maps, the rest κ (0:
     /// κ for every lobe, as the paper). On the front of venice only: 0.5 takes single
     /// scattering from 0.378 to 0.369 against the truth for 3.8× the frame (docs/BENCHMARKS.md,
     /// "Options judged against the truth").
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 0.0))]
     pub every_strand_share: f32,
     /// Renders per timing (the median is reported).
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = 3))]
     pub timing_runs: usize,
     /// Also search the fewest median-cut lights whose error is at most the SRBF frame's
     /// (Ren Fig. 6) and report the speed-up at equal error. Slow: it renders up to
     /// --reference-lights baseline lights.
-    #[cfg_attr(any(feature = "cli", test), arg(long))]
     pub equal_error: bool,
     /// The directional-light baseline: median cut over the whole map (Debevec 2005, Ren's
     /// baseline), or the compact sources exactly and median cut over the rest.
-    #[cfg_attr(
-        any(feature = "cli", test),
-        arg(long, value_enum, default_value = "median-cut")
-    )]
     pub baseline: Baseline,
     /// The error --equal-error matches: relative RMSE, or HDR-FLIP over the hair.
-    #[cfg_attr(
-        any(feature = "cli", test),
-        arg(long, value_enum, default_value = "relative-rmse")
-    )]
     pub equal_error_metric: ErrorMetric,
     /// Diagnostic: every single-scattering transmittance 1 in all three renders, so the error
     /// left is the lighting (fit, median cut) and table error without the shadowing error.
-    #[cfg_attr(any(feature = "cli", test), arg(long))]
     pub unshadowed: bool,
     /// Texels across every light map (DODM) of all three renders, the reference's included:
     /// the reference converges in its light count at this size, and light maps of another size
     /// shadow each strand differently (docs/BENCHMARKS.md, "Light-map size").
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = DodmSettings::default().resolution))]
     pub light_map_size: u32,
     /// The look of all three renders.
-    #[cfg_attr(any(feature = "cli", test), command(flatten))]
     pub look: LookArgs,
     /// The path-traced ground truth (Mitsuba 3; the Chiang fiber only, which is Mitsuba's
     /// `hair`): `cached` measures every frame against it where `strandlight truth` or an
     /// earlier run rendered it, `render` renders what is missing (minutes), `off` never.
-    #[cfg_attr(
-        any(feature = "cli", test),
-        arg(long, value_enum, default_value = "cached")
-    )]
     pub ground_truth: TruthUse,
     /// Most samples per pixel of one ground-truth image (its ladder climbs ×4 from 1024, or from
-    /// a quarter of this when that is less, until N and 4N agree within --reference-tolerance or
+    /// a quarter of this when that is less, until N and 4N agree within `reference_tolerance` or
     /// the next rung would pass this; at 640×480, 256 costs what 4096 costs at 160×120).
-    #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = TruthSettings::default().max_spp))]
     pub truth_max_spp: u32,
+}
+
+impl Default for CompareSettings {
+    /// The paper's comparison: 640×480, Marschner `brown`, a converged reference of up to
+    /// 6144 lights, the default fit and look, the ground truth where it is cached.
+    fn default() -> Self {
+        let fit = FitOptions::default();
+        let sources = strandlight_precompute::compact_sources::SourceOptions::default();
+        Self {
+            hair: PathBuf::new(),
+            env: String::new(),
+            max_lobes: 64,
+            target_error: fit.target_relative_mse,
+            lambda_max: fit.lambda_max,
+            sources: sources.max_sources,
+            source_radius: sources.radius_degrees,
+            source_min_share: sources.min_norm_share,
+            wider_source_radius:
+                strandlight_precompute::compact_sources::DEFAULT_WIDER_RADIUS_DEGREES,
+            size: "640x480".to_string(),
+            json: false,
+            reference_lights: None,
+            reference_tolerance: 0.01,
+            reference_max_lights: 6144,
+            reference_shading_lights: 0,
+            shading: EnvShading::Marschner,
+            preset: "brown".to_string(),
+            out: PathBuf::from("out/compare"),
+            cache: PathBuf::from("out/cache"),
+            rotate: 0.0,
+            sanitize: false,
+            table_resolution: None,
+            modes: vec![ScatteringMode::Single, ScatteringMode::Full],
+            kappa: 0.1,
+            every_strand_share: 0.0,
+            timing_runs: 3,
+            equal_error: false,
+            baseline: Baseline::MedianCut,
+            equal_error_metric: ErrorMetric::RelativeRmse,
+            unshadowed: false,
+            light_map_size: DodmSettings::default().resolution,
+            look: LookArgs::default(),
+            ground_truth: TruthUse::Cached,
+            truth_max_spp: TruthSettings::default().max_spp,
+        }
+    }
 }
 
 /// Everything fixed before the first render.
@@ -230,17 +230,20 @@ pub enum ReferenceLighting {
     Fit,
 }
 
-/// The flags' values checked together, before any work (for callers that build the args).
-pub(crate) fn check_args(args: &CompareArgs) -> anyhow::Result<()> {
+/// The settings checked together, before any work (for callers that build them).
+pub(crate) fn check_args(args: &CompareSettings) -> anyhow::Result<()> {
     validate(args).map(drop)
 }
 
-fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
+fn validate(args: &CompareSettings) -> anyhow::Result<ReferenceChoice> {
+    if args.env.is_empty() {
+        bail!("--env: no environment given (on the command line or in --settings)");
+    }
     if args.max_lobes == 0 {
-        bail!("--max-lobes 0: at least one SRBF lobe is needed");
+        bail!("max_lobes 0: at least one SRBF lobe is needed");
     }
     if args.timing_runs == 0 {
-        bail!("--timing-runs 0: at least one render per timing");
+        bail!("timing_runs 0: at least one render per timing");
     }
     args.look.look()?;
     light_maps(args).check().with_context(|| {
@@ -252,11 +255,11 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
     if let Some(n) = args.table_resolution
         && !(2..=256).contains(&n)
     {
-        bail!("--table-resolution {n}: use 2 to 256 nodes per direction axis");
+        bail!("table_resolution {n}: use 2 to 256 nodes per direction axis");
     }
     if !(args.source_radius > 0.0 && args.source_radius <= 20.0) {
         bail!(
-            "--source-radius {}: a compact source's angular radius in degrees, in (0, 20]",
+            "source_radius {}: a compact source's angular radius in degrees, in (0, 20]",
             args.source_radius
         );
     }
@@ -264,19 +267,19 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
         && !(r > args.source_radius && r <= 20.0)
     {
         bail!(
-            "--wider-source-radius {r}: must be wider than --source-radius ({}) and at most 20 degrees (0: never)",
+            "wider_source_radius {r}: must be wider than source_radius ({}) and at most 20 degrees (0: never)",
             args.source_radius
         );
     }
     if !(args.source_min_share > 0.0 && args.source_min_share <= 1.0) {
         bail!(
-            "--source-min-share {}: a share of the map's squared norm, in (0, 1]",
+            "source_min_share {}: a share of the map's squared norm, in (0, 1]",
             args.source_min_share
         );
     }
     if !(args.reference_tolerance > 0.0 && args.reference_tolerance < 1.0) {
         bail!(
-            "--reference-tolerance {}: must be in (0, 1)",
+            "reference_tolerance {}: must be in (0, 1)",
             args.reference_tolerance
         );
     }
@@ -293,10 +296,10 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
             format!("{flag} {count}: must be 6n² for a cube of n×n texels per face (e.g. 6, 24, 96, 384, 1536, 6144)")
         })
     };
-    let most = check("--reference-max-lights", args.reference_max_lights)?;
+    let most = check("reference_max_lights", args.reference_max_lights)?;
     if most < 2 * FIRST_CONVERGENCE_FACE {
         bail!(
-            "--reference-max-lights {}: a converged reference compares N with 4N lights from {} up; allow at least {}",
+            "reference_max_lights {}: a converged reference compares N with 4N lights from {} up; allow at least {}",
             args.reference_max_lights,
             6 * FIRST_CONVERGENCE_FACE * FIRST_CONVERGENCE_FACE,
             24 * FIRST_CONVERGENCE_FACE * FIRST_CONVERGENCE_FACE
@@ -310,7 +313,7 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
         let finest = choice.finest_face();
         if m < finest || !m.is_multiple_of(finest) {
             bail!(
-                "--reference-shading-lights {}: its {m}² texels per face must split every reference texel, up to the finest cube's {finest}²: use 6m² with m a multiple of {finest}",
+                "reference_shading_lights {}: its {m}² texels per face must split every reference texel, up to the finest cube's {finest}²: use 6m² with m a multiple of {finest}",
                 args.reference_shading_lights
             );
         }
@@ -319,11 +322,11 @@ fn validate(args: &CompareArgs) -> anyhow::Result<ReferenceChoice> {
 }
 
 /// The reference's shading cube's face resolution m (None: shaded at the texel lights).
-fn shading_face(args: &CompareArgs) -> anyhow::Result<Option<usize>> {
+fn shading_face(args: &CompareSettings) -> anyhow::Result<Option<usize>> {
     match args.reference_shading_lights {
         0 => Ok(None),
         count => face_resolution_for(count).map(Some).with_context(|| {
-            format!("--reference-shading-lights {count}: must be 0 or 6m² (e.g. 24576 = 6·64², 98304 = 6·128²)")
+            format!("reference_shading_lights {count}: must be 0 or 6m² (e.g. 24576 = 6·64², 98304 = 6·128²)")
         }),
     }
 }
@@ -357,7 +360,10 @@ impl ReferenceChoice {
 }
 
 /// Loads the hair file, fits, bakes and builds the light sets (every step timed into `steps`).
-pub fn prepare(args: &CompareArgs, steps: &mut Steps) -> anyhow::Result<CompareScene> {
+pub fn prepare(args: &CompareSettings, steps: &mut Steps) -> anyhow::Result<CompareScene> {
+    if args.hair.as_os_str().is_empty() {
+        bail!("--hair: no hair file given (on the command line or in --settings)");
+    }
     validate(args)?;
     let (hair, hair_sha256) = steps.run(
         "hair",
@@ -376,7 +382,7 @@ pub fn prepare(args: &CompareArgs, steps: &mut Steps) -> anyhow::Result<CompareS
 
 /// [`prepare`] for a hair already loaded (`hair_sha256` identifies it in the reference cache).
 pub fn prepare_with_hair(
-    args: &CompareArgs,
+    args: &CompareSettings,
     hair: HairModel,
     hair_sha256: String,
     steps: &mut Steps,
@@ -516,7 +522,7 @@ impl CompareScene {
     /// The reference's lights for n×n texels per cube face: the compact sources exactly, the
     /// rest of the map one light per cube texel.
     /// Shaded over a `shading_face`² cube per face when that is finer (see
-    /// [`CompareArgs::reference_shading_lights`]).
+    /// [`CompareSettings::reference_shading_lights`]).
     pub fn reference_set(
         &self,
         face: usize,
@@ -533,7 +539,7 @@ impl CompareScene {
         let shading = shading_face.unwrap_or(face).max(face);
         let specs =
             reference_lights_shaded(&self.map, face, shading, rotate, &self.reference_sources)
-                .with_context(|| format!("--reference-shading-lights {}", 6 * shading * shading))?;
+                .with_context(|| format!("reference_shading_lights {}", 6 * shading * shading))?;
         Ok(to_env_lights(&specs, self.up))
     }
 }
@@ -588,7 +594,7 @@ impl EqualErrorResult {
 
 /// The baseline's (`--baseline`) lights for a budget of `count`: exactly `count`, except that
 /// median cut with exact sources keeps every source and at least one light for the rest.
-pub fn baseline_set(scene: &CompareScene, args: &CompareArgs, count: usize) -> Vec<EnvLight> {
+pub fn baseline_set(scene: &CompareScene, args: &CompareSettings, count: usize) -> Vec<EnvLight> {
     let specs = args
         .baseline
         .lights(&scene.map, count, args.rotate, &scene.reference_sources);
@@ -599,7 +605,7 @@ pub fn baseline_set(scene: &CompareScene, args: &CompareArgs, count: usize) -> V
 pub fn render_baseline(
     render: Renderer,
     scene: &CompareScene,
-    args: &CompareArgs,
+    args: &CompareSettings,
     mode: ScatteringMode,
     lights: usize,
 ) -> anyhow::Result<RenderedEnv> {
@@ -613,7 +619,7 @@ pub fn render_baseline(
 fn equal_error_baseline(
     render: Renderer,
     scene: &CompareScene,
-    args: &CompareArgs,
+    args: &CompareSettings,
     mode: ScatteringMode,
     yardstick: &Image,
     most: usize,
@@ -643,13 +649,13 @@ fn equal_error_baseline(
 }
 
 /// The ground-truth settings of `args`.
-pub fn truth_settings(args: &CompareArgs) -> TruthSettings {
+pub fn truth_settings(args: &CompareSettings) -> TruthSettings {
     TruthSettings::with_budget(args.truth_max_spp, args.reference_tolerance)
 }
 
 /// Mitsuba's `hair` parameters of the scene's fiber, where the shading model is the one the
 /// path tracer has (Chiang et al. 2016); None for the others, which the DOM reference measures.
-pub fn truth_fiber(scene: &CompareScene, args: &CompareArgs) -> Option<Value> {
+pub fn truth_fiber(scene: &CompareScene, args: &CompareSettings) -> Option<Value> {
     (args.shading == EnvShading::Chiang)
         .then(|| serde_json::to_value(&scene.fiber.chiang).expect("fiber parameters serialize"))
 }
@@ -657,7 +663,7 @@ pub fn truth_fiber(scene: &CompareScene, args: &CompareArgs) -> Option<Value> {
 /// The path-traced ground truth of `mode` (cached, rendered or none: `--ground-truth`).
 pub fn truth_of(
     scene: &CompareScene,
-    args: &CompareArgs,
+    args: &CompareSettings,
     mode: ScatteringMode,
     steps: &mut Steps,
 ) -> anyhow::Result<Option<GroundTruth>> {
@@ -690,7 +696,7 @@ pub fn truth_of(
 
 pub fn frame<'a>(
     scene: &'a CompareScene,
-    args: &CompareArgs,
+    args: &CompareSettings,
     lights: &'a [EnvLight],
     mode: ScatteringMode,
 ) -> EnvFrame<'a> {
@@ -709,12 +715,12 @@ pub fn frame<'a>(
 }
 
 /// The light maps of every frame (checked by `validate`).
-fn light_maps(args: &CompareArgs) -> DodmSettings {
+fn light_maps(args: &CompareSettings) -> DodmSettings {
     DodmSettings::at_resolution(args.light_map_size)
 }
 
 /// The renderer choices of every frame (checked by `validate`).
-fn look(args: &CompareArgs) -> EnvLook {
+fn look(args: &CompareSettings) -> EnvLook {
     EnvLook {
         shadowed: !args.unshadowed,
         dodm: light_maps(args),
@@ -724,7 +730,7 @@ fn look(args: &CompareArgs) -> EnvLook {
 
 fn reference_frame<'a>(
     scene: &'a CompareScene,
-    args: &CompareArgs,
+    args: &CompareSettings,
     lights: &'a [EnvLight],
     mode: ScatteringMode,
 ) -> EnvFrame<'a> {
@@ -741,7 +747,7 @@ const REFERENCE_MULTIPLE_TABLES: [&str; 3] = ["multiple", "fiber_averages", "att
 /// What identifies a reference image: everything its render reads, nothing else.
 fn reference_inputs(
     scene: &CompareScene,
-    args: &CompareArgs,
+    args: &CompareSettings,
     face: usize,
     lights: usize,
     mode: ScatteringMode,
@@ -784,7 +790,7 @@ fn reference_inputs(
 fn run_mode(
     render: Renderer,
     scene: &CompareScene,
-    args: &CompareArgs,
+    args: &CompareSettings,
     mode: ScatteringMode,
     steps: &mut Steps,
 ) -> anyhow::Result<ModeResult> {
@@ -892,7 +898,7 @@ fn run_mode(
 }
 
 /// What the steps call a reference of `lighting` under `args`.
-fn reference_name(lighting: ReferenceLighting, args: &CompareArgs) -> &'static str {
+fn reference_name(lighting: ReferenceLighting, args: &CompareSettings) -> &'static str {
     match (lighting, args.unshadowed) {
         (ReferenceLighting::Map, false) => "reference",
         (ReferenceLighting::Map, true) => "unshadowed reference",
@@ -905,7 +911,7 @@ fn reference_name(lighting: ReferenceLighting, args: &CompareArgs) -> &'static s
 fn reference_with_face(
     render: Renderer,
     scene: &CompareScene,
-    args: &CompareArgs,
+    args: &CompareSettings,
     mode: ScatteringMode,
     face: usize,
     lighting: ReferenceLighting,
@@ -955,7 +961,7 @@ fn reference_with_face(
 pub fn reference(
     render: Renderer,
     scene: &CompareScene,
-    args: &CompareArgs,
+    args: &CompareSettings,
     mode: ScatteringMode,
     steps: &mut Steps,
 ) -> anyhow::Result<Reference> {
@@ -966,7 +972,7 @@ pub fn reference(
 pub fn reference_of(
     render: Renderer,
     scene: &CompareScene,
-    args: &CompareArgs,
+    args: &CompareSettings,
     mode: ScatteringMode,
     lighting: ReferenceLighting,
     steps: &mut Steps,
@@ -1010,7 +1016,7 @@ pub fn reference_of(
 }
 
 fn write_mode_images(
-    args: &CompareArgs,
+    args: &CompareSettings,
     mode: ScatteringMode,
     r: &ModeResult,
     description: &str,
@@ -1070,12 +1076,14 @@ fn write_mode_images(
 /// Renders both modes three ways with `render`, writes the images and returns the report
 /// (`{"single": {...}, "full": {...}, "steps": [...]}`; the shape of the issue's JSON).
 pub fn execute(
-    args: &CompareArgs,
+    args: &CompareSettings,
     scene: &CompareScene,
     steps: &mut Steps,
     render: Renderer,
 ) -> anyhow::Result<Value> {
     let mut report = serde_json::Map::new();
+    // What `compare --settings REPORT.json` reads back to measure the same thing again.
+    report.insert("settings".into(), serde_json::to_value(args)?);
     let description = format!(
         "strandlight compare: {} under {} ({:?}, preset {})",
         args.hair.display(),
@@ -1217,21 +1225,21 @@ fn truth_line(mode: ScatteringMode, truth: &GroundTruth, figures: &Value) -> Str
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clap::Parser;
 
-    #[derive(Parser)]
-    struct Cli {
-        #[command(flatten)]
-        args: CompareArgs,
-    }
-
-    fn args(line: &[&str]) -> Result<CompareArgs, clap::Error> {
-        Cli::try_parse_from(std::iter::once("compare").chain(line.iter().copied())).map(|c| c.args)
+    /// Settings for hair `h` under map `e`, changed by `change`.
+    fn settings(change: impl FnOnce(&mut CompareSettings)) -> CompareSettings {
+        let mut s = CompareSettings {
+            hair: "h".into(),
+            env: "e".into(),
+            ..CompareSettings::default()
+        };
+        change(&mut s);
+        s
     }
 
     #[test]
-    fn arguments_parse_with_the_issue_defaults_and_bad_values_are_named() {
-        let a = args(&["--hair", "h.hair", "--env", "procedural:studio"]).unwrap();
+    fn settings_default_to_the_issue_and_bad_values_are_named() {
+        let a = settings(|_| {});
         assert_eq!(
             (a.max_lobes, a.size.as_str(), a.reference_lights, a.shading),
             (64, "640x480", None, EnvShading::Marschner)
@@ -1240,74 +1248,94 @@ mod tests {
             validate(&a).unwrap(),
             ReferenceChoice::Converged { most_face: 32 }
         );
-        for (flag, value, wanted) in [
-            ("--reference-shading-lights", "100", "6m²"),
-            ("--reference-shading-lights", "1536", "multiple of 32"),
-            ("--reference-max-lights", "100", "6n²"),
-            ("--reference-max-lights", "96", "allow at least 384"),
-            ("--reference-tolerance", "0", "(0, 1)"),
-            ("--light-map-size", "0", "1 to 2048"),
-            ("--light-map-size", "4096", "1 to 2048"),
-            ("--truth-max-spp", "3", "at least 4"),
-            ("--every-strand-share", "1.5", "[0, 1]"),
-            ("--every-strand-share", "NaN", "[0, 1]"),
-        ] {
-            let a = args(&["--hair", "h", "--env", "e", flag, value]).unwrap();
-            let e = validate(&a).unwrap_err().to_string();
-            assert!(e.contains(flag) && e.contains(wanted), "{e}");
+        type Change = Box<dyn Fn(&mut CompareSettings)>;
+        let cases: Vec<(&str, &str, Change)> = vec![
+            (
+                "reference_shading_lights 100",
+                "6m²",
+                Box::new(|s| s.reference_shading_lights = 100),
+            ),
+            (
+                "reference_shading_lights 1536",
+                "multiple of 32",
+                Box::new(|s| s.reference_shading_lights = 1536),
+            ),
+            (
+                "reference_max_lights 100",
+                "6n²",
+                Box::new(|s| s.reference_max_lights = 100),
+            ),
+            (
+                "reference_max_lights 96",
+                "allow at least 384",
+                Box::new(|s| s.reference_max_lights = 96),
+            ),
+            (
+                "reference_tolerance 0",
+                "(0, 1)",
+                Box::new(|s| s.reference_tolerance = 0.0),
+            ),
+            (
+                "--light-map-size 0",
+                "1 to 2048",
+                Box::new(|s| s.light_map_size = 0),
+            ),
+            (
+                "--light-map-size 4096",
+                "1 to 2048",
+                Box::new(|s| s.light_map_size = 4096),
+            ),
+            (
+                "--truth-max-spp 3",
+                "at least 4",
+                Box::new(|s| s.truth_max_spp = 3),
+            ),
+            (
+                "--every-strand-share 1.5",
+                "[0, 1]",
+                Box::new(|s| s.every_strand_share = 1.5),
+            ),
+            (
+                "--every-strand-share NaN",
+                "[0, 1]",
+                Box::new(|s| s.every_strand_share = f32::NAN),
+            ),
+            ("max_lobes 0", "at least one", Box::new(|s| s.max_lobes = 0)),
+            (
+                "--reference-lights 100",
+                "6n²",
+                Box::new(|s| s.reference_lights = Some(100)),
+            ),
+            ("--env", "no environment", Box::new(|s| s.env.clear())),
+        ];
+        for (named, wanted, change) in cases {
+            let e = validate(&settings(change)).unwrap_err().to_string();
+            assert!(e.contains(named) && e.contains(wanted), "{named}: {e}");
         }
-        assert!(args(&["--env", "x.hdr"]).is_err(), "--hair is required");
-        let a = args(&["--hair", "h", "--env", "e", "--reference-lights", "100"]).unwrap();
-        let e = validate(&a).unwrap_err().to_string();
-        assert!(
-            e.contains("--reference-lights 100") && e.contains("6n²"),
-            "{e}"
-        );
-        let a = args(&[
-            "--hair",
-            "h",
-            "--env",
-            "e",
-            "--shading",
-            "artist",
-            "--reference-lights",
-            "96",
-            "--size",
-            "64x48",
-            "--json",
-        ])
-        .unwrap();
-        assert_eq!(
-            (a.shading, validate(&a).unwrap(), a.json),
-            (EnvShading::Artist, ReferenceChoice::Fixed(4), true)
-        );
-        let a = args(&[
-            "--hair",
-            "h",
-            "--env",
-            "e",
-            "--reference-shading-lights",
-            "24576",
-        ])
-        .unwrap();
+        let a = settings(|s| {
+            s.shading = EnvShading::Artist;
+            s.reference_lights = Some(96);
+        });
+        assert_eq!(validate(&a).unwrap(), ReferenceChoice::Fixed(4));
+        let a = settings(|s| s.reference_shading_lights = 24576);
         assert_eq!(
             validate(&a).unwrap(),
             ReferenceChoice::Converged { most_face: 32 }
         );
-        assert!(args(&["--hair", "h", "--env", "e", "--shading", "kajiya-kay"]).is_err());
+        let no_hair = settings(|s| s.hair = PathBuf::new());
+        let e = prepare(&no_hair, &mut Steps::new(true))
+            .err()
+            .expect("must fail");
+        assert!(format!("{e:#}").contains("--hair"), "{e:#}");
     }
 
     #[test]
     fn a_missing_hair_file_is_named_before_any_work() {
-        let a = args(&[
-            "--hair",
-            "/nonexistent/straight.hair",
-            "--env",
-            "procedural:studio",
-            "--reference-lights",
-            "96",
-        ])
-        .unwrap();
+        let a = settings(|s| {
+            s.hair = "/nonexistent/straight.hair".into();
+            s.env = "procedural:studio".into();
+            s.reference_lights = Some(96);
+        });
         let e = prepare(&a, &mut Steps::new(true)).err().expect("must fail");
         assert!(
             format!("{e:#}").contains("/nonexistent/straight.hair"),
@@ -1384,29 +1412,19 @@ mod tests {
                 dir.join("out").display().to_string(),
                 dir.join("cache").display().to_string(),
             );
-            let a = args(&[
-                "--hair",
-                "groom",
-                "--env",
-                "procedural:studio",
-                "--max-lobes",
-                "8",
-                "--size",
-                "16x12",
-                "--reference-tolerance",
-                tolerance,
-                "--table-resolution",
-                "4",
-                "--timing-runs",
-                "1",
-                "--modes",
-                "single",
-                "--out",
-                &out,
-                "--cache",
-                &cache,
-            ])
-            .unwrap();
+            let a = CompareSettings {
+                hair: "groom".into(),
+                env: "procedural:studio".into(),
+                max_lobes: 8,
+                size: "16x12".into(),
+                reference_tolerance: tolerance.parse().unwrap(),
+                table_resolution: Some(4),
+                timing_runs: 1,
+                modes: vec![ScatteringMode::Single],
+                out: (&out).into(),
+                cache: (&cache).into(),
+                ..CompareSettings::default()
+            };
             let mut steps = Steps::new(true);
             let scene = prepare_with_hair(&a, groom.clone(), "groom".into(), &mut steps).unwrap();
             let report = execute(&a, &scene, &mut steps, &converging_renderer).unwrap();
@@ -1438,28 +1456,19 @@ mod tests {
             dir.join("out").display().to_string(),
             dir.join("cache").display().to_string(),
         );
-        let a = args(&[
-            "--hair",
-            "groom",
-            "--env",
-            "procedural:studio",
-            "--max-lobes",
-            "8",
-            "--size",
-            "32x24",
-            "--reference-lights",
-            "96",
-            "--table-resolution",
-            "4",
-            "--timing-runs",
-            "1",
-            "--out",
-            &out,
-            "--cache",
-            &cache,
-            "--json",
-        ])
-        .unwrap();
+        let a = CompareSettings {
+            hair: "groom".into(),
+            env: "procedural:studio".into(),
+            max_lobes: 8,
+            size: "32x24".into(),
+            reference_lights: Some(96),
+            table_resolution: Some(4),
+            timing_runs: 1,
+            out: (&out).into(),
+            cache: (&cache).into(),
+            json: true,
+            ..CompareSettings::default()
+        };
         let groom =
             strandlight_runtime::hair::generate_groom(&strandlight_runtime::hair::GroomParams {
                 strand_count: 40,

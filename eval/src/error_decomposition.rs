@@ -24,7 +24,7 @@
 //! as the DOM reference of the fit's lights, and the tables are not apart from the one
 //! visibility per lobe there.
 
-use crate::compare::{self, CompareArgs, CompareScene, Reference, ReferenceLighting};
+use crate::compare::{self, CompareScene, CompareSettings, Reference, ReferenceLighting};
 use crate::ground_truth::GroundTruth;
 use crate::hdr_flip::hdr_flip;
 use serde::{Deserialize, Serialize};
@@ -104,8 +104,8 @@ pub const SHARP_SOURCE_MAP_SCALE: u32 = 4;
 pub struct DecompositionInputs<'a> {
     pub render: compare::Renderer<'a>,
     pub scene: &'a CompareScene,
-    pub args: &'a CompareArgs,
-    pub unshadowed_args: &'a CompareArgs,
+    pub args: &'a CompareSettings,
+    pub unshadowed_args: &'a CompareSettings,
     pub lights: &'a [EnvLight],
     pub kappa: f32,
 }
@@ -113,7 +113,7 @@ pub struct DecompositionInputs<'a> {
 impl DecompositionInputs<'_> {
     fn srbf(
         &self,
-        args: &CompareArgs,
+        args: &CompareSettings,
         mode: ScatteringMode,
         kappa: f32,
         label: &str,
@@ -307,7 +307,7 @@ pub fn single_scattering_against_truth(
 ) -> anyhow::Result<ErrorDecomposition> {
     let mode = ScatteringMode::Single;
     let lights = reference.chosen.record.lights;
-    let fit_args = CompareArgs {
+    let fit_args = CompareSettings {
         reference_lights: Some(lights),
         ..inputs.args.clone()
     };

@@ -58,7 +58,7 @@ impl LobeVisibilityArg {
 }
 
 /// The renderer choices of the env-lit commands.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::Args))]
 pub struct LookArgs {
     /// The nearest fiber of each pixel (opaque), or every fiber weighted by its visibility
