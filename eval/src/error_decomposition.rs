@@ -294,6 +294,13 @@ pub fn full_scattering(
     })
 }
 
+/// The cube's 6n² texel lights of a reference whose record also counts its compact sources
+/// (at most a few, far fewer than the gap to the next cube: quarry's 1537 is 1536 + its sun).
+fn cube_lights(recorded: usize) -> usize {
+    let face = ((recorded / 6) as f64).sqrt().floor() as usize;
+    6 * face * face
+}
+
 /// Single scattering against the ground truth: the DOM reference of the map and of the fit's
 /// lights (at the map reference's light count), Ren's SRBF frame at κ 1 and at the default κ,
 /// the visibility volume in its place (the default), and, where the map has compact sources,
@@ -306,9 +313,8 @@ pub fn single_scattering_against_truth(
     steps: &mut Steps,
 ) -> anyhow::Result<ErrorDecomposition> {
     let mode = ScatteringMode::Single;
-    let lights = reference.chosen.record.lights;
     let fit_args = CompareSettings {
-        reference_lights: Some(lights),
+        reference_lights: Some(cube_lights(reference.chosen.record.lights)),
         ..inputs.args.clone()
     };
     let fit = compare::reference_of(
@@ -339,7 +345,7 @@ pub fn single_scattering_against_truth(
     Ok(ErrorDecomposition {
         map: map.into(),
         mode: mode.name().into(),
-        reference_lights: lights,
+        reference_lights: reference.chosen.record.lights,
         reference_converged: reference.converged,
         unshadowed_reference_lights: None,
         unshadowed_converged: None,
@@ -394,6 +400,13 @@ impl ErrorDecomposition {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_reference_record_with_sources_gives_its_cube() {
+        for (recorded, cube) in [(1536, 1536), (1537, 1536), (104, 96), (6147, 6144), (6, 6)] {
+            assert_eq!(cube_lights(recorded), cube, "{recorded}");
+        }
+    }
     use strandlight_precompute::env_lights::face_resolution_for;
 
     #[test]
