@@ -21,6 +21,7 @@
 //!   what that costs against NVIDIA's own HDR-FLIP (the `flip-evaluator` package).
 
 use strandlight_scene::image_metrics::{CompareError, HAIR_ALPHA, Image};
+use strandlight_tables::colour::{luminance_f32, srgb_encode_f32};
 
 /// Pixels per degree of visual angle: FLIP's default, a 0.7 m wide 4K monitor seen from 0.7 m.
 pub const PIXELS_PER_DEGREE: f32 = nv_flip::DEFAULT_PIXELS_PER_DEGREE;
@@ -49,20 +50,12 @@ pub struct HdrFlip {
 }
 
 fn luminance(p: &[f32; 4]) -> f32 {
-    0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]
+    luminance_f32([p[0], p[1], p[2]])
 }
 
 fn aces(x: f32) -> f32 {
     let [a, b, c, d, e, f] = ACES;
     ((x * x * a + x * b + c) / (x * x * d + x * e + f)).clamp(0.0, 1.0)
-}
-
-fn linear_to_srgb(x: f32) -> f32 {
-    if x <= 0.003_130_8 {
-        x * 12.92
-    } else {
-        1.055 * x.powf(1.0 / 2.4) - 0.055
-    }
 }
 
 /// The exposure bracket (start, stop) of NVIDIA's `computeExposures` for the luminances given.
@@ -92,7 +85,7 @@ fn exposed_srgb8(image: &Image, exposure: f32) -> Vec<u8> {
         .iter()
         .flat_map(|p| {
             [p[0], p[1], p[2]].map(|c| {
-                let v = linear_to_srgb(aces(c.max(0.0) * scale));
+                let v = srgb_encode_f32(aces(c.max(0.0) * scale));
                 (v * 255.0 + 0.5) as u8
             })
         })

@@ -69,7 +69,7 @@ impl SourceOptions {
     }
 }
 
-const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
+const LUMINANCE: [f64; 3] = strandlight_tables::colour::REC709_LUMINANCE;
 
 fn luminance(p: [f32; 3]) -> f64 {
     (0..3).map(|c| LUMINANCE[c] * p[c] as f64).sum()

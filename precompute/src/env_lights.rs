@@ -13,6 +13,7 @@ use crate::envmap::{EnvMap, rotate_about_up};
 use crate::median_cut::{DirectionalLight, median_cut};
 use crate::srbf_set::{LightKind, SrbfSet};
 use glam::DVec3;
+use strandlight_tables::colour::luminance;
 use strandlight_tables::srbf;
 
 /// One light: an SRBF (`lambda` = Some, `rgb` its amplitude, radiance) or a directional light
@@ -183,10 +184,6 @@ pub fn reference_lights_shaded(
         }
     }
     Ok(lights)
-}
-
-fn luminance(rgb: [f64; 3]) -> f64 {
-    0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
 }
 
 /// The sub-texels of the `n·m` cube whose visibility the map of coarse `texel` contributes to,

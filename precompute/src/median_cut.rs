@@ -50,7 +50,7 @@ impl EnergyTable {
 }
 
 fn luminance(p: [f32; 3]) -> f64 {
-    0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64
+    strandlight_tables::colour::luminance(p.map(f64::from))
 }
 
 /// `count` lights (fewer only if the map has fewer pixels).

@@ -8,6 +8,7 @@
 use crate::envmap::EnvMap;
 use std::path::Path;
 use strandlight_tables::atomic_write::write_atomically;
+use strandlight_tables::colour::{luminance, srgb_encode};
 use strandlight_tables::srbf::SrbfLobe;
 
 pub const TONEMAP: &str = "exposure to mean luminance 0.18, Reinhard x/(1+x), sRGB";
@@ -32,7 +33,7 @@ pub fn write_preview(
     let original = map.downsampled(panel_width, panel_width / 2);
     let (w, h) = (original.width(), original.height());
     let fit = crate::procedural_env::from_srbf_lobes(w, lobes);
-    let lum = |p: [f32; 3]| 0.2126 * p[0] as f64 + 0.7152 * p[1] as f64 + 0.0722 * p[2] as f64;
+    let lum = |p: [f32; 3]| luminance(p.map(f64::from));
     let mean: f64 = (0..h)
         .map(|y| {
             original.row_solid_angle(y) * (0..w).map(|x| lum(original.pixel(x, y))).sum::<f64>()
@@ -73,10 +74,5 @@ fn encode(x: f64) -> u8 {
     } else {
         0.0
     };
-    let s = if t <= 0.0031308 {
-        12.92 * t
-    } else {
-        1.055 * t.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0 + 0.5).clamp(0.0, 255.0) as u8
+    (srgb_encode(t) * 255.0 + 0.5).clamp(0.0, 255.0) as u8
 }

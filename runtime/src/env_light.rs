@@ -3,6 +3,7 @@
 //! group into shadow batches. Every pass that shades or shadows them imports them from here.
 
 use glam::Vec3;
+use strandlight_tables::colour::luminance_f32;
 
 /// One light of an environment.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -89,8 +90,7 @@ impl EnvLight {
 
     /// [`EnvLight::power`]'s luminance (Rec. 709 weights): how lights are ranked by strength.
     pub fn luminous_power(&self) -> f32 {
-        let [r, g, b] = self.power();
-        0.2126 * r + 0.7152 * g + 0.0722 * b
+        luminance_f32(self.power())
     }
 
     /// What the light delivers to a fiber facing it, before shadowing: for an SRBF its

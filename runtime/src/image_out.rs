@@ -3,6 +3,7 @@
 
 use std::io;
 use std::path::{Path, PathBuf};
+use strandlight_tables::colour::srgb_encode;
 
 use strandlight_tables::atomic_write::write_atomically;
 
@@ -91,12 +92,7 @@ pub fn tonemap_channel(c: f32) -> u8 {
         0.0
     };
     let p = c / (1.0 + c);
-    let encoded = if p <= 0.0031308 {
-        12.92 * p
-    } else {
-        1.055 * p.powf(1.0 / 2.4) - 0.055
-    };
-    (encoded * 255.0).round().clamp(0.0, 255.0) as u8
+    (srgb_encode(p) * 255.0).round().clamp(0.0, 255.0) as u8
 }
 
 /// 8-bit RGB PNG tonemapped with [`PNG_TONEMAP`] (named in its `Tonemap` text chunk).

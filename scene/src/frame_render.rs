@@ -27,6 +27,7 @@ use strandlight_runtime::passes::fiber_shading::ShadingModel;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
 use strandlight_runtime::render::{self, RenderOptions, ShadowMaps, render_frame_with_model};
 use strandlight_tables::checksum::sha256_hex;
+use strandlight_tables::colour::luminance_f32;
 
 /// A loaded hair and a line naming where it came from.
 pub struct LoadedHair {
@@ -241,8 +242,7 @@ pub fn frame_lights(prepared: &PreparedEnv, env: &EnvLighting) -> Vec<EnvLight> 
 
 /// The luminance of a light's power (Rec. 709 weights).
 pub fn light_luminance(light: &EnvLight) -> f32 {
-    let [r, g, b] = light.power();
-    0.2126 * r + 0.7152 * g + 0.0722 * b
+    luminance_f32(light.power())
 }
 
 /// How an env-lit frame of `env` looks.

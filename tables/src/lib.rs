@@ -14,6 +14,7 @@ pub mod asset;
 pub mod atomic_write;
 pub mod checksum;
 pub mod chiang;
+pub mod colour;
 pub mod dual_scattering;
 pub mod dual_scattering_hard_cases;
 pub mod error;

@@ -23,6 +23,7 @@
 //! are in the EXR and are magenta [`PNG_NON_FINITE_COLOR`] in the PNG.
 
 use crate::atomic_write::write_atomically;
+use crate::colour::srgb_encode;
 use crate::table::{Axis, Table};
 use std::io;
 use std::path::{Path, PathBuf};
@@ -167,15 +168,6 @@ impl PngTonemap {
             PngTonemap::Log10 { .. } => 0.0,
         };
         (p * 255.0).round() as u8
-    }
-}
-
-/// The sRGB transfer curve (IEC 61966-2-1) for linear p ∈ [0, 1].
-fn srgb_encode(p: f64) -> f64 {
-    if p <= 0.0031308 {
-        12.92 * p
-    } else {
-        1.055 * p.powf(1.0 / 2.4) - 0.055
     }
 }
 

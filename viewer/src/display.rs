@@ -10,6 +10,7 @@ use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::image_out::tonemap_channel;
 use strandlight_scene::image_metrics::HAIR_ALPHA;
 use strandlight_scene::world_lights::world_to_env;
+use strandlight_tables::colour::luminance_f32;
 
 /// Automatic exposure puts the hair's 90th-percentile radiance here (Reinhard: 2/3 of white).
 const AUTO_TARGET: f32 = 2.0;
@@ -21,7 +22,7 @@ pub fn auto_exposure_stops(image: &LinearImage) -> f32 {
         .pixels
         .iter()
         .filter(|p| p[3] > HAIR_ALPHA)
-        .map(|p| (0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]) / p[3])
+        .map(|p| luminance_f32([p[0], p[1], p[2]]) / p[3])
         .filter(|l| l.is_finite() && *l > 0.0)
         .collect();
     if luminance.is_empty() {
