@@ -4,6 +4,7 @@ pub mod bind_layout;
 pub mod device;
 pub mod limits;
 pub mod pass_timer;
+pub mod pipeline;
 pub mod readback;
 pub mod texture;
 

@@ -16,6 +16,7 @@ use super::forward_scattering::CpuForwardScattering;
 use super::shadow_paths::{LightMedium, light_direction};
 use crate::env_light::EnvLight;
 use crate::gpu::bind_layout::{storage_entry, uniform_entry};
+use crate::gpu::pipeline::{compute_pipeline, wgsl_module};
 use crate::gpu::{GpuContext, GpuLimits, read_buffer};
 use crate::multiple::{ForwardScatteringGrid, ForwardScatteringSource};
 
@@ -251,10 +252,11 @@ fn pack_medium(medium: &LightMedium, out: &mut Vec<[f32; 4]>) {
 
 fn build_pipeline(gpu: &GpuContext) -> (wgpu::ComputePipeline, wgpu::BindGroupLayout) {
     let device = &gpu.device;
-    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("gpu_shadow_paths.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(include_str!("gpu_shadow_paths.wgsl").into()),
-    });
+    let shader = wgsl_module(
+        device,
+        "gpu_shadow_paths.wgsl",
+        include_str!("gpu_shadow_paths.wgsl"),
+    );
     let compute = wgpu::ShaderStages::COMPUTE;
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("shadow paths"),
@@ -271,13 +273,12 @@ fn build_pipeline(gpu: &GpuContext) -> (wgpu::ComputePipeline, wgpu::BindGroupLa
         bind_group_layouts: &[Some(&layout)],
         immediate_size: 0,
     });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("march_samples"),
-        layout: Some(&pipeline_layout),
-        module: &shader,
-        entry_point: Some("march_samples"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
+    let pipeline = compute_pipeline(
+        device,
+        "march_samples",
+        &pipeline_layout,
+        &shader,
+        "march_samples",
+    );
     (pipeline, layout)
 }

@@ -21,6 +21,7 @@ use crate::gpu::bind_layout::{
     uniform_entry,
 };
 use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels, fit_within};
+use crate::gpu::pipeline::{StrandDraw, color_target, compute_pipeline, depth_test, wgsl_module};
 use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::passes::fiber_shading::{ModelBinding, ShadingModel};
 use crate::passes::frame_params::FrameParams;
@@ -152,79 +153,30 @@ impl ABufferLayouts {
 
 /// Depth-tested and written: the DBK prepass and its opaque fallback.
 fn depth_tested() -> wgpu::DepthStencilState {
-    wgpu::DepthStencilState {
-        format: DEPTH_FORMAT,
-        depth_write_enabled: Some(true),
-        depth_compare: Some(wgpu::CompareFunction::Less),
-        stencil: Default::default(),
-        bias: Default::default(),
-    }
+    depth_test(DEPTH_FORMAT, true, wgpu::CompareFunction::Less)
 }
 
 /// A depth attachment only to give the A-buffer build a size; every fragment passes.
 pub(crate) fn every_fragment() -> wgpu::DepthStencilState {
-    wgpu::DepthStencilState {
-        format: DEPTH_FORMAT,
-        depth_write_enabled: Some(false),
-        depth_compare: Some(wgpu::CompareFunction::Always),
-        stencil: Default::default(),
-        bias: Default::default(),
-    }
-}
-
-/// A pipeline drawing strand quads (`vs_main`), with fragment entry point `fragment` and its
-/// colour targets, or depth only.
-pub(crate) fn strand_quad_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    layout: &wgpu::PipelineLayout,
-    module: &wgpu::ShaderModule,
-    fragment: Option<(&str, &[Option<wgpu::ColorTargetState>])>,
-    depth: wgpu::DepthStencilState,
-) -> wgpu::RenderPipeline {
-    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some(label),
-        layout: Some(layout),
-        vertex: wgpu::VertexState {
-            module,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        },
-        fragment: fragment.map(|(entry, targets)| wgpu::FragmentState {
-            module,
-            entry_point: Some(entry),
-            compilation_options: Default::default(),
-            targets,
-        }),
-        primitive: wgpu::PrimitiveState {
-            topology: wgpu::PrimitiveTopology::TriangleList,
-            cull_mode: None,
-            ..Default::default()
-        },
-        depth_stencil: Some(depth),
-        multisample: Default::default(),
-        multiview_mask: None,
-        cache: None,
-    })
+    depth_test(DEPTH_FORMAT, false, wgpu::CompareFunction::Always)
 }
 
 fn resolve_pipeline(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
 ) -> wgpu::ComputePipeline {
-    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("abuffer_resolve.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(include_str!("abuffer_resolve.wgsl").into()),
-    });
-    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("abuffer resolve"),
-        layout: Some(&pipeline_layout(device, "abuffer resolve", &[Some(layout)])),
-        module: &shader,
-        entry_point: Some("resolve"),
-        compilation_options: Default::default(),
-        cache: None,
-    })
+    let shader = wgsl_module(
+        device,
+        "abuffer_resolve.wgsl",
+        include_str!("abuffer_resolve.wgsl"),
+    );
+    compute_pipeline(
+        device,
+        "abuffer resolve",
+        &pipeline_layout(device, "abuffer resolve", &[Some(layout)]),
+        &shader,
+        "resolve",
+    )
 }
 
 /// Bytes of the per-pixel list heads, resolved colours and nodes of a `width`×`height` frame
@@ -495,12 +447,11 @@ impl ABufferPass {
     /// Fragments shaded with `model`; its tables and constants are uploaded once, here.
     pub fn with_model(gpu: &GpuContext, shading: &ShadingModel) -> Self {
         let device = &gpu.device;
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("abuffer.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(
-                shading_source(shading, include_str!("abuffer.wgsl")).into(),
-            ),
-        });
+        let shader = wgsl_module(
+            device,
+            "abuffer.wgsl",
+            &shading_source(shading, include_str!("abuffer.wgsl")),
+        );
         let model = ModelBinding::new(gpu, shading);
         let layouts = ABufferLayouts::new(device);
         let model_layout = model.as_ref().map(|m| &m.layout);
@@ -516,13 +467,17 @@ impl ABufferPass {
             pipeline_layout(device, "abuffer build", &shading_groups(&layouts.lists));
         let dbk_layout = pipeline_layout(device, "dbk build", &shading_groups(&layouts.dbk_lists));
         let prepass_layout = pipeline_layout(device, "dbk depth prepass", &[Some(&layouts.strand)]);
-        let fallback_target = [Some(wgpu::ColorTargetState {
-            format: gpu.hdr_format(),
-            blend: None,
-            write_mask: wgpu::ColorWrites::ALL,
-        })];
+        let fallback_target = [color_target(gpu.hdr_format(), None)];
         let quads = |label, layout, fragment, depth| {
-            strand_quad_pipeline(device, label, layout, &shader, fragment, depth)
+            StrandDraw {
+                label,
+                layout,
+                shader: &shader,
+                vertex_entry: "vs_main",
+                fragment,
+                depth: Some(depth),
+            }
+            .build(device)
         };
         Self {
             build: quads(

@@ -22,6 +22,7 @@ use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{
     bind_group, pipeline_layout, storage_entry, storage_texture_entry, uniform_entry,
 };
+use crate::gpu::pipeline::{compute_pipeline, wgsl_module};
 use crate::gpu::texture::texture_2d;
 use crate::hair::{Aabb, HairModel};
 
@@ -397,16 +398,14 @@ pub struct ConvolutionDepthPass {
 impl ConvolutionDepthPass {
     pub fn new(gpu: &GpuContext) -> Self {
         let device = &gpu.device;
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("convolution_depth.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(
-                concat!(
-                    include_str!("strand_quads.wgsl"),
-                    include_str!("convolution_depth.wgsl")
-                )
-                .into(),
+        let shader = wgsl_module(
+            device,
+            "convolution_depth.wgsl",
+            concat!(
+                include_str!("strand_quads.wgsl"),
+                include_str!("convolution_depth.wgsl")
             ),
-        });
+        );
         let compute = wgpu::ShaderStages::COMPUTE;
         let strand_layout = strand_bind_group_layout_for(device, compute);
         let splat_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -434,16 +433,7 @@ impl ConvolutionDepthPass {
                 Some(&output_layout),
             ],
         );
-        let kernel = |entry: &str| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&layout),
-                module: &shader,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let kernel = |entry: &str| compute_pipeline(device, entry, &layout, &shader, entry);
         Self {
             nearest: kernel("splat_nearest"),
             layers: kernel("splat_layers"),

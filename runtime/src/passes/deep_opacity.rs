@@ -27,6 +27,7 @@ use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
 use crate::camera::Camera;
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{bind_group, depth_texture_entry, uniform_entry};
+use crate::gpu::pipeline::{ADDITIVE, StrandDraw, color_target, depth_test, wgsl_module};
 use crate::gpu::readback::{ReadbackError, read_texture_layer_rgba};
 use crate::gpu::texture::texture_2d;
 use crate::hair::Aabb;
@@ -340,16 +341,14 @@ pub struct DeepOpacityPass {
 impl DeepOpacityPass {
     pub fn new(gpu: &GpuContext) -> Self {
         let device = &gpu.device;
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("deep_opacity.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(
-                concat!(
-                    include_str!("strand_quads.wgsl"),
-                    include_str!("deep_opacity.wgsl")
-                )
-                .into(),
+        let shader = wgsl_module(
+            device,
+            "deep_opacity.wgsl",
+            concat!(
+                include_str!("strand_quads.wgsl"),
+                include_str!("deep_opacity.wgsl")
             ),
-        });
+        );
         let strand_layout = strand_bind_group_layout(device);
         let dom_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dom"),
@@ -368,64 +367,26 @@ impl DeepOpacityPass {
             bind_group_layouts: &[Some(&strand_layout), Some(&dom_layout)],
             immediate_size: 0,
         });
-        let vertex = wgpu::VertexState {
-            module: &shader,
-            entry_point: Some("vs_main"),
-            compilation_options: Default::default(),
-            buffers: &[],
-        };
-        let primitive = wgpu::PrimitiveState {
-            topology: wgpu::PrimitiveTopology::TriangleList,
-            cull_mode: None,
-            ..Default::default()
-        };
-        let depth_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("dom depth"),
-            layout: Some(&depth_layout),
-            vertex: vertex.clone(),
+        let depth_pipeline = StrandDraw {
+            label: "dom depth",
+            layout: &depth_layout,
+            shader: &shader,
+            vertex_entry: "vs_main",
             fragment: None,
-            primitive,
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        });
-        let additive = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let target = Some(wgpu::ColorTargetState {
-            format: gpu.hdr_format(),
-            blend: Some(wgpu::BlendState {
-                color: additive,
-                alpha: additive,
-            }),
-            write_mask: wgpu::ColorWrites::ALL,
-        });
-        let targets = vec![target; TARGETS_PER_PASS as usize];
-        let layer_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("dom layers"),
-            layout: Some(&layer_layout),
-            vertex,
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_layers"),
-                compilation_options: Default::default(),
-                targets: &targets,
-            }),
-            primitive,
-            depth_stencil: None,
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        });
+            depth: Some(depth_test(DEPTH_FORMAT, true, wgpu::CompareFunction::Less)),
+        }
+        .build(device);
+        let targets =
+            vec![color_target(gpu.hdr_format(), Some(ADDITIVE)); TARGETS_PER_PASS as usize];
+        let layer_pipeline = StrandDraw {
+            label: "dom layers",
+            layout: &layer_layout,
+            shader: &shader,
+            vertex_entry: "vs_main",
+            fragment: Some(("fs_layers", &targets)),
+            depth: None,
+        }
+        .build(device);
         Self {
             depth_pipeline,
             layer_pipeline,

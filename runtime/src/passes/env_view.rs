@@ -29,6 +29,7 @@ use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{
     float_array_texture_entry, float_texture_entry, pipeline_layout, storage_entry, uniform_entry,
 };
+use crate::gpu::pipeline::{ADDITIVE, StrandDraw, color_target, compute_pipeline, wgsl_module};
 use crate::gpu::texture::texture_2d;
 use crate::multiple::ForwardScatteringGrid;
 use crate::visibility::VisibilityVolume;
@@ -709,10 +710,7 @@ fn env_view_shader(device: &wgpu::Device) -> wgpu::ShaderModule {
         include_str!("view_visibility.wgsl"),
     ]
     .concat();
-    device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("env_view.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    })
+    wgsl_module(device, "env_view.wgsl", &source)
 }
 
 /// A view pipeline writing the single and multiple targets from vertex entry `vertex` and
@@ -722,40 +720,18 @@ fn view_pipeline(
     layout: &wgpu::PipelineLayout,
     shader: &wgpu::ShaderModule,
     (label, vertex, entry): (&str, &str, &str),
-    blend: Option<wgpu::BlendComponent>,
-    depth: Option<wgpu::DepthStencilState>,
+    blend: Option<wgpu::BlendState>,
 ) -> wgpu::RenderPipeline {
-    let target = Some(wgpu::ColorTargetState {
-        format: gpu.hdr_format(),
-        blend: blend.map(|b| wgpu::BlendState { color: b, alpha: b }),
-        write_mask: wgpu::ColorWrites::ALL,
-    });
-    gpu.device
-        .create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some(label),
-            layout: Some(layout),
-            vertex: wgpu::VertexState {
-                module: shader,
-                entry_point: Some(vertex),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: shader,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                targets: &[target.clone(), target],
-            }),
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: depth,
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        })
+    let target = color_target(gpu.hdr_format(), blend);
+    StrandDraw {
+        label,
+        layout,
+        shader,
+        vertex_entry: vertex,
+        fragment: Some((entry, &[target.clone(), target])),
+        depth: None,
+    }
+    .build(&gpu.device)
 }
 
 /// The compute pass adding a batch's two images into the sums, and its layout.
@@ -770,18 +746,18 @@ fn accumulate_pipeline(device: &wgpu::Device) -> (wgpu::ComputePipeline, wgpu::B
             uniform_entry(3, compute),
         ],
     });
-    let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("env_accumulate.wgsl"),
-        source: wgpu::ShaderSource::Wgsl(include_str!("env_accumulate.wgsl").into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("env accumulate"),
-        layout: Some(&pipeline_layout(device, "env accumulate", &[Some(&layout)])),
-        module: &shader,
-        entry_point: Some("accumulate"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
+    let shader = wgsl_module(
+        device,
+        "env_accumulate.wgsl",
+        include_str!("env_accumulate.wgsl"),
+    );
+    let pipeline = compute_pipeline(
+        device,
+        "env accumulate",
+        &pipeline_layout(device, "env accumulate", &[Some(&layout)]),
+        &shader,
+        "accumulate",
+    );
     (pipeline, layout)
 }
 
@@ -814,11 +790,6 @@ impl EnvViewPass {
             &strands_only,
             gpu.hdr_format(),
         );
-        let additive = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::One,
-            operation: wgpu::BlendOperation::Add,
-        };
         // The depth prepass left each pixel's nearest fiber in two textures: the opaque view
         // shades those pixels, rasterizing no strand per batch.
         let opaque = view_pipeline(
@@ -827,15 +798,13 @@ impl EnvViewPass {
             &shader,
             ("env view (opaque)", "vs_fullscreen", "fs_env_deferred"),
             None,
-            None,
         );
         let transparent = view_pipeline(
             gpu,
             &layout,
             &shader,
             ("env view (occupancy)", "vs_main", "fs_env_transparent"),
-            Some(additive),
-            None,
+            Some(ADDITIVE),
         );
         let (accumulate, accumulate_layout) = accumulate_pipeline(device);
         Self {

@@ -8,18 +8,17 @@
 
 use wgpu::util::DeviceExt;
 
-use super::abuffer::{every_fragment, strand_quad_pipeline};
+use super::abuffer::every_fragment;
 use super::attachments::cleared_depth;
-use super::fiber_shading::{ModelBinding, ShadingModel};
+use super::fiber_shading::ShadingModel;
 use super::frame_params::FrameParams;
 use super::render_target::RenderTarget;
-use super::shadow_slots::{
-    ShadowInput, TooManyShadowMaps, shadow_bind_group_for, shadow_bind_group_layout,
-};
+use super::shadow_slots::{ShadowInput, TooManyShadowMaps, shadow_bind_group_for};
 use super::strand_geometry::StrandGeometry;
-use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
-use super::strands::shading_source;
+use super::strand_quads::strand_bind_group;
+use super::strands::{ShadedStrandLayouts, shading_source};
 use crate::gpu::bind_layout::{bind_group, pipeline_layout, storage_entry, uniform_entry};
+use crate::gpu::pipeline::{StrandDraw, compute_pipeline, wgsl_module};
 use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::gpu::{GpuContext, GpuLimits, LimitError};
 
@@ -64,11 +63,9 @@ pub struct KBufferPass {
     depths: wgpu::RenderPipeline,
     colors: wgpu::RenderPipeline,
     resolve: wgpu::ComputePipeline,
-    strand_layout: wgpu::BindGroupLayout,
-    shadow_layout: wgpu::BindGroupLayout,
+    layouts: ShadedStrandLayouts,
     slots_layout: wgpu::BindGroupLayout,
     resolve_layout: wgpu::BindGroupLayout,
-    model: Option<ModelBinding>,
 }
 
 impl KBufferPass {
@@ -84,34 +81,23 @@ impl KBufferPass {
                 uniform_entry(3, fragment),
             ],
         });
-        let strand_layout = strand_bind_group_layout(device);
-        let shadow_layout = shadow_bind_group_layout(device);
-        let model = ModelBinding::new(gpu, shading);
-        let build_layout = pipeline_layout(
+        let layouts = ShadedStrandLayouts::new(gpu, shading);
+        let build_layout = layouts.pipeline_layout(device, "kbuffer build", Some(&slots_layout));
+        let shader = wgsl_module(
             device,
-            "kbuffer build",
-            &[
-                Some(&strand_layout),
-                Some(&shadow_layout),
-                model.as_ref().map(|m| &m.layout),
-                Some(&slots_layout),
-            ],
+            "kbuffer.wgsl",
+            &shading_source(shading, include_str!("kbuffer.wgsl")),
         );
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("kbuffer.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(
-                shading_source(shading, include_str!("kbuffer.wgsl")).into(),
-            ),
-        });
         let build = |label, entry| {
-            strand_quad_pipeline(
-                device,
+            StrandDraw {
                 label,
-                &build_layout,
-                &shader,
-                Some((entry, &[])),
-                every_fragment(),
-            )
+                layout: &build_layout,
+                shader: &shader,
+                vertex_entry: "vs_main",
+                fragment: Some((entry, &[])),
+                depth: Some(every_fragment()),
+            }
+            .build(device)
         };
         let compute = wgpu::ShaderStages::COMPUTE;
         let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -124,31 +110,25 @@ impl KBufferPass {
                 uniform_entry(4, compute),
             ],
         });
-        let resolve_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("kbuffer_resolve.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("kbuffer_resolve.wgsl").into()),
-        });
-        let resolve = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("kbuffer resolve"),
-            layout: Some(&pipeline_layout(
-                device,
-                "kbuffer resolve",
-                &[Some(&resolve_layout)],
-            )),
-            module: &resolve_shader,
-            entry_point: Some("resolve"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let resolve_shader = wgsl_module(
+            device,
+            "kbuffer_resolve.wgsl",
+            include_str!("kbuffer_resolve.wgsl"),
+        );
+        let resolve = compute_pipeline(
+            device,
+            "kbuffer resolve",
+            &pipeline_layout(device, "kbuffer resolve", &[Some(&resolve_layout)]),
+            &resolve_shader,
+            "resolve",
+        );
         Self {
             depths: build("kbuffer depths", "fs_kbuffer_depths"),
             colors: build("kbuffer colours", "fs_kbuffer_colors"),
             resolve,
-            strand_layout,
-            shadow_layout,
+            layouts,
             slots_layout,
             resolve_layout,
-            model,
         }
     }
 
@@ -233,8 +213,8 @@ impl KBufferPass {
                 resolve_params.as_entire_binding(),
             ],
         );
-        let shadow_group = shadow_bind_group_for(gpu, &self.shadow_layout, frame, shadows)?;
-        let strands = strand_bind_group(gpu, &self.strand_layout, geometry, frame);
+        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows)?;
+        let strands = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
         // Only to give the build passes a size: every fragment passes its test.
         let target = RenderTarget::new(gpu, width, height);
         let depth_view = target.depth.create_view(&Default::default());
@@ -254,7 +234,7 @@ impl KBufferPass {
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &strands, &[]);
             pass.set_bind_group(1, &shadow_group, &[]);
-            if let Some(model) = &self.model {
+            if let Some(model) = &self.layouts.model {
                 pass.set_bind_group(2, &model.group, &[]);
             }
             pass.set_bind_group(3, &slots_group, &[]);

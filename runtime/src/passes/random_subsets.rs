@@ -9,17 +9,18 @@
 use wgpu::util::DeviceExt;
 
 use super::attachments::{cleared_color, cleared_depth};
-use super::fiber_shading::{ModelBinding, ShadingModel};
+use super::fiber_shading::ShadingModel;
 use super::frame_params::FrameParams;
 use super::render_target::DEPTH_FORMAT;
-use super::shadow_slots::{
-    ShadowInput, TooManyShadowMaps, shadow_bind_group_for, shadow_bind_group_layout,
-};
+use super::shadow_slots::{ShadowInput, TooManyShadowMaps, shadow_bind_group_for};
 use super::strand_geometry::StrandGeometry;
-use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
-use super::strands::shading_source;
+use super::strand_quads::strand_bind_group;
+use super::strands::{ShadedStrandLayouts, shading_source};
 use crate::gpu::bind_layout::{
     bind_group, pipeline_layout, storage_entry, texture_entry, uniform_entry,
+};
+use crate::gpu::pipeline::{
+    PREMULTIPLIED_OVER, StrandDraw, color_target, compute_pipeline, depth_test, wgsl_module,
 };
 use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::gpu::texture::texture_2d;
@@ -88,83 +89,38 @@ struct ResolveParams {
 pub struct RandomSubsetsPass {
     draw: wgpu::RenderPipeline,
     resolve: wgpu::ComputePipeline,
-    strand_layout: wgpu::BindGroupLayout,
-    shadow_layout: wgpu::BindGroupLayout,
+    layouts: ShadedStrandLayouts,
     order_layout: wgpu::BindGroupLayout,
     resolve_layout: wgpu::BindGroupLayout,
-    model: Option<ModelBinding>,
 }
 
 impl RandomSubsetsPass {
     pub fn with_model(gpu: &GpuContext, shading: &ShadingModel) -> Self {
         let device = &gpu.device;
-        let strand_layout = strand_bind_group_layout(device);
-        let shadow_layout = shadow_bind_group_layout(device);
+        let layouts = ShadedStrandLayouts::new(gpu, shading);
         let order_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("subset segments"),
             entries: &[storage_entry(0, wgpu::ShaderStages::VERTEX, true)],
         });
-        let model = ModelBinding::new(gpu, shading);
-        let layout = pipeline_layout(
+        let layout = layouts.pipeline_layout(device, "random subsets", Some(&order_layout));
+        // The sorted pass's vertex stage reads segments through an index list: here, a subset's.
+        let shader = wgsl_module(
             device,
             "random subsets",
-            &[
-                Some(&strand_layout),
-                Some(&shadow_layout),
-                model.as_ref().map(|m| &m.layout),
-                Some(&order_layout),
-            ],
+            &shading_source(shading, include_str!("sorted_blend_draw.wgsl")),
         );
-        // The sorted pass's vertex stage reads segments through an index list: here, a subset's.
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("random subsets"),
-            source: wgpu::ShaderSource::Wgsl(
-                shading_source(shading, include_str!("sorted_blend_draw.wgsl")).into(),
-            ),
-        });
-        let premultiplied_over = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let draw = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("random subsets"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_sorted"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: SUBSET_COLOR_FORMAT,
-                    blend: Some(wgpu::BlendState {
-                        color: premultiplied_over,
-                        alpha: premultiplied_over,
-                    }),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        });
+        let draw = StrandDraw {
+            label: "random subsets",
+            layout: &layout,
+            shader: &shader,
+            vertex_entry: "vs_sorted",
+            fragment: Some((
+                "fs_main",
+                &[color_target(SUBSET_COLOR_FORMAT, Some(PREMULTIPLIED_OVER))],
+            )),
+            depth: Some(depth_test(DEPTH_FORMAT, true, wgpu::CompareFunction::Less)),
+        }
+        .build(device);
         let compute = wgpu::ShaderStages::COMPUTE;
         let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("random subsets resolve"),
@@ -185,30 +141,24 @@ impl RandomSubsetsPass {
                 uniform_entry(3, compute),
             ],
         });
-        let resolve_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("random_subsets_resolve.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("random_subsets_resolve.wgsl").into()),
-        });
-        let resolve = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("random subsets resolve"),
-            layout: Some(&pipeline_layout(
-                device,
-                "random subsets resolve",
-                &[Some(&resolve_layout)],
-            )),
-            module: &resolve_shader,
-            entry_point: Some("resolve"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let resolve_shader = wgsl_module(
+            device,
+            "random_subsets_resolve.wgsl",
+            include_str!("random_subsets_resolve.wgsl"),
+        );
+        let resolve = compute_pipeline(
+            device,
+            "random subsets resolve",
+            &pipeline_layout(device, "random subsets resolve", &[Some(&resolve_layout)]),
+            &resolve_shader,
+            "resolve",
+        );
         Self {
             draw,
             resolve,
-            strand_layout,
-            shadow_layout,
+            layouts,
             order_layout,
             resolve_layout,
-            model,
         }
     }
 
@@ -276,8 +226,8 @@ impl RandomSubsetsPass {
             }),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let shadow_group = shadow_bind_group_for(gpu, &self.shadow_layout, frame, shadows)?;
-        let strands = strand_bind_group(gpu, &self.strand_layout, geometry, frame);
+        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows)?;
+        let strands = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
         let order_group = bind_group(
             device,
             "subset segments",
@@ -307,7 +257,7 @@ impl RandomSubsetsPass {
             pass.set_pipeline(&self.draw);
             pass.set_bind_group(0, &strands, &[]);
             pass.set_bind_group(1, &shadow_group, &[]);
-            if let Some(model) = &self.model {
+            if let Some(model) = &self.layouts.model {
                 pass.set_bind_group(2, &model.group, &[]);
             }
             pass.set_bind_group(3, &order_group, &[]);

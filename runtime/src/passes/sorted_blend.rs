@@ -9,17 +9,18 @@
 use wgpu::util::DeviceExt;
 
 use super::attachments::cleared_color;
-use super::fiber_shading::{ModelBinding, ShadingModel};
+use super::fiber_shading::ShadingModel;
 use super::frame_params::FrameParams;
 use super::render_target::RenderTarget;
-use super::shadow_slots::{
-    ShadowInput, TooManyShadowMaps, shadow_bind_group_for, shadow_bind_group_layout,
-};
+use super::shadow_slots::{ShadowInput, TooManyShadowMaps, shadow_bind_group_for};
 use super::strand_geometry::StrandGeometry;
-use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
-use super::strands::shading_source;
+use super::strand_quads::strand_bind_group;
+use super::strands::{ShadedStrandLayouts, shading_source};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{bind_group, pipeline_layout, storage_entry, uniform_entry};
+use crate::gpu::pipeline::{
+    PREMULTIPLIED_OVER, StrandDraw, color_target, compute_pipeline, wgsl_module,
+};
 use crate::hair::Aabb;
 
 /// Kim 2003 and Hunz use a few hundred depth bins.
@@ -65,10 +66,8 @@ pub struct SortedBlendPass {
     scatter: wgpu::ComputePipeline,
     sort_layout: wgpu::BindGroupLayout,
     draw: wgpu::RenderPipeline,
-    strand_layout: wgpu::BindGroupLayout,
-    shadow_layout: wgpu::BindGroupLayout,
+    layouts: ShadedStrandLayouts,
     order_layout: wgpu::BindGroupLayout,
-    model: Option<ModelBinding>,
 }
 
 impl SortedBlendPass {
@@ -85,93 +84,47 @@ impl SortedBlendPass {
                 storage_entry(4, compute, false),
             ],
         });
-        let sort_shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("sorted_blend.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("sorted_blend.wgsl").into()),
-        });
+        let sort_shader = wgsl_module(
+            device,
+            "sorted_blend.wgsl",
+            include_str!("sorted_blend.wgsl"),
+        );
         let sort_pipeline_layout = pipeline_layout(device, "segment sort", &[Some(&sort_layout)]);
-        let stage = |entry| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&sort_pipeline_layout),
-                module: &sort_shader,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let stage =
+            |entry| compute_pipeline(device, entry, &sort_pipeline_layout, &sort_shader, entry);
         let (histogram, scan, scatter) = (stage("histogram"), stage("scan"), stage("scatter"));
 
-        let strand_layout = strand_bind_group_layout(device);
-        let shadow_layout = shadow_bind_group_layout(device);
+        let layouts = ShadedStrandLayouts::new(gpu, shading);
         let order_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("draw order"),
             entries: &[storage_entry(0, wgpu::ShaderStages::VERTEX, true)],
         });
-        let model = ModelBinding::new(gpu, shading);
-        let draw_layout = pipeline_layout(
+        let draw_layout = layouts.pipeline_layout(device, "sorted blend", Some(&order_layout));
+        let shader = wgsl_module(
             device,
-            "sorted blend",
-            &[
-                Some(&strand_layout),
-                Some(&shadow_layout),
-                model.as_ref().map(|m| &m.layout),
-                Some(&order_layout),
-            ],
+            "sorted_blend_draw.wgsl",
+            &shading_source(shading, include_str!("sorted_blend_draw.wgsl")),
         );
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("sorted_blend_draw.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(
-                shading_source(shading, include_str!("sorted_blend_draw.wgsl")).into(),
-            ),
-        });
-        let premultiplied_over = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let draw = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("sorted blend"),
-            layout: Some(&draw_layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_sorted"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: gpu.hdr_format(),
-                    blend: Some(wgpu::BlendState {
-                        color: premultiplied_over,
-                        alpha: premultiplied_over,
-                    }),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: None,
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        });
+        let draw = StrandDraw {
+            label: "sorted blend",
+            layout: &draw_layout,
+            shader: &shader,
+            vertex_entry: "vs_sorted",
+            fragment: Some((
+                "fs_main",
+                &[color_target(gpu.hdr_format(), Some(PREMULTIPLIED_OVER))],
+            )),
+            depth: None,
+        }
+        .build(device);
         Self {
             histogram,
             scan,
             scatter,
             sort_layout,
             draw,
-            strand_layout,
-            shadow_layout,
+            layouts,
             order_layout,
-            model,
         }
     }
 
@@ -265,8 +218,8 @@ impl SortedBlendPass {
         target: &RenderTarget,
     ) -> Result<(), TooManyShadowMaps> {
         let device = &gpu.device;
-        let shadow_group = shadow_bind_group_for(gpu, &self.shadow_layout, frame, shadows)?;
-        let strands = strand_bind_group(gpu, &self.strand_layout, geometry, frame);
+        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows)?;
+        let strands = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
         let order_group = bind_group(
             device,
             "draw order",
@@ -287,7 +240,7 @@ impl SortedBlendPass {
             pass.set_pipeline(&self.draw);
             pass.set_bind_group(0, &strands, &[]);
             pass.set_bind_group(1, &shadow_group, &[]);
-            if let Some(model) = &self.model {
+            if let Some(model) = &self.layouts.model {
                 pass.set_bind_group(2, &model.group, &[]);
             }
             pass.set_bind_group(3, &order_group, &[]);

@@ -14,14 +14,13 @@ use super::shadow_slots::{
 use super::strand_geometry::StrandGeometry;
 use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
 use crate::gpu::GpuContext;
+use crate::gpu::bind_layout::pipeline_layout;
+use crate::gpu::pipeline::{PREMULTIPLIED_OVER, StrandDraw, color_target, depth_test, wgsl_module};
 
 /// The compiled pipeline; reusable across frames and models.
 pub struct StrandPass {
     pipeline: wgpu::RenderPipeline,
-    layout: wgpu::BindGroupLayout,
-    shadow_layout: wgpu::BindGroupLayout,
-    /// Group 2: the fiber model's constants and tables (none for Kajiya-Kay).
-    model: Option<ModelBinding>,
+    layouts: ShadedStrandLayouts,
 }
 
 impl StrandPass {
@@ -34,71 +33,22 @@ impl StrandPass {
     pub fn with_model(gpu: &GpuContext, model: &ShadingModel) -> Self {
         let device = &gpu.device;
         let source = shading_source(model, "");
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("strands.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-        let layout = strand_bind_group_layout(device);
-        let shadow_layout = shadow_bind_group_layout(device);
-        let model = ModelBinding::new(gpu, model);
-        let mut group_layouts = vec![Some(&layout), Some(&shadow_layout)];
-        if let Some(m) = &model {
-            group_layouts.push(Some(&m.layout));
+        let shader = wgsl_module(device, "strands.wgsl", &source);
+        let layouts = ShadedStrandLayouts::new(gpu, model);
+        let pipeline_layout = layouts.pipeline_layout(device, "strands", None);
+        let pipeline = StrandDraw {
+            label: "strands",
+            layout: &pipeline_layout,
+            shader: &shader,
+            vertex_entry: "vs_main",
+            fragment: Some((
+                "fs_main",
+                &[color_target(gpu.hdr_format(), Some(PREMULTIPLIED_OVER))],
+            )),
+            depth: Some(depth_test(DEPTH_FORMAT, true, wgpu::CompareFunction::Less)),
         }
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("strands"),
-            bind_group_layouts: &group_layouts,
-            immediate_size: 0,
-        });
-        let premultiplied_over = wgpu::BlendComponent {
-            src_factor: wgpu::BlendFactor::One,
-            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
-            operation: wgpu::BlendOperation::Add,
-        };
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("strands"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &shader,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            fragment: Some(wgpu::FragmentState {
-                module: &shader,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format: gpu.hdr_format(),
-                    blend: Some(wgpu::BlendState {
-                        color: premultiplied_over,
-                        alpha: premultiplied_over,
-                    }),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            multiview_mask: None,
-            cache: None,
-        });
-        Self {
-            pipeline,
-            layout,
-            shadow_layout,
-            model,
-        }
+        .build(device);
+        Self { pipeline, layouts }
     }
 
     /// Clears the target to transparent black and draws every segment.
@@ -125,8 +75,8 @@ impl StrandPass {
         shadows: &[ShadowInput<'_>],
     ) -> Result<(), TooManyShadowMaps> {
         let device = &gpu.device;
-        let shadow_group = shadow_bind_group_for(gpu, &self.shadow_layout, frame, shadows)?;
-        let bind_group = strand_bind_group(gpu, &self.layout, geometry, frame);
+        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows)?;
+        let bind_group = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
         let color_view = target.color.create_view(&Default::default());
         let depth_view = target.depth.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
@@ -142,13 +92,52 @@ impl StrandPass {
             pass.set_pipeline(&self.pipeline);
             pass.set_bind_group(0, &bind_group, &[]);
             pass.set_bind_group(1, &shadow_group, &[]);
-            if let Some(model) = &self.model {
+            if let Some(model) = &self.layouts.model {
                 pass.set_bind_group(2, &model.group, &[]);
             }
             pass.draw(0..6, 0..geometry.segment_count);
         }
         gpu.queue.submit([encoder.finish()]);
         Ok(())
+    }
+}
+
+/// The bind group layouts of a pass that shades strand quads under point lights: the strands
+/// (group 0), their shadow maps (1), the fiber model's constants and tables (2; none for
+/// Kajiya-Kay), then what the pass adds (3).
+pub(crate) struct ShadedStrandLayouts {
+    pub strand: wgpu::BindGroupLayout,
+    pub shadow: wgpu::BindGroupLayout,
+    pub model: Option<ModelBinding>,
+}
+
+impl ShadedStrandLayouts {
+    /// The layouts for `shading`, its tables and constants uploaded once, here.
+    pub fn new(gpu: &GpuContext, shading: &ShadingModel) -> Self {
+        Self {
+            strand: strand_bind_group_layout(&gpu.device),
+            shadow: shadow_bind_group_layout(&gpu.device),
+            model: ModelBinding::new(gpu, shading),
+        }
+    }
+
+    /// The pipeline layout of groups 0–2 and the pass's own group 3, if it has one.
+    pub fn pipeline_layout(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        own: Option<&wgpu::BindGroupLayout>,
+    ) -> wgpu::PipelineLayout {
+        let mut groups = vec![
+            Some(&self.strand),
+            Some(&self.shadow),
+            self.model.as_ref().map(|m| &m.layout),
+            own,
+        ];
+        while groups.last() == Some(&None) {
+            groups.pop();
+        }
+        pipeline_layout(device, label, &groups)
     }
 }
 

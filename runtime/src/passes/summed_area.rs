@@ -15,6 +15,7 @@ use super::convolution_depth::{DodmBatch, DodmSettings};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{storage_entry, texture_entry, uniform_entry};
 use crate::gpu::limits::{GpuLimits, LimitError};
+use crate::gpu::pipeline::{compute_pipeline, wgsl_module};
 
 pub const FIXED_POINT_SCALE: f32 = 256.0;
 pub const MAX_TEXEL_TAU: f32 = 16.0;
@@ -100,10 +101,7 @@ pub struct SummedAreaPass {
 impl SummedAreaPass {
     pub fn new(gpu: &GpuContext) -> Self {
         let device = &gpu.device;
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("summed_area.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("summed_area.wgsl").into()),
-        });
+        let shader = wgsl_module(device, "summed_area.wgsl", include_str!("summed_area.wgsl"));
         let compute = wgpu::ShaderStages::COMPUTE;
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("summed area"),
@@ -123,16 +121,7 @@ impl SummedAreaPass {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = |entry| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&pipeline_layout),
-                module: &shader,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let pipeline = |entry| compute_pipeline(device, entry, &pipeline_layout, &shader, entry);
         Self {
             rows: pipeline("scan_rows"),
             columns: pipeline("scan_columns"),

@@ -8,6 +8,7 @@ use wgpu::util::DeviceExt;
 use super::env_view::{BatchBinding, transmittance_bind_group_layout};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::storage_entry;
+use crate::gpu::pipeline::{compute_pipeline, wgsl_module};
 use crate::gpu::readback::{ReadbackError, read_buffer};
 
 #[repr(C)]
@@ -51,10 +52,7 @@ impl TransmittanceProbe {
             include_str!("transmittance_probe.wgsl"),
         ]
         .concat();
-        let shader = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("transmittance_probe.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
+        let shader = wgsl_module(device, "transmittance_probe.wgsl", &source);
         let compute = wgpu::ShaderStages::COMPUTE;
         let probe_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe"),
@@ -71,16 +69,7 @@ impl TransmittanceProbe {
             bind_group_layouts: &[Some(&probe_layout), Some(&batch_layout)],
             immediate_size: 0,
         });
-        let pipeline = |entry| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: Some(&layout),
-                module: &shader,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let pipeline = |entry| compute_pipeline(device, entry, &layout, &shader, entry);
         Self {
             transmittance: pipeline("probe_transmittance"),
             boxes: pipeline("probe_box_sums"),

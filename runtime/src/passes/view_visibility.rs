@@ -21,6 +21,7 @@ use super::attachments::{cleared_color, cleared_depth, prepassed_depth};
 use super::render_target::{DEPTH_FORMAT, RenderTarget};
 use crate::gpu::GpuContext;
 use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels};
+use crate::gpu::pipeline::{StrandDraw, depth_test};
 use crate::gpu::readback::{ReadbackError, read_texture_rgba};
 
 /// The format of the view's nearest-surface targets (`EnvViewTargets::nearest_position` and
@@ -182,37 +183,15 @@ impl ViewVisibilityPass {
                 Some("fs_nearest_surface") => &nearest_targets,
                 _ => &[],
             };
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(layout),
-                vertex: wgpu::VertexState {
-                    module,
-                    entry_point: Some("vs_main"),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                fragment: fragment.map(|entry| wgpu::FragmentState {
-                    module,
-                    entry_point: Some(entry),
-                    compilation_options: Default::default(),
-                    targets,
-                }),
-                primitive: wgpu::PrimitiveState {
-                    topology: wgpu::PrimitiveTopology::TriangleList,
-                    cull_mode: None,
-                    ..Default::default()
-                },
-                depth_stencil: depth.map(|(compare, write)| wgpu::DepthStencilState {
-                    format: DEPTH_FORMAT,
-                    depth_write_enabled: Some(write),
-                    depth_compare: Some(compare),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                multiview_mask: None,
-                cache: None,
-            })
+            StrandDraw {
+                label,
+                layout,
+                shader: module,
+                vertex_entry: "vs_main",
+                fragment: fragment.map(|entry| (entry, targets)),
+                depth: depth.map(|(compare, write)| depth_test(DEPTH_FORMAT, write, compare)),
+            }
+            .build(device)
         };
         use wgpu::CompareFunction::{Always, Equal, Less};
         let reading =
