@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use strandlight_eval::baseline::Baseline;
 use strandlight_eval::compare::{CompareSettings, execute, prepare};
 use strandlight_eval::ground_truth::TruthUse;
-use strandlight_scene::env_frame::render_lights;
+use strandlight_scene::env_frame::{env_adapter, render_lights};
 use strandlight_scene::look::{EnvTransparency, ForwardDevice, LobeVisibilityArg};
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
 use strandlight_scene::steps::Steps;
@@ -194,6 +194,8 @@ impl CompareArgs {
 pub fn run(args: CompareArgs) -> anyhow::Result<()> {
     let settings = args.settings()?;
     let mut steps = Steps::new(settings.json);
+    // Before the fit, bake and references: a machine without a usable GPU device is told at once.
+    steps.run("GPU", env_adapter, |adapter| adapter.clone())?;
     let scene = prepare(&settings, &mut steps)?;
     let report = execute(&settings, &scene, &mut steps, &render_lights)?;
     if settings.json {

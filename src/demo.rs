@@ -10,7 +10,9 @@ use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::EnvRenderOptions;
 use strandlight_runtime::hair::{GroomParams, generate_groom};
 use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
-use strandlight_scene::env_frame::{EnvFrame, FrameRole, light_summary, render_lights};
+use strandlight_scene::env_frame::{
+    EnvFrame, FrameRole, env_adapter, light_summary, render_lights,
+};
 use strandlight_scene::env_scene::{EnvSceneRequest, prepare_env_scene};
 use strandlight_scene::environment::{ensure_procedural_envmap, load_env};
 use strandlight_scene::look::{EnvTransparency, LookArgs};
@@ -44,6 +46,8 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     }
     .look()?;
     let mut steps = Steps::new(false);
+    // Before minutes of fit and bake: a machine without a usable GPU device is told at once.
+    steps.run("GPU", env_adapter, |adapter| adapter.clone())?;
     let env = steps
         .run(
             "environment",

@@ -9,7 +9,7 @@ use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
 use strandlight_runtime::render::{PassTiming, TIMING_METHOD};
 use strandlight_scene::camera_choice::{CameraChoice, CameraKind, UpChoice};
-use strandlight_scene::env_frame::{light_summary, render_lights};
+use strandlight_scene::env_frame::{env_adapter, light_summary, render_lights};
 use strandlight_scene::frame_render::{
     env_frame, env_look, frame_lights, load_settings_hair, prepare_env, prepare_point, render_point,
 };
@@ -383,6 +383,8 @@ fn run_env(args: &OutputArgs, settings: &FrameSettings, env: &EnvLighting) -> an
         ..env_look(env)?
     };
     let mut steps = Steps::new(args.json);
+    // Before the fit and bake: a machine without a usable GPU device is told at once.
+    steps.run("GPU", env_adapter, |adapter| adapter.clone())?;
     let hair = steps.run(
         "hair",
         || load_settings_hair(settings),

@@ -62,7 +62,15 @@ fn summary_json_has_every_section() {
         println!("furnace: {row}");
         let sum = f(&row["r"]) + f(&row["tt"]) + f(&row["trt"]);
         assert!((sum - f(&row["total"])).abs() < 1e-12);
-        assert!(f(&row["total"]) > 0.5 && f(&row["total"]) < 1.5);
+        // White hair loses only the higher-order paths (E_p≥3, a few percent) and gains or
+        // loses a few percent from M_p's spread over θ_d (tables/src/marschner/tests.rs,
+        // white_furnace_energy_per_lobe): within 10% of 1, not an order-of-magnitude window.
+        assert!((f(&row["total"]) - 1.0).abs() < 0.1, "{row}");
+        // Twice the quadrature panels moves the total by less than 1e-4: it has converged.
+        assert!(
+            (f(&row["total_refined"]) - f(&row["total"])).abs() < 1e-4,
+            "{row}"
+        );
     }
     assert_eq!(
         s["single_event_albedo_marschner"].as_array().unwrap().len(),

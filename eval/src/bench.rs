@@ -310,7 +310,8 @@ impl BenchPlan {
             Path::new("cache"),
             Path::new("out"),
         );
-        compare::check_args(&probe)?;
+        // The cause names the comparison's setting; the context, the bench flags that set it.
+        compare::check_args(&probe).with_context(|| format!("bench{}", self.regenerate_args()))?;
         Ok(self)
     }
 }
