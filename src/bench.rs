@@ -73,6 +73,14 @@ pub struct BenchArgs {
 }
 
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
+    // Its generated section is rewritten at the end: a page that is not there is said now, not
+    // after an hour of measuring (a quick run writes its own REPORT.md instead).
+    if !args.quick && !args.benchmarks.is_file() {
+        anyhow::bail!(
+            "--benchmarks {}: no such page, whose generated section the run would rewrite (copy docs/BENCHMARKS.md there, or name it)",
+            args.benchmarks.display()
+        );
+    }
     let report = match args.from_report.is_empty() {
         false => {
             let reports = args

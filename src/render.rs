@@ -5,11 +5,10 @@
 use anyhow::bail;
 use clap::{Args, Subcommand};
 use std::path::{Path, PathBuf};
-use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
 use strandlight_runtime::render::{PassTiming, TIMING_METHOD};
 use strandlight_scene::camera_choice::{CameraChoice, CameraKind, UpChoice};
-use strandlight_scene::env_frame::{env_adapter, light_summary, render_lights};
+use strandlight_scene::env_frame::{env_adapter, light_summary, render_lights, shared_gpu};
 use strandlight_scene::frame_render::{
     env_frame, env_look, frame_lights, load_settings_hair, prepare_env, prepare_point, render_point,
 };
@@ -308,8 +307,8 @@ fn run_point(
     let prepared = prepare_point(settings, point)?;
     let hair = load_settings_hair(settings)?;
     let (model, source) = (&hair.model, &hair.source);
-    let gpu = GpuContext::new_headless()?;
-    let rendered = render_point(&gpu, settings, point, model, &prepared, settings.size)?;
+    let gpu = shared_gpu()?;
+    let rendered = render_point(gpu, settings, point, model, &prepared, settings.size)?;
     let [width, height] = settings.size;
     let shading_description = &prepared.description;
     let stem = output_stem(&args.out);

@@ -80,28 +80,27 @@ pub struct RenderedEnv {
     pub memory_per_batch: Vec<(String, u64)>,
 }
 
-/// The GPU device and the renderer's pipelines, created on first use and kept for every frame
-/// of the run (pipeline creation is a one-time cost, not part of a frame).
-struct GpuRenderer {
-    gpu: GpuContext,
-    renderer: EnvRenderer,
-}
-
-fn gpu_renderer() -> anyhow::Result<&'static GpuRenderer> {
-    static RENDERER: OnceLock<Result<GpuRenderer, String>> = OnceLock::new();
-    RENDERER
-        .get_or_init(|| {
-            let gpu = GpuContext::new_headless().map_err(|e| e.to_string())?;
-            let renderer = EnvRenderer::new(&gpu);
-            Ok(GpuRenderer { gpu, renderer })
-        })
+/// The process's GPU device: created on first use by whichever frame needs it first (an
+/// env-lit frame, a point-light frame, the viewer's render thread) and shared by all of them,
+/// so a run opens one device and every timing is on the same adapter.
+pub fn shared_gpu() -> anyhow::Result<&'static GpuContext> {
+    static GPU: OnceLock<Result<GpuContext, String>> = OnceLock::new();
+    GPU.get_or_init(|| GpuContext::new_headless().map_err(|e| e.to_string()))
         .as_ref()
-        .map_err(|e| anyhow::anyhow!("no GPU device for the environment-lit renderer: {e}"))
+        .map_err(|e| anyhow::anyhow!("no GPU device: {e}"))
 }
 
-/// The adapter the environment-lit renderer runs on (creating the device on first use).
+/// The environment-lit renderer's pipelines on [`shared_gpu`], created on first use and kept for
+/// every frame of the run (pipeline creation is a one-time cost, not part of a frame).
+fn env_renderer() -> anyhow::Result<(&'static GpuContext, &'static EnvRenderer)> {
+    static RENDERER: OnceLock<EnvRenderer> = OnceLock::new();
+    let gpu = shared_gpu()?;
+    Ok((gpu, RENDERER.get_or_init(|| EnvRenderer::new(gpu))))
+}
+
+/// The adapter the renderers run on (creating the device on first use).
 pub fn env_adapter() -> anyhow::Result<String> {
-    Ok(gpu_renderer()?.gpu.report.to_string())
+    Ok(shared_gpu()?.report.to_string())
 }
 
 /// Passes an application pays once (device, pipelines, uploads of hair and tables), not per
@@ -233,17 +232,16 @@ fn env_tables(frame: &EnvFrame) -> anyhow::Result<EnvTables> {
 /// `tables.get(shading.srbf_table(mode))`, directional lights `tables.get(shading.direct_table(mode))`
 /// (4 axes, the 1/λ axis a single node), and the full mode also [`MULTIPLE_TABLES`].
 pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
-    let r = gpu_renderer()?;
+    let (gpu, renderer) = env_renderer()?;
     let tables = env_tables(frame)?;
     let source = match frame.mode {
         ScatteringMode::Single => None,
-        ScatteringMode::Full => Some(forward_scattering(frame, &r.gpu)?),
+        ScatteringMode::Full => Some(forward_scattering(frame, gpu)?),
     };
     let multiple = source.as_deref();
-    let out = r
-        .renderer
+    let out = renderer
         .render_part(
-            &r.gpu,
+            gpu,
             frame.hair,
             &frame.camera,
             frame.width,

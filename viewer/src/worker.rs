@@ -13,9 +13,8 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 use strandlight_runtime::camera::Camera;
 use strandlight_runtime::env_light::EnvLight;
-use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::render::TIMING_METHOD;
-use strandlight_scene::env_frame::{env_adapter, render_lights};
+use strandlight_scene::env_frame::{env_adapter, render_lights, shared_gpu};
 use strandlight_scene::env_scene::PrepareProgress;
 use strandlight_scene::frame_render::{
     LoadedHair, PreparedEnv, PreparedPoint, env_frame, env_look, frame_lights, light_luminance,
@@ -148,7 +147,6 @@ struct WorkerState {
     point: Option<(String, Arc<PreparedPoint>)>,
     env: Option<(TablesKey, Arc<PreparedEnv>)>,
     baking: Option<(TablesKey, Receiver<BakeResult>)>,
-    gpu: Option<GpuContext>,
     job: Option<Job>,
 }
 
@@ -161,7 +159,6 @@ impl WorkerState {
             point: None,
             env: None,
             baking: None,
-            gpu: None,
             job: None,
         }
     }
@@ -458,10 +455,7 @@ impl WorkerState {
         prepared: &PreparedPoint,
         step: Step,
     ) -> anyhow::Result<(LinearImage, FrameStats)> {
-        if self.gpu.is_none() {
-            self.gpu = Some(GpuContext::new_headless()?);
-        }
-        let gpu = self.gpu.as_ref().expect("created above");
+        let gpu = shared_gpu()?;
         let size = step.size(settings.size);
         let frame = render_point(gpu, settings, point, &hair.model, prepared, size)?;
         let stats = FrameStats {
