@@ -604,7 +604,8 @@ mod tests {
         let again = splice(&second, &format!("{BEGIN}\nB\n{END}\n")).unwrap();
         assert_eq!(again, second, "idempotent");
         let damaged = format!("{page}{END}\n{BEGIN}\n");
-        assert!(splice(&damaged, "x").is_err());
+        let e = splice(&damaged, "x").unwrap_err().to_string();
+        assert!(e.contains("markers") && e.contains("damaged"), "{e}");
     }
 
     fn report_of(plan: BenchPlan) -> BenchReport {

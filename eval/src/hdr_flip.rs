@@ -200,7 +200,10 @@ mod tests {
             Err(CompareError::SizeMismatch { .. })
         ));
         let black = image(64, 48, |_, _| [0.0, 0.0, 0.0, 1.0]);
-        assert!(hdr_flip(&reference, &black).is_err());
+        assert!(matches!(
+            hdr_flip(&reference, &black),
+            Err(CompareError::BlackReference)
+        ));
         let mut nan = reference.clone();
         nan.pixels[100][1] = f32::NAN;
         assert!(matches!(

@@ -978,7 +978,10 @@ mod tests {
             "{err}"
         );
         assert!(err.to_string().contains("azimuth"));
-        assert!(LutResolution::square(MAX_LUT_NODES + 1).validate().is_err());
+        assert!(matches!(
+            LutResolution::square(MAX_LUT_NODES + 1).validate(),
+            Err(LutError::Resolution { .. })
+        ));
         let res = LutResolution {
             sin_theta_i: 40,
             sin_theta_o: 50,
@@ -998,7 +1001,11 @@ mod tests {
             (partial.azimuth, partial.sin_theta_i, partial.azimuth_axis),
             (64, 128, AzimuthAxis::CosPhi)
         );
-        assert!(serde_json::from_str::<LutResolution>(r#"{"cos_ph": 64}"#).is_err());
+        let typo = serde_json::from_str::<LutResolution>(r#"{"cos_ph": 64}"#).unwrap_err();
+        assert!(
+            typo.to_string().contains("unknown field `cos_ph`"),
+            "{typo}"
+        );
         let luts = PointLightLuts::bake(&brown(), &res).unwrap();
         // 40·50·4 + 60·70·9 f32 values, counted by hand.
         assert_eq!(luts.bytes(), (8000 + 37800) * 4);

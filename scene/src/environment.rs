@@ -128,7 +128,11 @@ mod tests {
         let loaded = load_env(&path.to_string_lossy(), false).unwrap();
         let generated = procedural_env::by_name("studio", PROCEDURAL_WIDTH).unwrap();
         assert_eq!(loaded.map, generated, "f32 EXR keeps every pixel");
-        assert!(ensure_procedural_envmap(&dir, "nowhere").is_err());
+        let e = ensure_procedural_envmap(&dir, "nowhere").unwrap_err();
+        assert!(
+            format!("{e:#}").contains("unknown procedural environment \"nowhere\""),
+            "{e:#}"
+        );
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

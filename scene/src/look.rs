@@ -204,7 +204,10 @@ mod tests {
             .look()
             .unwrap();
         assert_eq!(maps.lobe_visibility, LobeVisibility::LightMaps);
-        assert!(Cli::try_parse_from(["x", "--lobe-visibility", "cone"]).is_err());
+        let e = Cli::try_parse_from(["x", "--lobe-visibility", "cone"])
+            .err()
+            .expect("an unknown value is refused");
+        assert_eq!(e.kind(), clap::error::ErrorKind::InvalidValue, "{e}");
     }
 
     #[test]

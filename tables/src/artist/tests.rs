@@ -312,12 +312,14 @@ fn validation_names_the_parameter() {
     );
     let mut p = ArtistParams::default();
     p.r.shift_deg = 60.0;
-    assert!(ArtistModel::new(p).is_err());
+    let e = ArtistModel::new(p).unwrap_err().to_string();
+    assert!(e.contains("artist.r.shift_deg"), "{e}");
     let json = serde_json::to_string_pretty(&ArtistParams::default()).unwrap();
     let back: ArtistParams = serde_json::from_str(&json).unwrap();
     assert_eq!(back, ArtistParams::default());
     let typo = json.replace("\"intensity\"", "\"intensty\"");
-    assert!(serde_json::from_str::<ArtistParams>(&typo).is_err());
+    let e = serde_json::from_str::<ArtistParams>(&typo).unwrap_err();
+    assert!(e.to_string().contains("unknown field `intensty`"), "{e}");
 }
 
 #[test]

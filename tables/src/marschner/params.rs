@@ -339,7 +339,8 @@ mod tests {
         let partial: MarschnerParams = serde_json::from_str(r#"{"eta": 1.7}"#).unwrap();
         assert_eq!(partial.eta, 1.7);
         assert_eq!(partial.beta_deg, MarschnerParams::default().beta_deg);
-        assert!(serde_json::from_str::<MarschnerParams>(r#"{"etta": 1.7}"#).is_err());
+        let e = serde_json::from_str::<MarschnerParams>(r#"{"etta": 1.7}"#).unwrap_err();
+        assert!(e.to_string().contains("unknown field `etta`"), "{e}");
     }
 
     /// The sign check of DESIGN.md: both elliptical indices reduce to η for a circle, whereas
