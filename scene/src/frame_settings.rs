@@ -542,6 +542,10 @@ mod tests {
         });
         exact.camera().unwrap();
         exact.up = [0.0, 0.0, 1.0];
-        assert!(exact.camera().is_err(), "up along the view is refused");
+        let e = exact.camera().unwrap_err().to_string();
+        assert!(
+            e.contains("not collinear"),
+            "up along the view is refused: {e}"
+        );
     }
 }

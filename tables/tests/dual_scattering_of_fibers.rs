@@ -487,7 +487,11 @@ fn divergent_forward_attenuation_is_a_typed_error() {
         density_forward: 1.5,
         ..Default::default()
     };
-    assert!(DualScatteringAverages::new(&toy(), bad).is_err());
+    let e = DualScatteringAverages::new(&toy(), bad).unwrap_err();
+    assert!(
+        e.to_string().contains("dual_scattering.density_forward"),
+        "{e}"
+    );
     let json = serde_json::to_string(&DualScatteringConfig::default()).unwrap();
     assert_eq!(
         serde_json::from_str::<DualScatteringConfig>(&json).unwrap(),

@@ -408,6 +408,16 @@ mod tests {
         let err = AttenuationRatio::from_table(&wrong_axes).unwrap_err();
         println!("{err}");
         assert!(err.to_string().contains("attenuation_ratio"));
-        assert!(SrbfSpread::from_table(&fiber_table(9)).is_err());
+        let err = SrbfSpread::from_table(&fiber_table(9)).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                ForwardScatteringError::TableShape {
+                    table: "srbf_spread",
+                    ..
+                }
+            ),
+            "{err}"
+        );
     }
 }
