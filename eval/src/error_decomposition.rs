@@ -199,6 +199,23 @@ fn part_step(
     })
 }
 
+/// A full-scattering frame's single- and multiple-scattering parts (`single` is the frame's
+/// single-scattering render) against the same parts of a yardstick, over its full image.
+fn scattering_parts(
+    (single, full): (&Image, &Image),
+    (yardstick_single, yardstick_full): (&Image, &Image),
+) -> anyhow::Result<[DecompositionStep; 2]> {
+    Ok([
+        part_step(SINGLE_PART, single, yardstick_single, yardstick_full)?,
+        part_step(
+            MULTIPLE_PART,
+            &full.minus(single)?,
+            &yardstick_full.minus(yardstick_single)?,
+            yardstick_full,
+        )?,
+    ])
+}
+
 /// Single scattering: fit, tables, shadowing at κ 1, κ; `reference` is the run's shadowed
 /// single-scattering reference.
 pub fn single_scattering(
@@ -281,16 +298,11 @@ pub fn full_scattering(
         unshadowed_reference_lights: None,
         unshadowed_converged: None,
         against_truth: false,
-        steps: vec![
-            part_step(SINGLE_PART, &srbf_single, r_single, r_full)?,
-            part_step(
-                MULTIPLE_PART,
-                &srbf_full.minus(&srbf_single)?,
-                &r_full.minus(r_single)?,
-                r_full,
-            )?,
-            step(FULL, &srbf_full, r_full)?,
-        ],
+        steps: [
+            scattering_parts((&srbf_single, &srbf_full), (r_single, r_full))?.to_vec(),
+            vec![step(FULL, &srbf_full, r_full)?],
+        ]
+        .concat(),
     })
 }
 
@@ -377,16 +389,11 @@ pub fn full_scattering_against_truth(
         unshadowed_reference_lights: None,
         unshadowed_converged: None,
         against_truth: true,
-        steps: vec![
-            part_step(SINGLE_PART, &srbf_single, t_single, t_full)?,
-            part_step(
-                MULTIPLE_PART,
-                &srbf_full.minus(&srbf_single)?,
-                &t_full.minus(t_single)?,
-                t_full,
-            )?,
-            truth_step(FULL, &srbf_full, full)?,
-        ],
+        steps: [
+            scattering_parts((&srbf_single, &srbf_full), (t_single, t_full))?.to_vec(),
+            vec![truth_step(FULL, &srbf_full, full)?],
+        ]
+        .concat(),
     })
 }
 
