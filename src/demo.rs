@@ -6,18 +6,18 @@
 use anyhow::Context;
 use std::path::Path;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
-use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_runtime::env::EnvRenderOptions;
-use strandlight_runtime::hair::{GroomParams, generate_groom};
-use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
-use strandlight_scene::env_frame::{
-    EnvFrame, FrameRole, env_adapter, light_summary, render_lights,
-};
+use strandlight_scene::env_frame::{env_adapter, light_summary};
 use strandlight_scene::env_scene::{EnvSceneRequest, prepare_env_scene};
-use strandlight_scene::environment::{ensure_procedural_envmap, load_env};
-use strandlight_scene::look::{EnvTransparency, LookArgs};
-use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
+use strandlight_scene::environment::{LoadedEnv, ensure_procedural_envmap, load_env};
+use strandlight_scene::frame_render::{
+    FrameDetails, FramePart, LoadedHair, Prepared, PreparedEnv, load_settings_hair, render_frame,
+};
+use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting, up_choice};
+use strandlight_scene::look::EnvTransparency;
+use strandlight_scene::point_shading::Shading;
+use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
+use strandlight_tables::image_out::{PNG_TONEMAP, write_exr, write_png};
 
 /// The environment the demo renders under, and where it is written.
 pub const DEMO_ENVIRONMENT: &str = "sun_and_sky";
@@ -40,15 +40,10 @@ pub struct DemoArgs {
 }
 
 pub fn run(args: DemoArgs) -> anyhow::Result<()> {
-    let look = LookArgs {
-        transparency: args.transparency,
-        ..Default::default()
-    }
-    .look()?;
     let mut steps = Steps::new(false);
     // Before minutes of fit and bake: a machine without a usable GPU device is told at once.
     steps.run("GPU", env_adapter, |adapter| adapter.clone())?;
-    let env = steps
+    let (env, env_path) = steps
         .run(
             "environment",
             || {
@@ -67,57 +62,36 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
                     }
                 )
             },
-        )?
-        .0;
+        )
+        .map(|(env, path, _)| (env, path))?;
+    let settings = demo_settings(&env_path.to_string_lossy(), args.transparency);
     let hair = steps.run(
         "groom",
-        || Ok(generate_groom(&GroomParams::default())?),
-        |h| format!("procedural groom, {} strands", h.strand_count()),
+        || load_settings_hair(&settings),
+        |h| format!("{}, {} strands", h.source, h.model.strand_count()),
     )?;
-    let fiber = FiberDescription::preset(DEMO_PRESET)?;
-    let shading = EnvShading::Marschner;
-    let up = UpAxis::detect(&hair);
-    let request = EnvSceneRequest {
-        env: &env,
-        fiber: &fiber,
-        shading,
-        scattering: ScatteringMode::Full,
-        resolution: BakeResolution::reduced(DEMO_TABLE_NODES),
-        cache_dir: Path::new(CACHE_DIR),
-        table_set: "demo",
-        up,
-    };
-    let scene = prepare_env_scene(&request, &mut steps)?;
-    let (lights, mode) = (&scene.lights, scene.mode);
-    let (width, height) = DEMO_SIZE;
-    let camera = Camera::framing_front(hair.bounds(), width as f32 / height as f32, false, up);
-    let frame = EnvFrame {
-        hair: &hair,
-        camera,
-        width,
-        height,
-        lights,
-        tables: &scene.tables,
-        shading,
-        mode,
-        role: FrameRole::Interactive {
-            kappa: EnvRenderOptions::default().kappa,
-        },
-        look,
-    };
+    let prepared = prepare_demo_scene(&settings, env, &hair, &mut steps)?;
     let rendered = steps.run(
         "render",
-        || render_lights(&frame),
+        || {
+            render_frame(
+                &settings,
+                &hair.model,
+                Prepared::Env(&prepared),
+                FramePart::Whole,
+                false,
+            )
+        },
         |r| {
             format!(
-                "{:.1} ms/frame, {}, {} scattering, {:?} view",
-                r.milliseconds,
-                light_summary(lights),
-                mode.name(),
-                args.transparency
+                "{:.1} ms/frame, {:?} view",
+                r.milliseconds, args.transparency
             )
         },
     )?;
+    let FrameDetails::Env { lights, mode, .. } = &rendered.details else {
+        anyhow::bail!("the demo is env-lit");
+    };
     let out = Path::new(OUT_DIR);
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let description = format!(
@@ -130,10 +104,56 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     write_exr(&exr, image.width, image.height, &image.pixels, &description)?;
     write_png(&png, image.width, image.height, &image.pixels, &description)?;
     steps.say(format!(
-        "wrote {} (linear) and {} ({PNG_TONEMAP}); total {:.1} s",
+        "{}, {} scattering; wrote {} (linear) and {} ({PNG_TONEMAP}); total {:.1} s",
+        light_summary(lights),
+        mode.name(),
         exr.display(),
         png.display(),
         steps.total_seconds()
     ));
     Ok(())
+}
+
+/// The demo as frame settings: the procedural groom framed from the front, Marschner
+/// `DEMO_PRESET` fibers, single and multiple scattering under the map at `map`.
+fn demo_settings(map: &str, transparency: EnvTransparency) -> FrameSettings {
+    let lighting = EnvLighting {
+        scattering: ScatteringMode::Full,
+        transparency,
+        ..EnvLighting::new(map)
+    };
+    FrameSettings {
+        shading: Some(Shading::Marschner),
+        preset: DEMO_PRESET.into(),
+        ..FrameSettings::new(Lighting::Environment(lighting), [DEMO_SIZE.0, DEMO_SIZE.1])
+    }
+}
+
+/// The fit and the demo's reduced tables (`DEMO_TABLE_NODES`), both cached under `CACHE_DIR`.
+fn prepare_demo_scene(
+    settings: &FrameSettings,
+    env: LoadedEnv,
+    hair: &LoadedHair,
+    steps: &mut Steps,
+) -> anyhow::Result<PreparedEnv> {
+    let fiber = FiberDescription::preset(DEMO_PRESET)?;
+    let shading = settings.env_shading()?;
+    let up = up_choice(settings).axis(&hair.model);
+    let request = EnvSceneRequest {
+        env: &env,
+        fiber: &fiber,
+        shading,
+        scattering: ScatteringMode::Full,
+        resolution: BakeResolution::reduced(DEMO_TABLE_NODES),
+        cache_dir: Path::new(CACHE_DIR),
+        table_set: "demo",
+        up,
+    };
+    let scene = prepare_env_scene(&request, steps)?;
+    Ok(PreparedEnv {
+        env,
+        scene,
+        shading,
+        up,
+    })
 }

@@ -73,7 +73,7 @@ pub fn run(args: ImageErrorArgs) -> anyhow::Result<()> {
     }
     if let Some(path) = &args.flip_map {
         let (w, h) = (reference.width, reference.height);
-        strandlight_runtime::image_out::write_png_rgb8(
+        strandlight_tables::image_out::write_png_rgb8(
             path,
             w,
             h,

@@ -2,25 +2,28 @@
 //! environment map or point lights, written as a linear EXR and a tonemapped PNG, with timings
 //! and GPU memory on request.
 
-use anyhow::bail;
+use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
+use std::io::Write;
 use std::path::{Path, PathBuf};
-use strandlight_runtime::image_out::{PNG_TONEMAP, write_exr, write_png};
-use strandlight_runtime::render::{PassTiming, TIMING_METHOD};
+use strandlight_runtime::render::PassTiming;
 use strandlight_scene::camera_choice::{CameraChoice, CameraKind, UpChoice};
-use strandlight_scene::env_frame::{env_adapter, light_summary, render_lights, shared_gpu};
+use strandlight_scene::env_frame::{env_adapter, light_summary};
 use strandlight_scene::frame_render::{
-    env_frame, env_look, frame_lights, load_settings_hair, prepare_env, prepare_point, render_point,
+    FrameDetails, FramePart, LoadedHair, Prepared, RenderedFrame, load_settings_hair, prepare_env,
+    prepare_point, render_frame,
 };
 use strandlight_scene::frame_settings::{
     CameraSettings, DEFAULT_LIGHT, EnvLighting, FrameSettings, Lighting, PointLighting, Shadows,
     Transparency,
 };
 use strandlight_scene::hair_input::parse_size;
-use strandlight_scene::look::{EnvLook, LookArgs};
+use strandlight_scene::look::LookArgs;
 use strandlight_scene::point_shading::{Shading, read_artist_params};
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
+use strandlight_tables::atomic_write::write_atomically;
+use strandlight_tables::image_out::{PNG_TONEMAP, write_exr, write_png};
 
 /// `render env`, `render lights` or `render replay`: each lighting has its own flags, so no
 /// flag belongs to two renderers.
@@ -80,7 +83,8 @@ struct SceneArgs {
 #[derive(Args, Debug)]
 #[command(next_help_heading = "Output")]
 struct OutputArgs {
-    /// Output stem: writes STEM.exr (linear) and STEM.png (tonemapped).
+    /// Output stem: writes STEM.exr (linear), STEM.png (tonemapped) and STEM.json (the
+    /// settings, for `render replay`).
     #[arg(long, default_value = "render")]
     out: PathBuf,
     /// Print adapter, per-pass milliseconds and GPU memory as JSON.
@@ -293,176 +297,214 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         RenderWhat::Replay(replay) => (FrameSettings::read(&replay.settings)?, &replay.output),
     };
     settings.check()?;
-    match &settings.lighting {
-        Lighting::Lights(point) => run_point(output, &settings, point),
-        Lighting::Environment(env) => run_env(output, &settings, env),
-    }
-}
-
-fn run_point(
-    args: &OutputArgs,
-    settings: &FrameSettings,
-    point: &PointLighting,
-) -> anyhow::Result<()> {
-    let prepared = prepare_point(settings, point)?;
-    let hair = load_settings_hair(settings)?;
-    let (model, source) = (&hair.model, &hair.source);
-    let gpu = shared_gpu()?;
-    let rendered = render_point(gpu, settings, point, model, &prepared, settings.size)?;
-    let [width, height] = settings.size;
-    let shading_description = &prepared.description;
-    let stem = output_stem(&args.out);
-    let exr_path = stem.with_extension("exr");
-    let png_path = stem.with_extension("png");
-    let description = format!(
-        "{source}; {width}x{height}; {shading_description}; shadows {:?}; lights {}; camera {:?}",
-        point.shadows,
-        point.lights.join(" "),
-        settings.camera
-    );
-    write_exr(&exr_path, width, height, &rendered.pixels, &description)?;
-    write_png(&png_path, width, height, &rendered.pixels, &description)?;
-    let covered = rendered.pixels.iter().filter(|p| p[3] > 0.0).count();
-    let stats = &rendered.stats;
-    if args.json {
-        let report = serde_json::json!({
-            "hair": source,
-            "strands": model.strand_count(),
-            "segments": stats.segments,
-            "size": [width, height],
-            "shading": shading_description,
-            "adapter": {
-                "name": stats.adapter.name,
-                "backend": stats.adapter.backend,
-                "device_type": stats.adapter.device_type,
-                "driver": stats.adapter.driver,
-            },
-            "timing_method": stats.timing_method,
-            "pass_ms": pass_ms(&stats.timings),
-            "pass_gpu_ms": pass_gpu_ms(&stats.timings),
-            "gpu_memory_bytes": stats.memory_bytes.iter().map(|(n, b)| (n.clone(), serde_json::json!(b))).collect::<serde_json::Map<_, _>>(),
-            "covered_pixels": covered,
-            "fragments_stored": stats.fragments.map(|f| f.stored),
-            "fragments_dropped": stats.fragments.map(|f| f.dropped),
-            "fragments_truncated_at_resolve": stats.fragments.map(|f| f.truncated),
-            "abuffer_node_capacity": stats.fragments.map(|f| f.capacity),
-            "outputs": { "exr": exr_path, "png": png_path, "png_tonemap": PNG_TONEMAP },
-        });
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
-        println!("adapter: {}", stats.adapter);
-        println!("shading: {shading_description}");
-        println!(
-            "hair: {source}, {} strands, {} segments",
-            model.strand_count(),
-            stats.segments
-        );
-        for t in &stats.timings {
-            println!("  {:<10} {:>9.2} ms", t.pass, t.milliseconds);
-        }
-        if let Some(f) = stats.fragments {
-            println!(
-                "A-buffer: {} fragments stored, {} dropped (node buffer holds {}), {} truncated at resolve (over 64 in a pixel)",
-                f.stored, f.dropped, f.capacity, f.truncated
-            );
-        }
-        println!(
-            "wrote {} and {} ({covered} pixels covered)",
-            exr_path.display(),
-            png_path.display()
-        );
-    }
-    Ok(())
-}
-
-/// `render env`: the SRBF path alone (fit and tables cached under out/cache).
-fn run_env(args: &OutputArgs, settings: &FrameSettings, env: &EnvLighting) -> anyhow::Result<()> {
-    let look = EnvLook {
-        count_fragments: args.json,
-        ..env_look(env)?
-    };
-    let mut steps = Steps::new(args.json);
+    let mut steps = Steps::new(output.json);
     // Before the fit and bake: a machine without a usable GPU device is told at once.
     steps.run("GPU", env_adapter, |adapter| adapter.clone())?;
     let hair = steps.run(
         "hair",
-        || load_settings_hair(settings),
+        || load_settings_hair(&settings),
         |h| format!("{} ({} strands)", h.source, h.model.strand_count()),
     )?;
-    let (model, source) = (&hair.model, &hair.source);
-    let prepared = prepare_env(
-        settings,
-        env,
-        model,
-        Path::new("out/cache"),
-        &mut steps,
-        &mut |_| {},
-    )?;
-    let lights = &frame_lights(&prepared, env);
-    let mode = prepared.scene.mode;
-    let frame = env_frame(settings, env, model, &prepared, lights, settings.size, look)?;
-    let [width, height] = settings.size;
-    let (env_spec, shading) = (&env.map, prepared.shading);
-    let look_args = env.look_args();
+    let (point, env);
+    let prepared = match &settings.lighting {
+        Lighting::Lights(lights) => {
+            point = steps.run(
+                "fiber",
+                || prepare_point(&settings, lights),
+                |p| p.description.clone(),
+            )?;
+            Prepared::Point(&point)
+        }
+        Lighting::Environment(lighting) => {
+            env = prepare_env(
+                &settings,
+                lighting,
+                &hair.model,
+                Path::new("out/cache"),
+                &mut steps,
+                &mut |_| {},
+            )?;
+            Prepared::Env(&env)
+        }
+    };
     let rendered = steps.run(
         "render",
-        || render_lights(&frame),
-        |r| {
-            format!(
-                "{:.1} ms/frame, {}, {} scattering",
-                r.milliseconds,
-                light_summary(lights),
-                mode.name()
+        || {
+            render_frame(
+                &settings,
+                &hair.model,
+                prepared,
+                FramePart::Whole,
+                output.json,
             )
         },
+        |r| format!("{:.1} ms/frame, {}", r.milliseconds, what_was_drawn(r)),
     )?;
-    let stem = output_stem(&args.out);
-    let (exr_path, png_path) = (stem.with_extension("exr"), stem.with_extension("png"));
-    let description = format!(
-        "{source}; {width}x{height}; env {env_spec}, {}; {shading:?} ({}), {} scattering",
-        light_summary(lights),
-        settings.preset,
-        mode.name()
-    );
-    let image = &rendered.image;
-    write_exr(&exr_path, width, height, &image.pixels, &description)?;
-    write_png(&png_path, width, height, &image.pixels, &description)?;
-    if args.json {
-        let report = serde_json::json!({
-            "hair": source,
-            "env": env_spec,
-            "srbf_lights": lights.iter().filter(|l| l.lambda.is_some()).count(),
-            "directional_lights": lights.iter().filter(|l| l.lambda.is_none()).count(),
-            "size": [width, height],
-            "mode": mode.name(),
-            "frame_ms": rendered.milliseconds,
-            "transparency": look_args.transparency,
-            "forward_scattering": look_args.view.forward_scattering,
-            "visibility_cutoff": look_args.view.visibility_cutoff,
-            "memory_per_batch_bytes": rendered.memory_per_batch.iter().map(|(n, b)| (n.clone(), serde_json::json!(b))).collect::<serde_json::Map<_, _>>(),
-            "memory_per_batch_total_bytes": rendered.memory_per_batch.iter().map(|(_, b)| b).sum::<u64>(),
-            "fragments": rendered.fragments.map(|f| serde_json::json!({ "rasterized": f.rasterized, "shaded": f.shaded, "note": "per batch (each batch draws the same fragments)" })),
-            "pass_ms": pass_ms(&rendered.passes),
-            "pass_gpu_ms": pass_gpu_ms(&rendered.passes),
-            "timing_method": format!("{TIMING_METHOD}; summed over batches"),
-            "exr": exr_path,
-            "png": png_path,
-        });
+    let written = write_outputs(&output.out, &settings, &hair, prepared, &rendered)?;
+    if output.json {
+        let report = json_report(&settings, &hair, &rendered, &written)?;
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        let memory: u64 = rendered.memory_per_batch.iter().map(|(_, b)| b).sum();
+        for line in text_report(&hair, &rendered) {
+            steps.say(line);
+        }
         steps.say(format!(
-            "GPU memory per batch of {} lights: {:.1} MB (--json lists it per resource)",
-            strandlight_runtime::passes::convolution_depth::DodmSettings::default().batch_size,
-            memory as f64 / 1e6
-        ));
-        steps.say(format!(
-            "wrote {} and {}",
-            exr_path.display(),
-            png_path.display()
+            "wrote {}, {} and {} (the settings, for `render replay`)",
+            written.exr.display(),
+            written.png.display(),
+            written.settings.display()
         ));
     }
     Ok(())
+}
+
+/// "N SRBF lights …, full scattering" or "3 point lights, shadows Dom".
+fn what_was_drawn(rendered: &RenderedFrame) -> String {
+    match &rendered.details {
+        FrameDetails::Env { lights, mode, .. } => {
+            format!("{}, {} scattering", light_summary(lights), mode.name())
+        }
+        FrameDetails::Point(stats) => format!("{} segments", stats.segments),
+    }
+}
+
+struct Written {
+    exr: PathBuf,
+    png: PathBuf,
+    settings: PathBuf,
+    covered_pixels: usize,
+}
+
+/// STEM.exr (linear), STEM.png (tonemapped) and STEM.json (the settings), each with a line
+/// describing the frame.
+fn write_outputs(
+    out: &Path,
+    settings: &FrameSettings,
+    hair: &LoadedHair,
+    prepared: Prepared,
+    rendered: &RenderedFrame,
+) -> anyhow::Result<Written> {
+    let stem = output_stem(out);
+    let [width, height] = settings.size;
+    let lighting = match (&settings.lighting, prepared, &rendered.details) {
+        (Lighting::Lights(point), Prepared::Point(p), _) => format!(
+            "{}; shadows {:?}; lights {}",
+            p.description,
+            point.shadows,
+            point.lights.join(" ")
+        ),
+        (Lighting::Environment(env), Prepared::Env(p), FrameDetails::Env { lights, mode, .. }) => {
+            format!(
+                "env {}, {}; {:?} ({}), {} scattering",
+                env.map,
+                light_summary(lights),
+                p.shading,
+                settings.preset,
+                mode.name()
+            )
+        }
+        _ => bail!("the frame's lighting was prepared for other settings"),
+    };
+    let description = format!(
+        "{}; {width}x{height}; {lighting}; camera {:?}",
+        hair.source, settings.camera
+    );
+    let written = Written {
+        exr: stem.with_extension("exr"),
+        png: stem.with_extension("png"),
+        settings: stem.with_extension("json"),
+        covered_pixels: rendered.image.pixels.iter().filter(|p| p[3] > 0.0).count(),
+    };
+    let image = &rendered.image;
+    write_exr(&written.exr, width, height, &image.pixels, &description)?;
+    write_png(&written.png, width, height, &image.pixels, &description)?;
+    write_atomically::<anyhow::Error, _>(&written.settings, |w| {
+        Ok(w.write_all(settings.to_json().as_bytes())?)
+    })
+    .with_context(|| format!("writing {}", written.settings.display()))?;
+    Ok(written)
+}
+
+fn json_report(
+    settings: &FrameSettings,
+    hair: &LoadedHair,
+    rendered: &RenderedFrame,
+    written: &Written,
+) -> anyhow::Result<serde_json::Value> {
+    let mut report = serde_json::json!({
+        "hair": hair.source,
+        "strands": hair.model.strand_count(),
+        "size": settings.size,
+        "frame_ms": rendered.milliseconds,
+        "adapter": rendered.adapter,
+        "timing_method": rendered.timing_method,
+        "pass_ms": pass_ms(&rendered.passes),
+        "pass_gpu_ms": pass_gpu_ms(&rendered.passes),
+        "gpu_memory_bytes": rendered.memory.iter().map(|(n, b)| (n.clone(), serde_json::json!(b))).collect::<serde_json::Map<_, _>>(),
+        "gpu_memory_total_bytes": rendered.memory.iter().map(|(_, b)| b).sum::<u64>(),
+        "covered_pixels": written.covered_pixels,
+        "outputs": { "exr": written.exr, "png": written.png, "png_tonemap": PNG_TONEMAP, "settings": written.settings },
+        "settings": serde_json::to_value(settings)?,
+    });
+    let extra = match &rendered.details {
+        FrameDetails::Point(stats) => serde_json::json!({
+            "segments": stats.segments,
+            "adapter_device_type": stats.adapter.device_type,
+            "adapter_backend": stats.adapter.backend,
+            "adapter_driver": stats.adapter.driver,
+            "fragments_stored": stats.fragments.map(|f| f.stored),
+            "fragments_dropped": stats.fragments.map(|f| f.dropped),
+            "fragments_truncated_at_resolve": stats.fragments.map(|f| f.truncated),
+            "abuffer_node_capacity": stats.fragments.map(|f| f.capacity),
+        }),
+        FrameDetails::Env {
+            lights,
+            mode,
+            fragments,
+        } => serde_json::json!({
+            "srbf_lights": lights.iter().filter(|l| l.lambda.is_some()).count(),
+            "directional_lights": lights.iter().filter(|l| l.lambda.is_none()).count(),
+            "mode": mode.name(),
+            "gpu_memory_note": "per batch of lights (each batch reuses the same resources)",
+            "fragments": fragments.map(|f| serde_json::json!({ "rasterized": f.rasterized, "shaded": f.shaded, "note": "per batch (each batch draws the same fragments)" })),
+        }),
+    };
+    if let (Some(report), serde_json::Value::Object(extra)) = (report.as_object_mut(), extra) {
+        report.extend(extra);
+    }
+    Ok(report)
+}
+
+fn text_report(hair: &LoadedHair, rendered: &RenderedFrame) -> Vec<String> {
+    let mut lines = vec![format!("adapter: {}", rendered.adapter)];
+    match &rendered.details {
+        FrameDetails::Point(stats) => {
+            lines.push(format!(
+                "hair: {}, {} strands, {} segments",
+                hair.source,
+                hair.model.strand_count(),
+                stats.segments
+            ));
+            for t in &stats.timings {
+                lines.push(format!("  {:<28} {:>9.2} ms", t.pass, t.milliseconds));
+            }
+            if let Some(f) = stats.fragments {
+                lines.push(format!(
+                    "A-buffer: {} fragments stored, {} dropped (node buffer holds {}), {} truncated at resolve (over 64 in a pixel)",
+                    f.stored, f.dropped, f.capacity, f.truncated
+                ));
+            }
+        }
+        FrameDetails::Env { .. } => {
+            let memory: u64 = rendered.memory.iter().map(|(_, b)| b).sum();
+            lines.push(format!(
+                "GPU memory per batch of {} lights: {:.1} MB (--json lists it per resource)",
+                strandlight_runtime::passes::convolution_depth::DodmSettings::default().batch_size,
+                memory as f64 / 1e6
+            ));
+        }
+    }
+    lines
 }
 
 /// Wall-clock milliseconds per pass, for the JSON report.

@@ -4,12 +4,16 @@
 //! - the window kept presenting frames while the rebake ran (no gap near the bake's length);
 //! - the screenshot is not blank, and its sidecar holds the orbited camera and the new control;
 //! - the capture of the whole window shows the screenshot's picture where the image sits;
-//! - `render replay` of the sidecar reproduces the screenshot's linear EXR.
+//! - `render replay` of the sidecar reproduces the screenshot's linear EXR;
+//! - switched to point lights (DOM shadows, sorted transparency) as the panel's radio button
+//!   does, and orbited again, the window converges to another picture whose screenshot
+//!   `render replay` also reproduces.
 
 use serde_json::{Value, json};
 use std::path::Path;
 use std::process::Command;
 use strandlight_eval::reference_cache::read_rgba_exr;
+use strandlight_scene::frame_settings::{PointLighting, Shadows, Transparency};
 use strandlight_scene::image_metrics::relative_rmse;
 use strandlight_tables::artist::ArtistParams;
 use strandlight_tables::outside_tools::{missing_tool, program_exists};
@@ -101,7 +105,13 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
         {"wait": "converged"},
         {"key": "O"},
         {"frames": 2},
-        {"screenshot": "shot"}
+        {"screenshot": "shot"},
+        {"settings": {"lighting": {"environment": null, "lights": point_lighting()}}},
+        {"wait": "converged"},
+        {"drag": [[0.5, 0.5], [0.4, 0.55]]},
+        {"wait": "converged"},
+        {"frames": 2},
+        {"screenshot": "points"}
     ]);
     std::fs::write(dir.join("script.json"), script.to_string()).unwrap();
     let out = Command::new(xvfb)
@@ -152,26 +162,34 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
 
     // The whole window, panel included: larger than the frame, and showing the same picture
     // where the frame sits.
-    let window = dir.join("shot-window.png");
-    assert_eq!(report["window_captures"], json!(["shot-window.png"]));
-    let (ww, wh, _) = read_rgb8(&window);
-    assert!(ww > 160 + 300 && wh > 120, "window capture {ww}x{wh}");
-    let rect: Vec<f64> = report["image_rect_px"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
-    let difference =
-        window_against_screenshot(&window, &dir.join("shot.png"), rect.try_into().unwrap());
-    println!(
-        "window capture against the screenshot in the image rect: mean |Δ| {difference:.2} levels"
+    assert_eq!(
+        report["window_captures"],
+        json!(["shot-window.png", "points-window.png"])
     );
-    // Both are the same 8-bit tonemap; the window adds an sRGB texture round trip.
-    assert!(
-        difference < 2.0,
-        "the window shows another picture: {difference} levels"
-    );
+    for (i, stem) in ["shot", "points"].into_iter().enumerate() {
+        let window = dir.join(format!("{stem}-window.png"));
+        let (ww, wh, _) = read_rgb8(&window);
+        assert!(ww > 160 + 300 && wh > 120, "window capture {ww}x{wh}");
+        let rect: Vec<f64> = report["window_capture_image_rects_px"][i]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let difference = window_against_screenshot(
+            &window,
+            &dir.join(format!("{stem}.png")),
+            rect.try_into().unwrap(),
+        );
+        println!(
+            "{stem}: window capture against the screenshot in the image rect: mean |Δ| {difference:.2} levels"
+        );
+        // Both are the same 8-bit tonemap; the window adds an sRGB texture round trip.
+        assert!(
+            difference < 2.0,
+            "{stem}: the window shows another picture: {difference} levels"
+        );
+    }
     let sidecar: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("shot.json")).unwrap()).unwrap();
     assert!(
@@ -180,8 +198,56 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
     );
     assert_eq!(sidecar["artist"]["r"]["intensity"], json!(1.5));
 
-    let replay = strandlight(&dir)
-        .args(["render", "replay", "shot.json", "--out", "replay"])
+    let shot = read_rgba_exr(&dir.join("shot.exr")).unwrap();
+    let error = replay_error(&dir, "shot");
+    println!("screenshot against its replay: relative RMSE {error:.2e}");
+    // The viewer sums its light batches on the CPU, `render` on the GPU: rounding only.
+    assert!(error < 1e-4, "replay differs: relative RMSE {error}");
+
+    // Point lights: the sidecar holds them, the picture changed, and it replays.
+    let sidecar: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("points.json")).unwrap()).unwrap();
+    assert_eq!(
+        sidecar["lighting"]["lights"]["shadows"],
+        json!("dom"),
+        "{sidecar}"
+    );
+    assert!(
+        lit_share(&dir.join("points.png")) > 0.02,
+        "blank point-lit screenshot"
+    );
+    let points = read_rgba_exr(&dir.join("points.exr")).unwrap();
+    let change = relative_rmse(&points, &shot).unwrap();
+    assert!(
+        change > 0.1,
+        "the point lights did not change the picture: {change}"
+    );
+    let error = replay_error(&dir, "points");
+    println!("point-lit screenshot against its replay: relative RMSE {error:.2e}");
+    // The same frame function on the same device: one call each, nothing summed.
+    assert!(
+        error < 1e-4,
+        "point-lit replay differs: relative RMSE {error}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The point lights the script switches to: the default light, shadowed by deep opacity maps,
+/// drawn with sorted transparency.
+fn point_lighting() -> Value {
+    serde_json::to_value(PointLighting {
+        shadows: Shadows::Dom,
+        transparency: Transparency::Sorted,
+        ..PointLighting::default()
+    })
+    .unwrap()
+}
+
+/// Relative RMSE between the screenshot `STEM.exr` and `render replay STEM.json`'s frame.
+fn replay_error(dir: &Path, stem: &str) -> f64 {
+    let out = format!("{stem}-replay");
+    let replay = strandlight(dir)
+        .args(["render", "replay", &format!("{stem}.json"), "--out", &out])
         .output()
         .unwrap();
     assert!(
@@ -189,11 +255,7 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
         "{}",
         String::from_utf8_lossy(&replay.stderr)
     );
-    let shot = read_rgba_exr(&dir.join("shot.exr")).unwrap();
-    let replayed = read_rgba_exr(&dir.join("replay.exr")).unwrap();
-    let error = relative_rmse(&shot, &replayed).unwrap();
-    println!("screenshot against its replay: relative RMSE {error:.2e}");
-    // The viewer sums its light batches on the CPU, `render` on the GPU: rounding only.
-    assert!(error < 1e-4, "replay differs: relative RMSE {error}");
-    std::fs::remove_dir_all(&dir).unwrap();
+    let shot = read_rgba_exr(&dir.join(format!("{stem}.exr"))).unwrap();
+    let replayed = read_rgba_exr(&dir.join(format!("{out}.exr"))).unwrap();
+    relative_rmse(&shot, &replayed).unwrap()
 }

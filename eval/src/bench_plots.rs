@@ -310,7 +310,7 @@ pub fn plot(
         r.mode,
         metric.name()
     );
-    strandlight_runtime::image_out::write_png_rgb8(&png, WIDTH, HEIGHT, &pixels, &description)?;
+    strandlight_tables::image_out::write_png_rgb8(&png, WIDTH, HEIGHT, &pixels, &description)?;
     let mut text = String::new();
     draw(
         SVGBackend::with_string(&mut text, (WIDTH, HEIGHT)).into_drawing_area(),

@@ -25,7 +25,6 @@ use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::EnvRenderOptions;
 use strandlight_runtime::env_light::{EnvLight, mark_every_strand, shadow_groups};
 use strandlight_runtime::hair::HairModel;
-use strandlight_runtime::image_out::{write_exr, write_png};
 use strandlight_runtime::passes::convolution_depth::{DodmSettings, MAX_DODM_RESOLUTION};
 use strandlight_scene::camera_choice::front_camera;
 use strandlight_scene::env_frame::{
@@ -42,6 +41,7 @@ use strandlight_scene::scene_tables::{
 use strandlight_scene::steps::Steps;
 use strandlight_scene::world_lights::to_env_lights;
 use strandlight_tables::checksum::sha256_hex;
+use strandlight_tables::image_out::{write_exr, write_png};
 
 /// Everything one comparison is set by: a plain value that the command line builds, `bench`
 /// and the tests build directly, and every `compare --json` report records, so
@@ -1052,7 +1052,7 @@ fn write_mode_images(
             r.reference.chosen.image.width,
             r.reference.chosen.image.height,
         );
-        strandlight_runtime::image_out::write_png_rgb8(
+        strandlight_tables::image_out::write_png_rgb8(
             &path,
             w,
             h,

@@ -574,7 +574,7 @@ pub fn write_truth_image(
     stem: &Path,
     description: &str,
 ) -> anyhow::Result<PathBuf> {
-    use strandlight_runtime::image_out::{write_exr, write_png};
+    use strandlight_tables::image_out::{write_exr, write_png};
     let (w, h) = (truth.image.width, truth.image.height);
     let exr = stem.with_extension("exr");
     write_exr(&exr, w, h, &truth.image.pixels, description)?;

@@ -8,10 +8,10 @@ use serde::de::DeserializeOwned;
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
-use strandlight_runtime::image_out::write_exr;
 use strandlight_scene::image_metrics::Image;
 use strandlight_scene::sealed_file::{Unsealed, read_sealed, seal, write_sealed};
 use strandlight_tables::checksum::sha256_hex;
+use strandlight_tables::image_out::write_exr;
 
 /// What is stored beside the image.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -114,7 +114,7 @@ fn intact(path: &Path) -> Option<Vec<u8>> {
     }
 }
 
-/// A linear RGBA EXR as written by `strandlight_runtime::image_out::write_exr`.
+/// A linear RGBA EXR as written by `strandlight_tables::image_out::write_exr`.
 pub fn read_rgba_exr(path: &Path) -> anyhow::Result<strandlight_scene::image_metrics::Image> {
     use exr::prelude::*;
     let image = read_first_rgba_layer_from_file(

@@ -11,6 +11,9 @@ pub enum EnvMapError {
         source: std::io::Error,
     },
 
+    #[error(transparent)]
+    Write(#[from] strandlight_tables::image_out::ImageWriteError),
+
     #[error("{path}: unknown environment map format (expected a Radiance .hdr or an OpenEXR .exr)")]
     UnknownFormat { path: PathBuf },
 

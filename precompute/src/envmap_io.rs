@@ -5,8 +5,8 @@
 use crate::envmap::{BadPixelCounts, EnvMap};
 use crate::envmap_error::EnvMapError;
 use std::path::{Path, PathBuf};
-use strandlight_tables::atomic_write::write_atomically;
 use strandlight_tables::checksum::sha256_hex;
+use strandlight_tables::image_out::write_exr_rgb;
 
 /// How to treat a map's bad pixels (NaN, ±Inf, negative).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -190,25 +190,16 @@ fn decode_exr(path: &Path, bytes: &[u8]) -> Result<EnvMap, EnvMapError> {
     Ok(EnvMap::from_pixels(pixels.width, height, pixels.data))
 }
 
-/// Writes an EXR (f32, RGB) atomically: used for tests and for debugging output.
+/// Writes an EXR (f32, RGB) atomically: the procedural maps, tests and debugging output.
 pub fn write_exr(map: &EnvMap, path: &Path) -> Result<(), EnvMapError> {
-    use exr::prelude::*;
-    let w = map.width();
-    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
-        let [r, g, b] = map.pixel(p.x(), p.y());
-        (r, g, b)
-    });
-    let image = Image::from_channels((w, map.height()), channels);
-    write_atomically(path, |out| {
-        image
-            .write()
-            .to_buffered(out)
-            .map_err(std::io::Error::other)
-    })
-    .map_err(|source| EnvMapError::Io {
-        path: path.into(),
-        source,
-    })
+    Ok(write_exr_rgb(
+        path,
+        map.width() as u32,
+        map.height() as u32,
+        map.pixels(),
+        "environment map",
+        "equirectangular, linear RGB",
+    )?)
 }
 
 #[cfg(test)]

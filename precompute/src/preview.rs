@@ -7,19 +7,16 @@
 
 use crate::envmap::EnvMap;
 use std::path::Path;
-use strandlight_tables::atomic_write::write_atomically;
 use strandlight_tables::colour::{luminance, srgb_encode};
+use strandlight_tables::image_out::{ImageWriteError, write_png_rgb8_with_text};
 use strandlight_tables::srbf::SrbfLobe;
 
 pub const TONEMAP: &str = "exposure to mean luminance 0.18, Reinhard x/(1+x), sRGB";
 
 #[derive(Debug, thiserror::Error)]
 pub enum PreviewError {
-    #[error("{path}: cannot write the preview: {message}")]
-    Write {
-        path: std::path::PathBuf,
-        message: String,
-    },
+    #[error("cannot write the preview: {0}")]
+    Write(#[from] ImageWriteError),
 }
 
 /// Writes the three panels at `panel_width × panel_width/2` each, `map` being the original.
@@ -42,30 +39,29 @@ pub fn write_preview(
         / (4.0 * std::f64::consts::PI);
     let exposure = if mean > 0.0 { 0.18 / mean } else { 1.0 };
     let gap = 4;
-    let mut img = image::RgbImage::new((3 * w + 2 * gap) as u32, h as u32);
+    let total_w = 3 * w + 2 * gap;
+    let mut bytes = vec![0u8; total_w * h * 3];
     for y in 0..h {
         for x in 0..w {
             let o = original.pixel(x, y);
             let f = fit.pixel(x, y);
             let e: [f32; 3] = std::array::from_fn(|c| (f[c] - o[c]).abs());
             for (panel, p) in [o, f, e].into_iter().enumerate() {
-                let px = image::Rgb(p.map(|v| encode(v as f64 * exposure)));
-                img.put_pixel((panel * (w + gap) + x) as u32, y as u32, px);
+                let at = 3 * (y * total_w + panel * (w + gap) + x);
+                bytes[at..at + 3].copy_from_slice(&p.map(|v| encode(v as f64 * exposure)));
             }
         }
     }
-    let mut bytes = Vec::new();
-    let write_err = |message: String| PreviewError::Write {
-        path: path.into(),
-        message,
-    };
-    img.write_to(
-        &mut std::io::Cursor::new(&mut bytes),
-        image::ImageFormat::Png,
-    )
-    .map_err(|e| write_err(e.to_string()))?;
-    write_atomically(path, |out| std::io::Write::write_all(out, &bytes))
-        .map_err(|e: std::io::Error| write_err(e.to_string()))
+    Ok(write_png_rgb8_with_text(
+        path,
+        total_w as u32,
+        h as u32,
+        &bytes,
+        &[
+            ("Description", "environment map | SRBF fit | |fit − map|"),
+            ("Tonemap", TONEMAP),
+        ],
+    )?)
 }
 
 fn encode(x: f64) -> u8 {

@@ -29,7 +29,7 @@ use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::hair::{self, HairModel};
-use strandlight_runtime::image_out::write_png;
+use strandlight_tables::image_out::write_png;
 use strandlight_tables::srbf::{integral, sample_cos_gamma};
 use strandlight_tables::table::{Axis, Table};
 use strandlight_tables::table_axes::{

@@ -5,7 +5,6 @@ pub mod env;
 pub mod env_light;
 pub mod gpu;
 pub mod hair;
-pub mod image_out;
 pub mod lights;
 pub mod multiple;
 pub mod passes;

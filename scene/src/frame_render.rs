@@ -1,31 +1,37 @@
 //! One frame from [`FrameSettings`], in the two steps a viewer keeps apart: *prepare* (load the
 //! hair; build the point-light fiber model, or fit and bake the environment's SRBF scene) and
-//! *render* (camera, lights and look → pixels). `strandlight render` does both once; the viewer
-//! prepares again only when a setting that preparation depends on changes.
+//! *render* ([`render_frame`]: camera, lights and look → pixels). `strandlight render` and the
+//! demo do both once; the viewer prepares again only when a setting that preparation depends on
+//! changes, and renders its preview and light batches through the same [`render_frame`].
 
-use crate::env_frame::{EnvFrame, FrameRole};
+use crate::env_frame::{EnvFrame, FrameRole, env_adapter, render_lights, shared_gpu};
 use crate::env_scene::{EnvScene, EnvSceneRequest, PrepareProgress, prepare_env_scene_reporting};
 use crate::environment::{LoadedEnv, load_env};
 use crate::frame_settings::{
-    EnvLighting, FrameSettings, PointLighting, Shadows, Transparency, up_choice,
+    EnvLighting, FrameSettings, Lighting, PointLighting, Shadows, Transparency, up_choice,
 };
 use crate::hair_input::load_hair;
+use crate::image_metrics::Image;
 use crate::look::EnvLook;
 use crate::point_shading::{PointShadingRequest, point_shading_model};
-use crate::scene_tables::EnvShading;
+use crate::scene_tables::{EnvShading, ScatteringMode};
 use crate::steps::Steps;
 use anyhow::Context;
 use glam::{Quat, Vec3};
 use std::path::Path;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_runtime::camera::{Camera, UpAxis};
+use strandlight_runtime::env::{FragmentCounts, ViewTransparency};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
 use strandlight_runtime::passes::fiber_shading::ShadingModel;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{self, RenderOptions, ShadowMaps, render_frame_with_model};
+use strandlight_runtime::render::{
+    self, PassTiming, RenderOptions, RenderStats, ShadowMaps, TIMING_METHOD,
+    render_frame_with_model,
+};
 use strandlight_tables::checksum::sha256_hex;
 use strandlight_tables::colour::luminance_f32;
 
@@ -131,8 +137,8 @@ pub fn point_render_options(point: &PointLighting, hair: &HairModel) -> RenderOp
     }
 }
 
-/// A point-lit frame of `settings` at `size` (the viewer's previews ask for a smaller one).
-pub fn render_point(
+/// A point-lit frame of `settings` at `size`.
+fn render_point(
     gpu: &GpuContext,
     settings: &FrameSettings,
     point: &PointLighting,
@@ -253,7 +259,7 @@ pub fn env_look(env: &EnvLighting) -> anyhow::Result<EnvLook> {
 }
 
 /// An env-lit frame of `settings` under `lights` (all or some of [`frame_lights`]) at `size`.
-pub fn env_frame<'a>(
+fn env_frame<'a>(
     settings: &FrameSettings,
     env: &EnvLighting,
     hair: &'a HairModel,
@@ -273,5 +279,186 @@ pub fn env_frame<'a>(
         mode: prepared.scene.mode,
         role: FrameRole::Interactive { kappa: env.kappa },
         look,
+    })
+}
+
+/// What a frame's lighting was prepared into (borrowed: the viewer keeps each kind cached).
+#[derive(Clone, Copy)]
+pub enum Prepared<'a> {
+    Point(&'a PreparedPoint),
+    Env(&'a PreparedEnv),
+}
+
+/// The viewer's preview draws this many of the most powerful lights.
+pub const PREVIEW_LIGHTS: usize = 8;
+/// The preview's light maps are at most this many texels across.
+pub const PREVIEW_MAP_RESOLUTION: u32 = 128;
+
+/// Which part of a settings' frame to render.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FramePart {
+    /// The whole frame at the settings' size.
+    Whole,
+    /// A cheap first look at half size: for an environment the [`PREVIEW_LIGHTS`] most
+    /// powerful lights, light maps of at most [`PREVIEW_MAP_RESOLUTION`]², the opaque view and
+    /// single scattering.
+    Preview,
+    /// Lights `first..first + count` of the env-lit frame ([`frame_lights`]' order): parts that
+    /// partition the lights sum to the whole frame.
+    Lights { first: usize, count: usize },
+}
+
+impl FramePart {
+    /// The image size of this part of a frame of `full` size.
+    pub fn size(self, full: [u32; 2]) -> [u32; 2] {
+        match self {
+            FramePart::Preview => full.map(|s| (s / 2).max(1)),
+            _ => full,
+        }
+    }
+}
+
+/// A rendered frame (or part of one) and what it cost.
+pub struct RenderedFrame {
+    pub image: Image,
+    /// Frame time without the one-time setup passes.
+    pub milliseconds: f64,
+    pub passes: Vec<PassTiming>,
+    /// GPU memory per resource while it renders (per light batch for an environment), bytes.
+    pub memory: Vec<(String, u64)>,
+    pub adapter: String,
+    pub timing_method: String,
+    pub details: FrameDetails,
+}
+
+/// What only one kind of lighting reports.
+pub enum FrameDetails {
+    Point(RenderStats),
+    Env {
+        /// The lights drawn, in the hair's world frame.
+        lights: Vec<EnvLight>,
+        /// The scattering rendered (dark hair without a multiple table falls back to single).
+        mode: ScatteringMode,
+        /// With `count_fragments`.
+        fragments: Option<FragmentCounts>,
+    },
+}
+
+impl RenderedFrame {
+    /// Lights drawn: point lights, or SRBF lobes and directional sources.
+    pub fn light_count(&self, settings: &FrameSettings) -> usize {
+        match (&self.details, &settings.lighting) {
+            (FrameDetails::Env { lights, .. }, _) => lights.len(),
+            (FrameDetails::Point(_), Lighting::Lights(point)) => point.lights.len(),
+            (FrameDetails::Point(_), _) => 0,
+        }
+    }
+}
+
+/// THE frame function: `part` of the frame of `settings` for `hair`, lit as `prepared` (from
+/// the same settings' [`prepare_point`] or [`prepare_env`]). `count_fragments` asks an env-lit
+/// frame to count its rasterized and shaded fragments (slower; reports only).
+pub fn render_frame(
+    settings: &FrameSettings,
+    hair: &HairModel,
+    prepared: Prepared,
+    part: FramePart,
+    count_fragments: bool,
+) -> anyhow::Result<RenderedFrame> {
+    let size = part.size(settings.size);
+    match (&settings.lighting, prepared) {
+        (Lighting::Lights(point), Prepared::Point(prepared)) => {
+            if let FramePart::Lights { .. } = part {
+                anyhow::bail!("a point-lit frame is rendered whole, not by light batches");
+            }
+            let gpu = shared_gpu()?;
+            let frame = render_point(gpu, settings, point, hair, prepared, size)?;
+            Ok(RenderedFrame {
+                image: Image {
+                    width: frame.width,
+                    height: frame.height,
+                    pixels: frame.pixels,
+                },
+                milliseconds: point_frame_milliseconds(&frame.stats.timings),
+                passes: frame.stats.timings.clone(),
+                memory: frame.stats.memory_bytes.clone(),
+                adapter: frame.stats.adapter.to_string(),
+                timing_method: frame.stats.timing_method.to_string(),
+                details: FrameDetails::Point(frame.stats),
+            })
+        }
+        (Lighting::Environment(env), Prepared::Env(prepared)) => {
+            render_env_part(settings, env, hair, prepared, part, count_fragments)
+        }
+        _ => anyhow::bail!("the frame's lighting was prepared for other settings"),
+    }
+}
+
+/// Milliseconds of a point-lit frame: its passes without the one-time setup (the hair's upload
+/// and pipeline creation), as [`crate::env_frame::frame_milliseconds`] does for env-lit frames.
+fn point_frame_milliseconds(passes: &[PassTiming]) -> f64 {
+    passes
+        .iter()
+        .filter(|t| t.pass != "upload" && !t.pass.ends_with("pipeline"))
+        .map(|t| t.milliseconds)
+        .sum()
+}
+
+fn render_env_part(
+    settings: &FrameSettings,
+    env: &EnvLighting,
+    hair: &HairModel,
+    prepared: &PreparedEnv,
+    part: FramePart,
+    count_fragments: bool,
+) -> anyhow::Result<RenderedFrame> {
+    let all = frame_lights(prepared, env);
+    let look = EnvLook {
+        count_fragments,
+        ..env_look(env)?
+    };
+    let (lights, look, mode) = match part {
+        FramePart::Whole => (all, look, prepared.scene.mode),
+        FramePart::Preview => {
+            let mut look = look;
+            look.dodm.resolution = look.dodm.resolution.min(PREVIEW_MAP_RESOLUTION);
+            look.transparency = ViewTransparency::Opaque;
+            let lights = all[..all.len().min(PREVIEW_LIGHTS)].to_vec();
+            (lights, look, ScatteringMode::Single)
+        }
+        FramePart::Lights { first, count } => {
+            let Some(lights) = all.get(first..first + count) else {
+                anyhow::bail!(
+                    "lights {first}..{} of a frame of {}",
+                    first + count,
+                    all.len()
+                );
+            };
+            // κ's windows continue from the lights before this batch, so the batches sum to
+            // the whole frame's one call.
+            let look = EnvLook {
+                simplified_lights_before: all[..first].iter().filter(|l| l.is_simplified()).count()
+                    as u32,
+                ..look
+            };
+            (lights.to_vec(), look, prepared.scene.mode)
+        }
+    };
+    let size = part.size(settings.size);
+    let mut frame = env_frame(settings, env, hair, prepared, &lights, size, look)?;
+    frame.mode = mode;
+    let rendered = render_lights(&frame)?;
+    Ok(RenderedFrame {
+        image: rendered.image,
+        milliseconds: rendered.milliseconds,
+        passes: rendered.passes,
+        memory: rendered.memory_per_batch,
+        adapter: env_adapter()?,
+        timing_method: TIMING_METHOD.into(),
+        details: FrameDetails::Env {
+            lights,
+            mode,
+            fragments: rendered.fragments,
+        },
     })
 }

@@ -2,9 +2,10 @@
 //! the pixels the reference's hair covers, a false-colour error picture, and the side-by-side
 //! PNG `compare` writes (SRBF | reference | baseline | error).
 
-use std::path::{Path, PathBuf};
-use strandlight_runtime::image_out::{PNG_TONEMAP, tonemap_channel};
-use strandlight_tables::atomic_write::write_atomically;
+use std::path::Path;
+use strandlight_tables::image_out::{
+    ImageWriteError, PNG_TONEMAP, tonemap_channel, write_png_rgb8,
+};
 use thiserror::Error;
 
 /// A linear RGBA float image, row-major from the top row (as the renderer returns it).
@@ -64,11 +65,8 @@ pub enum CompareError {
         "half the reference's hair pixels or more are black: HDR-FLIP's exposure range (up to the median luminance) is undefined"
     )]
     DarkMedian,
-    #[error("{}: {source}", .path.display())]
-    Write {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Write(#[from] ImageWriteError),
 }
 
 impl Image {
@@ -388,21 +386,13 @@ pub fn write_side_by_side(
         "{description}; panels: SRBF | reference | baseline | error; images: {PNG_TONEMAP}; {}",
         error_legend()
     );
-    let encode = |out: &mut std::io::BufWriter<std::fs::File>| -> Result<(), png::EncodingError> {
-        let mut encoder = png::Encoder::new(out, total_w as u32, total_h as u32);
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        encoder.add_itxt_chunk("Description".into(), legend.clone())?;
-        let mut writer = encoder.write_header()?;
-        writer.write_image_data(&bytes)?;
-        writer.finish()
-    };
-    write_atomically(path, |out| encode(out).map_err(std::io::Error::other)).map_err(|source| {
-        CompareError::Write {
-            path: path.into(),
-            source,
-        }
-    })
+    Ok(write_png_rgb8(
+        path,
+        total_w as u32,
+        total_h as u32,
+        &bytes,
+        &legend,
+    )?)
 }
 
 #[cfg(test)]

@@ -19,6 +19,7 @@ pub mod dual_scattering;
 pub mod dual_scattering_hard_cases;
 pub mod error;
 pub mod hard_case_sweep;
+pub mod image_out;
 pub mod kajiya_kay;
 pub mod longitudinal;
 pub mod marschner;

@@ -22,11 +22,10 @@
 //! are 0 in the EXR and dark blue [`PNG_GAP_COLOR`] in the PNG; non-finite values stay as they
 //! are in the EXR and are magenta [`PNG_NON_FINITE_COLOR`] in the PNG.
 
-use crate::atomic_write::write_atomically;
 use crate::colour::srgb_encode;
+use crate::image_out::{ImageWriteError, write_exr_rgb, write_png_rgb8_with_text};
 use crate::table::{Axis, Table};
-use std::io;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use thiserror::Error;
 
 /// Largest picture side in pixels (keeps PNG viewers and memory sane).
@@ -40,8 +39,8 @@ pub enum SliceError {
     InvalidLayout(String),
     #[error("slice picture would be {width} × {height} pixels; at most {MAX_SIDE} per side")]
     TooLarge { width: u64, height: u64 },
-    #[error("{}: {source}", .path.display())]
-    Write { path: PathBuf, source: io::Error },
+    #[error(transparent)]
+    Write(#[from] ImageWriteError),
 }
 
 /// Which axes step from tile to tile.
@@ -237,31 +236,14 @@ impl SlicePicture {
 
     /// Linear float RGB EXR (ZIP-compressed, lossless), written atomically.
     pub fn write_exr(&self, path: &Path) -> Result<(), SliceError> {
-        use exr::prelude::*;
-        let mut attributes = LayerAttributes::named(latin1_text("table slices"));
-        attributes.comments = Some(latin1_text(&self.description));
-        attributes.software_name = Some(latin1_text(concat!(
-            "strandlight-tables ",
-            env!("CARGO_PKG_VERSION")
-        )));
-        let width = self.width as usize;
-        let layer = Layer::new(
-            (width, self.height as usize),
-            attributes,
-            Encoding::SMALL_LOSSLESS,
-            SpecificChannels::rgb(|p: Vec2<usize>| {
-                let [r, g, b] = self.pixels[p.y() * width + p.x()];
-                (r, g, b)
-            }),
-        );
-        let image = Image::from_layer(layer);
-        write_atomically(path, |w| {
-            image.write().to_buffered(w).map_err(io::Error::other)
-        })
-        .map_err(|source| SliceError::Write {
-            path: path.to_path_buf(),
-            source,
-        })
+        Ok(write_exr_rgb(
+            path,
+            self.width,
+            self.height,
+            &self.pixels,
+            "table slices",
+            &self.description,
+        )?)
     }
 
     /// 8-bit RGB PNG tonemapped with `tonemap`, written atomically; returns the description
@@ -279,31 +261,16 @@ impl SlicePicture {
             bytes.extend_from_slice(&code);
         }
         let tonemap_text = tonemap.describe(self.table_max);
-        let text = [
-            (
-                "Software",
-                concat!("strandlight-tables ", env!("CARGO_PKG_VERSION")).to_string(),
-            ),
-            ("Description", self.description.clone()),
-            ("Tonemap", tonemap_text.clone()),
-        ];
-        let encode = |w: &mut std::io::BufWriter<std::fs::File>| -> Result<(), png::EncodingError> {
-            let mut encoder = png::Encoder::new(w, self.width, self.height);
-            encoder.set_color(png::ColorType::Rgb);
-            encoder.set_depth(png::BitDepth::Eight);
-            for (key, value) in &text {
-                encoder.add_itxt_chunk(key.to_string(), value.clone())?;
-            }
-            let mut writer = encoder.write_header()?;
-            writer.write_image_data(&bytes)?;
-            writer.finish()
-        };
-        write_atomically(path, |w| encode(w).map_err(io::Error::other)).map_err(|source| {
-            SliceError::Write {
-                path: path.to_path_buf(),
-                source,
-            }
-        })?;
+        write_png_rgb8_with_text(
+            path,
+            self.width,
+            self.height,
+            &bytes,
+            &[
+                ("Description", &self.description),
+                ("Tonemap", &tonemap_text),
+            ],
+        )?;
         Ok(tonemap_text)
     }
 }
@@ -329,21 +296,6 @@ fn rgb_of(values: &[f32]) -> [f32; 3] {
         [r, g, b] => [*r, *g, *b],
         _ => unreachable!("tables have 1 or 3 channels"),
     }
-}
-
-/// EXR text is Latin-1: other characters (ξ, λ, φ) are written as `<U+03BE>`.
-fn latin1_text(s: &str) -> exr::meta::attribute::Text {
-    let latin1: String = s
-        .chars()
-        .map(|c| {
-            if (c as u32) < 256 {
-                c.to_string()
-            } else {
-                format!("<U+{:04X}>", c as u32)
-            }
-        })
-        .collect();
-    exr::meta::attribute::Text::new_or_none(latin1).expect("only Latin-1 characters remain")
 }
 
 /// A tile's column, its row counted from the bottom, and the grid axes' node indices in it.

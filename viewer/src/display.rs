@@ -1,16 +1,16 @@
 //! From a linear frame to the window's pixels: exposure (automatic by default, so a first image is
 //! never black), the environment drawn behind the hair, and the PNG's tonemap curve
-//! ([`PNG_TONEMAP`](strandlight_runtime::image_out::PNG_TONEMAP)) so the window and a screenshot
+//! ([`PNG_TONEMAP`](strandlight_tables::image_out::PNG_TONEMAP)) so the window and a screenshot
 //! show the same thing.
 
 use crate::frame::LinearImage;
 use glam::{Quat, Vec4};
 use strandlight_precompute::envmap::EnvMap;
 use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_runtime::image_out::tonemap_channel;
 use strandlight_scene::image_metrics::HAIR_ALPHA;
 use strandlight_scene::world_lights::world_to_env;
 use strandlight_tables::colour::luminance_f32;
+use strandlight_tables::image_out::tonemap_channel;
 
 /// Automatic exposure puts the hair's 90th-percentile radiance here (Reinhard: 2/3 of white).
 const AUTO_TARGET: f32 = 2.0;

@@ -255,7 +255,7 @@ fn point_controls(ui: &mut egui::Ui, p: &mut PointLighting) {
     if ui.button("add a point light").clicked() {
         p.lights.push("point:0,1,2:4".into());
     }
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("shadows");
         ui.radio_value(&mut p.shadows, Shadows::None, "none");
         ui.radio_value(&mut p.shadows, Shadows::Dom, "deep opacity maps");
@@ -289,7 +289,7 @@ fn point_controls(ui: &mut egui::Ui, p: &mut PointLighting) {
             });
     }
     ui.label(Recompute::Frame.label());
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("transparency");
         ui.radio_value(&mut p.transparency, Transparency::None, "opaque");
         ui.radio_value(&mut p.transparency, Transparency::Sorted, "sorted");

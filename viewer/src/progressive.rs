@@ -5,14 +5,7 @@
 
 use crate::frame::{FrameStats, LinearImage, Stage};
 use std::sync::Arc;
-use strandlight_runtime::env::ViewTransparency;
-use strandlight_runtime::env_light::EnvLight;
-use strandlight_scene::look::EnvLook;
-
-/// The preview draws this many of the most powerful lights.
-pub const PREVIEW_LIGHTS: usize = 8;
-/// The preview's light maps are at most this many texels across.
-pub const PREVIEW_MAP_RESOLUTION: u32 = 128;
+use strandlight_scene::frame_render::FramePart;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Step {
@@ -30,11 +23,12 @@ pub enum Step {
 }
 
 impl Step {
-    /// The image size of this step for a frame of `full` size.
-    pub fn size(self, full: [u32; 2]) -> [u32; 2] {
+    /// The part of the frame this step renders.
+    pub fn part(self) -> FramePart {
         match self {
-            Step::Preview => full.map(|s| (s / 2).max(1)),
-            _ => full,
+            Step::Preview => FramePart::Preview,
+            Step::Batch { first, count, .. } => FramePart::Lights { first, count },
+            Step::Full => FramePart::Whole,
         }
     }
 }
@@ -65,18 +59,6 @@ pub fn plan_steps(env: Option<(&[f32], usize)>) -> Vec<Step> {
         }
     }
     steps
-}
-
-/// The preview's lights: the most powerful few (`all` comes sorted by power).
-pub fn preview_lights(all: &[EnvLight]) -> Vec<EnvLight> {
-    all[..all.len().min(PREVIEW_LIGHTS)].to_vec()
-}
-
-/// The preview's look: opaque, with small light maps.
-pub fn preview_look(mut look: EnvLook) -> EnvLook {
-    look.dodm.resolution = look.dodm.resolution.min(PREVIEW_MAP_RESOLUTION);
-    look.transparency = ViewTransparency::Opaque;
-    look
 }
 
 /// Sums the steps of one request into the image the window shows.

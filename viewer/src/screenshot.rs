@@ -7,9 +7,9 @@ use crate::frame::LinearImage;
 use crate::recompute::Display;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
-use strandlight_runtime::image_out::{write_exr, write_png};
 use strandlight_scene::frame_settings::FrameSettings;
 use strandlight_tables::atomic_write::write_atomically;
+use strandlight_tables::image_out::{write_exr, write_png};
 
 /// The files of a screenshot at `stem`.
 pub struct ScreenshotFiles {

@@ -32,6 +32,9 @@ pub struct SessionReport {
     pub screenshots: Vec<PathBuf>,
     /// Captures of the whole window (panel included), one per screenshot.
     pub window_captures: Vec<PathBuf>,
+    /// Where the image sat in each window capture, physical pixels: [x0, y0, x1, y1] (the
+    /// panel's width follows its controls, so the image moves between captures).
+    pub window_capture_image_rects_px: Vec<[f32; 4]>,
     /// Where the image sat in the window when last drawn, physical pixels: [x0, y0, x1, y1].
     pub image_rect_px: [f32; 4],
     pub adapter: String,
@@ -598,7 +601,12 @@ impl Session {
         for capture in captures {
             match capture.result {
                 None => self.window_captures.push(capture),
-                Some(Ok(())) => self.report.window_captures.push(capture.path),
+                Some(Ok(())) => {
+                    self.report.window_captures.push(capture.path);
+                    self.report
+                        .window_capture_image_rects_px
+                        .push(self.report.image_rect_px);
+                }
                 Some(Err(e)) => {
                     let e = format!("window capture {}: {e:#}", capture.path.display());
                     self.report.errors.push(e.clone());

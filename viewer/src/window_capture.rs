@@ -5,7 +5,7 @@
 
 use anyhow::{Context, bail};
 use std::path::Path;
-use strandlight_tables::atomic_write::write_atomically;
+use strandlight_tables::image_out::write_png_rgb8;
 
 /// The target a capture is drawn into, and the buffer it is read back through.
 pub struct CaptureTarget {
@@ -111,20 +111,14 @@ impl CaptureTarget {
 
     /// Writes `rgb` (from [`read_rgb`](Self::read_rgb)) as a PNG, atomically.
     pub fn write_png(&self, path: &Path, rgb: &[u8]) -> anyhow::Result<()> {
-        write_atomically::<anyhow::Error, _>(path, |out| {
-            let mut encoder = png::Encoder::new(out, self.width, self.height);
-            encoder.set_color(png::ColorType::Rgb);
-            encoder.set_depth(png::BitDepth::Eight);
-            encoder.add_itxt_chunk(
-                "Description".into(),
-                "strandlight view: the whole window".into(),
-            )?;
-            let mut writer = encoder.write_header()?;
-            writer.write_image_data(rgb)?;
-            writer.finish()?;
-            Ok(())
-        })
-        .with_context(|| format!("writing the window capture {}", path.display()))
+        write_png_rgb8(
+            path,
+            self.width,
+            self.height,
+            rgb,
+            "strandlight view: the whole window",
+        )
+        .context("writing the window capture")
     }
 }
 

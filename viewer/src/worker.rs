@@ -4,7 +4,7 @@
 //! sum after each batch. A newer request abandons the old one between batches. Table bakes run
 //! on a thread of their own, and the previous tables keep lighting frames until they finish.
 
-use crate::progressive::{Accumulator, Step, plan_steps, preview_lights, preview_look};
+use crate::progressive::{Accumulator, Step, plan_steps};
 use anyhow::Context;
 use glam::Vec3;
 use std::path::PathBuf;
@@ -12,19 +12,14 @@ use std::sync::mpsc::{Receiver, TryRecvError, channel};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env_light::EnvLight;
-use strandlight_runtime::render::TIMING_METHOD;
-use strandlight_scene::env_frame::{env_adapter, render_lights, shared_gpu};
 use strandlight_scene::env_scene::PrepareProgress;
 use strandlight_scene::frame_render::{
-    LoadedHair, PreparedEnv, PreparedPoint, env_frame, env_look, frame_lights, light_luminance,
-    load_settings_hair, prepare_env, prepare_point, render_point, settings_camera,
+    LoadedHair, Prepared, PreparedEnv, PreparedPoint, env_look, frame_lights, light_luminance,
+    load_settings_hair, prepare_env, prepare_point, render_frame, settings_camera,
 };
 use strandlight_scene::frame_settings::{
     EnvLighting, FrameSettings, Lighting, PointLighting, up_choice,
 };
-use strandlight_scene::look::EnvLook;
-use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 
 use crate::frame::{FrameStats, LinearImage, Stage};
@@ -399,19 +394,35 @@ impl WorkerState {
         let job = self.job.as_ref().expect("a job");
         let settings = job.settings.clone();
         let hair = self.hair(&settings)?;
-        let mut env_used = None;
-        let (image, stats) = match &settings.lighting {
-            Lighting::Lights(point) => {
-                let prepared = self.prepared_point(&settings, point)?;
-                self.point_step(&settings, point, &hair, &prepared, step)?
-            }
-            Lighting::Environment(env) => {
+        let point;
+        let env_used = match &settings.lighting {
+            Lighting::Lights(_) => None,
+            Lighting::Environment(_) => {
                 let (_, prepared) = self.env.as_ref().context("no tables yet")?;
-                let prepared = prepared.clone();
-                let out = env_step(&settings, env, &hair, &prepared, step)?;
-                env_used = Some(prepared);
-                out
+                Some(prepared.clone())
             }
+        };
+        let prepared = match (&settings.lighting, &env_used) {
+            (Lighting::Environment(_), Some(env)) => Prepared::Env(env),
+            (Lighting::Lights(lights), _) => {
+                point = self.prepared_point(&settings, lights)?;
+                Prepared::Point(&point)
+            }
+            (Lighting::Environment(_), None) => unreachable!("set just above"),
+        };
+        let rendered = render_frame(&settings, &hair.model, prepared, step.part(), false)?;
+        let stats = FrameStats {
+            lights: rendered.light_count(&settings),
+            passes: rendered.passes,
+            memory: rendered.memory,
+            batches: 1,
+            adapter: rendered.adapter,
+            timing_method: rendered.timing_method,
+        };
+        let image = LinearImage {
+            width: rendered.image.width,
+            height: rendered.image.height,
+            pixels: rendered.image.pixels,
         };
         let camera = settings_camera(&settings, &hair.model)?;
         let front = up_choice(&settings).axis(&hair.model).toward_front();
@@ -446,82 +457,4 @@ impl WorkerState {
         });
         Ok(())
     }
-
-    fn point_step(
-        &mut self,
-        settings: &FrameSettings,
-        point: &PointLighting,
-        hair: &LoadedHair,
-        prepared: &PreparedPoint,
-        step: Step,
-    ) -> anyhow::Result<(LinearImage, FrameStats)> {
-        let gpu = shared_gpu()?;
-        let size = step.size(settings.size);
-        let frame = render_point(gpu, settings, point, &hair.model, prepared, size)?;
-        let stats = FrameStats {
-            passes: frame.stats.timings.clone(),
-            memory: frame.stats.memory_bytes.clone(),
-            lights: point.lights.len(),
-            batches: 1,
-            adapter: frame.stats.adapter.to_string(),
-            timing_method: frame.stats.timing_method.to_string(),
-        };
-        let image = LinearImage {
-            width: frame.width,
-            height: frame.height,
-            pixels: frame.pixels,
-        };
-        Ok((image, stats))
-    }
-}
-
-/// The lights of `lights` whose maps κ thins (SRBFs not drawing every strand): a batch's
-/// windows continue from there, so the batches sum to `render replay`'s one-call frame.
-fn simplified_lights(lights: &[EnvLight]) -> u32 {
-    lights.iter().filter(|l| l.is_simplified()).count() as u32
-}
-
-/// One step of an env-lit request: the preview, or one batch of the full frame's lights.
-fn env_step(
-    settings: &FrameSettings,
-    env: &EnvLighting,
-    hair: &LoadedHair,
-    prepared: &PreparedEnv,
-    step: Step,
-) -> anyhow::Result<(LinearImage, FrameStats)> {
-    let all = frame_lights(prepared, env);
-    let (lights, look, mode) = match step {
-        Step::Preview => (
-            preview_lights(&all),
-            preview_look(env_look(env)?),
-            ScatteringMode::Single,
-        ),
-        Step::Batch { first, count, .. } => (
-            all[first..first + count].to_vec(),
-            EnvLook {
-                simplified_lights_before: simplified_lights(&all[..first]),
-                ..env_look(env)?
-            },
-            prepared.scene.mode,
-        ),
-        Step::Full => anyhow::bail!("an env-lit frame is refined in batches"),
-    };
-    let size = step.size(settings.size);
-    let mut frame = env_frame(settings, env, &hair.model, prepared, &lights, size, look)?;
-    frame.mode = mode;
-    let rendered = render_lights(&frame)?;
-    let stats = FrameStats {
-        passes: rendered.passes,
-        memory: rendered.memory_per_batch,
-        lights: lights.len(),
-        batches: 1,
-        adapter: env_adapter()?,
-        timing_method: TIMING_METHOD.into(),
-    };
-    let image = LinearImage {
-        width: rendered.image.width,
-        height: rendered.image.height,
-        pixels: rendered.image.pixels,
-    };
-    Ok((image, stats))
 }

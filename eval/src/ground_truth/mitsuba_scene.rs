@@ -27,10 +27,10 @@ use strandlight_precompute::EnvMap;
 use strandlight_precompute::envmap::rotate_about_up;
 use strandlight_runtime::camera::{Camera, Projection, UpAxis};
 use strandlight_runtime::hair::HairModel;
-use strandlight_runtime::image_out::write_exr;
 use strandlight_runtime::passes::strand_geometry::default_thickness;
 use strandlight_scene::world_lights::env_to_world;
 use strandlight_tables::atomic_write::write_atomically;
+use strandlight_tables::image_out::write_exr;
 
 /// The script that renders a scene file (written beside it).
 pub const RENDER_SCRIPT: &str = include_str!("mitsuba_render.py");

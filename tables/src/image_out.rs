@@ -1,11 +1,17 @@
-//! Writing rendered frames: a linear EXR (RGBA, alpha pre-multiplied as OpenEXR expects) and a
-//! tonemapped 8-bit PNG for looking at. Both are written atomically.
+//! Every image file the project writes, in one place: linear EXRs (RGBA frames, alpha
+//! pre-multiplied as OpenEXR expects; RGB maps and table slices) and 8-bit PNGs for looking at
+//! (frames tonemapped with [`PNG_TONEMAP`], or pictures already in sRGB bytes). All are written
+//! atomically, so a failed write never leaves a half-written file, and each carries the
+//! software's name and a description in its metadata.
 
 use std::io;
 use std::path::{Path, PathBuf};
-use strandlight_tables::colour::srgb_encode;
 
-use strandlight_tables::atomic_write::write_atomically;
+use crate::atomic_write::write_atomically;
+use crate::colour::srgb_encode;
+
+/// The software name written into every file.
+const SOFTWARE: &str = concat!("strandlight ", env!("CARGO_PKG_VERSION"));
 
 #[derive(Debug, thiserror::Error)]
 pub enum ImageWriteError {
@@ -29,26 +35,21 @@ pub enum ImageWriteError {
 pub const PNG_TONEMAP: &str = "composited over black (pre-multiplied colour as is), exposure 1, \
     Reinhard c/(1+c) per channel, sRGB transfer curve, 8 bit RGB";
 
-fn check_size(
-    path: &Path,
-    width: u32,
-    height: u32,
-    pixels: &[[f32; 4]],
-) -> Result<(), ImageWriteError> {
+fn check_size(path: &Path, width: u32, height: u32, got: usize) -> Result<(), ImageWriteError> {
     let expected = width as usize * height as usize;
-    if pixels.len() != expected {
+    if got != expected {
         return Err(ImageWriteError::WrongSize {
             path: path.into(),
             width,
             height,
             expected,
-            got: pixels.len(),
+            got,
         });
     }
     Ok(())
 }
 
-/// Linear float RGBA EXR, ZIP-compressed.
+/// Linear float RGBA EXR, ZIP-compressed: a rendered frame.
 pub fn write_exr(
     path: &Path,
     width: u32,
@@ -57,30 +58,67 @@ pub fn write_exr(
     comment: &str,
 ) -> Result<(), ImageWriteError> {
     use exr::prelude::*;
-    check_size(path, width, height, pixels)?;
-    let mut attributes = LayerAttributes::named(latin1_text("strandlight render"));
-    attributes.comments = Some(latin1_text(comment));
-    attributes.software_name = Some(latin1_text(concat!(
-        "strandlight-runtime ",
-        env!("CARGO_PKG_VERSION")
-    )));
+    check_size(path, width, height, pixels.len())?;
     let w = width as usize;
+    let channels = SpecificChannels::rgba(|p: Vec2<usize>| {
+        let [r, g, b, a] = pixels[p.y() * w + p.x()];
+        (r, g, b, a)
+    });
+    let attributes = exr_attributes("strandlight render", comment);
     let layer = Layer::new(
         (w, height as usize),
         attributes,
         Encoding::SMALL_LOSSLESS,
-        SpecificChannels::rgba(|p: Vec2<usize>| {
-            let [r, g, b, a] = pixels[p.y() * w + p.x()];
-            (r, g, b, a)
-        }),
+        channels,
     );
     let image = Image::from_layer(layer);
-    write_atomically(path, |out| {
-        image.write().to_buffered(out).map_err(io::Error::other)
-    })
-    .map_err(|source| ImageWriteError::Write {
-        path: path.into(),
-        source,
+    write_exr_file(path, |out| image.write().to_buffered(out))
+}
+
+/// Linear float RGB EXR, ZIP-compressed: an environment map or a picture of a table.
+pub fn write_exr_rgb(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 3]],
+    layer_name: &str,
+    comment: &str,
+) -> Result<(), ImageWriteError> {
+    use exr::prelude::*;
+    check_size(path, width, height, pixels.len())?;
+    let w = width as usize;
+    let channels = SpecificChannels::rgb(|p: Vec2<usize>| {
+        let [r, g, b] = pixels[p.y() * w + p.x()];
+        (r, g, b)
+    });
+    let attributes = exr_attributes(layer_name, comment);
+    let layer = Layer::new(
+        (w, height as usize),
+        attributes,
+        Encoding::SMALL_LOSSLESS,
+        channels,
+    );
+    let image = Image::from_layer(layer);
+    write_exr_file(path, |out| image.write().to_buffered(out))
+}
+
+/// The layer's name, the comment and the software's name, in EXR's Latin-1 text.
+fn exr_attributes(layer_name: &str, comment: &str) -> exr::meta::header::LayerAttributes {
+    let mut attributes = exr::meta::header::LayerAttributes::named(latin1_text(layer_name));
+    attributes.comments = Some(latin1_text(comment));
+    attributes.software_name = Some(latin1_text(SOFTWARE));
+    attributes
+}
+
+fn write_exr_file(
+    path: &Path,
+    write: impl FnOnce(&mut io::BufWriter<std::fs::File>) -> exr::error::UnitResult,
+) -> Result<(), ImageWriteError> {
+    write_atomically(path, |out| write(out).map_err(io::Error::other)).map_err(|source| {
+        ImageWriteError::Write {
+            path: path.into(),
+            source,
+        }
     })
 }
 
@@ -103,7 +141,7 @@ pub fn write_png(
     pixels: &[[f32; 4]],
     description: &str,
 ) -> Result<(), ImageWriteError> {
-    check_size(path, width, height, pixels)?;
+    check_size(path, width, height, pixels.len())?;
     let bytes: Vec<u8> = pixels
         .iter()
         .flat_map(|p| {
@@ -114,7 +152,7 @@ pub fn write_png(
             ]
         })
         .collect();
-    encode_png(
+    write_png_rgb8_with_text(
         path,
         width,
         height,
@@ -132,35 +170,32 @@ pub fn write_png_rgb8(
     bytes: &[u8],
     description: &str,
 ) -> Result<(), ImageWriteError> {
-    let expected = width as usize * height as usize;
-    if bytes.len() != 3 * expected {
-        return Err(ImageWriteError::WrongSize {
-            path: path.into(),
-            width,
-            height,
-            expected,
-            got: bytes.len() / 3,
-        });
-    }
-    encode_png(path, width, height, bytes, &[("Description", description)])
+    write_png_rgb8_with_text(path, width, height, bytes, &[("Description", description)])
 }
 
-/// RGB8 PNG written atomically, with the software's name and `text` as iTXt chunks.
-fn encode_png(
+/// [`write_png_rgb8`] with any text chunks (key, value) beside the software's name.
+pub fn write_png_rgb8_with_text(
     path: &Path,
     width: u32,
     height: u32,
     bytes: &[u8],
     text: &[(&str, &str)],
 ) -> Result<(), ImageWriteError> {
+    if !bytes.len().is_multiple_of(3) {
+        return Err(ImageWriteError::WrongSize {
+            path: path.into(),
+            width,
+            height,
+            expected: width as usize * height as usize,
+            got: bytes.len() / 3,
+        });
+    }
+    check_size(path, width, height, bytes.len() / 3)?;
     let encode = |w: &mut std::io::BufWriter<std::fs::File>| -> Result<(), png::EncodingError> {
         let mut encoder = png::Encoder::new(w, width, height);
         encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);
-        encoder.add_itxt_chunk(
-            "Software".into(),
-            concat!("strandlight-runtime ", env!("CARGO_PKG_VERSION")).into(),
-        )?;
+        encoder.add_itxt_chunk("Software".into(), SOFTWARE.into())?;
         for (key, value) in text {
             encoder.add_itxt_chunk((*key).into(), (*value).into())?;
         }
