@@ -101,8 +101,13 @@ pub enum SrbfSetError {
 }
 
 impl SrbfSet {
+    /// The bytes [`Self::save`] writes (pretty JSON), in memory: what [`Self::from_json`] reads.
+    pub fn to_json(&self) -> Vec<u8> {
+        serde_json::to_vec_pretty(self).expect("an SrbfSet always serializes")
+    }
+
     pub fn save(&self, path: &Path) -> Result<(), SrbfSetError> {
-        let json = serde_json::to_vec_pretty(self).expect("an SrbfSet always serializes");
+        let json = self.to_json();
         write_atomically(path, |out| std::io::Write::write_all(out, &json)).map_err(|source| {
             SrbfSetError::Io {
                 path: path.into(),
@@ -343,5 +348,64 @@ impl SrbfSet {
             history,
             seconds,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn small_set() -> SrbfSet {
+        SrbfSet {
+            format: FORMAT.into(),
+            version: FORMAT_VERSION,
+            kind: LightKind::Srbf,
+            lobes: vec![SrbfLobe {
+                center: [0.6, 0.0, -0.8],
+                lambda: 120.0,
+                amplitude: [1.5, 0.1 + 0.2, 1.0 / 3.0],
+            }],
+            sources: vec![CompactSource {
+                direction: [0.0, 0.6, 0.8],
+                power: [2.0, 1.5, 1.0],
+                power_share: 0.4,
+                angular_variance: 1e-4,
+            }],
+            source: "studio \"small\".hdr".into(),
+            source_sha256: "0".repeat(64),
+            options: FitOptions::default(),
+            sanitized: BadPixelCounts::default(),
+            fit_grid: [64, 32],
+            relative_l2_error: 0.1,
+            relative_mse: 0.01,
+            full_resolution_relative_mse: -0.0,
+            power_ratio: [1.0, f64::MIN_POSITIVE, 1e300],
+            history: vec![RoundRecord {
+                lobes: 1,
+                relative_mse: 0.01,
+                evaluations: 100,
+            }],
+            seconds: 0.5,
+        }
+    }
+
+    #[test]
+    fn to_json_is_what_save_writes_and_loads_back_bit_for_bit() {
+        let set = small_set();
+        let json = set.to_json();
+        let again = SrbfSet::from_json(Path::new("memory.json"), &json).unwrap();
+        assert_eq!(again, set);
+        // Bit for bit, signed zero and the extremes included.
+        assert_eq!(again.to_json(), json);
+        assert_eq!(
+            again.full_resolution_relative_mse.to_bits(),
+            (-0.0f64).to_bits()
+        );
+        let dir = std::env::temp_dir().join(format!("strandlight-srbf-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("set.json");
+        set.save(&path).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), json);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

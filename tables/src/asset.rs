@@ -221,6 +221,26 @@ pub fn write_asset(
     Ok(metadata)
 }
 
+/// Writes the bytes [`write_asset`] would put in a file to `out` instead (no temporary file, no
+/// fsync), returning the metadata written; `path` only names the asset in errors. For callers
+/// that keep the asset in memory or in a file they manage, such as the fuzz harness's round trip.
+pub fn write_asset_to(
+    out: &mut impl Write,
+    path: &Path,
+    table: &Table,
+    description: &AssetDescription,
+    storage: Storage,
+) -> Result<AssetMetadata, AssetError> {
+    let (metadata, head, payload) = encode_asset(path, table, description, storage)?;
+    out.write_all(&head)
+        .and_then(|()| out.write_all(&payload))
+        .map_err(|source| AssetError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    Ok(metadata)
+}
+
 /// The header + metadata + padding bytes and the payload bytes of an asset.
 fn encode_asset(
     path: &Path,
@@ -643,6 +663,35 @@ mod tests {
         let path = dir.join(name);
         write_asset(&path, table, &description(), storage).unwrap();
         path
+    }
+
+    #[test]
+    fn write_asset_to_gives_the_bytes_of_write_asset() {
+        let dir = scratch_dir("asset-write-to");
+        let mut rng = Pcg64::seed_from_u64(5);
+        let table = random_table(&mut rng, 3, 6.0e4);
+        for storage in [Storage::F32, Storage::F16] {
+            let path = write(&dir, "t.sltab", &table, storage);
+            let mut bytes = Vec::new();
+            let metadata =
+                write_asset_to(&mut bytes, &path, &table, &description(), storage).unwrap();
+            assert_eq!(bytes, std::fs::read(&path).unwrap(), "{storage:?}");
+            assert_eq!(metadata, read_asset(&path).unwrap().metadata);
+        }
+        // Its refusals name the path it was given.
+        let mut values = table.values().to_vec();
+        values[7] = f32::NAN;
+        let bad = Table::new(axes(), 3, values).unwrap();
+        let e = write_asset_to(
+            &mut Vec::new(),
+            Path::new("memory.sltab"),
+            &bad,
+            &description(),
+            Storage::F32,
+        )
+        .unwrap_err();
+        assert!(matches!(e, AssetError::NonFiniteValue { .. }), "{e}");
+        assert!(e.to_string().contains("memory.sltab"), "{e}");
     }
 
     #[test]

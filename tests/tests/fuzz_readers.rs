@@ -33,6 +33,65 @@ fn every_target_has_a_test_here() {
     );
 }
 
+/// The round-trip check can fail: every target run with a re-load that changes the last bit of
+/// one value (a position, a pixel, a table value, a field of the SRBF set) reports every load
+/// as a round-trip finding, saved like any other under its own name.
+#[test]
+fn a_round_trip_that_changes_one_bit_is_a_finding() {
+    use fuzz::round_trip::{self, Reloaded};
+    use fuzz::targets::Loaded;
+    fn corrupted(first: &Loaded) -> Result<Reloaded, String> {
+        match round_trip::write_and_reload(first)? {
+            Reloaded::Loaded(mut again) => {
+                round_trip::corrupt(&mut again);
+                Ok(Reloaded::Loaded(again))
+            }
+            other => Ok(other),
+        }
+    }
+    let _measuring = alloc::MEASURING.lock().unwrap_or_else(|e| e.into_inner());
+    assert!(alloc::is_installed());
+    for target in fuzz::targets::all() {
+        let seeds = fuzz::seeds::seeds(target.name);
+        let name: &'static str = Box::leak(format!("{}-corrupted-reload", target.name).into());
+        let corrupting = fuzz::targets::Target {
+            name,
+            reload: corrupted,
+            execs: 64,
+            ..target
+        };
+        let report = fuzz::run_with_seeds(&corrupting, seeds);
+        let round_trip_findings = report
+            .findings
+            .iter()
+            .filter(|f| matches!(f.problem, fuzz::Problem::RoundTrip { .. }))
+            .count();
+        eprintln!(
+            "{name}: {} loads, {round_trip_findings} round-trip findings, e.g. {}",
+            report.ok,
+            report
+                .findings
+                .first()
+                .map(|f| f.problem.to_string())
+                .unwrap_or_default()
+        );
+        assert!(report.ok > 0, "{name}: nothing loaded");
+        assert_eq!(report.round_trips, 0, "{name}");
+        assert_eq!(
+            round_trip_findings,
+            report.ok - report.not_representable,
+            "{name}: every load written back is a finding"
+        );
+        assert_eq!(round_trip_findings, report.findings.len(), "{name}");
+        assert!(
+            report.findings[0]
+                .saved
+                .starts_with(fuzz::fuzz_dir().join(name))
+        );
+        assert!(report.findings[0].saved.exists());
+    }
+}
+
 #[test]
 fn hair() {
     fuzz::fuzz_target("hair");
@@ -148,7 +207,7 @@ fn absurd_sizes_are_refused_before_any_allocation() {
         let (result, largest) = alloc::measure(|| (target.run)(&bytes));
         let refusal = match result {
             Err(r) => r,
-            Ok(()) => panic!("{name}: {what} loaded"),
+            Ok(_) => panic!("{name}: {what} loaded"),
         };
         eprintln!(
             "{name} ({what}): {} in {:.1} ms, largest allocation {largest} bytes",

@@ -8,7 +8,15 @@
 //!   (measured by the [`alloc::CountingAlloc`] the test binary installs),
 //! - it takes less than [`EXEC_TIME_CAP`] (a watchdog ends the process, with the input saved,
 //!   if one runs for [`WATCHDOG`]),
-//! - a refusal names the file (its message contains the target's `file_name`).
+//! - a refusal names the file (its message contains the target's `file_name`),
+//! - a load round-trips (issue #39): what loaded is written back with the project's writer for
+//!   that kind of data, loaded again, and must be the same data bit for bit (counts, positions,
+//!   widths and colours; map size and pixels; table asset; SRBF set); a mismatch, a writer that
+//!   refuses what the reader accepted, or a written file that does not load is a finding.
+//!   [`round_trip`] lists the writer of each target and why no tolerance is needed. (Outside
+//!   the allocation and time figures of the reader; under `catch_unwind` and the watchdog. A
+//!   load with the [`round_trip::fingerprint`] of one that round-tripped already is counted
+//!   without writing it again: the writers and readers are deterministic.)
 //!
 //! Strict prefixes of the seeds must be refused where the format fixes its own size (every
 //! prefix of the smallest generated seed, a sample of the others). Deterministic: the same
@@ -21,10 +29,11 @@
 
 pub mod alloc;
 pub mod mutate;
+pub mod round_trip;
 pub mod seeds;
 pub mod targets;
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -148,6 +157,12 @@ pub enum Problem {
         prefix: usize,
         of: usize,
     },
+    /// The input loaded, but written back and loaded again it is not the same (or the writer
+    /// refused it, or its output did not load, or either panicked).
+    RoundTrip {
+        through: &'static str,
+        mismatch: String,
+    },
 }
 
 impl std::fmt::Display for Problem {
@@ -175,6 +190,9 @@ impl std::fmt::Display for Problem {
             Problem::PrefixLoaded { prefix, of } => {
                 write!(f, "the first {prefix} of {of} bytes of a valid file loaded")
             }
+            Problem::RoundTrip { through, mismatch } => {
+                write!(f, "round trip ({through}): {mismatch}")
+            }
         }
     }
 }
@@ -195,7 +213,17 @@ pub struct Report {
     pub target: String,
     pub seeds: Vec<(String, usize)>,
     pub executions: usize,
+    /// Executions that loaded (whatever their round trip gave).
     pub ok: usize,
+    /// The writer and reader of the round trip.
+    pub round_trip: &'static str,
+    /// Loads written back, loaded again and found the same (or, `round_trips_repeated` of them,
+    /// the same data as such a load).
+    pub round_trips: usize,
+    pub round_trips_repeated: usize,
+    /// Loads the written format cannot hold (not findings), with one reason.
+    pub not_representable: usize,
+    pub not_representable_example: Option<String>,
     /// Refusals by error variant.
     pub refusals: BTreeMap<String, usize>,
     /// One message per variant, for the log.
@@ -223,6 +251,16 @@ impl Report {
         );
         for (name, len) in &self.seeds {
             eprintln!("  seed {name}: {len} bytes");
+        }
+        eprintln!(
+            "  round trip ({}): {} of {} loads the same when written and loaded again ({} of them the same data as an earlier load)",
+            self.round_trip, self.round_trips, self.ok, self.round_trips_repeated
+        );
+        if let Some(why) = &self.not_representable_example {
+            eprintln!(
+                "  {} loads not representable in the written format, e.g. {why}",
+                self.not_representable
+            );
         }
         for (kind, count) in &self.refusals {
             eprintln!(
@@ -317,7 +355,13 @@ fn start_watchdog() {
 
 /// The result of one execution.
 enum Outcome {
-    Ok,
+    /// Loaded, written back and loaded again the same; or `repeated`: loaded to the same data
+    /// as an earlier input that did.
+    Ok {
+        repeated: bool,
+    },
+    /// Loaded; the written format cannot hold it.
+    NotRepresentable(String),
     Refused(targets::Refusal),
     Problem(Problem),
 }
@@ -329,8 +373,14 @@ pub fn allocation_bound(target: &Target, len: usize) -> usize {
         .saturating_add(ALLOCATION_SLACK)
 }
 
-/// Runs one input through `target` with every check.
-fn execute(target: &Target, data: &[u8], current: &mut std::fs::File) -> (Outcome, usize) {
+/// Runs one input through `target` with every check. `round_tripped` holds the
+/// [`round_trip::fingerprint`]s of the loads that round-tripped already.
+fn execute(
+    target: &Target,
+    data: &[u8],
+    current: &mut std::fs::File,
+    round_tripped: &mut HashSet<u64>,
+) -> (Outcome, usize) {
     // Kept on disk first: an abort inside the reader leaves the input behind. (One open file,
     // rewritten in place: cheaper than creating a file per execution.)
     {
@@ -346,24 +396,52 @@ fn execute(target: &Target, data: &[u8], current: &mut std::fs::File) -> (Outcom
     let (result, largest) =
         alloc::measure(|| catch_unwind(AssertUnwindSafe(|| (target.run)(data))));
     let elapsed = start.elapsed();
-    STARTED_MS.store(0, Ordering::SeqCst);
-    FUZZING.store(false, Ordering::SeqCst);
     let bound = allocation_bound(target, data.len());
+    let panic_message = || {
+        LAST_PANIC
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .take()
+            .unwrap_or_else(|| "(no message)".into())
+    };
     let outcome = match result {
-        Err(_) => {
-            let message = LAST_PANIC
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .take()
-                .unwrap_or_else(|| "(no message)".into());
-            Outcome::Problem(Problem::Panic(message))
-        }
+        Err(_) => Outcome::Problem(Problem::Panic(panic_message())),
         Ok(_) if largest > bound => Outcome::Problem(Problem::WildAllocation {
             bytes: largest,
             bound,
         }),
         Ok(_) if elapsed > EXEC_TIME_CAP => Outcome::Problem(Problem::Slow(elapsed)),
-        Ok(Ok(())) => Outcome::Ok,
+        Ok(Ok(loaded)) => {
+            // The round trip, still under the watchdog but outside the reader's figures; once
+            // for each distinct load (the writers and readers are deterministic).
+            let fingerprint = round_trip::fingerprint(&loaded);
+            let round_trip = catch_unwind(AssertUnwindSafe(|| {
+                if round_tripped.contains(&fingerprint) {
+                    return Ok(Outcome::Ok { repeated: true });
+                }
+                match (target.reload)(&loaded)? {
+                    round_trip::Reloaded::Loaded(again) => {
+                        round_trip::compare(&loaded, &again)?;
+                        round_tripped.insert(fingerprint);
+                        Ok(Outcome::Ok { repeated: false })
+                    }
+                    round_trip::Reloaded::NotRepresentable(why) => {
+                        Ok(Outcome::NotRepresentable(why))
+                    }
+                }
+            }));
+            let mismatch = |mismatch| {
+                Outcome::Problem(Problem::RoundTrip {
+                    through: target.round_trip,
+                    mismatch,
+                })
+            };
+            match round_trip {
+                Ok(Ok(outcome)) => outcome,
+                Ok(Err(m)) => mismatch(m),
+                Err(_) => mismatch(format!("panic: {}", panic_message())),
+            }
+        }
         Ok(Err(refusal)) if !refusal.message.contains(target.file_name) => {
             Outcome::Problem(Problem::UnnamedFile {
                 kind: refusal.kind,
@@ -372,6 +450,8 @@ fn execute(target: &Target, data: &[u8], current: &mut std::fs::File) -> (Outcom
         }
         Ok(Err(refusal)) => Outcome::Refused(refusal),
     };
+    STARTED_MS.store(0, Ordering::SeqCst);
+    FUZZING.store(false, Ordering::SeqCst);
     (outcome, largest)
 }
 
@@ -381,13 +461,17 @@ fn stream_seed(name: &str) -> u64 {
         .fold(0xF0CC_5EED_u64, |h, b| h.rotate_left(8) ^ b as u64)
 }
 
+/// Fuzzes one target from its own seeds: see [`run_with_seeds`].
+pub fn run(target: &Target) -> Report {
+    run_with_seeds(target, seeds::seeds(target.name))
+}
+
 /// Fuzzes one target: seeds, prefixes, mutants and junk. The caller holds
 /// [`alloc::MEASURING`] and has checked [`alloc::is_installed`].
-pub fn run(target: &Target) -> Report {
+pub fn run_with_seeds(target: &Target, seeds: Vec<Seed>) -> Report {
     install_panic_hook();
     start_watchdog();
     let started = Instant::now();
-    let seeds: Vec<Seed> = seeds::seeds(target.name);
     assert!(!seeds.is_empty(), "{}: no seeds", target.name);
     let out_dir = fuzz_dir().join(target.name);
     std::fs::create_dir_all(&out_dir).expect("target/ is writable");
@@ -395,6 +479,7 @@ pub fn run(target: &Target) -> Report {
     *CURRENT_INPUT.lock().unwrap_or_else(|e| e.into_inner()) = Some(current.clone());
     let mut report = Report {
         target: target.name.into(),
+        round_trip: target.round_trip,
         seeds: seeds
             .iter()
             .map(|s| (s.name.clone(), s.bytes.len()))
@@ -404,17 +489,27 @@ pub fn run(target: &Target) -> Report {
     let mut rng = SplitMix64::new(stream_seed(target.name));
 
     let mut current_file = std::fs::File::create(&current).expect("target/ is writable");
+    let mut round_tripped = HashSet::new();
     let mut record = |report: &mut Report, data: &[u8], origin: String| {
-        let (outcome, largest) = execute(target, data, &mut current_file);
+        let (outcome, largest) = execute(target, data, &mut current_file, &mut round_tripped);
         report.executions += 1;
         if data.len() >= 1024 {
             report.largest_allocation_per_byte = report
                 .largest_allocation_per_byte
                 .max(largest as f64 / data.len() as f64);
         }
+        // Returns whether the input loaded.
         let problem = match outcome {
-            Outcome::Ok => {
+            Outcome::Ok { repeated } => {
                 report.ok += 1;
+                report.round_trips += 1;
+                report.round_trips_repeated += repeated as usize;
+                return true;
+            }
+            Outcome::NotRepresentable(why) => {
+                report.ok += 1;
+                report.not_representable += 1;
+                report.not_representable_example.get_or_insert(why);
                 return true;
             }
             Outcome::Refused(r) => {
@@ -424,8 +519,10 @@ pub fn run(target: &Target) -> Report {
             }
             Outcome::Problem(p) => p,
         };
+        let loaded = matches!(problem, Problem::RoundTrip { .. });
+        report.ok += loaded as usize;
         save_finding(report, &out_dir, data, problem, origin);
-        false
+        loaded
     };
 
     // Every seed loads (the generated ones must; a shared one that does not is reported).
@@ -459,14 +556,13 @@ pub fn run(target: &Target) -> Report {
             };
             for cut in cuts {
                 let prefix = &seed.bytes[..cut];
-                let before = report.findings.len();
                 let loaded = record(
                     &mut report,
                     prefix,
                     format!("seed {}, first {cut} bytes", seed.name),
                 );
                 report.prefixes_checked += 1;
-                if loaded && report.findings.len() == before {
+                if loaded {
                     save_finding(
                         &mut report,
                         &out_dir,
@@ -575,6 +671,11 @@ pub fn fuzz_target(name: &str) -> Report {
         "fuzz {name}: the mutants reach only {:?} and {} loads; the fuzzing is shallow",
         report.refusals.keys().collect::<Vec<_>>(),
         report.ok
+    );
+    assert!(
+        report.round_trips > 0 || !report.findings.is_empty(),
+        "fuzz {name}: no load was round-tripped ({} not representable)",
+        report.not_representable
     );
     assert!(
         report.findings.is_empty(),

@@ -1,16 +1,19 @@
-//! The readers under test, each as a function from bytes to Ok or a classified error. Each
-//! decodes as a user's file would be loaded: the hair parsers with cleaning, the environment
-//! maps through `envmap_io::load_bytes` (2:1 and bad-pixel checks, sanitizing), the table asset
-//! and SRBF set through their public loaders.
+//! The readers under test, each as a function from bytes to what it loaded or a classified
+//! error. Each decodes as a user's file would be loaded: the hair parsers with cleaning, the
+//! environment maps through `envmap_io::load_bytes` (2:1 and bad-pixel checks, sanitizing), the
+//! table asset and SRBF set through their public loaders. What loaded goes on to the round trip
+//! of [`super::round_trip`].
 
 use std::fs::File;
 use std::path::{Path, PathBuf};
 use std::sync::{Mutex, OnceLock};
 
 use strandlight_precompute::SrbfSet;
-use strandlight_precompute::envmap_io::{LoadOptions, load_bytes};
+use strandlight_precompute::envmap_io::{LoadOptions, LoadedEnvMap, load_bytes};
 use strandlight_runtime::hair;
 use strandlight_tables::asset;
+
+use super::round_trip::{self, Reloaded};
 
 /// A reader's failure: the error's variant (for the tally) and its message.
 #[derive(Clone, Debug)]
@@ -19,20 +22,36 @@ pub struct Refusal {
     pub message: String,
 }
 
+/// What a reader loaded, kept for the round trip.
+#[derive(Clone, Debug)]
+pub enum Loaded {
+    Hair(hair::LoadedHair),
+    EnvMap(LoadedEnvMap),
+    Asset(asset::TableAsset),
+    Srbf(SrbfSet),
+}
+
 /// One reader.
 pub struct Target {
     /// Short name, also the extension of the seed files (`hair`, `sltab`, …).
     pub name: &'static str,
     /// The name errors must mention (the path handed to the reader ends with it).
     pub file_name: &'static str,
-    pub run: fn(&[u8]) -> Result<(), Refusal>,
+    pub run: fn(&[u8]) -> Result<Loaded, Refusal>,
+    /// Writes what `run` loaded with the project's writer for its kind and loads that again
+    /// ([`round_trip::write_and_reload`]; a test swaps in a corrupting one to see the check fail).
+    pub reload: fn(&Loaded) -> Result<Reloaded, String>,
+    /// The writer and reader of the round trip, for the report.
+    pub round_trip: &'static str,
     /// Every strict prefix of a valid file is refused (the format fixes its own size).
     pub prefixes_fail: bool,
     /// Pixels (or values) a byte of this format can legitimately decode to at most: the
     /// allowance of the wild-allocation check beyond 64 bytes per input byte.
     pub bytes_out_per_byte_in: u64,
     /// Executions in CI (times `STRANDLIGHT_FUZZ_EXECS`): chosen so the whole file runs in
-    /// about 100 s in the test profile on 2 cores.
+    /// about 100 s in the test profile on 2 cores. (With the round trip, `tfx`, `hdr` and `exr`
+    /// were cut from 250 000, 350 000 and 150 000: an environment map's round trip through the
+    /// EXR writer and reader costs about 1 ms.)
     pub execs: usize,
     /// Fixes up a mutant so that it gets past an integrity check to the parser behind it.
     pub reseal: Option<fn(&mut [u8])>,
@@ -55,63 +74,90 @@ fn hair_with(
     parse: fn(&[u8], &Path) -> Result<hair::LoadedHair, hair::HairError>,
     file: &str,
     bytes: &[u8],
-) -> Result<(), Refusal> {
-    parse(bytes, Path::new(file)).map(drop).map_err(refusal)
+) -> Result<Loaded, Refusal> {
+    parse(bytes, Path::new(file))
+        .map(Loaded::Hair)
+        .map_err(refusal)
 }
 
-fn run_hair(bytes: &[u8]) -> Result<(), Refusal> {
+fn run_hair(bytes: &[u8]) -> Result<Loaded, Refusal> {
     hair_with(hair::yuksel::parse_hair, "fuzz-input.hair", bytes)
 }
 
-fn run_tfx(bytes: &[u8]) -> Result<(), Refusal> {
+fn run_tfx(bytes: &[u8]) -> Result<Loaded, Refusal> {
     hair_with(hair::tfx::parse_tfx, "fuzz-input.tfx", bytes)
 }
 
-fn run_data(bytes: &[u8]) -> Result<(), Refusal> {
+fn run_data(bytes: &[u8]) -> Result<Loaded, Refusal> {
     hair_with(hair::usc::parse_usc, "fuzz-input.data", bytes)
 }
 
-fn run_ply(bytes: &[u8]) -> Result<(), Refusal> {
+fn run_ply(bytes: &[u8]) -> Result<Loaded, Refusal> {
     hair_with(hair::ply::parse_ply, "fuzz-input.ply", bytes)
 }
 
 /// Environment maps are loaded with sanitizing on, so that decoded maps with bad pixels go on
 /// through the cleaning code instead of stopping at the refusal.
-fn run_envmap(file: &str, bytes: &[u8]) -> Result<(), Refusal> {
+fn run_envmap(file: &str, bytes: &[u8]) -> Result<Loaded, Refusal> {
     let loaded = load_bytes(Path::new(file), bytes, LoadOptions { sanitize: true });
-    loaded.map(drop).map_err(refusal)
+    loaded.map(Loaded::EnvMap).map_err(refusal)
 }
 
-fn run_hdr(bytes: &[u8]) -> Result<(), Refusal> {
+fn run_hdr(bytes: &[u8]) -> Result<Loaded, Refusal> {
     run_envmap("fuzz-input.hdr", bytes)
 }
 
-fn run_exr(bytes: &[u8]) -> Result<(), Refusal> {
+fn run_exr(bytes: &[u8]) -> Result<Loaded, Refusal> {
     run_envmap("fuzz-input.exr", bytes)
 }
 
-/// The table asset reader takes a path, so each input goes through one scratch file, kept
-/// open and rewritten in place (creating a file per execution costs milliseconds here).
-fn run_sltab(bytes: &[u8]) -> Result<(), Refusal> {
-    use std::io::{Seek, Write};
-    static FILE: OnceLock<(PathBuf, Mutex<File>)> = OnceLock::new();
-    let (path, file) = FILE.get_or_init(|| {
-        let path = super::scratch_dir().join("fuzz-input.sltab");
-        let file = File::create(&path).expect("the scratch folder is writable");
-        (path, Mutex::new(file))
-    });
-    {
-        let mut file = file.lock().unwrap_or_else(|e| e.into_inner());
-        file.set_len(0).expect("the scratch file is writable");
-        file.rewind().expect("the scratch file is writable");
-        file.write_all(bytes).expect("the scratch file is writable");
-    }
-    asset::read_asset(path).map(drop).map_err(refusal)
+/// A file of the scratch folder kept open and rewritten in place, for readers and writers that
+/// take a path (creating a file per execution costs milliseconds here).
+pub struct ScratchFile {
+    path: PathBuf,
+    file: Mutex<File>,
 }
 
-fn run_srbf(bytes: &[u8]) -> Result<(), Refusal> {
+impl ScratchFile {
+    /// `name` in [`super::scratch_dir`], created (empty).
+    pub fn new(name: &str) -> Self {
+        let path = super::scratch_dir().join(name);
+        let file = File::create(&path).expect("the scratch folder is writable");
+        Self {
+            path,
+            file: Mutex::new(file),
+        }
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Empties the file and lets `write` fill it again.
+    pub fn rewrite<T>(&self, write: impl FnOnce(&mut File) -> T) -> T {
+        use std::io::Seek;
+        let mut file = self.file.lock().unwrap_or_else(|e| e.into_inner());
+        file.set_len(0).expect("the scratch file is writable");
+        file.rewind().expect("the scratch file is writable");
+        write(&mut file)
+    }
+}
+
+/// The table asset reader takes a path, so each input goes through one scratch file.
+fn run_sltab(bytes: &[u8]) -> Result<Loaded, Refusal> {
+    use std::io::Write;
+    static FILE: OnceLock<ScratchFile> = OnceLock::new();
+    let file = FILE.get_or_init(|| ScratchFile::new("fuzz-input.sltab"));
+    file.rewrite(|f| f.write_all(bytes))
+        .expect("the scratch file is writable");
+    asset::read_asset(file.path())
+        .map(Loaded::Asset)
+        .map_err(refusal)
+}
+
+fn run_srbf(bytes: &[u8]) -> Result<Loaded, Refusal> {
     SrbfSet::from_json(Path::new("fuzz-input.srbf.json"), bytes)
-        .map(drop)
+        .map(Loaded::Srbf)
         .map_err(refusal)
 }
 
@@ -134,12 +180,14 @@ pub fn reseal_asset(data: &mut [u8]) {
     }
 }
 
-/// Every reader, with its CI execution count.
+/// Every reader, with its CI execution count and the writer its loads round-trip through.
 pub fn all() -> Vec<Target> {
     let target = |name, file_name, run, execs| Target {
         name,
         file_name,
         run,
+        reload: round_trip::write_and_reload,
+        round_trip: round_trip::describe(name),
         prefixes_fail: true,
         bytes_out_per_byte_in: 64,
         execs,
@@ -149,27 +197,27 @@ pub fn all() -> Vec<Target> {
         target(
             "hair",
             "fuzz-input.hair",
-            run_hair as fn(&[u8]) -> _,
+            run_hair as fn(&[u8]) -> Result<Loaded, Refusal>,
             500_000,
         ),
         Target {
             // Offsets may leave gaps and trailing bytes (TressFX files have them), so a file
             // cut after its last array still loads.
             prefixes_fail: false,
-            ..target("tfx", "fuzz-input.tfx", run_tfx, 250_000)
+            ..target("tfx", "fuzz-input.tfx", run_tfx, 200_000)
         },
         target("data", "fuzz-input.data", run_data, 400_000),
         target("ply", "fuzz-input.ply", run_ply, 350_000),
         Target {
             // A byte of run-length code holds up to 16 pixels of 12 bytes (f32 RGB) each.
             bytes_out_per_byte_in: 16 * 12,
-            ..target("hdr", "fuzz-input.hdr", run_hdr, 350_000)
+            ..target("hdr", "fuzz-input.hdr", run_hdr, 250_000)
         },
         Target {
             // Up to 1376 bytes of samples per byte (PXR24's deflate), 6 of them (half RGB) per
             // pixel of 12 bytes (f32 RGB) in memory.
             bytes_out_per_byte_in: 1376 * 12 / 6,
-            ..target("exr", "fuzz-input.exr", run_exr, 150_000)
+            ..target("exr", "fuzz-input.exr", run_exr, 100_000)
         },
         Target {
             reseal: Some(reseal_asset),
