@@ -12,16 +12,13 @@ use super::attachments::{cleared_color, cleared_depth};
 use super::fiber_shading::ShadingModel;
 use super::frame_params::FrameParams;
 use super::render_target::DEPTH_FORMAT;
-use super::shadow_slots::{ShadowInput, TooManyShadowMaps, shadow_bind_group_for};
+use super::shadow_slots::{ShadowInput, TooManyShadowMaps};
+use super::sorted_blend::IndexedStrandDraw;
 use super::strand_geometry::StrandGeometry;
-use super::strand_quads::strand_bind_group;
-use super::strands::{ShadedStrandLayouts, shading_source};
 use crate::gpu::bind_layout::{
     bind_group, pipeline_layout, storage_entry, texture_entry, uniform_entry,
 };
-use crate::gpu::pipeline::{
-    PREMULTIPLIED_OVER, StrandDraw, color_target, compute_pipeline, depth_test, wgsl_module,
-};
+use crate::gpu::pipeline::{compute_pipeline, depth_test, wgsl_module};
 use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::gpu::texture::texture_2d;
 use crate::gpu::{GpuContext, GpuLimits, LimitError};
@@ -87,40 +84,22 @@ struct ResolveParams {
 }
 
 pub struct RandomSubsetsPass {
-    draw: wgpu::RenderPipeline,
+    draw: IndexedStrandDraw,
     resolve: wgpu::ComputePipeline,
-    layouts: ShadedStrandLayouts,
-    order_layout: wgpu::BindGroupLayout,
     resolve_layout: wgpu::BindGroupLayout,
 }
 
 impl RandomSubsetsPass {
     pub fn with_model(gpu: &GpuContext, shading: &ShadingModel) -> Self {
         let device = &gpu.device;
-        let layouts = ShadedStrandLayouts::new(gpu, shading);
-        let order_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("subset segments"),
-            entries: &[storage_entry(0, wgpu::ShaderStages::VERTEX, true)],
-        });
-        let layout = layouts.pipeline_layout(device, "random subsets", Some(&order_layout));
-        // The sorted pass's vertex stage reads segments through an index list: here, a subset's.
-        let shader = wgsl_module(
-            device,
+        // The sorted pass's draw reads segments through an index list: here, a subset's.
+        let draw = IndexedStrandDraw::new(
+            gpu,
+            shading,
             "random subsets",
-            &shading_source(shading, include_str!("sorted_blend_draw.wgsl")),
+            SUBSET_COLOR_FORMAT,
+            Some(depth_test(DEPTH_FORMAT, true, wgpu::CompareFunction::Less)),
         );
-        let draw = StrandDraw {
-            label: "random subsets",
-            layout: &layout,
-            shader: &shader,
-            vertex_entry: "vs_sorted",
-            fragment: Some((
-                "fs_main",
-                &[color_target(SUBSET_COLOR_FORMAT, Some(PREMULTIPLIED_OVER))],
-            )),
-            depth: Some(depth_test(DEPTH_FORMAT, true, wgpu::CompareFunction::Less)),
-        }
-        .build(device);
         let compute = wgpu::ShaderStages::COMPUTE;
         let resolve_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("random subsets resolve"),
@@ -156,8 +135,6 @@ impl RandomSubsetsPass {
         Self {
             draw,
             resolve,
-            layouts,
-            order_layout,
             resolve_layout,
         }
     }
@@ -226,14 +203,7 @@ impl RandomSubsetsPass {
             }),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows)?;
-        let strands = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
-        let order_group = bind_group(
-            device,
-            "subset segments",
-            &self.order_layout,
-            &[order.as_entire_binding()],
-        );
+        let groups = self.draw.groups(gpu, geometry, frame, shadows, &order)?;
         let layer_view = |texture: &wgpu::Texture, layer| {
             texture.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2),
@@ -254,15 +224,8 @@ impl RandomSubsetsPass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.draw);
-            pass.set_bind_group(0, &strands, &[]);
-            pass.set_bind_group(1, &shadow_group, &[]);
-            if let Some(model) = &self.layouts.model {
-                pass.set_bind_group(2, &model.group, &[]);
-            }
-            pass.set_bind_group(3, &order_group, &[]);
             let (start, end) = (bounds[subset as usize], bounds[subset as usize + 1]);
-            pass.draw(0..6, start..end);
+            self.draw.record(&mut pass, &groups, start..end);
         }
         let array_view = |texture: &wgpu::Texture| {
             texture.create_view(&wgpu::TextureViewDescriptor {

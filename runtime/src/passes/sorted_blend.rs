@@ -65,9 +65,7 @@ pub struct SortedBlendPass {
     scan: wgpu::ComputePipeline,
     scatter: wgpu::ComputePipeline,
     sort_layout: wgpu::BindGroupLayout,
-    draw: wgpu::RenderPipeline,
-    layouts: ShadedStrandLayouts,
-    order_layout: wgpu::BindGroupLayout,
+    draw: IndexedStrandDraw,
 }
 
 impl SortedBlendPass {
@@ -94,37 +92,13 @@ impl SortedBlendPass {
             |entry| compute_pipeline(device, entry, &sort_pipeline_layout, &sort_shader, entry);
         let (histogram, scan, scatter) = (stage("histogram"), stage("scan"), stage("scatter"));
 
-        let layouts = ShadedStrandLayouts::new(gpu, shading);
-        let order_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("draw order"),
-            entries: &[storage_entry(0, wgpu::ShaderStages::VERTEX, true)],
-        });
-        let draw_layout = layouts.pipeline_layout(device, "sorted blend", Some(&order_layout));
-        let shader = wgsl_module(
-            device,
-            "sorted_blend_draw.wgsl",
-            &shading_source(shading, include_str!("sorted_blend_draw.wgsl")),
-        );
-        let draw = StrandDraw {
-            label: "sorted blend",
-            layout: &draw_layout,
-            shader: &shader,
-            vertex_entry: "vs_sorted",
-            fragment: Some((
-                "fs_main",
-                &[color_target(gpu.hdr_format(), Some(PREMULTIPLIED_OVER))],
-            )),
-            depth: None,
-        }
-        .build(device);
+        let draw = IndexedStrandDraw::new(gpu, shading, "sorted blend", gpu.hdr_format(), None);
         Self {
             histogram,
             scan,
             scatter,
             sort_layout,
             draw,
-            layouts,
-            order_layout,
         }
     }
 
@@ -217,17 +191,11 @@ impl SortedBlendPass {
         order: &SegmentOrder,
         target: &RenderTarget,
     ) -> Result<(), TooManyShadowMaps> {
-        let device = &gpu.device;
-        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows)?;
-        let strands = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
-        let order_group = bind_group(
-            device,
-            "draw order",
-            &self.order_layout,
-            &[order.order.as_entire_binding()],
-        );
+        let groups = self
+            .draw
+            .groups(gpu, geometry, frame, shadows, &order.order)?;
         let color_view = target.color.create_view(&Default::default());
-        let mut encoder = device.create_command_encoder(&Default::default());
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("sorted blend"),
@@ -237,16 +205,102 @@ impl SortedBlendPass {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.draw);
-            pass.set_bind_group(0, &strands, &[]);
-            pass.set_bind_group(1, &shadow_group, &[]);
-            if let Some(model) = &self.layouts.model {
-                pass.set_bind_group(2, &model.group, &[]);
-            }
-            pass.set_bind_group(3, &order_group, &[]);
-            pass.draw(0..6, 0..geometry.segment_count);
+            self.draw
+                .record(&mut pass, &groups, 0..geometry.segment_count);
         }
         gpu.queue.submit([encoder.finish()]);
         Ok(())
+    }
+}
+
+/// The draw that sorted blending and random subsets share (`sorted_blend_draw.wgsl`): strand
+/// quads whose segments come from an index list (group 3) rather than the instance index, shaded
+/// with the pass's fiber model and blended pre-multiplied "over". The passes differ only in the
+/// target's format, the depth test and which indices they draw.
+pub(crate) struct IndexedStrandDraw {
+    pipeline: wgpu::RenderPipeline,
+    layouts: ShadedStrandLayouts,
+    order_layout: wgpu::BindGroupLayout,
+}
+
+/// One frame's bind groups for an [`IndexedStrandDraw`].
+pub(crate) struct IndexedStrandGroups {
+    strands: wgpu::BindGroup,
+    shadows: wgpu::BindGroup,
+    order: wgpu::BindGroup,
+}
+
+impl IndexedStrandDraw {
+    pub fn new(
+        gpu: &GpuContext,
+        shading: &ShadingModel,
+        label: &str,
+        format: wgpu::TextureFormat,
+        depth: Option<wgpu::DepthStencilState>,
+    ) -> Self {
+        let device = &gpu.device;
+        let layouts = ShadedStrandLayouts::new(gpu, shading);
+        let order_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("segment order"),
+            entries: &[storage_entry(0, wgpu::ShaderStages::VERTEX, true)],
+        });
+        let layout = layouts.pipeline_layout(device, label, Some(&order_layout));
+        let shader = wgsl_module(
+            device,
+            label,
+            &shading_source(shading, include_str!("sorted_blend_draw.wgsl")),
+        );
+        let pipeline = StrandDraw {
+            label,
+            layout: &layout,
+            shader: &shader,
+            vertex_entry: "vs_sorted",
+            fragment: Some(("fs_main", &[color_target(format, Some(PREMULTIPLIED_OVER))])),
+            depth,
+        }
+        .build(device);
+        Self {
+            pipeline,
+            layouts,
+            order_layout,
+        }
+    }
+
+    /// The groups that draw `geometry` in `frame`, segment `order[i]` as instance i.
+    pub fn groups(
+        &self,
+        gpu: &GpuContext,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        shadows: &[ShadowInput<'_>],
+        order: &wgpu::Buffer,
+    ) -> Result<IndexedStrandGroups, TooManyShadowMaps> {
+        Ok(IndexedStrandGroups {
+            strands: strand_bind_group(gpu, &self.layouts.strand, geometry, frame),
+            shadows: shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows)?,
+            order: bind_group(
+                &gpu.device,
+                "segment order",
+                &self.order_layout,
+                &[order.as_entire_binding()],
+            ),
+        })
+    }
+
+    /// Draws the segments listed at `positions` of the order into `pass`.
+    pub fn record(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        groups: &IndexedStrandGroups,
+        positions: std::ops::Range<u32>,
+    ) {
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &groups.strands, &[]);
+        pass.set_bind_group(1, &groups.shadows, &[]);
+        if let Some(model) = &self.layouts.model {
+            pass.set_bind_group(2, &model.group, &[]);
+        }
+        pass.set_bind_group(3, &groups.order, &[]);
+        pass.draw(0..6, positions);
     }
 }
