@@ -224,9 +224,12 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
     );
     let error = replay_error(&dir, "points");
     println!("point-lit screenshot against its replay: relative RMSE {error:.2e}");
-    // The same frame function on the same device: one call each, nothing summed.
+    // The same frame function on the same device, but sorted transparency bins its segments with
+    // atomics and blends each bin in whatever order they give (sorted_blend.wgsl), so two runs of
+    // one frame differ where fragments of one bin overlap: 1.4e-4 measured, 1e-3 allowed, a hundredth
+    // of what the switch to point lights moved the picture (above).
     assert!(
-        error < 1e-4,
+        error < 1e-3,
         "point-lit replay differs: relative RMSE {error}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
