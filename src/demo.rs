@@ -9,6 +9,7 @@ use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_scene::env_frame::{env_adapter, light_summary};
 use strandlight_scene::env_scene::{EnvSceneRequest, prepare_env_scene};
 use strandlight_scene::environment::{LoadedEnv, ensure_procedural_envmap, load_env};
+use strandlight_scene::exposure::{Exposure, exposure_problem};
 use strandlight_scene::frame_render::{
     FrameDetails, FramePart, LoadedHair, Prepared, PreparedEnv, load_settings_hair, render_frame,
 };
@@ -17,7 +18,7 @@ use strandlight_scene::look::EnvTransparency;
 use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
-use strandlight_tables::image_out::{PNG_TONEMAP, write_exr, write_png};
+use strandlight_tables::image_out::{png_tonemap, write_exr, write_png_exposed};
 
 /// The environment the demo renders under, and where it is written.
 pub const DEMO_ENVIRONMENT: &str = "sun_and_sky";
@@ -102,13 +103,26 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let (exr, png) = (out.join("demo.exr"), out.join("demo.png"));
     let image = &rendered.image;
     write_exr(&exr, image.width, image.height, &image.pixels, &description)?;
-    write_png(&png, image.width, image.height, &image.pixels, &description)?;
+    // Metered on the hair, as the viewer and `render` do: the sun and sky would wash it out.
+    let stops = Exposure::Auto.stops_for(&image.pixels);
+    write_png_exposed(
+        &png,
+        image.width,
+        image.height,
+        &image.pixels,
+        stops,
+        &description,
+    )?;
+    if let Some(problem) = exposure_problem(&image.pixels, Exposure::Auto, stops) {
+        eprintln!("warning: {}: {problem}", png.display());
+    }
     steps.say(format!(
-        "{}, {} scattering; wrote {} (linear) and {} ({PNG_TONEMAP}); total {:.1} s",
+        "{}, {} scattering; wrote {} (linear) and {} ({}); total {:.1} s",
         light_summary(lights),
         mode.name(),
         exr.display(),
         png.display(),
+        png_tonemap(stops),
         steps.total_seconds()
     ));
     Ok(())

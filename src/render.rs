@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use strandlight_runtime::render::PassTiming;
 use strandlight_scene::camera_choice::{CameraChoice, CameraKind, UpChoice};
 use strandlight_scene::env_frame::{env_adapter, light_summary};
+use strandlight_scene::exposure::{Exposure, ExposureProblem, exposure_problem};
 use strandlight_scene::frame_render::{
     FrameDetails, FramePart, LoadedHair, Prepared, RenderedFrame, load_settings_hair, prepare_env,
     prepare_point, render_frame,
@@ -23,7 +24,7 @@ use strandlight_scene::point_shading::{Shading, read_artist_params};
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 use strandlight_tables::atomic_write::write_atomically;
-use strandlight_tables::image_out::{PNG_TONEMAP, write_exr, write_png};
+use strandlight_tables::image_out::{png_tonemap, write_exr, write_png_exposed};
 
 /// `render env`, `render lights` or `render replay`: each lighting has its own flags, so no
 /// flag belongs to two renderers.
@@ -90,6 +91,10 @@ struct OutputArgs {
     /// Print adapter, per-pass milliseconds and GPU memory as JSON.
     #[arg(long)]
     json: bool,
+    /// The PNG's exposure: auto (metered on the hair's pixels) or stops (0: the radiance as is);
+    /// the EXR is always the linear radiance.
+    #[arg(long, default_value = "auto")]
+    exposure: Exposure,
 }
 
 #[derive(Args, Debug)]
@@ -127,9 +132,6 @@ struct LightsArgs {
     /// spot:X,Y,Z:DX,DY,DZ:HALF_ANGLE_DEGREES[:I].
     #[arg(long = "light", default_value = DEFAULT_LIGHT)]
     lights: Vec<String>,
-    /// Nodes per axis of the Marschner and Chiang lookup tables, baked at startup.
-    #[arg(long, default_value_t = 128)]
-    lut_size: usize,
     #[command(flatten)]
     shadows: ShadowArgs,
     #[command(flatten)]
@@ -282,7 +284,6 @@ fn point_lighting(args: &LightsArgs) -> Lighting {
         dom_spacing: shadows.dom_spacing,
         dom_size: shadows.light_map_size,
         dbk_delta: transparency.dbk_delta,
-        lut_size: args.lut_size,
         ..defaults
     })
 }
@@ -340,7 +341,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         },
         |r| format!("{:.1} ms/frame, {}", r.milliseconds, what_was_drawn(r)),
     )?;
-    let written = write_outputs(&output.out, &settings, &hair, prepared, &rendered)?;
+    let written = write_outputs(output, &settings, &hair, prepared, &rendered)?;
+    if let Some(problem) = &written.problem {
+        eprintln!("warning: {}: {problem}", written.png.display());
+    }
     if output.json {
         let report = json_report(&settings, &hair, &rendered, &written)?;
         println!("{}", serde_json::to_string_pretty(&report)?);
@@ -349,9 +353,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             steps.say(line);
         }
         steps.say(format!(
-            "wrote {}, {} and {} (the settings, for `render replay`)",
+            "wrote {}, {} (exposure {:+.2} stops, {}) and {} (the settings, for `render replay`)",
             written.exr.display(),
             written.png.display(),
+            written.exposure_stops,
+            output.exposure,
             written.settings.display()
         ));
     }
@@ -373,18 +379,21 @@ struct Written {
     png: PathBuf,
     settings: PathBuf,
     covered_pixels: usize,
+    exposure_stops: f32,
+    /// What a person would not see in the PNG: black or clipped hair.
+    problem: Option<ExposureProblem>,
 }
 
 /// STEM.exr (linear), STEM.png (tonemapped) and STEM.json (the settings), each with a line
 /// describing the frame.
 fn write_outputs(
-    out: &Path,
+    output: &OutputArgs,
     settings: &FrameSettings,
     hair: &LoadedHair,
     prepared: Prepared,
     rendered: &RenderedFrame,
 ) -> anyhow::Result<Written> {
-    let stem = output_stem(out);
+    let stem = output_stem(&output.out);
     let [width, height] = settings.size;
     let lighting = match (&settings.lighting, prepared, &rendered.details) {
         (Lighting::Lights(point), Prepared::Point(p), _) => format!(
@@ -409,15 +418,25 @@ fn write_outputs(
         "{}; {width}x{height}; {lighting}; camera {:?}",
         hair.source, settings.camera
     );
+    let exposure_stops = output.exposure.stops_for(&rendered.image.pixels);
     let written = Written {
         exr: stem.with_extension("exr"),
         png: stem.with_extension("png"),
         settings: stem.with_extension("json"),
         covered_pixels: rendered.image.pixels.iter().filter(|p| p[3] > 0.0).count(),
+        exposure_stops,
+        problem: exposure_problem(&rendered.image.pixels, output.exposure, exposure_stops),
     };
     let image = &rendered.image;
     write_exr(&written.exr, width, height, &image.pixels, &description)?;
-    write_png(&written.png, width, height, &image.pixels, &description)?;
+    write_png_exposed(
+        &written.png,
+        width,
+        height,
+        &image.pixels,
+        exposure_stops,
+        &description,
+    )?;
     write_atomically::<anyhow::Error, _>(&written.settings, |w| {
         Ok(w.write_all(settings.to_json().as_bytes())?)
     })
@@ -443,7 +462,9 @@ fn json_report(
         "gpu_memory_bytes": rendered.memory.iter().map(|(n, b)| (n.clone(), serde_json::json!(b))).collect::<serde_json::Map<_, _>>(),
         "gpu_memory_total_bytes": rendered.memory.iter().map(|(_, b)| b).sum::<u64>(),
         "covered_pixels": written.covered_pixels,
-        "outputs": { "exr": written.exr, "png": written.png, "png_tonemap": PNG_TONEMAP, "settings": written.settings },
+        "outputs": { "exr": written.exr, "png": written.png, "png_tonemap": png_tonemap(written.exposure_stops), "settings": written.settings },
+        "exposure_stops": written.exposure_stops,
+        "exposure_warning": written.problem.as_ref().map(|p| p.to_string()),
         "settings": serde_json::to_value(settings)?,
     });
     let extra = match &rendered.details {

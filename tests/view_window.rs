@@ -100,9 +100,13 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
         {"key": "B"},
         {"frames": 3},
         {"key": "B"},
+        {"frames": 3},
+        {"key": "B"},
         {"settings": {"artist": artist}},
         {"frames": 20},
         {"wait": "converged"},
+        {"key": "O"},
+        {"frames": 2},
         {"key": "O"},
         {"frames": 2},
         {"screenshot": "shot"},
@@ -159,6 +163,25 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
     assert!(gap < 1500.0, "the window stalled {gap} ms during a bake");
 
     assert!(lit_share(&dir.join("shot.png")) > 0.02, "blank screenshot");
+
+    // The timing readout sits beside the image, so it never covers the hair.
+    let rect_of = |v: &Value| -> [f64; 4] {
+        let r: Vec<f64> = v
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect();
+        r.try_into().unwrap()
+    };
+    let image = rect_of(&report["image_rect_px"]);
+    let readout = rect_of(&report["readout_rect_px"]);
+    let overlap_x = image[2].min(readout[2]) - image[0].max(readout[0]);
+    let overlap_y = image[3].min(readout[3]) - image[1].max(readout[1]);
+    assert!(
+        overlap_x <= 0.0 || overlap_y <= 0.0,
+        "the readout {readout:?} covers the image {image:?}"
+    );
 
     // The whole window, panel included: larger than the frame, and showing the same picture
     // where the frame sits.

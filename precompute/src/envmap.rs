@@ -125,6 +125,24 @@ impl EnvMap {
         self.pixel(x, y)
     }
 
+    /// Radiance in direction `w` (unit) interpolated between the four nearest pixel centres:
+    /// wrapping around in longitude, clamped at the poles. For a small (prefiltered) map drawn
+    /// large, where the nearest pixel would show its blocks.
+    pub fn radiance_bilinear(&self, w: DVec3) -> Rgb32 {
+        let (u, v) = direction_to_uv(w);
+        let fx = u * self.width as f64 - 0.5;
+        let fy = (v * self.height as f64 - 0.5).clamp(0.0, (self.height - 1) as f64);
+        let (x0, y0) = (fx.floor(), fy.floor());
+        let (tx, ty) = ((fx - x0) as f32, (fy - y0) as f32);
+        let column = |x: f64| (x as i64).rem_euclid(self.width as i64) as usize;
+        let (xa, xb) = (column(x0), column(x0 + 1.0));
+        let (ya, yb) = (y0 as usize, (y0 as usize + 1).min(self.height - 1));
+        let mix = |a: Rgb32, b: Rgb32, t: f32| [0, 1, 2].map(|k| a[k] + t * (b[k] - a[k]));
+        let top = mix(self.pixel(xa, ya), self.pixel(xb, ya), tx);
+        let bottom = mix(self.pixel(xa, yb), self.pixel(xb, yb), tx);
+        mix(top, bottom, ty)
+    }
+
     /// Counts NaN, ±Inf and negative channel values.
     pub fn bad_pixels(&self) -> BadPixelCounts {
         let mut c = BadPixelCounts::default();
@@ -294,6 +312,42 @@ mod tests {
         assert!(close(uv_to_direction(0.0, 0.5), DVec3::Z));
         assert!(close(uv_to_direction(0.3, 0.0), DVec3::Y));
         assert!(close(uv_to_direction(0.3, 1.0), DVec3::NEG_Y));
+    }
+
+    #[test]
+    fn bilinear_radiance_hits_pixel_centres_and_blends_between_them_across_the_seam() {
+        // Pixel value = column index, so the interpolant in x is linear in u.
+        let (w, h) = (8usize, 4usize);
+        let map = EnvMap::from_pixels(
+            w,
+            h,
+            (0..w * h)
+                .map(|i| [(i % w) as f32, (i / w) as f32, 1.0])
+                .collect(),
+        );
+        let at = |u: f64, v: f64| map.radiance_bilinear(uv_to_direction(u, v));
+        let centre =
+            |x: usize, y: usize| ((x as f64 + 0.5) / w as f64, (y as f64 + 0.5) / h as f64);
+        for (x, y) in [(0, 0), (3, 1), (7, 3)] {
+            let (u, v) = centre(x, y);
+            let got = at(u, v);
+            assert!(
+                (got[0] - x as f32).abs() < 1e-4 && (got[1] - y as f32).abs() < 1e-4,
+                "{x},{y}: {got:?}"
+            );
+        }
+        // Half way between columns 2 and 3, and between rows 1 and 2.
+        let got = at(3.0 / w as f64, 2.0 / h as f64);
+        assert!(
+            (got[0] - 2.5).abs() < 1e-4 && (got[1] - 1.5).abs() < 1e-4,
+            "{got:?}"
+        );
+        // Across the seam: half way between the last column (7) and the first (0).
+        let got = at(1e-9, 0.5);
+        assert!((got[0] - 3.5).abs() < 1e-3, "{got:?}");
+        // Above the first row's centre the poles clamp to it.
+        assert!((at(0.3, 0.0)[1] - 0.0).abs() < 1e-6);
+        assert!((at(0.3, 1.0)[1] - 3.0).abs() < 1e-6);
     }
 
     #[test]

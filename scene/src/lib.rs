@@ -11,6 +11,7 @@ pub mod camera_choice;
 pub mod env_frame;
 pub mod env_scene;
 pub mod environment;
+pub mod exposure;
 pub mod fit_cache;
 pub mod frame_render;
 pub mod frame_settings;

@@ -141,23 +141,41 @@ pub fn write_png(
     pixels: &[[f32; 4]],
     description: &str,
 ) -> Result<(), ImageWriteError> {
+    write_png_exposed(path, width, height, pixels, 0.0, description)
+}
+
+/// [`PNG_TONEMAP`] with the exposure of [`write_png_exposed`] in place of exposure 1.
+pub fn png_tonemap(stops: f32) -> String {
+    if stops == 0.0 {
+        return PNG_TONEMAP.to_string();
+    }
+    PNG_TONEMAP.replace("exposure 1", &format!("exposure {stops:+.2} stops"))
+}
+
+/// [`write_png`] with the radiance scaled by `2^stops` before the tonemap.
+pub fn write_png_exposed(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 4]],
+    stops: f32,
+    description: &str,
+) -> Result<(), ImageWriteError> {
     check_size(path, width, height, pixels.len())?;
+    let scale = stops.exp2();
     let bytes: Vec<u8> = pixels
         .iter()
-        .flat_map(|p| {
-            [
-                tonemap_channel(p[0]),
-                tonemap_channel(p[1]),
-                tonemap_channel(p[2]),
-            ]
-        })
+        .flat_map(|p| [0, 1, 2].map(|k| tonemap_channel(scale * p[k])))
         .collect();
     write_png_rgb8_with_text(
         path,
         width,
         height,
         &bytes,
-        &[("Description", description), ("Tonemap", PNG_TONEMAP)],
+        &[
+            ("Description", description),
+            ("Tonemap", &png_tonemap(stops)),
+        ],
     )
 }
 

@@ -102,7 +102,7 @@ impl WindowGpu {
         let attributes = Window::default_attributes()
             .with_title("strandlight")
             .with_inner_size(winit::dpi::LogicalSize::new(
-                size[0] as f64 + PANEL_WIDTH + 16.0,
+                size[0] as f64 + PANEL_WIDTH + crate::session::READOUT_WIDTH as f64 + 16.0,
                 (size[1] as f64 + 16.0).max(560.0),
             ));
         let window = Arc::new(event_loop.create_window(attributes)?);

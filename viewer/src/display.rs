@@ -1,40 +1,41 @@
-//! From a linear frame to the window's pixels: exposure (automatic by default, so a first image is
-//! never black), the environment drawn behind the hair, and the PNG's tonemap curve
+//! From a linear frame to the window's pixels: the backdrop drawn behind the hair (exposure is
+//! `strandlight_scene::exposure`'s, metered on the hair), and the PNG's tonemap curve
 //! ([`PNG_TONEMAP`](strandlight_tables::image_out::PNG_TONEMAP)) so the window and a screenshot
 //! show the same thing.
 
 use crate::frame::LinearImage;
-use glam::{Quat, Vec4};
+use crate::recompute::Backdrop;
+use glam::{DVec3, Quat, Vec4};
 use strandlight_precompute::envmap::EnvMap;
 use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_scene::image_metrics::HAIR_ALPHA;
 use strandlight_scene::world_lights::world_to_env;
-use strandlight_tables::colour::luminance_f32;
 use strandlight_tables::image_out::tonemap_channel;
 
-/// Automatic exposure puts the hair's 90th-percentile radiance here (Reinhard: 2/3 of white).
-const AUTO_TARGET: f32 = 2.0;
-
-/// Stops that bring the 90th percentile of the hair's (un-premultiplied) luminance to
-/// [`AUTO_TARGET`]; 0 for an image without lit hair.
-pub fn auto_exposure_stops(image: &LinearImage) -> f32 {
-    let mut luminance: Vec<f32> = image
-        .pixels
-        .iter()
-        .filter(|p| p[3] > HAIR_ALPHA)
-        .map(|p| luminance_f32([p[0], p[1], p[2]]) / p[3])
-        .filter(|l| l.is_finite() && *l > 0.0)
-        .collect();
-    if luminance.is_empty() {
-        return 0.0;
-    }
-    let k = (luminance.len() * 9 / 10).min(luminance.len() - 1);
-    let (_, p90, _) = luminance.select_nth_unstable_by(k, f32::total_cmp);
-    (AUTO_TARGET / *p90).log2().clamp(-20.0, 20.0)
+/// The world direction through each pixel of `camera` at `size`, in the map's frame (the map
+/// turned `rotation_deg` about `up`, as the lights are).
+fn pixel_directions(
+    camera: &Camera,
+    size: [u32; 2],
+    up: UpAxis,
+    rotation_deg: f32,
+) -> impl Iterator<Item = DVec3> {
+    let [w, h] = size;
+    let clip_to_world = (camera.projection_matrix(w as f32 / h as f32) * camera.view()).inverse();
+    let unturn = Quat::from_axis_angle(up.vector(), -rotation_deg.to_radians());
+    (0..h).flat_map(move |y| {
+        (0..w).map(move |x| {
+            let ndc_x = 2.0 * (x as f32 + 0.5) / w as f32 - 1.0;
+            let ndc_y = 1.0 - 2.0 * (y as f32 + 0.5) / h as f32;
+            let far = clip_to_world * Vec4::new(ndc_x, ndc_y, 1.0, 1.0);
+            let near = clip_to_world * Vec4::new(ndc_x, ndc_y, 0.0, 1.0);
+            let ray = far.truncate() / far.w - near.truncate() / near.w;
+            let world = unturn * ray.normalize_or_zero();
+            world_to_env(world.as_dvec3(), up)
+        })
+    })
 }
 
-/// Radiance of the environment seen through every pixel of `camera` at `size` (the map turned
-/// `rotation_deg` about `up`, as the lights are).
+/// Radiance of the environment seen through every pixel of `camera` at `size`.
 pub fn background(
     map: &EnvMap,
     camera: &Camera,
@@ -42,22 +43,41 @@ pub fn background(
     up: UpAxis,
     rotation_deg: f32,
 ) -> Vec<[f32; 3]> {
-    let [w, h] = size;
-    let clip_to_world = (camera.projection_matrix(w as f32 / h as f32) * camera.view()).inverse();
-    let unturn = Quat::from_axis_angle(up.vector(), -rotation_deg.to_radians());
-    let mut out = Vec::with_capacity(w as usize * h as usize);
-    for y in 0..h {
-        for x in 0..w {
-            let ndc_x = 2.0 * (x as f32 + 0.5) / w as f32 - 1.0;
-            let ndc_y = 1.0 - 2.0 * (y as f32 + 0.5) / h as f32;
-            let far = clip_to_world * Vec4::new(ndc_x, ndc_y, 1.0, 1.0);
-            let near = clip_to_world * Vec4::new(ndc_x, ndc_y, 0.0, 1.0);
-            let ray = far.truncate() / far.w - near.truncate() / near.w;
-            let world = unturn * ray.normalize_or_zero();
-            out.push(map.radiance(world_to_env(world.as_dvec3(), up)));
+    pixel_directions(camera, size, up, rotation_deg)
+        .map(|d| map.radiance(d))
+        .collect()
+}
+
+/// The soft backdrop sits this many stops under the hair's exposure.
+pub const SOFT_BACKDROP_STOPS: f32 = -2.0;
+
+/// The soft backdrop's prefiltered map: 64 × 32 pixels, about 6° each, so the sky's gradients
+/// stay and its detail (trees, windows, a sun's disc) does not compete with the fibers.
+const SOFT_BACKDROP_MAP: [usize; 2] = [64, 32];
+
+/// What `backdrop` draws behind the hair at the hair's exposure: None for black.
+pub fn backdrop_pixels(
+    backdrop: Backdrop,
+    map: &EnvMap,
+    camera: &Camera,
+    size: [u32; 2],
+    up: UpAxis,
+    rotation_deg: f32,
+) -> Option<Vec<[f32; 3]>> {
+    match backdrop {
+        Backdrop::Black => None,
+        Backdrop::Environment => Some(background(map, camera, size, up, rotation_deg)),
+        Backdrop::Soft => {
+            let [w, h] = SOFT_BACKDROP_MAP;
+            let blurred = map.downsampled(w, h);
+            let dim = SOFT_BACKDROP_STOPS.exp2();
+            Some(
+                pixel_directions(camera, size, up, rotation_deg)
+                    .map(|d| blurred.radiance_bilinear(d).map(|c| dim * c))
+                    .collect(),
+            )
         }
     }
-    out
 }
 
 /// The hair scaled by `2^stops` over the (equally exposed) background, as linear RGB + alpha 1
@@ -99,31 +119,8 @@ pub fn to_rgba8(pixels: &[[f32; 4]]) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::{DVec3, Vec3};
+    use glam::Vec3;
     use strandlight_runtime::camera::Projection;
-
-    #[test]
-    fn auto_exposure_lands_the_bright_hair_mid_curve_and_leaves_empty_images_alone() {
-        let mut pixels = vec![[0.0; 4]; 100];
-        for (i, p) in pixels.iter_mut().enumerate().take(50) {
-            let v = 0.001 * (i + 1) as f32;
-            *p = [0.5 * v, 0.5 * v, 0.5 * v, 0.5];
-        }
-        let image = LinearImage {
-            width: 10,
-            height: 10,
-            pixels,
-        };
-        let stops = auto_exposure_stops(&image);
-        // 90th percentile of the 50 lit pixels is the 46th: radiance 0.046.
-        assert!((stops - (2.0f32 / 0.046).log2()).abs() < 1e-4, "{stops}");
-        let empty = LinearImage {
-            width: 1,
-            height: 1,
-            pixels: vec![[0.0; 4]],
-        };
-        assert_eq!(auto_exposure_stops(&empty), 0.0);
-    }
 
     #[test]
     fn the_background_through_the_centre_pixel_is_what_lies_behind_the_target() {
@@ -149,6 +146,45 @@ mod tests {
         // Turned half way round, the bright spot is behind the camera.
         let turned = background(&map, &camera, [9, 9], UpAxis::Y, 180.0);
         assert_eq!(turned[4 * 9 + 4], [0.0; 3]);
+    }
+
+    #[test]
+    fn the_soft_backdrop_is_the_map_blurred_and_two_stops_darker() {
+        let camera = Camera {
+            eye: Vec3::new(0.0, 0.0, 3.0),
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            projection: Projection::Perspective { fov_y: 1.0 },
+            near: 0.1,
+            far: 10.0,
+        };
+        let soft = |map: &EnvMap| {
+            backdrop_pixels(Backdrop::Soft, map, &camera, [16, 16], UpAxis::Y, 0.0).unwrap()
+        };
+        // A uniform sky stays uniform, a quarter as bright.
+        let uniform = EnvMap::from_fn(256, 128, |_| [3.0, 2.0, 1.0]);
+        for p in soft(&uniform) {
+            assert!(
+                (p[0] - 0.75).abs() < 1e-5 && (p[2] - 0.25).abs() < 1e-5,
+                "{p:?}"
+            );
+        }
+        // A small sun (2.6° wide) straight behind the hair is spread over the blurred map's 5.6°
+        // pixels and dimmed two stops: ten times dimmer at the centre or more, but not gone.
+        let sun = EnvMap::from_fn(256, 128, |d| {
+            if d.dot(DVec3::NEG_Z) > 0.999 {
+                [1e4; 3]
+            } else {
+                [0.0; 3]
+            }
+        });
+        let sharp = background(&sun, &camera, [17, 17], UpAxis::Y, 0.0)[8 * 17 + 8][0];
+        let blurred =
+            backdrop_pixels(Backdrop::Soft, &sun, &camera, [17, 17], UpAxis::Y, 0.0).unwrap();
+        let centre = blurred[8 * 17 + 8][0];
+        assert_eq!(sharp, 1e4);
+        assert!(centre > 0.0 && centre < 0.1 * sharp, "{centre}");
+        assert!(backdrop_pixels(Backdrop::Black, &sun, &camera, [4, 4], UpAxis::Y, 0.0).is_none());
     }
 
     #[test]

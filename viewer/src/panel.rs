@@ -1,9 +1,9 @@
 //! The side panel (every choice `render` offers, the artist controls, display and screenshot)
-//! and the overlay on the image (adapter, frame time per pass, GPU memory, lights and batches).
+//! and the readout beside the image (adapter, frame time per pass, GPU memory, lights and batches).
 //! Each group says what its changes cost ([`Recompute::label`]).
 
 use crate::frame::{FrameStats, Stage};
-use crate::recompute::{Recompute, ViewState};
+use crate::recompute::{Backdrop, Recompute, ViewState};
 use crate::worker::Status;
 use egui_file_dialog::FileDialog;
 use std::path::PathBuf;
@@ -398,8 +398,13 @@ fn display(ui: &mut egui::Ui, state: &mut ViewState, outcome: &mut PanelOutcome)
         egui::Slider::new(&mut stops, -10.0..=10.0).text("exposure (stops)"),
     );
     d.exposure_stops = (!auto).then_some(stops);
-    ui.checkbox(&mut d.background, "environment as background (B)");
-    ui.checkbox(&mut d.overlay, "timing overlay (O)");
+    ui.horizontal_wrapped(|ui| {
+        ui.label("backdrop (B)");
+        for backdrop in Backdrop::ALL {
+            ui.radio_value(&mut d.backdrop, backdrop, backdrop.name());
+        }
+    });
+    ui.checkbox(&mut d.overlay, "timing readout (O)");
     ui.horizontal(|ui| {
         outcome.screenshot = ui.button("Screenshot (S)").clicked();
         outcome.reset_camera = outcome.reset_camera || ui.button("Reset camera (R)").clicked();
@@ -407,23 +412,29 @@ fn display(ui: &mut egui::Ui, state: &mut ViewState, outcome: &mut PanelOutcome)
     ui.small("drag: orbit · right drag: pan · scroll: zoom");
 }
 
-/// Adapter, stage, per-pass times, GPU memory and lights over the image's top left corner.
-pub fn overlay(ui: &egui::Ui, rect: egui::Rect, status: &Status, exposure: Option<f32>) {
-    let Some(shown) = &status.shown else {
-        let text = if status.bake.is_some() {
-            "fitting and baking…"
-        } else {
-            "starting…"
-        };
-        ui.painter().text(
-            rect.center(),
-            egui::Align2::CENTER_CENTER,
-            text,
-            egui::FontId::proportional(16.0),
-            egui::Color32::WHITE,
-        );
+/// What the image area shows before the first frame: the worker's stage, centred.
+pub fn waiting_text(ui: &egui::Ui, rect: egui::Rect, status: &Status) {
+    if status.shown.is_some() {
         return;
+    }
+    let text = if status.bake.is_some() {
+        "fitting and baking…"
+    } else {
+        "starting…"
     };
+    ui.painter().text(
+        rect.center(),
+        egui::Align2::CENTER_CENTER,
+        text,
+        egui::FontId::proportional(16.0),
+        egui::Color32::WHITE,
+    );
+}
+
+/// Adapter, stage, per-pass times, GPU memory and lights, in their own panel right of the image
+/// so that they never cover the hair.
+pub fn readout(ui: &mut egui::Ui, status: &Status, exposure: Option<f32>) {
+    let Some(shown) = &status.shown else { return };
     let st = &shown.stats;
     let mut lines = vec![
         st.adapter.clone(),
@@ -453,21 +464,15 @@ pub fn overlay(ui: &egui::Ui, rect: egui::Rect, status: &Status, exposure: Optio
     let mut memory_items = st.memory.clone();
     memory_items.sort_by_key(|item| std::cmp::Reverse(item.1));
     for (name, bytes) in memory_items.iter().take(4) {
-        lines.push(format!("  {name:<22} {:>8.1} MB", *bytes as f64 / 1e6));
+        lines.push(format!("  {name:<20} {:>7.1} MB", *bytes as f64 / 1e6));
     }
     if let Some(stops) = exposure {
         lines.push(format!("exposure {stops:+.2} stops"));
     }
-    let galley = ui.painter().layout_no_wrap(
-        lines.join("\n"),
-        egui::FontId::monospace(11.0),
-        egui::Color32::from_gray(230),
+    ui.add(
+        egui::Label::new(egui::RichText::new(lines.join("\n")).monospace().size(10.0))
+            .wrap_mode(egui::TextWrapMode::Wrap),
     );
-    let at = rect.min + egui::vec2(6.0, 6.0);
-    let back = egui::Rect::from_min_size(at, galley.size()).expand(4.0);
-    ui.painter()
-        .rect_filled(back, 3.0, egui::Color32::from_black_alpha(150));
-    ui.painter().galley(at, galley, egui::Color32::WHITE);
 }
 
 /// The frame's total and its six slowest passes: wall clock, and the GPU's own time where the

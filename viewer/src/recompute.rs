@@ -42,9 +42,9 @@ impl Recompute {
 pub struct Display {
     /// Stops of exposure; None: automatic (the hair's bright pixels land mid-curve).
     pub exposure_stops: Option<f32>,
-    /// The environment map drawn behind the hair.
-    pub background: bool,
-    /// The adapter, timing and memory readout drawn over the image.
+    /// What is drawn behind the hair.
+    pub backdrop: Backdrop,
+    /// The adapter, timing and memory readout beside the image.
     pub overlay: bool,
 }
 
@@ -52,9 +52,40 @@ impl Default for Display {
     fn default() -> Self {
         Self {
             exposure_stops: None,
-            background: true,
+            backdrop: Backdrop::Soft,
             overlay: true,
         }
+    }
+}
+
+/// What the window draws behind the hair (display only; `render` writes the hair over black).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Backdrop {
+    /// The environment blurred and two stops darker than the hair's exposure: the sky a person
+    /// knows, behind hair that still reads against it (the default).
+    #[default]
+    Soft,
+    /// The environment as the lights see it, at the hair's exposure.
+    Environment,
+    /// Nothing: the hair over black, as `render` writes it.
+    Black,
+}
+
+impl Backdrop {
+    pub const ALL: [Backdrop; 3] = [Self::Soft, Self::Environment, Self::Black];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Soft => "soft",
+            Self::Environment => "environment",
+            Self::Black => "black",
+        }
+    }
+
+    /// The one after this, for the B key.
+    pub fn next(self) -> Self {
+        let i = Self::ALL.iter().position(|b| *b == self).unwrap_or(0);
+        Self::ALL[(i + 1) % Self::ALL.len()]
     }
 }
 
@@ -200,7 +231,7 @@ mod tests {
             Recompute::Nothing
         );
         assert_eq!(
-            cost(&lit, |s| s.display.background = false),
+            cost(&lit, |s| s.display.backdrop = Backdrop::Black),
             Recompute::Nothing
         );
         assert_eq!(

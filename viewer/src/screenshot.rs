@@ -54,14 +54,14 @@ pub fn save(
     let json = settings.to_json();
     let compact = serde_json::to_string(settings)?;
     let look = format!(
-        "strandlight view screenshot; exposure {exposure_stops:+.2} stops ({}), background {}; \
+        "strandlight view screenshot; exposure {exposure_stops:+.2} stops ({}), backdrop {}; \
          replay: strandlight render replay {}; settings {compact}",
         if display.exposure_stops.is_none() {
             "auto"
         } else {
             "manual"
         },
-        if display.background { "on" } else { "off" },
+        display.backdrop.name(),
         files.sidecar.display()
     );
     let (w, h) = (frame.width, frame.height);

@@ -32,7 +32,7 @@ pub enum Step {
     Pan([[f32; 2]; 2]),
     /// Scroll steps over the image (zoom; positive is closer).
     Scroll(f32),
-    /// A key press: B (background), O (overlay), S (screenshot), R (reset camera).
+    /// A key press: B (next backdrop), O (readout), S (screenshot), R (reset camera).
     Key(String),
     /// A JSON merge patch (RFC 7396) on the frame settings, as a panel control would change them.
     Settings(Value),

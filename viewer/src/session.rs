@@ -2,11 +2,11 @@
 //! screen and the screenshots asked for. It draws one egui frame at a time and never waits for
 //! the renderer.
 
-use crate::display::{auto_exposure_stops, background, composite, to_rgba8};
+use crate::display::{backdrop_pixels, composite, to_rgba8};
 use crate::frame::{LinearImage, Stage};
 use crate::orbit::Orbit;
 use crate::panel::{Panel, PanelOutcome};
-use crate::recompute::{Display, Recompute, ViewState, recompute};
+use crate::recompute::{Backdrop, Display, Recompute, ViewState, recompute};
 use crate::screenshot::{ScreenshotFiles, save};
 use crate::script::{Action, WaitFor, merge_patch};
 use crate::worker::{Shown, Status, Worker};
@@ -14,10 +14,14 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use strandlight_scene::camera_choice::CameraChoice;
+use strandlight_scene::exposure::metered_stops;
 use strandlight_scene::frame_settings::{CameraSettings, ExactCamera, FrameSettings, Lighting};
 
 /// Changes that need a rebake wait this long after the last edit (a slider being dragged).
 const REBAKE_SETTLE: Duration = Duration::from_millis(400);
+
+/// The readout panel's width in points: its monospace pass table fits without wrapping.
+pub const READOUT_WIDTH: f32 = 260.0;
 
 /// What a session has measured, for `--report`.
 #[derive(Clone, Debug, Default, serde::Serialize)]
@@ -37,6 +41,8 @@ pub struct SessionReport {
     pub window_capture_image_rects_px: Vec<[f32; 4]>,
     /// Where the image sat in the window when last drawn, physical pixels: [x0, y0, x1, y1].
     pub image_rect_px: [f32; 4],
+    /// Where the timing readout sat when last drawn (None: hidden), beside the image, never on it.
+    pub readout_rect_px: Option<[f32; 4]>,
     pub adapter: String,
     pub window_adapter: String,
     pub errors: Vec<String>,
@@ -94,6 +100,7 @@ pub struct Session {
 /// What the background behind the hair depends on.
 #[derive(PartialEq)]
 struct BackgroundKey {
+    backdrop: Backdrop,
     camera: ExactCamera,
     size: [u32; 2],
     rotation_deg: f32,
@@ -225,6 +232,7 @@ impl Session {
             self.edited_at = Instant::now();
         }
         self.apply_panel(outcome);
+        self.readout_panel(ui, &status);
         self.image_area(ui, &status);
         self.submit_when_due(ctx);
         self.save_screenshots(&status);
@@ -243,7 +251,7 @@ impl Session {
             )
         });
         if b {
-            self.state.display.background = !self.state.display.background;
+            self.state.display.backdrop = self.state.display.backdrop.next();
         }
         if o {
             self.state.display.overlay = !self.state.display.overlay;
@@ -386,7 +394,7 @@ impl Session {
     fn exposure_for(&self, image: &LinearImage) -> f32 {
         match self.state.display.exposure_stops {
             Some(stops) => stops,
-            None => auto_exposure_stops(image),
+            None => metered_stops(&image.pixels).unwrap_or(0.0),
         }
     }
 
@@ -431,7 +439,7 @@ impl Session {
     /// The map behind the hair, computed once per view (the refinement steps of one request
     /// share it).
     fn background_of(&mut self, shown: &Shown, image: &LinearImage) -> Option<Arc<Vec<[f32; 3]>>> {
-        if !self.state.display.background {
+        if self.state.display.backdrop == Backdrop::Black {
             return None;
         }
         let (env, Lighting::Environment(lighting)) =
@@ -440,6 +448,7 @@ impl Session {
             return None;
         };
         let key = BackgroundKey {
+            backdrop: self.state.display.backdrop,
             camera: ExactCamera::of(&shown.camera),
             size: [image.width, image.height],
             rotation_deg: lighting.rotation_deg,
@@ -450,18 +459,35 @@ impl Session {
         {
             return Some(pixels.clone());
         }
-        let pixels = Arc::new(background(
+        let pixels = Arc::new(backdrop_pixels(
+            key.backdrop,
             &env.env.map,
             &shown.camera,
             key.size,
             env.up,
             key.rotation_deg,
-        ));
+        )?);
         self.background = Some((key, pixels.clone()));
         Some(pixels)
     }
 
-    /// The image, scaled to fit, taking orbit drags, pans and zoom; the overlay on top.
+    /// The readout right of the image, where it cannot cover the hair.
+    fn readout_panel(&mut self, ui: &mut egui::Ui, status: &Status) {
+        if !self.state.display.overlay {
+            self.report.readout_rect_px = None;
+            return;
+        }
+        let exposure = self.on_screen.as_ref().map(|o| o.exposure_stops);
+        let response = egui::Panel::right("readout")
+            .default_size(READOUT_WIDTH)
+            .show(ui, |ui| crate::panel::readout(ui, status, exposure));
+        let rect = response.response.rect;
+        let ppp = ui.ctx().pixels_per_point();
+        self.report.readout_rect_px =
+            Some([rect.min.x, rect.min.y, rect.max.x, rect.max.y].map(|v| v * ppp));
+    }
+
+    /// The image, scaled to fit, taking orbit drags, pans and zoom.
     fn image_area(&mut self, ui: &mut egui::Ui, status: &Status) {
         egui::CentralPanel::default()
             .frame(egui::Frame::NONE.fill(egui::Color32::from_gray(20)))
@@ -485,14 +511,7 @@ impl Session {
                     );
                 }
                 self.camera_input(ui, &response, status, size.y / scale);
-                if self.state.display.overlay {
-                    crate::panel::overlay(
-                        ui,
-                        rect,
-                        status,
-                        self.on_screen.as_ref().map(|o| o.exposure_stops),
-                    );
-                }
+                crate::panel::waiting_text(ui, rect, status);
             });
     }
 
