@@ -574,3 +574,57 @@ pub fn render_frame_with_model(
         },
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shadow_layout::CubeLight;
+    use glam::Vec3;
+
+    fn deep(layers: u32) -> ShadowMaps {
+        ShadowMaps::Deep {
+            settings: DomSettings {
+                resolution: 64,
+                layers,
+                spacing: 0.1,
+            },
+            pcf: 1,
+        }
+    }
+
+    /// A cube's six faces of layers must fit the adapter's array limit: refused with the
+    /// limit named and a layer count that fits, where one frustum of the same layers passes.
+    #[test]
+    fn a_cube_of_layers_past_the_array_limit_is_refused_naming_it() {
+        let limits = GpuLimits::from_limits(wgpu::Limits {
+            max_texture_array_layers: 16,
+            ..wgpu::Limits::downlevel_defaults()
+        });
+        let bounds = crate::hair::Aabb {
+            min: Vec3::splat(-1.0),
+            max: Vec3::splat(1.0),
+        };
+        let cube = ShadowLayout::Cube(CubeLight::around(Vec3::ZERO, bounds));
+        let frustum = ShadowLayout::Frustum(crate::camera::light_camera(Vec3::Z, bounds));
+        // 16 layers: 4 array layers per face; 24 for the cube.
+        assert!(check_layout_layers(&limits, &deep(16), &frustum).is_ok());
+        let e = check_layout_layers(&limits, &deep(16), &cube).unwrap_err();
+        let message = e.to_string();
+        assert!(
+            message.contains("max_texture_array_layers 16") && message.contains("24 array layers"),
+            "{message}"
+        );
+        // 16 / 6 faces: 2 array layers, 8 optical depth layers per face.
+        assert!(message.contains("at most 8 DOM layers"), "{message}");
+        assert!(check_layout_layers(&limits, &deep(8), &cube).is_ok());
+        // Depth-only maps keep a placeholder of 2 array layers per face: 12 fit.
+        let hard = ShadowMaps::Depth {
+            resolution: 64,
+            lookup: ShadowLookup::Hard {
+                kernel: 1,
+                bias: 0.0,
+            },
+        };
+        assert!(check_layout_layers(&limits, &hard, &cube).is_ok());
+    }
+}

@@ -328,18 +328,19 @@ impl DeepOpacityMap {
             .collect())
     }
 
+    /// Bytes per texture (a cube's six faces included).
     pub fn memory(&self) -> Vec<(String, u64)> {
-        let texels = self.settings.resolution as u64
-            * self.settings.resolution as u64
-            * self.layout.face_count() as u64;
+        let face_texels = self.settings.resolution as u64 * self.settings.resolution as u64;
+        let depth_bytes = face_texels * self.layout.face_count() as u64 * 4;
         if !self.lookup.uses_layers() {
-            return vec![("shadow map depth".into(), texels * 4)];
+            return vec![("shadow map depth".into(), depth_bytes)];
         }
         let layer_texel = self.layers.format().block_copy_size(None).unwrap_or(16) as u64;
+        // Every face's array layers: the texture's whole depth.
         let array_layers = self.layers.depth_or_array_layers() as u64;
         vec![
-            ("dom nearest depth".into(), texels * 4),
-            ("dom layers".into(), array_layers * texels * layer_texel),
+            ("dom nearest depth".into(), depth_bytes),
+            ("dom layers".into(), array_layers * face_texels * layer_texel),
         ]
     }
 }
