@@ -275,6 +275,14 @@ struct Ray<'a> {
     axis: DVec3,
 }
 
+/// A light and its maps, checked to `tolerance`.
+struct Case<'a> {
+    name: &'a str,
+    light: Light,
+    shadows: ShadowMaps,
+    tolerance: f32,
+}
+
 /// Per cube face: decided receiver pixels in shadow and in light.
 type FaceCounts = [[usize; 2]; CUBE_FACES];
 
@@ -283,14 +291,17 @@ type FaceCounts = [[usize; 2]; CUBE_FACES];
 /// occluders and 1 elsewhere, within `tolerance`. Pixels `skip` rejects are left out.
 fn check_plane(
     gpu: &GpuContext,
-    name: &str,
     plane: &Plane,
-    light: Light,
-    shadows: ShadowMaps,
-    tolerance: f32,
+    case: Case,
     expected: &dyn Fn(&Ray) -> f32,
     skip: &dyn Fn(Vec3) -> bool,
 ) -> FaceCounts {
+    let Case {
+        name,
+        light,
+        shadows,
+        tolerance,
+    } = case;
     let layout = ShadowLayout::for_light(&light, plane.hair().bounds(), PointLayoutChoice::Auto);
     let lit = render(gpu, plane, light, None);
     let shadowed = render(gpu, plane, light, Some(shadows));
@@ -349,16 +360,13 @@ fn check_all_faces(
             "{layout:?}"
         );
         let name = format!("{name}, ring facing {}", plane.normal);
-        let counts = check_plane(
-            &gpu,
-            &name,
-            plane,
+        let case = Case {
+            name: &name,
             light,
             shadows,
             tolerance,
-            &expected,
-            &|_| false,
-        );
+        };
+        let counts = check_plane(&gpu, plane, case, &expected, &|_| false);
         for (t, c) in total.iter_mut().zip(counts) {
             t[0] += c[0];
             t[1] += c[1];
@@ -503,13 +511,16 @@ fn spot_lights_inside_the_ring_shadow_through_their_cone_or_the_cube() {
                 .to_degrees()
         };
         let name = format!("spot {half_degrees}°");
+        let case = Case {
+            name: &name,
+            light: spot,
+            shadows,
+            tolerance: HARD_TOLERANCE,
+        };
         let counts = check_plane(
             &gpu,
-            &name,
             plane,
-            spot,
-            shadows,
-            HARD_TOLERANCE,
+            case,
             &|_| 0.0,
             // Outside the cone the spot lights nothing, shadowed or not: no ratio to check.
             &|p| off_axis(p) > half_degrees as f64 - CONE_MARGIN_DEGREES,

@@ -18,7 +18,7 @@ use strandlight_runtime::shadow_layout::{PointLayoutChoice, ShadowLayout};
 use strandlight_scene::frame_render::point_render_options;
 use strandlight_scene::frame_settings::{PointLighting, Shadows};
 
-const SIZE: u32 = 512;
+const SIZE: u32 = 256;
 
 fn median(values: &mut [f64]) -> f64 {
     values.sort_by(f64::total_cmp);
@@ -95,8 +95,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     println!(
-        "straight.hair, {SIZE}x{SIZE}, light at {position} ({}), {rounds} rounds, adapter {}",
-        "far: one frustum holds the hair", gpu.report
+        "straight.hair, {SIZE}x{SIZE}, light at {position} (far: one frustum holds the hair), \
+         {rounds} rounds, adapter {}",
+        gpu.report
     );
     for c in &configs {
         render_frame(&gpu, &model, &frame, &c.options)?;

@@ -340,7 +340,10 @@ impl DeepOpacityMap {
         let array_layers = self.layers.depth_or_array_layers() as u64;
         vec![
             ("dom nearest depth".into(), depth_bytes),
-            ("dom layers".into(), array_layers * face_texels * layer_texel),
+            (
+                "dom layers".into(),
+                array_layers * face_texels * layer_texel,
+            ),
         ]
     }
 }
