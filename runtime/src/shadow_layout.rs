@@ -308,8 +308,17 @@ mod tests {
             let depth = (c - lamp).dot(FACE_AXES[cube.face_of(c)]);
             assert!(depth > cube.near && depth < cube.far, "{c}: {depth}");
         }
-        // Only the −x face looks at the box; +x looks away from it.
-        assert_eq!(cube.drawn, [false, true, false, false, false, false]);
+        // The +x face looks away from the box and is not drawn; every point of the box lies
+        // in a face that is.
+        assert!(!cube.drawn[0] && cube.drawn[1], "{:?}", cube.drawn);
+        for p in points_around(bounds().center()) {
+            let p = p.clamp(bounds().min, bounds().max);
+            assert!(
+                cube.drawn[cube.face_of(p)],
+                "{p} in face {}",
+                cube.face_of(p)
+            );
+        }
         let inside = CubeLight::around(bounds().center(), bounds());
         assert_eq!(inside.drawn, [true; CUBE_FACES]);
     }
