@@ -6,6 +6,9 @@
 //! and upload) and of the light-map pass, and the cube/frustum ratios of the same run.
 //!
 //! Run: `cargo run --release -p strandlight-scene --example shadow_layout_bench [ROUNDS]`
+//! (`cargo build --release -p strandlight -p strandlight-scene --example shadow_layout_bench`
+//! shares the CLI's wgpu build instead of compiling one with the scene crate's features alone).
+//! The image is 256² to keep the strand pass, which both layouts share, from drowning the maps.
 
 use glam::Vec3;
 use strandlight_runtime::camera::Camera;
