@@ -192,6 +192,7 @@ fn probe_fragments(
         &RenderOptions {
             shadows: None,
             transparency,
+            ..Default::default()
         },
     )?;
     let f = out
@@ -331,6 +332,7 @@ fn main() -> Result<(), BoxError> {
                 RenderOptions {
                     shadows,
                     transparency,
+                    ..Default::default()
                 },
             )
         })

@@ -201,6 +201,7 @@ fn main() -> Result<(), BoxError> {
         transparency: Transparency::ABuffer {
             nodes_per_pixel: None,
         },
+        ..Default::default()
     };
     let reference = render(reference_options(1536, 9, 32))?;
     let coarser = render(reference_options(1195, 7, 32))?;
@@ -215,6 +216,7 @@ fn main() -> Result<(), BoxError> {
                 options: RenderOptions {
                     shadows: shadow,
                     transparency: t,
+                    ..Default::default()
                 },
                 map_ms: Vec::new(),
                 hair_ms: Vec::new(),

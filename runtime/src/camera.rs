@@ -269,7 +269,7 @@ pub fn light_camera(toward_light: Vec3, bounds: Aabb) -> Camera {
 /// perspective shadow map sees all of the hair from there.
 #[derive(Debug, thiserror::Error, PartialEq)]
 #[error(
-    "light at {position} sees the hair's bounding box ({min} to {max}) over {cone_degrees:.0}° or from inside it; a single perspective shadow map covers at most {MAX_LIGHT_CONE_DEGREES}°: move the light farther out or use a directional light"
+    "light at {position} sees the hair's bounding box ({min} to {max}) over {cone_degrees:.0}° or from inside it; a single perspective shadow map covers at most {MAX_LIGHT_CONE_DEGREES}° (the renderer then uses a cube of six maps, `ShadowLayout::Cube`)"
 )]
 pub struct LightInsideHair {
     pub position: Vec3,
@@ -284,8 +284,9 @@ pub const MAX_LIGHT_CONE_DEGREES: f32 = 150.0;
 
 /// The perspective camera of a point or spot light at `position`: one frustum aimed at the
 /// box's centre whose cone just holds its eight corners (so the whole box, which is their convex
-/// hull). A cube or dual-paraboloid layout would serve lights inside the hair; a light that
-/// lights a groom from outside needs only this frustum, with all of its texels on the hair.
+/// hull). A light that lights a groom from outside needs only this frustum, with all of its
+/// texels on the hair; where it cannot hold the box, [`crate::shadow_layout::ShadowLayout`]
+/// falls back to a cube of six.
 pub fn point_light_camera(position: Vec3, bounds: Aabb) -> Result<Camera, LightInsideHair> {
     let refuse = |cone_degrees| LightInsideHair {
         position,

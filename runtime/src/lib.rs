@@ -9,4 +9,5 @@ pub mod lights;
 pub mod multiple;
 pub mod passes;
 pub mod render;
+pub mod shadow_layout;
 pub mod visibility;

@@ -1,14 +1,13 @@
 //! One headless frame end to end: upload, strand pass, readback, with per-pass timings and the
 //! GPU memory each buffer and texture holds.
 
-use crate::camera::{light_camera, point_light_camera};
 use crate::gpu::readback::ReadbackError;
 use crate::gpu::{AdapterReport, GpuContext, GpuLimits, LimitError, read_texture_rgba};
 use crate::hair::HairModel;
-use crate::lights::Light;
 use crate::passes::abuffer::{ABufferError, ABufferPass, ListMode};
 use crate::passes::deep_opacity::{
     DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError, ShadowLookup, ShadowMapError,
+    array_layers_for,
 };
 use crate::passes::fiber_shading::ShadingModel;
 use crate::passes::frame_params::FrameParams;
@@ -19,6 +18,7 @@ use crate::passes::shadow_slots::{MAX_SHADOWED_LIGHTS, ShadowInput, TooManyShado
 use crate::passes::sorted_blend::{BadSortBins, SortedBlendPass};
 use crate::passes::strand_geometry::{StrandGeometry, TooManyPoints};
 use crate::passes::strands::StrandPass;
+use crate::shadow_layout::{PointLayoutChoice, ShadowLayout};
 
 #[derive(Debug, thiserror::Error)]
 pub enum RenderError {
@@ -141,18 +141,58 @@ impl From<ABufferError> for RenderError {
 fn check_frame_limits(
     gpu: &GpuContext,
     frame: &FrameParams,
-    shadowed_lights: &[(ShadowMaps, u32, Light)],
+    shadowed_lights: &[ShadowedLight],
 ) -> Result<(), LimitError> {
     let limits = GpuLimits::of(gpu);
     limits.check_image(frame.width, frame.height)?;
     // Every light's map has the same settings.
-    if let Some((settings, _, _)) = shadowed_lights.first() {
-        let res = settings.resolution();
+    if let Some(first) = shadowed_lights.first() {
+        let res = first.maps.resolution();
         limits.check_texture_2d("light map", res, res, |max| {
             format!("use a shadow map resolution of at most {max}")
         })?;
     }
+    for light in shadowed_lights {
+        check_layout_layers(&limits, &light.maps, &light.layout)?;
+    }
     Ok(())
+}
+
+/// A light's layer texture holds its faces' layers in one array: a cube's six faces of deep
+/// opacity layers (or opacity slices) may pass the adapter's `max_texture_array_layers`.
+pub fn check_layout_layers(
+    limits: &GpuLimits,
+    maps: &ShadowMaps,
+    layout: &ShadowLayout,
+) -> Result<(), LimitError> {
+    let layers = maps.layers();
+    let faces = layout.face_count();
+    limits.check_texture_layers(
+        "light map layers",
+        faces * array_layers_for(layers),
+        |max| {
+            let per_face = max / faces / 2 * LAYERS_PER_ARRAY_PAIR;
+            let what = if faces > 1 {
+                format!("a cube's {faces} faces of")
+            } else {
+                "the".to_string()
+            };
+            format!(
+                "{what} {layers} layers do not fit: use at most {per_face} DOM layers or OSM \
+                 slices (array layers hold 4 each, in pairs), or a light farther from the hair"
+            )
+        },
+    )
+}
+
+/// Optical depth layers in the two RGBA array layers one layer pass fills.
+const LAYERS_PER_ARRAY_PAIR: u32 = 8;
+
+/// A light that gets maps: its maps' settings, its index in the frame, and where they look from.
+struct ShadowedLight {
+    maps: ShadowMaps,
+    index: u32,
+    layout: ShadowLayout,
 }
 
 /// How overlapping fibers combine.
@@ -184,7 +224,8 @@ pub enum Transparency {
 /// How lights are shadowed. Deep opacity and opacity shadow maps are layers of optical depth
 /// along the light, looked up the same way, differing in where the layers start; shadow maps
 /// and ADSM keep only the nearest fiber's depth. Directional lights get an orthographic map,
-/// point and spot lights a perspective one ([`point_light_camera`]).
+/// point and spot lights a perspective one, or a cube of six where one cannot hold the hair
+/// ([`ShadowLayout`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ShadowMaps {
     /// Deep opacity maps (Yuksel & Keyser 2008): layers from each texel's nearest fiber, read
@@ -258,31 +299,35 @@ impl ShadowMaps {
         }
     }
 
-    /// The map of `light` shining onto hair within `bounds`.
+    /// Optical depth layers per face (1 for depth-only maps, whose layer texture is a
+    /// placeholder).
+    pub fn layers(&self) -> u32 {
+        match *self {
+            ShadowMaps::Deep { settings, .. } => settings.layers,
+            ShadowMaps::OpacitySlices { slices, .. } => slices,
+            ShadowMaps::Depth { .. } => 1,
+        }
+    }
+
+    /// The map of a light shining onto hair within `bounds`, seen through `layout`.
     fn map_for(
         &self,
         gpu: &GpuContext,
-        light: &Light,
+        layout: ShadowLayout,
         bounds: crate::hair::Aabb,
     ) -> Result<DeepOpacityMap, ShadowMapError> {
-        let camera = match *light {
-            Light::Directional { direction, .. } => light_camera(direction, bounds),
-            Light::Point { position, .. } | Light::Spot { position, .. } => {
-                point_light_camera(position, bounds)?
-            }
-        };
         Ok(match *self {
             ShadowMaps::Deep { settings, pcf } => {
-                DeepOpacityMap::new(gpu, camera, settings).with_layer_pcf(pcf)?
+                DeepOpacityMap::new(gpu, layout, settings).with_layer_pcf(pcf)?
             }
             ShadowMaps::OpacitySlices {
                 resolution,
                 slices,
                 pcf,
-            } => DeepOpacityMap::opacity_slices(gpu, camera, bounds, resolution, slices)?
+            } => DeepOpacityMap::opacity_slices(gpu, layout, bounds, resolution, slices)?
                 .with_layer_pcf(pcf)?,
             ShadowMaps::Depth { resolution, lookup } => {
-                DeepOpacityMap::depth_only(gpu, camera, resolution, lookup)?
+                DeepOpacityMap::depth_only(gpu, layout, resolution, lookup)?
             }
         })
     }
@@ -295,6 +340,9 @@ pub struct RenderOptions {
     /// transparency mode.
     pub shadows: Option<ShadowMaps>,
     pub transparency: Transparency,
+    /// Point and spot lights: one frustum where it holds the hair (the default), or always a
+    /// cube ([`ShadowLayout`]).
+    pub point_layout: PointLayoutChoice,
 }
 
 pub struct Frame {
@@ -341,7 +389,7 @@ pub fn render_frame_with_model(
     shading: &ShadingModel,
 ) -> Result<Frame, RenderError> {
     // Every light gets a map; every pass shadows them all.
-    let shadowed_lights: Vec<(ShadowMaps, u32, Light)> = match options.shadows {
+    let shadowed_lights: Vec<ShadowedLight> = match options.shadows {
         None => Vec::new(),
         Some(settings) => {
             settings.check()?;
@@ -353,10 +401,19 @@ pub fn render_frame_with_model(
                     maps: frame.lights.len(),
                 }));
             }
+            let bounds = model.bounds();
             (0..)
                 .zip(&frame.lights)
-                .map(|(i, light)| (settings, i, *light))
-                .collect()
+                .map(|(index, light)| {
+                    let layout = ShadowLayout::for_light(light, bounds, options.point_layout)
+                        .map_err(ShadowMapError::from)?;
+                    Ok(ShadowedLight {
+                        maps: settings,
+                        index,
+                        layout,
+                    })
+                })
+                .collect::<Result<_, RenderError>>()?
         }
     };
     check_frame_limits(gpu, frame, &shadowed_lights)?;
@@ -371,10 +428,17 @@ pub fn render_frame_with_model(
         let dom_pass = timed(&mut timings, gpu, "light map pipeline", || {
             DeepOpacityPass::new(gpu)
         });
-        for &(settings, index, light) in &shadowed_lights {
-            let map = settings.map_for(gpu, &light, model.bounds())?;
-            // One entry per light, so that reports keyed by pass name keep them all.
-            let label = format!("{} (light {index})", settings.pass_name());
+        for &ShadowedLight {
+            maps,
+            index,
+            layout,
+        } in &shadowed_lights
+        {
+            let map = maps.map_for(gpu, layout, model.bounds())?;
+            // One entry per light, so that reports keyed by pass name keep them all; a cube's
+            // says so, since it costs up to six maps.
+            let cube = if layout.is_cube() { ", cube" } else { "" };
+            let label = format!("{} (light {index}{cube})", maps.pass_name());
             timed(&mut timings, gpu, &label, || {
                 dom_pass.draw(gpu, &geometry, &map)
             });
@@ -509,4 +573,58 @@ pub fn render_frame_with_model(
             fragments,
         },
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shadow_layout::CubeLight;
+    use glam::Vec3;
+
+    fn deep(layers: u32) -> ShadowMaps {
+        ShadowMaps::Deep {
+            settings: DomSettings {
+                resolution: 64,
+                layers,
+                spacing: 0.1,
+            },
+            pcf: 1,
+        }
+    }
+
+    /// A cube's six faces of layers must fit the adapter's array limit: refused with the
+    /// limit named and a layer count that fits, where one frustum of the same layers passes.
+    #[test]
+    fn a_cube_of_layers_past_the_array_limit_is_refused_naming_it() {
+        let limits = GpuLimits::from_limits(wgpu::Limits {
+            max_texture_array_layers: 16,
+            ..wgpu::Limits::downlevel_defaults()
+        });
+        let bounds = crate::hair::Aabb {
+            min: Vec3::splat(-1.0),
+            max: Vec3::splat(1.0),
+        };
+        let cube = ShadowLayout::Cube(CubeLight::around(Vec3::ZERO, bounds));
+        let frustum = ShadowLayout::Frustum(crate::camera::light_camera(Vec3::Z, bounds));
+        // 16 layers: 4 array layers per face; 24 for the cube.
+        assert!(check_layout_layers(&limits, &deep(16), &frustum).is_ok());
+        let e = check_layout_layers(&limits, &deep(16), &cube).unwrap_err();
+        let message = e.to_string();
+        assert!(
+            message.contains("max_texture_array_layers 16") && message.contains("24 array layers"),
+            "{message}"
+        );
+        // 16 / 6 faces: 2 array layers, 8 optical depth layers per face.
+        assert!(message.contains("at most 8 DOM layers"), "{message}");
+        assert!(check_layout_layers(&limits, &deep(8), &cube).is_ok());
+        // Depth-only maps keep a placeholder of 2 array layers per face: 12 fit.
+        let hard = ShadowMaps::Depth {
+            resolution: 64,
+            lookup: ShadowLookup::Hard {
+                kernel: 1,
+                bias: 0.0,
+            },
+        };
+        assert!(check_layout_layers(&limits, &hard, &cube).is_ok());
+    }
 }

@@ -505,7 +505,7 @@ fn a_reused_map_equals_a_fresh_one_for_each_light() {
     let mut reused = DeepOpacityMap::new(&gpu, ortho_camera(), settings);
     pass.draw(&gpu, &geometry, &reused);
     let first = reused.read_layers(&gpu).unwrap();
-    reused.camera = tilted;
+    reused.layout = tilted.into();
     pass.draw(&gpu, &geometry, &reused);
     let fresh = DeepOpacityMap::new(&gpu, tilted, settings);
     pass.draw(&gpu, &geometry, &fresh);

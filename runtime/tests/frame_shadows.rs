@@ -28,6 +28,7 @@ use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
 use strandlight_runtime::render::{RenderOptions, ShadowMaps, render_frame};
+use strandlight_runtime::shadow_layout::{PointLayoutChoice, ShadowLayout};
 
 const RECEIVER_Y: f32 = -0.6;
 const RECEIVER_Z: f32 = -0.4;
@@ -107,6 +108,17 @@ fn render(
     light: Light,
     shadows: Option<ShadowMaps>,
 ) -> Vec<[f32; 4]> {
+    render_with_layout(gpu, hair, light, shadows, PointLayoutChoice::Auto)
+}
+
+/// [`render`] with the point-light maps' layout chosen.
+fn render_with_layout(
+    gpu: &GpuContext,
+    hair: &HairModel,
+    light: Light,
+    shadows: Option<ShadowMaps>,
+    point_layout: PointLayoutChoice,
+) -> Vec<[f32; 4]> {
     let frame = FrameParams {
         camera: ortho_camera(),
         width: RES,
@@ -117,6 +129,7 @@ fn render(
     };
     let options = RenderOptions {
         shadows,
+        point_layout,
         ..Default::default()
     };
     render_frame(gpu, hair, &frame, &options)
@@ -142,29 +155,6 @@ fn receiver_pixels() -> Vec<(usize, Vec3)> {
         }
     }
     out
-}
-
-/// The shortest distance between segments p0p1 and q0q1 (Ericson, Real-Time Collision
-/// Detection §5.1.9; neither segment degenerate).
-fn segment_distance(p0: DVec3, p1: DVec3, q0: DVec3, q1: DVec3) -> f64 {
-    let (d1, d2, r) = (p1 - p0, q1 - q0, p0 - q0);
-    let (a, e, f) = (d1.dot(d1), d2.dot(d2), d2.dot(r));
-    let (b, c) = (d1.dot(d2), d1.dot(r));
-    let denom = a * e - b * b;
-    let mut s = if denom > 1e-12 {
-        ((b * f - c * e) / denom).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let mut t = (b * s + f) / e;
-    if t < 0.0 {
-        t = 0.0;
-        s = (-c / a).clamp(0.0, 1.0);
-    } else if t > 1.0 {
-        t = 1.0;
-        s = ((b - c) / a).clamp(0.0, 1.0);
-    }
-    ((p0 + d1 * s) - (q0 + d2 * t)).length()
 }
 
 /// Where the light `light` is seen from `p`: its position, or far along its direction.
@@ -480,4 +470,197 @@ fn a_spot_light_is_the_point_light_inside_its_cone_and_dark_outside() {
         inside >= 20 && outside >= 20 && in_shadow >= 20 && in_light >= 20,
         "too few decided pixels: {inside} in the cone, {outside} outside, {in_shadow} shadowed, {in_light} lit"
     );
+}
+
+/// The point light at [`LAMP`] (a ~66° cone: one frustum holds the hair).
+fn lamp() -> Light {
+    Light::Point {
+        position: LAMP,
+        intensity: 9.0,
+    }
+}
+
+/// The unit axis along which `layout`'s map measures the depth of `p`: the frustum's, or the
+/// axis of the cube face that holds `p`.
+fn map_axis(layout: &ShadowLayout, p: Vec3) -> DVec3 {
+    let camera = match layout {
+        ShadowLayout::Frustum(camera) => *camera,
+        ShadowLayout::Cube(cube) => cube.face(cube.face_of(p)),
+    };
+    (camera.target - camera.eye).as_dvec3().normalize()
+}
+
+/// The point of the ray from `from` toward `to` nearest the line through `axis` (where the ray
+/// crosses that occluder's camera-facing quad, up to the quad's tilt).
+fn crossing(from: DVec3, to: DVec3, axis: [Vec3; 2]) -> DVec3 {
+    let [a, b] = axis.map(|v| v.as_dvec3());
+    let (d1, d2, r) = (to - from, b - a, from - a);
+    let (aa, bb, ee) = (d1.dot(d1), d1.dot(d2), d2.dot(d2));
+    let t = (bb * d2.dot(r) - ee * d1.dot(r)) / (aa * ee - bb * bb);
+    from + d1 * t
+}
+
+/// Checks every decided receiver pixel under the lamp with its maps in `choice`'s layout, as
+/// [`check_directional`] does: `expected(crossed, p, axis)` behind the occluders (`axis`: the
+/// map's depth axis at `p`), 1 elsewhere. Returns the layout and the transmittance per pixel.
+fn check_lamp(
+    name: &str,
+    shadows: ShadowMaps,
+    choice: PointLayoutChoice,
+    tolerance: f32,
+    expected: impl Fn(&[[Vec3; 2]], Vec3, DVec3) -> f32,
+) -> (ShadowLayout, Vec<(usize, f32)>) {
+    let gpu = gpu();
+    let hair = scene();
+    let layout = ShadowLayout::for_light(&lamp(), hair.bounds(), choice).unwrap();
+    let lit = render(&gpu, &hair, lamp(), None);
+    let shadowed = render_with_layout(&gpu, &hair, lamp(), Some(shadows), choice);
+    let (mut in_shadow, mut in_light, mut worst) = (0, 0, 0.0f32);
+    let mut seen = Vec::new();
+    for (pixel, p) in receiver_pixels() {
+        let Some(crossed) = occluders_crossed(p, &lamp()) else {
+            continue;
+        };
+        let want = if crossed.is_empty() {
+            in_light += 1;
+            1.0
+        } else {
+            in_shadow += 1;
+            expected(&crossed, p, map_axis(&layout, p))
+        };
+        let got = transmittance(&shadowed, &lit, pixel);
+        worst = worst.max((got - want).abs());
+        assert!(
+            (got - want).abs() <= tolerance,
+            "{name}: receiver point {p} behind {} occluders: transmittance {got}, expected {want}",
+            crossed.len()
+        );
+        seen.push((pixel, got));
+    }
+    eprintln!(
+        "{name}: {in_shadow} shadowed and {in_light} lit receiver pixels; worst error {worst:.2e}"
+    );
+    assert!(
+        in_shadow >= 20 && in_light >= 20,
+        "{name}: {in_shadow} shadowed, {in_light} lit"
+    );
+    (layout, seen)
+}
+
+/// Layered maps: each crossed occluder must lie in a layer wholly in front of the receiver's
+/// position, counted along the map's axis from the nearest crossed occluder (the DOM's start at
+/// that texel); then the light passes 1 − opacity per fiber.
+fn layered_expectation(spacing: f64) -> impl Fn(&[[Vec3; 2]], Vec3, DVec3) -> f32 {
+    move |crossed, p, axis| {
+        let lamp = LAMP.as_dvec3();
+        let depth = |q: DVec3| (q - lamp).dot(axis);
+        let depths: Vec<f64> = crossed
+            .iter()
+            .map(|&a| depth(crossing(p.as_dvec3(), lamp, a)))
+            .collect();
+        let nearest = depths.iter().copied().fold(f64::INFINITY, f64::min);
+        let receiver = (depth(p.as_dvec3()) - nearest) / spacing;
+        for d in &depths {
+            assert!(
+                ((d - nearest) / spacing).floor() + 1.0 <= receiver,
+                "an occluder in the receiver's layer at {p}"
+            );
+        }
+        fibers_transmittance(crossed)
+    }
+}
+
+/// The cube of a far lamp against its one frustum, for every technique: both against the CPU
+/// ray test, each with its own map axis, so the cube can be trusted wherever the frustum was.
+/// Texel densities differ (the cube's 90° faces spread 128 texels over a wider angle than the
+/// ~66° frustum), which the edge margin absorbs: only pixels whose rays clear every occluder
+/// edge by 0.06 units (≥ 3 texels of either layout at the occluders) are compared.
+#[test]
+fn a_forced_cube_matches_the_frustum_and_the_cpu_for_a_far_lamp() {
+    let spacing = 0.25;
+    let dom = ShadowMaps::Deep {
+        settings: DomSettings {
+            resolution: MAP_RES,
+            layers: 8,
+            spacing,
+        },
+        pcf: 1,
+    };
+    let hard = ShadowMaps::Depth {
+        resolution: MAP_RES,
+        lookup: ShadowLookup::Hard {
+            kernel: 1,
+            bias: 0.02,
+        },
+    };
+    let (alpha, adsm_spacing, bias) = (0.3f32, 0.5f32, 0.05f32);
+    let adsm = ShadowMaps::Depth {
+        resolution: MAP_RES,
+        lookup: ShadowLookup::Adsm {
+            kernel: 1,
+            bias,
+            alpha,
+            spacing: adsm_spacing,
+        },
+    };
+    let adsm_expected = |crossed: &[[Vec3; 2]], p: Vec3, axis: DVec3| {
+        let lamp = LAMP.as_dvec3();
+        let behind = crossed
+            .iter()
+            .map(|&a| (p.as_dvec3() - crossing(p.as_dvec3(), lamp, a)).dot(axis))
+            .fold(f64::NEG_INFINITY, f64::max);
+        (1.0 - alpha as f64).powf(1.0 + (behind - bias as f64) / adsm_spacing as f64) as f32
+    };
+    for choice in [PointLayoutChoice::Auto, PointLayoutChoice::Cube] {
+        let name = |what: &str| format!("{what}, lamp, {choice:?}");
+        let (layout, _) = check_lamp(
+            &name("deep opacity"),
+            dom,
+            choice,
+            SOFT_TOLERANCE,
+            layered_expectation(spacing as f64),
+        );
+        assert_eq!(layout.is_cube(), choice == PointLayoutChoice::Cube);
+        check_lamp(
+            &name("shadow map"),
+            hard,
+            choice,
+            HARD_TOLERANCE,
+            |_, _, _| 0.0,
+        );
+        check_lamp(&name("ADSM"), adsm, choice, SOFT_TOLERANCE, adsm_expected);
+    }
+}
+
+/// Opacity shadow maps, whose slices start at each face's nearest extent of the hair: the cube
+/// gives the frustum's transmittance, 1 − opacity per fiber, pixel for pixel.
+#[test]
+fn a_forced_cube_gives_the_frustums_opacity_shadow_maps_for_a_far_lamp() {
+    let osm = ShadowMaps::OpacitySlices {
+        resolution: MAP_RES,
+        slices: 16,
+        pcf: 1,
+    };
+    let mut frames = Vec::new();
+    for choice in [PointLayoutChoice::Auto, PointLayoutChoice::Cube] {
+        // The slices' spacing follows the layout; only fibers in slices wholly in front of the
+        // receiver's count in full, which holds here: the occluders lie ≥ 1.1 units in front
+        // of the receiver along every ray, and 16 slices over any face's or the frustum's
+        // depth range of the ~2.3-unit hair are under 0.16 units thick.
+        let (_, seen) = check_lamp(
+            &format!("opacity shadow maps, lamp, {choice:?}"),
+            osm,
+            choice,
+            SOFT_TOLERANCE,
+            |crossed, _, _| fibers_transmittance(crossed),
+        );
+        frames.push(seen);
+    }
+    assert_eq!(frames[0].len(), frames[1].len());
+    for ((pixel, frustum), (_, cube)) in frames[0].iter().zip(&frames[1]) {
+        assert!(
+            (frustum - cube).abs() <= 2.0 * SOFT_TOLERANCE,
+            "pixel {pixel}: frustum {frustum}, cube {cube}"
+        );
+    }
 }

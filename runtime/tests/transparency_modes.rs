@@ -48,6 +48,7 @@ fn render(gpu: &strandlight_runtime::gpu::GpuContext, hair: &HairModel, t: Trans
     let options = RenderOptions {
         shadows: None,
         transparency: t,
+        ..Default::default()
     };
     render_frame(gpu, hair, &frame, &options).unwrap_or_else(|e| panic!("{t:?}: {e}"))
 }
@@ -198,6 +199,7 @@ fn bad_counts_are_refused() {
         let options = RenderOptions {
             shadows: None,
             transparency: t,
+            ..Default::default()
         };
         let error = render_frame(&gpu, &hair, &frame, &options).err();
         assert!(error.is_some(), "{t:?} was accepted");

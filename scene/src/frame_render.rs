@@ -134,6 +134,7 @@ pub fn point_render_options(point: &PointLighting, hair: &HairModel) -> RenderOp
     RenderOptions {
         shadows,
         transparency,
+        ..Default::default()
     }
 }
 

@@ -97,6 +97,19 @@ pub fn depth_texture_entry(
     )
 }
 
+/// A 2D depth texture array read with `textureLoad`.
+pub fn depth_array_texture_entry(
+    binding: u32,
+    visibility: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayoutEntry {
+    texture_entry(
+        binding,
+        visibility,
+        wgpu::TextureSampleType::Depth,
+        wgpu::TextureViewDimension::D2Array,
+    )
+}
+
 /// A 2D storage texture of `format` at `binding`, written (never read) by the shader.
 pub fn storage_texture_entry(
     binding: u32,

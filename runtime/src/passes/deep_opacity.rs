@@ -10,6 +10,9 @@
 //! ([`DeepOpacityMap::opacity_slices`]): no prepass, so the slices do not follow the hair's
 //! surface and need more of them for the same accuracy.
 //!
+//! A point or spot light that no frustum holds gets a cube of six faces ([`ShadowLayout`]): every
+//! texture holds one group of array layers per face, each face drawn from its own camera.
+//!
 //! [`point_light_camera`]: crate::camera::point_light_camera
 //!
 //! Inputs: [`StrandGeometry`], the light's camera, the hair's bounds, [`DomSettings`].
@@ -24,13 +27,13 @@ use super::frame_params::{FrameParams, KajiyaKay};
 use super::render_target::DEPTH_FORMAT;
 use super::strand_geometry::StrandGeometry;
 use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
-use crate::camera::Camera;
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{bind_group, depth_texture_entry, uniform_entry};
 use crate::gpu::pipeline::{ADDITIVE, StrandDraw, color_target, depth_test, wgsl_module};
 use crate::gpu::readback::{ReadbackError, read_texture_layer_rgba};
 use crate::gpu::texture::texture_2d;
 use crate::hair::Aabb;
+use crate::shadow_layout::{CUBE_FACES, ShadowLayout};
 
 /// At most this many layers (eight RGBA array layers; the layer pass fills them
 /// [`LAYERS_PER_PASS`] at a time).
@@ -92,9 +95,9 @@ struct DomUniform {
 pub enum LayerStart {
     /// At each texel's nearest fiber, found by a depth prepass (deep opacity maps).
     NearestFiber,
-    /// At one depth for every texel, normalized between the light camera's near (0) and far
-    /// (1) planes (opacity shadow maps).
-    Fixed(f32),
+    /// At one depth for every texel of a face, normalized between the light camera's near (0)
+    /// and far (1) planes, per face (index 0 for a frustum; opacity shadow maps).
+    Fixed([f32; CUBE_FACES]),
 }
 
 /// How the shading passes read a light's map.
@@ -169,33 +172,39 @@ impl ShadowLookup {
 
 /// One light's maps.
 pub struct DeepOpacityMap {
-    pub camera: Camera,
+    /// One frustum, or a cube's six faces.
+    pub layout: ShadowLayout,
     pub settings: DomSettings,
     pub layer_start: LayerStart,
     pub lookup: ShadowLookup,
+    /// Array layer f: face f's nearest depth.
     pub nearest_depth: wgpu::Texture,
-    /// Layer k in channel k % 4 of array layer k / 4 (rounded up to whole passes).
+    /// Face f's layer k in channel k % 4 of array layer f · [`Self::face_array_layers`] + k / 4
+    /// (rounded up to whole passes).
     pub layers: wgpu::Texture,
 }
 
 /// Array layers holding `layers` optical depth layers: whole passes of [`TARGETS_PER_PASS`].
-fn array_layers_for(layers: u32) -> u32 {
+pub fn array_layers_for(layers: u32) -> u32 {
     layers.max(1).div_ceil(LAYERS_PER_PASS) * TARGETS_PER_PASS
 }
 
 impl DeepOpacityMap {
-    pub fn new(gpu: &GpuContext, camera: Camera, settings: DomSettings) -> Self {
+    /// Empty maps for `layout` (a [`crate::camera::Camera`] converts to one frustum).
+    pub fn new(gpu: &GpuContext, layout: impl Into<ShadowLayout>, settings: DomSettings) -> Self {
+        let layout = layout.into();
+        let faces = layout.face_count();
         let size = wgpu::Extent3d {
             width: settings.resolution,
             height: settings.resolution,
-            depth_or_array_layers: 1,
+            depth_or_array_layers: faces,
         };
         let texture = |label, format, usage| texture_2d(gpu, label, size, format, usage);
         let layer_usage = wgpu::TextureUsages::RENDER_ATTACHMENT
             | wgpu::TextureUsages::TEXTURE_BINDING
             | wgpu::TextureUsages::COPY_SRC;
         Self {
-            camera,
+            layout,
             settings,
             layer_start: LayerStart::NearestFiber,
             lookup: ShadowLookup::Layers { kernel: 1 },
@@ -208,7 +217,7 @@ impl DeepOpacityMap {
                 gpu,
                 "dom layers",
                 wgpu::Extent3d {
-                    depth_or_array_layers: array_layers_for(settings.layers),
+                    depth_or_array_layers: faces * array_layers_for(settings.layers),
                     ..size
                 },
                 gpu.hdr_format(),
@@ -218,33 +227,45 @@ impl DeepOpacityMap {
     }
 
     /// An opacity shadow map: `slices` layers of equal thickness from the nearest to the
-    /// farthest extent of `bounds` along the light camera's axis.
+    /// farthest extent of `bounds` along the light camera's axis. A cube's faces each start at
+    /// their own nearest extent (no nearer than their near plane) and share the widest face's
+    /// spacing, so that one spacing serves the lookup.
     pub fn opacity_slices(
         gpu: &GpuContext,
-        camera: Camera,
+        layout: impl Into<ShadowLayout>,
         bounds: Aabb,
         resolution: u32,
         slices: u32,
     ) -> Result<Self, DomSettingsError> {
-        // View-space depth along the axis: for a perspective camera too, the quantity the layer
-        // pass linearizes to.
-        let forward = (camera.target - camera.eye).normalize();
-        let depths = bounds.corners().map(|c| (c - camera.eye).dot(forward));
-        let nearest = depths.iter().copied().fold(f32::INFINITY, f32::min);
-        let farthest = depths.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+        let layout = layout.into();
+        let faces = layout.faces();
+        let ranges: Vec<(f32, f32)> = faces.iter().map(|c| depth_extent(c, bounds)).collect();
+        let widest = ranges
+            .iter()
+            .map(|(nearest, farthest)| farthest - nearest)
+            .fold(0.0f32, f32::max);
         // A flat hair (all corners at one depth) still gets a usable, positive spacing.
-        let range = (farthest - nearest).max(1e-6 * (camera.far - camera.near));
+        let camera = faces[0];
+        let range = widest.max(1e-6 * (camera.far - camera.near));
         let settings = DomSettings {
             resolution,
             layers: slices,
             spacing: range / slices as f32,
         };
         settings.check()?;
-        let start = camera.depth_buffer_value(nearest).clamp(0.0, 1.0);
+        let mut start = [0.0; CUBE_FACES];
+        for ((face, camera), (nearest, _)) in start.iter_mut().zip(&faces).zip(&ranges) {
+            *face = camera.depth_buffer_value(*nearest).clamp(0.0, 1.0);
+        }
         Ok(Self {
             layer_start: LayerStart::Fixed(start),
-            ..Self::new(gpu, camera, settings)
+            ..Self::new(gpu, layout, settings)
         })
+    }
+
+    /// Array layers of [`Self::layers`] per face.
+    pub fn face_array_layers(&self) -> u32 {
+        self.layers.depth_or_array_layers() / self.layout.face_count()
     }
 
     /// The same map read through `kernel`×`kernel` PCF (layer lookups only).
@@ -259,10 +280,11 @@ impl DeepOpacityMap {
     /// placeholders for the shading passes' bindings.
     pub fn depth_only(
         gpu: &GpuContext,
-        camera: Camera,
+        layout: impl Into<ShadowLayout>,
         resolution: u32,
         lookup: ShadowLookup,
     ) -> Result<Self, ShadowMapError> {
+        let layout = layout.into();
         lookup.check()?;
         let settings = DomSettings {
             resolution,
@@ -270,10 +292,10 @@ impl DeepOpacityMap {
             spacing: 1.0,
         };
         settings.check()?;
-        let mut map = Self::new(gpu, camera, settings);
+        let mut map = Self::new(gpu, layout, settings);
         let placeholder = Self::new(
             gpu,
-            camera,
+            layout,
             DomSettings {
                 resolution: 1,
                 ..settings
@@ -284,11 +306,21 @@ impl DeepOpacityMap {
         Ok(map)
     }
 
-    /// Per texel, the K layers' optical depths (row-major from the top).
+    /// Per texel, the K layers' optical depths (row-major from the top), of the first face.
     pub fn read_layers(&self, gpu: &GpuContext) -> Result<Vec<Vec<f32>>, ReadbackError> {
+        self.read_face_layers(gpu, 0)
+    }
+
+    /// [`Self::read_layers`] of face `face`.
+    pub fn read_face_layers(
+        &self,
+        gpu: &GpuContext,
+        face: u32,
+    ) -> Result<Vec<Vec<f32>>, ReadbackError> {
         let k = self.settings.layers as usize;
+        let first = face * self.face_array_layers();
         let groups = (0..k.div_ceil(4) as u32)
-            .map(|g| read_texture_layer_rgba(gpu, &self.layers, g))
+            .map(|g| read_texture_layer_rgba(gpu, &self.layers, first + g))
             .collect::<Result<Vec<_>, _>>()?;
         let texels = groups[0].len();
         Ok((0..texels)
@@ -296,16 +328,22 @@ impl DeepOpacityMap {
             .collect())
     }
 
+    /// Bytes per texture (a cube's six faces included).
     pub fn memory(&self) -> Vec<(String, u64)> {
-        let texels = self.settings.resolution as u64 * self.settings.resolution as u64;
+        let face_texels = self.settings.resolution as u64 * self.settings.resolution as u64;
+        let depth_bytes = face_texels * self.layout.face_count() as u64 * 4;
         if !self.lookup.uses_layers() {
-            return vec![("shadow map depth".into(), texels * 4)];
+            return vec![("shadow map depth".into(), depth_bytes)];
         }
         let layer_texel = self.layers.format().block_copy_size(None).unwrap_or(16) as u64;
+        // Every face's array layers: the texture's whole depth.
         let array_layers = self.layers.depth_or_array_layers() as u64;
         vec![
-            ("dom nearest depth".into(), texels * 4),
-            ("dom layers".into(), array_layers * texels * layer_texel),
+            ("dom nearest depth".into(), depth_bytes),
+            (
+                "dom layers".into(),
+                array_layers * face_texels * layer_texel,
+            ),
         ]
     }
 }
@@ -319,6 +357,20 @@ pub enum ShadowMapError {
     Lookup(#[from] ShadowLookupError),
     #[error(transparent)]
     LightInsideHair(#[from] crate::camera::LightInsideHair),
+    #[error(transparent)]
+    LightNotFinite(#[from] crate::shadow_layout::LightNotFinite),
+}
+
+/// The nearest and farthest depth of `bounds`' corners along `camera`'s axis (view-space depth:
+/// for a perspective camera too, the quantity the layer pass linearizes to), no nearer than its
+/// near plane.
+fn depth_extent(camera: &crate::camera::Camera, bounds: Aabb) -> (f32, f32) {
+    let forward = (camera.target - camera.eye).normalize();
+    let depths = bounds.corners().map(|c| (c - camera.eye).dot(forward));
+    let nearest = depths.iter().copied().fold(f32::INFINITY, f32::min);
+    let farthest = depths.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+    let nearest = nearest.max(camera.near);
+    (nearest, farthest.max(nearest))
 }
 
 /// Transmittance in front of layer `k` from one texel's layers: exp(−Σ_{j<k} layer_j).
@@ -395,12 +447,31 @@ impl DeepOpacityPass {
         }
     }
 
-    /// Fills `map` from `geometry` as seen from its light camera.
+    /// Fills `map` from `geometry` as seen from its light camera (each face of a cube from its
+    /// own; a face that cannot see the hair is cleared, not drawn).
     pub fn draw(&self, gpu: &GpuContext, geometry: &StrandGeometry, map: &DeepOpacityMap) {
-        let device = &gpu.device;
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        for face in 0..map.layout.face_count() {
+            self.draw_face(gpu, geometry, map, face, &mut encoder);
+        }
+        gpu.queue.submit([encoder.finish()]);
+    }
+
+    /// Records the passes of face `face`: the nearest depth (or the fixed start), then the
+    /// layers; without `drawn`, the same clears with nothing drawn.
+    fn draw_face(
+        &self,
+        gpu: &GpuContext,
+        geometry: &StrandGeometry,
+        map: &DeepOpacityMap,
+        face: u32,
+        encoder: &mut wgpu::CommandEncoder,
+    ) {
+        let camera = map.layout.faces()[face as usize];
+        let drawn = map.layout.face_drawn(face as usize);
         let res = map.settings.resolution;
         let frame = FrameParams {
-            camera: map.camera,
+            camera,
             width: res,
             height: res,
             lights: Vec::new(),
@@ -408,8 +479,8 @@ impl DeepOpacityPass {
             width_override_px: None,
         };
         let strands = strand_bind_group(gpu, &self.strand_layout, geometry, &frame);
-        let depth_view = map.nearest_depth.create_view(&Default::default());
-        let mut encoder = device.create_command_encoder(&Default::default());
+        let depth_view = array_layer_view(&map.nearest_depth, face);
+        let segments = if drawn { geometry.segment_count } else { 0 };
         match map.layer_start {
             LayerStart::NearestFiber => {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -422,7 +493,7 @@ impl DeepOpacityPass {
                 });
                 pass.set_pipeline(&self.depth_pipeline);
                 pass.set_bind_group(0, &strands, &[]);
-                pass.draw(0..6, 0..geometry.segment_count);
+                pass.draw(0..6, 0..segments);
             }
             LayerStart::Fixed(start) => {
                 // The layer pass and the lookup read the start from the depth texture either way.
@@ -431,7 +502,7 @@ impl DeepOpacityPass {
                     depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                         view: &depth_view,
                         depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(start),
+                            load: wgpu::LoadOp::Clear(start[face as usize]),
                             store: wgpu::StoreOp::Store,
                         }),
                         stencil_ops: None,
@@ -441,13 +512,13 @@ impl DeepOpacityPass {
             }
         }
         if !map.lookup.uses_layers() {
-            gpu.queue.submit([encoder.finish()]);
             return;
         }
+        let first_array_layer = face * map.face_array_layers();
         for first_layer in (0..map.settings.layers).step_by(LAYERS_PER_PASS as usize) {
-            let dom_group = self.layer_group(gpu, map, &depth_view, first_layer);
+            let dom_group = self.layer_group(gpu, map, &camera, &depth_view, first_layer);
             let views: Vec<_> = (0..TARGETS_PER_PASS)
-                .map(|t| array_layer_view(&map.layers, first_layer / 4 + t))
+                .map(|t| array_layer_view(&map.layers, first_array_layer + first_layer / 4 + t))
                 .collect();
             let attachments: Vec<_> = views.iter().map(cleared_color).collect();
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -461,9 +532,8 @@ impl DeepOpacityPass {
             pass.set_pipeline(&self.layer_pipeline);
             pass.set_bind_group(0, &strands, &[]);
             pass.set_bind_group(1, &dom_group, &[]);
-            pass.draw(0..6, 0..geometry.segment_count);
+            pass.draw(0..6, 0..segments);
         }
-        gpu.queue.submit([encoder.finish()]);
     }
 
     /// Group 1 of the layer pass that fills layers `first_layer..first_layer + LAYERS_PER_PASS`.
@@ -471,6 +541,7 @@ impl DeepOpacityPass {
         &self,
         gpu: &GpuContext,
         map: &DeepOpacityMap,
+        camera: &crate::camera::Camera,
         depth_view: &wgpu::TextureView,
         first_layer: u32,
     ) -> wgpu::BindGroup {
@@ -479,11 +550,11 @@ impl DeepOpacityPass {
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("dom params"),
                 contents: bytemuck::bytes_of(&DomUniform {
-                    near: map.camera.near,
-                    far: map.camera.far,
+                    near: camera.near,
+                    far: camera.far,
                     spacing: map.settings.spacing,
                     layers: map.settings.layers,
-                    perspective: map.camera.is_perspective() as u32,
+                    perspective: camera.is_perspective() as u32,
                     first_layer,
                     _pad: [0; 2],
                 }),

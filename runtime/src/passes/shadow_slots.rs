@@ -1,13 +1,20 @@
 //! Group 1 of the shading passes (`strands.wgsl`): up to [`MAX_SHADOWED_LIGHTS`] light maps
-//! (deep opacity, opacity shadow, shadow maps or ADSM), each shadowing one light of the frame, in fixed slots; unused slots hold 1×1
-//! placeholders that shadow no light.
+//! (deep opacity, opacity shadow, shadow maps or ADSM), each shadowing one light of the frame, in
+//! fixed slots; unused slots hold 1×1 placeholders that shadow no light. A slot holds one light's
+//! maps whatever their [`ShadowLayout`]: a frustum's one face or a cube's six, as array layers,
+//! with one view-projection per face.
+//!
+//! [`ShadowLayout`]: crate::shadow_layout::ShadowLayout
 
 use wgpu::util::DeviceExt;
 
 use super::deep_opacity::{DeepOpacityMap, DomSettings, ShadowLookup};
 use super::frame_params::FrameParams;
 use crate::gpu::GpuContext;
-use crate::gpu::bind_layout::{depth_texture_entry, float_array_texture_entry, uniform_entry};
+use crate::gpu::bind_layout::{
+    depth_array_texture_entry, float_array_texture_entry, uniform_entry,
+};
+use crate::shadow_layout::{CUBE_FACES, ShadowLayout};
 
 /// A deep opacity map that shadows light `light_index` of the frame.
 #[derive(Clone, Copy)]
@@ -30,7 +37,10 @@ pub struct TooManyShadowMaps {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct ShadowUniform {
-    view_proj: [[f32; 4]; 4],
+    /// Face f's view-projection (a frustum: face 0 only).
+    view_proj: [[[f32; 4]; 4]; CUBE_FACES],
+    /// xyz: a cube's light position; w: faces (1 or 6).
+    cube: [f32; 4],
     near: f32,
     far: f32,
     spacing: f32,
@@ -43,6 +53,9 @@ struct ShadowUniform {
     bias: f32,
     adsm_alpha: f32,
     adsm_spacing: f32,
+    /// Array layers of the layer texture per face.
+    face_array_layers: u32,
+    _pad: [u32; 3],
 }
 
 /// `ShadowParams.lookup` in `strands.wgsl`.
@@ -61,7 +74,7 @@ pub fn shadow_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout 
     let fragment = wgpu::ShaderStages::FRAGMENT;
     let mut entries = Vec::new();
     for slot in 0..MAX_SHADOWED_LIGHTS as u32 {
-        entries.push(depth_texture_entry(2 * slot, fragment));
+        entries.push(depth_array_texture_entry(2 * slot, fragment));
         entries.push(float_array_texture_entry(2 * slot + 1, fragment));
     }
     entries.push(uniform_entry(2 * MAX_SHADOWED_LIGHTS as u32, fragment));
@@ -124,21 +137,31 @@ pub fn shadow_bind_group_for(
                     spacing,
                 } => (kernel, bias, alpha, spacing),
             };
+            let faces = map.layout.faces();
+            let camera = faces[0];
             ShadowUniform {
-                view_proj: (map.camera.projection_matrix(1.0) * map.camera.view())
-                    .to_cols_array_2d(),
-                near: map.camera.near,
-                far: map.camera.far,
+                view_proj: std::array::from_fn(|f| {
+                    let c = faces.get(f).unwrap_or(&camera);
+                    (c.projection_matrix(1.0) * c.view()).to_cols_array_2d()
+                }),
+                cube: match map.layout {
+                    ShadowLayout::Cube(cube) => cube.position.extend(CUBE_FACES as f32).into(),
+                    ShadowLayout::Frustum(_) => [0.0, 0.0, 0.0, 1.0],
+                },
+                near: camera.near,
+                far: camera.far,
                 spacing: map.settings.spacing,
                 layers: map.settings.layers,
                 light_index,
                 resolution: map.settings.resolution as f32,
                 lookup: lookup_code(&map.lookup),
-                perspective: map.camera.is_perspective() as u32,
+                perspective: camera.is_perspective() as u32,
                 kernel,
                 bias,
                 adsm_alpha,
                 adsm_spacing,
+                face_array_layers: map.face_array_layers(),
+                _pad: [0; 3],
             }
         })
         .collect();
@@ -151,7 +174,10 @@ pub fn shadow_bind_group_for(
         .iter()
         .flat_map(|(map, _)| {
             [
-                map.nearest_depth.create_view(&Default::default()),
+                map.nearest_depth.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2Array),
+                    ..Default::default()
+                }),
                 map.layers.create_view(&wgpu::TextureViewDescriptor {
                     dimension: Some(wgpu::TextureViewDimension::D2Array),
                     ..Default::default()

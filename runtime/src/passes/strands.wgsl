@@ -4,8 +4,12 @@
 
 // The maps of up to four lights (Svoboda §4, Hunz §4); slot k shadows light
 // shadow[k].light_index, 0xffffffff: an unused slot (a 1×1 placeholder map is bound there).
+// A slot holds one frustum (face 0) or a cube's six faces (+x, −x, +y, −y, +z, −z around a point
+// light; shadow_layout.rs), each face a group of array layers of the same textures.
 struct ShadowParams {
-    view_proj: mat4x4<f32>,
+    view_proj: array<mat4x4<f32>, 6>,
+    // xyz: a cube's light position; w: faces (1 or 6).
+    cube: vec4<f32>,
     near: f32,
     far: f32,
     spacing: f32,
@@ -22,6 +26,11 @@ struct ShadowParams {
     // ADSM: one fiber of this opacity every adsm_spacing world units behind the nearest one.
     adsm_alpha: f32,
     adsm_spacing: f32,
+    // Array layers of shadow_layers_k per face.
+    face_array_layers: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 const LOOKUP_LAYERS: u32 = 0u;
@@ -30,13 +39,13 @@ const LOOKUP_ADSM: u32 = 2u;
 
 const SHADOW_SLOTS: u32 = 4u;
 
-@group(1) @binding(0) var shadow_depth_0: texture_depth_2d;
+@group(1) @binding(0) var shadow_depth_0: texture_depth_2d_array;
 @group(1) @binding(1) var shadow_layers_0: texture_2d_array<f32>;
-@group(1) @binding(2) var shadow_depth_1: texture_depth_2d;
+@group(1) @binding(2) var shadow_depth_1: texture_depth_2d_array;
 @group(1) @binding(3) var shadow_layers_1: texture_2d_array<f32>;
-@group(1) @binding(4) var shadow_depth_2: texture_depth_2d;
+@group(1) @binding(4) var shadow_depth_2: texture_depth_2d_array;
 @group(1) @binding(5) var shadow_layers_2: texture_2d_array<f32>;
-@group(1) @binding(6) var shadow_depth_3: texture_depth_2d;
+@group(1) @binding(6) var shadow_depth_3: texture_depth_2d_array;
 @group(1) @binding(7) var shadow_layers_3: texture_2d_array<f32>;
 @group(1) @binding(8) var<uniform> shadow: array<ShadowParams, 4>;
 
@@ -48,10 +57,33 @@ fn light_depth(p: ShadowParams, z: f32) -> f32 {
     return p.near + z * (p.far - p.near);
 }
 
+// The face of a slot's maps that holds `world`: 0 for a frustum; for a cube the dominant axis of
+// (world − light) and its sign, ties going to x before y before z (CubeLight::face_of).
+fn shadow_face(p: ShadowParams, world: vec3<f32>) -> u32 {
+    if (p.cube.w < 1.5) { return 0u; }
+    let d = world - p.cube.xyz;
+    let a = abs(d);
+    if (a.x >= a.y && a.x >= a.z) { return select(0u, 1u, d.x < 0.0); }
+    if (a.y >= a.z) { return select(2u, 3u, d.y < 0.0); }
+    return select(4u, 5u, d.z < 0.0);
+}
+
+// One face of a slot's maps: the face index and its first array layer of the layer texture.
+struct Face {
+    index: u32,
+    first_layer: u32,
+};
+
 // The light a fragment at light depth `d` receives past one texel's nearest fiber: a hard test
 // (shadow map) or TressFX's fiber count (ADSM).
-fn depth_test_texel(depth: texture_depth_2d, texel: vec2<i32>, d: f32, p: ShadowParams) -> f32 {
-    let z0 = textureLoad(depth, texel, 0);
+fn depth_test_texel(
+    depth: texture_depth_2d_array,
+    face: Face,
+    texel: vec2<i32>,
+    d: f32,
+    p: ShadowParams,
+) -> f32 {
+    let z0 = textureLoad(depth, texel, face.index, 0);
     if (z0 >= 1.0) { return 1.0; }
     let behind = d - light_depth(p, z0) - p.bias;
     if (behind <= 0.0) { return 1.0; }
@@ -60,15 +92,21 @@ fn depth_test_texel(depth: texture_depth_2d, texel: vec2<i32>, d: f32, p: Shadow
 }
 
 // Percentage-closer filtering: the depth test averaged over kernel × kernel texels (clamped at
-// the map's edges).
-fn filtered_depth_test(depth: texture_depth_2d, texel: vec2<i32>, d: f32, p: ShadowParams) -> f32 {
+// the map's edges, a cube face's too: the kernel does not cross onto the next face).
+fn filtered_depth_test(
+    depth: texture_depth_2d_array,
+    face: Face,
+    texel: vec2<i32>,
+    d: f32,
+    p: ShadowParams,
+) -> f32 {
     let r = i32(p.kernel / 2u);
     let last = vec2<i32>(textureDimensions(depth)) - vec2<i32>(1);
     var sum = 0.0;
     for (var dy = -r; dy <= r; dy++) {
         for (var dx = -r; dx <= r; dx++) {
             let t = clamp(texel + vec2<i32>(dx, dy), vec2<i32>(0), last);
-            sum += depth_test_texel(depth, t, d, p);
+            sum += depth_test_texel(depth, face, t, d, p);
         }
     }
     let side = f32(2 * r + 1);
@@ -79,27 +117,32 @@ fn filtered_depth_test(depth: texture_depth_2d, texel: vec2<i32>, d: f32, p: Sha
 // front of it), the layers before its own plus the part of its own layer in front of it (linear
 // within the layer), the last layer being spread over one spacing.
 fn map_transmittance(
-    depth: texture_depth_2d,
+    depth: texture_depth_2d_array,
     layers: texture_2d_array<f32>,
     p: ShadowParams,
     world: vec3<f32>,
 ) -> f32 {
-    let clip = p.view_proj * vec4<f32>(world, 1.0);
+    let index = shadow_face(p, world);
+    let face = Face(index, index * p.face_array_layers);
+    let clip = p.view_proj[index] * vec4<f32>(world, 1.0);
     if (clip.w <= 0.0) { return 1.0; }
     let ndc = clip.xyz / clip.w;
     let uv = vec2<f32>(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
-    if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }
-    let texel = vec2<i32>(uv * p.resolution);
+    // Outside a frustum the light is unshadowed; a cube face holds its point up to rounding at
+    // the seams, so its texel is clamped onto the face instead.
+    let outside = any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0));
+    if (outside && p.cube.w < 1.5) { return 1.0; }
+    let last = vec2<i32>(textureDimensions(depth)) - vec2<i32>(1);
+    let texel = clamp(vec2<i32>(floor(uv * p.resolution)), vec2<i32>(0), last);
     let d = light_depth(p, ndc.z);
-    if (p.lookup != LOOKUP_LAYERS) { return filtered_depth_test(depth, texel, d, p); }
+    if (p.lookup != LOOKUP_LAYERS) { return filtered_depth_test(depth, face, texel, d, p); }
     // PCF: the transmittance of each texel in the kernel, averaged (clamped at the edges).
     let r = i32(p.kernel / 2u);
-    let last = vec2<i32>(textureDimensions(depth)) - vec2<i32>(1);
     var sum = 0.0;
     for (var dy = -r; dy <= r; dy++) {
         for (var dx = -r; dx <= r; dx++) {
             let t = clamp(texel + vec2<i32>(dx, dy), vec2<i32>(0), last);
-            sum += layer_transmittance(depth, layers, p, t, d);
+            sum += layer_transmittance(depth, layers, p, face, t, d);
         }
     }
     let side = f32(2 * r + 1);
@@ -108,21 +151,23 @@ fn map_transmittance(
 
 // Transmittance at light depth `d` through one texel's layers.
 fn layer_transmittance(
-    depth: texture_depth_2d,
+    depth: texture_depth_2d_array,
     layers: texture_2d_array<f32>,
     p: ShadowParams,
+    face: Face,
     texel: vec2<i32>,
     d: f32,
 ) -> f32 {
-    let z0 = textureLoad(depth, texel, 0);
+    let z0 = textureLoad(depth, texel, face.index, 0);
     if (z0 >= 1.0) { return 1.0; }
     let d0 = light_depth(p, z0);
     let position = max(d - d0, 0.0) / p.spacing;
-    // Layer k is channel k % 4 of array layer k / 4; only the layers in front are read.
+    // Layer k is channel k % 4 of the face's array layer k / 4; only the layers in front are
+    // read.
     let reached = min(p.layers, u32(ceil(position)));
     var tau = 0.0;
     for (var group = 0u; group * 4u < reached; group++) {
-        let four = textureLoad(layers, texel, group, 0);
+        let four = textureLoad(layers, texel, face.first_layer + group, 0);
         for (var c = 0u; c < 4u; c++) {
             let k = group * 4u + c;
             tau += clamp(position - f32(k), 0.0, 1.0) * four[c];

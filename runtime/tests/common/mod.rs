@@ -2,7 +2,7 @@
 //! parallel strands whose transmittance has a closed form.
 #![allow(dead_code)] // each test binary uses its own subset
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use strandlight_runtime::camera::{Camera, Projection};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::{Attribute, HairModel};
@@ -72,4 +72,27 @@ pub fn slab_with_gap(rows: usize, thickness: f32, gap: std::ops::Range<u32>) -> 
         None,
     )
     .unwrap()
+}
+
+/// The shortest distance between segments p0p1 and q0q1 (Ericson, Real-Time Collision
+/// Detection §5.1.9; neither segment degenerate).
+pub fn segment_distance(p0: DVec3, p1: DVec3, q0: DVec3, q1: DVec3) -> f64 {
+    let (d1, d2, r) = (p1 - p0, q1 - q0, p0 - q0);
+    let (a, e, f) = (d1.dot(d1), d2.dot(d2), d2.dot(r));
+    let (b, c) = (d1.dot(d2), d1.dot(r));
+    let denom = a * e - b * b;
+    let mut s = if denom > 1e-12 {
+        ((b * f - c * e) / denom).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let mut t = (b * s + f) / e;
+    if t < 0.0 {
+        t = 0.0;
+        s = (-c / a).clamp(0.0, 1.0);
+    } else if t > 1.0 {
+        t = 1.0;
+        s = ((b - c) / a).clamp(0.0, 1.0);
+    }
+    ((p0 + d1 * s) - (q0 + d2 * t)).length()
 }
