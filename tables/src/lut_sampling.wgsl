@@ -64,6 +64,39 @@ fn strandlight_lut_3d(tex: texture_3d<f32>, samp: sampler, lut: StrandLut, coord
     return mix(lower, upper, upper_weight);
 }
 
+// The lower node of the cell holding x (x) and the upper node's weight (y).
+fn strandlight_lut_cell(a: StrandLutAxis, x: f32) -> vec2<f32> {
+    let f = strandlight_lut_position(a, x);
+    let lower = min(floor(f), max(a.last_index - 1.0, 0.0));
+    return vec2<f32>(lower, f - lower);
+}
+
+// strandlight_lut_3d without the hardware filter: the 16 nodes around the coordinates,
+// weighted here. One-node axes get weight 0 on their (absent) upper node.
+fn strandlight_lut_3d_exact(tex: texture_3d<f32>, lut: StrandLut, coords: vec4<f32>) -> vec4<f32> {
+    var c = array<vec2<f32>, 4>(
+        strandlight_lut_cell(lut.axes[0], coords.x),
+        strandlight_lut_cell(lut.axes[1], coords.y),
+        strandlight_lut_cell(lut.axes[2], coords.z),
+        strandlight_lut_cell(lut.axes[3], coords.w),
+    );
+    let n0 = u32(lut.axes[0].last_index) + 1u;
+    var acc = vec4<f32>(0.0);
+    for (var corner = 0u; corner < 16u; corner++) {
+        var weight = 1.0;
+        var node = vec4<u32>(0u);
+        for (var k = 0u; k < 4u; k++) {
+            let upper = (corner >> k) & 1u;
+            weight *= select(1.0 - c[k].y, c[k].y, upper == 1u);
+            node[k] = u32(c[k].x) + upper;
+        }
+        if (weight == 0.0) { continue; }
+        let texel = vec3<u32>(node.z, node.y, node.w * n0 + node.x);
+        acc += weight * textureLoad(tex, texel, 0);
+    }
+    return acc;
+}
+
 // A table of one or two axes (a 2D texture): texel (x, y) = (node of axis 1, node of axis 0).
 // A one-axis table is exported as if a one-node axis came first: pass its coordinate in `.y`.
 fn strandlight_lut_2d(tex: texture_2d<f32>, samp: sampler, lut: StrandLut, coords: vec2<f32>) -> vec4<f32> {
@@ -73,4 +106,19 @@ fn strandlight_lut_2d(tex: texture_2d<f32>, samp: sampler, lut: StrandLut, coord
         strandlight_lut_position(lut.axes[0], coords.x),
     );
     return textureSampleLevel(tex, samp, (f + 0.5) / size, 0.0);
+}
+
+// strandlight_lut_2d without the hardware filter: the 4 nodes around the coordinates.
+fn strandlight_lut_2d_exact(tex: texture_2d<f32>, lut: StrandLut, coords: vec2<f32>) -> vec4<f32> {
+    let cx = strandlight_lut_cell(lut.axes[1], coords.y);
+    let cy = strandlight_lut_cell(lut.axes[0], coords.x);
+    var acc = vec4<f32>(0.0);
+    for (var corner = 0u; corner < 4u; corner++) {
+        let ux = corner & 1u;
+        let uy = (corner >> 1u) & 1u;
+        let weight = select(1.0 - cx.y, cx.y, ux == 1u) * select(1.0 - cy.y, cy.y, uy == 1u);
+        if (weight == 0.0) { continue; }
+        acc += weight * textureLoad(tex, vec2<u32>(u32(cx.x) + ux, u32(cy.x) + uy), 0);
+    }
+    return acc;
 }
