@@ -301,6 +301,12 @@ fn sidecar_of(
                 "strandlight_lut_2d"
             }
             .into(),
+            exact_function: if layout.is_3d() {
+                "strandlight_lut_3d_exact"
+            } else {
+                "strandlight_lut_2d_exact"
+            }
+            .into(),
             uniform: gpu_uniform(asset),
         },
         half_rounding,

@@ -74,7 +74,10 @@ pub struct SidecarAxis {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SidecarWgsl {
     pub file: String,
+    /// The hardware-filtered sampling function (needs a filterable format).
     pub function: String,
+    /// The same lookup from textureLoads, exact in f32 and for any float format.
+    pub exact_function: String,
     /// The four `StrandLutAxis` values of this table's `StrandLut` uniform, in order (one-node
     /// axes fill the places of missing ones).
     pub uniform: Vec<SidecarGpuAxis>,

@@ -329,7 +329,18 @@ fn the_sidecar_and_wgsl_describe_the_texture() {
     let wgsl = write_wgsl(&dir).unwrap();
     assert_eq!(wgsl, dir.join(WGSL_FILE));
     let text = std::fs::read_to_string(wgsl).unwrap();
-    assert!(text.contains("fn strandlight_lut_3d(") && text.contains("fn strandlight_lut_2d("));
+    for function in [
+        "strandlight_lut_3d",
+        "strandlight_lut_2d",
+        "strandlight_lut_3d_exact",
+        "strandlight_lut_2d_exact",
+    ] {
+        assert!(text.contains(&format!("fn {function}(")), "{function}");
+    }
+    assert_eq!(
+        sidecar["wgsl"]["exact_function"],
+        "strandlight_lut_3d_exact"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
