@@ -14,6 +14,7 @@ use strandlight_precompute::baked_tables_check::check_asset;
 use strandlight_precompute::srbf_set::SrbfSet;
 use strandlight_scene::scene_tables::lambda_range_of_set;
 use strandlight_tables::asset::{Storage, read_asset};
+use strandlight_tables::lut_export::{TexelStorage, export_ktx2, write_wgsl};
 use strandlight_tables::slices::{PngTonemap, SliceLayout, write_slices};
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -52,6 +53,26 @@ pub struct BakeArgs {
     pub out: PathBuf,
     #[arg(long)]
     pub json: bool,
+    /// Also write every table as a texture other engines load: OUT/ktx2/NAME.ktx2 with a JSON
+    /// sidecar (axes, texel centres, sampling formula) and strandlight_lut.wgsl.
+    #[arg(long, value_enum, value_name = "CONTAINER")]
+    pub export: Option<ExportContainer>,
+    /// Texel type of --export: half (rgba16float, filterable on every device; max relative
+    /// error 2⁻¹¹) or float (rgba32float, exact).
+    #[arg(long, value_enum, default_value = "half", requires = "export")]
+    pub export_format: ExportFormat,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum ExportContainer {
+    /// Khronos KTX 2.0.
+    Ktx2,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum ExportFormat {
+    Half,
+    Float,
 }
 
 #[derive(clap::Args)]
@@ -188,11 +209,15 @@ pub fn bake(args: BakeArgs) -> anyhow::Result<()> {
     }
     bar.finish_and_clear();
     let total = start.elapsed().as_secs_f64();
+    let exported = match args.export {
+        Some(ExportContainer::Ktx2) => Some(export_ktx2_all(&baked, &args)?),
+        None => None,
+    };
     if args.json {
         let tables: Vec<_> = baked.iter().map(|t| json!({"name": t.name, "bytes": t.bytes, "seconds": t.seconds, "cached": t.cached, "replaced_damaged": t.replaced_damaged, "path": t.path})).collect();
         println!(
             "{}",
-            json!({"tables": tables, "skipped": plan.skipped, "multiple_scattering_share": plan.multiple_scattering_share, "total_seconds": total, "total_bytes": baked.iter().map(|t| t.bytes).sum::<u64>()})
+            json!({"tables": tables, "skipped": plan.skipped, "multiple_scattering_share": plan.multiple_scattering_share, "total_seconds": total, "total_bytes": baked.iter().map(|t| t.bytes).sum::<u64>(), "export": exported})
         );
     } else {
         println!(
@@ -223,6 +248,57 @@ fn table_files(dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
         );
     }
     Ok(files)
+}
+
+/// `--export ktx2`: every baked table as OUT/ktx2/NAME.ktx2 + NAME.json, and the WGSL.
+fn export_ktx2_all(baked: &[BakedTable], args: &BakeArgs) -> anyhow::Result<serde_json::Value> {
+    let start = Instant::now();
+    let dir = args.out.join("ktx2");
+    std::fs::create_dir_all(&dir)
+        .with_context(|| format!("cannot create the export folder {}", dir.display()))?;
+    let storage = match args.export_format {
+        ExportFormat::Half => TexelStorage::Half,
+        ExportFormat::Float => TexelStorage::Float,
+    };
+    let mut exports = Vec::new();
+    for t in baked {
+        let lut = export_ktx2(&read_asset(&t.path)?, &dir, storage)?;
+        if !args.json {
+            let rounding = lut.half_rounding.map_or(String::new(), |r| {
+                format!("  half: max rel. error {:.1e}", r.max_relative_error)
+            });
+            println!(
+                "{:<18} {:>10} bytes  {}×{}×{}{rounding}  {}",
+                lut.table,
+                lut.texture_bytes,
+                lut.width,
+                lut.height,
+                lut.depth,
+                lut.texture.display()
+            );
+        }
+        if let Some((extent, limit)) = lut.exceeds_webgpu_limit {
+            eprintln!(
+                "warning: {} is {extent} texels along one axis; WebGPU only guarantees {limit} (bake with a smaller --resolution for the web)",
+                lut.texture.display()
+            );
+        }
+        exports.push(lut);
+    }
+    let wgsl = write_wgsl(&dir)?;
+    let seconds = start.elapsed().as_secs_f64();
+    let bytes: u64 = exports.iter().map(|e| e.texture_bytes).sum();
+    if !args.json {
+        println!(
+            "exported {} textures, {bytes} texel bytes, {seconds:.1} s → {} (sampling: {})",
+            exports.len(),
+            dir.display(),
+            wgsl.display()
+        );
+    }
+    Ok(
+        json!({"dir": dir, "textures": exports, "wgsl": wgsl, "seconds": seconds, "texel_bytes": bytes}),
+    )
 }
 
 pub fn check(args: CheckArgs) -> anyhow::Result<()> {

@@ -51,6 +51,9 @@ pub struct GpuContext {
     pub report: AdapterReport,
     /// `Rgba32Float` can be a blended render target (else the passes use `Rgba16Float`).
     pub float32_blendable: bool,
+    /// `Rgba32Float` / `R32Float` textures can be sampled with linear filtering (an exported
+    /// LUT in float, `bake --export ktx2 --export-format float`).
+    pub float32_filterable: bool,
     /// GPU time per pass, on adapters with timestamp queries.
     pub pass_timer: Option<PassTimer>,
 }
@@ -108,6 +111,12 @@ impl GpuContext {
         if float32_blendable {
             required_features |= wgpu::Features::FLOAT32_BLENDABLE;
         }
+        let float32_filterable = adapter
+            .features()
+            .contains(wgpu::Features::FLOAT32_FILTERABLE);
+        if float32_filterable {
+            required_features |= wgpu::Features::FLOAT32_FILTERABLE;
+        }
         if adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
             required_features |= wgpu::Features::TIMESTAMP_QUERY;
         }
@@ -132,6 +141,7 @@ impl GpuContext {
             queue,
             report,
             float32_blendable,
+            float32_filterable,
         })
     }
 
