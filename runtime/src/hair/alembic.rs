@@ -45,7 +45,7 @@ pub fn parse_alembic(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> 
     let mut info = vec![format!(
         "Alembic: {} ICurves object(s) ({}); no units in Alembic, the file's kept",
         names.len(),
-        names.join(", ")
+        super::usd::printable(&names.join(", "))
     )];
     info.extend(notes);
     finish(raw, file, HairFormat::Alembic, info.join("; "))

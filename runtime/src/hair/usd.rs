@@ -51,6 +51,7 @@ pub fn load_usd(path: &Path) -> Result<LoadedHair, HairError> {
     let text = path
         .to_str()
         .ok_or_else(|| decode("the path is not UTF-8".into()))?;
+    check_text_prim_names(path)?;
     let (batches, mut info) = without_panics(path, FORMAT, || {
         let stage = Stage::open(text).map_err(|e| decode(format!("{e:#}")))?;
         read_stage(&stage, path).map_err(|e| match e {
@@ -61,6 +62,49 @@ pub fn load_usd(path: &Path) -> Result<LoadedHair, HairError> {
     let (raw, notes) = assemble(batches, path)?;
     info.extend(notes);
     finish(raw, path, HairFormat::Usd, info.join("; "))
+}
+
+/// Refuses a text layer whose `def`/`over`/`class` line names a prim with other characters than
+/// an identifier's: openusd 0.6 recurses until the stack overflows (an abort, which no catch
+/// stops) when composing such a prim (the fuzzer found `def BasisCurves "Curl}"`). Only text
+/// layers can be checked here; the reader itself sees binary ones.
+fn check_text_prim_names(path: &Path) -> Result<(), HairError> {
+    let Ok(data) = std::fs::read(path) else {
+        return Ok(()); // openusd reports it
+    };
+    if !data.starts_with(b"#usda") {
+        return Ok(());
+    }
+    let text = String::from_utf8_lossy(&data);
+    for (n, line) in text.lines().enumerate() {
+        let line = line.trim_start();
+        if !["def ", "over ", "class "]
+            .iter()
+            .any(|k| line.starts_with(k))
+        {
+            continue;
+        }
+        let Some(name) = line.split('"').nth(1) else {
+            continue;
+        };
+        let mut chars = name.chars();
+        let identifier = chars
+            .next()
+            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+            && chars.all(|c| c.is_ascii_alphanumeric() || c == '_');
+        if !identifier {
+            return Err(HairError::Decode {
+                file: path.into(),
+                format: FORMAT,
+                why: format!(
+                    "line {}: prim name \"{}\" is not an identifier",
+                    n + 1,
+                    name.escape_debug()
+                ),
+            });
+        }
+    }
+    Ok(())
 }
 
 enum Read {
@@ -134,9 +178,23 @@ fn read_stage(stage: &Stage, file: &Path) -> Result<(Vec<CurveBatch>, Vec<String
         if z_up { "Z" } else { "Y" },
     )];
     if !skipped.is_empty() {
-        info.push(format!("not drawn: {}", skipped.join(", ")));
+        info.push(format!("not drawn: {}", printable(&skipped.join(", "))));
     }
     Ok((batches, info))
+}
+
+/// A name for the report: control characters (which a damaged file can put in names) escaped.
+pub(crate) fn printable(name: &str) -> String {
+    name.chars()
+        .flat_map(|c| {
+            let escaped: Vec<char> = if c.is_control() {
+                c.escape_default().collect()
+            } else {
+                vec![c]
+            };
+            escaped
+        })
+        .collect()
 }
 
 /// Why a prim is not drawn by a renderer: hidden by itself or an ancestor, or a guide/proxy.
@@ -183,6 +241,7 @@ fn world_transform(prim: &Prim) -> anyhow::Result<DMat4> {
             break;
         }
         let x = AnyXformable(prim.stage().prim(path.clone()));
+        check_op_names(&x)?;
         // openusd's matrices are USD's row-vector ones; read column-major they are the
         // column-vector matrix glam applies.
         let local = x.local_to_parent_transform(TimeCode::EARLIEST)?;
@@ -193,6 +252,29 @@ fn world_transform(prim: &Prim) -> anyhow::Result<DMat4> {
         at = path.parent();
     }
     Ok(m)
+}
+
+/// Refuses an `xformOpOrder` entry that is no attribute name: openusd 0.6 never returns when
+/// asked for such an op's value (the fuzzer found one with a string spanning lines).
+fn check_op_names(x: &AnyXformable) -> anyhow::Result<()> {
+    let valid = |op: &str| {
+        let name = op.strip_prefix("!invert!").unwrap_or(op);
+        op == "!resetXformStack!"
+            || (name.starts_with("xformOp:")
+                && name
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == ':'))
+    };
+    for op in x.xform_op_order()?.unwrap_or_default() {
+        if !valid(&op) {
+            anyhow::bail!(
+                "{}: xformOpOrder names {:?}, which is not an xformOp attribute",
+                x.0.path().as_str(),
+                op.escape_debug().to_string()
+            );
+        }
+    }
+    Ok(())
 }
 
 fn read_prim(prim: &Prim, to_world: DMat4, file: &Path) -> Result<CurveBatch, Read> {
@@ -440,6 +522,12 @@ def BasisCurves "Hair" {
             "this is { not usda",
             "Decode",
             "cannot read as USD",
+        );
+        check(
+            "name.usda",
+            &TWO_CURVES.replace("\"Hair\"", "\"Ha}r\""),
+            "Decode",
+            "prim name \"Ha}r\" is not an identifier",
         );
         check(
             "short.usda",

@@ -64,7 +64,7 @@ pub fn seeds(name: &str) -> Vec<Seed> {
         "exr" => exr_seeds(),
         "sltab" => sltab_seeds(),
         "srbf" => vec![generated("2 lobes, 1 source", srbf_json())],
-        "usda" | "usdc" | "usdz" | "abc" => scene_seeds(name),
+        "usda" | "abc" => scene_seeds(name),
         other => panic!("no seeds for target {other}"),
     };
     out.extend(shared_seeds(name));
@@ -72,7 +72,7 @@ pub fn seeds(name: &str) -> Vec<Seed> {
 }
 
 /// Targets whose seeds another project's writer makes (usd-core, PyAlembic).
-pub const SCENE_TARGETS: [&str; 4] = ["usda", "usdc", "usdz", "abc"];
+pub const SCENE_TARGETS: [&str; 2] = ["usda", "abc"];
 
 /// Whether the seeds of `target` can be made here: always for the project's own formats; for
 /// the scene formats when Python has the writer (otherwise the skip is printed, or under
@@ -82,7 +82,7 @@ pub fn available(target: &str) -> bool {
 }
 
 /// The test grooms of `tests/scripts/` written once per process into the fuzz folder: USD
-/// (usda, usdc, usdz) from usd-core, Alembic from PyAlembic. Generated at test time, never
+/// text from usd-core, Alembic from PyAlembic. Generated at test time, never
 /// checked in; empty when the writer is missing.
 fn scene_seeds(target: &str) -> Vec<Seed> {
     use crate::scene_grooms::Writer;

@@ -96,31 +96,20 @@ fn run_ply(bytes: &[u8]) -> Result<Loaded, Refusal> {
     hair_with(hair::ply::parse_ply, "fuzz-input.ply", bytes)
 }
 
-/// USD stages open through a path (openusd picks the layer format by extension), so each
-/// extension has its own scratch file.
-fn run_usd(file: &OnceLock<ScratchFile>, name: &str, bytes: &[u8]) -> Result<Loaded, Refusal> {
+/// USD stages open through a path (openusd picks the layer format by extension). Only text
+/// stages are fuzzed: openusd 0.6's crate-file reader allocates what a corrupt array count asks
+/// for (`ReadExt::read_vec`), and the failed allocation aborts the process, which no catch can
+/// stop; the fuzzer found that within its first few hundred `.usdc` mutants. `.usdz` holds a
+/// `.usdc`. Both wait for a fixed openusd (docs/RELIABILITY.md).
+fn run_usda(bytes: &[u8]) -> Result<Loaded, Refusal> {
     use std::io::Write;
-    let file = file.get_or_init(|| ScratchFile::new(name));
+    static FILE: OnceLock<ScratchFile> = OnceLock::new();
+    let file = FILE.get_or_init(|| ScratchFile::new("fuzz-input.usda"));
     file.rewrite(|f| f.write_all(bytes))
         .expect("the scratch file is writable");
     hair::load_usd(file.path())
         .map(Loaded::Hair)
         .map_err(refusal)
-}
-
-fn run_usda(bytes: &[u8]) -> Result<Loaded, Refusal> {
-    static FILE: OnceLock<ScratchFile> = OnceLock::new();
-    run_usd(&FILE, "fuzz-input.usda", bytes)
-}
-
-fn run_usdc(bytes: &[u8]) -> Result<Loaded, Refusal> {
-    static FILE: OnceLock<ScratchFile> = OnceLock::new();
-    run_usd(&FILE, "fuzz-input.usdc", bytes)
-}
-
-fn run_usdz(bytes: &[u8]) -> Result<Loaded, Refusal> {
-    static FILE: OnceLock<ScratchFile> = OnceLock::new();
-    run_usd(&FILE, "fuzz-input.usdz", bytes)
 }
 
 fn run_abc(bytes: &[u8]) -> Result<Loaded, Refusal> {
@@ -211,9 +200,9 @@ pub fn reseal_asset(data: &mut [u8]) {
     }
 }
 
-/// CI executions of each USD target and of the Alembic one.
-const USD_EXECS: usize = 3_000;
-const ABC_EXECS: usize = 10_000;
+/// CI executions of the USD text and Alembic targets (about 0.5 ms and 0.2 ms each here).
+const USDA_EXECS: usize = 10_000;
+const ABC_EXECS: usize = 20_000;
 
 /// Every reader, with its CI execution count and the writer its loads round-trip through.
 pub fn all() -> Vec<Target> {
@@ -259,15 +248,12 @@ pub fn all() -> Vec<Target> {
             ..target("sltab", "fuzz-input.sltab", run_sltab, 100_000)
         },
         target("srbf", "fuzz-input.srbf.json", run_srbf, 350_000),
-        // The scene formats' seeds come from usd-core and PyAlembic (`seeds::scene_seeds`);
-        // their decoders are other projects' and cost about a millisecond an execution.
+        // The scene formats' seeds come from usd-core and PyAlembic (`seeds::scene_seeds`).
         Target {
             // A text stage cut after a closing brace is a whole stage.
             prefixes_fail: false,
-            ..target("usda", "fuzz-input.usda", run_usda, USD_EXECS)
+            ..target("usda", "fuzz-input.usda", run_usda, USDA_EXECS)
         },
-        target("usdc", "fuzz-input.usdc", run_usdc, USD_EXECS),
-        target("usdz", "fuzz-input.usdz", run_usdz, USD_EXECS),
         target("abc", "fuzz-input.abc", run_abc, ABC_EXECS),
     ]
 }
