@@ -317,9 +317,9 @@ fn curve_stencils(n: usize, shape: Shape, wrap: Wrap) -> Result<Vec<Stencil>, St
     let step = if basis == Basis::Bezier { 3 } else { 1 };
     let m = controls.len();
     let segments = match (periodic, basis) {
-        (true, Basis::Bezier) if m >= 3 && m % 3 == 0 => m / 3,
+        (true, Basis::Bezier) if m >= 3 && m.is_multiple_of(3) => m / 3,
         (true, _) if m >= 3 => m,
-        (false, Basis::Bezier) if m >= 4 && (m - 4) % 3 == 0 => (m - 4) / 3 + 1,
+        (false, Basis::Bezier) if m >= 4 && (m - 4).is_multiple_of(3) => (m - 4) / 3 + 1,
         (false, Basis::Bspline | Basis::CatmullRom) if m >= 4 => m - 3,
         _ => {
             return Err(format!(
