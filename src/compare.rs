@@ -34,7 +34,7 @@ pub struct CompareArgs {
 #[derive(Args, Debug)]
 #[command(next_help_heading = "Scene")]
 struct SceneFlags {
-    /// Hair file (.hair, .tfx, .data, .ply).
+    /// Hair file (.hair, .tfx, .data, .ply, USD .usda/.usdc/.usdz BasisCurves, Alembic .abc ICurves).
     #[arg(long)]
     hair: Option<PathBuf>,
     /// Environment: a Radiance .hdr / OpenEXR equirectangular map, or procedural:NAME.

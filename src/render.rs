@@ -50,7 +50,7 @@ enum RenderWhat {
 #[derive(Args, Debug)]
 #[command(next_help_heading = "Scene")]
 struct SceneArgs {
-    /// Hair file (.hair, .tfx, .data, .ply); the procedural groom when omitted.
+    /// Hair file (.hair, .tfx, .data, .ply, USD .usda/.usdc/.usdz BasisCurves, Alembic .abc ICurves); the procedural groom when omitted.
     #[arg(long)]
     hair: Option<PathBuf>,
     /// Fiber model (default: kajiya-kay under lights, marschner under an environment).

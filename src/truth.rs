@@ -15,7 +15,7 @@ use strandlight_scene::steps::Steps;
 
 #[derive(Args, Debug)]
 pub struct TruthArgs {
-    /// Hair file (.hair, .tfx, .data, .ply); rendered with opaque fibers of the file's width.
+    /// Hair file (.hair, .tfx, .data, .ply, USD .usda/.usdc/.usdz BasisCurves, Alembic .abc ICurves); rendered with opaque fibers of the file's width.
     #[arg(long)]
     pub hair: PathBuf,
     /// Environment map (.hdr, .exr) or procedural:NAME.

@@ -13,7 +13,7 @@ use crate::demo::{DEMO_ENVIRONMENT, DEMO_PRESET};
 
 #[derive(Args, Debug)]
 pub struct ViewArgs {
-    /// Hair file (.hair, .tfx, .data, .ply); the procedural groom when omitted.
+    /// Hair file (.hair, .tfx, .data, .ply, USD .usda/.usdc/.usdz BasisCurves, Alembic .abc ICurves); the procedural groom when omitted.
     #[arg(long)]
     hair: Option<PathBuf>,
     /// Environment map (.hdr/.exr or procedural:NAME); the demo's sun and sky by default.

@@ -51,7 +51,7 @@ use strandlight_tables::image_out::{write_exr, write_png};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CompareSettings {
-    /// Hair file (.hair, .tfx, .data, .ply).
+    /// Hair file (.hair, .tfx, .data, .ply, USD .usda/.usdc/.usdz BasisCurves, Alembic .abc ICurves).
     pub hair: PathBuf,
     /// Environment: a Radiance .hdr / OpenEXR equirectangular map, or procedural:NAME.
     pub env: String,

@@ -6,12 +6,23 @@ use anyhow::{Context, bail};
 use std::path::Path;
 use strandlight_runtime::hair::{self, GroomParams, HairModel};
 
-/// The hair file at `path` (format by extension), or the procedural groom, with a description.
+/// The hair file at `path` (format by extension, see [`hair::EXTENSIONS`]), or the procedural
+/// groom, with a description. A scene file's description says what was read and how it was
+/// converted (prims, units, up axis, values dropped), since a user cannot see that in the picture.
 pub fn load_hair(path: Option<&Path>) -> anyhow::Result<(HairModel, String)> {
     match path {
         Some(path) => {
             let loaded = hair::load(path)?;
-            Ok((loaded.model, path.display().to_string()))
+            let scene_file = matches!(
+                loaded.report.format,
+                hair::HairFormat::Usd | hair::HairFormat::Alembic
+            );
+            let source = if scene_file {
+                format!("{} ({})", path.display(), loaded.report.info)
+            } else {
+                path.display().to_string()
+            };
+            Ok((loaded.model, source))
         }
         None => Ok((
             hair::generate_groom(&GroomParams::default())?,

@@ -7,6 +7,7 @@ use crate::recompute::{Backdrop, Recompute, ViewState};
 use crate::worker::Status;
 use egui_file_dialog::FileDialog;
 use std::path::PathBuf;
+use strandlight_runtime::hair;
 use strandlight_runtime::passes::deep_opacity::MAX_LAYERS;
 use strandlight_scene::frame_settings::{
     EnvLighting, Lighting, PointLighting, Shadows, Transparency,
@@ -104,7 +105,11 @@ impl Panel {
                 let mut dialog = FileDialog::new()
                     .add_file_filter_extensions(
                         "hair and maps",
-                        vec!["hair", "tfx", "data", "ply", "hdr", "exr"],
+                        hair::EXTENSIONS
+                            .iter()
+                            .chain(&["hdr", "exr"])
+                            .copied()
+                            .collect(),
                     )
                     .default_file_filter("hair and maps");
                 dialog.pick_file();
@@ -115,7 +120,7 @@ impl Panel {
                 outcome.reset_camera = true;
             }
         });
-        ui.small("or drop a .hair/.tfx/.data/.ply or .hdr/.exr file on the window");
+        ui.small("or drop a .hair/.tfx/.data/.ply/.usd*/.abc or .hdr/.exr file on the window");
         let mut shading = s.shading();
         egui::ComboBox::from_label("fiber model")
             .selected_text(format!("{shading:?}"))

@@ -13,6 +13,7 @@ use crate::worker::{Shown, Status, Worker};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+use strandlight_runtime::hair;
 use strandlight_scene::camera_choice::CameraChoice;
 use strandlight_scene::exposure::metered_stops;
 use strandlight_scene::frame_settings::{CameraSettings, ExactCamera, FrameSettings, Lighting};
@@ -287,7 +288,7 @@ impl Session {
             .unwrap_or("")
             .to_ascii_lowercase();
         match ext.as_str() {
-            "hair" | "tfx" | "data" | "ply" => {
+            e if hair::EXTENSIONS.contains(&e) => {
                 self.orbit = None;
                 self.edit(|s| {
                     s.settings.hair = Some(path);
@@ -300,7 +301,7 @@ impl Session {
             }
             _ => {
                 self.message = Some(format!(
-                    "{}: not a hair file (.hair, .tfx, .data, .ply) or an environment map (.hdr, .exr)",
+                    "{}: not a hair file (.hair, .tfx, .data, .ply, .usda, .usdc, .usdz, .usd, .abc) or an environment map (.hdr, .exr)",
                     path.display()
                 ))
             }

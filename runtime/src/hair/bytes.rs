@@ -45,6 +45,11 @@ impl<'a> FileBytes<'a> {
         Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
     }
 
+    pub fn u64_at(&self, offset: u64, what: &str) -> Result<u64, HairError> {
+        let b = self.slice(offset, 8, || what.to_string())?;
+        Ok(u64::from_le_bytes(b.try_into().expect("8 bytes")))
+    }
+
     pub fn i32_at(&self, offset: u64, what: &str) -> Result<i32, HairError> {
         Ok(self.u32_at(offset, what)? as i32)
     }

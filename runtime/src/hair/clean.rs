@@ -18,6 +18,10 @@ pub enum HairFormat {
     UscHairSalon,
     /// Binary PLY with `vertex` and `strand` elements.
     Ply,
+    /// `BasisCurves` prims of a USD stage (`.usda`, `.usdc`, `.usdz`, `.usd`).
+    Usd,
+    /// `ICurves` objects of an Alembic (Ogawa) archive, `.abc`.
+    Alembic,
 }
 
 /// What loading did to the file's strands.

@@ -89,7 +89,35 @@ pub enum HairError {
     #[error("{file}: no strand with at least two distinct points is left after cleaning")]
     NoStrands { file: PathBuf },
 
-    #[error("{file}: unknown hair file extension (expected .hair, .tfx, .data or .ply)")]
+    /// A scene file (USD, Alembic) that another library could not decode: `why` is that
+    /// library's own message, or the panic it raised (caught: a bad file never ends the process).
+    #[error("{file}: cannot read as {format}: {why}")]
+    Decode {
+        file: PathBuf,
+        format: &'static str,
+        why: String,
+    },
+
+    /// A scene file that decodes but holds no curves of the kind read as hair.
+    #[error("{file}: no {looked_for} in this {format} file, so there is no hair to draw")]
+    NoCurves {
+        file: PathBuf,
+        format: &'static str,
+        looked_for: &'static str,
+    },
+
+    /// One batch of curves in a scene file (a USD prim, an Alembic object, named by `at`) whose
+    /// arrays disagree, e.g. vertex counts that do not sum to the number of points.
+    #[error("{file}: {at}: {problem}")]
+    BadCurves {
+        file: PathBuf,
+        at: String,
+        problem: String,
+    },
+
+    #[error(
+        "{file}: unknown hair file extension (expected .hair, .tfx, .data, .ply, .usda, .usdc, .usdz, .usd or .abc)"
+    )]
     UnknownExtension { file: PathBuf },
 
     /// An in-memory model (from code, not a file) that breaks an invariant of [`super::HairModel`].

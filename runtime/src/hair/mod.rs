@@ -1,23 +1,31 @@
 //! Hair input: the [`HairModel`] every pass draws, loaders for the strand formats others publish
-//! (Cem Yuksel's `.hair`, AMD TressFX `.tfx`, USC-HairSalon `.data`, hapPLY-style `.ply`), a
-//! `.hair` writer, and the procedural [`groom`] that is the project's own default hair.
+//! (Cem Yuksel's `.hair`, AMD TressFX `.tfx`, USC-HairSalon `.data`, hapPLY-style `.ply`) and
+//! for the curves of the scene files a groom leaves a DCC in (USD `BasisCurves`, Alembic
+//! `ICurves`), a `.hair` writer, and the procedural [`groom`] that is the project's own default
+//! hair.
 //!
 //! Loading reads the whole file, refuses absurd counts before allocating anything sized by them,
 //! checks every value, merges zero-length segments and drops strands left with fewer than two
 //! points; what it changed is in the [`LoadReport`].
 
+pub mod alembic;
 mod bytes;
 mod clean;
+mod curves;
 mod error;
 pub mod groom;
+mod guard;
 mod model;
+mod ogawa;
 pub mod ply;
 pub mod tfx;
 pub mod usc;
+pub mod usd;
 pub mod yuksel;
 
 use std::path::Path;
 
+pub use alembic::load_alembic;
 pub use clean::{HairFormat, LoadReport, LoadedHair, is_degenerate_segment};
 pub use error::HairError;
 pub use groom::{GroomParams, Scalp, generate_groom};
@@ -25,9 +33,15 @@ pub use model::{Aabb, Attribute, AttributeKind, HairModel, HairSummary};
 pub use ply::load_ply;
 pub use tfx::load_tfx;
 pub use usc::{load_usc, write_usc};
+pub use usd::load_usd;
 pub use yuksel::{HairWriteOptions, load_hair, write_hair};
 
-/// Loads a hair file, choosing the format by extension (`.hair`, `.tfx`, `.data`, `.ply`).
+/// The extensions [`load`] reads, lower case, for file dialogs and help texts.
+pub const EXTENSIONS: [&str; 9] = [
+    "hair", "tfx", "data", "ply", "usda", "usdc", "usdz", "usd", "abc",
+];
+
+/// Loads a hair file, choosing the format by extension (see [`EXTENSIONS`]).
 pub fn load(path: &Path) -> Result<LoadedHair, HairError> {
     let ext = path
         .extension()
@@ -38,6 +52,8 @@ pub fn load(path: &Path) -> Result<LoadedHair, HairError> {
         Some("tfx") => load_tfx(path),
         Some("data") => load_usc(path),
         Some("ply") => load_ply(path),
+        Some("usda" | "usdc" | "usdz" | "usd") => load_usd(path),
+        Some("abc") => load_alembic(path),
         _ => Err(HairError::UnknownExtension { file: path.into() }),
     }
 }

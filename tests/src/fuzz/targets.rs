@@ -96,6 +96,26 @@ fn run_ply(bytes: &[u8]) -> Result<Loaded, Refusal> {
     hair_with(hair::ply::parse_ply, "fuzz-input.ply", bytes)
 }
 
+/// USD stages open through a path (openusd picks the layer format by extension). Only text
+/// stages are fuzzed: openusd 0.6's crate-file reader allocates what a corrupt array count asks
+/// for (`ReadExt::read_vec`), and the failed allocation aborts the process, which no catch can
+/// stop; the fuzzer found that within its first few hundred `.usdc` mutants. `.usdz` holds a
+/// `.usdc`. Both wait for a fixed openusd (docs/RELIABILITY.md).
+fn run_usda(bytes: &[u8]) -> Result<Loaded, Refusal> {
+    use std::io::Write;
+    static FILE: OnceLock<ScratchFile> = OnceLock::new();
+    let file = FILE.get_or_init(|| ScratchFile::new("fuzz-input.usda"));
+    file.rewrite(|f| f.write_all(bytes))
+        .expect("the scratch file is writable");
+    hair::load_usd(file.path())
+        .map(Loaded::Hair)
+        .map_err(refusal)
+}
+
+fn run_abc(bytes: &[u8]) -> Result<Loaded, Refusal> {
+    hair_with(hair::alembic::parse_alembic, "fuzz-input.abc", bytes)
+}
+
 /// Environment maps are loaded with sanitizing on, so that decoded maps with bad pixels go on
 /// through the cleaning code instead of stopping at the refusal.
 fn run_envmap(file: &str, bytes: &[u8]) -> Result<Loaded, Refusal> {
@@ -180,6 +200,10 @@ pub fn reseal_asset(data: &mut [u8]) {
     }
 }
 
+/// CI executions of the USD text and Alembic targets (about 0.5 ms and 0.2 ms each here).
+const USDA_EXECS: usize = 10_000;
+const ABC_EXECS: usize = 20_000;
+
 /// Every reader, with its CI execution count and the writer its loads round-trip through.
 pub fn all() -> Vec<Target> {
     let target = |name, file_name, run, execs| Target {
@@ -224,5 +248,12 @@ pub fn all() -> Vec<Target> {
             ..target("sltab", "fuzz-input.sltab", run_sltab, 100_000)
         },
         target("srbf", "fuzz-input.srbf.json", run_srbf, 350_000),
+        // The scene formats' seeds come from usd-core and PyAlembic (`seeds::scene_seeds`).
+        Target {
+            // A text stage cut after a closing brace is a whole stage.
+            prefixes_fail: false,
+            ..target("usda", "fuzz-input.usda", run_usda, USDA_EXECS)
+        },
+        target("abc", "fuzz-input.abc", run_abc, ABC_EXECS),
     ]
 }
