@@ -55,10 +55,22 @@ pub const SOFT_BACKDROP_STOPS: f32 = -2.0;
 /// stay and its detail (trees, windows, a sun's disc) does not compete with the fibers.
 const SOFT_BACKDROP_MAP: [usize; 2] = [64, 32];
 
-/// What `backdrop` draws behind the hair at the hair's exposure: None for black.
+/// The map the soft backdrop samples. Computed on a pool of its own: the window's thread must
+/// not wait for the global rayon pool while a bake fills it (that stalled the window 4.8 s).
+pub fn soft_backdrop_map(map: &EnvMap) -> EnvMap {
+    let [w, h] = SOFT_BACKDROP_MAP;
+    match rayon::ThreadPoolBuilder::new().num_threads(1).build() {
+        Ok(pool) => pool.install(|| map.downsampled(w, h)),
+        Err(_) => map.downsampled(w, h),
+    }
+}
+
+/// What `backdrop` draws behind the hair at the hair's exposure: None for black. `blurred` is
+/// [`soft_backdrop_map`] of `map`.
 pub fn backdrop_pixels(
     backdrop: Backdrop,
     map: &EnvMap,
+    blurred: &EnvMap,
     camera: &Camera,
     size: [u32; 2],
     up: UpAxis,
@@ -68,8 +80,6 @@ pub fn backdrop_pixels(
         Backdrop::Black => None,
         Backdrop::Environment => Some(background(map, camera, size, up, rotation_deg)),
         Backdrop::Soft => {
-            let [w, h] = SOFT_BACKDROP_MAP;
-            let blurred = map.downsampled(w, h);
             let dim = SOFT_BACKDROP_STOPS.exp2();
             Some(
                 pixel_directions(camera, size, up, rotation_deg)
@@ -158,12 +168,13 @@ mod tests {
             near: 0.1,
             far: 10.0,
         };
-        let soft = |map: &EnvMap| {
-            backdrop_pixels(Backdrop::Soft, map, &camera, [16, 16], UpAxis::Y, 0.0).unwrap()
+        let soft = |map: &EnvMap, size: [u32; 2]| {
+            let blurred = soft_backdrop_map(map);
+            backdrop_pixels(Backdrop::Soft, map, &blurred, &camera, size, UpAxis::Y, 0.0).unwrap()
         };
         // A uniform sky stays uniform, a quarter as bright.
         let uniform = EnvMap::from_fn(256, 128, |_| [3.0, 2.0, 1.0]);
-        for p in soft(&uniform) {
+        for p in soft(&uniform, [16, 16]) {
             assert!(
                 (p[0] - 0.75).abs() < 1e-5 && (p[2] - 0.25).abs() < 1e-5,
                 "{p:?}"
@@ -179,12 +190,13 @@ mod tests {
             }
         });
         let sharp = background(&sun, &camera, [17, 17], UpAxis::Y, 0.0)[8 * 17 + 8][0];
-        let blurred =
-            backdrop_pixels(Backdrop::Soft, &sun, &camera, [17, 17], UpAxis::Y, 0.0).unwrap();
+        let blurred = soft(&sun, [17, 17]);
         let centre = blurred[8 * 17 + 8][0];
         assert_eq!(sharp, 1e4);
         assert!(centre > 0.0 && centre < 0.1 * sharp, "{centre}");
-        assert!(backdrop_pixels(Backdrop::Black, &sun, &camera, [4, 4], UpAxis::Y, 0.0).is_none());
+        assert!(
+            backdrop_pixels(Backdrop::Black, &sun, &sun, &camera, [4, 4], UpAxis::Y, 0.0).is_none()
+        );
     }
 
     #[test]

@@ -2,7 +2,7 @@
 //! screen and the screenshots asked for. It draws one egui frame at a time and never waits for
 //! the renderer.
 
-use crate::display::{backdrop_pixels, composite, to_rgba8};
+use crate::display::{backdrop_pixels, composite, soft_backdrop_map, to_rgba8};
 use crate::frame::{LinearImage, Stage};
 use crate::orbit::Orbit;
 use crate::panel::{Panel, PanelOutcome};
@@ -13,6 +13,7 @@ use crate::worker::{Shown, Status, Worker};
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+use strandlight_precompute::envmap::EnvMap;
 use strandlight_runtime::hair;
 use strandlight_scene::camera_choice::CameraChoice;
 use strandlight_scene::exposure::metered_stops;
@@ -96,6 +97,8 @@ pub struct Session {
     handled_error: Option<u64>,
     image_rect: egui::Rect,
     background: Option<(BackgroundKey, Arc<Vec<[f32; 3]>>)>,
+    /// The soft backdrop's blurred map, by the map's pixel hash: made once per map.
+    soft_map: Option<(String, Arc<EnvMap>)>,
 }
 
 /// What the background behind the hair depends on.
@@ -137,6 +140,7 @@ impl Session {
             handled_error: None,
             image_rect: egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(640.0, 480.0)),
             background: None,
+            soft_map: None,
         }
     }
 
@@ -460,9 +464,18 @@ impl Session {
         {
             return Some(pixels.clone());
         }
+        let blurred = match &self.soft_map {
+            Some((sha, map)) if *sha == key.map => map.clone(),
+            _ => {
+                let map = Arc::new(soft_backdrop_map(&env.env.map));
+                self.soft_map = Some((key.map.clone(), map.clone()));
+                map
+            }
+        };
         let pixels = Arc::new(backdrop_pixels(
             key.backdrop,
             &env.env.map,
+            &blurred,
             &shown.camera,
             key.size,
             env.up,
