@@ -6,7 +6,7 @@
 //!
 //! Scene (orthographic camera looking down −z, 64², 32 pixels per unit): a head, the sphere of
 //! radius 0.4 at the origin, and three vertical fibers (x, z) = (0.1, −0.6) behind the head from
-//! the camera, (−0.7, 0) on its −x side and (0.7, 0) on its +x side. A light toward +x leaves the
+//! the camera, (−0.7, 0) on its −x side and (0.7, −0.3) on its +x side. A light toward +x leaves the
 //! part |y| < 0.4 of the −x fiber in the head's shadow and never shades the +x one.
 //!
 //! Shadows are read as the ratio of the shadowed frame to the unshadowed one at the same pixel,
@@ -31,6 +31,8 @@ use strandlight_tables::table_axes::{
 const RADIUS: f32 = 0.4;
 const BEHIND_X: f32 = 0.1;
 const SIDE_X: f32 = 0.7;
+/// The +x fiber sits off the −x fiber's line toward +x (else it would shadow it).
+const SIDE_Z: f32 = -0.3;
 /// Light-map texels are 1/32 unit over the hair's ~2.6-unit diagonal at 128²: within two of the
 /// head's silhouette from the light, rasterization decides, not geometry.
 const EDGE_MARGIN: f64 = 0.08;
@@ -66,7 +68,7 @@ fn scene() -> HairModel {
     hair(&[
         fiber(BEHIND_X, -0.6),
         fiber(-SIDE_X, 0.0),
-        fiber(SIDE_X, 0.0),
+        fiber(SIDE_X, SIDE_Z),
     ])
 }
 
@@ -165,7 +167,7 @@ fn the_head_hides_the_fiber_behind_it_and_shows_skin() {
     // changes; where it sticks out above and below, it is there.
     let without_behind = render(
         &gpu,
-        &hair(&[fiber(-SIDE_X, 0.0), fiber(SIDE_X, 0.0)]),
+        &hair(&[fiber(-SIDE_X, 0.0), fiber(SIDE_X, SIDE_Z)]),
         &lights,
         false,
         Some(&head),
@@ -258,13 +260,13 @@ fn the_head_shadows_every_light_map_where_the_geometry_says() {
         let no_head = render(&gpu, &scene(), &lights, true, None);
         let (mut dark, mut bright) = (0, 0);
         for (row, y) in rows() {
-            for x in [-SIDE_X, SIDE_X] {
+            for (x, z) in [(-SIDE_X, 0.0), (SIDE_X, SIDE_Z)] {
                 let i = pixel(x, y);
                 if lit[i][3] < 0.5 {
                     continue;
                 }
                 let ratio = shadowed[i][0] / lit[i][0];
-                let p = Vec3::new(x, y, 0.0);
+                let p = Vec3::new(x, y, z);
                 // The CPU reference: does the ray from the fiber toward the light meet the head,
                 // and how far from its silhouette does it pass?
                 let blocked = head.ray_hit(p, toward.as_vec3(), 10.0).is_some();

@@ -358,7 +358,7 @@ mod tests {
         // Every vertex inside the block: the SH of T(ω) evaluated through a wide lobe equals the
         // lobe-weighted mean of the marched T (brute force over 20 000 directions).
         let hair = uniform_fibers_along_x(16, 0.125, 1.2);
-        let volume = VisibilityVolume::from_hair_volume(&hair, 512);
+        let volume = VisibilityVolume::from_hair_volume(&hair, 512, None);
         let p = Vec3::splat(1.0);
         let dirs = fibonacci_directions(20_000);
         for (xi, lambda) in [
