@@ -9,9 +9,22 @@
 //                Rust and tested there against f64 quadrature.
 // Multiple scattering from the hair onto the skin is left out.
 
+// Broad lobes (λ < 3): the zonal harmonics l ≤ 2 (head::srbf_irradiance_sh2).
+fn srbf_irradiance_sh2(c: f32, lambda: f32) -> f32 {
+    let l = lambda;
+    let e = exp(-2.0 * l);
+    let i0 = (1.0 - e) / l;
+    let i1 = 1.0 / l - 1.0 / (l * l) + e * (1.0 / l + 1.0 / (l * l));
+    let m2 = (1.0 / l - 2.0 / (l * l) + 2.0 / (l * l * l))
+        - e * (1.0 / l + 2.0 / (l * l) + 2.0 / (l * l * l));
+    let i2 = (3.0 * m2 - i0) / 2.0;
+    return 3.141592654 * (0.5 * i0 + i1 * c + 0.625 * i2 * (3.0 * c * c - 1.0) / 2.0);
+}
+
 // ∫ exp(λ(ω·ξ − 1)) max(n·ω, 0) dω for cos = n·ξ and λ = 1/inv_lambda.
 fn srbf_irradiance(cos_n_xi: f32, inv_lambda: f32) -> f32 {
     let lambda = 1.0 / inv_lambda;
+    if (lambda < 3.0) { return max(srbf_irradiance_sh2(cos_n_xi, lambda), 0.0); }
     let eml = exp(-lambda);
     let em2l = eml * eml;
     let scale = 1.0 + 2.0 * em2l - inv_lambda;
