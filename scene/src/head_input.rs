@@ -107,7 +107,6 @@ pub fn load_obj(path: &Path) -> anyhow::Result<TriangleMesh> {
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let (models, _materials) = tobj::load_obj(path, &options).with_context(|| {
         format!(
@@ -240,8 +239,9 @@ fn least_squares<const N: usize>(rows: impl Iterator<Item = ([f64; N], f64)>) ->
         for row in 0..N {
             if row != col {
                 let f = m[row][col] / m[col][col];
-                for k in 0..N {
-                    m[row][k] -= f * m[col][k];
+                let pivot_row = m[col];
+                for (a, p) in m[row].iter_mut().zip(pivot_row) {
+                    *a -= f * p;
                 }
                 v[row] -= f * v[col];
             }
