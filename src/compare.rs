@@ -55,6 +55,10 @@ struct SceneFlags {
     /// Melanin preset of the fiber: white, blonde, red, auburn, brown, dark (default: brown).
     #[arg(long)]
     preset: Option<String>,
+    /// The head in every frame (the SRBF path's, the reference's, the baseline's, the truth's):
+    /// none, ellipsoid (fitted to the strand roots) or FILE.obj (default: none).
+    #[arg(long, value_name = "none|ellipsoid|FILE.obj")]
+    head: Option<strandlight_scene::head_input::HeadChoice>,
 }
 
 #[derive(Args, Debug)]
@@ -171,6 +175,7 @@ impl CompareArgs {
         set(&mut s.size, scene.size);
         set(&mut s.shading, scene.shading);
         set(&mut s.preset, scene.preset);
+        set(&mut s.head, scene.head);
         set(&mut s.modes, measure.modes);
         set(&mut s.reference_lights, measure.reference_lights.map(Some));
         set(&mut s.baseline, measure.baseline);

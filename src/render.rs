@@ -19,6 +19,7 @@ use strandlight_scene::frame_settings::{
     Transparency,
 };
 use strandlight_scene::hair_input::parse_size;
+use strandlight_scene::head_input::HeadChoice;
 use strandlight_scene::look::LookArgs;
 use strandlight_scene::point_shading::{Shading, read_artist_params};
 use strandlight_scene::scene_tables::ScatteringMode;
@@ -118,6 +119,14 @@ struct EnvArgs {
     /// Side of each light's convolution optical depth map, texels.
     #[arg(long, default_value_t = 512)]
     light_map_size: u32,
+    /// The head the hair grows from: none, ellipsoid (fitted to the strand roots) or FILE.obj (in
+    /// the hair's units and frame); it hides the hair behind it, is drawn as diffuse skin and
+    /// shadows every light.
+    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE.obj")]
+    head: HeadChoice,
+    /// The head's skin: diffuse albedo, linear R,G,B each in [0, 1].
+    #[arg(long, value_name = "R,G,B")]
+    skin: Option<String>,
     #[command(flatten)]
     look: LookArgs,
     #[command(flatten)]
@@ -250,6 +259,8 @@ fn frame_settings(scene: &SceneArgs, lighting: Lighting) -> anyhow::Result<Frame
             .transpose()?,
         fiber_width_px: scene.fiber_width_px,
         lighting,
+        head: HeadChoice::None,
+        skin_albedo: strandlight_scene::head_input::default_skin_albedo(),
     })
 }
 
@@ -290,7 +301,14 @@ fn point_lighting(args: &LightsArgs) -> Lighting {
 
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let (settings, output) = match &args.what {
-        RenderWhat::Env(env) => (frame_settings(&env.scene, env_lighting(env))?, &env.output),
+        RenderWhat::Env(env) => {
+            let mut settings = frame_settings(&env.scene, env_lighting(env))?;
+            settings.head = env.head.clone();
+            if let Some(skin) = &env.skin {
+                settings.skin_albedo = parse_vec3("--skin", skin)?;
+            }
+            (settings, &env.output)
+        }
         RenderWhat::Lights(lights) => (
             frame_settings(&lights.scene, point_lighting(lights))?,
             &lights.output,

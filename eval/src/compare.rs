@@ -33,6 +33,7 @@ use strandlight_scene::env_frame::{
 use strandlight_scene::environment::load_env;
 use strandlight_scene::fit_cache::fit_cached;
 use strandlight_scene::hair_input::{fibers_for, load_hair, parse_size};
+use strandlight_scene::head_input::{HeadChoice, default_skin_albedo, load_head};
 use strandlight_scene::image_metrics::{Image, error_legend, relative_rmse, write_side_by_side};
 use strandlight_scene::look::{EnvLook, LookArgs};
 use strandlight_scene::scene_tables::{
@@ -137,6 +138,9 @@ pub struct CompareSettings {
     pub light_map_size: u32,
     /// The look of all three renders.
     pub look: LookArgs,
+    /// The head in every frame (issue 40): none, an ellipsoid fitted to the roots, an OBJ.
+    #[serde(skip_serializing_if = "HeadChoice::is_none")]
+    pub head: HeadChoice,
     /// The path-traced ground truth (Mitsuba 3; the Chiang fiber only, which is Mitsuba's
     /// `hair`): `cached` measures every frame against it where `strandlight truth` or an
     /// earlier run rendered it, `render` renders what is missing (minutes), `off` never.
@@ -189,6 +193,7 @@ impl Default for CompareSettings {
             look: LookArgs::default(),
             ground_truth: TruthUse::Cached,
             truth_max_spp: TruthSettings::default().max_spp,
+            head: HeadChoice::None,
         }
     }
 }
@@ -217,6 +222,8 @@ pub struct CompareScene {
     /// The fitted set's lights in the map's frame (what `srbf` holds in the world's), for a
     /// reference of the fit's own lighting ([`ReferenceLighting::Fit`]).
     pub fit_lights: Vec<LightSpec>,
+    /// The head (`--head`), in every frame: the SRBF path's, the reference's and the baseline's.
+    pub head: Option<strandlight_runtime::head::Head>,
 }
 
 /// What a brute-force reference lights the hair with.
@@ -476,6 +483,7 @@ pub fn prepare_with_hair(
         ));
     }
     let fit_relative_l2_error = fit.set.relative_l2_error;
+    let head = load_head(&args.head, &hair, default_skin_albedo())?;
     Ok(CompareScene {
         hair,
         hair_sha256,
@@ -493,6 +501,7 @@ pub fn prepare_with_hair(
         fit_relative_l2_error,
         compact_sources: fit.set.sources.clone(),
         fit_lights,
+        head,
     })
 }
 
@@ -680,6 +689,7 @@ pub fn truth_of(
             rotate_degrees: args.rotate,
             directional: &[],
             fiber: &fiber,
+            head: scene.head.as_ref(),
         },
         hair_sha256: &scene.hair_sha256,
         map_sha256: &scene.map_sha256,
@@ -711,6 +721,7 @@ pub fn frame<'a>(
         mode,
         role: FrameRole::Interactive { kappa: args.kappa },
         look: look(args),
+        head: scene.head.clone(),
     }
 }
 
@@ -772,6 +783,10 @@ fn reference_inputs(
         "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, transparency: look(args).transparency, dodm: look(args).dodm, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
     });
     // Only the fit's lighting adds a key, so the map's references keep their cache entries.
+    // Only with a head: the references rendered before it keep their keys.
+    if let Some(head) = &scene.head {
+        inputs["head"] = json!(format!("{:016x}", head.fingerprint()));
+    }
     if lighting == ReferenceLighting::Fit {
         inputs["reference_lighting"] = json!({
             "fit_lights": sha256_hex(format!("{:?}", scene.fit_lights).as_bytes()),

@@ -155,7 +155,7 @@ pub struct TruthInputs<'a> {
 
 impl TruthInputs<'_> {
     fn key(&self, run: MitsubaRun) -> Value {
-        json!({
+        let mut key = json!({
             "renderer": "mitsuba3 scalar_rgb path, hair BSDF, bsplinecurve through the strand points, envmap (hidden from the camera), box filter",
             "hair_sha256": self.hair_sha256,
             "map_sha256": self.map_sha256,
@@ -167,7 +167,12 @@ impl TruthInputs<'_> {
             "fiber": self.scene.fiber,
             "run": run,
             "script_sha256": sha256_hex(mitsuba_scene::RENDER_SCRIPT.as_bytes()),
-        })
+        });
+        // Only with a head, so that truths rendered before it keep their keys.
+        if let Some(head) = self.scene.head {
+            key["head"] = json!(format!("{:016x}", head.fingerprint()));
+        }
+        key
     }
 }
 
@@ -548,6 +553,7 @@ impl TruthScene {
                 rotate_degrees,
                 directional: &[],
                 fiber: &self.fiber,
+                head: None,
             },
             hair_sha256: &self.hair_sha256,
             map_sha256: &self.map_sha256,
@@ -694,6 +700,7 @@ mod tests {
                 rotate_degrees: 0.0,
                 directional: &[],
                 fiber: &fiber,
+                head: None,
             },
             hair_sha256: "h",
             map_sha256: "m",

@@ -94,6 +94,7 @@ fn ours(
             shadowed,
             ..LookArgs::default().look().unwrap()
         },
+        head: None,
     };
     render_lights(&frame).unwrap().image
 }
@@ -116,6 +117,7 @@ fn mitsuba_scene<'a>(
         rotate_degrees: 0.0,
         directional,
         fiber,
+        head: None,
     }
 }
 

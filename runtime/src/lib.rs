@@ -5,6 +5,7 @@ pub mod env;
 pub mod env_light;
 pub mod gpu;
 pub mod hair;
+pub mod head;
 pub mod lights;
 pub mod multiple;
 pub mod passes;

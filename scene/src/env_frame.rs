@@ -14,6 +14,7 @@ use strandlight_runtime::env::{
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
+use strandlight_runtime::head::Head;
 use strandlight_runtime::multiple::ForwardScatteringSource;
 use strandlight_runtime::multiple::{
     CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering,
@@ -66,6 +67,8 @@ pub struct EnvFrame<'a> {
     pub mode: ScatteringMode,
     pub role: FrameRole,
     pub look: EnvLook,
+    /// The head (issue 40): hides the fibers behind it, drawn as skin, opaque to every light.
+    pub head: Option<Head>,
 }
 
 /// A rendered frame and its GPU time.
@@ -177,7 +180,8 @@ fn forward_scattering<'g>(
         &frame.tables.get("srbf_spread")?.table,
     )?;
     let settings = forward_settings(frame.role);
-    let cpu = CpuForwardScattering::new(frame.hair, tables, settings)?;
+    let cpu =
+        CpuForwardScattering::new(frame.hair, tables, settings)?.with_head(frame.head.clone());
     // The GPU marches from every sample: the same grid without the CPU's light sweep.
     let on_gpu = |cpu: CpuForwardScattering| {
         let march = ForwardScatteringSettings {
@@ -188,6 +192,8 @@ fn forward_scattering<'g>(
     };
     Ok(match frame.look.forward_scattering {
         _ if frame.role == FrameRole::Reference => Box::new(cpu),
+        // The head blocks the CPU's samples only (the GPU march does not know it yet).
+        _ if frame.head.is_some() => Box::new(cpu),
         ForwardDevice::Cpu => Box::new(cpu),
         ForwardDevice::Gpu => Box::new(on_gpu(cpu).context("--forward-scattering gpu")?),
         ForwardDevice::Auto if gpu.report.is_software => Box::new(cpu),
@@ -250,6 +256,7 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
             &tables,
             &render_options(frame),
             multiple,
+            frame.head.as_ref(),
         )
         .with_context(|| {
             format!(

@@ -11,6 +11,7 @@ use crate::frame_settings::{
     EnvLighting, FrameSettings, Lighting, PointLighting, Shadows, Transparency, up_choice,
 };
 use crate::hair_input::load_hair;
+use crate::head_input::load_head;
 use crate::image_metrics::Image;
 use crate::look::EnvLook;
 use crate::point_shading::{PointShadingRequest, point_shading_model};
@@ -280,6 +281,7 @@ fn env_frame<'a>(
         mode: prepared.scene.mode,
         role: FrameRole::Interactive { kappa: env.kappa },
         look,
+        head: load_head(&settings.head, hair, settings.skin_albedo)?,
     })
 }
 

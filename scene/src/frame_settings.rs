@@ -3,6 +3,7 @@
 //! `render replay` reads back to reproduce that screenshot.
 
 use crate::camera_choice::{CameraChoice, UpChoice};
+use crate::head_input::{HeadChoice, default_skin_albedo};
 use crate::look::{EnvTransparency, LookArgs, ViewArgs};
 use crate::point_shading::Shading;
 use crate::scene_tables::{EnvShading, ScatteringMode};
@@ -34,6 +35,20 @@ pub struct FrameSettings {
     /// Every fiber this many pixels wide; None: the file's thickness, projected.
     pub fiber_width_px: Option<f32>,
     pub lighting: Lighting,
+    /// The head the hair grows from (issue 40): none, an ellipsoid fitted to the strand roots,
+    /// or an OBJ mesh. Absent from settings written before it: none, as they were rendered.
+    #[serde(default, skip_serializing_if = "HeadChoice::is_none")]
+    pub head: HeadChoice,
+    /// The head's skin: linear RGB diffuse albedo.
+    #[serde(
+        default = "default_skin_albedo",
+        skip_serializing_if = "is_default_skin"
+    )]
+    pub skin_albedo: [f32; 3],
+}
+
+fn is_default_skin(albedo: &[f32; 3]) -> bool {
+    *albedo == default_skin_albedo()
 }
 
 /// Where the camera is.
@@ -347,6 +362,8 @@ impl FrameSettings {
             artist: None,
             fiber_width_px: None,
             lighting,
+            head: HeadChoice::None,
+            skin_albedo: default_skin_albedo(),
         }
     }
 
@@ -414,6 +431,12 @@ impl FrameSettings {
         }
         if let CameraSettings::Exact(exact) = &self.camera {
             exact.camera()?;
+        }
+        if self.skin_albedo.iter().any(|a| !(0.0..=1.0).contains(a)) {
+            bail!(
+                "--skin {:?}: each channel of the skin's albedo must be in [0, 1]",
+                self.skin_albedo
+            );
         }
         if let Some(params) = self.artist {
             ArtistModel::new(params).context("artist controls")?;
@@ -511,6 +534,30 @@ mod tests {
         settings.artist = Some(ArtistParams::default());
         let back: FrameSettings = serde_json::from_str(&settings.to_json()).unwrap();
         assert_eq!(back, settings);
+    }
+
+    #[test]
+    fn settings_written_before_the_head_read_as_no_head_and_write_back_the_same() {
+        let settings = FrameSettings::new(
+            Lighting::Environment(EnvLighting::new("procedural:studio")),
+            [64, 48],
+        );
+        // The JSON of a settings value has no head keys while the head is none and the skin the
+        // default, exactly as every settings file written before them.
+        let old = settings.to_json();
+        assert!(!old.contains("head") && !old.contains("skin"), "{old}");
+        let back: FrameSettings = serde_json::from_str(&old).unwrap();
+        assert_eq!(back.head, HeadChoice::None);
+        assert_eq!(back.skin_albedo, default_skin_albedo());
+        let mut with_head = settings.clone();
+        with_head.head = HeadChoice::Mesh("heads/a.obj".into());
+        with_head.skin_albedo = [0.2, 0.1, 0.05];
+        let json = with_head.to_json();
+        let back: FrameSettings = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, with_head);
+        with_head.skin_albedo = [1.5, 0.1, 0.05];
+        let error = format!("{:#}", with_head.check().unwrap_err());
+        assert!(error.contains("--skin"), "{error}");
     }
 
     #[test]

@@ -16,6 +16,7 @@ pub mod fit_cache;
 pub mod frame_render;
 pub mod frame_settings;
 pub mod hair_input;
+pub mod head_input;
 pub mod image_metrics;
 pub mod look;
 pub mod point_shading;

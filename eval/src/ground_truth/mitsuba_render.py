@@ -85,6 +85,18 @@ def main(path):
     for i, curves in enumerate(scene["curves"]):
         # B-splines: `hair` reads the fiber frame that `bsplinecurve` builds from the tangent.
         description[f"hair{i}"] = {"type": "bsplinecurve", "filename": curves, "bsdf": bsdf}
+    head = scene.get("head")
+    if head:
+        # The head: an opaque Lambertian mesh (strandlight's skin), two-sided as strandlight
+        # draws it.
+        description["head"] = {
+            "type": "obj",
+            "filename": head["obj"],
+            "bsdf": {
+                "type": "twosided",
+                "bsdf": {"type": "diffuse", "reflectance": {"type": "rgb", "value": head["albedo"]}},
+            },
+        }
     start = time.time()
     loaded = mi.load_dict(description)
     image = mi.render(loaded)

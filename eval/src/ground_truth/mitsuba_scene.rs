@@ -27,6 +27,7 @@ use strandlight_precompute::EnvMap;
 use strandlight_precompute::envmap::rotate_about_up;
 use strandlight_runtime::camera::{Camera, Projection, UpAxis};
 use strandlight_runtime::hair::HairModel;
+use strandlight_runtime::head::Head;
 use strandlight_runtime::passes::strand_geometry::default_thickness;
 use strandlight_scene::world_lights::env_to_world;
 use strandlight_tables::atomic_write::write_atomically;
@@ -57,6 +58,9 @@ pub struct MitsubaScene<'a> {
     /// `eumelanin`, `pheomelanin`, `sigma_a` (null for melanin), `longitudinal_roughness`,
     /// `azimuthal_roughness`, `ior`, `scale_tilt_degrees`.
     pub fiber: &'a serde_json::Value,
+    /// The head (issue 40): an opaque Lambertian mesh (`diffuse` BSDF of the skin's albedo);
+    /// an ellipsoid goes as its tessellation (Mitsuba's `sphere` takes no non-uniform scale).
+    pub head: Option<&'a Head>,
 }
 
 /// What one render does: the path tracer's depth and samples.
@@ -94,11 +98,21 @@ pub fn write_scene(
     if let Some(environment) = scene.map {
         write_map(environment, &map)?;
     }
+    let head_obj = dir.join("head.obj");
+    if let Some(head) = scene.head {
+        write_head_obj(head, &head_obj)?;
+    }
     let script = dir.join(RENDER_SCRIPT_NAME);
     std::fs::write(&script, RENDER_SCRIPT)
         .with_context(|| format!("cannot write {}", script.display()))?;
     let json = dir.join("scene.json");
-    let description = scene_json(scene, run, &curves, &map, output)?;
+    let mut description = scene_json(scene, run, &curves, &map, output)?;
+    if let Some(head) = scene.head {
+        description["head"] = serde_json::json!({
+            "obj": absolute(&head_obj)?,
+            "albedo": head.albedo,
+        });
+    }
     write_atomically(&json, |out| {
         out.write_all(serde_json::to_string_pretty(&description)?.as_bytes())
     })
@@ -147,6 +161,25 @@ pub fn scene_json(
         "seed": run.seed,
         "output": absolute(output)?,
     }))
+}
+
+/// The head's triangles as a Wavefront OBJ with per-vertex normals (Mitsuba's `obj` shape).
+pub fn write_head_obj(head: &Head, path: &Path) -> anyhow::Result<()> {
+    let mesh = head.triangles();
+    write_atomically(path, |out| {
+        for p in &mesh.positions {
+            writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
+        }
+        for n in &mesh.normals {
+            writeln!(out, "vn {} {} {}", n.x, n.y, n.z)?;
+        }
+        for t in mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0] + 1, t[1] + 1, t[2] + 1];
+            writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}")?;
+        }
+        Ok::<(), std::io::Error>(())
+    })
+    .with_context(|| format!("cannot write the head {}", path.display()))
 }
 
 fn absolute(path: &Path) -> anyhow::Result<String> {

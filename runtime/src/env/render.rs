@@ -14,6 +14,7 @@ use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels, fit_within};
 use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::gpu::{AdapterReport, GpuContext};
 use crate::hair::{Aabb, HairModel};
+use crate::head::Head;
 use crate::multiple::{ForwardScatteringGrid, ForwardScatteringSource};
 use crate::passes::convolution_depth::{
     ConvolutionDepthPass, DodmBatch, DodmSettings, DodmSettingsError, SimplifiedSegments,
@@ -24,6 +25,7 @@ use crate::passes::env_view::{
     ViewBinding, VolumeBuffers,
 };
 use crate::passes::frame_params::{FrameParams, KajiyaKay};
+use crate::passes::head::{HeadDepthMaps, HeadGeometry};
 use crate::passes::strand_geometry::{StrandGeometry, TooManyPoints};
 use crate::passes::summed_area::{SummedAreaPass, SummedAreaTables};
 pub use crate::passes::transmittance_filter::TransmittanceFilter;
@@ -558,6 +560,10 @@ struct FrameResources {
     directional_tables: Option<TableBinding>,
     /// The groom's visibility volume (or its placeholder under Ren's light maps).
     volume: Arc<VolumeBuffers>,
+    /// The head (issue 40), drawn into the view's depth and every light map.
+    head: Option<HeadGeometry>,
+    /// [`EnvViewTargets::head_position`] and `head_normal`.
+    head_views: [wgpu::TextureView; 2],
 }
 
 /// Texels across the light maps bound, unread, by SRBF batches that read the visibility volume.
@@ -567,6 +573,8 @@ const PLACEHOLDER_MAP_RESOLUTION: u32 = 8;
 struct LightMaps {
     dodm: DodmBatch,
     sat: SummedAreaTables,
+    /// The head's depth from each slot's light, where the frame has a head.
+    head: Option<HeadDepthMaps>,
 }
 
 impl LightMaps {
@@ -580,6 +588,7 @@ impl LightMaps {
         Ok(Self {
             sat: SummedAreaTables::new(gpu, resolution, slots)?,
             dodm: DodmBatch::new(gpu, resolution, slots, first_layer),
+            head: None,
         })
     }
 
@@ -643,6 +652,9 @@ impl LightMaps {
         let named = |(name, bytes): (String, u64)| (format!("{prefix}{name}"), bytes);
         let mut memory: Vec<_> = self.dodm.memory().into_iter().map(named).collect();
         memory.extend(self.sat.memory().into_iter().map(named));
+        if let Some(head) = &self.head {
+            memory.push(named(("head light depth".into(), head.memory())));
+        }
         memory
     }
 
@@ -677,6 +689,8 @@ impl FrameResources {
             transparency: options.transparency,
             width: self.sums.width,
             height: self.sums.height,
+            head: [&self.head_views[0], &self.head_views[1]],
+            skin: self.head.as_ref().map(|h| h.albedo),
         }
     }
 
@@ -707,6 +721,9 @@ impl FrameResources {
         memory.push(self.occupancy.memory());
         memory.push(("env sums".into(), self.sums.sums.size()));
         memory.push(("visibility volume".into(), self.volume.bytes));
+        if let Some(head) = &self.head {
+            memory.push(("head geometry".into(), head.bytes()));
+        }
         memory
     }
 }
@@ -739,6 +756,7 @@ struct FrameRequest<'a> {
     tables: &'a EnvTables,
     options: &'a EnvRenderOptions,
     multiple: Option<&'a dyn ForwardScatteringSource>,
+    head: Option<&'a Head>,
 }
 
 impl EnvRenderer {
@@ -772,6 +790,7 @@ impl EnvRenderer {
         &self,
         gpu: &GpuContext,
         model: &HairModel,
+        head: Option<&Head>,
         options: &EnvRenderOptions,
         timings: &mut Timings,
     ) -> Result<Arc<VolumeBuffers>, EnvRenderError> {
@@ -782,13 +801,15 @@ impl EnvRenderer {
         else {
             return Ok(Arc::new(VolumeBuffers::new(gpu, None)));
         };
-        let key = (hair_fingerprint(model), *settings);
+        // The head is in the volume (its marches stop at it): another head, another volume.
+        let scene = hair_fingerprint(model) ^ head.map_or(0, |h| h.fingerprint().rotate_left(17));
+        let key = (scene, *settings);
         let mut cache = self.volume.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(cached) = cache.as_ref().filter(|c| c.key == key) {
             return Ok(cached.buffers.clone());
         }
         let volume = timings.time(gpu, "visibility volume", || {
-            VisibilityVolume::build(model, settings)
+            VisibilityVolume::build_with_head(model, settings, head)
         })?;
         GpuLimits::of(gpu).check_storage_buffer(
             "visibility volume",
@@ -821,14 +842,15 @@ impl EnvRenderer {
     ) -> Result<EnvFrame, EnvRenderError> {
         let part = (lights, 0);
         self.render_part(
-            gpu, model, camera, width, height, part, tables, options, multiple,
+            gpu, model, camera, width, height, part, tables, options, multiple, None,
         )
     }
 
     /// [`Self::render`] for `lights` that continue a frame rendered in parts (the viewer's
     /// progressive batches): its simplified lights draw the strand windows from `first_window`
     /// on, the number of simplified lights in the parts before, so the parts sum to the frame
-    /// rendered at once ([`SimplifiedSegments::window`]).
+    /// rendered at once ([`SimplifiedSegments::window`]). With `head`, the head hides the fibers
+    /// behind it, is drawn as skin and is opaque in every light's visibility.
     #[allow(clippy::too_many_arguments)]
     pub fn render_part(
         &self,
@@ -841,6 +863,7 @@ impl EnvRenderer {
         tables: &EnvTables,
         options: &EnvRenderOptions,
         multiple: Option<&dyn ForwardScatteringSource>,
+        head: Option<&Head>,
     ) -> Result<EnvFrame, EnvRenderError> {
         let request = FrameRequest {
             model,
@@ -850,6 +873,7 @@ impl EnvRenderer {
             tables,
             options,
             multiple,
+            head,
         };
         let mut timings = Timings(Vec::new());
         let kinds = LightKinds::of(lights);
@@ -858,7 +882,7 @@ impl EnvRenderer {
         let mut frame = self.frame_resources(gpu, &request, &kinds, &mut timings)?;
         frame.next_window = first_window;
         let mut memory = frame.memory();
-        self.encode_visibility(gpu, &frame, options, &mut timings);
+        self.encode_visibility(gpu, &frame, options, camera, &mut timings);
         let fragments = match options.count_fragments {
             true => Some(self.count_fragments(gpu, &frame, options)?),
             false => None,
@@ -931,6 +955,7 @@ impl EnvRenderer {
             tables,
             options,
             multiple,
+            head,
         } = *request;
         GpuLimits::of(gpu).check_image(width, height)?;
         let occupancy = OccupancyMap::new(gpu, options.transparency, width, height)?;
@@ -942,8 +967,26 @@ impl EnvRenderer {
         });
         let bounds = model.bounds();
         let first_layer = options.dodm.first_layer_for(bounds);
-        let (full_maps, simplified_maps) = LightMaps::for_frame(gpu, options, kinds, first_layer)?;
-        let targets = EnvViewTargets::new(gpu, width, height, options.transparency);
+        let (mut full_maps, mut simplified_maps) =
+            LightMaps::for_frame(gpu, options, kinds, first_layer)?;
+        let head_geometry =
+            head.map(|h| timings.time(gpu, "upload", || HeadGeometry::upload(gpu, h)));
+        if head_geometry.is_some() {
+            for maps in [&mut full_maps, &mut simplified_maps].into_iter().flatten() {
+                maps.head = Some(HeadDepthMaps::new(
+                    gpu,
+                    maps.dodm.resolution,
+                    maps.dodm.slots,
+                ));
+            }
+        }
+        let targets = EnvViewTargets::new(
+            gpu,
+            width,
+            height,
+            options.transparency,
+            head_geometry.is_some(),
+        );
         let sums = self.view.accumulator(gpu, &targets);
         let view_params = FrameParams {
             camera: *camera,
@@ -954,7 +997,7 @@ impl EnvRenderer {
             width_override_px: options.width_override_px,
         };
         check_table_limits(gpu, tables, kinds, multiple.is_some())?;
-        let volume = self.volume_buffers(gpu, model, options, timings)?;
+        let volume = self.volume_buffers(gpu, model, head, options, timings)?;
         let (srbf_tables, directional_tables) = timings.time(gpu, "table upload", || {
             let multiple_table = multiple.and(tables.multiple.as_ref());
             let bind = |needed: bool, t: &Option<Table>| {
@@ -967,6 +1010,8 @@ impl EnvRenderer {
                 bind(kinds.has_directional(), &tables.direct),
             )
         });
+        let head_views = [&targets.head_position, &targets.head_normal]
+            .map(|t| t.create_view(&Default::default()));
         Ok(FrameResources {
             strands: self.view.strands(gpu, &geometry, &view_params),
             coverage_view: targets.coverage.create_view(&Default::default()),
@@ -986,6 +1031,8 @@ impl EnvRenderer {
             srbf_tables,
             directional_tables,
             volume,
+            head_views,
+            head: head_geometry,
         })
     }
 
@@ -995,12 +1042,23 @@ impl EnvRenderer {
         gpu: &GpuContext,
         frame: &FrameResources,
         options: &EnvRenderOptions,
+        camera: &Camera,
         timings: &mut Timings,
     ) {
         timings.time(gpu, "view visibility", || {
             let visibility = frame.visibility(options);
             let view = ViewBinding::new(gpu, &self.view.view_layout, None, &visibility);
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            // The head first: its depth bounds the hair's passes (and clears the depth).
+            self.view.head.encode_view(
+                gpu,
+                &mut encoder,
+                frame.head.as_ref(),
+                camera,
+                (frame.sums.width, frame.sums.height),
+                &frame.depth_view,
+                [&frame.head_views[0], &frame.head_views[1]],
+            );
             self.view.visibility.encode(
                 gpu,
                 &mut encoder,
@@ -1077,6 +1135,7 @@ impl EnvRenderer {
                 options.shadowed,
                 grid.is_some(),
                 options.transmittance_filter,
+                maps.head.as_ref().filter(|_| !srbf_from_volume),
             );
             let visibility = frame.visibility(options);
             let view = ViewBinding::new(gpu, &self.view.view_layout, grid.as_ref(), &visibility);
@@ -1093,6 +1152,7 @@ impl EnvRenderer {
                 &view,
                 &frame.targets,
                 &frame.sums,
+                frame.head.is_some(),
             );
             gpu.queue.submit([encoder.finish()]);
         });
@@ -1129,6 +1189,7 @@ impl EnvRenderer {
             bounds,
             full_maps,
             simplified_maps,
+            head,
             ..
         } = frame;
         let geometry = if simplified { light_geometry } else { geometry };
@@ -1145,6 +1206,15 @@ impl EnvRenderer {
                 [tau_scale, enlargement],
                 &mut maps.dodm,
             );
+            if let (Some(head), Some(head_maps)) = (head.as_ref(), maps.head.as_ref()) {
+                self.view.head.encode_light_depths(
+                    gpu,
+                    &mut encoder,
+                    head,
+                    &maps.dodm.cameras,
+                    head_maps,
+                );
+            }
             gpu.queue.submit([encoder.finish()]);
         });
         timings.time(gpu, "summed-area tables", || {

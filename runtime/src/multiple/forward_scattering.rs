@@ -17,6 +17,7 @@ use super::shadow_paths::{
 };
 use crate::env_light::EnvLight;
 use crate::hair::HairModel;
+use crate::head::Head;
 
 /// Everything that sets the grid's accuracy and cost.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -187,9 +188,32 @@ pub struct CpuForwardScattering {
     settings: ForwardScatteringSettings,
     sample_grid: SampleGrid,
     positions: Vec<Vec3>,
+    /// An opaque head (issue 40): a sample whose ray toward the light meets it gets T = 0.
+    head: Option<Head>,
 }
 
 impl CpuForwardScattering {
+    /// The head as the grid's opaque boundary: samples behind it from a light receive none of
+    /// that light's forward-scattered radiance (exact ray test, [`Head::ray_hit`]); σ̄_f stays.
+    pub fn with_head(mut self, head: Option<Head>) -> Self {
+        self.head = head;
+        self
+    }
+
+    /// T = 0 at the samples `points` whose ray toward `xi` meets the head.
+    fn block_by_head(&self, xi: Vec3, points: &[Vec3], values: &mut [[f32; 4]]) {
+        let Some(head) = &self.head else { return };
+        values
+            .par_iter_mut()
+            .zip(points.par_iter())
+            .filter(|(_, p)| head.ray_hit(**p, xi, f32::INFINITY).is_some())
+            .for_each(|(v, _)| {
+                v[0] = 0.0;
+                v[1] = 0.0;
+                v[2] = 0.0;
+            });
+    }
+
     /// Voxelizes `model` and checks the tables and settings.
     pub fn new(
         model: &HairModel,
@@ -215,6 +239,7 @@ impl CpuForwardScattering {
             settings,
             sample_grid,
             positions,
+            head: None,
         }
     }
 
@@ -235,7 +260,7 @@ impl CpuForwardScattering {
                 ),
             });
         }
-        Ok(Self::from_volume(self.volume, self.tables, settings))
+        Ok(Self::from_volume(self.volume, self.tables, settings).with_head(self.head))
     }
 
     pub fn volume(&self) -> &HairVolume {
@@ -264,6 +289,12 @@ impl CpuForwardScattering {
     /// convergence study and tests probe fixed points with it.
     /// Uses the light sweep when the settings ask for it.
     pub fn values_at(&self, light: &EnvLight, points: &[Vec3]) -> Vec<[f32; 4]> {
+        let mut values = self.unblocked_values_at(light, points);
+        self.block_by_head(light_direction(light), points, &mut values);
+        values
+    }
+
+    fn unblocked_values_at(&self, light: &EnvLight, points: &[Vec3]) -> Vec<[f32; 4]> {
         let medium = self.medium(light);
         let xi = light_direction(light);
         let march = self.settings.march();

@@ -756,3 +756,34 @@ fn the_grid_and_its_paths_do_not_depend_on_the_thread_count() {
         );
     }
 }
+
+/// The head as the grid's opaque boundary (issue 40): in the parallel block, a sphere between a
+/// sample and the light leaves it T = 0, exactly where the ray meets it (f64 roots); a sample
+/// beside the sphere, or lit from the other side, keeps the value it has without the head.
+#[test]
+fn the_head_blocks_the_forward_scattered_light_where_its_ray_meets_it() {
+    use crate::head::Head;
+    let model = parallel_block(Some(0.05));
+    let plain = CpuForwardScattering::new(&model, tables(), settings(16, 2, 0.5)).unwrap();
+    let head = Head::ellipsoid(Vec3::new(8.0, 16.0, 12.0), Vec3::splat(2.5));
+    let with_head = plain.clone().with_head(Some(head.clone()));
+    let light = EnvLight::directional(Vec3::Z, [1.0; 3]);
+    let behind = Vec3::new(8.0, 16.0, 4.0);
+    let beside = Vec3::new(8.0, 20.0, 4.0);
+    let probes = [behind, beside];
+    let (a, b) = (
+        plain.values_at(&light, &probes),
+        with_head.values_at(&light, &probes),
+    );
+    assert!(head.ray_hit(behind, Vec3::Z, f32::INFINITY).is_some());
+    assert!(head.ray_hit(beside, Vec3::Z, f32::INFINITY).is_none());
+    assert!(a[0][0] > 0.0, "{a:?}");
+    assert_eq!(b[0][..3], [0.0; 3], "behind the head");
+    assert_eq!(b[1], a[1], "beside the head");
+    // Lit from −z the same sample is in front of the head.
+    let below = EnvLight::directional(-Vec3::Z, [1.0; 3]);
+    assert_eq!(
+        with_head.values_at(&below, &[behind]),
+        plain.values_at(&below, &[behind])
+    );
+}

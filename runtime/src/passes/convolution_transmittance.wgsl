@@ -53,10 +53,14 @@ struct BatchParams {
 @group(1) @binding(2) var dodm_depth: texture_2d_array<f32>;
 @group(1) @binding(3) var<storage, read> sat: array<vec4<u32>>;
 @group(1) @binding(4) var<storage, read> shading_samples: array<ShadingSample>;
+// The head's depth from each slot's light (head.wgsl; 1 where it is not drawn). Read only with
+// FLAG_HEAD: frames without a head bind a 1×1 placeholder.
+@group(1) @binding(5) var head_depth: texture_2d_array<f32>;
 
 const SAT_FIXED_POINT_SCALE: f32 = 256.0;
 const FLAG_UNSHADOWED: u32 = 1u;
 const FLAG_GRID: u32 = 2u;
+const FLAG_HEAD: u32 = 4u;
 
 fn sat_at(slot: u32, x: i32, y: i32) -> vec4<u32> {
     if (x < 0 || y < 0) { return vec4<u32>(0u); }
@@ -122,8 +126,52 @@ fn nearest_depth_around(slot: u32, texel: vec2<i32>) -> f32 {
     return z0;
 }
 
+// Taps per side of the head's percentage-closer filter.
+const HEAD_TAPS: i32 = 5;
+
+// The fraction of the light that passes the head: 0 behind it, 1 in front. A point sees the
+// head's depth map over a box that widens with its distance behind the head as the lobe's box
+// does with the distance behind the hair (R = δ/2 · slope; a directional light reads one
+// texel), so that a broad lobe's head shadow is soft; 5 × 5 taps across the box, each opaque
+// where the head is nearer the light than the point by more than two texels (the head's own
+// surface, and the roots on it, must not shadow themselves).
+fn head_transmittance(slot: u32, uv: vec2<f32>, z: f32) -> f32 {
+    if ((batch.flags & FLAG_HEAD) == 0u) { return 1.0; }
+    let light = env_lights[slot];
+    let res = f32(batch.resolution);
+    let last = i32(batch.resolution) - 1;
+    let texel = min(vec2<i32>(uv * res), vec2<i32>(last));
+    let bias = 2.0 / (light.texels_per_unit * (light.far - light.near));
+    let centre = textureLoad(head_depth, texel, i32(slot), 0).r;
+    let behind = max(z - centre, 0.0) * (light.far - light.near);
+    let radius = min(0.5 * behind * light.rgb.w * light.texels_per_unit, f32(batch.max_half_size));
+    if (radius < 0.5) {
+        return select(1.0, 0.0, centre < z - bias);
+    }
+    var passed = 0.0;
+    for (var j = 0; j < HEAD_TAPS; j++) {
+        for (var i = 0; i < HEAD_TAPS; i++) {
+            let offset = (vec2<f32>(f32(i), f32(j)) / f32(HEAD_TAPS - 1) * 2.0 - 1.0) * radius;
+            let t = clamp(texel + vec2<i32>(round(offset)), vec2<i32>(0), vec2<i32>(last));
+            let d = textureLoad(head_depth, t, i32(slot), 0).r;
+            passed += select(1.0, 0.0, d < z - bias);
+        }
+    }
+    return passed / f32(HEAD_TAPS * HEAD_TAPS);
+}
+
 fn effective_transmittance(slot: u32, world: vec3<f32>) -> f32 {
     if ((batch.flags & FLAG_UNSHADOWED) != 0u) { return 1.0; }
+    let light = env_lights[slot];
+    let clip = light.view_proj * vec4<f32>(world, 1.0);
+    let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
+    if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }
+    let head = head_transmittance(slot, uv, clip.z);
+    if (head <= 0.0) { return 0.0; }
+    return head * hair_transmittance(slot, world);
+}
+
+fn hair_transmittance(slot: u32, world: vec3<f32>) -> f32 {
     let light = env_lights[slot];
     let clip = light.view_proj * vec4<f32>(world, 1.0);
     let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);

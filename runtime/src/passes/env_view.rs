@@ -16,6 +16,7 @@ use wgpu::util::DeviceExt;
 use super::attachments::cleared_color;
 use super::convolution_depth::DodmBatch;
 use super::frame_params::FrameParams;
+use super::head::{HeadDepthMaps, HeadPass};
 use super::render_target::DEPTH_FORMAT;
 use super::strand_geometry::StrandGeometry;
 use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
@@ -84,6 +85,8 @@ struct BatchUniform {
 
 const FLAG_UNSHADOWED: u32 = 1;
 const FLAG_GRID: u32 = 2;
+/// The batch binds the head's depth from each light (`HeadDepthMaps`).
+const FLAG_HEAD: u32 = 4;
 
 /// Group 1 of the view pass and the probe (`convolution_transmittance.wgsl`).
 pub fn transmittance_bind_group_layout(
@@ -98,6 +101,7 @@ pub fn transmittance_bind_group_layout(
             float_array_texture_entry(2, visibility),
             storage_entry(3, visibility, true),
             storage_entry(4, visibility, true),
+            float_array_texture_entry(5, visibility),
         ],
     })
 }
@@ -150,11 +154,14 @@ impl BatchBinding {
                 lights: one,
             })
             .collect();
-        Self::with_groups(gpu, layout, &groups, dodm, sat, shadowed, with_grid, filter)
+        Self::with_groups(
+            gpu, layout, &groups, dodm, sat, shadowed, with_grid, filter, None,
+        )
     }
 
     /// `groups[slot]` shaded with the visibility of DODM slot `slot`; `shadowed = false`
-    /// forces T̃ = 1. SRBF lights take the box of `filter`.
+    /// forces T̃ = 1. SRBF lights take the box of `filter`. `head`: the head's depth from each
+    /// slot's light (layer `slot`), opaque in every lobe's visibility.
     #[allow(clippy::too_many_arguments)]
     pub fn with_groups(
         gpu: &GpuContext,
@@ -165,8 +172,18 @@ impl BatchBinding {
         shadowed: bool,
         with_grid: bool,
         filter: TransmittanceFilter,
+        head: Option<&HeadDepthMaps>,
     ) -> Self {
         let device = &gpu.device;
+        let placeholder;
+        let head_maps = match head {
+            Some(maps) => maps,
+            None => {
+                placeholder = HeadDepthMaps::placeholder(gpu);
+                &placeholder
+            }
+        };
+        let head_view = head_maps.array_view();
         let mut samples: Vec<ShadingSampleGpu> = Vec::new();
         let mut gpu_lights: Vec<EnvLightGpu> = groups
             .iter()
@@ -209,8 +226,13 @@ impl BatchBinding {
         if gpu_lights.is_empty() {
             gpu_lights.push(bytemuck::Zeroable::zeroed());
         }
-        let flags =
-            if shadowed { 0 } else { FLAG_UNSHADOWED } | if with_grid { FLAG_GRID } else { 0 };
+        let flags = if shadowed { 0 } else { FLAG_UNSHADOWED }
+            | if with_grid { FLAG_GRID } else { 0 }
+            | if head.is_some() && shadowed {
+                FLAG_HEAD
+            } else {
+                0
+            };
         let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("env batch"),
             contents: bytemuck::bytes_of(&BatchUniform {
@@ -256,6 +278,10 @@ impl BatchBinding {
                     binding: 4,
                     resource: sample_buffer.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&head_view),
+                },
             ],
         });
         Self { group }
@@ -295,6 +321,8 @@ struct ViewUniform {
     height: u32,
     visibility_cutoff: f32,
     _pad: u32,
+    /// rgb: the head's skin albedo; w: 1 where the frame has a head.
+    skin: [f32; 4],
 }
 
 /// Group 2: the single-scattering table (the SRBF convolution table, or the direct table for
@@ -463,6 +491,10 @@ pub struct FrameVisibility<'a> {
     pub transparency: ViewTransparency,
     pub width: u32,
     pub height: u32,
+    /// [`EnvViewTargets::head_position`] and [`EnvViewTargets::head_normal`].
+    pub head: [&'a wgpu::TextureView; 2],
+    /// The head's skin albedo; None: no head.
+    pub skin: Option<[f32; 3]>,
 }
 
 impl ViewBinding {
@@ -482,6 +514,10 @@ impl ViewBinding {
             height: visibility.height,
             visibility_cutoff: visibility.transparency.visibility_cutoff(),
             _pad: 0,
+            skin: match visibility.skin {
+                Some([r, g, b]) => [r, g, b, 1.0],
+                None => [0.0; 4],
+            },
         };
         let values = match grid {
             Some(g) => {
@@ -544,6 +580,14 @@ impl ViewBinding {
                     binding: 7,
                     resource: visibility.volume.coefficients.as_entire_binding(),
                 },
+                wgpu::BindGroupEntry {
+                    binding: 8,
+                    resource: wgpu::BindingResource::TextureView(visibility.head[0]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 9,
+                    resource: wgpu::BindingResource::TextureView(visibility.head[1]),
+                },
             ],
         });
         Self {
@@ -565,10 +609,20 @@ pub struct EnvViewTargets {
     pub coverage: wgpu::Texture,
     pub nearest_position: wgpu::Texture,
     pub nearest_tangent: wgpu::Texture,
+    /// The head seen from the view (`head.wgsl`): world position (w: 1 on the head) and normal;
+    /// 1×1 without a head.
+    pub head_position: wgpu::Texture,
+    pub head_normal: wgpu::Texture,
 }
 
 impl EnvViewTargets {
-    pub fn new(gpu: &GpuContext, width: u32, height: u32, transparency: ViewTransparency) -> Self {
+    pub fn new(
+        gpu: &GpuContext,
+        width: u32,
+        height: u32,
+        transparency: ViewTransparency,
+        with_head: bool,
+    ) -> Self {
         let size = wgpu::Extent3d {
             width,
             height,
@@ -589,6 +643,15 @@ impl EnvViewTargets {
         let read_by_view =
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         let visibility = |label, format| texture_2d(gpu, label, opaque_only, format, read_by_view);
+        let head_size = match with_head {
+            true => size,
+            false => wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+        };
+        let head = |label| texture_2d(gpu, label, head_size, NEAREST_SURFACE_FORMAT, read_by_view);
         Self {
             single: texture("env single", gpu.hdr_format(), color),
             multiple: texture("env multiple", gpu.hdr_format(), color),
@@ -600,6 +663,8 @@ impl EnvViewTargets {
             coverage: visibility("env coverage", gpu.hdr_format()),
             nearest_position: visibility("env nearest position", NEAREST_SURFACE_FORMAT),
             nearest_tangent: visibility("env nearest tangent", NEAREST_SURFACE_FORMAT),
+            head_position: head("env head position"),
+            head_normal: head("env head normal"),
         }
     }
 
@@ -616,6 +681,8 @@ impl EnvViewTargets {
             ("env coverage".into(), bytes(&self.coverage)),
             ("env nearest position".into(), bytes(&self.nearest_position)),
             ("env nearest tangent".into(), bytes(&self.nearest_tangent)),
+            ("env head position".into(), bytes(&self.head_position)),
+            ("env head normal".into(), bytes(&self.head_normal)),
         ]
     }
 }
@@ -640,6 +707,9 @@ struct AccumulateUniform {
 pub struct EnvViewPass {
     opaque: wgpu::RenderPipeline,
     transparent: wgpu::RenderPipeline,
+    /// Occupancy view: the skin behind the pixel's fibers (`skin.wgsl`), added after them.
+    skin_behind_hair: wgpu::RenderPipeline,
+    pub head: HeadPass,
     pub visibility: ViewVisibilityPass,
     accumulate: wgpu::ComputePipeline,
     accumulate_layout: wgpu::BindGroupLayout,
@@ -690,6 +760,8 @@ impl EnvViewLayouts {
                     float_texture_entry(5, fragment),
                     uniform_entry(6, fragment),
                     storage_entry(7, fragment, true),
+                    float_texture_entry(8, fragment),
+                    float_texture_entry(9, fragment),
                 ],
             ),
         }
@@ -708,6 +780,7 @@ fn env_view_shader(device: &wgpu::Device) -> wgpu::ShaderModule {
         include_str!("env_view.wgsl"),
         include_str!("visibility_volume.wgsl"),
         include_str!("view_visibility.wgsl"),
+        include_str!("skin.wgsl"),
     ]
     .concat();
     wgsl_module(device, "env_view.wgsl", &source)
@@ -806,10 +879,23 @@ impl EnvViewPass {
             ("env view (occupancy)", "vs_main", "fs_env_transparent"),
             Some(ADDITIVE),
         );
+        let skin_behind_hair = view_pipeline(
+            gpu,
+            &layout,
+            &shader,
+            (
+                "env view (skin behind hair)",
+                "vs_fullscreen",
+                "fs_env_skin",
+            ),
+            Some(ADDITIVE),
+        );
         let (accumulate, accumulate_layout) = accumulate_pipeline(device);
         Self {
             opaque,
             transparent,
+            skin_behind_hair,
+            head: HeadPass::new(gpu),
             visibility,
             accumulate,
             accumulate_layout,
@@ -902,6 +988,7 @@ impl EnvViewPass {
         view: &ViewBinding,
         targets: &EnvViewTargets,
         sums: &EnvAccumulator,
+        with_head: bool,
     ) {
         let single = targets.single.create_view(&Default::default());
         let multiple = targets.multiple.create_view(&Default::default());
@@ -924,6 +1011,10 @@ impl EnvViewPass {
             pass.set_bind_group(2, &tables.group, &[]);
             pass.set_bind_group(3, &view.group, &[]);
             pass.draw(0..vertices, 0..instances);
+            if let (ViewTransparency::Occupancy { .. }, true) = (transparency, with_head) {
+                pass.set_pipeline(&self.skin_behind_hair);
+                pass.draw(0..3, 0..1);
+            }
         }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("env accumulate"),

@@ -39,6 +39,8 @@ struct ViewParams {
     // Fragments seen less than this stop before shading (transparent view).
     visibility_cutoff: f32,
     _pad: u32,
+    // rgb: the head's skin albedo; w: 1 where the frame has a head (skin.wgsl).
+    skin: vec4<f32>,
 };
 
 @group(2) @binding(0) var<uniform> single_layout: TableLayout;
@@ -54,6 +56,9 @@ struct ViewParams {
 // w 1 where the pixel holds hair; and its (unnormalized) tangent.
 @group(3) @binding(4) var nearest_position: texture_2d<f32>;
 @group(3) @binding(5) var nearest_tangent: texture_2d<f32>;
+// The head seen from the view (head.wgsl): xyz its world position, w 1 on the head; its normal.
+@group(3) @binding(8) var head_position: texture_2d<f32>;
+@group(3) @binding(9) var head_normal: texture_2d<f32>;
 
 // The 16 corners of a 4D cell: base offset, per-axis steps (0 on one-node axes), weights.
 struct Cell4 {
@@ -203,17 +208,33 @@ fn vs_fullscreen(@builtin(vertex_index) vertex: u32) -> @builtin(position) vec4<
     return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
 }
 
+// With a head, the prepass and the coverage kept only fibers in front of it (depth test against
+// the head's depth): the hair's radiance over the skin's, the skin seen through 1 − coverage.
 @fragment
 fn fs_env_deferred(@builtin(position) pixel: vec4<f32>) -> EnvOut {
     let p = vec2<i32>(pixel.xy);
     let nearest = textureLoad(nearest_position, p, 0);
-    if (nearest.w == 0.0) { discard; }
-    let tau = textureLoad(coverage, p, 0).r;
-    return shade(nearest.xyz, textureLoad(nearest_tangent, p, 0).xyz, 1.0 - exp(-tau));
+    let head = head_at(p);
+    if (nearest.w == 0.0 && head.w == 0.0) { discard; }
+    var out: EnvOut;
+    out.single = vec4<f32>(0.0);
+    out.multiple = vec4<f32>(0.0);
+    if (nearest.w != 0.0) {
+        let tau = textureLoad(coverage, p, 0).r;
+        out = shade(nearest.xyz, textureLoad(nearest_tangent, p, 0).xyz, 1.0 - exp(-tau));
+    }
+    if (head.w != 0.0) {
+        let seen = 1.0 - out.single.a;
+        let skin = shade_skin(head.xyz, textureLoad(head_normal, p, 0).xyz) * seen;
+        out.single += vec4<f32>(skin, seen);
+        out.multiple.a += seen;
+    }
+    return out;
 }
 
 @fragment
 fn fs_env_transparent(in: VertexOut) -> EnvOut {
+    if (behind_head(in)) { discard; }
     let seen = occupancy_visibility(in);
     if (seen < view.visibility_cutoff) { discard; }
     return shade(in.world, in.tangent, in.alpha * seen);

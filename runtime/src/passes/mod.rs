@@ -7,6 +7,7 @@ pub mod deep_opacity;
 pub mod env_view;
 pub mod fiber_shading;
 pub mod frame_params;
+pub mod head;
 pub mod kbuffer;
 pub mod random_subsets;
 pub mod render_target;

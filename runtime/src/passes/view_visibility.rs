@@ -203,7 +203,14 @@ impl ViewVisibilityPass {
                 Some("fs_nearest_surface"),
                 Some((Less, true)),
             ),
-            coverage: pipeline("view coverage", strands_only, Some("fs_coverage"), None),
+            // Against the head's depth alone (the head pass wrote it; the prepass runs after):
+            // fibers behind the head add no coverage.
+            coverage: pipeline(
+                "view coverage",
+                strands_only,
+                Some("fs_coverage"),
+                Some((Less, false)),
+            ),
             range: reading("occupancy depth range", "fs_occupancy_range", Always),
             slices: reading("occupancy slices", "fs_occupancy_slices", Always),
             count_rasterized: reading("count rasterized", "fs_count_rasterized", Always),
@@ -212,10 +219,11 @@ impl ViewVisibilityPass {
         }
     }
 
-    /// Encodes the frame's build: the depth prepass into `depth` with each pixel's nearest fiber
-    /// into `nearest` (position, tangent), and the coverage into `coverage` (opaque, all kept
-    /// for the view passes), or the occupancy map zeroed and its two passes. `view` must bind
-    /// `map`.
+    /// Encodes the frame's build: the coverage into `coverage`, then the depth prepass into
+    /// `depth` with each pixel's nearest fiber into `nearest` (position, tangent) (opaque, all
+    /// kept for the view passes; both test against the head's depth, which `depth` holds on
+    /// entry), or the occupancy map zeroed and its two passes (which test against the head in
+    /// the shader). `view` must bind `map`.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
         &self,
@@ -239,18 +247,12 @@ impl ViewVisibilityPass {
             bool,
         )> = match transparency {
             ViewTransparency::Opaque => vec![
+                ("view coverage", vec![coverage], true, &self.coverage, false),
                 (
                     "view depth prepass",
                     nearest.to_vec(),
                     true,
                     &self.depth_prepass,
-                    false,
-                ),
-                (
-                    "view coverage",
-                    vec![coverage],
-                    false,
-                    &self.coverage,
                     false,
                 ),
             ],
@@ -267,10 +269,12 @@ impl ViewVisibilityPass {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some(label),
                 color_attachments: &color_attachments,
-                depth_stencil_attachment: if with_depth {
-                    cleared_depth(depth, true)
-                } else {
-                    None
+                // The opaque view's passes keep the head's depth; the occupancy passes test
+                // Always (against the head in the shader).
+                depth_stencil_attachment: match (with_depth, transparency) {
+                    (false, _) => None,
+                    (true, ViewTransparency::Opaque) => prepassed_depth(depth),
+                    (true, ViewTransparency::Occupancy { .. }) => cleared_depth(depth, true),
                 },
                 timestamp_writes: gpu.render_timestamps(),
                 occlusion_query_set: None,

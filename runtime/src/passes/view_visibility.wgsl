@@ -24,6 +24,7 @@ fn fs_nearest_surface(in: VertexOut) -> NearestSurface {
 // Pass 1: the nearest and farthest view depth of each pixel's fragments.
 @fragment
 fn fs_occupancy_range(in: VertexOut) {
+    if (behind_head(in)) { discard; }
     let r = occupancy_record(in.clip.xy, view.width);
     let key = ordered_depth(view_depth(in.world));
     atomicMax(&occupancy_map[r], ~key);
@@ -45,6 +46,7 @@ fn pixel_depth_range(r: u32) -> DepthRange {
 // Pass 2: each fragment marks its slice and adds its optical depth to its slab.
 @fragment
 fn fs_occupancy_slices(in: VertexOut) {
+    if (behind_head(in)) { discard; }
     let r = occupancy_record(in.clip.xy, view.width);
     let range = pixel_depth_range(r);
     let s = occupancy_slice(view_depth(in.world), range.nearest, range.farthest);
@@ -69,6 +71,7 @@ fn fs_count_nearest(in: VertexOut) -> @location(0) vec4<f32> {
 
 @fragment
 fn fs_count_visible(in: VertexOut) -> @location(0) vec4<f32> {
+    if (behind_head(in)) { discard; }
     if (occupancy_visibility(in) < view.visibility_cutoff) { discard; }
     return vec4<f32>(0.0, 1.0, 0.0, 0.0);
 }

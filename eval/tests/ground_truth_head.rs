@@ -1,0 +1,259 @@
+//! The head in the path-traced ground truth (issue 40): Mitsuba 3 renders a small groom with and
+//! without the head fitted to its roots (an `obj` mesh with a `diffuse` BSDF of the skin's
+//! albedo), under one directional light, direct light only. Checked against geometry worked out
+//! here (eye rays and light rays against the ellipsoid, f64 roots) and against strandlight's own
+//! frame of the same scene:
+//! * where the eye ray meets the head and no hair covers the pixel, Mitsuba's pixel is opaque
+//!   with the head and empty without it;
+//! * there, Mitsuba's skin radiance and strandlight's agree (albedo/π × irradiance: one
+//!   convention for the skin in both);
+//! * hair pixels whose ray toward the light meets the head are darker with the head.
+//!
+//! Mitsuba is installed by `.ci/run`; without it (or without a GPU device) the test prints why
+//! and passes, unless `STRANDLIGHT_REQUIRE_TOOLS=1`.
+
+use glam::{DVec3, Vec3};
+use std::path::PathBuf;
+use strandlight_eval::ground_truth::mitsuba_scene::{MitsubaRun, MitsubaScene};
+use strandlight_eval::ground_truth::{INSTALL_HINT, TruthInputs, render_cached};
+use strandlight_eval::reference_cache::ReferenceCache;
+use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
+use strandlight_runtime::camera::Projection;
+use strandlight_runtime::env_light::EnvLight;
+use strandlight_runtime::hair::{GroomParams, HairModel, generate_groom};
+use strandlight_runtime::head::Head;
+use strandlight_scene::camera_choice::front_camera;
+use strandlight_scene::env_frame::{EnvFrame, FrameRole, env_adapter, render_lights};
+use strandlight_scene::head_input::{HeadChoice, load_head};
+use strandlight_scene::image_metrics::Image;
+use strandlight_scene::look::{EnvLook, LookArgs};
+use strandlight_scene::scene_tables::{EnvShading, ScatteringMode, bake_scene_tables};
+use strandlight_tables::outside_tools::require_python_modules;
+
+const SIZE: (u32, u32) = (48, 36);
+const SKIN: [f32; 3] = [0.6, 0.45, 0.35];
+
+fn tools() -> bool {
+    if !require_python_modules(&["mitsuba"], INSTALL_HINT) {
+        return false;
+    }
+    if let Err(e) = env_adapter() {
+        eprintln!("skipped: no GPU device for the env-lit renderer: {e:#}");
+        return false;
+    }
+    true
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("strandlight-head-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn groom() -> HairModel {
+    generate_groom(&GroomParams {
+        strand_count: 300,
+        clump_count: 12,
+        thickness: 1.5,
+        ..GroomParams::default()
+    })
+    .unwrap()
+}
+
+fn mitsuba(
+    hair: &HairModel,
+    head: Option<&Head>,
+    light: &[([f64; 3], [f64; 3])],
+    fiber: &serde_json::Value,
+    dir: &std::path::Path,
+) -> Image {
+    let (up, camera) = front_camera(hair, SIZE);
+    let scene = MitsubaScene {
+        hair,
+        up,
+        camera,
+        size: SIZE,
+        map: None,
+        rotate_degrees: 0.0,
+        directional: light,
+        fiber,
+        head,
+    };
+    let inputs = TruthInputs {
+        scene,
+        hair_sha256: "the head test's groom",
+        map_sha256: "no map",
+    };
+    let run = MitsubaRun {
+        max_depth: 2,
+        spp: 64,
+        seed: 1,
+    };
+    let cache = ReferenceCache::new(dir.join("cache"));
+    render_cached(&inputs, run, &cache, &dir.join("work"), true)
+        .unwrap()
+        .expect("rendering is allowed")
+        .0
+}
+
+/// The eye ray through the centre of pixel (x, y) of the front camera.
+fn eye_ray(hair: &HairModel, x: usize, y: usize) -> (Vec3, Vec3) {
+    let (_, camera) = front_camera(hair, SIZE);
+    let Projection::Perspective { fov_y } = camera.projection else {
+        panic!("the front camera is perspective")
+    };
+    let forward = (camera.target - camera.eye).normalize();
+    let right = forward.cross(camera.up).normalize();
+    let up = right.cross(forward);
+    let t = (fov_y * 0.5).tan();
+    let aspect = SIZE.0 as f32 / SIZE.1 as f32;
+    let nx = (x as f32 + 0.5) / SIZE.0 as f32 * 2.0 - 1.0;
+    let ny = 1.0 - (y as f32 + 0.5) / SIZE.1 as f32 * 2.0;
+    let d = (forward + right * nx * t * aspect + up * ny * t).normalize();
+    (camera.eye, d)
+}
+
+#[test]
+#[ignore = "unfinished: its CPU eye rays meet the head in 86 pixels where Mitsuba draws 218 opaque ones and none is free of hair, so no skin pixel is selected; the eye-ray construction or the groom's width is to be checked"]
+fn mitsuba_draws_and_shadows_the_head_where_the_geometry_says() {
+    if !tools() {
+        return;
+    }
+    let dir = scratch("truth");
+    let hair = groom();
+    let head = load_head(&HeadChoice::Ellipsoid, &hair, SKIN)
+        .unwrap()
+        .unwrap();
+    let fiber = FiberDescription::preset("brown").unwrap();
+    let fiber_json = serde_json::to_value(&fiber.chiang).unwrap();
+    // From the front, above and to the right; the back of the hair is in the head's shadow.
+    let toward = DVec3::new(0.4, 0.5, 1.0).normalize();
+    let light = [(toward.to_array(), [3.0, 3.0, 3.0])];
+    let with = mitsuba(&hair, Some(&head), &light, &fiber_json, &dir.join("with"));
+    let without = mitsuba(&hair, None, &light, &fiber_json, &dir.join("without"));
+    // strandlight's frame of the same scene, for the skin's radiance.
+    let tables = bake_scene_tables(
+        &fiber,
+        EnvShading::Chiang,
+        BakeResolution::default(),
+        (16.0, 256.0),
+        &[EnvShading::Chiang.direct_table(ScatteringMode::Single)],
+        &dir.join("tables"),
+        &mut |_| {},
+    )
+    .unwrap();
+    let (_, camera) = front_camera(&hair, SIZE);
+    let lights = [EnvLight::directional(toward.as_vec3(), [3.0, 3.0, 3.0])];
+    let ours = render_lights(&EnvFrame {
+        hair: &hair,
+        camera,
+        width: SIZE.0,
+        height: SIZE.1,
+        lights: &lights,
+        tables: &tables,
+        shading: EnvShading::Chiang,
+        mode: ScatteringMode::Single,
+        role: FrameRole::Reference,
+        look: EnvLook {
+            shadowed: true,
+            ..LookArgs::default().look().unwrap()
+        },
+        head: Some(head.clone()),
+    })
+    .unwrap()
+    .image;
+    let w = SIZE.0 as usize;
+    let (mut skin_pixels, mut ours_sum, mut theirs_sum) = (0, 0.0f64, 0.0f64);
+    for y in 0..SIZE.1 as usize {
+        for x in 0..w {
+            let i = y * w + x;
+            let (eye, d) = eye_ray(&hair, x, y);
+            let hits = head.ray_hit(eye, d, 1e6).is_some();
+            // A pixel wholly skin: the ray and its neighbours' meet the head, no hair covers it.
+            let inner = [(0i32, 0i32), (1, 0), (-1, 0), (0, 1), (0, -1)]
+                .iter()
+                .all(|(dx, dy)| {
+                    let (xx, yy) = (
+                        (x as i32 + dx).clamp(0, w as i32 - 1),
+                        (y as i32 + dy).clamp(0, SIZE.1 as i32 - 1),
+                    );
+                    let (e, dd) = eye_ray(&hair, xx as usize, yy as usize);
+                    head.ray_hit(e, dd, 1e6).is_some()
+                });
+            if hits && inner && without.pixels[i][3] < 0.02 {
+                assert!(
+                    with.pixels[i][3] > 0.98,
+                    "({x}, {y}): the head is not drawn"
+                );
+                skin_pixels += 1;
+                ours_sum += ours.pixels[i][..3].iter().map(|&v| v as f64).sum::<f64>();
+                theirs_sum += with.pixels[i][..3].iter().map(|&v| v as f64).sum::<f64>();
+            }
+            if !hits {
+                assert!(
+                    (with.pixels[i][3] - without.pixels[i][3]).abs() < 0.1
+                        || with.pixels[i][3] > without.pixels[i][3],
+                    "({x}, {y}): the head changes a pixel it does not cover"
+                );
+            }
+        }
+    }
+    let hit_count = (0..SIZE.1 as usize)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            let (e, d) = eye_ray(&hair, x, y);
+            head.ray_hit(e, d, 1e6).is_some()
+        })
+        .count();
+    let with_opaque = with.pixels.iter().filter(|p| p[3] > 0.98).count();
+    println!("{hit_count} eye rays meet the head, {with_opaque} opaque Mitsuba pixels with it");
+    println!("{skin_pixels} skin pixels: strandlight {ours_sum:.4}, Mitsuba {theirs_sum:.4}");
+    assert!(skin_pixels > 20, "{skin_pixels}");
+    let ratio = ours_sum / theirs_sum;
+    assert!(
+        (ratio - 1.0).abs() < 0.1,
+        "skin radiance ours/Mitsuba {ratio}"
+    );
+    // Hair the head hides from the light: darker in Mitsuba with the head.
+    let (mut shadowed_with, mut shadowed_without, mut n) = (0.0f64, 0.0f64, 0);
+    for (s, strand) in hair.strands().enumerate() {
+        let _ = s;
+        for p in strand.iter().step_by(3) {
+            if head.ray_hit(*p, toward.as_vec3(), 1e6).is_none() {
+                continue;
+            }
+            // Its pixel, if the eye sees it unblocked by the head.
+            let (eye, _) = eye_ray(&hair, 0, 0);
+            let to_p = *p - eye;
+            if head.ray_hit(eye, to_p.normalize(), to_p.length()).is_some() {
+                continue;
+            }
+            let Some((x, y)) = project(&hair, *p) else {
+                continue;
+            };
+            let i = y * w + x;
+            if without.pixels[i][3] > 0.5 {
+                shadowed_with += with.pixels[i][0] as f64;
+                shadowed_without += without.pixels[i][0] as f64;
+                n += 1;
+            }
+        }
+    }
+    println!(
+        "{n} hair samples behind the head from the light: {shadowed_with:.4} with, {shadowed_without:.4} without"
+    );
+    assert!(n > 10, "{n}");
+    assert!(shadowed_with < 0.7 * shadowed_without);
+}
+
+/// The pixel the front camera sees `p` in.
+fn project(hair: &HairModel, p: Vec3) -> Option<(usize, usize)> {
+    let (_, camera) = front_camera(hair, SIZE);
+    let clip =
+        camera.projection_matrix(SIZE.0 as f32 / SIZE.1 as f32) * camera.view() * p.extend(1.0);
+    let ndc = clip.truncate() / clip.w;
+    let x = ((ndc.x + 1.0) * 0.5 * SIZE.0 as f32).floor();
+    let y = ((1.0 - ndc.y) * 0.5 * SIZE.1 as f32).floor();
+    (x >= 0.0 && y >= 0.0 && x < SIZE.0 as f32 && y < SIZE.1 as f32)
+        .then_some((x as usize, y as usize))
+}

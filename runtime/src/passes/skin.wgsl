@@ -1,0 +1,111 @@
+// The head's skin in the env-lit view (appended to the env view module): a Lambertian surface
+// of albedo `view.skin.rgb` under the batch's lights, each seen through the hair and the head
+// as the fibers see it (effective_transmittance, with the head's depth maps), or through the
+// visibility volume for SRBF lobes that read it. Radiance = albedo/π · Σ_j T_j · E_j(n), with
+// E_j the irradiance of light j on the normal n:
+//   directional: L_j · max(n·ω_j, 0) (L_j is the light's irradiance);
+//   SRBF:        L_j · ∫ G(ω; ξ_j, λ_j) max(n·ω, 0) dω, Hill's fitted closed form (2016,
+//                "Irradiance from a spherical Gaussian"), mirrored by head::srbf_irradiance in
+//                Rust and tested there against f64 quadrature.
+// Multiple scattering from the hair onto the skin is left out.
+
+// Broad lobes (λ < 3): the zonal harmonics l ≤ 2 (head::srbf_irradiance_sh2).
+fn srbf_irradiance_sh2(c: f32, lambda: f32) -> f32 {
+    let l = lambda;
+    let e = exp(-2.0 * l);
+    let i0 = (1.0 - e) / l;
+    let i1 = 1.0 / l - 1.0 / (l * l) + e * (1.0 / l + 1.0 / (l * l));
+    let m2 = (1.0 / l - 2.0 / (l * l) + 2.0 / (l * l * l))
+        - e * (1.0 / l + 2.0 / (l * l) + 2.0 / (l * l * l));
+    let i2 = (3.0 * m2 - i0) / 2.0;
+    return 3.141592654 * (0.5 * i0 + i1 * c + 0.625 * i2 * (3.0 * c * c - 1.0) / 2.0);
+}
+
+// ∫ exp(λ(ω·ξ − 1)) max(n·ω, 0) dω for cos = n·ξ and λ = 1/inv_lambda.
+fn srbf_irradiance(cos_n_xi: f32, inv_lambda: f32) -> f32 {
+    let lambda = 1.0 / inv_lambda;
+    if (lambda < 3.0) { return max(srbf_irradiance_sh2(cos_n_xi, lambda), 0.0); }
+    let eml = exp(-lambda);
+    let em2l = eml * eml;
+    let scale = 1.0 + 2.0 * em2l - inv_lambda;
+    let bias = (eml - em2l) * inv_lambda - em2l;
+    let x = sqrt(max(1.0 - scale, 0.0));
+    let x0 = 0.36 * cos_n_xi;
+    let x1 = x / (4.0 * 0.36);
+    var y = clamp(cos_n_xi, 0.0, 1.0);
+    if (abs(x0) <= x1) {
+        let n = x0 + x1;
+        y = n * n / x;
+    }
+    let integral = 6.283185307 * inv_lambda * (1.0 - em2l);
+    return max(scale * y + bias, 0.0) * integral;
+}
+
+fn frame_has_head() -> bool {
+    return view.skin.w > 0.5;
+}
+
+// The head's position (w: 1 on the head) at `pixel`.
+fn head_at(pixel: vec2<i32>) -> vec4<f32> {
+    if (!frame_has_head()) { return vec4<f32>(0.0); }
+    return textureLoad(head_position, pixel, 0);
+}
+
+// Whether the fiber fragment `in` lies behind the head along its pixel's ray (the occupancy
+// passes and the transparent view have no depth attachment: they test in the shader).
+fn behind_head(in: VertexOut) -> bool {
+    let head = head_at(vec2<i32>(in.clip.xy));
+    return head.w > 0.0 && view_depth(in.world) > view_depth(head.xyz);
+}
+
+// Skin radiance at `world` with normal `n` under the batch's lights.
+fn shade_skin(world: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let with_volume = shades_from_volume();
+    // Lift the lookup point off the surface by about a light-map texel, so that the head's own
+    // depth in the maps does not shadow the skin it was drawn from (acne).
+    var e = vec3<f32>(0.0);
+    for (var slot = 0u; slot < batch.light_count; slot++) {
+        let light = env_lights[slot];
+        let lift = 2.0 / max(light.texels_per_unit, 1e-6);
+        let p = world + n * lift;
+        var visible: f32;
+        if (with_volume && light.direction.w > 0.0) {
+            visible = volume_lobe_visibility(volume_coefficients(p), light.direction.xyz, light.direction.w);
+        } else {
+            visible = effective_transmittance(slot, p);
+        }
+        if (visible <= 0.0) { continue; }
+        for (var s = light.first_sample; s < light.first_sample + light.sample_count; s++) {
+            let sample = shading_samples[s];
+            let c = dot(n, sample.direction.xyz);
+            var irradiance: f32;
+            if (sample.direction.w > 0.0) {
+                irradiance = srbf_irradiance(c, sample.direction.w);
+            } else {
+                irradiance = max(c, 0.0);
+            }
+            e += visible * irradiance * sample.rgb.xyz;
+        }
+    }
+    return view.skin.rgb * e / 3.141592654;
+}
+
+// Occupancy view: the skin behind all the pixel's fibers, seen through their optical depth
+// (every slab of the occupancy record: its fibers all lie in front of the head).
+@fragment
+fn fs_env_skin(@builtin(position) pixel: vec4<f32>) -> EnvOut {
+    let p = vec2<i32>(pixel.xy);
+    let head = head_at(p);
+    if (head.w == 0.0) { discard; }
+    let r = occupancy_record(pixel.xy, view.width);
+    var tau = 0.0;
+    for (var k = 0u; k < 4u; k++) {
+        tau += f32(atomicLoad(&occupancy_map[r + 6u + k]));
+    }
+    let seen = exp(-tau / OCC_TAU_SCALE);
+    let n = textureLoad(head_normal, p, 0).xyz;
+    var out: EnvOut;
+    out.single = vec4<f32>(shade_skin(head.xyz, n) * seen, seen);
+    out.multiple = vec4<f32>(0.0, 0.0, 0.0, seen);
+    return out;
+}
