@@ -14,6 +14,7 @@ use strandlight_eval::bench_plots::{Metric, plot};
 use strandlight_eval::bench_report::{
     details, section, splice, splice_truth, truth_details, truth_section,
 };
+use strandlight_scene::head_input::HeadChoice;
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 use strandlight_tables::atomic_write::write_atomically;
@@ -61,6 +62,10 @@ pub struct BenchArgs {
     /// report merges (`--from-report`) beside the sweeps' reports of the same maps.
     #[arg(long)]
     pub decomposition_only: bool,
+    /// The head in every frame, the ground truth's too: none, ellipsoid (fitted to the strand
+    /// roots) or FILE.obj (default: the plan's, none).
+    #[arg(long, value_name = "none|ellipsoid|FILE.obj")]
+    pub head: Option<HeadChoice>,
     /// Cache folder (fits, tables, reference images), shared with `compare`.
     #[arg(long, default_value = "out/cache")]
     pub cache: PathBuf,
@@ -68,7 +73,7 @@ pub struct BenchArgs {
     /// wrote (after a change to how they are drawn, without the hour of measuring). Several
     /// reports of the same plan on different maps or modes (a sweep run map by map, each with
     /// the reference budget its map needs) make one page.
-    #[arg(long, value_name = "REPORT_JSON", num_args = 1.., conflicts_with_all = ["quick", "truth", "maps", "data", "modes", "reference_max_lights", "baseline_lights", "baseline", "decomposition_only"])]
+    #[arg(long, value_name = "REPORT_JSON", num_args = 1.., conflicts_with_all = ["quick", "truth", "maps", "data", "modes", "reference_max_lights", "baseline_lights", "baseline", "decomposition_only", "head"])]
     pub from_report: Vec<PathBuf>,
 }
 
@@ -185,6 +190,7 @@ fn measure(args: &BenchArgs) -> anyhow::Result<Option<BenchReport>> {
         baseline_lights: args.baseline_lights.clone(),
         baseline: args.baseline,
         decomposition_only: args.decomposition_only,
+        head: args.head.clone(),
     })?;
     let mut steps = Steps::new(false);
     let paths = BenchPaths {

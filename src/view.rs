@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use std::time::Duration;
 use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting, PointLighting};
 use strandlight_scene::hair_input::parse_size;
+use strandlight_scene::head_input::HeadChoice;
 use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
 
@@ -29,6 +30,9 @@ pub struct ViewArgs {
     preset: String,
     #[arg(long, value_enum, default_value = "full")]
     scattering: ScatteringMode,
+    /// The head the hair grows from: none, ellipsoid (fitted to the strand roots) or FILE.obj.
+    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE.obj")]
+    head: HeadChoice,
     /// Image size WxH in pixels (the window shows it scaled to fit).
     #[arg(long, default_value = "640x480")]
     size: String,
@@ -84,6 +88,7 @@ fn settings(args: &ViewArgs) -> anyhow::Result<FrameSettings> {
     settings.hair = args.hair.clone();
     settings.shading = args.shading;
     settings.preset = args.preset.clone();
+    settings.head = args.head.clone();
     Ok(settings)
 }
 

@@ -30,6 +30,7 @@ use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_scene::env_frame::{EnvFrame, FrameRole, render_lights};
 use strandlight_scene::environment::load_env;
 use strandlight_scene::fit_cache::fit_cached;
+use strandlight_scene::head_input::HeadChoice;
 use strandlight_scene::image_metrics::{Image, relative_rmse};
 use strandlight_scene::look::{EnvTransparency, LobeVisibilityArg, LookArgs, ViewArgs};
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
@@ -80,6 +81,10 @@ pub struct BenchPlan {
     /// before it existed: true.
     #[serde(default = "yes")]
     pub decomposition: bool,
+    /// The head in every frame, the ground truth's too (issue 40). Reports written before it
+    /// existed: none.
+    #[serde(default, skip_serializing_if = "HeadChoice::is_none")]
+    pub head: HeadChoice,
 }
 
 fn one_run() -> usize {
@@ -145,6 +150,9 @@ impl BenchPlan {
         if plan.decomposition_only {
             args += " --decomposition-only";
         }
+        if !plan.head.is_none() {
+            args += &format!(" --head {}", plan.head);
+        }
         args
     }
 
@@ -173,6 +181,7 @@ impl BenchPlan {
             ground_truth: false,
             truth_max_spp: truth_max_spp(),
             decomposition: true,
+            head: HeadChoice::None,
         }
     }
 
@@ -240,12 +249,13 @@ impl BenchPlan {
             ground_truth: false,
             truth_max_spp: truth_max_spp(),
             decomposition: true,
+            head: HeadChoice::None,
         }
     }
 }
 
 /// What a run changes of its base plan (`bench --maps --modes --reference-max-lights
-/// --baseline-lights --baseline`): a subset, or a longer ladder, more baseline points or the
+/// --baseline-lights --baseline --head`): a subset, or a longer ladder, more baseline points or the
 /// other baseline where one map needs them, without editing the plan.
 #[derive(Debug, Clone, Default)]
 pub struct PlanChanges {
@@ -255,6 +265,7 @@ pub struct PlanChanges {
     pub baseline_lights: Vec<usize>,
     pub baseline: Option<Baseline>,
     pub decomposition_only: bool,
+    pub head: Option<HeadChoice>,
 }
 
 /// The most median-cut lights a bench frame may ask for (a light map each; the largest
@@ -304,6 +315,9 @@ impl BenchPlan {
             self.baseline = baseline;
         }
         self.decomposition_only |= changes.decomposition_only;
+        if let Some(head) = &changes.head {
+            self.head = head.clone();
+        }
         let probe = compare_args(
             &self,
             Path::new("map"),
@@ -591,6 +605,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         timing_runs: plan.timing_runs,
         baseline: plan.baseline,
         light_map_size: plan.dodm_sizes[0],
+        head: plan.head.clone(),
         look: LookArgs {
             transparency: EnvTransparency::Opaque,
             view: ViewArgs {

@@ -592,6 +592,7 @@ mod tests {
     use super::*;
     use crate::baseline::Baseline;
     use crate::bench::{BenchPlan, PlanChanges, Point};
+    use strandlight_scene::head_input::HeadChoice;
 
     #[test]
     fn the_generated_section_is_replaced_and_the_rest_kept() {
@@ -926,12 +927,13 @@ mod tests {
             baseline_lights: vec![256, 16, 64, 16],
             baseline: Some(Baseline::MedianCutSources),
             decomposition_only: true,
+            head: Some(HeadChoice::Ellipsoid),
         };
         let plan = BenchPlan::quick().changed(&changes).unwrap();
         assert_eq!(plan.baseline_lights, [16, 64, 256]);
         assert_eq!(
             plan.regenerate_args(),
-            " --quick --maps quarry_01_1k.hdr --modes full --reference-max-lights 6144 --baseline-lights 16,64,256 --baseline median-cut-sources --decomposition-only"
+            " --quick --maps quarry_01_1k.hdr --modes full --reference-max-lights 6144 --baseline-lights 16,64,256 --baseline median-cut-sources --decomposition-only --head ellipsoid"
         );
         let unchanged = PlanChanges {
             modes: BenchPlan::full().modes,

@@ -12,6 +12,7 @@ use strandlight_runtime::passes::deep_opacity::MAX_LAYERS;
 use strandlight_scene::frame_settings::{
     EnvLighting, Lighting, PointLighting, Shadows, Transparency,
 };
+use strandlight_scene::head_input::HeadChoice;
 use strandlight_scene::look::{EnvTransparency, LobeVisibilityArg};
 use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
@@ -107,7 +108,7 @@ impl Panel {
                         "hair and maps",
                         hair::EXTENSIONS
                             .iter()
-                            .chain(&["hdr", "exr"])
+                            .chain(&["hdr", "exr", "obj"])
                             .copied()
                             .collect(),
                     )
@@ -120,7 +121,10 @@ impl Panel {
                 outcome.reset_camera = true;
             }
         });
-        ui.small("or drop a .hair/.tfx/.data/.ply/.usd*/.abc or .hdr/.exr file on the window");
+        ui.small(
+            "or drop a .hair/.tfx/.data/.ply/.usd*/.abc, .hdr/.exr or head .obj file on the window",
+        );
+        head(ui, &mut s.head);
         let mut shading = s.shading();
         egui::ComboBox::from_label("fiber model")
             .selected_text(format!("{shading:?}"))
@@ -148,6 +152,23 @@ impl Panel {
             });
         ui.separator();
     }
+}
+
+/// The head the hair grows from: none, the ellipsoid fitted to the roots, or the mesh the flags or
+/// a dropped .obj gave.
+fn head(ui: &mut egui::Ui, head: &mut HeadChoice) {
+    let mut choices = vec![HeadChoice::None, HeadChoice::Ellipsoid];
+    if let HeadChoice::Mesh(_) = head {
+        choices.push(head.clone());
+    }
+    egui::ComboBox::from_label(format!("head ({})", Recompute::ShadowMaps.label()))
+        .selected_text(head.to_string())
+        .show_ui(ui, |ui| {
+            for choice in choices {
+                let text = choice.to_string();
+                ui.selectable_value(head, choice, text);
+            }
+        });
 }
 
 fn lighting(ui: &mut egui::Ui, state: &mut ViewState, lobes: &mut usize, status: &Status) {

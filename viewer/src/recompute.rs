@@ -132,9 +132,10 @@ pub fn tables_key(settings: &FrameSettings) -> TablesKey {
     }
 }
 
-/// What the light passes depend on.
+/// What the light passes depend on: the lights, the map choices and the head, opaque in every map.
 fn light_maps_key(settings: &FrameSettings) -> String {
-    match &settings.lighting {
+    let head = format!("{} {:?}", settings.head, settings.skin_albedo);
+    let lights = match &settings.lighting {
         Lighting::Lights(p) => format!(
             "{:?} {:?} {} {:?} {} {} {} {:?} {} {:?}",
             p.lights,
@@ -152,7 +153,8 @@ fn light_maps_key(settings: &FrameSettings) -> String {
             "{} {:?} {} {}",
             e.kappa, e.lobes, e.rotation_deg, e.dodm_size
         ),
-    }
+    };
+    format!("{lights} {head}")
 }
 
 pub fn recompute(old: &ViewState, new: &ViewState) -> Recompute {
@@ -174,6 +176,7 @@ pub fn recompute(old: &ViewState, new: &ViewState) -> Recompute {
 mod tests {
     use super::*;
     use strandlight_scene::frame_settings::{EnvLighting, PointLighting, Shadows};
+    use strandlight_scene::head_input::HeadChoice;
     use strandlight_scene::scene_tables::ScatteringMode;
 
     fn state(lighting: Lighting, shading: Shading) -> ViewState {
@@ -248,6 +251,10 @@ mod tests {
             Recompute::ShadowMaps
         );
         assert_eq!(cost(&lit, |s| env_of(s).kappa = 1.0), Recompute::ShadowMaps);
+        assert_eq!(
+            cost(&lit, |s| s.settings.head = HeadChoice::Ellipsoid),
+            Recompute::ShadowMaps
+        );
         assert_eq!(
             cost(&lit, |s| env_of(s).scattering = ScatteringMode::Single),
             Recompute::Tables

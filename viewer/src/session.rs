@@ -18,6 +18,7 @@ use strandlight_runtime::hair;
 use strandlight_scene::camera_choice::CameraChoice;
 use strandlight_scene::exposure::metered_stops;
 use strandlight_scene::frame_settings::{CameraSettings, ExactCamera, FrameSettings, Lighting};
+use strandlight_scene::head_input::HeadChoice;
 
 /// Changes that need a rebake wait this long after the last edit (a slider being dragged).
 const REBAKE_SETTLE: Duration = Duration::from_millis(400);
@@ -284,7 +285,7 @@ impl Session {
         self.edit(|s| s.settings.camera = CameraSettings::Framed(CameraChoice::default()));
     }
 
-    /// A dropped or picked file: hair by its extension, else an environment map.
+    /// A dropped or picked file by its extension: hair, an environment map or a head mesh.
     fn open(&mut self, path: PathBuf) {
         let ext = path
             .extension()
@@ -303,9 +304,10 @@ impl Session {
                 let map = path.display().to_string();
                 self.edit(|s| s.settings.light_with_environment(map));
             }
+            "obj" => self.edit(|s| s.settings.head = HeadChoice::Mesh(path)),
             _ => {
                 self.message = Some(format!(
-                    "{}: not a hair file (.hair, .tfx, .data, .ply, .usda, .usdc, .usdz, .usd, .abc) or an environment map (.hdr, .exr)",
+                    "{}: not a hair file (.hair, .tfx, .data, .ply, .usda, .usdc, .usdz, .usd, .abc), an environment map (.hdr, .exr) or a head mesh (.obj)",
                     path.display()
                 ))
             }
