@@ -61,18 +61,20 @@ fn behind_head(in: VertexOut) -> bool {
 // Skin radiance at `world` with normal `n` under the batch's lights.
 fn shade_skin(world: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let with_volume = shades_from_volume();
-    // Lift the lookup point off the surface by about a light-map texel, so that the head's own
-    // depth in the maps does not shadow the skin it was drawn from (acne).
+    // The light maps' lookup point is lifted off the surface by two of their texels, so that the
+    // head's own depth in the maps does not shadow the skin it was drawn from (acne).
     var e = vec3<f32>(0.0);
     for (var slot = 0u; slot < batch.light_count; slot++) {
         let light = env_lights[slot];
-        let lift = 2.0 / max(light.texels_per_unit, 1e-6);
-        let p = world + n * lift;
         var visible: f32;
         if (with_volume && light.direction.w > 0.0) {
-            visible = volume_lobe_visibility(volume_coefficients(p), light.direction.xyz, light.direction.w);
+            // No lift: the volume's vertices inside the head hold what the surface sees outward
+            // (visibility/volume.rs). The light maps of volume batches are placeholders, whose
+            // texel size would lift the point out of the hair altogether.
+            visible = volume_lobe_visibility(volume_coefficients(world), light.direction.xyz, light.direction.w);
         } else {
-            visible = effective_transmittance(slot, p);
+            let lift = 2.0 / max(light.texels_per_unit, 1e-6);
+            visible = effective_transmittance(slot, world + n * lift);
         }
         if (visible <= 0.0) { continue; }
         for (var s = light.first_sample; s < light.first_sample + light.sample_count; s++) {
