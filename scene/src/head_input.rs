@@ -153,11 +153,7 @@ pub fn load_obj(path: &Path) -> anyhow::Result<TriangleMesh> {
         bail!("{}: a vertex position is not finite", path.display());
     }
     Ok(match every_normal {
-        true => TriangleMesh {
-            positions,
-            normals,
-            indices,
-        },
+        true => TriangleMesh::new(positions, normals, indices),
         false => TriangleMesh::with_computed_normals(positions, indices),
     })
 }
