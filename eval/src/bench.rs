@@ -714,11 +714,11 @@ fn light_maps_label(kappa: f32, dodm: u32) -> String {
 fn srbf_configs(plan: &BenchPlan) -> Vec<SrbfConfig> {
     let (lobes, kappa, dodm) = (plan.lobes[0], plan.kappas[0], plan.dodm_sizes[0]);
     let default = SrbfConfig {
-        label: format!("default ({lobes} lobes, visibility volume)"),
+        label: format!("default ({lobes} lobes, visibility volume; light maps under a head)"),
         lobes,
         kappa,
         dodm,
-        lobe_visibility: LobeVisibilityArg::Volume,
+        lobe_visibility: LobeVisibilityArg::Auto,
     };
     let light_maps = SrbfConfig {
         label: light_maps_label(kappa, dodm),
@@ -768,7 +768,8 @@ fn srbf_points(
             kappa: config.kappa,
         };
         frame.look.dodm = DodmSettings::at_resolution(config.dodm);
-        frame.look.lobe_visibility = config.lobe_visibility.settings();
+        frame.look.lobe_visibility = config.lobe_visibility.settings(false);
+        frame.look.light_maps_under_a_head = config.lobe_visibility == LobeVisibilityArg::Auto;
         let r = steps.run(
             &format!("{}: SRBF {}", mode.name(), config.label),
             || compare::timed_render(&render_lights, &frame, args.timing_runs),
@@ -1348,7 +1349,7 @@ mod tests {
             assert_eq!(changed(light_maps, default), 1);
             for c in &configs[1..] {
                 let base = match c.lobe_visibility {
-                    LobeVisibilityArg::Volume => default,
+                    LobeVisibilityArg::Auto | LobeVisibilityArg::Volume => default,
                     LobeVisibilityArg::LightMaps if c.label == light_maps.label => default,
                     LobeVisibilityArg::LightMaps => light_maps,
                 };

@@ -135,7 +135,7 @@ impl DecompositionInputs<'_> {
     ) -> anyhow::Result<Image> {
         let mut frame: EnvFrame = compare::frame(self.scene, self.args, self.lights, mode);
         frame.role = FrameRole::Interactive { kappa: self.kappa };
-        frame.look.lobe_visibility = LobeVisibilityArg::Volume.settings();
+        frame.look.lobe_visibility = LobeVisibilityArg::Volume.settings(false);
         frame.look.dodm = dodm;
         self.render_srbf(&frame, mode, label, steps)
     }

@@ -152,6 +152,9 @@ fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
         // Only SRBF lobes read the volume: frames without them (the reference, the baselines)
         // keep the options, and so the cache keys, they always had.
         lobe_visibility: match srbf {
+            true if frame.head.is_some() && look.light_maps_under_a_head => {
+                LobeVisibility::LightMaps
+            }
             true => look.lobe_visibility,
             false => LobeVisibility::LightMaps,
         },

@@ -40,19 +40,28 @@ pub enum ForwardDevice {
 #[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum LobeVisibilityArg {
+    /// The volume, or light maps in a frame with a head: the volume's voxels (about 2 units on
+    /// straight.hair) cannot resolve the hair lying on the scalp, and the skin under it read
+    /// far too bright (venice with the fitted ellipsoid: 0.76 against the truth, light maps
+    /// 0.17; docs/BENCHMARKS.md, "A head under the hair").
+    #[default]
+    Auto,
     /// Ren 2010: each lobe's own convolution optical depth map, read at its centre.
     LightMaps,
     /// The groom's visibility volume (SH of the transmittance, marched once per groom),
     /// integrated over each lobe: no light pass per lobe.
-    #[default]
     Volume,
 }
 
 impl LobeVisibilityArg {
-    pub fn settings(self) -> LobeVisibility {
+    /// The visibility of a frame without (`head` false) or with a head.
+    pub fn settings(self, head: bool) -> LobeVisibility {
         match self {
             Self::LightMaps => LobeVisibility::LightMaps,
-            Self::Volume => LobeVisibility::Volume(VisibilityVolumeSettings::default()),
+            Self::Auto if head => LobeVisibility::LightMaps,
+            Self::Auto | Self::Volume => {
+                LobeVisibility::Volume(VisibilityVolumeSettings::default())
+            }
         }
     }
 }
@@ -78,11 +87,12 @@ pub struct LookArgs {
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::Args))]
 pub struct ViewArgs {
-    /// Where SRBF lobes' visibility comes from: their light maps (Ren 2010) or the groom's
-    /// visibility volume integrated over each lobe (docs/BENCHMARKS.md, "Lobe visibility").
+    /// Where SRBF lobes' visibility comes from: auto (the volume; light maps in a frame with a
+    /// head), their light maps (Ren 2010) or the groom's visibility volume integrated over each
+    /// lobe (docs/BENCHMARKS.md, "Lobe visibility", "A head under the hair").
     #[cfg_attr(
         any(feature = "cli", test),
-        arg(long, value_enum, default_value = "volume")
+        arg(long, value_enum, default_value = "auto")
     )]
     #[serde(default = "light_maps")]
     pub lobe_visibility: LobeVisibilityArg,
@@ -154,7 +164,8 @@ impl LookArgs {
             dodm: DodmSettings::default(),
             simplification_seed: view.simplification_seed,
             simplified_lights_before: 0,
-            lobe_visibility: view.lobe_visibility.settings(),
+            lobe_visibility: view.lobe_visibility.settings(false),
+            light_maps_under_a_head: view.lobe_visibility == LobeVisibilityArg::Auto,
         })
     }
 }
@@ -177,8 +188,10 @@ pub struct EnvLook {
     /// parts before this one, so that each light draws the strands it draws in the whole
     /// frame (`EnvRenderer::render_part`). 0 for a whole frame.
     pub simplified_lights_before: u32,
-    /// Where SRBF lobes' visibility comes from ([`ViewArgs::lobe_visibility`]).
+    /// Where SRBF lobes' visibility comes from ([`ViewArgs::lobe_visibility`]) without a head.
     pub lobe_visibility: LobeVisibility,
+    /// A frame with a head uses light maps instead ([`LobeVisibilityArg::Auto`]).
+    pub light_maps_under_a_head: bool,
 }
 
 #[cfg(test)]
@@ -216,9 +229,6 @@ mod tests {
         saved.as_object_mut().unwrap().remove("lobe_visibility");
         let old: ViewArgs = serde_json::from_value(saved).unwrap();
         assert_eq!(old.lobe_visibility, LobeVisibilityArg::LightMaps);
-        assert_eq!(
-            ViewArgs::default().lobe_visibility,
-            LobeVisibilityArg::Volume
-        );
+        assert_eq!(ViewArgs::default().lobe_visibility, LobeVisibilityArg::Auto);
     }
 }
