@@ -533,6 +533,7 @@ impl ABufferPass {
     /// [`Self::draw`] with a deep opacity map for each of up to
     /// [`MAX_SHADOWED_LIGHTS`](crate::passes::shadow_slots::MAX_SHADOWED_LIGHTS) lights, into
     /// resources made for this one frame.
+    #[allow(clippy::too_many_arguments)]
     pub fn draw_shadowed(
         &self,
         gpu: &GpuContext,

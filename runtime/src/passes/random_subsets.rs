@@ -140,6 +140,7 @@ impl RandomSubsetsPass {
     }
 
     /// `model`'s strands (uploaded as `geometry`) in `subsets` random subsets, composited.
+    #[allow(clippy::too_many_arguments)]
     pub fn draw(
         &self,
         gpu: &GpuContext,

@@ -182,6 +182,7 @@ impl SortedBlendPass {
     }
 
     /// Clears `target` and blends every segment over it in `order`.
+    #[allow(clippy::too_many_arguments)]
     pub fn draw(
         &self,
         gpu: &GpuContext,
