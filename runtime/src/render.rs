@@ -469,17 +469,8 @@ pub fn render_frame_with_head(
             light_index: *light_index,
         })
         .collect();
-    let head = match head {
-        Some(head) => Some(prepare_head(
-            gpu,
-            head,
-            frame,
-            &shadows,
-            &mut timings,
-            &mut memory_bytes,
-        )),
-        None => None,
-    };
+    let head =
+        head.map(|head| prepare_head(gpu, head, frame, &shadows, &mut timings, &mut memory_bytes));
     let head_input = head.as_ref().map(|(_, head)| head.input());
     let mut fragments = None;
     let mut pixels = match options.transparency {
