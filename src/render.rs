@@ -79,6 +79,11 @@ struct SceneArgs {
     /// Every fiber this many pixels wide (default: the file's thickness, projected).
     #[arg(long)]
     fiber_width_px: Option<f32>,
+    /// The head the hair grows from: none, ellipsoid (fitted to the strand roots) or FILE.obj (in
+    /// the hair's units and frame); it hides the hair behind it, is drawn as diffuse skin and
+    /// shadows every light.
+    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE.obj")]
+    head: HeadChoice,
 }
 
 /// Where the frame goes.
@@ -119,11 +124,6 @@ struct EnvArgs {
     /// Side of each light's convolution optical depth map, texels.
     #[arg(long, default_value_t = 512)]
     light_map_size: u32,
-    /// The head the hair grows from: none, ellipsoid (fitted to the strand roots) or FILE.obj (in
-    /// the hair's units and frame); it hides the hair behind it, is drawn as diffuse skin and
-    /// shadows every light.
-    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE.obj")]
-    head: HeadChoice,
     /// The head's skin: diffuse albedo, linear R,G,B each in [0, 1].
     #[arg(long, value_name = "R,G,B")]
     skin: Option<String>,
@@ -167,19 +167,17 @@ struct ShadowArgs {
     /// (1..=32, default 4), opacity shadow map slices with --shadows osm (1..=32, default 16).
     #[arg(long, value_name = "N")]
     layers: Option<u32>,
-    /// Deep opacity layer spacing in world units (default: 1% of the hair's bounding-box
+    /// World units between depth layers along the light: deep opacity map layers with --shadows
+    /// dom, ADSM's assumed fibers with --shadows adsm (default: 1% of the hair's bounding-box
     /// diagonal).
     #[arg(long)]
-    dom_spacing: Option<f32>,
+    layer_spacing: Option<f32>,
     /// Shadow map and ADSM depth bias along the light, world units (default: two map texels).
     #[arg(long)]
     shadow_bias: Option<f32>,
     /// ADSM: opacity of one fiber, in (0, 1).
     #[arg(long, default_value_t = strandlight_scene::frame_settings::DEFAULT_ADSM_ALPHA)]
     adsm_alpha: f32,
-    /// ADSM: world units between fibers along the light (default: 1% of the hair's diagonal).
-    #[arg(long)]
-    adsm_spacing: Option<f32>,
 }
 
 /// The transparency technique of `render lights` and its parameters. Its finer settings (the
@@ -259,7 +257,7 @@ fn frame_settings(scene: &SceneArgs, lighting: Lighting) -> anyhow::Result<Frame
             .transpose()?,
         fiber_width_px: scene.fiber_width_px,
         lighting,
-        head: HeadChoice::None,
+        head: scene.head.clone(),
         skin_albedo: strandlight_scene::head_input::default_skin_albedo(),
     })
 }
@@ -291,8 +289,9 @@ fn point_lighting(args: &LightsArgs) -> Lighting {
         subsets: transparency.subsets,
         shadow_bias: shadows.shadow_bias,
         adsm_alpha: shadows.adsm_alpha,
-        adsm_spacing: shadows.adsm_spacing,
-        dom_spacing: shadows.dom_spacing,
+        // One flag for both: only one technique runs (as --layers for DOM layers and OSM slices).
+        adsm_spacing: shadows.layer_spacing,
+        dom_spacing: shadows.layer_spacing,
         dom_size: shadows.light_map_size,
         dbk_delta: transparency.dbk_delta,
         ..defaults
@@ -303,7 +302,6 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let (settings, output) = match &args.what {
         RenderWhat::Env(env) => {
             let mut settings = frame_settings(&env.scene, env_lighting(env))?;
-            settings.head = env.head.clone();
             if let Some(skin) = &env.skin {
                 settings.skin_albedo = parse_vec3("--skin", skin)?;
             }

@@ -4,6 +4,7 @@
 use crate::gpu::readback::ReadbackError;
 use crate::gpu::{AdapterReport, GpuContext, GpuLimits, LimitError, read_texture_rgba};
 use crate::hair::HairModel;
+use crate::head::Head;
 use crate::passes::abuffer::{ABufferError, ABufferPass, ListMode};
 use crate::passes::deep_opacity::{
     DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError, ShadowLookup, ShadowMapError,
@@ -12,6 +13,7 @@ use crate::passes::deep_opacity::{
 use crate::passes::fiber_shading::ShadingModel;
 use crate::passes::frame_params::FrameParams;
 use crate::passes::kbuffer::{KBufferError, KBufferPass};
+use crate::passes::point_skin::{PointHead, PointSkinPass, composite_over};
 use crate::passes::random_subsets::{RandomSubsetsPass, SubsetsError};
 use crate::passes::render_target::RenderTarget;
 use crate::passes::shadow_slots::{MAX_SHADOWED_LIGHTS, ShadowInput, TooManyShadowMaps};
@@ -388,6 +390,20 @@ pub fn render_frame_with_model(
     options: &RenderOptions,
     shading: &ShadingModel,
 ) -> Result<Frame, RenderError> {
+    render_frame_with_head(gpu, model, frame, options, shading, None)
+}
+
+/// [`render_frame_with_model`] with the head the hair grows from (issue 40): opaque in every
+/// light's maps and in the view, where it hides the fibers behind it, and drawn as Lambertian
+/// skin of the head's albedo under the same lights, the remaining fibers composited over it.
+pub fn render_frame_with_head(
+    gpu: &GpuContext,
+    model: &HairModel,
+    frame: &FrameParams,
+    options: &RenderOptions,
+    shading: &ShadingModel,
+    head: Option<&Head>,
+) -> Result<Frame, RenderError> {
     // Every light gets a map; every pass shadows them all.
     let shadowed_lights: Vec<ShadowedLight> = match options.shadows {
         None => Vec::new(),
@@ -401,7 +417,7 @@ pub fn render_frame_with_model(
                     maps: frame.lights.len(),
                 }));
             }
-            let bounds = model.bounds();
+            let bounds = caster_bounds(model, head);
             (0..)
                 .zip(&frame.lights)
                 .map(|(index, light)| {
@@ -453,15 +469,18 @@ pub fn render_frame_with_model(
             light_index: *light_index,
         })
         .collect();
+    let head =
+        head.map(|head| prepare_head(gpu, head, frame, &shadows, &mut timings, &mut memory_bytes));
+    let head_input = head.as_ref().map(|(_, head)| head.input());
     let mut fragments = None;
-    let pixels = match options.transparency {
+    let mut pixels = match options.transparency {
         Transparency::Opaque => {
             let pass = timed(&mut timings, gpu, "strand pipeline", || {
                 StrandPass::with_model(gpu, shading)
             });
             let target = RenderTarget::new(gpu, frame.width, frame.height);
             timed(&mut timings, gpu, "strands", || {
-                pass.draw_shadowed(gpu, &geometry, frame, &target, &shadows)
+                pass.draw_shadowed(gpu, &geometry, frame, &target, &shadows, head_input)
             })?;
             memory_bytes.extend(target.memory());
             timed(&mut timings, gpu, "readback", || {
@@ -477,7 +496,7 @@ pub fn render_frame_with_model(
             })?;
             let target = RenderTarget::new(gpu, frame.width, frame.height);
             timed(&mut timings, gpu, "sorted blend", || {
-                pass.draw(gpu, &geometry, frame, &shadows, &order, &target)
+                pass.draw(gpu, &geometry, frame, &shadows, head_input, &order, &target)
             })?;
             memory_bytes.extend(order.memory());
             memory_bytes.extend(target.memory());
@@ -493,7 +512,7 @@ pub fn render_frame_with_model(
                 &mut timings,
                 gpu,
                 "kbuffer build + resolve + readback",
-                || pass.draw(gpu, &geometry, frame, &shadows, k),
+                || pass.draw(gpu, &geometry, frame, &shadows, head_input, k),
             )?;
             memory_bytes.extend(out.memory_bytes);
             let slots = frame.width as u64 * frame.height as u64 * k as u64;
@@ -514,7 +533,7 @@ pub fn render_frame_with_model(
                 &mut timings,
                 gpu,
                 "random subsets + resolve + readback",
-                || pass.draw(gpu, model, &geometry, frame, &shadows, subsets),
+                || pass.draw(gpu, model, &geometry, frame, &shadows, head_input, subsets),
             )?;
             memory_bytes.extend(out.memory_bytes);
             out.pixels
@@ -534,7 +553,7 @@ pub fn render_frame_with_model(
                 Some(0) => return Err(RenderError::NoListNodes),
                 Some(n) => frame.width as u64 * frame.height as u64 * n as u64,
                 None => timed(&mut timings, gpu, "abuffer count", || {
-                    abuffer.count_fragments(gpu, &geometry, frame, &shadows, list_mode)
+                    abuffer.count_fragments(gpu, &geometry, frame, &shadows, head_input, list_mode)
                 })?
                 .max(1),
             };
@@ -543,7 +562,11 @@ pub fn render_frame_with_model(
                 &mut timings,
                 gpu,
                 "abuffer build + resolve + readback",
-                || abuffer.draw_shadowed(gpu, &geometry, frame, &shadows, capacity, list_mode),
+                || {
+                    abuffer.draw_shadowed(
+                        gpu, &geometry, frame, &shadows, head_input, capacity, list_mode,
+                    )
+                },
             )
             .map_err(RenderError::from)?;
             memory_bytes.extend(out.memory_bytes);
@@ -557,6 +580,15 @@ pub fn render_frame_with_model(
             out.pixels
         }
     };
+    if let Some((pass, head)) = &head {
+        let skin = timed(&mut timings, gpu, "skin", || {
+            pass.shade(gpu, &geometry, frame, &shadows, head)
+        })?;
+        let skin = timed(&mut timings, gpu, "skin readback", || {
+            read_texture_rgba(gpu, &skin.color)
+        })?;
+        composite_over(&mut pixels, &skin);
+    }
     if let Some(error) = pollster::block_on(scope.pop()) {
         return Err(RenderError::Gpu(error.to_string()));
     }
@@ -573,6 +605,39 @@ pub fn render_frame_with_model(
             fragments,
         },
     })
+}
+
+/// What the light maps must hold: the hair, and the head, which casts too (a frustum fitted to
+/// the hair alone would clip a head reaching past it, and nothing would stop the light there).
+fn caster_bounds(model: &HairModel, head: Option<&Head>) -> crate::hair::Aabb {
+    let hair = model.bounds();
+    match head {
+        Some(head) => {
+            let head = head.bounds();
+            crate::hair::Aabb {
+                min: hair.min.min(head.min),
+                max: hair.max.max(head.max),
+            }
+        }
+        None => hair,
+    }
+}
+
+/// The head's pipelines, its upload and its depth in every light face and in the view.
+fn prepare_head(
+    gpu: &GpuContext,
+    head: &Head,
+    frame: &FrameParams,
+    shadows: &[ShadowInput<'_>],
+    timings: &mut Vec<PassTiming>,
+    memory_bytes: &mut Vec<(String, u64)>,
+) -> (PointSkinPass, PointHead) {
+    let pass = timed(timings, gpu, "head pipelines", || PointSkinPass::new(gpu));
+    let prepared = timed(timings, gpu, "head depth (lights + view)", || {
+        pass.prepare(gpu, head, frame, shadows)
+    });
+    memory_bytes.extend(prepared.memory());
+    (pass, prepared)
 }
 
 #[cfg(test)]

@@ -343,12 +343,12 @@ fn abuffer_and_dbk_shade_like_the_opaque_pass_for_every_model() {
     for (name, model) in &models {
         let target = RenderTarget::new(&gpu, SIZE, SIZE);
         StrandPass::with_model(&gpu, model)
-            .draw_shadowed(&gpu, &geometry, &frame, &target, &shadows)
+            .draw_shadowed(&gpu, &geometry, &frame, &target, &shadows, None)
             .unwrap();
         let opaque = read_texture_rgba(&gpu, &target.color).unwrap();
         let pass = ABufferPass::with_model(&gpu, model);
         let draw = |shadows: &[ShadowInput], mode| {
-            pass.draw_shadowed(&gpu, &geometry, &frame, shadows, capacity, mode)
+            pass.draw_shadowed(&gpu, &geometry, &frame, shadows, None, capacity, mode)
                 .unwrap_or_else(|e| panic!("{e}"))
         };
         let abuffer = draw(&shadows, ListMode::All);

@@ -87,6 +87,7 @@ fn each_shadowed_light_is_dimmed_by_its_own_map() {
                 light_index: 0,
             },
         ],
+        None,
     )
     .unwrap();
     let pixels = read_texture_rgba(&gpu, &target.color).unwrap();
@@ -120,7 +121,7 @@ fn each_shadowed_light_is_dimmed_by_its_own_map() {
         })
         .collect();
     assert_eq!(
-        pass.draw_shadowed(&gpu, &geometry, &frame, &target, &too_many),
+        pass.draw_shadowed(&gpu, &geometry, &frame, &target, &too_many, None),
         Err(TooManyShadowMaps {
             maps: MAX_SHADOWED_LIGHTS + 1
         })

@@ -30,8 +30,7 @@ use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
 use strandlight_runtime::passes::fiber_shading::ShadingModel;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
 use strandlight_runtime::render::{
-    self, PassTiming, RenderOptions, RenderStats, ShadowMaps, TIMING_METHOD,
-    render_frame_with_model,
+    self, PassTiming, RenderOptions, RenderStats, ShadowMaps, TIMING_METHOD, render_frame_with_head,
 };
 use strandlight_tables::checksum::sha256_hex;
 use strandlight_tables::colour::luminance_f32;
@@ -157,12 +156,15 @@ fn render_point(
         shading: KajiyaKay::default(),
         width_override_px: settings.fiber_width_px,
     };
-    Ok(render_frame_with_model(
+    // The head (issue 40): opaque in every light's maps and in the view, drawn as skin.
+    let head = load_head(&settings.head, hair, settings.skin_albedo)?;
+    Ok(render_frame_with_head(
         gpu,
         hair,
         &frame,
         &point_render_options(point, hair),
         &prepared.shading,
+        head.as_ref(),
     )?)
 }
 

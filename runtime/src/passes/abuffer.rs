@@ -27,7 +27,7 @@ use crate::passes::fiber_shading::{ModelBinding, ShadingModel};
 use crate::passes::frame_params::FrameParams;
 use crate::passes::render_target::{DEPTH_FORMAT, RenderTarget};
 use crate::passes::shadow_slots::{
-    ShadowInput, TooManyShadowMaps, shadow_bind_group_for, shadow_bind_group_layout,
+    HeadInput, ShadowInput, TooManyShadowMaps, shadow_bind_group_for, shadow_bind_group_layout,
 };
 use crate::passes::strand_geometry::StrandGeometry;
 use crate::passes::strand_quads::{strand_bind_group, strand_bind_group_layout};
@@ -519,24 +519,34 @@ impl ABufferPass {
         capacity: u32,
         mode: ListMode,
     ) -> Result<ABufferFrame, ABufferError> {
-        self.draw_shadowed(gpu, geometry, frame, shadow.as_slice(), capacity, mode)
+        self.draw_shadowed(
+            gpu,
+            geometry,
+            frame,
+            shadow.as_slice(),
+            None,
+            capacity,
+            mode,
+        )
     }
 
     /// [`Self::draw`] with a deep opacity map for each of up to
     /// [`MAX_SHADOWED_LIGHTS`](crate::passes::shadow_slots::MAX_SHADOWED_LIGHTS) lights, into
     /// resources made for this one frame.
+    #[allow(clippy::too_many_arguments)]
     pub fn draw_shadowed(
         &self,
         gpu: &GpuContext,
         geometry: &StrandGeometry,
         frame: &FrameParams,
         shadows: &[ShadowInput<'_>],
+        head: Option<HeadInput<'_>>,
         capacity: u32,
         mode: ListMode,
     ) -> Result<ABufferFrame, ABufferError> {
         let resources =
             ABufferResources::new(gpu, self, (frame.width, frame.height), capacity, mode)?;
-        self.draw_into(gpu, &resources, geometry, frame, shadows)
+        self.draw_into(gpu, &resources, geometry, frame, shadows, head)
     }
 
     /// Builds and resolves one frame in `resources` (whose size must be the frame's).
@@ -547,6 +557,7 @@ impl ABufferPass {
         geometry: &StrandGeometry,
         frame: &FrameParams,
         shadows: &[ShadowInput<'_>],
+        head: Option<HeadInput<'_>>,
     ) -> Result<ABufferFrame, ABufferError> {
         if (frame.width, frame.height) != (resources.width, resources.height) {
             return Err(ABufferError::SizeMismatch {
@@ -557,7 +568,7 @@ impl ABufferPass {
             });
         }
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        self.encode_build(gpu, &mut encoder, resources, geometry, frame, shadows)?;
+        self.encode_build(gpu, &mut encoder, resources, geometry, frame, shadows, head)?;
         self.encode_resolve(gpu, &mut encoder, resources);
         gpu.queue.submit([encoder.finish()]);
         Ok(resources.read(gpu)?)
@@ -572,11 +583,20 @@ impl ABufferPass {
         geometry: &StrandGeometry,
         frame: &FrameParams,
         shadows: &[ShadowInput<'_>],
+        head: Option<HeadInput<'_>>,
         mode: ListMode,
     ) -> Result<u64, ABufferError> {
         let resources = ABufferResources::new(gpu, self, (frame.width, frame.height), 1, mode)?;
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        self.encode_build(gpu, &mut encoder, &resources, geometry, frame, shadows)?;
+        self.encode_build(
+            gpu,
+            &mut encoder,
+            &resources,
+            geometry,
+            frame,
+            shadows,
+            head,
+        )?;
         gpu.queue.submit([encoder.finish()]);
         let counters = read_buffer(gpu, &resources.counters)?;
         let counts: &[u32] = bytemuck::cast_slice(&counters);
@@ -584,6 +604,7 @@ impl ABufferPass {
     }
 
     /// Empties `resources` and records the list build of `frame`.
+    #[allow(clippy::too_many_arguments)]
     fn encode_build(
         &self,
         gpu: &GpuContext,
@@ -592,8 +613,9 @@ impl ABufferPass {
         geometry: &StrandGeometry,
         frame: &FrameParams,
         shadows: &[ShadowInput<'_>],
+        head: Option<HeadInput<'_>>,
     ) -> Result<(), ABufferError> {
-        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows)?;
+        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows, head)?;
         let strands = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
         let groups = [&strands, &shadow_group, &resources.lists];
         resources.reset(gpu, encoder, frame);

@@ -28,6 +28,7 @@ const END_OF_LIST: u32 = 0xffffffffu;
 
 @fragment
 fn fs_abuffer(in: VertexOut) {
+    if (behind_head(in)) { return; }
     let color = shade(in);
     if (color.a <= 0.0) { return; }
     let index = atomicAdd(&counters[0], 1u);
@@ -66,6 +67,7 @@ fn view_depth(z: f32) -> f32 {
 
 @fragment
 fn fs_dbk(in: VertexOut) -> @location(0) vec4<f32> {
+    if (behind_head(in)) { discard; }
     let color = shade(in);
     let z0 = textureLoad(view_nearest, vec2<i32>(in.clip.xy), 0);
     if (view_depth(in.clip.z) <= view_depth(z0) + dbk.delta) {

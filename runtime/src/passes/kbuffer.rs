@@ -13,7 +13,7 @@ use super::attachments::cleared_depth;
 use super::fiber_shading::ShadingModel;
 use super::frame_params::FrameParams;
 use super::render_target::RenderTarget;
-use super::shadow_slots::{ShadowInput, TooManyShadowMaps, shadow_bind_group_for};
+use super::shadow_slots::{HeadInput, ShadowInput, TooManyShadowMaps, shadow_bind_group_for};
 use super::strand_geometry::StrandGeometry;
 use super::strand_quads::strand_bind_group;
 use super::strands::{ShadedStrandLayouts, shading_source};
@@ -139,6 +139,7 @@ impl KBufferPass {
         geometry: &StrandGeometry,
         frame: &FrameParams,
         shadows: &[ShadowInput<'_>],
+        head: Option<HeadInput<'_>>,
         k: u32,
     ) -> Result<KBufferFrame, KBufferError> {
         if !(1..=MAX_K).contains(&k) {
@@ -213,7 +214,7 @@ impl KBufferPass {
                 resolve_params.as_entire_binding(),
             ],
         );
-        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows)?;
+        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows, head)?;
         let strands = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
         // Only to give the build passes a size: every fragment passes its test.
         let target = RenderTarget::new(gpu, width, height);

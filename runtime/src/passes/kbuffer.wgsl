@@ -38,7 +38,7 @@ fn first_slot(in: VertexOut) -> u32 {
 
 @fragment
 fn fs_kbuffer_depths(in: VertexOut) {
-    if (in.alpha <= 0.0) { return; }
+    if (in.alpha <= 0.0 || behind_head(in)) { return; }
     let base = first_slot(in);
     var key = depth_key(in);
     for (var i = 0u; i < kbuffer.k; i++) {
@@ -50,7 +50,7 @@ fn fs_kbuffer_depths(in: VertexOut) {
 
 @fragment
 fn fs_kbuffer_colors(in: VertexOut) {
-    if (in.alpha <= 0.0) { return; }
+    if (in.alpha <= 0.0 || behind_head(in)) { return; }
     let base = first_slot(in);
     let key = depth_key(in);
     for (var i = 0u; i < kbuffer.k; i++) {

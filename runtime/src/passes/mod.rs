@@ -9,6 +9,7 @@ pub mod fiber_shading;
 pub mod frame_params;
 pub mod head;
 pub mod kbuffer;
+pub mod point_skin;
 pub mod random_subsets;
 pub mod render_target;
 pub mod shadow_slots;

@@ -12,7 +12,7 @@ use super::attachments::{cleared_color, cleared_depth};
 use super::fiber_shading::ShadingModel;
 use super::frame_params::FrameParams;
 use super::render_target::DEPTH_FORMAT;
-use super::shadow_slots::{ShadowInput, TooManyShadowMaps};
+use super::shadow_slots::{HeadInput, ShadowInput, TooManyShadowMaps};
 use super::sorted_blend::IndexedStrandDraw;
 use super::strand_geometry::StrandGeometry;
 use crate::gpu::bind_layout::{
@@ -140,6 +140,7 @@ impl RandomSubsetsPass {
     }
 
     /// `model`'s strands (uploaded as `geometry`) in `subsets` random subsets, composited.
+    #[allow(clippy::too_many_arguments)]
     pub fn draw(
         &self,
         gpu: &GpuContext,
@@ -147,6 +148,7 @@ impl RandomSubsetsPass {
         geometry: &StrandGeometry,
         frame: &FrameParams,
         shadows: &[ShadowInput<'_>],
+        head: Option<HeadInput<'_>>,
         subsets: u32,
     ) -> Result<SubsetsFrame, SubsetsError> {
         if !(1..=MAX_SUBSETS).contains(&subsets) {
@@ -203,7 +205,9 @@ impl RandomSubsetsPass {
             }),
             usage: wgpu::BufferUsages::UNIFORM,
         });
-        let groups = self.draw.groups(gpu, geometry, frame, shadows, &order)?;
+        let groups = self
+            .draw
+            .groups(gpu, geometry, frame, shadows, head, &order)?;
         let layer_view = |texture: &wgpu::Texture, layer| {
             texture.create_view(&wgpu::TextureViewDescriptor {
                 dimension: Some(wgpu::TextureViewDimension::D2),

@@ -12,7 +12,7 @@ use super::attachments::cleared_color;
 use super::fiber_shading::ShadingModel;
 use super::frame_params::FrameParams;
 use super::render_target::RenderTarget;
-use super::shadow_slots::{ShadowInput, TooManyShadowMaps, shadow_bind_group_for};
+use super::shadow_slots::{HeadInput, ShadowInput, TooManyShadowMaps, shadow_bind_group_for};
 use super::strand_geometry::StrandGeometry;
 use super::strand_quads::strand_bind_group;
 use super::strands::{ShadedStrandLayouts, shading_source};
@@ -182,18 +182,20 @@ impl SortedBlendPass {
     }
 
     /// Clears `target` and blends every segment over it in `order`.
+    #[allow(clippy::too_many_arguments)]
     pub fn draw(
         &self,
         gpu: &GpuContext,
         geometry: &StrandGeometry,
         frame: &FrameParams,
         shadows: &[ShadowInput<'_>],
+        head: Option<HeadInput<'_>>,
         order: &SegmentOrder,
         target: &RenderTarget,
     ) -> Result<(), TooManyShadowMaps> {
         let groups = self
             .draw
-            .groups(gpu, geometry, frame, shadows, &order.order)?;
+            .groups(gpu, geometry, frame, shadows, head, &order.order)?;
         let color_view = target.color.create_view(&Default::default());
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
@@ -273,11 +275,12 @@ impl IndexedStrandDraw {
         geometry: &StrandGeometry,
         frame: &FrameParams,
         shadows: &[ShadowInput<'_>],
+        head: Option<HeadInput<'_>>,
         order: &wgpu::Buffer,
     ) -> Result<IndexedStrandGroups, TooManyShadowMaps> {
         Ok(IndexedStrandGroups {
             strands: strand_bind_group(gpu, &self.layouts.strand, geometry, frame),
-            shadows: shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows)?,
+            shadows: shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows, head)?,
             order: bind_group(
                 &gpu.device,
                 "segment order",

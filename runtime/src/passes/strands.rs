@@ -9,7 +9,7 @@ use super::fiber_shading::{ModelBinding, ShadingModel};
 use super::frame_params::FrameParams;
 use super::render_target::{DEPTH_FORMAT, RenderTarget};
 use super::shadow_slots::{
-    ShadowInput, TooManyShadowMaps, shadow_bind_group_for, shadow_bind_group_layout,
+    HeadInput, ShadowInput, TooManyShadowMaps, shadow_bind_group_for, shadow_bind_group_layout,
 };
 use super::strand_geometry::StrandGeometry;
 use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
@@ -60,12 +60,12 @@ impl StrandPass {
         target: &RenderTarget,
         shadow: Option<ShadowInput<'_>>,
     ) {
-        self.draw_shadowed(gpu, geometry, frame, target, shadow.as_slice())
+        self.draw_shadowed(gpu, geometry, frame, target, shadow.as_slice(), None)
             .expect("one shadow map is within the limit");
     }
 
     /// [`StrandPass::draw`] with a deep opacity map for each of up to [`MAX_SHADOWED_LIGHTS`]
-    /// lights.
+    /// lights, and the head hiding and shadowing fibers.
     pub fn draw_shadowed(
         &self,
         gpu: &GpuContext,
@@ -73,9 +73,10 @@ impl StrandPass {
         frame: &FrameParams,
         target: &RenderTarget,
         shadows: &[ShadowInput<'_>],
+        head: Option<HeadInput<'_>>,
     ) -> Result<(), TooManyShadowMaps> {
         let device = &gpu.device;
-        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows)?;
+        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows, head)?;
         let bind_group = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
         let color_view = target.color.create_view(&Default::default());
         let depth_view = target.depth.create_view(&Default::default());

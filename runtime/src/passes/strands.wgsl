@@ -28,9 +28,11 @@ struct ShadowParams {
     adsm_spacing: f32,
     // Array layers of shadow_layers_k per face.
     face_array_layers: u32,
+    // First layer of this slot's faces in head_light_depth; NO_HEAD_LAYER: no head.
+    head_layer: u32,
+    // World size of one map texel: at unit depth along the light (perspective), or anywhere.
+    texel_world: f32,
     _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
 };
 
 const LOOKUP_LAYERS: u32 = 0u;
@@ -48,6 +50,30 @@ const SHADOW_SLOTS: u32 = 4u;
 @group(1) @binding(6) var shadow_depth_3: texture_depth_2d_array;
 @group(1) @binding(7) var shadow_layers_3: texture_2d_array<f32>;
 @group(1) @binding(8) var<uniform> shadow: array<ShadowParams, 4>;
+
+// The head (issue 40), opaque to every light and to the view (head.wgsl draws both depths): its
+// depth in the light maps' 0..1 range, one layer per face of each slot, and from the frame's
+// camera. 1×1 placeholders, never read, without a head.
+const NO_HEAD_LAYER: u32 = 0xffffffffu;
+
+struct HeadView {
+    // 1: the view has a head; fibers behind it are not drawn.
+    in_view: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+};
+
+@group(1) @binding(9) var head_light_depth: texture_2d_array<f32>;
+@group(1) @binding(10) var head_view_depth: texture_depth_2d;
+@group(1) @binding(11) var<uniform> head_view: HeadView;
+
+// Whether the fragment lies behind the head along its pixel's ray. Every transparency mode's
+// fragment entry point drops such fragments, since most of them draw without a depth test.
+fn behind_head(in: VertexOut) -> bool {
+    if (head_view.in_view == 0u) { return false; }
+    return in.clip.z > textureLoad(head_view_depth, vec2<i32>(in.clip.xy), 0);
+}
 
 // Distance along the light camera's axis from a depth-buffer value.
 fn light_depth(p: ShadowParams, z: f32) -> f32 {
@@ -135,7 +161,9 @@ fn map_transmittance(
     let last = vec2<i32>(textureDimensions(depth)) - vec2<i32>(1);
     let texel = clamp(vec2<i32>(floor(uv * p.resolution)), vec2<i32>(0), last);
     let d = light_depth(p, ndc.z);
-    if (p.lookup != LOOKUP_LAYERS) { return filtered_depth_test(depth, face, texel, d, p); }
+    let past_head = head_visibility(p, face, texel, d);
+    if (past_head <= 0.0) { return 0.0; }
+    if (p.lookup != LOOKUP_LAYERS) { return past_head * filtered_depth_test(depth, face, texel, d, p); }
     // PCF: the transmittance of each texel in the kernel, averaged (clamped at the edges).
     let r = i32(p.kernel / 2u);
     var sum = 0.0;
@@ -143,6 +171,32 @@ fn map_transmittance(
         for (var dx = -r; dx <= r; dx++) {
             let t = clamp(texel + vec2<i32>(dx, dy), vec2<i32>(0), last);
             sum += layer_transmittance(depth, layers, p, face, t, d);
+        }
+    }
+    let side = f32(2 * r + 1);
+    return past_head * sum / (side * side);
+}
+
+// World size of one of the slot's map texels at light depth `d`.
+fn texel_size(p: ShadowParams, d: f32) -> f32 {
+    if (p.perspective != 0u) { return p.texel_world * d; }
+    return p.texel_world;
+}
+
+// The fraction of the slot's kernel (PCF, as the hair's lookup) whose texel sees no head in
+// front of light depth `d`. The head is opaque: past its nearest depth nothing arrives. Two
+// texels of bias keep what lies on the surface facing the light (the roots, the skin) lit.
+fn head_visibility(p: ShadowParams, face: Face, texel: vec2<i32>, d: f32) -> f32 {
+    if (p.head_layer == NO_HEAD_LAYER) { return 1.0; }
+    let bias = 2.0 * texel_size(p, d);
+    let r = i32(p.kernel / 2u);
+    let last = vec2<i32>(textureDimensions(head_light_depth)) - vec2<i32>(1);
+    var sum = 0.0;
+    for (var dy = -r; dy <= r; dy++) {
+        for (var dx = -r; dx <= r; dx++) {
+            let t = clamp(texel + vec2<i32>(dx, dy), vec2<i32>(0), last);
+            let z = textureLoad(head_light_depth, t, p.head_layer + face.index, 0).r;
+            if (z >= 1.0 || d - light_depth(p, z) <= bias) { sum += 1.0; }
         }
     }
     let side = f32(2 * r + 1);
@@ -193,6 +247,19 @@ fn shadow_transmittance(light_index: u32, world: vec3<f32>) -> f32 {
     return 1.0;
 }
 
+// World size of one texel of the map that shadows light `light_index` at `world` (0: none), to
+// lift a surface's lookup off the depth it was drawn into itself.
+fn shadow_texel_at(light_index: u32, world: vec3<f32>) -> f32 {
+    for (var k = 0u; k < SHADOW_SLOTS; k++) {
+        let p = shadow[k];
+        if (p.light_index != light_index) { continue; }
+        let clip = p.view_proj[shadow_face(p, world)] * vec4<f32>(world, 1.0);
+        if (clip.w <= 0.0) { return 0.0; }
+        return texel_size(p, light_depth(p, clip.z / clip.w));
+    }
+    return 0.0;
+}
+
 // Direction toward the light and the irradiance it brings to `world`.
 fn light_at(light: Light, world: vec3<f32>) -> vec4<f32> {
     let kind = light.position_or_direction.w;
@@ -224,5 +291,6 @@ fn shade(in: VertexOut) -> vec4<f32> {
 // Blended in draw order with "one, one − source alpha".
 @fragment
 fn fs_main(in: VertexOut) -> @location(0) vec4<f32> {
+    if (behind_head(in)) { discard; }
     return shade(in);
 }
