@@ -244,12 +244,8 @@ fn env_controls(ui: &mut egui::Ui, e: &mut EnvLighting, lobes: &mut usize, total
     });
     ui.horizontal(|ui| {
         ui.label("lobe visibility");
-        ui.radio_value(
-            &mut e.view.lobe_visibility,
-            LobeVisibilityArg::Auto,
-            "auto",
-        )
-        .on_hover_text("the volume; light maps under a head");
+        ui.radio_value(&mut e.view.lobe_visibility, LobeVisibilityArg::Auto, "auto")
+            .on_hover_text("the volume; light maps under a head");
         ui.radio_value(
             &mut e.view.lobe_visibility,
             LobeVisibilityArg::LightMaps,
