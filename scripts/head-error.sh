@@ -8,12 +8,14 @@
 #   scripts/head-error.sh [MAP_FILE ...]     (default: the eight maps; ~6 min a map here)
 #
 # STRANDLIGHT: the binary (default target/release/strandlight); TRUTH_SPP: the truth's most
-# samples per pixel (default 1024: its noise is reported and taken out of the error).
+# samples per pixel (default 1024: its noise is reported and taken out of the error); HEADS:
+# which heads (default "none ellipsoid").
 set -euo pipefail
 cd "$(dirname "$0")/.."
 BIN=${STRANDLIGHT:-target/release/strandlight}
 DATA=${STRANDLIGHT_SHARED_DATA:-../shared/data}
 SPP=${TRUTH_SPP:-1024}
+HEADS=${HEADS:-none ellipsoid}
 OUT=out/head-error
 mkdir -p "$OUT"
 MAPS=("$@")
@@ -22,7 +24,7 @@ if [ ${#MAPS[@]} -eq 0 ]; then
         royal_esplanade_1k.hdr spruit_sunrise_1k.hdr venice_sunset_1k.hdr piz_compressed.exr)
 fi
 for map in "${MAPS[@]}"; do
-  for head in none ellipsoid; do
+  for head in $HEADS; do
     stem="$OUT/${map%.*}-$head"
     [ -s "$stem.json" ] && continue
     "$BIN" compare --hair "$DATA/hair/straight.hair" --env "$DATA/envmaps/$map" --shading chiang \

@@ -494,8 +494,9 @@ impl Session {
             return;
         }
         let exposure = self.on_screen.as_ref().map(|o| o.exposure_stops);
+        // Exact: a panel of wrapping text shrinks to egui's 96-point minimum otherwise.
         let response = egui::Panel::right("readout")
-            .default_size(READOUT_WIDTH)
+            .exact_size(READOUT_WIDTH)
             .show(ui, |ui| crate::panel::readout(ui, status, exposure));
         let rect = response.response.rect;
         let ppp = ui.ctx().pixels_per_point();
