@@ -195,8 +195,6 @@ fn forward_scattering<'g>(
     };
     Ok(match frame.look.forward_scattering {
         _ if frame.role == FrameRole::Reference => Box::new(cpu),
-        // The head blocks the CPU's samples only (the GPU march does not know it yet).
-        _ if frame.head.is_some() => Box::new(cpu),
         ForwardDevice::Cpu => Box::new(cpu),
         ForwardDevice::Gpu => Box::new(on_gpu(cpu).context("--forward-scattering gpu")?),
         ForwardDevice::Auto if gpu.report.is_software => Box::new(cpu),

@@ -200,8 +200,9 @@ impl CpuForwardScattering {
         self
     }
 
-    /// T = 0 at the samples `points` whose ray toward `xi` meets the head.
-    fn block_by_head(&self, xi: Vec3, points: &[Vec3], values: &mut [[f32; 4]]) {
+    /// T = 0 at the samples `points` whose ray toward `xi` meets the head (the GPU's march
+    /// applies it to its values too).
+    pub(crate) fn block_by_head(&self, xi: Vec3, points: &[Vec3], values: &mut [[f32; 4]]) {
         let Some(head) = &self.head else { return };
         values
             .par_iter_mut()

@@ -222,9 +222,17 @@ impl<'g> GpuForwardScattering<'g> {
 
 impl ForwardScatteringSource for GpuForwardScattering<'_> {
     fn grid(&self, lights: &[EnvLight]) -> Result<ForwardScatteringGrid, ForwardScatteringError> {
-        let mut values = Vec::with_capacity(self.cpu.sample_points().len() * lights.len());
+        let points = self.cpu.sample_points();
+        let mut values = Vec::with_capacity(points.len() * lights.len());
         for chunk in lights.chunks(self.lights_per_dispatch as usize) {
-            values.extend(self.march_chunk(chunk)?);
+            let mut marched = self.march_chunk(chunk)?;
+            // The head stops the light as on the CPU: the same exact ray test per sample, after
+            // the march (the shader knows only the voxelized hair).
+            for (light, light_values) in chunk.iter().zip(marched.chunks_mut(points.len())) {
+                self.cpu
+                    .block_by_head(light_direction(light), points, light_values);
+            }
+            values.extend(marched);
         }
         let grid = self.cpu.sample_grid();
         Ok(ForwardScatteringGrid {

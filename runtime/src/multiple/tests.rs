@@ -787,3 +787,41 @@ fn the_head_blocks_the_forward_scattered_light_where_its_ray_meets_it() {
         plain.values_at(&below, &[behind])
     );
 }
+
+/// The GPU's march stops at the head as the CPU's does: with the head, the GPU grid equals the
+/// CPU grid (T = 0 at the same samples, the rest as marched), and the head blocks some samples.
+#[test]
+fn the_gpu_march_is_blocked_by_the_head_where_the_cpu_is() {
+    use crate::head::Head;
+    let model = parallel_block(Some(0.05));
+    let head = Head::ellipsoid(Vec3::new(8.0, 16.0, 12.0), Vec3::splat(2.5));
+    let s = ForwardScatteringSettings {
+        coarse_factor: 2,
+        ..settings(16, 2, 0.5)
+    };
+    let cpu = CpuForwardScattering::new(&model, tables(), s)
+        .unwrap()
+        .with_head(Some(head));
+    let lights = [
+        EnvLight::directional(Vec3::Z, [1.0; 3]),
+        EnvLight::srbf(Vec3::new(0.3, -0.2, 1.0), 20.0, [1.0; 3]),
+    ];
+    let want = cpu.grid(&lights).unwrap();
+    let gpu = crate::gpu::GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
+    let got = GpuForwardScattering::new(&gpu, cpu)
+        .unwrap()
+        .grid(&lights)
+        .unwrap();
+    assert_eq!(got.values.len(), want.values.len());
+    let mut blocked = 0;
+    for (g, w) in got.values.iter().zip(&want.values) {
+        if w[..3] == [0.0; 3] {
+            assert_eq!(g[..3], [0.0; 3], "blocked on the CPU, not on the GPU");
+            blocked += 1;
+        }
+        for c in 0..4 {
+            assert!((g[c] - w[c]).abs() < 1e-4, "{g:?} vs {w:?}");
+        }
+    }
+    assert!(blocked > 4, "{blocked} samples behind the head");
+}
