@@ -22,6 +22,8 @@ use crate::hair::Aabb;
 pub const DEFAULT_SKIN_ALBEDO: [f32; 3] = [0.56, 0.38, 0.30];
 
 /// Triangles with per-vertex normals (unit, outward where the mesh is closed and consistent).
+/// Build a changed mesh anew ([`TriangleMesh::new`]) rather than editing one that has answered a
+/// ray query: its BVH is built once, from the triangles it had then.
 #[derive(Clone, Debug)]
 pub struct TriangleMesh {
     pub positions: Vec<Vec3>,
