@@ -20,7 +20,7 @@ use strandlight_runtime::camera::Camera;
 use strandlight_runtime::env::{EnvRenderOptions, EnvRenderer, EnvTables};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
-use strandlight_runtime::hair::{Attribute, HairModel};
+use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::head::{Head, HeadSurface, srbf_irradiance, tessellate_ellipsoid};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_runtime::visibility::{LobeVisibility, VisibilityVolumeSettings};
@@ -29,7 +29,7 @@ use strandlight_tables::table_axes::{
     AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_U_DOT_WO, AXIS_U_DOT_XI,
 };
 
-const RADIUS: f32 = 0.4;
+const RADIUS: f32 = HEAD_RADIUS;
 const BEHIND_X: f32 = 0.1;
 const SIDE_X: f32 = 0.7;
 /// The +x fiber sits off the −x fiber's line toward +x (else it would shadow it).
@@ -37,32 +37,18 @@ const SIDE_Z: f32 = -0.3;
 /// Light-map texels are 1/32 unit over the hair's ~2.6-unit diagonal at 128²: within two of the
 /// head's silhouette from the light, rasterization decides, not geometry.
 const EDGE_MARGIN: f64 = 0.08;
-const SKIN: [f32; 3] = [0.6, 0.4, 0.3];
+const SKIN: [f32; 3] = HEAD_SKIN;
 
 fn head() -> Head {
-    Head {
-        albedo: SKIN,
-        ..Head::ellipsoid(Vec3::ZERO, Vec3::splat(RADIUS))
-    }
+    sphere_head()
 }
 
 fn fiber(x: f32, z: f32) -> [Vec3; 2] {
-    [Vec3::new(x, -0.9, z), Vec3::new(x, 0.9, z)]
+    vertical_fiber(x, z)
 }
 
 fn hair(fibers: &[[Vec3; 2]]) -> HairModel {
-    let points: Vec<Vec3> = fibers.iter().flatten().copied().collect();
-    let offsets = (0..=fibers.len() as u32).map(|i| 2 * i).collect();
-    // 3 pixels wide on screen: full coverage at the fiber's column; thin in the light maps is
-    // not needed: one fiber alone casts nothing on itself at its own depth.
-    HairModel::new(
-        points,
-        offsets,
-        Some(Attribute::Uniform(3.0 / 32.0)),
-        None,
-        None,
-    )
-    .unwrap()
+    two_point_hair(fibers)
 }
 
 fn scene() -> HairModel {
@@ -116,23 +102,7 @@ fn render(
     shadowed: bool,
     head: Option<&Head>,
 ) -> Vec<[f32; 4]> {
-    let renderer = EnvRenderer::new(gpu);
-    let camera: Camera = ortho_camera();
-    renderer
-        .render_part(
-            gpu,
-            model,
-            &camera,
-            RES,
-            RES,
-            (lights, 0),
-            &tables(),
-            &options(shadowed),
-            None,
-            head,
-        )
-        .unwrap_or_else(|e| panic!("{e}"))
-        .pixels
+    render_with(gpu, model, lights, &options(shadowed), head)
 }
 
 /// The pixel whose centre lies nearest world (x, y) (32 per unit, y down).
@@ -314,7 +284,7 @@ fn render_with(
     model: &HairModel,
     lights: &[EnvLight],
     options: &EnvRenderOptions,
-    head: &Head,
+    head: Option<&Head>,
 ) -> Vec<[f32; 4]> {
     let camera: Camera = ortho_camera();
     EnvRenderer::new(gpu)
@@ -328,7 +298,7 @@ fn render_with(
             &tables(),
             options,
             None,
-            Some(head),
+            head,
         )
         .unwrap_or_else(|e| panic!("{e}"))
         .pixels
@@ -350,10 +320,10 @@ fn the_skin_under_fibers_is_shadowed_through_the_volume_and_a_mesh_head_agrees()
     };
     let lights = [EnvLight::srbf(Vec3::X, 300.0, [1.0; 3])];
     let model = screen();
-    let maps = render_with(&gpu, &model, &lights, &options(true), &ellipsoid);
-    let volume = render_with(&gpu, &model, &lights, &with_volume(true), &ellipsoid);
-    let volume_mesh = render_with(&gpu, &model, &lights, &with_volume(true), &mesh);
-    let open = render_with(&gpu, &model, &lights, &with_volume(false), &ellipsoid);
+    let maps = render_with(&gpu, &model, &lights, &options(true), Some(&ellipsoid));
+    let volume = render_with(&gpu, &model, &lights, &with_volume(true), Some(&ellipsoid));
+    let volume_mesh = render_with(&gpu, &model, &lights, &with_volume(true), Some(&mesh));
+    let open = render_with(&gpu, &model, &lights, &with_volume(false), Some(&ellipsoid));
     // Skin facing the light: x in 0.25..0.35 (n·x ≥ 0.6), rows near y = 0.
     let (mut n, mut sums) = (0, [0.0f64; 4]);
     for (_, y) in rows().filter(|(_, y)| y.abs() < 0.15) {

@@ -27,7 +27,7 @@ use common::*;
 
 use glam::{DVec3, Vec3};
 use strandlight_runtime::gpu::GpuContext;
-use strandlight_runtime::hair::{Attribute, HairModel};
+use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::head::Head;
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
@@ -38,7 +38,7 @@ use strandlight_runtime::render::{
 };
 use strandlight_runtime::shadow_layout::{PointLayoutChoice, ShadowLayout};
 
-const RADIUS: f32 = 0.4;
+const RADIUS: f32 = HEAD_RADIUS;
 const BEHIND_X: f32 = 0.1;
 const SIDE_X: f32 = 0.7;
 /// The +x fiber sits off the −x fiber's line toward +x (else it would shadow it).
@@ -47,32 +47,19 @@ const SIDE_Z: f32 = -0.3;
 /// cube face's 90° at ≤ 1.3 units): rays passing within a few texels of the sphere's
 /// silhouette are left to rasterization and the bias.
 const EDGE_MARGIN: f64 = 0.07;
-const SKIN: [f32; 3] = [0.6, 0.4, 0.3];
+const SKIN: [f32; 3] = HEAD_SKIN;
 const MAP_RES: u32 = 128;
 
 fn head() -> Head {
-    Head {
-        albedo: SKIN,
-        ..Head::ellipsoid(Vec3::ZERO, Vec3::splat(RADIUS))
-    }
+    sphere_head()
 }
 
 fn fiber(x: f32, z: f32) -> [Vec3; 2] {
-    [Vec3::new(x, -0.9, z), Vec3::new(x, 0.9, z)]
+    vertical_fiber(x, z)
 }
 
 fn hair(fibers: &[[Vec3; 2]]) -> HairModel {
-    let points: Vec<Vec3> = fibers.iter().flatten().copied().collect();
-    let offsets = (0..=fibers.len() as u32).map(|i| 2 * i).collect();
-    // 3 pixels wide on screen: full coverage at the fiber's column.
-    HairModel::new(
-        points,
-        offsets,
-        Some(Attribute::Uniform(3.0 / 32.0)),
-        None,
-        None,
-    )
-    .unwrap()
+    two_point_hair(fibers)
 }
 
 fn scene() -> HairModel {

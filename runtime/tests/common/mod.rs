@@ -96,3 +96,34 @@ pub fn segment_distance(p0: DVec3, p1: DVec3, q0: DVec3, q1: DVec3) -> f64 {
     }
     ((p0 + d1 * s) - (q0 + d2 * t)).length()
 }
+
+/// The head tests' scene (head_occlusion.rs, head_point_lights.rs): a sphere of radius
+/// `HEAD_RADIUS` at the origin with skin `HEAD_SKIN`, and vertical fibers beside or behind it.
+pub const HEAD_RADIUS: f32 = 0.4;
+pub const HEAD_SKIN: [f32; 3] = [0.6, 0.4, 0.3];
+
+pub fn sphere_head() -> strandlight_runtime::head::Head {
+    strandlight_runtime::head::Head {
+        albedo: HEAD_SKIN,
+        ..strandlight_runtime::head::Head::ellipsoid(Vec3::ZERO, Vec3::splat(HEAD_RADIUS))
+    }
+}
+
+/// A fiber along y from −0.9 to 0.9 at (x, z).
+pub fn vertical_fiber(x: f32, z: f32) -> [Vec3; 2] {
+    [Vec3::new(x, -0.9, z), Vec3::new(x, 0.9, z)]
+}
+
+/// One two-point strand per fiber, 3 pixels wide on screen (full coverage at its column).
+pub fn two_point_hair(fibers: &[[Vec3; 2]]) -> HairModel {
+    let points: Vec<Vec3> = fibers.iter().flatten().copied().collect();
+    let offsets = (0..=fibers.len() as u32).map(|i| 2 * i).collect();
+    HairModel::new(
+        points,
+        offsets,
+        Some(Attribute::Uniform(3.0 / 32.0)),
+        None,
+        None,
+    )
+    .unwrap()
+}
