@@ -235,17 +235,34 @@ fn env_tables(frame: &EnvFrame) -> anyhow::Result<EnvTables> {
     Ok(tables)
 }
 
+/// What the renderer is called with for `frame`, besides the frame itself.
+pub struct LightsCall<'g> {
+    pub tables: EnvTables,
+    pub options: EnvRenderOptions,
+    /// Multiple scattering's source in full mode.
+    pub source: Option<Box<dyn ForwardScatteringSource + 'g>>,
+}
+
+/// The tables, options and forward-scattering source [`render_lights`] renders `frame` with on
+/// `gpu` (a web page calls the renderer with them itself).
+pub fn lights_call<'g>(frame: &EnvFrame, gpu: &'g GpuContext) -> anyhow::Result<LightsCall<'g>> {
+    Ok(LightsCall {
+        tables: env_tables(frame)?,
+        options: render_options(frame),
+        source: match frame.mode {
+            ScatteringMode::Single => None,
+            ScatteringMode::Full => Some(forward_scattering(frame, gpu)?),
+        },
+    })
+}
+
 /// THE call into the environment-lit renderer. The SRBF path reads
 /// `tables.get(shading.srbf_table(mode))`, directional lights `tables.get(shading.direct_table(mode))`
 /// (4 axes, the 1/λ axis a single node), and the full mode also [`MULTIPLE_TABLES`].
 pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
     let (gpu, renderer) = env_renderer()?;
-    let tables = env_tables(frame)?;
-    let source = match frame.mode {
-        ScatteringMode::Single => None,
-        ScatteringMode::Full => Some(forward_scattering(frame, gpu)?),
-    };
-    let multiple = source.as_deref();
+    let call = lights_call(frame, gpu)?;
+    let (tables, multiple) = (&call.tables, call.source.as_deref());
     let out = renderer
         .render_part(
             gpu,
@@ -254,8 +271,8 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
             frame.width,
             frame.height,
             (frame.lights, frame.look.simplified_lights_before),
-            &tables,
-            &render_options(frame),
+            tables,
+            &call.options,
             multiple,
             frame.head.as_ref(),
         )

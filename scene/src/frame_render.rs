@@ -234,8 +234,14 @@ pub fn prepare_env(
 /// The lights of a frame: the `env.lobes` most powerful SRBFs (all when None) and every
 /// compact source, turned `env.rotation_deg` about the up axis, most powerful first.
 pub fn frame_lights(prepared: &PreparedEnv, env: &EnvLighting) -> Vec<EnvLight> {
+    select_lights(&prepared.scene.lights, prepared.up, env)
+}
+
+/// [`frame_lights`] from a scene's `lights` and the hair's `up` axis (a web page has no
+/// [`PreparedEnv`], only the fit's lights).
+pub fn select_lights(lights: &[EnvLight], up: UpAxis, env: &EnvLighting) -> Vec<EnvLight> {
     let luminance = light_luminance;
-    let mut lights = prepared.scene.lights.clone();
+    let mut lights = lights.to_vec();
     lights.sort_by(|a, b| luminance(b).total_cmp(&luminance(a)));
     let mut srbf_kept = 0;
     lights.retain(|l| {
@@ -243,7 +249,7 @@ pub fn frame_lights(prepared: &PreparedEnv, env: &EnvLighting) -> Vec<EnvLight> 
         srbf_kept += usize::from(l.lambda.is_some() && keep);
         keep
     });
-    let turn = Quat::from_axis_angle(prepared.up.vector(), env.rotation_deg.to_radians());
+    let turn = Quat::from_axis_angle(up.vector(), env.rotation_deg.to_radians());
     for light in &mut lights {
         light.direction = (turn * light.direction).normalize_or(Vec3::Y);
     }
@@ -409,27 +415,42 @@ fn point_frame_milliseconds(passes: &[PassTiming]) -> f64 {
         .sum()
 }
 
-fn render_env_part(
-    settings: &FrameSettings,
+/// What `part` of an env-lit frame draws: its lights, look and scattering.
+pub struct EnvPart {
+    pub lights: Vec<EnvLight>,
+    pub look: EnvLook,
+    pub mode: ScatteringMode,
+}
+
+/// `part` of the env-lit frame of `env` whose lights are `all` ([`frame_lights`]' order) and
+/// whose scene renders in `mode`.
+pub fn env_part(
     env: &EnvLighting,
-    hair: &HairModel,
-    prepared: &PreparedEnv,
+    all: Vec<EnvLight>,
+    mode: ScatteringMode,
     part: FramePart,
     count_fragments: bool,
-) -> anyhow::Result<RenderedFrame> {
-    let all = frame_lights(prepared, env);
+) -> anyhow::Result<EnvPart> {
     let look = EnvLook {
         count_fragments,
         ..env_look(env)?
     };
-    let (lights, look, mode) = match part {
-        FramePart::Whole => (all, look, prepared.scene.mode),
+    Ok(match part {
+        FramePart::Whole => EnvPart {
+            lights: all,
+            look,
+            mode,
+        },
         FramePart::Preview => {
             let mut look = look;
             look.dodm.resolution = look.dodm.resolution.min(PREVIEW_MAP_RESOLUTION);
             look.transparency = ViewTransparency::Opaque;
             let lights = all[..all.len().min(PREVIEW_LIGHTS)].to_vec();
-            (lights, look, ScatteringMode::Single)
+            EnvPart {
+                lights,
+                look,
+                mode: ScatteringMode::Single,
+            }
         }
         FramePart::Lights { first, count } => {
             let Some(lights) = all.get(first..first + count) else {
@@ -446,9 +467,26 @@ fn render_env_part(
                     as u32,
                 ..look
             };
-            (lights.to_vec(), look, prepared.scene.mode)
+            EnvPart {
+                lights: lights.to_vec(),
+                look,
+                mode,
+            }
         }
-    };
+    })
+}
+
+fn render_env_part(
+    settings: &FrameSettings,
+    env: &EnvLighting,
+    hair: &HairModel,
+    prepared: &PreparedEnv,
+    part: FramePart,
+    count_fragments: bool,
+) -> anyhow::Result<RenderedFrame> {
+    let all = frame_lights(prepared, env);
+    let EnvPart { lights, look, mode } =
+        env_part(env, all, prepared.scene.mode, part, count_fragments)?;
     let size = part.size(settings.size);
     let mut frame = env_frame(settings, env, hair, prepared, &lights, size, look)?;
     frame.mode = mode;

@@ -322,7 +322,17 @@ fn encode_payload(path: &Path, table: &Table, storage: Storage) -> Result<Vec<u8
 
 /// Reads and checks an asset: header, metadata, shape, payload size and checksum.
 pub fn read_asset(path: &Path) -> Result<TableAsset, AssetError> {
-    let mut opened = OpenedAsset::open(path)?;
+    read_opened(OpenedAsset::open(path)?)
+}
+
+/// [`read_asset`] of an asset already in memory (fetched by a web page); `path` names it in
+/// errors.
+pub fn read_asset_bytes(path: &Path, bytes: &[u8]) -> Result<TableAsset, AssetError> {
+    let source = std::io::Cursor::new(bytes);
+    read_opened(OpenedAsset::from_source(path, source, bytes.len() as u64)?)
+}
+
+fn read_opened<R: Read + Seek>(mut opened: OpenedAsset<R>) -> Result<TableAsset, AssetError> {
     let payload = opened.read_payload()?;
     let OpenedAsset { path, metadata, .. } = opened;
     let computed = sha256_hex(&payload);
@@ -357,23 +367,34 @@ pub fn read_asset_metadata(path: &Path) -> Result<AssetMetadata, AssetError> {
 }
 
 /// An asset whose header and metadata have been read and checked against the file size.
-struct OpenedAsset {
+struct OpenedAsset<R> {
     path: PathBuf,
-    file: File,
+    file: R,
     metadata: AssetMetadata,
     payload_offset: u64,
     payload_bytes: u64,
 }
 
-impl OpenedAsset {
+impl OpenedAsset<File> {
     fn open(path: &Path) -> Result<Self, AssetError> {
+        let io_error = |source| AssetError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let file = File::open(path).map_err(io_error)?;
+        let file_len = file.metadata().map_err(io_error)?.len();
+        Self::from_source(path, file, file_len)
+    }
+}
+
+impl<R: Read + Seek> OpenedAsset<R> {
+    /// Reads and checks the header and metadata of `file_len` bytes from `file`.
+    fn from_source(path: &Path, mut file: R, file_len: u64) -> Result<Self, AssetError> {
         let path_buf = path.to_path_buf();
         let io_error = |source| AssetError::Io {
             path: path_buf.clone(),
             source,
         };
-        let mut file = File::open(path).map_err(io_error)?;
-        let file_len = file.metadata().map_err(io_error)?.len();
         let truncated = |section, needed| AssetError::Truncated {
             path: path_buf.clone(),
             section,
@@ -692,6 +713,29 @@ mod tests {
         .unwrap_err();
         assert!(matches!(e, AssetError::NonFiniteValue { .. }), "{e}");
         assert!(e.to_string().contains("memory.sltab"), "{e}");
+    }
+
+    /// The in-memory reader (a web page's fetched bytes) is the file reader: same table, same
+    /// refusals, naming the path it was given.
+    #[test]
+    fn bytes_read_as_the_file_does() {
+        let dir = scratch_dir("asset-bytes");
+        let mut rng = Pcg64::seed_from_u64(9);
+        let table = random_table(&mut rng, 3, 6.0e4);
+        for storage in [Storage::F32, Storage::F16] {
+            let path = write(&dir, "t.sltab", &table, storage);
+            let bytes = std::fs::read(&path).unwrap();
+            let from_bytes = read_asset_bytes(&path, &bytes).unwrap();
+            assert_eq!(from_bytes, read_asset(&path).unwrap(), "{storage:?}");
+            let named = Path::new("bundle/tables/t.sltab");
+            let e = read_asset_bytes(named, &bytes[..bytes.len() - 3]).unwrap_err();
+            assert!(matches!(e, AssetError::Truncated { .. }), "{e}");
+            assert!(e.to_string().contains("bundle/tables/t.sltab"), "{e}");
+            let mut flipped = bytes.clone();
+            *flipped.last_mut().unwrap() ^= 1;
+            let e = read_asset_bytes(named, &flipped).unwrap_err();
+            assert!(matches!(e, AssetError::ChecksumMismatch { .. }), "{e}");
+        }
     }
 
     #[test]

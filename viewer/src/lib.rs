@@ -6,7 +6,7 @@
 mod app;
 pub mod display;
 pub mod frame;
-pub mod orbit;
+pub use strandlight_scene::orbit;
 mod panel;
 pub mod progressive;
 pub mod recompute;

@@ -8,7 +8,7 @@
 
 pub mod render;
 pub use render::{
-    DEFAULT_SIMPLIFICATION_SEED, EnvFrame, EnvRenderError, EnvRenderOptions, EnvRenderStats,
-    EnvRenderer, EnvTableError, EnvTables, FragmentCounts, OccupancyError, TransmittanceFilter,
-    ViewTransparency, render_env_frame,
+    DEFAULT_SIMPLIFICATION_SEED, EncodedFrame, EnvFrame, EnvRenderError, EnvRenderOptions,
+    EnvRenderStats, EnvRenderer, EnvTableError, EnvTables, FragmentCounts, OccupancyError,
+    TransmittanceFilter, ViewTransparency, render_env_frame,
 };

@@ -242,6 +242,18 @@ pub struct EnvFrame {
     pub stats: EnvRenderStats,
 }
 
+/// A frame whose passes are submitted and whose pixels are still on the GPU
+/// ([`EnvRenderer::encode_part`]).
+pub struct EncodedFrame {
+    pub width: u32,
+    pub height: u32,
+    /// Linear, pre-multiplied RGBA f32, row-major from the top: single scattering for every
+    /// pixel, then (`with_multiple`) multiple scattering for every pixel.
+    pub sums: wgpu::Buffer,
+    pub with_multiple: bool,
+    pub stats: EnvRenderStats,
+}
+
 fn check_light(index: usize, light: &EnvLight) -> Result<(), EnvRenderError> {
     let bad = |problem: String| EnvRenderError::BadLight { index, problem };
     if !light.direction.is_finite() || light.direction.length() < 1e-6 {
@@ -859,12 +871,53 @@ impl EnvRenderer {
         camera: &Camera,
         width: u32,
         height: u32,
-        (lights, first_window): (&[EnvLight], u32),
+        part: (&[EnvLight], u32),
         tables: &EnvTables,
         options: &EnvRenderOptions,
         multiple: Option<&dyn ForwardScatteringSource>,
         head: Option<&Head>,
     ) -> Result<EnvFrame, EnvRenderError> {
+        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let encoded = self.encode_part(
+            gpu, model, camera, width, height, part, tables, options, multiple, head,
+        )?;
+        let mut timings = Timings(encoded.stats.timings.clone());
+        let bytes = timings.time(gpu, "readback", || read_buffer(gpu, &encoded.sums))?;
+        if let Some(error) = pollster::block_on(scope.pop()) {
+            return Err(EnvRenderError::Gpu(error.to_string()));
+        }
+        let (pixels, single_pixels, multiple_pixels) =
+            split_sums(&bytes, width, height, encoded.with_multiple);
+        Ok(EnvFrame {
+            width,
+            height,
+            pixels,
+            single_pixels,
+            multiple_pixels,
+            stats: EnvRenderStats {
+                timings: timings.0,
+                ..encoded.stats
+            },
+        })
+    }
+
+    /// [`Self::render_part`] up to the pixels: every pass submitted, the sums left on the GPU
+    /// (a web page cannot wait for a readback; it draws them or maps them later). The caller
+    /// owns the error scope.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode_part(
+        &self,
+        gpu: &GpuContext,
+        model: &HairModel,
+        camera: &Camera,
+        width: u32,
+        height: u32,
+        (lights, first_window): (&[EnvLight], u32),
+        tables: &EnvTables,
+        options: &EnvRenderOptions,
+        multiple: Option<&dyn ForwardScatteringSource>,
+        head: Option<&Head>,
+    ) -> Result<EncodedFrame, EnvRenderError> {
         let request = FrameRequest {
             model,
             camera,
@@ -878,7 +931,6 @@ impl EnvRenderer {
         let mut timings = Timings(Vec::new());
         let kinds = LightKinds::of(lights);
         check_inputs(lights, &kinds, tables, options, multiple.is_some())?;
-        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let mut frame = self.frame_resources(gpu, &request, &kinds, &mut timings)?;
         frame.next_window = first_window;
         let mut memory = frame.memory();
@@ -913,18 +965,11 @@ impl EnvRenderer {
         }
         memory.push(("env tables".into(), usage.table_bytes));
         memory.push(("forward-scattering grid".into(), usage.grid_bytes));
-        let bytes = timings.time(gpu, "readback", || read_buffer(gpu, &frame.sums.sums))?;
-        if let Some(error) = pollster::block_on(scope.pop()) {
-            return Err(EnvRenderError::Gpu(error.to_string()));
-        }
-        let (pixels, single_pixels, multiple_pixels) =
-            split_sums(&bytes, width, height, multiple.is_some());
-        Ok(EnvFrame {
+        Ok(EncodedFrame {
             width,
             height,
-            pixels,
-            single_pixels,
-            multiple_pixels,
+            sums: frame.sums.sums,
+            with_multiple: multiple.is_some(),
             stats: EnvRenderStats {
                 adapter: gpu.report.clone(),
                 timings: timings.0,

@@ -94,6 +94,17 @@ impl GpuContext {
                 .await
                 .map_err(|_| DeviceError::NoAdapter { looked_at })?,
         };
+        Self::for_adapter(instance, adapter, None).await
+    }
+
+    /// A device on `adapter` with the features the passes use: `limits` (a web page asks for
+    /// WebGPU's defaults), or the adapter's own. Timestamps are read back by blocking, which a
+    /// browser cannot do: there the passes go untimed.
+    pub async fn for_adapter(
+        instance: wgpu::Instance,
+        adapter: wgpu::Adapter,
+        limits: Option<wgpu::Limits>,
+    ) -> Result<Self, DeviceError> {
         let info = adapter.get_info();
         let report = AdapterReport {
             name: info.name.clone(),
@@ -117,14 +128,15 @@ impl GpuContext {
         if float32_filterable {
             required_features |= wgpu::Features::FLOAT32_FILTERABLE;
         }
-        if adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
+        let timestamps = !cfg!(target_arch = "wasm32");
+        if timestamps && adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
             required_features |= wgpu::Features::TIMESTAMP_QUERY;
         }
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("strandlight"),
                 required_features,
-                required_limits: adapter.limits(),
+                required_limits: limits.unwrap_or_else(|| adapter.limits()),
                 ..Default::default()
             })
             .await

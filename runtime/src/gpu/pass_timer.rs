@@ -154,7 +154,8 @@ impl GpuContext {
     /// milliseconds of the passes it recorded.
     pub fn time_passes<T>(&self, work: impl FnOnce() -> T) -> (T, f64, Option<f64>) {
         let mut open = CloseOnUnwind(self.pass_timer.as_ref().filter(|t| t.begin()));
-        let start = std::time::Instant::now();
+        // std's clock panics in a browser; web-time is std's elsewhere.
+        let start = web_time::Instant::now();
         let out = work();
         self.wait_idle();
         let wall_ms = start.elapsed().as_secs_f64() * 1e3;

@@ -1,4 +1,4 @@
-//! The viewer's camera: an orbit around a target (yaw about the hair's up axis, pitch above its
+//! The viewers' camera (the window's and the web page's): an orbit around a target (yaw about the hair's up axis, pitch above its
 //! normal plane, a distance), panned in the view plane and zoomed by distance. It starts from
 //! the same framing `render` uses, and always hands the renderer an exact camera.
 
