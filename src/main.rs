@@ -13,6 +13,7 @@ mod sweep_cmd;
 mod tables_cmd;
 mod truth;
 mod view;
+mod web;
 
 use clap::{Parser, Subcommand};
 
@@ -62,6 +63,10 @@ enum Command {
     /// Open a window on hair lit live: orbit, environment or lights, artist controls,
     /// progressive refinement, screenshots that `render replay` reproduces.
     View(view::ViewArgs),
+    /// A static site that renders the scene in a browser (WebGPU): the page and its bundle.
+    Web(web::WebArgs),
+    /// Serve a folder (the site of `web`) on localhost.
+    Serve(web::ServeArgs),
 }
 
 fn main() -> anyhow::Result<()> {
@@ -82,6 +87,8 @@ fn main() -> anyhow::Result<()> {
         Command::Demo(args) => demo::run(args),
         Command::View(args) => view::run(args),
         Command::Truth(args) => truth::run(args),
+        Command::Web(args) => web::run(args),
+        Command::Serve(args) => web::serve(args),
     }
 }
 

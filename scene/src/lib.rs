@@ -25,4 +25,5 @@ pub mod progressive;
 pub mod scene_tables;
 pub mod sealed_file;
 pub mod steps;
+pub mod web_bundle;
 pub mod world_lights;

@@ -19,7 +19,7 @@ use super::frame_params::FrameParams;
 use super::head::{HeadDepthMaps, HeadPass};
 use super::render_target::DEPTH_FORMAT;
 use super::strand_geometry::StrandGeometry;
-use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
+use super::strand_quads::{strand_bind_group, strand_bind_group_layout_vertex_storage};
 use super::summed_area::{MAX_BOX_HALF_SIZE, SummedAreaTables};
 use super::transmittance_filter::TransmittanceFilter;
 use super::view_visibility::{
@@ -738,7 +738,7 @@ impl EnvViewLayouts {
             })
         };
         Self {
-            strand: strand_bind_group_layout(device),
+            strand: strand_bind_group_layout_vertex_storage(device),
             batch: transmittance_bind_group_layout(device, fragment),
             table: layout(
                 "env tables",

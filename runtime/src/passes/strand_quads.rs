@@ -22,14 +22,33 @@ pub fn strand_bind_group_layout_for(
     device: &wgpu::Device,
     stages: wgpu::ShaderStages,
 ) -> wgpu::BindGroupLayout {
+    strand_layout(device, stages, stages)
+}
+
+/// [`strand_bind_group_layout`] whose storage buffers only the vertex stage sees (they build
+/// the quads): a fragment stage with many buffers of its own (the env view's eight) stays
+/// within WebGPU's default of 8 storage buffers per stage.
+pub fn strand_bind_group_layout_vertex_storage(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    strand_layout(
+        device,
+        wgpu::ShaderStages::VERTEX_FRAGMENT,
+        wgpu::ShaderStages::VERTEX,
+    )
+}
+
+fn strand_layout(
+    device: &wgpu::Device,
+    uniform_stages: wgpu::ShaderStages,
+    storage_stages: wgpu::ShaderStages,
+) -> wgpu::BindGroupLayout {
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("strands"),
         entries: &[
-            uniform_entry(0, stages),
-            storage_entry(1, stages, true),
-            storage_entry(2, stages, true),
-            storage_entry(3, stages, true),
-            storage_entry(4, stages, true),
+            uniform_entry(0, uniform_stages),
+            storage_entry(1, storage_stages, true),
+            storage_entry(2, storage_stages, true),
+            storage_entry(3, storage_stages, true),
+            storage_entry(4, storage_stages, true),
         ],
     })
 }

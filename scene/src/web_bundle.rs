@@ -1,0 +1,187 @@
+//! The web page's bundle: one scene the page renders without the desktop tool. `strandlight
+//! web` writes it; the page (`web/`) reads it. Everything is a file a static server serves:
+//!
+//! - `settings.json`: the [`FrameSettings`] the page starts from (`render replay` renders the
+//!   same frame natively);
+//! - `scene.json`: [`BundleScene`], the SRBF fit and, per fiber preset baked, its tables' files;
+//! - `hair.hair`: the groom in cyHairFile's binary format (the page also takes a dropped one);
+//! - `tables/*.sltab`: the baked tables, checksummed assets, half floats where their error
+//!   allows ([`BundledTable::max_relative_error`]).
+//!
+//! The page recomputes the lights from the fit exactly as `prepare_env_scene` does
+//! ([`BundleScene::lights`]), so a bundle never holds a derived copy that could disagree.
+
+use crate::frame_render::PreparedEnv;
+use crate::scene_tables::{EnvShading, ScatteringMode, SceneTables};
+use crate::world_lights::to_env_lights;
+use anyhow::Context;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+use strandlight_precompute::env_lights::srbf_set_lights;
+use strandlight_precompute::srbf_set::SrbfSet;
+use strandlight_runtime::camera::UpAxis;
+use strandlight_runtime::env_light::EnvLight;
+use strandlight_tables::asset::{Storage, TableAsset, read_asset_bytes, write_asset_to};
+
+pub const SETTINGS_FILE: &str = "settings.json";
+pub const SCENE_FILE: &str = "scene.json";
+pub const HAIR_FILE: &str = "hair.hair";
+pub const TABLES_DIR: &str = "tables";
+/// Bumped when a reader of the old layout would misread the new one.
+pub const FORMAT: u32 = 1;
+
+/// Half floats are kept only where they change no table value by more than this (relative to
+/// the table's largest value): below the tables' own interpolation error (docs/BENCHMARKS.md).
+pub const HALF_TOLERANCE: f64 = 1e-3;
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BundleScene {
+    pub format: u32,
+    /// The environment's name, for the page's panel.
+    pub environment: String,
+    pub fit: SrbfSet,
+    pub shading: EnvShading,
+    pub mode: ScatteringMode,
+    /// Per fiber preset baked into the bundle: its tables.
+    pub presets: BTreeMap<String, Vec<BundledTable>>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BundledTable {
+    /// The name the renderer asks for (`SceneTables::get`).
+    pub name: String,
+    /// Under `tables/`.
+    pub file: String,
+    pub bytes: u64,
+    pub storage: Storage,
+    /// Largest |half − f32| over the table's largest |value| (0 for f32).
+    pub max_relative_error: f64,
+}
+
+impl BundleScene {
+    pub fn parse(bytes: &[u8]) -> anyhow::Result<Self> {
+        let scene: Self = serde_json::from_slice(bytes).context(SCENE_FILE)?;
+        anyhow::ensure!(
+            scene.format == FORMAT,
+            "{SCENE_FILE}: bundle format {} (this page reads {FORMAT}); rebuild it with `strandlight web`",
+            scene.format
+        );
+        anyhow::ensure!(!scene.presets.is_empty(), "{SCENE_FILE}: no fiber preset");
+        Ok(scene)
+    }
+
+    /// The scene's lights, as `prepare_env_scene` makes them from the same fit.
+    pub fn lights(&self, up: UpAxis) -> Vec<EnvLight> {
+        to_env_lights(&srbf_set_lights(&self.fit), up)
+    }
+
+    /// The tables a frame of this scene reads: the SRBF table of its mode, and the direct table
+    /// where the fit took compact sources out as directional lights.
+    pub fn table_names(&self) -> Vec<&'static str> {
+        let mut names = vec![self.shading.srbf_table(self.mode)];
+        if !self.fit.sources.is_empty() {
+            names.push(self.shading.direct_table(self.mode));
+        }
+        names
+    }
+
+    /// `preset`'s tables from their files' bytes (`fetched(file)`), checked as any asset is.
+    pub fn scene_tables(
+        &self,
+        preset: &str,
+        fetched: impl Fn(&str) -> Option<Vec<u8>>,
+    ) -> anyhow::Result<SceneTables> {
+        let tables = self
+            .presets
+            .get(preset)
+            .with_context(|| format!("{SCENE_FILE}: no preset {preset:?}"))?;
+        let mut assets = BTreeMap::new();
+        for table in tables {
+            let path = Path::new(TABLES_DIR).join(&table.file);
+            let bytes = fetched(&table.file)
+                .with_context(|| format!("{} was not fetched", path.display()))?;
+            assets.insert(table.name.clone(), read_asset_bytes(&path, &bytes)?);
+        }
+        Ok(SceneTables {
+            assets,
+            baked: Vec::new(),
+            skipped: Vec::new(),
+        })
+    }
+}
+
+/// A table's file in the bundle: half floats within [`HALF_TOLERANCE`], else f32.
+pub fn bundled_table_bytes(
+    name: &str,
+    file: &str,
+    asset: &TableAsset,
+) -> anyhow::Result<(BundledTable, Vec<u8>)> {
+    let path = Path::new(TABLES_DIR).join(file);
+    let description = &asset.metadata.description;
+    let half = write_half(&path, asset).ok();
+    let (storage, bytes, error) = match half {
+        Some((bytes, error)) if error <= HALF_TOLERANCE => (Storage::F16, bytes, error),
+        _ => {
+            let mut bytes = Vec::new();
+            write_asset_to(&mut bytes, &path, &asset.table, description, Storage::F32)?;
+            (Storage::F32, bytes, 0.0)
+        }
+    };
+    let entry = BundledTable {
+        name: name.into(),
+        file: file.into(),
+        bytes: bytes.len() as u64,
+        storage,
+        max_relative_error: error,
+    };
+    Ok((entry, bytes))
+}
+
+/// The asset in half floats and its largest error relative to the table's largest value.
+fn write_half(path: &Path, asset: &TableAsset) -> anyhow::Result<(Vec<u8>, f64)> {
+    let mut bytes = Vec::new();
+    let description = &asset.metadata.description;
+    write_asset_to(&mut bytes, path, &asset.table, description, Storage::F16)?;
+    let back = read_asset_bytes(path, &bytes)?;
+    let values = asset.table.values();
+    let largest = values.iter().fold(0.0f64, |m, v| m.max(v.abs() as f64));
+    let worst = values
+        .iter()
+        .zip(back.table.values())
+        .fold(0.0f64, |m, (a, b)| m.max((*a as f64 - *b as f64).abs()));
+    Ok((bytes, if largest > 0.0 { worst / largest } else { 0.0 }))
+}
+
+/// The bundle's scene description and table files for `prepared` (one per preset).
+pub fn bundle_scene(
+    environment: &str,
+    presets: &[(String, &PreparedEnv)],
+) -> anyhow::Result<(BundleScene, Vec<(String, Vec<u8>)>)> {
+    let (_, first) = presets.first().context("no preset to bundle")?;
+    let mut scene = BundleScene {
+        format: FORMAT,
+        environment: environment.into(),
+        fit: first.scene.fit.set.clone(),
+        shading: first.shading,
+        mode: first.scene.mode,
+        presets: BTreeMap::new(),
+    };
+    let mut files = Vec::new();
+    for (preset, prepared) in presets {
+        anyhow::ensure!(
+            prepared.scene.fit.set == scene.fit && prepared.scene.mode == scene.mode,
+            "preset {preset}: prepared under another fit or scattering mode than the first"
+        );
+        let mut entries = Vec::new();
+        for name in scene.table_names() {
+            let asset = prepared.scene.tables.get(name)?;
+            let file = format!("{preset}-{name}.sltab");
+            let (entry, bytes) = bundled_table_bytes(name, &file, asset)?;
+            files.push((file, bytes));
+            entries.push(entry);
+        }
+        scene.presets.insert(preset.clone(), entries);
+    }
+    Ok((scene, files))
+}

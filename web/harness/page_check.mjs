@@ -1,0 +1,56 @@
+// Drives the web page as a person would, in headless Chromium on SwiftShader's WebGPU: loads
+// it, waits until its title says converged (or error), reads the frame back, takes a
+// screenshot, then drops a file that is not a groom on the picture and checks that the page
+// says so and keeps its scene. Writes OUT/frame.f32, OUT/page.png and OUT/report.json.
+//
+//   node page_check.mjs URL OUT [TIMEOUT_S]
+import { chromium } from 'playwright-core';
+import { writeFileSync } from 'node:fs';
+import { join } from 'node:path';
+
+const [url, out, timeoutText] = process.argv.slice(2);
+const timeout = 1000 * Number(timeoutText ?? 600);
+const browser = await chromium.launch({
+  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
+  args: [
+    '--headless=new', '--no-sandbox', '--enable-unsafe-webgpu', '--use-webgpu-adapter=swiftshader',
+    '--enable-unsafe-swiftshader', '--disable-background-networking', '--disable-component-update',
+    '--no-first-run', '--disable-sync', '--disable-quic', ...(process.env.CHROMIUM_LOG ? ['--enable-logging=stderr', '--v=0'] : []),
+  ],
+});
+const report = { console: [] };
+try {
+  const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
+  page.on('console', (m) => report.console.push(`${m.type()}: ${m.text()}`));
+  page.on('pageerror', (e) => report.console.push(`pageerror: ${e.message}`));
+  await page.goto(url);
+  const ending = (t) => t.endsWith('converged') || t.includes('error:');
+  await page.waitForFunction(() => document.title.endsWith('converged') || document.title.includes('error:'),
+    null, { timeout, polling: 250 });
+  report.title = await page.title();
+  if (!ending(report.title) || report.title.includes('error:')) throw new Error(report.title);
+  report.timing = await page.evaluate(() => window.strandlight.report);
+  report.size = await page.evaluate(() => window.strandlight.size());
+  report.describe = JSON.parse(await page.evaluate(() => window.strandlight.page.describe()));
+  const frame = await page.evaluate(() => window.strandlight.frame());
+  writeFileSync(join(out, 'frame.f32'), Buffer.from(frame, 'base64'));
+  await page.locator('#view').screenshot({ path: join(out, 'page.png') });
+  await page.screenshot({ path: join(out, 'whole-page.png') });
+
+  // A bad file dropped on the picture: a message, and the last good scene.
+  await page.evaluate(() => {
+    const file = new File([new Uint8Array([1, 2, 3, 4, 5])], 'broken.hair');
+    const data = new DataTransfer();
+    data.items.add(file);
+    document.getElementById('view').dispatchEvent(new DragEvent('drop', { dataTransfer: data, bubbles: true, cancelable: true }));
+  });
+  await page.waitForFunction(() => window.strandlight.message() !== '', null, { timeout: 30000 });
+  report.badFileMessage = await page.evaluate(() => window.strandlight.message());
+  await page.waitForTimeout(500);
+  report.titleAfterBadFile = await page.title();
+  const after = await page.evaluate(() => window.strandlight.frame());
+  report.frameKeptAfterBadFile = after === frame;
+} finally {
+  writeFileSync(join(out, 'report.json'), JSON.stringify(report, null, 2));
+  await browser.close();
+}

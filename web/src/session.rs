@@ -1,0 +1,500 @@
+//! What the page shows and how far it is: the bundle's scene, the settings the controls edit,
+//! and the progressive plan of the current frame, one step per call to [`Session::step`]. It
+//! holds no browser types, so it runs natively too (its test sums the steps on lavapipe and
+//! compares them with `render_frame`).
+
+use crate::accumulate::AccumulatePass;
+use anyhow::Context;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use strandlight_runtime::env::EnvRenderer;
+use strandlight_runtime::env_light::EnvLight;
+use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::hair::HairModel;
+use strandlight_runtime::hair::yuksel::parse_hair;
+use strandlight_scene::env_frame::{EnvFrame, FrameRole, lights_call};
+use strandlight_scene::exposure::Exposure;
+use strandlight_scene::frame_render::{
+    env_look, env_part, light_luminance, select_lights, settings_camera,
+};
+use strandlight_scene::frame_settings::{
+    CameraSettings, EnvLighting, ExactCamera, FrameSettings, Lighting, up_choice,
+};
+use strandlight_scene::head_input::load_head;
+use strandlight_scene::orbit::Orbit;
+use strandlight_scene::progressive::{Step, plan_steps};
+use strandlight_scene::scene_tables::{ScatteringMode, SceneTables};
+use strandlight_scene::web_bundle::{BundleScene, HAIR_FILE, SCENE_FILE, SETTINGS_FILE};
+use strandlight_tables::image_out::tonemap_channel;
+
+/// The bundle's files, fetched: `settings.json`, `scene.json`, `hair.hair` and the tables by
+/// their file names.
+pub type BundleFiles = HashMap<String, Vec<u8>>;
+
+/// How far the current frame is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stage {
+    /// Nothing drawn yet.
+    Starting,
+    Preview,
+    Refining {
+        done: usize,
+        total: usize,
+    },
+    Converged,
+}
+
+/// A copy of the shown sums to read back (exposure metering, the converged frame).
+pub struct Readback {
+    pub buffer: wgpu::Buffer,
+    pub key: (u64, usize),
+    /// Pixels per image (the sums hold one, or two with multiple scattering).
+    pub pixels: usize,
+    size: [u32; 2],
+    with_multiple: bool,
+    /// The share of the lights' power the copied sums hold.
+    power: f32,
+}
+
+/// The picture the canvas shows.
+struct ShownSums {
+    buffer: wgpu::Buffer,
+    size: [u32; 2],
+    with_multiple: bool,
+    /// Share of the lights' power summed (1 for a preview, which is a frame of its own).
+    power: f32,
+}
+
+pub struct Session {
+    gpu: GpuContext,
+    renderer: EnvRenderer,
+    accumulate: AccumulatePass,
+    bundle: BundleScene,
+    files: BundleFiles,
+    tables: SceneTables,
+    pub settings: FrameSettings,
+    hair: HairModel,
+    orbit: Orbit,
+    pub exposure: Exposure,
+    /// Linear RGB behind the hair (before exposure).
+    background: [f32; 3],
+    /// The frame: bumped by every change that restarts it.
+    generation: u64,
+    plan: Vec<Step>,
+    next: usize,
+    lights: Vec<EnvLight>,
+    total: Option<wgpu::Buffer>,
+    shown: Option<ShownSums>,
+    /// (generation, steps) of the picture last metered.
+    metered: Option<(u64, usize)>,
+    /// The exposure changed: meter the shown picture again.
+    remeter: bool,
+    stops: f32,
+    /// The converged frame (single + multiple, linear, pre-multiplied RGBA).
+    pub converged: Option<Vec<[f32; 4]>>,
+    /// The latest picture read back (linear, scaled to the whole frame's power) and its size.
+    read: Option<(Vec<[f32; 4]>, [u32; 2])>,
+    /// Bumped whenever [`Self::picture`] would return another picture.
+    pub picture_version: u64,
+    /// The scene before a dropped hair, until the new hair's first step succeeds.
+    fallback: Option<Fallback>,
+}
+
+struct Fallback {
+    name: String,
+    hair: HairModel,
+    settings: FrameSettings,
+    orbit: Orbit,
+}
+
+impl Session {
+    /// The session of a bundle.
+    pub fn new(gpu: GpuContext, files: BundleFiles) -> anyhow::Result<Self> {
+        let file = |name: &str| {
+            files
+                .get(name)
+                .with_context(|| format!("the bundle has no {name}"))
+        };
+        let bundle = BundleScene::parse(file(SCENE_FILE)?)?;
+        let settings: FrameSettings =
+            serde_json::from_slice(file(SETTINGS_FILE)?).context(SETTINGS_FILE)?;
+        settings.check().context(SETTINGS_FILE)?;
+        let hair = parse_hair(file(HAIR_FILE)?, Path::new(HAIR_FILE))?.model;
+        let tables = bundle.scene_tables(&settings.preset, |f| files.get(f).cloned())?;
+        let renderer = EnvRenderer::new(&gpu);
+        let accumulate = AccumulatePass::new(&gpu.device);
+        let orbit = orbit_of(&settings, &hair)?;
+        let mut session = Self {
+            gpu,
+            renderer,
+            accumulate,
+            bundle,
+            files,
+            tables,
+            settings,
+            hair,
+            orbit,
+            exposure: Exposure::Auto,
+            background: [0.0; 3],
+            generation: 0,
+            plan: Vec::new(),
+            next: 0,
+            lights: Vec::new(),
+            total: None,
+            shown: None,
+            metered: None,
+            remeter: false,
+            stops: 0.0,
+            converged: None,
+            read: None,
+            picture_version: 0,
+            fallback: None,
+        };
+        session.restart()?;
+        Ok(session)
+    }
+
+    pub fn gpu(&self) -> &GpuContext {
+        &self.gpu
+    }
+
+    pub fn bundle(&self) -> &BundleScene {
+        &self.bundle
+    }
+
+    fn env(&self) -> anyhow::Result<&EnvLighting> {
+        match &self.settings.lighting {
+            Lighting::Environment(env) => Ok(env),
+            Lighting::Lights(_) => anyhow::bail!("the page renders env-lit frames only"),
+        }
+    }
+
+    fn env_mut(&mut self) -> &mut EnvLighting {
+        match &mut self.settings.lighting {
+            Lighting::Environment(env) => env,
+            Lighting::Lights(_) => unreachable!("checked when the session was made"),
+        }
+    }
+
+    /// Plans the frame of the current settings from its first step; the old picture stays on
+    /// the canvas until the new preview replaces it.
+    fn restart(&mut self) -> anyhow::Result<()> {
+        anyhow::ensure!(
+            self.bundle.mode == ScatteringMode::Single,
+            "multiple scattering needs the desktop tool (`strandlight view`): its grid is \
+             marched with a readback a page cannot wait for"
+        );
+        let env = self.env()?.clone();
+        let up = up_choice(&self.settings).axis(&self.hair);
+        self.lights = select_lights(&self.bundle.lights(up), up, &env);
+        let powers: Vec<f32> = self.lights.iter().map(light_luminance).collect();
+        let batch = env_look(&env)?.dodm.batch_size as usize;
+        self.plan = plan_steps(Some((&powers, batch)));
+        self.next = 0;
+        self.generation += 1;
+        self.total = None;
+        self.converged = None;
+        Ok(())
+    }
+
+    /// How far the frame is on the GPU: the latest step whose picture was read back (so a
+    /// preview counts once it has been drawn, not when it was sent).
+    pub fn stage(&self) -> Stage {
+        let batches = self.plan.len().saturating_sub(1);
+        let done = match self.metered {
+            Some((generation, steps)) if generation == self.generation => steps,
+            _ => 0,
+        };
+        match done {
+            _ if self.converged.is_some() => Stage::Converged,
+            0 => Stage::Starting,
+            1 => Stage::Preview,
+            n => Stage::Refining {
+                done: n - 1,
+                total: batches,
+            },
+        }
+    }
+
+    /// Whether steps remain to encode.
+    pub fn refining(&self) -> bool {
+        self.next < self.plan.len()
+    }
+
+    /// Encodes the next step of the plan (one frame's work: a preview or one light batch). A
+    /// dropped hair whose first step fails (the GPU's limits, say) gives way to the scene
+    /// before it.
+    pub fn step(&mut self) -> anyhow::Result<()> {
+        match (self.encode_step(), self.fallback.take()) {
+            (Ok(()), _) => Ok(()),
+            (Err(e), None) => Err(e),
+            (Err(e), Some(before)) => {
+                self.hair = before.hair;
+                self.settings = before.settings;
+                self.orbit = before.orbit;
+                self.restart()?;
+                Err(e.context(format!("{}: kept the scene before it", before.name)))
+            }
+        }
+    }
+
+    fn encode_step(&mut self) -> anyhow::Result<()> {
+        let Some(&step) = self.plan.get(self.next) else {
+            return Ok(());
+        };
+        let env = self.env()?.clone();
+        let part = env_part(
+            &env,
+            self.lights.clone(),
+            self.bundle.mode,
+            step.part(),
+            false,
+        )?;
+        let [width, height] = step.part().size(self.settings.size);
+        let frame = EnvFrame {
+            hair: &self.hair,
+            camera: settings_camera(&self.settings, &self.hair)?,
+            width,
+            height,
+            lights: &part.lights,
+            tables: &self.tables,
+            shading: self.bundle.shading,
+            mode: part.mode,
+            role: FrameRole::Interactive { kappa: env.kappa },
+            look: part.look,
+            head: load_head(&self.settings.head, &self.hair, self.settings.skin_albedo)?,
+        };
+        let call = lights_call(&frame, &self.gpu)?;
+        let encoded = self.renderer.encode_part(
+            &self.gpu,
+            frame.hair,
+            &frame.camera,
+            width,
+            height,
+            (frame.lights, frame.look.simplified_lights_before),
+            &call.tables,
+            &call.options,
+            call.source.as_deref(),
+            frame.head.as_ref(),
+        )?;
+        let shown = match step {
+            Step::Batch { power_after, .. } => {
+                let total = self.total.get_or_insert_with(|| {
+                    self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some("page sum"),
+                        size: encoded.sums.size(),
+                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                        mapped_at_creation: false,
+                    })
+                });
+                let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+                self.accumulate
+                    .encode(&self.gpu.device, &mut encoder, &encoded.sums, total);
+                self.gpu.queue.submit([encoder.finish()]);
+                ShownSums {
+                    buffer: total.clone(),
+                    size: [width, height],
+                    with_multiple: encoded.with_multiple,
+                    power: power_after,
+                }
+            }
+            Step::Preview | Step::Full => ShownSums {
+                buffer: encoded.sums,
+                size: [width, height],
+                with_multiple: encoded.with_multiple,
+                power: 1.0,
+            },
+        };
+        self.shown = Some(shown);
+        self.next += 1;
+        Ok(())
+    }
+
+    /// The picture of the latest frame read back: its radiance exposed, over the background,
+    /// through the PNG's tonemap (`tonemap_channel`, so the page shows what `render` writes),
+    /// as 8-bit RGBA rows from the top, and its size (half the frame's for a preview).
+    pub fn picture(&self) -> Option<(Vec<u8>, [u32; 2])> {
+        let (image, size) = self.read.as_ref()?;
+        let exposure = self.stops.exp2();
+        let bytes = image
+            .iter()
+            .flat_map(|p| {
+                let behind = 1.0 - p[3].clamp(0.0, 1.0);
+                let [r, g, b] = [0, 1, 2]
+                    .map(|k| tonemap_channel(exposure * (p[k] + self.background[k] * behind)));
+                [r, g, b, 255]
+            })
+            .collect();
+        Some((bytes, *size))
+    }
+
+    /// A copy of the shown sums to map, when the shown picture has not been metered yet.
+    pub fn readback(&self) -> Option<Readback> {
+        let shown = self.shown.as_ref()?;
+        let key = (self.generation, self.next);
+        if self.metered == Some(key) && !self.remeter {
+            return None;
+        }
+        let buffer = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("page readback"),
+            size: shown.buffer.size(),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&shown.buffer, 0, &buffer, 0, shown.buffer.size());
+        self.gpu.queue.submit([encoder.finish()]);
+        Some(Readback {
+            buffer,
+            key,
+            pixels: (shown.size[0] * shown.size[1]) as usize,
+            size: shown.size,
+            with_multiple: shown.with_multiple,
+            power: shown.power,
+        })
+    }
+
+    /// The sums read back for `key`: meters the exposure on them and, after the last step,
+    /// keeps them as the converged frame. Stale readbacks (of a restarted frame) are dropped.
+    pub fn readback_done(&mut self, readback: &Readback, sums: &[[f32; 4]]) {
+        let key = readback.key;
+        let older = self.metered.is_some_and(|m| m.0 == key.0 && m.1 > key.1);
+        if key.0 != self.generation || older {
+            return;
+        }
+        let pixels = readback.pixels;
+        let scale = 1.0 / readback.power.max(f32::MIN_POSITIVE);
+        let image: Vec<[f32; 4]> = (0..pixels)
+            .map(|i| {
+                let s = sums[i];
+                let m = match readback.with_multiple {
+                    true => sums[i + pixels],
+                    false => [0.0; 4],
+                };
+                [
+                    (s[0] + m[0]) * scale,
+                    (s[1] + m[1]) * scale,
+                    (s[2] + m[2]) * scale,
+                    s[3],
+                ]
+            })
+            .collect();
+        self.stops = self.exposure.stops_for(&image);
+        self.metered = Some(key);
+        self.remeter = false;
+        if key.1 == self.plan.len() {
+            self.converged = Some(image.clone());
+        }
+        self.read = Some((image, readback.size));
+        self.picture_version += 1;
+    }
+
+    /// The exposure applied now, in stops.
+    pub fn stops(&self) -> f32 {
+        self.stops
+    }
+
+    /// Sets the exposure and meters it again on the shown picture.
+    pub fn set_exposure(&mut self, exposure: Exposure) {
+        self.exposure = exposure;
+        self.remeter = true;
+    }
+
+    /// Linear RGB behind the hair.
+    pub fn set_background(&mut self, rgb: [f32; 3]) {
+        self.background = rgb;
+        self.picture_version += 1;
+    }
+
+    pub fn set_rotation(&mut self, degrees: f32) -> anyhow::Result<()> {
+        self.env_mut().rotation_deg = degrees;
+        self.restart()
+    }
+
+    /// The number of SRBF lobes drawn (0: all).
+    pub fn set_lobes(&mut self, lobes: usize) -> anyhow::Result<()> {
+        self.env_mut().lobes = (lobes > 0).then_some(lobes);
+        self.restart()
+    }
+
+    pub fn set_kappa(&mut self, kappa: f32) -> anyhow::Result<()> {
+        anyhow::ensure!(
+            kappa.is_finite() && kappa > 0.0 && kappa <= 1.0,
+            "κ = {kappa} must be in (0, 1]"
+        );
+        self.env_mut().kappa = kappa;
+        self.restart()
+    }
+
+    /// Switches to another fiber preset baked into the bundle.
+    pub fn set_preset(&mut self, preset: &str) -> anyhow::Result<()> {
+        let files = &self.files;
+        self.tables = self
+            .bundle
+            .scene_tables(preset, |f| files.get(f).cloned())?;
+        self.settings.preset = preset.into();
+        self.restart()
+    }
+
+    /// Orbit (drag), pan (drag with a modifier) and zoom (wheel steps).
+    pub fn rotate(&mut self, dx: f32, dy: f32) -> anyhow::Result<()> {
+        self.orbit.rotate(dx, dy);
+        self.camera_moved()
+    }
+
+    pub fn pan(&mut self, dx: f32, dy: f32) -> anyhow::Result<()> {
+        let height = self.settings.size[1] as f32;
+        self.orbit.pan(dx, dy, height);
+        self.camera_moved()
+    }
+
+    pub fn zoom(&mut self, steps: f32) -> anyhow::Result<()> {
+        self.orbit.zoom(steps);
+        self.camera_moved()
+    }
+
+    fn camera_moved(&mut self) -> anyhow::Result<()> {
+        self.settings.camera = CameraSettings::Exact(ExactCamera::of(&self.orbit.camera()));
+        self.restart()
+    }
+
+    /// A `.hair` file dropped on the page. A file that does not load, or whose frame cannot be
+    /// set up, leaves the current scene as it was and says why.
+    pub fn load_hair(&mut self, name: &str, bytes: &[u8]) -> anyhow::Result<()> {
+        anyhow::ensure!(
+            name.to_ascii_lowercase().ends_with(".hair"),
+            "{name}: the page reads .hair files (cyHairFile); other formats need the desktop tool"
+        );
+        let model = parse_hair(bytes, Path::new(name))?.model;
+        let mut settings = self.settings.clone();
+        settings.hair = Some(PathBuf::from(name));
+        settings.camera = CameraSettings::Framed(Default::default());
+        let orbit = orbit_of(&settings, &model)?;
+        let hair = std::mem::replace(&mut self.hair, model);
+        let settings = std::mem::replace(&mut self.settings, settings);
+        let orbit = std::mem::replace(&mut self.orbit, orbit);
+        self.fallback = Some(Fallback {
+            name: name.into(),
+            hair,
+            settings,
+            orbit,
+        });
+        self.restart()
+    }
+
+    /// The settings, as `render replay` reads them.
+    pub fn settings_json(&self) -> String {
+        serde_json::to_string_pretty(&self.settings).expect("settings serialize")
+    }
+}
+
+/// The orbit through the settings' camera.
+fn orbit_of(settings: &FrameSettings, hair: &HairModel) -> anyhow::Result<Orbit> {
+    let camera = settings_camera(settings, hair)?;
+    let front = up_choice(settings).axis(hair).toward_front();
+    Ok(Orbit::from_camera(
+        &camera,
+        front,
+        0.5 * hair.bounds().diagonal(),
+    ))
+}
