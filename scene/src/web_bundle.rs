@@ -153,11 +153,14 @@ fn write_half(path: &Path, asset: &TableAsset) -> anyhow::Result<(Vec<u8>, f64)>
     Ok((bytes, if largest > 0.0 { worst / largest } else { 0.0 }))
 }
 
+/// A table file of the bundle: its name under `tables/` and its bytes.
+pub type TableFile = (String, Vec<u8>);
+
 /// The bundle's scene description and table files for `prepared` (one per preset).
 pub fn bundle_scene(
     environment: &str,
     presets: &[(String, &PreparedEnv)],
-) -> anyhow::Result<(BundleScene, Vec<(String, Vec<u8>)>)> {
+) -> anyhow::Result<(BundleScene, Vec<TableFile>)> {
     let (_, first) = presets.first().context("no preset to bundle")?;
     let mut scene = BundleScene {
         format: FORMAT,

@@ -9,8 +9,7 @@
 //! Expected pixel: `E · S(θ_i, θ_o, φ) · cos θ_i`, E = the light's intensity (directional) or
 //! intensity / d² (point), the angles from `FiberAngles::from_directions` in f64.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::{DVec3, Vec3};
 use strandlight_precompute::point_light_luts::{

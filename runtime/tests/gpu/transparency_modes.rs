@@ -10,8 +10,7 @@
 //! - DBK with Δ covering the whole hair lists every fragment and equals it (also on three
 //!   strands in `abuffer.rs`).
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::Vec3;
 use strandlight_runtime::camera::Camera;

@@ -2,8 +2,7 @@
 //! strand at sampled pixels (f64, several lights of every kind), and the coverage alpha of
 //! sub-pixel strands summed across the strand against their width in pixels.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::Vec3;
 use strandlight_runtime::camera::{Camera, Projection};

@@ -1,6 +1,5 @@
 //! Scene pieces shared by the GPU tests: a device, the orthographic test camera and the slab of
 //! parallel strands whose transmittance has a closed form.
-#![allow(dead_code)] // each test binary uses its own subset
 
 use glam::{DVec3, Vec3};
 use strandlight_runtime::camera::{Camera, Projection};

@@ -2,8 +2,7 @@
 //! diameter d spaced s apart, each row at an independent lateral offset, transmit (1 − d/s)
 //! per row, so the light reaching depth m rows in is (1 − d/s)^m.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::Vec3;
 use strandlight_runtime::camera::{Camera, Projection};

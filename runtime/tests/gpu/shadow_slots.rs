@@ -2,8 +2,7 @@
 //! opacity map, checked against the closed-form transmittance of a slab of parallel strands,
 //! (1 − d/s)^m after m rows of fibers of diameter d spaced s apart.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::Vec3;
 use strandlight_runtime::gpu::{GpuContext, read_texture_rgba};

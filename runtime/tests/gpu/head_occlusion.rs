@@ -12,8 +12,7 @@
 //! Shadows are read as the ratio of the shadowed frame to the unshadowed one at the same pixel,
 //! so they test the transmittance the shader applied whatever the fiber shading.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::{DVec3, Vec3};
 use strandlight_runtime::camera::Camera;

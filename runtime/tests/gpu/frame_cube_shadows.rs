@@ -14,8 +14,7 @@
 //! the ring's centre and plane, so no ray runs along a seam by construction. The scene is drawn
 //! in two orientations, the plane z = 0 (faces ±x, ±y) and x = 0 (faces ±y, ±z): all six faces.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::{DVec3, Vec3};
 use strandlight_runtime::camera::{Camera, Projection};

@@ -2,8 +2,7 @@
 //! physically possible — every pass's GPU time is positive and fits inside the wall-clock
 //! window that enclosed its submission and completion.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::Vec3;
 use strandlight_runtime::lights::Light;

@@ -5,8 +5,7 @@
 //! Marschner-LUT and artist shading and several shadow maps, a single strand through the A-buffer
 //! and DBK equals the opaque pass.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::Vec3;
 use strandlight_precompute::point_light_luts::{LutResolution, bake_lut_m, bake_lut_n};

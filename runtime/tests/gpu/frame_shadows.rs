@@ -18,8 +18,7 @@
 //! Every comparison is a ratio of the shadowed frame to the unshadowed one (`shadows: None`)
 //! at the same pixel, so it reads the transmittance the shader applied whatever the shading.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::{DVec3, Vec3};
 use strandlight_runtime::gpu::GpuContext;

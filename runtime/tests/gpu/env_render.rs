@@ -2,8 +2,7 @@
 //! transmittance of a slab of fibers against a numerical cone integral of the exact ray
 //! visibility, and the view pass's shading against `Table::lookup` on the CPU.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::{DVec3, Vec2, Vec3};
 use strandlight_runtime::camera::{Camera, Projection, light_camera};

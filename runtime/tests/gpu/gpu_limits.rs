@@ -3,8 +3,7 @@
 //! limit is reached on the real device where a setting can reach it; `gpu::limits`'s unit tests
 //! reach the rest with small synthetic limits.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::Vec3;
 use strandlight_runtime::camera::Camera;

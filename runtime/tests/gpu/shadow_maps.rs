@@ -8,8 +8,7 @@
 //! x = 0.3, z = −0.5, seen by the orthographic test camera from +z. The maps are built from the
 //! occluders alone, so the receiver never shadows itself.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::Vec3;
 use strandlight_runtime::camera::{Camera, light_camera, point_light_camera};

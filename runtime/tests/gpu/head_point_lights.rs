@@ -22,8 +22,7 @@
 //! left out (point_skin.wgsl), every probed pixel of every shadow choice and light (0.853 vs
 //! 0.272 at (32, 32) under the point light).
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::{DVec3, Vec3};
 use strandlight_runtime::gpu::GpuContext;

@@ -2,8 +2,7 @@
 //! drawn in a shuffled order, against front-to-back "over" compositing done here in f64 —
 //! Σ_k c_k α Π_{j<k} (1 − α) — with each fiber's colour c_k from `Table::lookup`.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 use glam::{DVec3, Vec3};
 use strandlight_runtime::env::{

@@ -3,11 +3,11 @@
 //! strand lit on the GPU from the export alone matches the runtime's lookup of the same table
 //! within the tolerance the example derives (half rounding + 8-bit filter weights + f32).
 
-mod common;
-#[path = "../examples/ktx2_strand.rs"]
-mod ktx2_strand;
+use crate::common;
+#[path = "../../examples/ktx2_strand.rs"]
+mod example;
 
-use ktx2_strand::Sampling;
+use example::Sampling;
 use std::path::PathBuf;
 use strandlight_precompute::convolution::ConvolutionSettings;
 use strandlight_precompute::convolution_table::{
@@ -94,7 +94,7 @@ fn a_strand_lit_from_the_exported_lut_alone_matches_the_runtime() {
             continue;
         }
         export_ktx2(&asset, &export, storage).unwrap();
-        let c = ktx2_strand::run(&gpu, &export, &dir, "marschner", sampling).unwrap();
+        let c = example::run(&gpu, &export, &dir, "marschner", sampling).unwrap();
         eprintln!(
             "{storage:?}, {sampling:?} on {}: {} points, max error {:.2e} of the largest radiance {:.3e}, max relative {:.2e}, {:.3} of the tolerance",
             gpu.report,
