@@ -1,5 +1,5 @@
 #!/bin/bash
-# BENCHMARKS "Compact source's shadow: the map size": the SRBF default (the volume) and the
+# BENCHMARKS history ("Compact source's shadow: the map size", docs/history/benchmarks-to-2026-11-28.md): the SRBF default (the volume) and the
 # 96-light DOM reference against the path-traced truth, single scattering, 160x120, by the size
 # of the light maps (with the volume, only the compact sources draw any). Renders each map's
 # truth once (cached). Usage: scripts/compact-source-map-size.sh [OUT_DIR]

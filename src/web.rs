@@ -11,7 +11,7 @@ use strandlight_scene::env_scene::{EnvSceneRequest, prepare_env_scene};
 use strandlight_scene::environment::{ensure_procedural_envmap, load_env};
 use strandlight_scene::frame_render::{PreparedEnv, load_settings_hair};
 use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting, up_choice};
-use strandlight_scene::look::LobeVisibilityArg;
+use strandlight_scene::look::{ForwardDevice, LobeVisibilityArg};
 use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
@@ -74,15 +74,18 @@ pub fn run(args: WebArgs) -> anyhow::Result<()> {
         settings.size = parse_size(size)?;
     }
     settings.check()?;
-    let Lighting::Environment(env) = &settings.lighting else {
+    let Lighting::Environment(env) = &mut settings.lighting else {
         anyhow::bail!("the page renders env-lit frames; the settings are point-lit");
     };
-    anyhow::ensure!(
-        env.scattering == ScatteringMode::Single,
-        "the page renders single scattering (its multiple-scattering grid is marched with a \
-         blocking readback, which a browser cannot wait for): set the settings' scattering to \
-         single"
-    );
+    if env.scattering == ScatteringMode::Full && env.view.forward_scattering != ForwardDevice::Gpu {
+        // So that `render replay` of the bundle's settings renders the page's frame.
+        steps.say(
+            "the page marches multiple scattering on the GPU: the bundle's settings say so"
+                .to_string(),
+        );
+        env.view.forward_scattering = ForwardDevice::Gpu;
+    }
+    let env = &env.clone();
     let hair = steps.run(
         "hair",
         || load_settings_hair(&settings),
@@ -126,15 +129,17 @@ pub fn run(args: WebArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The demo's scene as the page starts it: single scattering, light maps for every lobe (the
-/// visibility volume is built on the CPU, which in a page would block its only thread).
+/// The demo's scene as the page starts it: single + multiple scattering with the grid marched
+/// on the GPU (as the page marches it), light maps for every lobe (the visibility volume is
+/// built on the CPU, which in a page would block its only thread), the nearest fiber per pixel.
 fn web_settings() -> anyhow::Result<FrameSettings> {
     let (path, _) = ensure_procedural_envmap(Path::new(ENVMAP_DIR), DEMO_ENVIRONMENT)?;
     let mut lighting = EnvLighting {
-        scattering: ScatteringMode::Single,
+        scattering: ScatteringMode::Full,
         ..EnvLighting::new(path.to_string_lossy())
     };
     lighting.view.lobe_visibility = LobeVisibilityArg::LightMaps;
+    lighting.view.forward_scattering = ForwardDevice::Gpu;
     Ok(FrameSettings {
         shading: Some(Shading::Marschner),
         preset: DEMO_PRESET.into(),
@@ -234,45 +239,79 @@ fn write_site(
     Ok(total)
 }
 
-/// Serves `dir` on 127.0.0.1 until interrupted (wasm with its MIME type, which browsers need to
-/// compile it while it downloads).
+/// Serves `dir` on 127.0.0.1 until interrupted: GET of the files under it, one request per
+/// connection, a thread each (wasm with its MIME type, which browsers need to compile it while
+/// it downloads). Hand-written after tiny_http 0.12 stalled a page's parallel fetches of its
+/// tables now and then (2 of 11 files never answered, with and without keep-alive).
 pub fn serve(args: ServeArgs) -> anyhow::Result<()> {
     let root = args
         .dir
         .canonicalize()
         .with_context(|| format!("{} is not a folder to serve", args.dir.display()))?;
-    let server = tiny_http::Server::http(("127.0.0.1", args.port))
-        .map_err(|e| anyhow::anyhow!("cannot listen on 127.0.0.1:{}: {e}", args.port))?;
-    let address = server.server_addr();
-    println!("serving {} at http://{address}/", root.display());
-    for request in server.incoming_requests() {
-        let response = respond(&root, request.url());
-        let _ = request.respond(response);
+    let listener = std::net::TcpListener::bind(("127.0.0.1", args.port))
+        .with_context(|| format!("cannot listen on 127.0.0.1:{}", args.port))?;
+    println!(
+        "serving {} at http://{}/",
+        root.display(),
+        listener.local_addr()?
+    );
+    for stream in listener.incoming() {
+        let Ok(stream) = stream else { continue };
+        let root = root.clone();
+        std::thread::spawn(move || {
+            let _ = answer(&root, stream);
+        });
     }
     Ok(())
 }
 
-fn respond(root: &Path, url: &str) -> tiny_http::Response<std::io::Cursor<Vec<u8>>> {
-    let path = url.split(['?', '#']).next().unwrap_or("/");
-    let relative = path.trim_start_matches('/');
-    let relative = if relative.is_empty() {
-        "index.html"
-    } else {
-        relative
+/// Reads one request from `stream` and answers it with the file, 404 or 405.
+fn answer(root: &Path, mut stream: std::net::TcpStream) -> std::io::Result<()> {
+    use std::io::{BufRead, Write};
+    let mut reader = std::io::BufReader::new(stream.try_clone()?);
+    let mut request_line = String::new();
+    reader.read_line(&mut request_line)?;
+    // The headers are read to their end and ignored.
+    let mut header = String::new();
+    while reader.read_line(&mut header)? > 2 {
+        header.clear();
+    }
+    let mut parts = request_line.split_whitespace();
+    let (method, url) = (parts.next().unwrap_or(""), parts.next().unwrap_or("/"));
+    let (status, content_type, body) = match method {
+        "GET" | "HEAD" => match file_of(root, url) {
+            Some(path) => match std::fs::read(&path) {
+                Ok(bytes) => ("200 OK", mime_type(&path), bytes),
+                Err(_) => ("404 Not Found", "text/plain", b"not found".to_vec()),
+            },
+            None => ("404 Not Found", "text/plain", b"not found".to_vec()),
+        },
+        _ => ("405 Method Not Allowed", "text/plain", Vec::new()),
     };
-    // No `..`, no absolute parts: only files under the root are served.
+    write!(
+        stream,
+        "HTTP/1.1 {status}\r\nContent-Type: {content_type}\r\nContent-Length: {}\r\n\
+         Connection: close\r\n\r\n",
+        body.len()
+    )?;
+    if method != "HEAD" {
+        stream.write_all(&body)?;
+    }
+    stream.flush()
+}
+
+/// The file under `root` that `url` names (`/` is `index.html`); None for anything that would
+/// leave the root.
+fn file_of(root: &Path, url: &str) -> Option<PathBuf> {
+    let path = url.split(['?', '#']).next().unwrap_or("/");
+    let relative = match path.trim_start_matches('/') {
+        "" => "index.html",
+        relative => relative,
+    };
     let safe = Path::new(relative)
         .components()
         .all(|c| matches!(c, std::path::Component::Normal(_)));
-    let file = root.join(relative);
-    match std::fs::read(&file) {
-        Ok(bytes) if safe => {
-            let header = tiny_http::Header::from_bytes("Content-Type", mime_type(&file))
-                .expect("a valid header");
-            tiny_http::Response::from_data(bytes).with_header(header)
-        }
-        _ => tiny_http::Response::from_data(b"not found".to_vec()).with_status_code(404),
-    }
+    safe.then(|| root.join(relative))
 }
 
 fn mime_type(path: &Path) -> &'static str {

@@ -177,11 +177,7 @@ fn forward_scattering<'g>(
     frame: &EnvFrame,
     gpu: &'g GpuContext,
 ) -> anyhow::Result<Box<dyn ForwardScatteringSource + 'g>> {
-    let tables = ForwardScatteringTables::from_tables(
-        &frame.tables.get("fiber_averages")?.table,
-        &frame.tables.get("attenuation_ratio")?.table,
-        &frame.tables.get("srbf_spread")?.table,
-    )?;
+    let tables = forward_tables(frame)?;
     let settings = forward_settings(frame.role);
     let cpu =
         CpuForwardScattering::new(frame.hair, tables, settings)?.with_head(frame.head.clone());
@@ -204,6 +200,27 @@ fn forward_scattering<'g>(
             Err(_) => Box::new(cpu),
         },
     })
+}
+
+fn forward_tables(frame: &EnvFrame) -> anyhow::Result<ForwardScatteringTables> {
+    Ok(ForwardScatteringTables::from_tables(
+        &frame.tables.get("fiber_averages")?.table,
+        &frame.tables.get("attenuation_ratio")?.table,
+        &frame.tables.get("srbf_spread")?.table,
+    )?)
+}
+
+/// The voxelized hair and medium of `frame`'s forward scattering, set up for the GPU march
+/// (`--forward-scattering gpu`): what the web page marches with `GpuForwardScattering`.
+pub fn gpu_march_volume(frame: &EnvFrame) -> anyhow::Result<CpuForwardScattering> {
+    let settings = ForwardScatteringSettings {
+        light_sweep: false,
+        ..forward_settings(frame.role)
+    };
+    Ok(
+        CpuForwardScattering::new(frame.hair, forward_tables(frame)?, settings)?
+            .with_head(frame.head.clone()),
+    )
 }
 
 /// The runtime's tables for `frame`: the SRBF table of its mode for SRBF lights, the direct
@@ -247,12 +264,21 @@ pub struct LightsCall<'g> {
 /// `gpu` (a web page calls the renderer with them itself).
 pub fn lights_call<'g>(frame: &EnvFrame, gpu: &'g GpuContext) -> anyhow::Result<LightsCall<'g>> {
     Ok(LightsCall {
-        tables: env_tables(frame)?,
-        options: render_options(frame),
         source: match frame.mode {
             ScatteringMode::Single => None,
             ScatteringMode::Full => Some(forward_scattering(frame, gpu)?),
         },
+        ..lights_call_without_source(frame)?
+    })
+}
+
+/// [`lights_call`] without its forward-scattering source, for a caller that marched the grid
+/// itself (the web page).
+pub fn lights_call_without_source<'g>(frame: &EnvFrame) -> anyhow::Result<LightsCall<'g>> {
+    Ok(LightsCall {
+        tables: env_tables(frame)?,
+        options: render_options(frame),
+        source: None,
     })
 }
 

@@ -12,7 +12,7 @@
 //! ([`BundleScene::lights`]), so a bundle never holds a derived copy that could disagree.
 
 use crate::frame_render::PreparedEnv;
-use crate::scene_tables::{EnvShading, ScatteringMode, SceneTables};
+use crate::scene_tables::{EnvShading, MULTIPLE_TABLES, ScatteringMode, SceneTables};
 use crate::world_lights::to_env_lights;
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
@@ -76,13 +76,26 @@ impl BundleScene {
         to_env_lights(&srbf_set_lights(&self.fit), up)
     }
 
-    /// The tables a frame of this scene reads: the SRBF table of its mode, and the direct table
-    /// where the fit took compact sources out as directional lights.
+    /// The tables the page reads: the SRBF table, and the direct table where the fit took
+    /// compact sources out as directional lights, of single scattering (the preview's, and the
+    /// frame's when the page asks for single) and, for a scene with multiple scattering, of
+    /// the full mode with the multiple-scattering tables.
     pub fn table_names(&self) -> Vec<&'static str> {
-        let mut names = vec![self.shading.srbf_table(self.mode)];
-        if !self.fit.sources.is_empty() {
-            names.push(self.shading.direct_table(self.mode));
+        let modes: &[ScatteringMode] = match self.mode {
+            ScatteringMode::Single => &[ScatteringMode::Single],
+            ScatteringMode::Full => &[ScatteringMode::Single, ScatteringMode::Full],
+        };
+        let mut names = Vec::new();
+        for &mode in modes {
+            names.push(self.shading.srbf_table(mode));
+            if !self.fit.sources.is_empty() {
+                names.push(self.shading.direct_table(mode));
+            }
         }
+        if self.mode == ScatteringMode::Full {
+            names.extend(MULTIPLE_TABLES);
+        }
+        names.dedup();
         names
     }
 

@@ -1,7 +1,10 @@
 // Drives the web page as a person would, in headless Chromium on SwiftShader's WebGPU: loads
 // it, waits until its title says converged (or error), reads the frame back, takes a
-// screenshot, then drops a file that is not a groom on the picture and checks that the page
-// says so and keeps its scene. Writes OUT/frame.f32, OUT/page.png and OUT/report.json.
+// screenshot, drops a file that is not a groom on the picture (the page must say so and keep
+// its scene), then orbits with the mouse and zooms with the wheel and reads the new converged
+// frame and the settings it was rendered with, then switches to single scattering and does
+// the same. Writes OUT/frame.f32, OUT/page.png, OUT/orbited.{f32,json}, OUT/single.{f32,json}
+// and OUT/report.json.
 //
 //   node page_check.mjs URL OUT [TIMEOUT_S]
 import { chromium } from 'playwright-core';
@@ -50,6 +53,32 @@ try {
   report.titleAfterBadFile = await page.title();
   const after = await page.evaluate(() => window.strandlight.frame());
   report.frameKeptAfterBadFile = after === frame;
+
+  // Orbit (a drag across the picture) and zoom (two wheel steps), then converge again.
+  const box = await page.locator('#view').boundingBox();
+  const [cx, cy] = [box.x + box.width / 2, box.y + box.height / 2];
+  await page.mouse.move(cx, cy);
+  await page.mouse.down();
+  for (let i = 1; i <= 8; i++) await page.mouse.move(cx + 10 * i, cy - 3 * i);
+  await page.mouse.up();
+  await page.mouse.wheel(0, -100);
+  await page.mouse.wheel(0, -100);
+  await page.waitForFunction((old) => {
+    const now = window.strandlight.frame();
+    return now !== null && now !== old && window.strandlight.status() === 'converged';
+  }, frame, { timeout, polling: 250 });
+  writeFileSync(join(out, 'orbited.f32'), Buffer.from(await page.evaluate(() => window.strandlight.frame()), 'base64'));
+  writeFileSync(join(out, 'orbited.json'), await page.evaluate(() => window.strandlight.page.settings_json()));
+
+  // Single scattering only, from the panel's choice.
+  const orbited = await page.evaluate(() => window.strandlight.frame());
+  await page.selectOption('#scattering', 'single');
+  await page.waitForFunction((old) => {
+    const now = window.strandlight.frame();
+    return now !== null && now !== old && window.strandlight.status() === 'converged';
+  }, orbited, { timeout, polling: 250 });
+  writeFileSync(join(out, 'single.f32'), Buffer.from(await page.evaluate(() => window.strandlight.frame()), 'base64'));
+  writeFileSync(join(out, 'single.json'), await page.evaluate(() => window.strandlight.page.settings_json()));
 } finally {
   writeFileSync(join(out, 'report.json'), JSON.stringify(report, null, 2));
   await browser.close();

@@ -11,6 +11,7 @@ use std::rc::Rc;
 use std::sync::{Arc, Mutex};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_scene::exposure::Exposure;
+use strandlight_scene::scene_tables::ScatteringMode;
 use wasm_bindgen::prelude::*;
 
 /// A readback the browser is mapping, and its outcome once the callback has run.
@@ -20,10 +21,18 @@ struct InFlight {
     mapped: Arc<Mutex<Option<Result<(), wgpu::BufferAsyncError>>>>,
 }
 
+/// The forward-scattering march's copies the browser is mapping: how many have mapped.
+struct MarchInFlight {
+    id: u64,
+    buffers: Vec<wgpu::Buffer>,
+    mapped: Arc<Mutex<Vec<Result<(), wgpu::BufferAsyncError>>>>,
+}
+
 #[wasm_bindgen]
 pub struct Page {
     session: Session,
     in_flight: Option<InFlight>,
+    march_in_flight: Option<MarchInFlight>,
     /// A GPU validation error reported after the step that caused it.
     gpu_error: Rc<RefCell<Option<String>>>,
     /// The last problem (a bad file, an out-of-range value): shown, the scene kept.
@@ -72,6 +81,7 @@ impl Page {
         Ok(Page {
             session,
             in_flight: None,
+            march_in_flight: None,
             gpu_error: Rc::new(RefCell::new(None)),
             message: None,
             failed: None,
@@ -101,6 +111,7 @@ impl Page {
                 self.report(e);
             }
         }
+        self.collect_march();
         self.collect_readback();
     }
 
@@ -132,6 +143,54 @@ impl Page {
     /// Changes whenever [`Self::picture`] would return another picture.
     pub fn picture_version(&self) -> f64 {
         self.session.picture_version as f64
+    }
+
+    /// Maps the forward-scattering march's copies once the session has submitted them all, and
+    /// hands their values over when the browser has mapped every one.
+    fn collect_march(&mut self) {
+        if let Some(flight) = &self.march_in_flight {
+            let outcomes = flight.mapped.lock().map(|m| m.clone()).unwrap_or_default();
+            if outcomes.len() < flight.buffers.len() {
+                return;
+            }
+            let flight = self.march_in_flight.take().expect("checked above");
+            if let Some(Err(e)) = outcomes.into_iter().find(Result::is_err) {
+                self.failed = Some(format!("reading the forward-scattering grid back: {e}"));
+                return;
+            }
+            let mut values = Vec::new();
+            for buffer in &flight.buffers {
+                match buffer.slice(..).get_mapped_range() {
+                    Ok(view) => values.push(bytemuck::pod_collect_to_vec(&view)),
+                    Err(e) => {
+                        self.failed =
+                            Some(format!("reading the forward-scattering grid back: {e}"));
+                        return;
+                    }
+                }
+                buffer.unmap();
+            }
+            if let Err(e) = self.session.march_done(flight.id, values) {
+                self.failed = Some(format!("{e:#}"));
+            }
+            return;
+        }
+        if let Some((id, buffers)) = self.session.march_readback() {
+            let mapped = Arc::new(Mutex::new(Vec::new()));
+            for buffer in &buffers {
+                let report = mapped.clone();
+                buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+                    if let Ok(mut outcomes) = report.lock() {
+                        outcomes.push(r);
+                    }
+                });
+            }
+            self.march_in_flight = Some(MarchInFlight {
+                id,
+                buffers,
+                mapped,
+            });
+        }
     }
 
     /// Starts a readback of the shown picture when none is in flight, and hands a mapped one
@@ -201,6 +260,11 @@ impl Page {
         self.message.clone().unwrap_or_default()
     }
 
+    /// What the page changed to fit the device (smaller light maps), or "".
+    pub fn notice(&self) -> String {
+        self.session.notice.clone().unwrap_or_default()
+    }
+
     /// The converged frame: linear, pre-multiplied RGBA f32, row-major from the top.
     pub fn converged_frame(&self) -> Option<Vec<f32>> {
         self.session
@@ -222,6 +286,7 @@ impl Page {
             "presets": bundle.presets.keys().collect::<Vec<_>>(),
             "preset": self.session.settings.preset,
             "lobes": bundle.fit.lobes.len(),
+            "multiple": bundle.mode == ScatteringMode::Full,
             "stops": self.session.stops(),
             "timestamps": self.session.gpu().pass_timer.is_some(),
         });
@@ -269,6 +334,16 @@ impl Page {
 
     pub fn set_kappa(&mut self, kappa: f32) {
         let r = self.session.set_kappa(kappa);
+        self.apply(r);
+    }
+
+    /// `single` or `full` (single + multiple scattering).
+    pub fn set_scattering(&mut self, mode: &str) {
+        let mode = match mode {
+            "full" => ScatteringMode::Full,
+            _ => ScatteringMode::Single,
+        };
+        let r = self.session.set_scattering(mode);
         self.apply(r);
     }
 

@@ -7,12 +7,19 @@ use crate::accumulate::AccumulatePass;
 use anyhow::Context;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use strandlight_runtime::env::EnvRenderer;
+use std::sync::Arc;
+use strandlight_runtime::env::{EnvRenderError, EnvRenderer};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::gpu::LimitError;
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::hair::yuksel::parse_hair;
-use strandlight_scene::env_frame::{EnvFrame, FrameRole, lights_call};
+use strandlight_runtime::multiple::{
+    CpuForwardScattering, ForwardScatteringSource, GpuForwardScattering, MarchedForwardScattering,
+};
+use strandlight_scene::env_frame::{
+    EnvFrame, FrameRole, gpu_march_volume, lights_call_without_source,
+};
 use strandlight_scene::exposure::Exposure;
 use strandlight_scene::frame_render::{
     env_look, env_part, light_luminance, select_lights, settings_camera,
@@ -98,7 +105,16 @@ pub struct Session {
     pub picture_version: u64,
     /// The scene before a dropped hair, until the new hair's first step succeeds.
     fallback: Option<Fallback>,
+    /// What the page changed to fit the device (smaller light maps), for the panel.
+    pub notice: Option<String>,
+    last_memory: Vec<(String, u64)>,
+    /// The hair voxelized for multiple scattering (per hair and tables).
+    volume: Option<CpuForwardScattering>,
+    march: March,
 }
+
+/// Light maps are not made smaller than this to fit a device's limits.
+pub const SMALLEST_LIGHT_MAP: u32 = 64;
 
 struct Fallback {
     name: String,
@@ -149,9 +165,18 @@ impl Session {
             read: None,
             picture_version: 0,
             fallback: None,
+            notice: None,
+            volume: None,
+            march: March::Idle,
+            last_memory: Vec::new(),
         };
         session.restart()?;
         Ok(session)
+    }
+
+    /// GPU memory per resource of the last step encoded (bytes).
+    pub fn last_memory(&self) -> &[(String, u64)] {
+        &self.last_memory
     }
 
     pub fn gpu(&self) -> &GpuContext {
@@ -179,11 +204,6 @@ impl Session {
     /// Plans the frame of the current settings from its first step; the old picture stays on
     /// the canvas until the new preview replaces it.
     fn restart(&mut self) -> anyhow::Result<()> {
-        anyhow::ensure!(
-            self.bundle.mode == ScatteringMode::Single,
-            "multiple scattering needs the desktop tool (`strandlight view`): its grid is \
-             marched with a readback a page cannot wait for"
-        );
         let env = self.env()?.clone();
         let up = up_choice(&self.settings).axis(&self.hair);
         self.lights = select_lights(&self.bundle.lights(up), up, &env);
@@ -225,16 +245,49 @@ impl Session {
     /// dropped hair whose first step fails (the GPU's limits, say) gives way to the scene
     /// before it.
     pub fn step(&mut self) -> anyhow::Result<()> {
-        match (self.encode_step(), self.fallback.take()) {
+        match (self.encode_fitting(), self.fallback.take()) {
             (Ok(()), _) => Ok(()),
             (Err(e), None) => Err(e),
             (Err(e), Some(before)) => {
                 self.hair = before.hair;
                 self.settings = before.settings;
                 self.orbit = before.orbit;
+                self.forget_march();
                 self.restart()?;
                 Err(e.context(format!("{}: kept the scene before it", before.name)))
             }
+        }
+    }
+
+    /// [`Self::encode_step`], halving the light maps while they (their DODM layers or
+    /// summed-area tables) exceed the device's limits
+    /// (WebGPU's defaults: 128 MiB a storage binding, 256 MiB a buffer), down to
+    /// [`SMALLEST_LIGHT_MAP`]; the frame restarts at the smaller size and [`Self::notice`] says so.
+    fn encode_fitting(&mut self) -> anyhow::Result<()> {
+        loop {
+            let error = match self.encode_step() {
+                Ok(()) => return Ok(()),
+                Err(e) => e,
+            };
+            let light_maps = match error.downcast_ref::<EnvRenderError>() {
+                Some(EnvRenderError::Limit(
+                    LimitError::BufferSize { what, .. }
+                    | LimitError::StorageBinding { what, .. }
+                    | LimitError::Texture2d { what, .. }
+                    | LimitError::TextureLayers { what, .. },
+                )) => what.starts_with("DODM"),
+                _ => false,
+            };
+            let size = self.env()?.dodm_size;
+            if !light_maps || size <= SMALLEST_LIGHT_MAP {
+                return Err(error);
+            }
+            let smaller = (size / 2).max(SMALLEST_LIGHT_MAP);
+            self.notice = Some(format!(
+                "light maps {size}² → {smaller}² to fit this device's limits ({error:#})"
+            ));
+            self.env_mut().dodm_size = smaller;
+            self.restart()?;
         }
     }
 
@@ -246,7 +299,7 @@ impl Session {
         let part = env_part(
             &env,
             self.lights.clone(),
-            self.bundle.mode,
+            self.scattering(),
             step.part(),
             false,
         )?;
@@ -264,7 +317,22 @@ impl Session {
             look: part.look,
             head: load_head(&self.settings.head, &self.hair, self.settings.skin_albedo)?,
         };
-        let call = lights_call(&frame, &self.gpu)?;
+        // Multiple scattering's grid is marched for all the frame's lights before the first
+        // batch that needs it; until the page has read it back, the step waits.
+        let marched = match frame.mode {
+            ScatteringMode::Single => None,
+            ScatteringMode::Full => {
+                let march = (&self.gpu, &mut self.march, &mut self.volume);
+                match advance_march(march, &self.lights, &frame)? {
+                    Some(marched) => Some(marched),
+                    None => return Ok(()),
+                }
+            }
+        };
+        let call = lights_call_without_source(&frame)?;
+        let source = marched
+            .as_deref()
+            .map(|m| m as &dyn ForwardScatteringSource);
         let encoded = self.renderer.encode_part(
             &self.gpu,
             frame.hair,
@@ -274,9 +342,10 @@ impl Session {
             (frame.lights, frame.look.simplified_lights_before),
             &call.tables,
             &call.options,
-            call.source.as_deref(),
+            source,
             frame.head.as_ref(),
         )?;
+        self.last_memory = encoded.stats.memory_per_batch.clone();
         let shown = match step {
             Step::Batch { power_after, .. } => {
                 let total = self.total.get_or_insert_with(|| {
@@ -335,15 +404,7 @@ impl Session {
         if self.metered == Some(key) && !self.remeter {
             return None;
         }
-        let buffer = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("page readback"),
-            size: shown.buffer.size(),
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(&shown.buffer, 0, &buffer, 0, shown.buffer.size());
-        self.gpu.queue.submit([encoder.finish()]);
+        let buffer = mappable_copy(&self.gpu, &shown.buffer);
         Some(Readback {
             buffer,
             key,
@@ -387,6 +448,64 @@ impl Session {
         }
         self.read = Some((image, readback.size));
         self.picture_version += 1;
+    }
+
+    /// The march's copies to map, once every dispatch is submitted (None otherwise, or when
+    /// the grid is read already).
+    pub fn march_readback(&self) -> Option<(u64, Vec<wgpu::Buffer>)> {
+        match &self.march {
+            March::Marching {
+                id,
+                staged,
+                dispatches,
+                ..
+            } if staged.len() == *dispatches => Some((*id, staged.clone())),
+            _ => None,
+        }
+    }
+
+    /// The values of march `id` read back, one list per copy of [`Self::march_readback`]: the
+    /// grid the batches read. The values of an earlier march are dropped.
+    pub fn march_done(&mut self, id: u64, marched: Vec<Vec<[f32; 4]>>) -> anyhow::Result<()> {
+        let March::Marching {
+            id: current,
+            lights,
+            ..
+        } = &self.march
+        else {
+            return Ok(());
+        };
+        if *current != id {
+            return Ok(());
+        }
+        let lights = lights.clone();
+        let Some(volume) = &self.volume else {
+            return Ok(());
+        };
+        let on_gpu = GpuForwardScattering::new(&self.gpu, volume.clone())?;
+        let grid = on_gpu.grid_from_values(&lights, marched);
+        self.march = March::Done(Arc::new(MarchedForwardScattering { lights, grid }));
+        Ok(())
+    }
+
+    /// The scattering the frame renders: single, or single + multiple where the settings ask
+    /// for it and the bundle has the tables.
+    fn scattering(&self) -> ScatteringMode {
+        match (self.env().map(|e| e.scattering), self.bundle.mode) {
+            (Ok(ScatteringMode::Full), ScatteringMode::Full) => ScatteringMode::Full,
+            _ => ScatteringMode::Single,
+        }
+    }
+
+    /// Single or single + multiple scattering (the latter where the bundle has its tables).
+    pub fn set_scattering(&mut self, mode: ScatteringMode) -> anyhow::Result<()> {
+        anyhow::ensure!(
+            mode == ScatteringMode::Single || self.bundle.mode == ScatteringMode::Full,
+            "this site has no multiple-scattering tables (`strandlight web` bakes them for \
+             settings with full scattering and hair light enough to need them)"
+        );
+        self.env_mut().scattering = mode;
+        self.restart()
     }
 
     /// The exposure applied now, in stops.
@@ -479,13 +598,103 @@ impl Session {
             settings,
             orbit,
         });
+        self.forget_march();
         self.restart()
+    }
+
+    /// Another hair or other tables: another volume, another grid.
+    fn forget_march(&mut self) {
+        self.volume = None;
+        self.march = March::Idle;
     }
 
     /// The settings, as `render replay` reads them.
     pub fn settings_json(&self) -> String {
         serde_json::to_string_pretty(&self.settings).expect("settings serialize")
     }
+}
+
+/// Multiple scattering's grid for a frame's lights, marched on the GPU one dispatch a step and
+/// read back by the page before the batches that need it.
+enum March {
+    Idle,
+    /// The mappable copies of the dispatches submitted so far.
+    Marching {
+        /// Tells a readback of this march from one of an earlier march.
+        id: u64,
+        lights: Vec<EnvLight>,
+        staged: Vec<wgpu::Buffer>,
+        dispatches: usize,
+    },
+    Done(Arc<MarchedForwardScattering>),
+}
+
+/// The marched grid of `lights` when it is ready; else the next dispatch submitted (or nothing
+/// while the page reads the last ones back) and `None`. The hair's voxel volume is built on
+/// first use and kept until the hair or the tables change.
+fn advance_march(
+    (gpu, march, volume): (&GpuContext, &mut March, &mut Option<CpuForwardScattering>),
+    lights: &[EnvLight],
+    frame: &EnvFrame,
+) -> anyhow::Result<Option<Arc<MarchedForwardScattering>>> {
+    let mut id = 0;
+    match march {
+        March::Done(done) if done.lights == lights => return Ok(Some(done.clone())),
+        March::Marching {
+            lights: marching, ..
+        } if marching == lights => {}
+        March::Marching { id: earlier, .. } => {
+            id = *earlier + 1;
+            *march = March::Idle;
+        }
+        March::Done(_) => *march = March::Idle,
+        March::Idle => {}
+    }
+    let volume = match volume {
+        Some(volume) => volume,
+        None => volume.insert(gpu_march_volume(frame)?),
+    };
+    let on_gpu = GpuForwardScattering::new(gpu, volume.clone())?;
+    let per = on_gpu.lights_per_dispatch();
+    if matches!(march, March::Idle) {
+        *march = March::Marching {
+            id,
+            lights: lights.to_vec(),
+            staged: Vec::new(),
+            dispatches: lights.len().div_ceil(per),
+        };
+    }
+    let March::Marching {
+        lights: marching,
+        staged,
+        dispatches,
+        ..
+    } = march
+    else {
+        unreachable!("idle became marching above")
+    };
+    if staged.len() < *dispatches {
+        let first = staged.len() * per;
+        let chunk = &marching[first..(first + per).min(marching.len())];
+        for values in on_gpu.encode_march(chunk) {
+            staged.push(mappable_copy(gpu, &values));
+        }
+    }
+    Ok(None)
+}
+
+/// A copy of `source` the CPU can map.
+fn mappable_copy(gpu: &GpuContext, source: &wgpu::Buffer) -> wgpu::Buffer {
+    let copy = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("page readback"),
+        size: source.size(),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    encoder.copy_buffer_to_buffer(source, 0, &copy, 0, source.size());
+    gpu.queue.submit([encoder.finish()]);
+    copy
 }
 
 /// The orbit through the settings' camera.

@@ -62,10 +62,16 @@ impl GpuContext {
     /// A headless device: hardware first (discrete, integrated, virtual), the software
     /// rasterizer last.
     pub fn new_headless() -> Result<Self, DeviceError> {
-        pollster::block_on(Self::new_headless_async())
+        pollster::block_on(Self::new_headless_async(None))
     }
 
-    async fn new_headless_async() -> Result<Self, DeviceError> {
+    /// [`Self::new_headless`] held to `limits` instead of the adapter's own: what a browser
+    /// grants a page (`wgpu::Limits::default()` is WebGPU's), on this machine's device.
+    pub fn new_headless_limited(limits: wgpu::Limits) -> Result<Self, DeviceError> {
+        pollster::block_on(Self::new_headless_async(Some(limits)))
+    }
+
+    async fn new_headless_async(limits: Option<wgpu::Limits>) -> Result<Self, DeviceError> {
         let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
         // Vulkan, Metal, DX12: every pass needs compute and storage buffers, which the GL
         // backend lacks. WGPU_BACKEND overrides.
@@ -94,7 +100,7 @@ impl GpuContext {
                 .await
                 .map_err(|_| DeviceError::NoAdapter { looked_at })?,
         };
-        Self::for_adapter(instance, adapter, None).await
+        Self::for_adapter(instance, adapter, limits).await
     }
 
     /// A device on `adapter` with the features the passes use: `limits` (a web page asks for

@@ -45,6 +45,7 @@ impl<'a> FileBytes<'a> {
         Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
     }
 
+    #[cfg(feature = "scene-files")]
     pub fn u64_at(&self, offset: u64, what: &str) -> Result<u64, HairError> {
         let b = self.slice(offset, 8, || what.to_string())?;
         Ok(u64::from_le_bytes(b.try_into().expect("8 bytes")))

@@ -120,6 +120,10 @@ pub enum HairError {
     )]
     UnknownExtension { file: PathBuf },
 
+    /// A scene-file format left out of this build (the web page reads no USD or Alembic).
+    #[error("{}: this build reads no {format} files (the desktop tool does)", .file.display())]
+    FormatNotBuilt { file: PathBuf, format: &'static str },
+
     /// An in-memory model (from code, not a file) that breaks an invariant of [`super::HairModel`].
     #[error("invalid hair model: {problem}")]
     InvalidModel { problem: String },

@@ -8,23 +8,29 @@
 //! checks every value, merges zero-length segments and drops strands left with fewer than two
 //! points; what it changed is in the [`LoadReport`].
 
+#[cfg(feature = "scene-files")]
 pub mod alembic;
 mod bytes;
 mod clean;
+#[cfg(feature = "scene-files")]
 mod curves;
 mod error;
 pub mod groom;
+#[cfg(feature = "scene-files")]
 mod guard;
 mod model;
+#[cfg(feature = "scene-files")]
 mod ogawa;
 pub mod ply;
 pub mod tfx;
 pub mod usc;
+#[cfg(feature = "scene-files")]
 pub mod usd;
 pub mod yuksel;
 
 use std::path::Path;
 
+#[cfg(feature = "scene-files")]
 pub use alembic::load_alembic;
 pub use clean::{HairFormat, LoadReport, LoadedHair, is_degenerate_segment};
 pub use error::HairError;
@@ -33,6 +39,7 @@ pub use model::{Aabb, Attribute, AttributeKind, HairModel, HairSummary};
 pub use ply::load_ply;
 pub use tfx::load_tfx;
 pub use usc::{load_usc, write_usc};
+#[cfg(feature = "scene-files")]
 pub use usd::load_usd;
 pub use yuksel::{HairWriteOptions, load_hair, write_hair};
 
@@ -52,8 +59,17 @@ pub fn load(path: &Path) -> Result<LoadedHair, HairError> {
         Some("tfx") => load_tfx(path),
         Some("data") => load_usc(path),
         Some("ply") => load_ply(path),
+        #[cfg(feature = "scene-files")]
         Some("usda" | "usdc" | "usdz" | "usd") => load_usd(path),
+        #[cfg(feature = "scene-files")]
         Some("abc") => load_alembic(path),
+        #[cfg(not(feature = "scene-files"))]
+        Some(format @ ("usda" | "usdc" | "usdz" | "usd" | "abc")) => {
+            Err(HairError::FormatNotBuilt {
+                file: path.into(),
+                format: if format == "abc" { "Alembic" } else { "USD" },
+            })
+        }
         _ => Err(HairError::UnknownExtension { file: path.into() }),
     }
 }

@@ -125,8 +125,51 @@ impl<'g> GpuForwardScattering<'g> {
         &self.cpu
     }
 
-    /// Marches `lights` (at most `lights_per_dispatch`) in one dispatch; values per light, in order.
-    fn march_chunk(&self, lights: &[EnvLight]) -> Result<Vec<[f32; 4]>, ForwardScatteringError> {
+    /// Lights one dispatch marches at most (the adapter's limits and 16).
+    pub fn lights_per_dispatch(&self) -> usize {
+        self.lights_per_dispatch as usize
+    }
+
+    /// Submits the march of `lights` in dispatches of at most [`Self::lights_per_dispatch`]
+    /// lights and returns each dispatch's values buffer (per light, in order; `COPY_SRC`), not
+    /// yet read: a web page maps them when the browser has them, then calls
+    /// [`Self::grid_from_values`].
+    pub fn encode_march(&self, lights: &[EnvLight]) -> Vec<wgpu::Buffer> {
+        lights
+            .chunks(self.lights_per_dispatch as usize)
+            .map(|chunk| self.encode_chunk(chunk))
+            .collect()
+    }
+
+    /// The grid of `lights` from the values of [`Self::encode_march`]'s buffers, in order. The
+    /// head stops the light as on the CPU: the same exact ray test per sample, after the march
+    /// (the shader knows only the voxelized hair).
+    pub fn grid_from_values(
+        &self,
+        lights: &[EnvLight],
+        marched: Vec<Vec<[f32; 4]>>,
+    ) -> ForwardScatteringGrid {
+        let points = self.cpu.sample_points();
+        let mut values = Vec::with_capacity(points.len() * lights.len());
+        let chunks = lights.chunks(self.lights_per_dispatch as usize);
+        for (chunk, mut chunk_values) in chunks.zip(marched) {
+            for (light, light_values) in chunk.iter().zip(chunk_values.chunks_mut(points.len())) {
+                self.cpu
+                    .block_by_head(light_direction(light), points, light_values);
+            }
+            values.extend(chunk_values);
+        }
+        let grid = self.cpu.sample_grid();
+        ForwardScatteringGrid {
+            origin: grid.origin,
+            spacing: grid.spacing,
+            dims: grid.dims,
+            values,
+        }
+    }
+
+    /// Submits the march of `lights` (at most `lights_per_dispatch`) in one dispatch.
+    fn encode_chunk(&self, lights: &[EnvLight]) -> wgpu::Buffer {
         let device = &self.gpu.device;
         let volume = self.cpu.volume();
         let settings = self.cpu.settings();
@@ -214,33 +257,22 @@ impl<'g> GpuForwardScattering<'g> {
             pass.dispatch_workgroups(samples.div_ceil(WORKGROUP_SIZE), lights.len() as u32, 1);
         }
         self.gpu.queue.submit([encoder.finish()]);
-        let bytes = read_buffer(self.gpu, &values)
-            .map_err(|e| ForwardScatteringError::Gpu(e.to_string()))?;
-        Ok(bytemuck::pod_collect_to_vec(&bytes))
+        values
     }
 }
 
 impl ForwardScatteringSource for GpuForwardScattering<'_> {
     fn grid(&self, lights: &[EnvLight]) -> Result<ForwardScatteringGrid, ForwardScatteringError> {
-        let points = self.cpu.sample_points();
-        let mut values = Vec::with_capacity(points.len() * lights.len());
-        for chunk in lights.chunks(self.lights_per_dispatch as usize) {
-            let mut marched = self.march_chunk(chunk)?;
-            // The head stops the light as on the CPU: the same exact ray test per sample, after
-            // the march (the shader knows only the voxelized hair).
-            for (light, light_values) in chunk.iter().zip(marched.chunks_mut(points.len())) {
-                self.cpu
-                    .block_by_head(light_direction(light), points, light_values);
-            }
-            values.extend(marched);
-        }
-        let grid = self.cpu.sample_grid();
-        Ok(ForwardScatteringGrid {
-            origin: grid.origin,
-            spacing: grid.spacing,
-            dims: grid.dims,
-            values,
-        })
+        let marched = self
+            .encode_march(lights)
+            .iter()
+            .map(|values| {
+                let bytes = read_buffer(self.gpu, values)
+                    .map_err(|e| ForwardScatteringError::Gpu(e.to_string()))?;
+                Ok(bytemuck::pod_collect_to_vec(&bytes))
+            })
+            .collect::<Result<Vec<_>, ForwardScatteringError>>()?;
+        Ok(self.grid_from_values(lights, marched))
     }
 
     fn device(&self) -> &'static str {
@@ -289,4 +321,43 @@ fn build_pipeline(gpu: &GpuContext) -> (wgpu::ComputePipeline, wgpu::BindGroupLa
         "march_samples",
     );
     (pipeline, layout)
+}
+
+/// A grid marched once for a frame's lights and handed out light batch by light batch: the web
+/// page marches every light before its batches (it cannot wait for a readback inside one).
+pub struct MarchedForwardScattering {
+    pub lights: Vec<EnvLight>,
+    pub grid: ForwardScatteringGrid,
+}
+
+impl ForwardScatteringSource for MarchedForwardScattering {
+    fn grid(&self, lights: &[EnvLight]) -> Result<ForwardScatteringGrid, ForwardScatteringError> {
+        let block = self
+            .grid
+            .dims
+            .iter()
+            .map(|&d| d as usize)
+            .product::<usize>();
+        let mut values = Vec::with_capacity(block * lights.len());
+        for light in lights {
+            let index = self
+                .lights
+                .iter()
+                .position(|marched| marched == light)
+                .ok_or_else(|| {
+                    ForwardScatteringError::Gpu(format!("light {light:?} was not marched"))
+                })?;
+            values.extend_from_slice(&self.grid.values[index * block..(index + 1) * block]);
+        }
+        Ok(ForwardScatteringGrid {
+            origin: self.grid.origin,
+            spacing: self.grid.spacing,
+            dims: self.grid.dims,
+            values,
+        })
+    }
+
+    fn device(&self) -> &'static str {
+        "GPU"
+    }
 }

@@ -47,7 +47,7 @@ fn linear_index(i: vec3<u32>) -> u32 {
 // The voxel holding p, or −1 outside the grid (written so that a NaN coordinate is outside).
 fn voxel_of(p: vec3<f32>) -> i32 {
     let q = (p - params.origin) / params.voxel_size;
-    let inside = q >= vec3<f32>(0.0) & q < vec3<f32>(params.dims);
+    let inside = (q >= vec3<f32>(0.0)) & (q < vec3<f32>(params.dims));
     if (!all(inside)) {
         return -1;
     }

@@ -27,5 +27,5 @@ pub use forward_scattering::{
     CpuForwardScattering, ForwardScatteringGrid, ForwardScatteringSettings,
     ForwardScatteringSource, SampleGrid, interpolate_grid,
 };
-pub use gpu_shadow_paths::GpuForwardScattering;
+pub use gpu_shadow_paths::{GpuForwardScattering, MarchedForwardScattering};
 pub use hair_volume::{HairVolume, VoxelGrid, VoxelSettings};
