@@ -108,21 +108,14 @@ impl Page {
                 }
             });
             if let Err(e) = stepped {
-                self.report(e);
+                self.failed = Some(format!("{e:#}"));
+            }
+            if let Some(why) = self.session.rejected.take() {
+                self.message = Some(why);
             }
         }
         self.collect_march();
         self.collect_readback();
-    }
-
-    /// A failure of the frame, or (when a fallback kept the scene) a message beside it.
-    fn report(&mut self, e: anyhow::Error) {
-        let text = format!("{e:#}");
-        if text.contains("kept the scene before it") {
-            self.message = Some(text);
-        } else {
-            self.failed = Some(text);
-        }
     }
 
     /// The picture as 8-bit RGBA (see [`Session::picture`]); empty before the first.

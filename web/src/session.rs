@@ -107,6 +107,8 @@ pub struct Session {
     fallback: Option<Fallback>,
     /// What the page changed to fit the device (smaller light maps), for the panel.
     pub notice: Option<String>,
+    /// Why the last dropped hair was given up for the scene before it.
+    pub rejected: Option<String>,
     last_memory: Vec<(String, u64)>,
     /// The hair voxelized for multiple scattering (per hair and tables).
     volume: Option<CpuForwardScattering>,
@@ -166,6 +168,7 @@ impl Session {
             picture_version: 0,
             fallback: None,
             notice: None,
+            rejected: None,
             volume: None,
             march: March::Idle,
             last_memory: Vec::new(),
@@ -174,7 +177,8 @@ impl Session {
         Ok(session)
     }
 
-    /// GPU memory per resource of the last step encoded (bytes).
+    /// GPU memory per resource of the last step encoded (bytes): what a test prints when a
+    /// limit it expected was not reached.
     pub fn last_memory(&self) -> &[(String, u64)] {
         &self.last_memory
     }
@@ -243,7 +247,7 @@ impl Session {
 
     /// Encodes the next step of the plan (one frame's work: a preview or one light batch). A
     /// dropped hair whose first step fails (the GPU's limits, say) gives way to the scene
-    /// before it.
+    /// before it, and [`Self::rejected`] says why.
     pub fn step(&mut self) -> anyhow::Result<()> {
         match (self.encode_fitting(), self.fallback.take()) {
             (Ok(()), _) => Ok(()),
@@ -254,7 +258,9 @@ impl Session {
                 self.orbit = before.orbit;
                 self.forget_march();
                 self.restart()?;
-                Err(e.context(format!("{}: kept the scene before it", before.name)))
+                let why = e.context(format!("{}: kept the scene before it", before.name));
+                self.rejected = Some(format!("{why:#}"));
+                Ok(())
             }
         }
     }
