@@ -95,8 +95,14 @@ impl BundleScene {
         if self.mode == ScatteringMode::Full {
             names.extend(MULTIPLE_TABLES);
         }
-        names.dedup();
-        names
+        // The artist fiber has one table for both modes: bundle it once.
+        let mut unique = Vec::new();
+        for name in names {
+            if !unique.contains(&name) {
+                unique.push(name);
+            }
+        }
+        unique
     }
 
     /// `preset`'s tables from their files' bytes (`fetched(file)`), checked as any asset is.
