@@ -2,15 +2,13 @@
 //! in a browser through WebGPU — the page's wasm module and glue, its HTML, and the bundle of
 //! `strandlight_scene::web_bundle`. `strandlight serve` serves a folder on localhost.
 
-use crate::demo::{CACHE_DIR, DEMO_ENVIRONMENT, DEMO_PRESET, DEMO_TABLE_NODES, ENVMAP_DIR};
+use crate::demo::{CACHE_DIR, DEMO_ENVIRONMENT, DEMO_PRESET, ENVMAP_DIR};
 use anyhow::Context;
 use std::path::{Path, PathBuf};
-use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_runtime::hair::yuksel::{HairWriteOptions, encode_hair};
-use strandlight_scene::env_scene::{EnvSceneRequest, prepare_env_scene};
-use strandlight_scene::environment::{ensure_procedural_envmap, load_env};
-use strandlight_scene::frame_render::{PreparedEnv, load_settings_hair};
-use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting, up_choice};
+use strandlight_scene::environment::ensure_procedural_envmap;
+use strandlight_scene::frame_render::{PreparedEnv, load_settings_hair, prepare_env};
+use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting};
 use strandlight_scene::look::{ForwardDevice, LobeVisibilityArg};
 use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
@@ -155,7 +153,8 @@ fn parse_size(text: &str) -> anyhow::Result<[u32; 2]> {
     parsed.with_context(|| format!("--size {text:?}: expected WxH, each in 1..=4096"))
 }
 
-/// The fit and `preset`'s tables at the demo's reduced resolution, cached with the demo's.
+/// The fit and `preset`'s tables as `render` prepares them, in its cache: `render replay` of the
+/// bundle's settings draws with the bundle's tables.
 fn prepare_preset(
     settings: &FrameSettings,
     env: &EnvLighting,
@@ -163,32 +162,12 @@ fn prepare_preset(
     preset: &str,
     steps: &mut Steps,
 ) -> anyhow::Result<PreparedEnv> {
-    let loaded = load_env(&env.map, false)?;
-    let fiber = FiberDescription::preset(preset).with_context(|| format!("--preset {preset:?}"))?;
-    let shading = settings.env_shading()?;
-    let up = up_choice(settings).axis(hair);
-    let table_set = match preset {
-        DEMO_PRESET => "demo".to_string(),
-        other => format!("demo-{other}"),
-    };
-    let request = EnvSceneRequest {
-        env: &loaded,
-        fiber: &fiber,
-        shading,
-        scattering: env.scattering,
-        resolution: BakeResolution::reduced(DEMO_TABLE_NODES),
-        cache_dir: Path::new(CACHE_DIR),
-        table_set: &table_set,
-        up,
-    };
     steps.say(format!("preset {preset}"));
-    let scene = prepare_env_scene(&request, steps)?;
-    Ok(PreparedEnv {
-        env: loaded,
-        scene,
-        shading,
-        up,
-    })
+    let settings = FrameSettings {
+        preset: preset.to_string(),
+        ..settings.clone()
+    };
+    prepare_env(&settings, env, hair, Path::new(CACHE_DIR), steps, &mut |_| {})
 }
 
 /// Writes the page and the bundle; returns the bytes written.

@@ -29,17 +29,17 @@ use strandlight_web::session::{BundleFiles, Session};
 /// pixels differ where a fiber's edge falls, while the light is the same: the error falls as
 /// the blocks it is measured over grow (the demo at 320×240, single scattering: 0.080 per pixel,
 /// 0.042 over 2×2, 0.017 over 4×4, 0.0055 over 8×8, totals equal to 1e-5). This test's frames
-/// (160×120, 8 lobes, fewer pixels per fiber): 0.086–0.103 per pixel, 0.012–0.020 over 8×8,
-/// totals within 0.22%. A shading or summing error (a batch missed, a wrong power share, the
-/// multiple-scattering grid of other lights) moves the totals by its share of the light.
+/// (160×120, 8 lobes, 256² light maps, fewer pixels per fiber): 0.087–0.105 per pixel,
+/// 0.012–0.021 over 8×8, totals within 0.37%. A shading or summing error (a batch missed, a
+/// wrong power share, the multiple-scattering grid of other lights) moves the totals by its
+/// share of the light.
 const PIXEL_TOLERANCE: f64 = 0.15;
 const BLOCK_TOLERANCE: f64 = 0.03;
 const TOTAL_TOLERANCE: f64 = 5e-3;
-/// The page's batches against `render replay`'s one call, both on lavapipe: 1.95e-3, the same
-/// with the bundle's half-float tables and with f32 ones, so it is the split into batches
-/// (`FramePart::Lights`, the desktop viewer's progressive steps as well), not the tables; why
-/// the batches differ from one call by that much is not yet known.
-const NATIVE_SESSION_TOLERANCE: f64 = 4e-3;
+/// The page's batches against `render replay`'s one call, both on lavapipe, with the bundle's
+/// half-float tables: 4.6e-5. (1.8e-3 while the bundle held the demo's coarser tables and the
+/// replay baked `render`'s: the difference once blamed on the split into batches.)
+const NATIVE_SESSION_TOLERANCE: f64 = 5e-4;
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -245,6 +245,8 @@ fn assert_matches(what: &str, browser: &Image, native: &Image) {
 #[test]
 fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() {
     let Some(page) = tools() else { return };
+    let started = std::time::Instant::now();
+    let phase = |what: &str| eprintln!("[{:6.1} s] {what}", started.elapsed().as_secs_f64());
     // Kept between runs: the fit and the tables are cached under it (out/cache).
     let work = std::env::temp_dir().join("strandlight-web-test");
     let site = work.join(format!("site-{}", std::process::id()));
@@ -258,10 +260,14 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
         .arg(&page)
         .arg("--out")
         .arg(&defaults));
+    phase("defaults site built (fit and tables)");
     let mut settings: serde_json::Value =
         serde_json::from_slice(&std::fs::read(defaults.join("bundle/settings.json")).unwrap())
             .unwrap();
     settings["lighting"]["environment"]["lobes"] = 8.into();
+    // SwiftShader draws light maps slowly: 256² (a quarter of the demo's texels) keeps the page's
+    // three convergences within CI's time; the limits check below goes back to 512².
+    settings["lighting"]["environment"]["dodm_size"] = 256.into();
     let test_settings = work.join(format!("settings-{}.json", std::process::id()));
     std::fs::write(&test_settings, serde_json::to_vec(&settings).unwrap()).unwrap();
     let _ = std::fs::remove_dir_all(&defaults);
@@ -272,6 +278,7 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
         .arg(&test_settings)
         .arg("--out")
         .arg(&site));
+    phase("test site built");
     let settings = site.join("bundle/settings.json");
     run(strandlight(&work)
         .args(["render", "replay"])
@@ -280,11 +287,13 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
         .arg(shots.join("native")));
     let native = read_rgba_exr(&shots.join("native.exr")).unwrap();
 
+    phase("native replay rendered");
     let session = native_session(&site.join("bundle"));
     let session_error = relative_rmse(&session, &native).unwrap();
     eprintln!("the page's steps on lavapipe vs render replay: relative RMSE {session_error:.2e}");
     assert!(session_error < NATIVE_SESSION_TOLERANCE, "{session_error}");
 
+    phase("native session stepped");
     let server = Server::start(&site);
     let harness = repo().join("web/harness/page_check.mjs");
     let out = Command::new("node")
@@ -294,6 +303,7 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
         .arg("600")
         .output()
         .unwrap();
+    phase("Chromium harness done");
     drop(server);
     let report_text = std::fs::read_to_string(shots.join("report.json")).unwrap_or_default();
     assert!(
@@ -323,6 +333,7 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
     );
     assert_matches("the orbited and zoomed frame", &orbited, &orbited_native);
 
+    phase("orbited frame replayed");
     // Switched to single scattering in the panel: less light, and render replay's frame.
     run(strandlight(&work)
         .args(["render", "replay"])
@@ -336,6 +347,7 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
     assert!(multiple_share > 0.05, "{multiple_share}");
     assert_matches("the single-scattering frame", &single, &single_native);
 
+    phase("single frame replayed");
     let message = report["badFileMessage"].as_str().unwrap();
     assert!(message.contains("broken.hair"), "{message}");
     assert!(message.contains("truncated"), "{message}");
@@ -348,15 +360,23 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
     assert_eq!(report["frameKeptAfterBadFile"], true);
 
     // A device held to 26 MiB storage bindings (WebGPU's default is 128): a batch of the
-    // sun-and-sky's seven compact sources at 512² needs 28 MiB of summed-area tables, the
-    // largest table 24 MiB. The page shrinks its light maps until a batch fits, says so, and
+    // sun-and-sky's seven compact sources at the demo's 512² needs 28 MiB of summed-area tables,
+    // the largest table 24 MiB. The page shrinks its light maps until a batch fits, says so, and
     // converges.
     let limits = wgpu::Limits {
         max_storage_buffer_binding_size: 26 << 20,
         ..wgpu::Limits::default()
     };
     let gpu = GpuContext::new_headless_limited(limits).unwrap();
-    let mut session = Session::new(gpu, bundle_files(&site.join("bundle"))).unwrap();
+    let mut files = bundle_files(&site.join("bundle"));
+    let mut demo_maps: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&settings).unwrap()).unwrap();
+    demo_maps["lighting"]["environment"]["dodm_size"] = 512.into();
+    files.insert(
+        settings.file_name().unwrap().to_string_lossy().to_string(),
+        serde_json::to_vec(&demo_maps).unwrap(),
+    );
+    let mut session = Session::new(gpu, files).unwrap();
     let Lighting::Environment(before) = session.settings.lighting.clone() else {
         unreachable!()
     };
@@ -378,6 +398,7 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
     );
     let fitted = converge(session);
     assert!(total(&fitted) > 0.5 * total(&native));
+    phase("limited session converged");
     let _ = std::fs::remove_dir_all(&site);
     let _ = std::fs::remove_file(&test_settings);
 }
