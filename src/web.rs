@@ -167,7 +167,14 @@ fn prepare_preset(
         preset: preset.to_string(),
         ..settings.clone()
     };
-    prepare_env(&settings, env, hair, Path::new(CACHE_DIR), steps, &mut |_| {})
+    prepare_env(
+        &settings,
+        env,
+        hair,
+        Path::new(CACHE_DIR),
+        steps,
+        &mut |_| {},
+    )
 }
 
 /// Writes the page and the bundle; returns the bytes written.

@@ -1,7 +1,7 @@
 //! Grooms written by writers this project did not write: Pixar's `usd-core` (BasisCurves as
 //! `.usda`, `.usdc`, `.usdz`) and PyAlembic, PyPI `alembic3d` (ICurves in an Ogawa `.abc`),
 //! each with the `expected.json` its script computed with the writer's own library. The scripts
-//! are in `tests/scripts/`; the comparison is `tests/tests/scene_grooms.rs`, and the fuzzer seeds
+//! are in `tests/scripts/`; the comparison is `tests/tests/integration/scene_grooms.rs`, and the fuzzer seeds
 //! its USD and Alembic targets from the same files.
 
 use std::path::{Path, PathBuf};
