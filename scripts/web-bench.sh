@@ -44,13 +44,14 @@ print(f"site: wasm {size('strandlight_web_bg.wasm') / 1e6:.2f} MB, glue {size('s
       f"settings + fit {size('bundle/settings.json', 'bundle/scene.json') / 1e3:.0f} kB; "
       f"adapter {pages[0]['describe']['adapter']}")
 print()
-print("| medians of %d | first preview (s) | converged (s) | longest main-thread tick (ms) |" % runs)
-print("|---|---|---|---|")
-print("| page, headless Chromium, WebGPU on SwiftShader | %.1f | %.1f | %.0f (median %.0f) |" % (
+print("| medians of %d | first preview (s) | converged (s) | longest main-thread tick (ms) | opening the bundle (ms) |" % runs)
+print("|---|---|---|---|---|")
+print("| page, headless Chromium, WebGPU on SwiftShader | %.1f | %.1f | %.0f (median %.0f) | %.0f |" % (
     med([p["timing"]["firstPreviewMs"] for p in pages]) / 1e3,
     med([p["timing"]["convergedMs"] for p in pages]) / 1e3,
     med([p["timing"]["longestTickMs"] for p in pages]),
-    med([p["timing"]["medianTickMs"] for p in pages])))
-print("| desktop viewer, Vulkan (lavapipe) | %.1f | %.1f | — (render thread) |" % (
+    med([p["timing"]["medianTickMs"] for p in pages]),
+    med([p["timing"]["loadMs"] for p in pages])))
+print("| desktop viewer, Vulkan (lavapipe) | %.1f | %.1f | — (render thread) | — |" % (
     med([v["preview_seconds"] for v in views]), med([v["converged_seconds"] for v in views])))
 PY

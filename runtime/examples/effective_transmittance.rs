@@ -131,8 +131,8 @@ fn constant_tables() -> Result<EnvTables, BoxError> {
     direct_axes.push(Axis::uniform("none", 0.0, 0.0, 1));
     let direct = Table::from_fn(direct_axes, 3, |_, out| out.fill(1.0))?;
     Ok(EnvTables {
-        srbf: Some(srbf),
-        direct: Some(direct),
+        srbf: Some(srbf.into()),
+        direct: Some(direct.into()),
         multiple: None,
     })
 }

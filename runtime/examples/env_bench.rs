@@ -76,7 +76,7 @@ fn main() -> Result<(), BoxError> {
         ..Default::default()
     })?;
     let tables = EnvTables {
-        srbf: Some(table()?),
+        srbf: Some(table()?.into()),
         ..Default::default()
     };
     let renderer = EnvRenderer::new(&gpu);

@@ -198,7 +198,9 @@ pub struct AssetMetadata {
 pub struct TableAsset {
     pub path: PathBuf,
     pub metadata: AssetMetadata,
-    pub table: Table,
+    /// Shared, so that a renderer can tell the same table from frame to frame by its address
+    /// and keep it on the GPU (`EnvRenderer`'s table bindings).
+    pub table: std::sync::Arc<Table>,
 }
 
 /// Writes `table` to `path` atomically, returning the metadata written.
@@ -356,7 +358,7 @@ fn read_opened<R: Read + Seek>(mut opened: OpenedAsset<R>) -> Result<TableAsset,
     Ok(TableAsset {
         path,
         metadata,
-        table,
+        table: table.into(),
     })
 }
 

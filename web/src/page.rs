@@ -39,6 +39,8 @@ pub struct Page {
     message: Option<String>,
     /// A failure that stops the frame.
     failed: Option<String>,
+    /// How long opening the bundle held the page's thread (tables decoded and checked).
+    load_ms: f64,
 }
 
 fn js_error(e: anyhow::Error) -> JsValue {
@@ -77,8 +79,11 @@ impl Page {
             .on_uncaptured_error(Arc::new(|error: wgpu::Error| {
                 web_sys::console::error_1(&format!("WebGPU: {error}").into());
             }));
+        let opening = web_time::Instant::now();
         let session = Session::new(gpu, bundle).map_err(js_error)?;
+        let load_ms = opening.elapsed().as_secs_f64() * 1e3;
         Ok(Page {
+            load_ms,
             session,
             in_flight: None,
             march_in_flight: None,
@@ -86,6 +91,11 @@ impl Page {
             message: None,
             failed: None,
         })
+    }
+
+    /// How long opening the bundle held the page's thread (ms).
+    pub fn load_ms(&self) -> f64 {
+        self.load_ms
     }
 
     /// One animation frame: the next step (if any), the picture, the readbacks.

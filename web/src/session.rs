@@ -656,18 +656,20 @@ fn advance_march(
         March::Done(_) => *march = March::Idle,
         March::Idle => {}
     }
-    let volume = match volume {
-        Some(volume) => volume,
-        None => volume.insert(gpu_march_volume(frame)?),
+    let Some(volume) = volume else {
+        // Voxelizing the groom is this tick's work; the first dispatch waits for the next.
+        *volume = Some(gpu_march_volume(frame)?);
+        return Ok(None);
     };
     let on_gpu = GpuForwardScattering::new(gpu, volume.clone())?;
-    let per = on_gpu.lights_per_dispatch();
     if matches!(march, March::Idle) {
+        // One light a dispatch and a tick: each light's per-voxel medium is looked up on the
+        // CPU, and sixteen of them in one tick held the page's thread for most of a second.
         *march = March::Marching {
             id,
             lights: lights.to_vec(),
             staged: Vec::new(),
-            dispatches: lights.len().div_ceil(per),
+            dispatches: lights.len(),
         };
     }
     let March::Marching {
@@ -680,9 +682,8 @@ fn advance_march(
         unreachable!("idle became marching above")
     };
     if staged.len() < *dispatches {
-        let first = staged.len() * per;
-        let chunk = &marching[first..(first + per).min(marching.len())];
-        for values in on_gpu.encode_march(chunk) {
+        let light = staged.len();
+        for values in on_gpu.encode_march(&marching[light..=light]) {
             staged.push(mappable_copy(gpu, &values));
         }
     }

@@ -43,9 +43,9 @@ use std::sync::{Arc, Mutex};
 /// * `multiple`: I_G, w = σ̄_f (used only with a [`ForwardScatteringSource`]).
 #[derive(Clone, Debug, Default)]
 pub struct EnvTables {
-    pub srbf: Option<Table>,
-    pub direct: Option<Table>,
-    pub multiple: Option<Table>,
+    pub srbf: Option<Arc<Table>>,
+    pub direct: Option<Arc<Table>>,
+    pub multiple: Option<Arc<Table>>,
 }
 
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -349,7 +349,22 @@ pub struct EnvRenderer {
     /// The last groom's visibility volume on the GPU, kept while frames ask for the same hair
     /// and settings (a static groom pays its build once).
     volume: Mutex<Option<CachedVolume>>,
+    /// The last frames' tables on the GPU, kept while frames bind the same tables (a
+    /// progressive frame's steps, a viewer's frames): their upload was most of a step's CPU
+    /// time in a web page (tens of MB a step).
+    table_bindings: Mutex<Vec<CachedTables>>,
 }
+
+/// Tables uploaded and bound: the same tables are the same allocations (`Arc::ptr_eq`), which
+/// the cache's own references keep from being reused by other tables.
+struct CachedTables {
+    single: Arc<Table>,
+    multiple: Option<Arc<Table>>,
+    binding: Arc<TableBinding>,
+}
+
+/// A frame binds at most two pairs of tables (SRBF and directional lights).
+const CACHED_TABLE_BINDINGS: usize = 2;
 
 /// A visibility volume uploaded for one groom and settings.
 struct CachedVolume {
@@ -423,12 +438,12 @@ impl LightKinds {
 
 /// The table a kind of light needs, checked for its layout.
 fn required_table<'t>(
-    table: &'t Option<Table>,
+    table: &'t Option<Arc<Table>>,
     name: &'static str,
     needed_by: &'static str,
     fourth_axis: Option<&str>,
 ) -> Result<&'t Table, EnvTableError> {
-    let t = table.as_ref().ok_or(EnvTableError::Missing {
+    let t = table.as_deref().ok_or(EnvTableError::Missing {
         table: name,
         needed_by,
     })?;
@@ -568,8 +583,8 @@ struct FrameResources {
     depth_view: wgpu::TextureView,
     /// The single-scattering tables of the SRBF and the directional lights (None: no such
     /// lights), each bound with the multiple-scattering table.
-    srbf_tables: Option<TableBinding>,
-    directional_tables: Option<TableBinding>,
+    srbf_tables: Option<Arc<TableBinding>>,
+    directional_tables: Option<Arc<TableBinding>>,
     /// The groom's visibility volume (or its placeholder under Ren's light maps).
     volume: Arc<VolumeBuffers>,
     /// The head (issue 40), drawn into the view's depth and every light map.
@@ -778,7 +793,45 @@ impl EnvRenderer {
             sat: SummedAreaPass::new(gpu),
             view: EnvViewPass::new(gpu),
             volume: Mutex::new(None),
+            table_bindings: Mutex::new(Vec::new()),
         }
+    }
+
+    /// `single` bound with `multiple` (see [`TableBinding`]), uploaded unless a recent frame
+    /// bound the same tables.
+    fn table_binding(
+        &self,
+        gpu: &GpuContext,
+        single: &Arc<Table>,
+        multiple: Option<&Arc<Table>>,
+    ) -> Arc<TableBinding> {
+        let mut cache = self.table_bindings.lock().expect("table cache lock");
+        let same = |c: &CachedTables| {
+            Arc::ptr_eq(&c.single, single)
+                && match (&c.multiple, multiple) {
+                    (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                    (None, None) => true,
+                    _ => false,
+                }
+        };
+        if let Some(cached) = cache.iter().find(|c| same(c)) {
+            return cached.binding.clone();
+        }
+        let binding = Arc::new(TableBinding::new(
+            gpu,
+            &self.view.table_layout,
+            single,
+            multiple.map(|m| &**m),
+        ));
+        if cache.len() == CACHED_TABLE_BINDINGS {
+            cache.remove(0);
+        }
+        cache.push(CachedTables {
+            single: single.clone(),
+            multiple: multiple.cloned(),
+            binding: binding.clone(),
+        });
+        binding
     }
 
     /// Makes `volume` the visibility volume of `model` under `settings` (instead of building
@@ -1045,10 +1098,10 @@ impl EnvRenderer {
         let volume = self.volume_buffers(gpu, model, head, options, timings)?;
         let (srbf_tables, directional_tables) = timings.time(gpu, "table upload", || {
             let multiple_table = multiple.and(tables.multiple.as_ref());
-            let bind = |needed: bool, t: &Option<Table>| {
+            let bind = |needed: bool, t: &Option<Arc<Table>>| {
                 t.as_ref()
                     .filter(|_| needed)
-                    .map(|t| TableBinding::new(gpu, &self.view.table_layout, t, multiple_table))
+                    .map(|t| self.table_binding(gpu, t, multiple_table))
             };
             (
                 bind(kinds.has_srbf(), &tables.srbf),

@@ -125,14 +125,9 @@ impl<'g> GpuForwardScattering<'g> {
         &self.cpu
     }
 
-    /// Lights one dispatch marches at most (the adapter's limits and 16).
-    pub fn lights_per_dispatch(&self) -> usize {
-        self.lights_per_dispatch as usize
-    }
-
-    /// Submits the march of `lights` in dispatches of at most [`Self::lights_per_dispatch`]
-    /// lights and returns each dispatch's values buffer (per light, in order; `COPY_SRC`), not
-    /// yet read: a web page maps them when the browser has them, then calls
+    /// Submits the march of `lights` in dispatches of at most `lights_per_dispatch` lights (the
+    /// adapter's limits and 16) and returns each dispatch's values buffer (per light, in order;
+    /// `COPY_SRC`), not yet read: a web page maps them when the browser has them, then calls
     /// [`Self::grid_from_values`].
     pub fn encode_march(&self, lights: &[EnvLight]) -> Vec<wgpu::Buffer> {
         lights
@@ -141,7 +136,8 @@ impl<'g> GpuForwardScattering<'g> {
             .collect()
     }
 
-    /// The grid of `lights` from the values of [`Self::encode_march`]'s buffers, in order. The
+    /// The grid of `lights` from the values of [`Self::encode_march`]'s buffers, in order (of
+    /// one call or of several, each buffer holding as many lights as its length says). The
     /// head stops the light as on the CPU: the same exact ray test per sample, after the march
     /// (the shader knows only the voxelized hair).
     pub fn grid_from_values(
@@ -151,13 +147,15 @@ impl<'g> GpuForwardScattering<'g> {
     ) -> ForwardScatteringGrid {
         let points = self.cpu.sample_points();
         let mut values = Vec::with_capacity(points.len() * lights.len());
-        let chunks = lights.chunks(self.lights_per_dispatch as usize);
-        for (chunk, mut chunk_values) in chunks.zip(marched) {
+        let mut rest = lights;
+        for mut chunk_values in marched {
+            let (chunk, after) = rest.split_at(chunk_values.len() / points.len());
             for (light, light_values) in chunk.iter().zip(chunk_values.chunks_mut(points.len())) {
                 self.cpu
                     .block_by_head(light_direction(light), points, light_values);
             }
             values.extend(chunk_values);
+            rest = after;
         }
         let grid = self.cpu.sample_grid();
         ForwardScatteringGrid {

@@ -610,7 +610,7 @@ fn unshadowed_srbf_image_is_the_sum_of_table_lookups() {
         EnvLight::srbf(Vec3::new(0.1, -0.6, -0.8), 11.0, [0.7, 0.7, 1.3]),
     ];
     let tables = EnvTables {
-        srbf: Some(table.clone()),
+        srbf: Some(table.clone().into()),
         ..Default::default()
     };
     let pixels = render_unshadowed(&model, &lights, &tables);
@@ -655,7 +655,7 @@ fn directional_light_image_is_s_cos_theta_times_irradiance() {
     let irradiance = [2.0f32, 1.0, 0.5];
     let light = EnvLight::directional(Vec3::new(0.2, 0.9, 0.4), irradiance);
     let tables = EnvTables {
-        direct: Some(direct.clone()),
+        direct: Some(direct.clone().into()),
         ..Default::default()
     };
     let pixels = render_unshadowed(&model, &[light], &tables);
@@ -748,9 +748,9 @@ fn multiple_scattering_is_power_times_attenuation_times_the_spread_table() {
         EnvLight::srbf(Vec3::new(-0.7, 0.1, 0.7), 40.0, [0.2, 0.9, 0.4]),
     ];
     let tables = EnvTables {
-        srbf: Some(single),
+        srbf: Some(single.into()),
         direct: None,
-        multiple: Some(multiple.clone()),
+        multiple: Some(multiple.clone().into()),
     };
     let (_, multiple_pixels) = render_unshadowed_with(&model, &lights, &tables, Some(&LinearGrid));
     let multiple_pixels = multiple_pixels.expect("a source was given");
@@ -779,7 +779,7 @@ fn bad_inputs_are_typed_errors() {
     let camera = ortho_camera();
     let srbf = synthetic_table(Axis::uniform(AXIS_INV_LAMBDA, 1.0 / 64.0, 1.0 / 8.0, 3));
     let tables = EnvTables {
-        srbf: Some(srbf.clone()),
+        srbf: Some(srbf.clone().into()),
         ..Default::default()
     };
     let light = [EnvLight::srbf(Vec3::Z, 20.0, [1.0; 3])];
@@ -815,7 +815,7 @@ fn bad_inputs_are_typed_errors() {
     let e = render(
         &light,
         &EnvTables {
-            srbf: Some(wrong),
+            srbf: Some(wrong.into()),
             ..Default::default()
         },
         &options,
@@ -989,7 +989,7 @@ fn occluder_scene() -> (HairModel, Table, EnvTables) {
     let model = HairModel::new(points, vec![0, 2, 4], Some(thickness), None, None).unwrap();
     let direct = synthetic_table(Axis::uniform("none", 0.0, 0.0, 1));
     let tables = EnvTables {
-        direct: Some(direct.clone()),
+        direct: Some(direct.clone().into()),
         ..Default::default()
     };
     (model, direct, tables)
@@ -1383,13 +1383,10 @@ fn groom_scene() -> (HairModel, Camera, EnvTables) {
     .unwrap();
     let camera = Camera::framing(model.bounds(), 1.0, false);
     let tables = EnvTables {
-        srbf: Some(synthetic_table(Axis::uniform(
-            AXIS_INV_LAMBDA,
-            1.0 / 64.0,
-            1.0 / 8.0,
-            5,
-        ))),
-        direct: Some(synthetic_table(Axis::uniform("none", 0.0, 0.0, 1))),
+        srbf: Some(
+            synthetic_table(Axis::uniform(AXIS_INV_LAMBDA, 1.0 / 64.0, 1.0 / 8.0, 5)).into(),
+        ),
+        direct: Some(synthetic_table(Axis::uniform("none", 0.0, 0.0, 1)).into()),
         ..Default::default()
     };
     (model, camera, tables)

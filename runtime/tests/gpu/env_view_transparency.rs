@@ -128,7 +128,7 @@ fn render_sized(
         ..Default::default()
     };
     let tables = EnvTables {
-        direct: Some(table.clone()),
+        direct: Some(table.clone().into()),
         ..Default::default()
     };
     let lights = [EnvLight::directional(LIGHT, [1.0; 3])];

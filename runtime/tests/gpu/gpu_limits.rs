@@ -55,7 +55,7 @@ fn env_render(
     let model = slab(1, 0.01);
     let camera = Camera::framing(model.bounds(), 1.0, false);
     let tables = EnvTables {
-        srbf: Some(srbf_table()),
+        srbf: Some(srbf_table().into()),
         ..Default::default()
     };
     render_env_frame(

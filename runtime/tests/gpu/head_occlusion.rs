@@ -75,8 +75,8 @@ fn table(fourth: Axis) -> Table {
 
 fn tables() -> EnvTables {
     EnvTables {
-        srbf: Some(table(Axis::uniform(AXIS_INV_LAMBDA, 0.0, 2.0, 5))),
-        direct: Some(table(Axis::uniform("direct", 0.0, 0.0, 1))),
+        srbf: Some(table(Axis::uniform(AXIS_INV_LAMBDA, 0.0, 2.0, 5)).into()),
+        direct: Some(table(Axis::uniform("direct", 0.0, 0.0, 1)).into()),
         multiple: None,
     }
 }

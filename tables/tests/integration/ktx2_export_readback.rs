@@ -350,7 +350,9 @@ fn refusals_name_the_file_and_leave_nothing_behind() {
     let mut big = asset(&dir, "big", &[3, 4], 1);
     let mut values = big.table.values().to_vec();
     values[5] = 7.0e4;
-    big.table = Table::new(big.table.axes().to_vec(), 1, values).unwrap();
+    big.table = Table::new(big.table.axes().to_vec(), 1, values)
+        .unwrap()
+        .into();
     let err = export_ktx2(&big, &dir, TexelStorage::Half).unwrap_err();
     assert!(
         matches!(&err, LutExportError::HalfOverflow { node, .. } if node == &vec![1, 1]),
@@ -367,7 +369,8 @@ fn refusals_name_the_file_and_leave_nothing_behind() {
             1,
             vec![0.5; 32],
         )
-        .unwrap(),
+        .unwrap()
+        .into(),
         ..five
     };
     let err = export_ktx2(&five, &dir, TexelStorage::Float).unwrap_err();

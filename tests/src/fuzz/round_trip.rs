@@ -373,7 +373,8 @@ pub fn corrupt(loaded: &mut Loaded) {
             values[0] = flip(values[0]);
             a.table =
                 strandlight_tables::table::Table::new(t.axes().to_vec(), t.channels(), values)
-                    .expect("the same shape");
+                    .expect("the same shape")
+                    .into();
         }
         Loaded::Srbf(s) => s.seconds = f64::from_bits(s.seconds.to_bits() ^ 1),
     }

@@ -136,7 +136,8 @@ fn the_multiple_scattering_table_relative_error_can_fail() {
             asset.table.channels(),
             asset.table.values().iter().map(|v| v * 1.05).collect(),
         )
-        .unwrap(),
+        .unwrap()
+        .into(),
         ..asset.clone()
     };
     let random = check_asset(&asset, 200, 5).unwrap();

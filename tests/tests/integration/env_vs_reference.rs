@@ -14,7 +14,7 @@
 
 use glam::DVec3;
 use std::collections::BTreeMap;
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 use strandlight_precompute::bake::bake_job;
 use strandlight_precompute::bake_plan::{
@@ -81,7 +81,7 @@ struct Scene {
     srbf_specs: Vec<LightSpec>,
     reference_specs: Vec<LightSpec>,
     up: UpAxis,
-    tables: BTreeMap<String, Table>,
+    tables: BTreeMap<String, Arc<Table>>,
 }
 
 /// A direction of the map's frame (+Y up, image centre toward −Z) in the world of a hair with
@@ -331,7 +331,7 @@ fn rotated(lights: &[EnvLight], up: UpAxis, degrees: f32) -> Vec<EnvLight> {
         .collect()
 }
 
-fn table(scene: &Scene, name: &str) -> Table {
+fn table(scene: &Scene, name: &str) -> Arc<Table> {
     scene.tables[name].clone()
 }
 
