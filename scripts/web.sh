@@ -17,8 +17,9 @@ if [ "$(wasm-bindgen --version 2>/dev/null | cut -d' ' -f2)" != "$version" ]; th
   cargo install --quiet --debug wasm-bindgen-cli --version "$version" --no-default-features --bin wasm-bindgen
 fi
 cargo build --quiet -p strandlight-web --target wasm32-unknown-unknown --profile web
+# The page goes where `strandlight web --page` looks by default, wherever cargo builds.
 wasm-bindgen --target web --no-typescript --out-dir target/web/pkg \
-  target/wasm32-unknown-unknown/web/strandlight_web.wasm
+  "${CARGO_TARGET_DIR:-target}/wasm32-unknown-unknown/web/strandlight_web.wasm"
 echo "page: target/web/pkg ($(du -h target/web/pkg/strandlight_web_bg.wasm | cut -f1) of wasm)"
 
 if [ "${1:-}" = "--page-only" ]; then
