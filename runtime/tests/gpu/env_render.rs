@@ -7,7 +7,9 @@ use crate::common::*;
 use glam::{DVec3, Vec2, Vec3};
 use strandlight_runtime::camera::{Camera, Projection, light_camera};
 use strandlight_runtime::env::TransmittanceFilter;
-use strandlight_runtime::env::{EnvFrame, EnvRenderOptions, EnvTables, render_env_frame};
+use strandlight_runtime::env::{
+    EnvFrame, EnvRenderOptions, EnvRenderer, EnvTables, render_env_frame,
+};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::{GpuContext, read_texture_rgba};
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
@@ -627,6 +629,65 @@ fn unshadowed_srbf_image_is_the_sum_of_table_lookups() {
         }
         sum
     });
+}
+
+/// `EnvRenderer` keeps the tables it bound on the GPU and knows them by allocation: frames with
+/// the same tables read the cached binding, and a new table of the same shape and name is
+/// uploaded, not mistaken for the old one.
+#[test]
+fn a_renderer_rebinds_tables_that_changed_and_reuses_the_same_ones() {
+    let (model, _) = three_strands();
+    let gpu = gpu();
+    let renderer = EnvRenderer::new(&gpu);
+    let options = EnvRenderOptions {
+        dodm: DodmSettings {
+            resolution: 64,
+            first_layer: None,
+            batch_size: 2,
+        },
+        kappa: 1.0,
+        shadowed: false,
+        ..Default::default()
+    };
+    let lights = [EnvLight::srbf(
+        Vec3::new(0.3, 0.8, 0.5),
+        20.0,
+        [1.0, 0.5, 0.25],
+    )];
+    let table = synthetic_table(Axis::uniform(AXIS_INV_LAMBDA, 1.0 / 64.0, 1.0 / 8.0, 5));
+    let doubled = Table::new(
+        table.axes().to_vec(),
+        3,
+        table.values().iter().map(|v| 2.0 * v).collect(),
+    )
+    .unwrap();
+    let frame = |t: &std::sync::Arc<Table>| {
+        let tables = EnvTables {
+            srbf: Some(t.clone()),
+            ..Default::default()
+        };
+        let camera = ortho_camera();
+        renderer
+            .render(
+                &gpu, &model, &camera, RES, RES, &lights, &tables, &options, None,
+            )
+            .unwrap_or_else(|e| panic!("{e}"))
+            .pixels
+    };
+    let total = |pixels: &[[f32; 4]]| pixels.iter().map(|p| p[0] as f64).sum::<f64>();
+    let table = std::sync::Arc::new(table);
+    let first = frame(&table);
+    assert!(total(&first) > 0.0, "the frame is lit");
+    assert_eq!(
+        frame(&table),
+        first,
+        "the same table renders the same frame"
+    );
+    let ratio = total(&frame(&std::sync::Arc::new(doubled))) / total(&first);
+    assert!(
+        (ratio - 2.0).abs() < 1e-4,
+        "a doubled table read {ratio}× the light"
+    );
 }
 
 #[test]
