@@ -17,8 +17,9 @@
 //!   background covering most of the frame, whose median luminance 0 would put the stop
 //!   exposure at infinity.
 //! - `nv-flip` takes 8-bit sRGB, so each tone-mapped exposure is quantized to 8 bits before
-//!   LDR-FLIP (NVIDIA's HDR path stays in float). `tests/tests/hdr_flip_vs_nvidia.rs` measures
-//!   what that costs against NVIDIA's own HDR-FLIP (the `flip-evaluator` package).
+//!   LDR-FLIP (NVIDIA's HDR path stays in float).
+//!   `eval/tests/integration/hdr_flip_vs_nvidia.rs` measures what that costs against NVIDIA's
+//!   own HDR-FLIP (the `flip-evaluator` package).
 
 use strandlight_scene::image_metrics::{CompareError, HAIR_ALPHA, Image};
 use strandlight_tables::colour::{luminance_f32, srgb_encode_f32};

@@ -2,7 +2,7 @@
 //! brute-force sphere quadrature (the white furnace of pbrt-v4's `bsdfs_test`), the h-integral
 //! against a uniform rule 100× finer, the N̄ table against the quadrature, symmetries, the
 //! scale tilt's sign, hard cases, and the lobe decomposition. Mitsuba itself is compared in
-//! `tests/chiang_vs_mitsuba.rs`.
+//! `tests/integration/chiang_vs_mitsuba.rs`.
 
 use super::azimuthal::{ViewGeometry, trimmed_logistic, wrap_pi};
 use super::*;
