@@ -526,15 +526,9 @@ fn render_unshadowed(model: &HairModel, lights: &[EnvLight], tables: &EnvTables)
     render_unshadowed_with(model, lights, tables, None).0
 }
 
-/// The frame's pixels and its multiple-scattering pixels.
-fn render_unshadowed_with(
-    model: &HairModel,
-    lights: &[EnvLight],
-    tables: &EnvTables,
-    multiple: Option<&dyn ForwardScatteringSource>,
-) -> (Vec<[f32; 4]>, Option<Vec<[f32; 4]>>) {
-    let gpu = gpu();
-    let options = EnvRenderOptions {
+/// No shadows, κ 1, small light maps: the frame is the sum of the lights' table lookups.
+fn unshadowed_options() -> EnvRenderOptions {
+    EnvRenderOptions {
         dodm: DodmSettings {
             resolution: 64,
             first_layer: None,
@@ -543,7 +537,18 @@ fn render_unshadowed_with(
         kappa: 1.0,
         shadowed: false,
         ..Default::default()
-    };
+    }
+}
+
+/// The frame's pixels and its multiple-scattering pixels.
+fn render_unshadowed_with(
+    model: &HairModel,
+    lights: &[EnvLight],
+    tables: &EnvTables,
+    multiple: Option<&dyn ForwardScatteringSource>,
+) -> (Vec<[f32; 4]>, Option<Vec<[f32; 4]>>) {
+    let gpu = gpu();
+    let options = unshadowed_options();
     let camera: Camera = ortho_camera();
     let frame = render_env_frame(
         &gpu, model, &camera, RES, RES, lights, tables, &options, multiple,
@@ -639,16 +644,7 @@ fn a_renderer_rebinds_tables_that_changed_and_reuses_the_same_ones() {
     let (model, _) = three_strands();
     let gpu = gpu();
     let renderer = EnvRenderer::new(&gpu);
-    let options = EnvRenderOptions {
-        dodm: DodmSettings {
-            resolution: 64,
-            first_layer: None,
-            batch_size: 2,
-        },
-        kappa: 1.0,
-        shadowed: false,
-        ..Default::default()
-    };
+    let options = unshadowed_options();
     let lights = [EnvLight::srbf(
         Vec3::new(0.3, 0.8, 0.5),
         20.0,
