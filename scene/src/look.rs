@@ -17,6 +17,8 @@ pub enum EnvTransparency {
     Opaque,
     /// Every fiber, weighted by coverage × its visibility through the occupancy map.
     Occupancy,
+    /// The occupancy map's weights gathered into a few layers per pixel, each shaded once.
+    Layered,
 }
 
 /// Where the forward-scattering shadow paths are marched (Ren §6).
@@ -150,6 +152,9 @@ impl LookArgs {
         let transparency = match self.transparency {
             EnvTransparency::Opaque => ViewTransparency::Opaque,
             EnvTransparency::Occupancy => ViewTransparency::Occupancy {
+                visibility_cutoff: view.visibility_cutoff,
+            },
+            EnvTransparency::Layered => ViewTransparency::Layered {
                 visibility_cutoff: view.visibility_cutoff,
             },
         };

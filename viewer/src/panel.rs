@@ -240,6 +240,8 @@ fn env_controls(ui: &mut egui::Ui, e: &mut EnvLighting, lobes: &mut usize, total
     ui.label(Recompute::Frame.label());
     ui.horizontal(|ui| {
         ui.radio_value(&mut e.transparency, EnvTransparency::Opaque, "opaque");
+        ui.radio_value(&mut e.transparency, EnvTransparency::Layered, "layered")
+            .on_hover_text("every fiber weighted through the occupancy map, shaded in 4 layers");
         ui.radio_value(&mut e.transparency, EnvTransparency::Occupancy, "occupancy");
     });
     ui.horizontal(|ui| {

@@ -589,6 +589,8 @@ struct FrameResources {
     volume: Arc<VolumeBuffers>,
     /// The head (issue 40), drawn into the view's depth and every light map.
     head: Option<HeadGeometry>,
+    /// The view camera's world to clip space.
+    view_proj: glam::Mat4,
     /// [`EnvViewTargets::head_position`] and `head_normal`.
     head_views: [wgpu::TextureView; 2],
 }
@@ -718,6 +720,7 @@ impl FrameResources {
             height: self.sums.height,
             head: [&self.head_views[0], &self.head_views[1]],
             skin: self.head.as_ref().map(|h| h.albedo),
+            view_proj: self.view_proj,
         }
     }
 
@@ -1112,6 +1115,7 @@ impl EnvRenderer {
             .map(|t| t.create_view(&Default::default()));
         Ok(FrameResources {
             strands: self.view.strands(gpu, &geometry, &view_params),
+            view_proj: view_params.view_proj(),
             coverage_view: targets.coverage.create_view(&Default::default()),
             nearest_views: [&targets.nearest_position, &targets.nearest_tangent]
                 .map(|t| t.create_view(&Default::default())),

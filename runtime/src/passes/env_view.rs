@@ -320,9 +320,11 @@ struct ViewUniform {
     width: u32,
     height: u32,
     visibility_cutoff: f32,
-    _pad: u32,
+    record_words: u32,
     /// rgb: the head's skin albedo; w: 1 where the frame has a head.
     skin: [f32; 4],
+    /// Clip space to world (the layered view's layers on their pixels' rays).
+    clip_to_world: [[f32; 4]; 4],
 }
 
 /// Group 2: the single-scattering table (the SRBF convolution table, or the direct table for
@@ -495,6 +497,8 @@ pub struct FrameVisibility<'a> {
     pub head: [&'a wgpu::TextureView; 2],
     /// The head's skin albedo; None: no head.
     pub skin: Option<[f32; 3]>,
+    /// The view camera's world-to-clip matrix (the layered view inverts it).
+    pub view_proj: glam::Mat4,
 }
 
 impl ViewBinding {
@@ -513,11 +517,12 @@ impl ViewBinding {
             width: visibility.width,
             height: visibility.height,
             visibility_cutoff: visibility.transparency.visibility_cutoff(),
-            _pad: 0,
+            record_words: visibility.transparency.record_words() as u32,
             skin: match visibility.skin {
                 Some([r, g, b]) => [r, g, b, 1.0],
                 None => [0.0; 4],
             },
+            clip_to_world: visibility.view_proj.inverse().to_cols_array_2d(),
         };
         let values = match grid {
             Some(g) => {
@@ -634,7 +639,7 @@ impl EnvViewTargets {
             | wgpu::TextureUsages::COPY_SRC;
         let opaque_only = match transparency {
             ViewTransparency::Opaque => size,
-            ViewTransparency::Occupancy { .. } => wgpu::Extent3d {
+            _ => wgpu::Extent3d {
                 width: 1,
                 height: 1,
                 depth_or_array_layers: 1,
@@ -707,7 +712,8 @@ struct AccumulateUniform {
 pub struct EnvViewPass {
     opaque: wgpu::RenderPipeline,
     transparent: wgpu::RenderPipeline,
-    /// Occupancy view: the skin behind the pixel's fibers (`skin.wgsl`), added after them.
+    layered: wgpu::RenderPipeline,
+    /// Occupancy and layered views: the skin behind the pixel's fibers (`skin.wgsl`), added after them.
     skin_behind_hair: wgpu::RenderPipeline,
     pub head: HeadPass,
     pub visibility: ViewVisibilityPass,
@@ -780,6 +786,7 @@ fn env_view_shader(device: &wgpu::Device) -> wgpu::ShaderModule {
         include_str!("env_view.wgsl"),
         include_str!("visibility_volume.wgsl"),
         include_str!("view_visibility.wgsl"),
+        include_str!("view_layers.wgsl"),
         include_str!("skin.wgsl"),
     ]
     .concat();
@@ -879,6 +886,14 @@ impl EnvViewPass {
             ("env view (occupancy)", "vs_main", "fs_env_transparent"),
             Some(ADDITIVE),
         );
+        // The layers the frame's visibility gathered: a full-screen pass, added to by the skin.
+        let layered = view_pipeline(
+            gpu,
+            &layout,
+            &shader,
+            ("env view (layered)", "vs_fullscreen", "fs_env_layered"),
+            Some(ADDITIVE),
+        );
         let skin_behind_hair = view_pipeline(
             gpu,
             &layout,
@@ -894,6 +909,7 @@ impl EnvViewPass {
         Self {
             opaque,
             transparent,
+            layered,
             skin_behind_hair,
             head: HeadPass::new(gpu),
             visibility,
@@ -995,6 +1011,7 @@ impl EnvViewPass {
         let (pipeline, vertices, instances) = match transparency {
             ViewTransparency::Opaque => (&self.opaque, 3, 1),
             ViewTransparency::Occupancy { .. } => (&self.transparent, 6, geometry.segment_count),
+            ViewTransparency::Layered { .. } => (&self.layered, 3, 1),
         };
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -1011,7 +1028,7 @@ impl EnvViewPass {
             pass.set_bind_group(2, &tables.group, &[]);
             pass.set_bind_group(3, &view.group, &[]);
             pass.draw(0..vertices, 0..instances);
-            if let (ViewTransparency::Occupancy { .. }, true) = (transparency, with_head) {
+            if transparency.uses_occupancy_map() && with_head {
                 pass.set_pipeline(&self.skin_behind_hair);
                 pass.draw(0..3, 0..1);
             }

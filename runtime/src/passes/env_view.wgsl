@@ -38,9 +38,12 @@ struct ViewParams {
     height: u32,
     // Fragments seen less than this stop before shading (transparent view).
     visibility_cutoff: f32,
-    _pad: u32,
+    // u32 per pixel of `occupancy_map` (occupancy_map.wgsl).
+    record_words: u32,
     // rgb: the head's skin albedo; w: 1 where the frame has a head (skin.wgsl).
     skin: vec4<f32>,
+    // Clip space to world: the layered view puts each layer's fibers back on its pixel's ray.
+    clip_to_world: mat4x4<f32>,
 };
 
 @group(2) @binding(0) var<uniform> single_layout: TableLayout;
@@ -237,5 +240,5 @@ fn fs_env_transparent(in: VertexOut) -> EnvOut {
     if (behind_head(in)) { discard; }
     let seen = occupancy_visibility(in);
     if (seen < view.visibility_cutoff) { discard; }
-    return shade(in.world, in.tangent, in.alpha * seen);
+    return shade(in.world, in.tangent, occupancy_weight(in, seen));
 }

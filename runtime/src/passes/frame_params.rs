@@ -57,10 +57,16 @@ pub(crate) struct FrameUniform {
 }
 
 impl FrameParams {
+    /// World to clip space of the camera at this frame's aspect.
+    pub(crate) fn view_proj(&self) -> Mat4 {
+        let aspect = self.width as f32 / self.height as f32;
+        self.camera.projection_matrix(aspect) * self.camera.view()
+    }
+
     pub(crate) fn uniform(&self, width_scale: f32) -> FrameUniform {
         let aspect = self.width as f32 / self.height as f32;
         let proj = self.camera.projection_matrix(aspect);
-        let view_proj: Mat4 = proj * self.camera.view();
+        let view_proj: Mat4 = self.view_proj();
         FrameUniform {
             view_proj: view_proj.to_cols_array_2d(),
             eye: self

@@ -8,10 +8,16 @@
 //!   twice per frame, not once per batch.
 //! * [`ViewTransparency::Occupancy`]: the occupancy and slab maps of Sintorn & Assarsson 2009
 //!   (`occupancy_map.wgsl`, `view_visibility.wgsl`): two passes record each pixel's depth range,
-//!   which of its 128 depth slices hold fragments and the optical depth per slab of 32 slices;
-//!   the view pass weighs every fragment by its coverage × exp(−optical depth in front) and adds
-//!   the results (order-independent), stopping before any light for fragments seen less than
-//!   the cutoff (the paper's early opacity culling).
+//!   which of its 128 depth slices hold fragments and the optical depth per slab of 32 slices,
+//!   and a third sums the weights this gives the pixel's fragments; the view pass weighs every
+//!   fragment by its coverage × exp(−optical depth in front), rescaled so that the pixel's
+//!   weights add up to its coverage, and adds the results (order-independent), stopping before
+//!   any light for fragments seen less than the cutoff (the paper's early opacity culling).
+//!
+//! * [`ViewTransparency::Layered`]: the occupancy map's three passes and a fourth that gathers
+//!   the weighted fragments of each pixel into a few layers of equal coverage
+//!   (`view_layers.wgsl`); each batch's view pass shades every layer once, in a full-screen
+//!   pass, at its fibers' weighted mean depth and tangent.
 //!
 //! Inputs: the strands' bind group and the view group (group 3, holding the [`OccupancyMap`]).
 //! Outputs: the view's depth, nearest-fiber and coverage textures (opaque) or the occupancy map
@@ -38,7 +44,16 @@ pub enum ViewTransparency {
     /// Every fiber in front weighs in by coverage × visibility; fragments seen less than
     /// `visibility_cutoff` (in [0, 1)) are not shaded.
     Occupancy { visibility_cutoff: f32 },
+    /// The occupancy view's weights gathered into [`VIEW_LAYERS`] layers of equal coverage per
+    /// pixel, each shaded once at its fibers' weighted mean depth and tangent
+    /// (`view_layers.wgsl`): the occupancy view's weighting at a few shading loops per pixel.
+    Layered { visibility_cutoff: f32 },
 }
+
+/// Layers per pixel of [`ViewTransparency::Layered`] (`OCC_LAYERS` in `view_layers.wgsl`).
+pub const VIEW_LAYERS: u64 = 4;
+/// u32 per layer (`OCC_LAYER_WORDS`): Σw, Σw·depth, Σw·tangent.
+const LAYER_WORDS: u64 = 5;
 
 impl ViewTransparency {
     /// Below 8-bit display precision: what is culled changes a pixel by at most 1/256 of the
@@ -51,26 +66,47 @@ impl ViewTransparency {
         }
     }
 
+    pub fn layered() -> Self {
+        Self::Layered {
+            visibility_cutoff: Self::DEFAULT_CUTOFF,
+        }
+    }
+
     /// The cutoff the view pass applies (0 for opaque: nothing is culled by visibility).
     pub fn visibility_cutoff(&self) -> f32 {
         match self {
             Self::Opaque => 0.0,
-            Self::Occupancy { visibility_cutoff } => *visibility_cutoff,
+            Self::Occupancy { visibility_cutoff } | Self::Layered { visibility_cutoff } => {
+                *visibility_cutoff
+            }
+        }
+    }
+
+    /// Whether the frame builds the occupancy map (every view but the opaque one).
+    pub fn uses_occupancy_map(&self) -> bool {
+        !matches!(self, Self::Opaque)
+    }
+
+    /// u32 per pixel of the [`OccupancyMap`] (`view.record_words`).
+    pub fn record_words(&self) -> u64 {
+        match self {
+            Self::Opaque | Self::Occupancy { .. } => RECORD_WORDS,
+            Self::Layered { .. } => RECORD_WORDS + VIEW_LAYERS * LAYER_WORDS,
         }
     }
 
     pub fn check(&self) -> Result<(), OccupancyError> {
-        match self {
-            Self::Occupancy { visibility_cutoff } if !(0.0..1.0).contains(visibility_cutoff) => {
-                Err(OccupancyError::Cutoff(*visibility_cutoff))
-            }
-            _ => Ok(()),
+        let cutoff = self.visibility_cutoff();
+        if !(0.0..1.0).contains(&cutoff) {
+            return Err(OccupancyError::Cutoff(cutoff));
         }
+        Ok(())
     }
 }
 
-/// u32 per pixel (`OCC_RECORD`): depth range, 4 words of occupancy bits, 4 slab optical depths.
-pub const RECORD_WORDS: u64 = 10;
+/// u32 per pixel (`OCC_RECORD`): depth range, 4 words of occupancy bits, 4 slab optical depths,
+/// the sum of the weights the map gives the pixel's fragments (the layered view adds its layers).
+pub const RECORD_WORDS: u64 = 11;
 
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum OccupancyError {
@@ -99,7 +135,7 @@ impl OccupancyMap {
     pub fn bytes(transparency: ViewTransparency, width: u32, height: u32) -> u64 {
         match transparency {
             ViewTransparency::Opaque => 16,
-            ViewTransparency::Occupancy { .. } => width as u64 * height as u64 * RECORD_WORDS * 4,
+            _ => width as u64 * height as u64 * transparency.record_words() * 4,
         }
     }
 
@@ -112,7 +148,7 @@ impl OccupancyMap {
         transparency.check()?;
         let bytes = Self::bytes(transparency, width, height);
         GpuLimits::of(gpu).check_storage_buffer("occupancy map", bytes, |max| {
-            let per_pixel = RECORD_WORDS * 4;
+            let per_pixel = transparency.record_words() * 4;
             let (w, h) = fit_pixels(width, height, max / per_pixel);
             format!("render at {w}x{h} or smaller, or use the opaque view")
         })?;
@@ -137,9 +173,12 @@ pub struct ViewVisibilityPass {
     coverage: wgpu::RenderPipeline,
     range: wgpu::RenderPipeline,
     slices: wgpu::RenderPipeline,
+    weights: wgpu::RenderPipeline,
+    layers: wgpu::RenderPipeline,
     count_rasterized: wgpu::RenderPipeline,
     count_nearest: wgpu::RenderPipeline,
     count_visible: wgpu::RenderPipeline,
+    count_layers: wgpu::RenderPipeline,
 }
 
 impl ViewVisibilityPass {
@@ -178,6 +217,11 @@ impl ViewVisibilityPass {
                         layout: &wgpu::PipelineLayout,
                         fragment: Option<&str>,
                         depth: Option<(wgpu::CompareFunction, bool)>| {
+            // The layer count is a full-screen pass; every other pass draws the strands.
+            let vertex_entry = match fragment {
+                Some("fs_count_layers") => "vs_fullscreen",
+                _ => "vs_main",
+            };
             let targets: &[Option<wgpu::ColorTargetState>] = match fragment {
                 Some(f) if f.starts_with("fs_count") || f == "fs_coverage" => &float_target,
                 Some("fs_nearest_surface") => &nearest_targets,
@@ -187,7 +231,7 @@ impl ViewVisibilityPass {
                 label,
                 layout,
                 shader: module,
-                vertex_entry: "vs_main",
+                vertex_entry,
                 fragment: fragment.map(|entry| (entry, targets)),
                 depth: depth.map(|(compare, write)| depth_test(DEPTH_FORMAT, write, compare)),
             }
@@ -213,16 +257,19 @@ impl ViewVisibilityPass {
             ),
             range: reading("occupancy depth range", "fs_occupancy_range", Always),
             slices: reading("occupancy slices", "fs_occupancy_slices", Always),
+            weights: reading("occupancy weights", "fs_occupancy_weights", Always),
+            layers: reading("view layers", "fs_view_layers", Always),
             count_rasterized: reading("count rasterized", "fs_count_rasterized", Always),
             count_nearest: reading("count nearest", "fs_count_nearest", Equal),
             count_visible: reading("count visible", "fs_count_visible", Always),
+            count_layers: reading("count layers", "fs_count_layers", Always),
         }
     }
 
     /// Encodes the frame's build: the coverage into `coverage`, then the depth prepass into
     /// `depth` with each pixel's nearest fiber into `nearest` (position, tangent) (opaque, all
     /// kept for the view passes; both test against the head's depth, which `depth` holds on
-    /// entry), or the occupancy map zeroed and its two passes (which test against the head in
+    /// entry), or the occupancy map zeroed and its three passes (which test against the head in
     /// the shader). `view` must bind `map`.
     #[allow(clippy::too_many_arguments)]
     pub fn encode(
@@ -261,6 +308,16 @@ impl ViewVisibilityPass {
                 vec![
                     ("occupancy depth range", vec![], true, &self.range, true),
                     ("occupancy slices", vec![], true, &self.slices, true),
+                    ("occupancy weights", vec![], true, &self.weights, true),
+                ]
+            }
+            ViewTransparency::Layered { .. } => {
+                encoder.clear_buffer(&map.buffer, 0, None);
+                vec![
+                    ("occupancy depth range", vec![], true, &self.range, true),
+                    ("occupancy slices", vec![], true, &self.slices, true),
+                    ("occupancy weights", vec![], true, &self.weights, true),
+                    ("view layers", vec![], true, &self.layers, true),
                 ]
             }
         };
@@ -274,7 +331,7 @@ impl ViewVisibilityPass {
                 depth_stencil_attachment: match (with_depth, transparency) {
                     (false, _) => None,
                     (true, ViewTransparency::Opaque) => prepassed_depth(depth),
-                    (true, ViewTransparency::Occupancy { .. }) => cleared_depth(depth, true),
+                    (true, _) => cleared_depth(depth, true),
                 },
                 timestamp_writes: gpu.render_timestamps(),
                 occlusion_query_set: None,
@@ -304,9 +361,10 @@ impl ViewVisibilityPass {
         segments: u32,
     ) -> Result<FragmentCounts, ReadbackError> {
         let counts = RenderTarget::new(gpu, width, height);
-        let shaded = match transparency {
-            ViewTransparency::Opaque => &self.count_nearest,
-            ViewTransparency::Occupancy { .. } => &self.count_visible,
+        let (shaded, shaded_vertices) = match transparency {
+            ViewTransparency::Opaque => (&self.count_nearest, 6 * segments),
+            ViewTransparency::Occupancy { .. } => (&self.count_visible, 6 * segments),
+            ViewTransparency::Layered { .. } => (&self.count_layers, 3),
         };
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
@@ -321,9 +379,12 @@ impl ViewVisibilityPass {
             });
             pass.set_bind_group(0, strands, &[]);
             pass.set_bind_group(3, view, &[]);
-            for pipeline in [&self.count_rasterized, shaded] {
+            for (pipeline, vertices) in [
+                (&self.count_rasterized, 6 * segments),
+                (shaded, shaded_vertices),
+            ] {
                 pass.set_pipeline(pipeline);
-                pass.draw(0..6 * segments, 0..1);
+                pass.draw(0..vertices, 0..1);
             }
         }
         gpu.queue.submit([encoder.finish()]);

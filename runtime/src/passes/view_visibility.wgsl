@@ -56,6 +56,16 @@ fn fs_occupancy_slices(in: VertexOut) {
     atomicAdd(&occupancy_map[r + 6u + slab], tau);
 }
 
+// Pass 3: each fragment adds the weight the map gives it to its pixel's sum (culled or not: the
+// culled fragments' share is dropped, not handed to the others).
+@fragment
+fn fs_occupancy_weights(in: VertexOut) {
+    if (behind_head(in)) { discard; }
+    let r = occupancy_record(in.clip.xy, view.width);
+    let weight = in.alpha * occupancy_visibility(in);
+    atomicAdd(&occupancy_map[r + 10u], u32(round(weight * OCC_WEIGHT_SCALE)));
+}
+
 // Benchmarks only, into an additively blended target summed on the CPU: red counts the
 // fragments the hair rasterizes into (depth test Always), green those the view pass shades (the
 // nearest, at an Equal depth after the prepass; or those the occupancy map does not cull).
@@ -93,4 +103,18 @@ fn occupancy_visibility(in: VertexOut) -> f32 {
     let occupied = max(countOneBits(bits), 1u);
     tau += f32(atomicLoad(&occupancy_map[r + 6u + slab])) * f32(before) / f32(occupied);
     return exp(-tau / OCC_TAU_SCALE);
+}
+
+// The fragment's share of its pixel, `seen` its occupancy_visibility: coverage × seen, scaled
+// so that the pixel's shares add up to its coverage 1 − exp(−Σ τ) (pass 3's sum).
+fn occupancy_weight(in: VertexOut, seen: f32) -> f32 {
+    let r = occupancy_record(in.clip.xy, view.width);
+    var tau = 0.0;
+    for (var k = 0u; k < OCC_SLICES / OCC_SLICES_PER_SLAB; k++) {
+        tau += f32(atomicLoad(&occupancy_map[r + 6u + k]));
+    }
+    let coverage = 1.0 - exp(-tau / OCC_TAU_SCALE);
+    let sum = f32(atomicLoad(&occupancy_map[r + 10u])) / OCC_WEIGHT_SCALE;
+    if (!(sum > 0.0)) { return 0.0; }
+    return in.alpha * seen * coverage / sum;
 }

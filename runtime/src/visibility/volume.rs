@@ -1,7 +1,7 @@
 //! [`VisibilityVolume`]: the transmittance toward every direction at the vertices of a grid
 //! around the hair, as SH coefficients (bands 0–3), built once for a groom that does not move.
 //!
-//! Each vertex next to a voxel holding fiber marches `directions` rays (a spherical Fibonacci
+//! Every vertex marches `directions` rays (a spherical Fibonacci
 //! lattice) through the voxelized hair ([`HairVolume`]) and projects T(ω) = exp(−∫σ(ω) ds)
 //! onto the SH basis. The extinction of a voxel along ω is its fibers' projected cross-section
 //! per volume: a fiber piece of length ℓ and diameter d seen along ω covers ℓ·d·|sin(t, ω)|, so
@@ -11,7 +11,11 @@
 //! of a ray through the real strands, which the path tracer traces.
 //!
 //! The stored coefficients are windowed against ringing
-//! ([`super::spherical_harmonics::RINGING_WINDOW`]). Vertices away from the hair keep T = 1. Between vertices the coefficients are interpolated
+//! ([`super::spherical_harmonics::RINGING_WINDOW`]). Vertices in the hair's gaps march too: the
+//! layered view shades a layer's mean fiber, which can lie between a pixel's front and back
+//! hair, and a gap's vertex left at T = 1 lit it as if no hair were around (venice at 160×120:
+//! 0.383 against the truth, 0.269 marching every vertex; the build time did not change
+//! measurably, 1.6 s). Between vertices the coefficients are interpolated
 //! trilinearly (on the GPU as here, [`VisibilityVolume::coefficients_at`]).
 
 use glam::Vec3;
@@ -155,9 +159,6 @@ impl VisibilityVolume {
             .into_par_iter()
             .map(|v| {
                 let [i, j, k] = unflatten(v, dims);
-                if !touches_fiber(hair, [i, j, k]) {
-                    return unoccluded_coefficients();
-                }
                 let p = grid.origin + Vec3::new(i as f32, j as f32, k as f32) * grid.voxel_size;
                 // A vertex inside the head is read only in the cells it shares with vertices
                 // outside, by the skin and the fibers at the scalp: it carries what the surface
@@ -239,22 +240,6 @@ fn unflatten(v: usize, dims: [u32; 3]) -> [u32; 3] {
 
 fn flatten([i, j, k]: [u32; 3], dims: [u32; 3]) -> usize {
     (k as usize * dims[1] as usize + j as usize) * dims[0] as usize + i as usize
-}
-
-/// Whether any of the up to eight voxels around vertex `v` holds fiber.
-fn touches_fiber(hair: &HairVolume, v: [u32; 3]) -> bool {
-    let dims = hair.grid.dims;
-    (0..8u32).any(|corner| {
-        let mut idx = [0u32; 3];
-        for a in 0..3 {
-            let back = (corner >> a) & 1;
-            if v[a] < back || v[a] - back >= dims[a] {
-                return false;
-            }
-            idx[a] = v[a] - back;
-        }
-        hair.fiber_length[hair.grid.linear_index(idx)] > 0.0
-    })
 }
 
 /// exp(−∫σ(w) ds) from `p` along `w` to the grid's border (midpoint rule, steps of `step`).

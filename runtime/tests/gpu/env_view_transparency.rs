@@ -44,6 +44,11 @@ fn direct_table() -> Table {
 /// opacity `opacity`; listed in the file in a shuffled order. Returns the model and the strands'
 /// tangents front to back.
 fn stacked_strands(layers: usize, opacity: f32) -> (HairModel, Vec<DVec3>) {
+    strands_spaced(layers, opacity, 0.1)
+}
+
+/// [`stacked_strands`] `spacing` apart in depth (0: all at one depth).
+fn strands_spaced(layers: usize, opacity: f32, spacing: f32) -> (HairModel, Vec<DVec3>) {
     let tangents: Vec<Vec3> = (0..layers)
         .map(|k| {
             let a = (10.0 + 17.0 * k as f32).to_radians();
@@ -56,7 +61,7 @@ fn stacked_strands(layers: usize, opacity: f32) -> (HairModel, Vec<DVec3>) {
     let mut points = Vec::new();
     let mut offsets = vec![0u32];
     for &k in &order {
-        let centre = CENTRE + Vec3::Z * (0.5 - 0.1 * k as f32);
+        let centre = CENTRE + Vec3::Z * (0.5 - spacing * k as f32);
         points.push(centre - tangents[k] * 0.3);
         points.push(centre + tangents[k] * 0.3);
         offsets.push(points.len() as u32);
@@ -199,6 +204,36 @@ fn occupancy_view_composites_stacked_fibers_front_to_back_in_any_draw_order() {
 }
 
 #[test]
+fn occupancy_view_weights_add_up_to_the_coverage_where_fibers_share_a_slice() {
+    // Six fibers at one depth share a slice: the map cannot order them, gives each its full
+    // α, and the weights would add up to 6α = 1.8. Rescaled, the pixel holds its coverage
+    // 1 − (1 − α)⁶ and each fiber a sixth of it.
+    let (layers, opacity) = (6, 0.3);
+    let (model, tangents) = strands_spaced(layers, opacity, 0.0);
+    let table = direct_table();
+    let coverage = 1.0 - (1.0 - opacity as f64).powi(layers as i32);
+    let mut want = [0.0, 0.0, 0.0, coverage];
+    for t in &tangents {
+        let c = colour(&table, *t);
+        for i in 0..3 {
+            want[i] += coverage / layers as f64 * c[i];
+        }
+    }
+    let (pixels, _) = render(&model, &table, ViewTransparency::occupancy()).unwrap();
+    let got = at_pixel(&pixels);
+    println!("occupancy view: got {got:?}, want {want:?}");
+    assert_close(got, want, 2e-3, "occupancy view, one slice");
+    // The layered view gathers those weights: its pixel holds the same coverage.
+    let (pixels, _) = render(&model, &table, ViewTransparency::layered()).unwrap();
+    let alpha = at_pixel(&pixels)[3];
+    println!("layered view: alpha {alpha}, coverage {coverage}");
+    assert!(
+        (alpha - coverage).abs() <= 2e-3 * coverage,
+        "layered view: {alpha} vs {coverage}"
+    );
+}
+
+#[test]
 fn occupancy_view_stops_shading_fragments_below_the_visibility_cutoff() {
     // Visibility through k layers of opacity 0.7 is 0.3^k: 0.09 at k = 2, 0.027 at k = 3, so a
     // cutoff of 0.05 keeps the three nearest layers and culls the rest (2.7% of the pixel).
@@ -226,6 +261,69 @@ fn occupancy_view_stops_shading_fragments_below_the_visibility_cutoff() {
     assert!(
         counts.shaded < counts.rasterized,
         "culled fragments are not shaded: {counts:?}"
+    );
+}
+
+/// The layered view's pixel, in f64: each fiber's weight α(1 − α)^k (k in front of it) goes to
+/// the layer of the share of the coverage in front of it, ⌊L·(1 − (1 − α)^k)/C⌋ of L layers
+/// (C the pixel's coverage); each layer shades the weighted mean of its tangents.
+fn layered(table: &Table, tangents: &[DVec3], alpha: f64, layers: usize) -> [f64; 4] {
+    let coverage = 1.0 - (1.0 - alpha).powi(tangents.len() as i32);
+    let mut sums = vec![(0.0, DVec3::ZERO); layers];
+    for (k, t) in tangents.iter().enumerate() {
+        let seen = (1.0 - alpha).powi(k as i32);
+        let layer = (((1.0 - seen) / coverage * layers as f64) as usize).min(layers - 1);
+        sums[layer].0 += alpha * seen;
+        sums[layer].1 += alpha * seen * *t;
+    }
+    let mut out = [0.0; 4];
+    for (w, wt) in sums.into_iter().filter(|(w, _)| *w > 0.0) {
+        let c = colour(table, wt.normalize());
+        for i in 0..3 {
+            out[i] += w * c[i];
+        }
+        out[3] += w;
+    }
+    out
+}
+
+#[test]
+fn layered_view_with_one_fiber_a_layer_composites_front_to_back() {
+    // α = 0.1 over 4 fibers: the coverage in front of fiber k is 0, 29, 55 and 79% of the
+    // pixel's, so each fiber has a layer of its own and the layers are the fibers.
+    let (layers, opacity) = (4, 0.1);
+    let (model, tangents) = stacked_strands(layers, opacity);
+    let table = direct_table();
+    let (pixels, _) = render(&model, &table, ViewTransparency::layered()).unwrap();
+    let want = composite(&table, &tangents, opacity as f64, layers);
+    let got = at_pixel(&pixels);
+    println!("layered view: got {got:?}, front-to-back over {want:?}");
+    // The slabs round each τ = −ln(1 − α) to 1/4096: 1e-3 of the pixel's coverage here.
+    assert_close(got, want, 1.5e-3, "layered view, one fiber a layer");
+}
+
+#[test]
+fn layered_view_shades_each_layer_at_its_fibers_mean_tangent() {
+    // 12 fibers of α = 0.3 in 4 layers: several fibers share a layer, whose colour is that of
+    // their weighted mean tangent (the over operator would differ: see the assertion below).
+    let (layers, opacity) = (12, 0.3);
+    let (model, tangents) = stacked_strands(layers, opacity);
+    let table = direct_table();
+    let (pixels, counts) = render(&model, &table, ViewTransparency::layered()).unwrap();
+    let want = layered(&table, &tangents, opacity as f64, 4);
+    let over = composite(&table, &tangents, opacity as f64, layers);
+    let got = at_pixel(&pixels);
+    println!("layered view: got {got:?}, layered in f64 {want:?}, over {over:?}");
+    assert_close(got, want, 1e-3, "layered view");
+    assert!(
+        (0..3).any(|c| (over[c] - want[c]).abs() > 0.02 * want[c]),
+        "the scene must tell the layers from the fibers: {over:?} vs {want:?}"
+    );
+    // Where the fibers cross, a batch shades 4 layers instead of 12 fragments.
+    let counts = counts.unwrap();
+    assert!(
+        counts.shaded + 8 <= counts.rasterized,
+        "a batch shades layers, not fragments: {counts:?}"
     );
 }
 
