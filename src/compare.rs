@@ -122,15 +122,16 @@ struct LookFlags {
     /// (default 512; docs/BENCHMARKS.md, "Light-map size").
     #[arg(long)]
     light_map_size: Option<u32>,
-    /// The nearest fiber of each pixel (opaque, the default), or every fiber weighted by its
-    /// visibility through an occupancy map (Ren §8).
+    /// Every fiber weighted by its visibility through an occupancy map (Ren §8), in 4 layers
+    /// per pixel (layered, the default) or one by one (occupancy), or the nearest fiber of each
+    /// pixel (opaque).
     #[arg(long, value_enum)]
     transparency: Option<EnvTransparency>,
     /// Where SRBF lobes' visibility comes from: the groom's visibility volume (the default) or
     /// each lobe's light map (Ren 2010).
     #[arg(long, value_enum)]
     lobe_visibility: Option<LobeVisibilityArg>,
-    /// With occupancy: fragments seen less than this fraction are not shaded.
+    /// With layered or occupancy: fragments seen less than this fraction are not shaded.
     #[arg(long)]
     visibility_cutoff: Option<f32>,
     /// Where multiple scattering's shadow paths are marched (default: auto).

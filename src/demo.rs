@@ -34,9 +34,10 @@ pub const CACHE_DIR: &str = "out/cache";
 
 #[derive(clap::Args, Debug)]
 pub struct DemoArgs {
-    /// The nearest fiber of each pixel (opaque, faster), or every fiber weighted by its
-    /// visibility through an occupancy map (Ren §8).
-    #[arg(long, value_enum, default_value = "occupancy")]
+    /// Every fiber weighted by its visibility through an occupancy map (Ren §8), shaded in 4
+    /// layers per pixel (layered) or one by one (occupancy), or the nearest fiber of each pixel
+    /// (opaque, fastest).
+    #[arg(long, value_enum, default_value = "layered")]
     pub transparency: EnvTransparency,
 }
 

@@ -4,8 +4,11 @@
 //! [reference] LOOK...` with LOOK = TRANSPARENCY/VISIBILITY (opaque|occupancy / light-maps|volume);
 //! EXRs go to out/view-study/.
 use anyhow::Context;
-use strandlight_eval::compare::{CompareSettings, ReferenceLighting, frame, prepare, truth_of};
+use strandlight_eval::compare::{
+    CompareSettings, ReferenceLighting, frame, prepare, timed_render, truth_of,
+};
 use strandlight_eval::ground_truth::TruthUse;
+use strandlight_eval::hdr_flip::hdr_flip;
 use strandlight_scene::env_frame::FrameRole;
 use strandlight_scene::env_frame::render_lights;
 use strandlight_scene::image_metrics::relative_rmse;
@@ -41,6 +44,11 @@ fn main() -> anyhow::Result<()> {
         .ok()
         .map(|n| n.parse())
         .transpose()?;
+    let runs: usize = std::env::var("RUNS")
+        .ok()
+        .map(|n| n.parse())
+        .transpose()?
+        .unwrap_or(3);
     let mut steps = Steps::new(true);
     let scene = prepare(&settings, &mut steps)?;
     let truth = truth_of(&scene, &settings, mode, &mut steps)?.context("no cached truth")?;

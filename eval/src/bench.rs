@@ -607,7 +607,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         light_map_size: plan.dodm_sizes[0],
         head: plan.head.clone(),
         look: LookArgs {
-            transparency: EnvTransparency::Opaque,
+            transparency: EnvTransparency::default(),
             view: ViewArgs {
                 // Every SRBF frame of the sweep sets its own ([`srbf_configs`]); the error
                 // decomposition against the DOM reference takes Ren's light maps apart (one

@@ -782,6 +782,11 @@ fn reference_inputs(
         "generator": env!("CARGO_PKG_VERSION"),
         "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, transparency: look(args).transparency, dodm: look(args).dodm, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
     });
+    // Occupancy references rendered before the view's weights were rescaled to each pixel's
+    // coverage are not this renderer's: the key tells them apart (opaque ones keep theirs).
+    if look(args).transparency.uses_occupancy_map() {
+        inputs["view_weights"] = json!("rescaled to each pixel's coverage");
+    }
     // Only the fit's lighting adds a key, so the map's references keep their cache entries.
     // Only with a head: the references rendered before it keep their keys.
     if let Some(head) = &scene.head {

@@ -337,7 +337,7 @@ impl EnvLighting {
             lobes: None,
             rotation_deg: 0.0,
             dodm_size: DodmSettings::default().resolution,
-            transparency: EnvTransparency::Opaque,
+            transparency: EnvTransparency::default(),
             view: ViewArgs::default(),
         }
     }

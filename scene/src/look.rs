@@ -8,16 +8,21 @@ use strandlight_runtime::env::{DEFAULT_SIMPLIFICATION_SEED, ViewTransparency};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_runtime::visibility::{LobeVisibility, VisibilityVolumeSettings};
 
-/// What the view shows of each pixel's fibers (Ren §8).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+/// What the view shows of each pixel's fibers (Ren §8). The default is the layered view: the
+/// path tracer's pixel averages every fiber it sees, so the opaque view's nearest (best-lit)
+/// fiber reads too bright (docs/BENCHMARKS.md, "The view: layers").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum EnvTransparency {
-    /// The nearest fiber, weighted by its coverage.
+    /// The nearest fiber, weighted by its coverage: one shading loop per pixel.
     Opaque,
-    /// Every fiber, weighted by coverage × its visibility through the occupancy map.
+    /// Every fiber, weighted by coverage × its visibility through the occupancy map, shaded
+    /// one by one: as many shading loops per pixel as it has fragments.
     Occupancy,
-    /// The occupancy map's weights gathered into a few layers per pixel, each shaded once.
+    /// The occupancy map's weights gathered into 4 layers of equal coverage per pixel, each
+    /// shaded once at its fibers' mean depth and tangent.
+    #[default]
     Layered,
 }
 
@@ -72,12 +77,13 @@ impl LobeVisibilityArg {
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::Args))]
 pub struct LookArgs {
-    /// The nearest fiber of each pixel (opaque), or every fiber weighted by its visibility
-    /// through an occupancy map (Ren §8; order-independent transparency; costs about as many
-    /// times the view pass as the hair has fragments per pixel).
+    /// Every fiber weighted by its visibility through an occupancy map (Ren §8), gathered into
+    /// 4 layers per pixel and shaded once a layer (layered), shaded one by one (occupancy;
+    /// costs as many times the view pass as a pixel has fragments), or the nearest fiber of each
+    /// pixel (opaque, fastest).
     #[cfg_attr(
         any(feature = "cli", test),
-        arg(long, value_enum, default_value = "opaque")
+        arg(long, value_enum, default_value = "layered")
     )]
     pub transparency: EnvTransparency,
     #[cfg_attr(any(feature = "cli", test), command(flatten))]
@@ -98,7 +104,7 @@ pub struct ViewArgs {
     )]
     #[serde(default = "light_maps")]
     pub lobe_visibility: LobeVisibilityArg,
-    /// With occupancy: fragments seen less than this fraction are not shaded (early termination).
+    /// With layered or occupancy: fragments seen less than this fraction are not shaded (early termination).
     #[cfg_attr(any(feature = "cli", test), arg(long, default_value_t = ViewTransparency::DEFAULT_CUTOFF))]
     pub visibility_cutoff: f32,
     /// Where multiple scattering's shadow paths are marched (the brute-force reference's dense
@@ -139,7 +145,7 @@ impl Default for ViewArgs {
 impl Default for LookArgs {
     fn default() -> Self {
         Self {
-            transparency: EnvTransparency::Opaque,
+            transparency: EnvTransparency::default(),
             view: ViewArgs::default(),
         }
     }
