@@ -54,6 +54,18 @@ fn main() -> anyhow::Result<()> {
     let truth = truth_of(&scene, &settings, mode, &mut steps)?.context("no cached truth")?;
     let out = std::path::Path::new("out/view-study");
     std::fs::create_dir_all(out)?;
+    let map_stem = std::path::Path::new(map)
+        .file_stem()
+        .unwrap()
+        .to_string_lossy()
+        .to_string();
+    strandlight_tables::image_out::write_exr(
+        &out.join(format!("{map_stem}-{}-truth.exr", mode.name())),
+        truth.image.width,
+        truth.image.height,
+        &truth.image.pixels,
+        "view study: the ground truth",
+    )?;
     for look in &args[2..] {
         let (t, v) = look
             .split_once('/')

@@ -85,6 +85,14 @@ pub struct BenchPlan {
     /// existed: none.
     #[serde(default, skip_serializing_if = "HeadChoice::is_none")]
     pub head: HeadChoice,
+    /// The view of every frame, the DOM reference's and median cut's too. Reports written
+    /// before it existed: opaque, the default then.
+    #[serde(default = "opaque_view")]
+    pub transparency: EnvTransparency,
+}
+
+fn opaque_view() -> EnvTransparency {
+    EnvTransparency::Opaque
 }
 
 fn one_run() -> usize {
@@ -182,6 +190,7 @@ impl BenchPlan {
             truth_max_spp: truth_max_spp(),
             decomposition: true,
             head: HeadChoice::None,
+            transparency: EnvTransparency::default(),
         }
     }
 
@@ -250,6 +259,7 @@ impl BenchPlan {
             truth_max_spp: truth_max_spp(),
             decomposition: true,
             head: HeadChoice::None,
+            transparency: EnvTransparency::default(),
         }
     }
 }
@@ -607,7 +617,7 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         light_map_size: plan.dodm_sizes[0],
         head: plan.head.clone(),
         look: LookArgs {
-            transparency: EnvTransparency::default(),
+            transparency: plan.transparency,
             view: ViewArgs {
                 // Every SRBF frame of the sweep sets its own ([`srbf_configs`]); the error
                 // decomposition against the DOM reference takes Ren's light maps apart (one
@@ -1310,8 +1320,11 @@ mod tests {
         other_plan.plan.size = (320, 240);
         let mut other_machine = report("b.hdr", "d", "r");
         other_machine.adapter = "b".into();
+        let mut other_view = report("b.hdr", "d", "r");
+        other_view.plan.transparency = EnvTransparency::Occupancy;
         for (second, says) in [
             (other_plan, "different plans"),
+            (other_view, "different plans"),
             (other_machine, "different machines"),
             (report("a.hdr", "d", "r"), "more than one report"),
         ] {
@@ -1320,6 +1333,15 @@ mod tests {
         }
         let none = BenchReport::merged(Vec::new()).unwrap_err().to_string();
         assert!(none.contains("no report to merge"), "{none}");
+    }
+
+    #[test]
+    fn a_report_written_before_the_view_was_recorded_reads_as_the_opaque_view() {
+        let mut plan = serde_json::to_value(BenchPlan::truth()).unwrap();
+        plan.as_object_mut().unwrap().remove("transparency");
+        let old: BenchPlan = serde_json::from_value(plan).unwrap();
+        assert_eq!(old.transparency, EnvTransparency::Opaque);
+        assert_eq!(BenchPlan::truth().transparency, EnvTransparency::Layered);
     }
 
     #[test]

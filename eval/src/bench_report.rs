@@ -5,6 +5,7 @@ use crate::bench::{BenchReport, EnvLitResult};
 use crate::error_decomposition::{self as decomposition, DecompositionStep, ErrorDecomposition};
 use anyhow::bail;
 use std::fmt::Write;
+use strandlight_scene::look::EnvTransparency;
 use strandlight_scene::scene_tables::ScatteringMode;
 
 pub const BEGIN: &str = "<!-- strandlight bench: generated section, begin -->";
@@ -318,7 +319,7 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
     };
     let _ = writeln!(
         out,
-        "{BEGIN}\n## Speed against error (`strandlight bench{heading_args}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and the opaque view; errors are over the reference's hair pixels (compact sources exact, the rest one light per cube texel; the reference climbs N = 96, 384, … until N and 4N lights agree within 1% relative RMSE, {budget}: each map below says whether it converged); ms are frame times on this machine's adapter, {} (lavapipe: ratios only).\n",
+        "{BEGIN}\n## Speed against error (`strandlight bench{heading_args}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and {}; errors are over the reference's hair pixels (compact sources exact, the rest one light per cube texel; the reference climbs N = 96, 384, … until N and 4N lights agree within 1% relative RMSE, {budget}: each map below says whether it converged); ms are frame times on this machine's adapter, {} (lavapipe: ratios only).\n",
         report.date,
         report.git_revision,
         report.machine,
@@ -326,6 +327,7 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
         report.seconds,
         plan.size.0,
         plan.size.1,
+        view_phrase(plan.transparency),
         match plan.timing_runs {
             1 => "one run each".to_string(),
             n => format!("the median of {n} runs each (the reference one run)"),
@@ -439,6 +441,21 @@ fn splice_between(
 /// The ground-truth plan's section: per map and mode the SRBF default, the DOM reference and
 /// the median-cut front, each against the path-traced ground truth, with the equal-error
 /// speed-ups measured against it and the path tracer's time beside the frame's.
+/// The view a plan's frames use, as the page says it.
+fn view_phrase(transparency: EnvTransparency) -> &'static str {
+    match transparency {
+        EnvTransparency::Opaque => {
+            "the opaque view (each pixel's nearest fiber, weighted by the coverage of all)"
+        }
+        EnvTransparency::Occupancy => {
+            "the occupancy view (every fiber weighted by its visibility through the occupancy map, shaded one by one)"
+        }
+        EnvTransparency::Layered => {
+            "the layered view (every fiber weighted by its visibility through the occupancy map, gathered into 4 layers per pixel, each shaded once)"
+        }
+    }
+}
+
 pub fn truth_section(report: &BenchReport, plot_dir: &str) -> String {
     let mut out = String::new();
     let plan = &report.plan;
@@ -455,7 +472,7 @@ pub fn truth_section(report: &BenchReport, plot_dir: &str) -> String {
     };
     let _ = writeln!(
         out,
-        "{TRUTH_BEGIN}\n## Against the path-traced ground truth (`strandlight bench --truth`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data` and Mitsuba 3: `pip install mitsuba`).\n\n**What is measured.** straight.hair under each shared map at {}×{} (default front camera), shaded with the `brown` Chiang fiber (Chiang et al. 2016: eumelanin 1.3, longitudinal and azimuthal roughness 0.3, IOR 1.55, scale tilt 2°). Fibers are opaque cylinders of the file's width in both renderers: straight.hair's transparency field (0.36) is ignored. **The ground truth** is Mitsuba 3's path tracer with its own `hair` BSDF (the same model, written by others), `bsplinecurve` fibers through the strands' points and the map as its `envmap`, hidden from the camera: single scattering at `max_depth` 2, full scattering at the first depth D where 2D moves the image by < 1%. Its samples climb ×4 from 1024 per pixel until N and 4N agree within 1% or the budget ({} spp single, {} full) is reached; the kept image averages both, and its noise (relative RMSE, from the last N-vs-4N difference) is given. **Errors** are relative RMSE over the truth's hair pixels, raw and with the truth's noise removed in quadrature (\"n.c.\"), and HDR-FLIP. The **DOM reference** is the project's own reference (the map as directional lights, each shadowed by a deep opacity map, 1536 of them unless the light ladder converged sooner; each map's section says whether it converged): its error against the truth is what it shares with the method and so cannot show. **× median cut** is the SRBF default's speed-up over median cut at equal error, both measured against the truth (log-log interpolated along median cut's measured front). ms are frame times on this machine's adapter (lavapipe: ratios only); Mitsuba's seconds are its render time on the same 2 cores. Every strandlight frame uses the default opaque view (each pixel's nearest fiber, weighted by its coverage; \"What the ground truth shows\" below measures what that costs). Mitsuba has no Marschner BSDF: the Marschner figures (\"Speed against error\", at the end of this page) stay measured against the DOM reference.\n",
+        "{TRUTH_BEGIN}\n## Against the path-traced ground truth (`strandlight bench --truth`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data` and Mitsuba 3: `pip install mitsuba`).\n\n**What is measured.** straight.hair under each shared map at {}×{} (default front camera), shaded with the `brown` Chiang fiber (Chiang et al. 2016: eumelanin 1.3, longitudinal and azimuthal roughness 0.3, IOR 1.55, scale tilt 2°). Fibers are opaque cylinders of the file's width in both renderers: straight.hair's transparency field (0.36) is ignored. **The ground truth** is Mitsuba 3's path tracer with its own `hair` BSDF (the same model, written by others), `bsplinecurve` fibers through the strands' points and the map as its `envmap`, hidden from the camera: single scattering at `max_depth` 2, full scattering at the first depth D where 2D moves the image by < 1%. Its samples climb ×4 from 1024 per pixel until N and 4N agree within 1% or the budget ({} spp single, {} full) is reached; the kept image averages both, and its noise (relative RMSE, from the last N-vs-4N difference) is given. **Errors** are relative RMSE over the truth's hair pixels, raw and with the truth's noise removed in quadrature (\"n.c.\"), and HDR-FLIP. The **DOM reference** is the project's own reference (the map as directional lights, each shadowed by a deep opacity map, 1536 of them unless the light ladder converged sooner; each map's section says whether it converged): its error against the truth is what it shares with the method and so cannot show. **× median cut** is the SRBF default's speed-up over median cut at equal error, both measured against the truth (log-log interpolated along median cut's measured front). ms are frame times on this machine's adapter (lavapipe: ratios only); Mitsuba's seconds are its render time on the same 2 cores. Every strandlight frame uses {}. Mitsuba has no Marschner BSDF: the Marschner figures (\"Speed against error\", at the end of this page) stay measured against the DOM reference.\n",
         report.date,
         report.git_revision,
         report.machine,
@@ -465,6 +482,7 @@ pub fn truth_section(report: &BenchReport, plot_dir: &str) -> String {
         plan.size.1,
         plan.truth_max_spp[0],
         plan.truth_max_spp[1],
+        view_phrase(plan.transparency),
     );
     out.push_str("| map | mode | SRBF ms | SRBF vs truth: rel. RMSE (n.c.) / HDR-FLIP | DOM reference vs truth | × median cut at equal rel. RMSE | at equal HDR-FLIP | truth: spp, depth, noise | Mitsuba s |\n|---|---|---:|---|---|---:|---:|---|---:|\n");
     for r in &report.env_lit {
@@ -685,6 +703,11 @@ mod tests {
         );
         assert!(section.contains("bench --truth"), "{section}");
         assert!(section.contains("no Marschner BSDF"), "{section}");
+        // The page names the view its frames were measured in: the plan's.
+        assert!(section.contains("uses the layered view"), "{section}");
+        report.plan.transparency = EnvTransparency::Opaque;
+        let opaque = truth_section(&report, "bench-truth");
+        assert!(opaque.contains("uses the opaque view"), "{opaque}");
         let page = "# Benchmarks\n\nIntro paragraph.\n\n## Older\n\ntext\n";
         let first = splice_truth(page, &section).unwrap();
         assert!(
