@@ -111,13 +111,6 @@ struct LookFlags {
     /// into the light maps (default 0.1; 1 = all). The reference and the baseline draw all.
     #[arg(long)]
     kappa: Option<f32>,
-    /// Adaptive κ, with `--lobe-visibility light-maps`: the most powerful SRBF lobes holding
-    /// this share of the lobes' power draw every strand into their light maps, the rest κ (0,
-    /// the default: κ for every lobe, as the paper). On the front of venice only: 0.5 takes
-    /// single scattering from 0.378 to 0.369 against the truth for 3.8× the frame
-    /// (docs/BENCHMARKS.md, "Options judged against the truth").
-    #[arg(long)]
-    every_strand_share: Option<f32>,
     /// Side of every light map of all three renders, the reference's included, texels
     /// (default 512; docs/BENCHMARKS.md, "Light-map size").
     #[arg(long)]
@@ -187,7 +180,6 @@ impl CompareArgs {
         set(&mut s.cache, measure.cache);
         s.json |= measure.json;
         set(&mut s.kappa, look.kappa);
-        set(&mut s.every_strand_share, look.every_strand_share);
         set(&mut s.light_map_size, look.light_map_size);
         set(&mut s.look.transparency, look.transparency);
         set(&mut s.look.view.lobe_visibility, look.lobe_visibility);

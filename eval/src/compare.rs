@@ -23,7 +23,7 @@ use strandlight_precompute::env_lights::{
 };
 use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::EnvRenderOptions;
-use strandlight_runtime::env_light::{EnvLight, mark_every_strand, shadow_groups};
+use strandlight_runtime::env_light::{EnvLight, shadow_groups};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::passes::convolution_depth::{DodmSettings, MAX_DODM_RESOLUTION};
 use strandlight_scene::camera_choice::front_camera;
@@ -112,12 +112,6 @@ pub struct CompareSettings {
     /// Stochastic simplification of the SRBF light pass (Ren §7): the fraction of strands drawn
     /// into the light maps (1 = all). The reference and the baseline always draw all.
     pub kappa: f32,
-    /// Adaptive κ, with `--lobe-visibility light-maps`: the most powerful SRBF lobes holding
-    /// this share of the lobes' power draw every strand into their light maps, the rest κ (0:
-    /// κ for every lobe, as the paper). On the front of venice only: 0.5 takes single
-    /// scattering from 0.378 to 0.369 against the truth for 3.8× the frame (docs/BENCHMARKS.md,
-    /// "Options judged against the truth").
-    pub every_strand_share: f32,
     /// Renders per timing (the median is reported).
     pub timing_runs: usize,
     /// Also search the fewest median-cut lights whose error is at most the SRBF frame's
@@ -183,7 +177,6 @@ impl Default for CompareSettings {
             table_resolution: None,
             modes: vec![ScatteringMode::Single, ScatteringMode::Full],
             kappa: 0.1,
-            every_strand_share: 0.0,
             timing_runs: 3,
             equal_error: false,
             baseline: Baseline::MedianCut,
@@ -288,12 +281,6 @@ fn validate(args: &CompareSettings) -> anyhow::Result<ReferenceChoice> {
         bail!(
             "reference_tolerance {}: must be in (0, 1)",
             args.reference_tolerance
-        );
-    }
-    if !(0.0..=1.0).contains(&args.every_strand_share) {
-        bail!(
-            "--every-strand-share {}: a share of the lobes' power, in [0, 1]",
-            args.every_strand_share
         );
     }
     crate::ground_truth::validate(&truth_settings(args))
@@ -473,15 +460,7 @@ pub fn prepare_with_hair(
     )?;
     let (up, camera) = front_camera(&hair, (width, height));
     let fit_lights = srbf_set_lights(&set);
-    let mut srbf = to_env_lights(&fit_lights, up);
-    let marked = mark_every_strand(&mut srbf, args.every_strand_share);
-    if marked > 0 {
-        steps.say(format!(
-            "adaptive κ: the {marked} strongest lobes (≥ {:.0}% of the lobes' power) draw every strand, the rest κ {}",
-            100.0 * args.every_strand_share,
-            args.kappa
-        ));
-    }
+    let srbf = to_env_lights(&fit_lights, up);
     let fit_relative_l2_error = fit.set.relative_l2_error;
     let head = load_head(&args.head, &hair, default_skin_albedo())?;
     Ok(CompareScene {
@@ -1169,7 +1148,7 @@ pub fn execute(
         "scene".into(),
         json!({
             "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
-            "preset": args.preset, "baseline": args.baseline, "lambda_max": args.lambda_max, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "kappa": args.kappa, "every_strand_share": args.every_strand_share, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
+            "preset": args.preset, "baseline": args.baseline, "lambda_max": args.lambda_max, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "kappa": args.kappa, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
             "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "lobe_visibility": args.look.view.lobe_visibility, "forward_scattering": args.look.view.forward_scattering,
             "fit_relative_l2_error": scene.fit_relative_l2_error,
             "compact_sources": scene.compact_sources,
@@ -1309,16 +1288,6 @@ mod tests {
                 "--truth-max-spp 3",
                 "at least 4",
                 Box::new(|s| s.truth_max_spp = 3),
-            ),
-            (
-                "--every-strand-share 1.5",
-                "[0, 1]",
-                Box::new(|s| s.every_strand_share = 1.5),
-            ),
-            (
-                "--every-strand-share NaN",
-                "[0, 1]",
-                Box::new(|s| s.every_strand_share = f32::NAN),
             ),
             ("max_lobes 0", "at least one", Box::new(|s| s.max_lobes = 0)),
             (

@@ -22,9 +22,9 @@ pub struct EnvLight {
     /// visibility is the texel's (`precompute/src/env_lights.rs`).
     pub shadowed_from: Option<Vec3>,
     /// Draw every strand into this light's map whatever the frame's κ. SRBFs default to κ's
-    /// thinning (Ren §7): its noise costs most on the few powerful lobes, and
-    /// [`mark_every_strand`] picks them (adaptive κ). Directional lights (the reference's, the
-    /// baseline's, a sun's) draw every strand.
+    /// thinning (Ren §7); directional lights (the reference's, the baseline's, a sun's) draw
+    /// every strand. (Marking the most powerful lobes so, adaptive κ, lost its one point on the
+    /// front to the layered view: docs/BENCHMARKS.md, "The view: layers".)
     pub every_strand: bool,
     /// Directional lights only: per-axis variance (rad²) of the directions the light stands
     /// for (an extended compact source: a softbox, a sun's disc). Its visibility is averaged
@@ -108,33 +108,6 @@ impl EnvLight {
     }
 }
 
-/// Marks the most powerful SRBF lights holding at least `share` of the SRBF lights' luminous
-/// power as [`EnvLight::every_strand`] (and clears the mark on the rest): adaptive κ, the
-/// simplification kept for the many weak lobes where its noise costs little. `share` ≤ 0 marks
-/// none, ≥ 1 all. Returns how many were marked.
-pub fn mark_every_strand(lights: &mut [EnvLight], share: f32) -> usize {
-    let mut order: Vec<usize> = (0..lights.len())
-        .filter(|&i| lights[i].lambda.is_some())
-        .collect();
-    order.sort_by(|&a, &b| {
-        lights[b]
-            .luminous_power()
-            .total_cmp(&lights[a].luminous_power())
-    });
-    let total: f32 = order.iter().map(|&i| lights[i].luminous_power()).sum();
-    let mut held = 0.0;
-    let mut marked = 0;
-    for i in order {
-        let mark = share > 0.0 && (held < share * total || share >= 1.0);
-        lights[i].every_strand = mark;
-        if mark {
-            held += lights[i].luminous_power();
-            marked += 1;
-        }
-    }
-    marked
-}
-
 /// Consecutive lights that share one shadow map (one DODM slot, one light pass, one
 /// forward-scattering grid block): a run of directional lights with the same
 /// [`EnvLight::shadowed_from`], or any other light alone.
@@ -170,33 +143,4 @@ pub fn shadow_groups(lights: &[EnvLight]) -> Vec<ShadowGroup<'_>> {
             lights: run,
         })
         .collect()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn lobe(amplitude: f32) -> EnvLight {
-        EnvLight::srbf(Vec3::Z, 10.0, [amplitude; 3])
-    }
-
-    #[test]
-    fn every_strand_goes_to_the_strongest_lobes_until_the_share_is_held() {
-        // Powers 4 : 3 : 2 : 1 (same λ); the sun is directional: every strand, left alone.
-        let sun = EnvLight::directional(Vec3::X, [100.0; 3]);
-        let mut lights = vec![lobe(2.0), sun, lobe(4.0), lobe(1.0), lobe(3.0)];
-        let marked =
-            |lights: &[EnvLight]| -> Vec<bool> { lights.iter().map(|l| l.every_strand).collect() };
-        // 40% of 10: the strongest (4) alone holds it.
-        assert_eq!(mark_every_strand(&mut lights, 0.4), 1);
-        assert_eq!(marked(&lights), [false, true, true, false, false]);
-        // 50%: 4 holds 40%, so 3 joins (70%).
-        assert_eq!(mark_every_strand(&mut lights, 0.5), 2);
-        assert_eq!(marked(&lights), [false, true, true, false, true]);
-        assert_eq!(mark_every_strand(&mut lights, 1.0), 4);
-        assert_eq!(marked(&lights), [true; 5]);
-        // 0 clears every earlier mark.
-        assert_eq!(mark_every_strand(&mut lights, 0.0), 0);
-        assert_eq!(marked(&lights), [false, true, false, false, false]);
-    }
 }
