@@ -1,8 +1,12 @@
-//! A study, not a product path: one scene prepared as `compare` prepares it, the SRBF frame (or
-//! the DOM reference's lights) rendered under several looks, each measured against the cached
-//! ground truth. `cargo run --release -p strandlight-eval --example view_study -- MAP MODE
-//! [reference] LOOK...` with LOOK = TRANSPARENCY/VISIBILITY (opaque|occupancy / light-maps|volume);
-//! EXRs go to out/view-study/.
+//! A study, not a product path: one scene prepared as `compare` prepares it (straight.hair,
+//! Chiang `brown`), the SRBF frame rendered under several looks, each timed and measured against
+//! the cached ground truth (`strandlight truth`, or an earlier `compare`/`bench --truth`):
+//! `cargo run --release -p strandlight-eval --example view_study -- MAP MODE LOOK...` with MODE
+//! single|full and LOOK = TRANSPARENCY/VISIBILITY (opaque|layered|occupancy / volume|light-maps).
+//! Prints a line and a JSON object per look (scripts/view-error.sh collects them); EXRs of the
+//! frames and of the truth go to out/view-study/. Environment: SIZE (160x120), RUNS (3 timed
+//! renders, the median kept), LIGHT_MAP_SIZE, KAPPA, TRUTH_MAX_SPP (4096; 256 at 640x480),
+//! REFERENCE=n (the DOM reference's 6n² lights instead of the SRBF frame).
 use anyhow::Context;
 use strandlight_eval::compare::{
     CompareSettings, ReferenceLighting, frame, prepare, timed_render, truth_of,
@@ -35,6 +39,9 @@ fn main() -> anyhow::Result<()> {
     };
     if let Ok(n) = std::env::var("LIGHT_MAP_SIZE") {
         settings.light_map_size = n.parse()?;
+    }
+    if let Ok(spp) = std::env::var("TRUTH_MAX_SPP") {
+        settings.truth_max_spp = spp.parse()?;
     }
     if let Ok(k) = std::env::var("KAPPA") {
         settings.kappa = k.parse()?;
@@ -93,12 +100,20 @@ fn main() -> anyhow::Result<()> {
             None => frame(&scene, &s, &scene.srbf, mode),
         };
         let _warm = render_lights(&f)?;
-        let r = render_lights(&f)?;
+        let r = timed_render(&render_lights, &f, runs)?;
         let e = relative_rmse(&r.image, &truth.image)?;
         let nc = (e * e - truth.noise * truth.noise).max(0.0).sqrt();
+        let flip = hdr_flip(&r.image, &truth.image)?.mean_over_hair;
         println!(
-            "{look}: {:.0} ms, vs truth {e:.4} (n.c. {nc:.4})",
+            "{look}: {:.0} ms, vs truth {e:.4} (n.c. {nc:.4}) HDR-FLIP {flip:.4}",
             r.milliseconds
+        );
+        println!(
+            "{}",
+            serde_json::json!({"map": map, "mode": mode.name(), "look": look, "ms": r.milliseconds,
+                "rel_rmse": e, "rel_rmse_nc": nc, "hdr_flip": flip, "truth_noise": truth.noise,
+                "truth_seconds": truth.seconds, "light_map_size": s.light_map_size,
+                "size": s.size, "reference_face": reference_face})
         );
         let stem = out.join(format!(
             "{}-{}-{t}-{v}",

@@ -1243,12 +1243,14 @@ impl EnvRenderer {
             let view = ViewBinding::new(gpu, &self.view.view_layout, grid.as_ref(), &visibility);
             usage.grid_bytes = usage.grid_bytes.max(view.bytes);
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            let directional = batch.first_light().is_some_and(|l| l.lambda.is_none());
+            let transparency = options.transparency.for_batch(directional);
             self.view.encode(
                 gpu,
                 &mut encoder,
                 &frame.geometry,
                 &frame.strands,
-                options.transparency,
+                transparency,
                 &lights,
                 batch.tables,
                 &view,

@@ -13,7 +13,9 @@ use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_tables::table::{Axis, Table};
-use strandlight_tables::table_axes::{AXIS_COS_DPHI, AXIS_U_DOT_WO, AXIS_U_DOT_XI};
+use strandlight_tables::table_axes::{
+    AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_U_DOT_WO, AXIS_U_DOT_XI,
+};
 
 /// The light: directional, toward +x (in the image plane), unit irradiance per channel.
 const LIGHT: Vec3 = Vec3::X;
@@ -25,11 +27,20 @@ const CENTRE: Vec3 = Vec3::new(1.0 / 64.0, 1.0 / 64.0, 0.0);
 /// A direct table (one-node fourth axis) that varies with u·ξ, so strands at different angles to
 /// the light have different colours and the compositing order shows.
 fn direct_table() -> Table {
+    table_with_fourth_axis("w")
+}
+
+/// [`direct_table`] as an SRBF table: the same colours on a one-node 1/λ axis.
+fn lobe_table() -> Table {
+    table_with_fourth_axis(AXIS_INV_LAMBDA)
+}
+
+fn table_with_fourth_axis(name: &str) -> Table {
     let axes = vec![
         Axis::uniform(AXIS_U_DOT_XI, -1.0, 1.0, 33),
         Axis::uniform(AXIS_U_DOT_WO, -1.0, 1.0, 3),
         Axis::uniform(AXIS_COS_DPHI, -1.0, 1.0, 3),
-        Axis::uniform("w", 0.0, 0.0, 1),
+        Axis::uniform(name, 0.0, 0.0, 1),
     ];
     Table::from_fn(axes, 3, |x, out| {
         out[0] = (1.0 + x[0]) as f32;
@@ -119,6 +130,35 @@ fn render_sized(
     width: u32,
     height: u32,
 ) -> Result<(Vec<[f32; 4]>, Option<FragmentCounts>), EnvRenderError> {
+    render_lit(model, table, transparency, Kind::Directional, width, height)
+}
+
+/// The light of a test frame: directional, or an SRBF lobe about the same direction (the
+/// table's one-node fourth axis reads the same colours for any λ).
+#[derive(Clone, Copy)]
+enum Kind {
+    Directional,
+    Srbf,
+}
+
+/// [`render`] under an SRBF lobe (`table`'s colours, [`lobe_table`]): what the layered view
+/// shades per layer.
+fn render_srbf(
+    model: &HairModel,
+    table: &Table,
+    transparency: ViewTransparency,
+) -> Result<(Vec<[f32; 4]>, Option<FragmentCounts>), EnvRenderError> {
+    render_lit(model, table, transparency, Kind::Srbf, RES, RES)
+}
+
+fn render_lit(
+    model: &HairModel,
+    table: &Table,
+    transparency: ViewTransparency,
+    kind: Kind,
+    width: u32,
+    height: u32,
+) -> Result<(Vec<[f32; 4]>, Option<FragmentCounts>), EnvRenderError> {
     let gpu = gpu();
     let options = EnvRenderOptions {
         dodm: DodmSettings {
@@ -132,11 +172,23 @@ fn render_sized(
         count_fragments: true,
         ..Default::default()
     };
-    let tables = EnvTables {
-        direct: Some(table.clone().into()),
-        ..Default::default()
+    let (tables, light) = match kind {
+        Kind::Directional => (
+            EnvTables {
+                direct: Some(table.clone().into()),
+                ..Default::default()
+            },
+            EnvLight::directional(LIGHT, [1.0; 3]),
+        ),
+        Kind::Srbf => (
+            EnvTables {
+                srbf: Some(lobe_table().into()),
+                ..Default::default()
+            },
+            EnvLight::srbf(LIGHT, 100.0, [1.0; 3]),
+        ),
     };
-    let lights = [EnvLight::directional(LIGHT, [1.0; 3])];
+    let lights = [light];
     let frame = render_env_frame(
         &gpu,
         model,
@@ -224,7 +276,7 @@ fn occupancy_view_weights_add_up_to_the_coverage_where_fibers_share_a_slice() {
     println!("occupancy view: got {got:?}, want {want:?}");
     assert_close(got, want, 2e-3, "occupancy view, one slice");
     // The layered view gathers those weights: its pixel holds the same coverage.
-    let (pixels, _) = render(&model, &table, ViewTransparency::layered()).unwrap();
+    let (pixels, _) = render_srbf(&model, &table, ViewTransparency::layered()).unwrap();
     let alpha = at_pixel(&pixels)[3];
     println!("layered view: alpha {alpha}, coverage {coverage}");
     assert!(
@@ -294,7 +346,7 @@ fn layered_view_with_one_fiber_a_layer_composites_front_to_back() {
     let (layers, opacity) = (4, 0.1);
     let (model, tangents) = stacked_strands(layers, opacity);
     let table = direct_table();
-    let (pixels, _) = render(&model, &table, ViewTransparency::layered()).unwrap();
+    let (pixels, _) = render_srbf(&model, &table, ViewTransparency::layered()).unwrap();
     let want = composite(&table, &tangents, opacity as f64, layers);
     let got = at_pixel(&pixels);
     println!("layered view: got {got:?}, front-to-back over {want:?}");
@@ -309,7 +361,7 @@ fn layered_view_shades_each_layer_at_its_fibers_mean_tangent() {
     let (layers, opacity) = (12, 0.3);
     let (model, tangents) = stacked_strands(layers, opacity);
     let table = direct_table();
-    let (pixels, counts) = render(&model, &table, ViewTransparency::layered()).unwrap();
+    let (pixels, counts) = render_srbf(&model, &table, ViewTransparency::layered()).unwrap();
     let want = layered(&table, &tangents, opacity as f64, 4);
     let over = composite(&table, &tangents, opacity as f64, layers);
     let got = at_pixel(&pixels);
@@ -325,6 +377,21 @@ fn layered_view_shades_each_layer_at_its_fibers_mean_tangent() {
         counts.shaded + 8 <= counts.rasterized,
         "a batch shades layers, not fragments: {counts:?}"
     );
+}
+
+#[test]
+fn layered_view_shades_a_directional_light_per_fragment() {
+    // The scene of the test above under a directional light: the layered view shades it
+    // fiber by fiber (its visibility is sharp at fiber scale), so the pixel is the over
+    // operator's, not the layers' (which differ by more than 2% there).
+    let (layers, opacity) = (12, 0.3);
+    let (model, tangents) = stacked_strands(layers, opacity);
+    let table = direct_table();
+    let (pixels, _) = render(&model, &table, ViewTransparency::layered()).unwrap();
+    let over = composite(&table, &tangents, opacity as f64, layers);
+    let got = at_pixel(&pixels);
+    println!("layered view, directional light: got {got:?}, over {over:?}");
+    assert_close(got, over, 1e-3, "layered view, directional light");
 }
 
 #[test]
