@@ -74,7 +74,7 @@ impl LobeVisibilityArg {
 }
 
 /// The renderer choices of the env-lit commands.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::Args))]
 pub struct LookArgs {
     /// Every fiber weighted by its visibility through an occupancy map (Ren §8), gathered into
@@ -138,15 +138,6 @@ impl Default for ViewArgs {
             visibility_cutoff: ViewTransparency::DEFAULT_CUTOFF,
             forward_scattering: ForwardDevice::Auto,
             simplification_seed: DEFAULT_SIMPLIFICATION_SEED,
-        }
-    }
-}
-
-impl Default for LookArgs {
-    fn default() -> Self {
-        Self {
-            transparency: EnvTransparency::default(),
-            view: ViewArgs::default(),
         }
     }
 }
