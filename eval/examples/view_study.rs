@@ -5,8 +5,9 @@
 //! single|full and LOOK = TRANSPARENCY/VISIBILITY (opaque|layered|occupancy / volume|light-maps).
 //! Prints a line and a JSON object per look (scripts/view-error.sh collects them); EXRs of the
 //! frames and of the truth go to out/view-study/. Environment: SIZE (160x120), RUNS (3 timed
-//! renders, the median kept), LIGHT_MAP_SIZE, KAPPA, TRUTH_MAX_SPP (4096; 256 at 640x480),
-//! REFERENCE=n (the DOM reference's 6n² lights instead of the SRBF frame).
+//! renders, the median kept), LIGHT_MAP_SIZE, KAPPA, TRUTH_MAX_SPP (the truth's ladder: by
+//! default `strandlight truth`'s, falling back to the cached pair of a smaller budget such as
+//! `--truth-max-spp 4096`), REFERENCE=n (the DOM reference's 6n² lights instead of the SRBF frame).
 use anyhow::Context;
 use strandlight_eval::compare::{
     CompareSettings, ReferenceLighting, frame, prepare, timed_render, truth_of,

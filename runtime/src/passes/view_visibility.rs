@@ -88,7 +88,7 @@ impl ViewTransparency {
     /// fiber would read the visibility of its mean position, not its fibers' mean visibility:
     /// the layered view shades directional batches per fragment, as the occupancy view does,
     /// and SRBF lobes, whose visibility is smooth over a layer, per layer (quarry at 160×120
-    /// against the truth: 0.338 with the sun per layer, 0.290 per fragment, for 2.8× the
+    /// against the truth: 0.338 with the sun per layer, 0.290 per fragment, for ~3× the
     /// frame; docs/BENCHMARKS.md, "The view: layers").
     pub fn for_batch(self, directional: bool) -> Self {
         match self {
