@@ -26,6 +26,7 @@ use strandlight_runtime::env::EnvRenderOptions;
 use strandlight_runtime::env_light::{EnvLight, shadow_groups};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::passes::convolution_depth::{DodmSettings, MAX_DODM_RESOLUTION};
+use strandlight_runtime::passes::view_visibility::ViewTransparency;
 use strandlight_scene::camera_choice::front_camera;
 use strandlight_scene::env_frame::{
     EnvFrame, FrameRole, RenderedEnv, fit_summary, forward_settings,
@@ -765,6 +766,11 @@ fn reference_inputs(
     // coverage are not this renderer's: the key tells them apart (opaque ones keep theirs).
     if look(args).transparency.uses_occupancy_map() {
         inputs["view_weights"] = json!("rescaled to each pixel's coverage");
+    }
+    // Layered references rendered before their texel lights were shaded per layer (as lights
+    // standing for regions, 2 Dec 2026) shaded them per fragment: not this renderer's.
+    if matches!(look(args).transparency, ViewTransparency::Layered { .. }) {
+        inputs["region_lights"] = json!("per layer; compact sources per fragment");
     }
     // Only the fit's lighting adds a key, so the map's references keep their cache entries.
     // Only with a head: the references rendered before it keep their keys.

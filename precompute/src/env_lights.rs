@@ -34,6 +34,11 @@ pub struct LightSpec {
     ///
     /// [`CompactSource::angular_variance`]: crate::compact_sources::CompactSource::angular_variance
     pub angular_variance: f64,
+    /// Directional lights only: the light stands for a region of the map (a reference's cube
+    /// texel, a median-cut region), not a compact source taken out whole (a sun, a lamp). The
+    /// region's own shadow is soft at fiber scale, so the layered view shades it per layer, as it
+    /// does SRBF lobes, and a compact source per fragment.
+    pub stands_for_region: bool,
 }
 
 impl LightSpec {
@@ -67,6 +72,7 @@ pub fn srbf_set_lights(set: &SrbfSet) -> Vec<LightSpec> {
             rgb: l.amplitude,
             shadowed_from: None,
             angular_variance: 0.0,
+            stands_for_region: false,
         },
         LightKind::Directional => LightSpec {
             direction: l.center().normalize(),
@@ -74,6 +80,7 @@ pub fn srbf_set_lights(set: &SrbfSet) -> Vec<LightSpec> {
             rgb: crate::srbf_set::power(l),
             shadowed_from: None,
             angular_variance: 0.0,
+            stands_for_region: true,
         },
     });
     let sources = set.sources.iter().map(|s| LightSpec {
@@ -82,11 +89,18 @@ pub fn srbf_set_lights(set: &SrbfSet) -> Vec<LightSpec> {
         rgb: s.power,
         shadowed_from: None,
         angular_variance: s.angular_variance,
+        stands_for_region: false,
     });
     lobes.chain(sources).collect()
 }
 
-fn directional(lights: Vec<DirectionalLight>, rotate_degrees: f64) -> Vec<LightSpec> {
+/// Point lights along `lights`' directions; `stands_for_region`: each stands for a region of
+/// the map ([`LightSpec::stands_for_region`]), not a compact source.
+fn directional(
+    lights: Vec<DirectionalLight>,
+    rotate_degrees: f64,
+    stands_for_region: bool,
+) -> Vec<LightSpec> {
     lights
         .into_iter()
         .map(|l| LightSpec {
@@ -95,6 +109,7 @@ fn directional(lights: Vec<DirectionalLight>, rotate_degrees: f64) -> Vec<LightS
             rgb: l.power,
             shadowed_from: None,
             angular_variance: 0.0,
+            stands_for_region,
         })
         .collect()
 }
@@ -158,10 +173,10 @@ pub fn reference_lights_shaded(
         direction: DVec3::from(s.direction),
         power: s.power,
     });
-    let mut lights = directional(source_lights.collect(), rotate_degrees);
+    let mut lights = directional(source_lights.collect(), rotate_degrees, false);
     let texel_lights = cube_face_lights(&residual, fine)?;
     if fine == n {
-        lights.extend(directional(texel_lights, rotate_degrees));
+        lights.extend(directional(texel_lights, rotate_degrees, true));
         return Ok(lights);
     }
     let m = fine / n;
@@ -178,6 +193,7 @@ pub fn reference_lights_shaded(
                     rgb: l.power.map(|p| p * w),
                     shadowed_from,
                     angular_variance: 0.0,
+                    stands_for_region: true,
                 })
             });
             lights.extend(samples);
@@ -254,19 +270,21 @@ pub fn fitted_reference_lights(
         .map(|l| LightSpec {
             shadowed_from: None,
             angular_variance: 0.0,
+            stands_for_region: false,
             ..*l
         });
     let mut lights: Vec<LightSpec> = sources.collect();
     lights.extend(directional(
         cube_face_lights(&radiance, face_resolution)?,
         0.0,
+        true,
     ));
     Ok(lights)
 }
 
 /// The equal-cost baseline: `count` median-cut directional lights (Debevec 2005).
 pub fn median_cut_lights(map: &EnvMap, count: usize, rotate_degrees: f64) -> Vec<LightSpec> {
-    directional(median_cut(map, count.max(1)), rotate_degrees)
+    directional(median_cut(map, count.max(1)), rotate_degrees, true)
 }
 
 /// The median-cut baseline given the same exact compact sources as the reference and the SRBF
@@ -289,7 +307,9 @@ pub fn median_cut_lights_with_sources(
         power: s.power,
     });
     let rest = median_cut(&residual, count.saturating_sub(found.len()).max(1));
-    directional(exact.chain(rest).collect(), rotate_degrees)
+    let mut lights = directional(exact.collect(), rotate_degrees, false);
+    lights.extend(directional(rest, rotate_degrees, true));
+    lights
 }
 
 /// Face resolution n of a reference with `count` = 6n² lights, or None when `count` is not of
@@ -340,6 +360,7 @@ mod tests {
             rgb,
             shadowed_from: None,
             angular_variance: 0.0,
+            stands_for_region: false,
         };
         let sun = LightSpec {
             direction: DVec3::new(0.3, 0.8, -0.2).normalize(),
@@ -347,6 +368,7 @@ mod tests {
             rgb: [5.0, 4.0, 3.0],
             shadowed_from: None,
             angular_variance: 1e-3,
+            stands_for_region: false,
         };
         let fit = [
             lobe(DVec3::new(0.0, 1.0, 0.0), 3.0, [1.0, 1.5, 2.0]),
@@ -360,6 +382,11 @@ mod tests {
         assert_eq!(
             lights[0].angular_variance, 0.0,
             "the reference's sources are points"
+        );
+        assert!(!lights[0].stands_for_region, "the sun is a compact source");
+        assert!(
+            lights[1..].iter().all(|l| l.stands_for_region),
+            "every cube texel's light stands for its texel"
         );
         let want: [f64; 3] = std::array::from_fn(|c| {
             sun.rgb[c]

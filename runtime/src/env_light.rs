@@ -31,6 +31,13 @@ pub struct EnvLight {
     /// over a box matched to it, as an SRBF's is over its lobe
     /// ([`TransmittanceFilter`](crate::env::render::TransmittanceFilter)); 0 reads one texel.
     pub angular_variance: f32,
+    /// Directional lights only: it stands for a region of the map (a reference's cube texel, a
+    /// median-cut region), not a compact source (a sun, a lamp). A region's own shadow is soft at
+    /// fiber scale, so the layered view shades it per layer, as it does SRBF lobes; a compact
+    /// source's is sharp, so per fragment ([`ViewTransparency::for_batch`]).
+    ///
+    /// [`ViewTransparency::for_batch`]: crate::passes::view_visibility::ViewTransparency::for_batch
+    pub stands_for_region: bool,
 }
 
 impl EnvLight {
@@ -42,6 +49,7 @@ impl EnvLight {
             shadowed_from: None,
             every_strand: false,
             angular_variance: 0.0,
+            stands_for_region: false,
         }
     }
 
@@ -53,6 +61,7 @@ impl EnvLight {
             shadowed_from: None,
             every_strand: true,
             angular_variance: 0.0,
+            stands_for_region: false,
         }
     }
 
@@ -81,6 +90,12 @@ impl EnvLight {
     /// of the strands): a light not marked [`EnvLight::every_strand`].
     pub fn is_simplified(&self) -> bool {
         !self.every_strand
+    }
+
+    /// A compact source: a directional light that does not stand for a region of the map
+    /// ([`EnvLight::stands_for_region`]), whose shadow is sharp at fiber scale.
+    pub fn has_sharp_shadow(&self) -> bool {
+        self.lambda.is_none() && !self.stands_for_region
     }
 
     /// The direction of the light pass whose map shadows this light.

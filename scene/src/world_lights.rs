@@ -37,7 +37,7 @@ pub fn to_env_lights(specs: &[LightSpec], up: UpAxis) -> Vec<EnvLight> {
         .map(|s| {
             let direction: Vec3 = env_to_world(s.direction, up).as_vec3();
             let rgb = s.rgb.map(|c| c as f32);
-            match (s.lambda, s.shadowed_from) {
+            let light = match (s.lambda, s.shadowed_from) {
                 (Some(lambda), _) => EnvLight::srbf(direction, lambda as f32, rgb),
                 (None, None) => EnvLight::extended(direction, rgb, s.angular_variance as f32),
                 (None, Some(from)) => EnvLight::directional_shadowed_from(
@@ -45,6 +45,10 @@ pub fn to_env_lights(specs: &[LightSpec], up: UpAxis) -> Vec<EnvLight> {
                     rgb,
                     env_to_world(from, up).as_vec3(),
                 ),
+            };
+            EnvLight {
+                stands_for_region: s.stands_for_region,
+                ..light
             }
         })
         .collect()
@@ -126,6 +130,7 @@ mod tests {
             rgb: [1.0, 2.0, 3.0],
             shadowed_from: None,
             angular_variance: 0.0,
+            stands_for_region: false,
         }];
         let l = to_env_lights(&srbf, UpAxis::Y)[0];
         assert_eq!(l.lambda, Some(32.0));

@@ -1011,12 +1011,16 @@ impl EnvRenderer {
         for (kind_lights, binding) in kind_tables {
             let Some(binding) = binding else { continue };
             let groups = shadow_groups(kind_lights);
-            for chunk in groups.chunks(options.dodm.batch_size as usize) {
-                let batch = LightBatch {
-                    groups: chunk,
-                    tables: binding,
-                };
-                self.render_batch(gpu, &mut frame, &batch, &request, &mut timings, &mut usage)?;
+            // A batch is shaded in one view: compact sources and region lights apart.
+            let sharp = |g: &ShadowGroup| g.lights[0].has_sharp_shadow();
+            for run in groups.chunk_by(|a, b| sharp(a) == sharp(b)) {
+                for chunk in run.chunks(options.dodm.batch_size as usize) {
+                    let batch = LightBatch {
+                        groups: chunk,
+                        tables: binding,
+                    };
+                    self.render_batch(gpu, &mut frame, &batch, &request, &mut timings, &mut usage)?;
+                }
             }
         }
         memory.push(("env tables".into(), usage.table_bytes));
@@ -1243,8 +1247,7 @@ impl EnvRenderer {
             let view = ViewBinding::new(gpu, &self.view.view_layout, grid.as_ref(), &visibility);
             usage.grid_bytes = usage.grid_bytes.max(view.bytes);
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            let directional = batch.first_light().is_some_and(|l| l.lambda.is_none());
-            let transparency = options.transparency.for_batch(directional);
+            let transparency = options.transparency.for_batch(batch.has_sharp_shadows());
             self.view.encode(
                 gpu,
                 &mut encoder,
@@ -1341,6 +1344,12 @@ impl LightBatch<'_> {
     /// A batch holds one kind of light: its first tells the kind.
     fn first_light(&self) -> Option<&EnvLight> {
         self.groups.first().map(|g| &g.lights[0])
+    }
+
+    /// Whether this batch's lights are compact sources, whose shadows are sharp at fiber scale
+    /// (a batch holds lights of one view: [`EnvLight::has_sharp_shadow`]).
+    fn has_sharp_shadows(&self) -> bool {
+        self.first_light().is_some_and(EnvLight::has_sharp_shadow)
     }
 
     /// Whether stochastic simplification thins this batch's maps.

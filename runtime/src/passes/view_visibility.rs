@@ -47,7 +47,7 @@ pub enum ViewTransparency {
     /// The occupancy view's weights gathered into [`VIEW_LAYERS`] layers of equal coverage per
     /// pixel, each shaded once at its fibers' weighted mean depth and tangent
     /// (`view_layers.wgsl`): the occupancy view's weighting at a few shading loops per pixel.
-    /// SRBF lobes only: directional lights are shaded per fragment ([`Self::for_batch`]).
+    /// Compact sources (suns, lamps) are shaded per fragment ([`Self::for_batch`]).
     Layered { visibility_cutoff: f32 },
 }
 
@@ -83,16 +83,18 @@ impl ViewTransparency {
         }
     }
 
-    /// The view a batch of lights is shaded in. A directional light's visibility is one deep
-    /// opacity texel per fiber (a sun's shadow is sharp at fiber scale), so a layer's mean
-    /// fiber would read the visibility of its mean position, not its fibers' mean visibility:
-    /// the layered view shades directional batches per fragment, as the occupancy view does,
-    /// and SRBF lobes, whose visibility is smooth over a layer, per layer (quarry at 160×120
-    /// against the truth: 0.338 with the sun per layer, 0.290 per fragment, for ~3× the
-    /// frame; docs/BENCHMARKS.md, "The view: layers").
-    pub fn for_batch(self, directional: bool) -> Self {
+    /// The view a batch of lights is shaded in. A compact source's visibility (a sun, a lamp:
+    /// a directional light not [standing for a region](crate::env_light::EnvLight::stands_for_region))
+    /// is one deep opacity texel per fiber, sharp at fiber scale, so a layer's mean fiber would
+    /// read the visibility of its mean position, not its fibers' mean visibility: the layered
+    /// view shades such batches per fragment, as the occupancy view does (quarry at 160×120
+    /// against the truth: 0.338 with the sun per layer, 0.290 per fragment, for ~3× the frame;
+    /// docs/BENCHMARKS.md, "The view: layers"). SRBF lobes and the lights that stand for a
+    /// region of the map (a reference's cube texel, a median-cut region), whose true shadows
+    /// are soft at fiber scale, are shaded per layer.
+    pub fn for_batch(self, sharp_shadow: bool) -> Self {
         match self {
-            Self::Layered { visibility_cutoff } if directional => {
+            Self::Layered { visibility_cutoff } if sharp_shadow => {
                 Self::Occupancy { visibility_cutoff }
             }
             view => view,

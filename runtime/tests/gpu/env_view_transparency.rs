@@ -130,14 +130,16 @@ fn render_sized(
     width: u32,
     height: u32,
 ) -> Result<(Vec<[f32; 4]>, Option<FragmentCounts>), EnvRenderError> {
-    render_lit(model, table, transparency, Kind::Directional, width, height)
+    render_lit(model, table, transparency, &[Kind::Directional], width, height)
 }
 
-/// The light of a test frame: directional, or an SRBF lobe about the same direction (the
-/// table's one-node fourth axis reads the same colours for any λ).
-#[derive(Clone, Copy)]
+/// The light of a test frame: directional (a compact source), directional standing for a region
+/// of the map, or an SRBF lobe about the same direction (the table's one-node fourth axis reads
+/// the same colours for any λ).
+#[derive(Clone, Copy, PartialEq)]
 enum Kind {
     Directional,
+    Region,
     Srbf,
 }
 
@@ -148,14 +150,14 @@ fn render_srbf(
     table: &Table,
     transparency: ViewTransparency,
 ) -> Result<(Vec<[f32; 4]>, Option<FragmentCounts>), EnvRenderError> {
-    render_lit(model, table, transparency, Kind::Srbf, RES, RES)
+    render_lit(model, table, transparency, &[Kind::Srbf], RES, RES)
 }
 
 fn render_lit(
     model: &HairModel,
     table: &Table,
     transparency: ViewTransparency,
-    kind: Kind,
+    kinds: &[Kind],
     width: u32,
     height: u32,
 ) -> Result<(Vec<[f32; 4]>, Option<FragmentCounts>), EnvRenderError> {
@@ -172,23 +174,27 @@ fn render_lit(
         count_fragments: true,
         ..Default::default()
     };
-    let (tables, light) = match kind {
-        Kind::Directional => (
-            EnvTables {
-                direct: Some(table.clone().into()),
-                ..Default::default()
-            },
-            EnvLight::directional(LIGHT, [1.0; 3]),
-        ),
-        Kind::Srbf => (
-            EnvTables {
-                srbf: Some(lobe_table().into()),
-                ..Default::default()
-            },
-            EnvLight::srbf(LIGHT, 100.0, [1.0; 3]),
-        ),
+    let tables = match kinds.contains(&Kind::Srbf) {
+        false => EnvTables {
+            direct: Some(table.clone().into()),
+            ..Default::default()
+        },
+        true => EnvTables {
+            srbf: Some(lobe_table().into()),
+            ..Default::default()
+        },
     };
-    let lights = [light];
+    let lights: Vec<EnvLight> = kinds
+        .iter()
+        .map(|kind| match kind {
+            Kind::Directional => EnvLight::directional(LIGHT, [1.0; 3]),
+            Kind::Region => EnvLight {
+                stands_for_region: true,
+                ..EnvLight::directional(LIGHT, [1.0; 3])
+            },
+            Kind::Srbf => EnvLight::srbf(LIGHT, 100.0, [1.0; 3]),
+        })
+        .collect();
     let frame = render_env_frame(
         &gpu,
         model,
@@ -392,6 +398,40 @@ fn layered_view_shades_a_directional_light_per_fragment() {
     let got = at_pixel(&pixels);
     println!("layered view, directional light: got {got:?}, over {over:?}");
     assert_close(got, over, 1e-3, "layered view, directional light");
+}
+
+#[test]
+fn layered_view_shades_lights_standing_for_regions_per_layer() {
+    // The same scene under a light standing for a region of the map (a reference texel, a
+    // median-cut region: its true shadow is soft at fiber scale) is shaded per layer, as an
+    // SRBF lobe is; between two of them, a compact source is still shaded per fragment, so
+    // the frame is two layered pixels and one over operator's (one batch of all three would
+    // shade them in one view).
+    let (layers, opacity) = (12, 0.3);
+    let (model, tangents) = stacked_strands(layers, opacity);
+    let table = direct_table();
+    let want = layered(&table, &tangents, opacity as f64, 4);
+    let over = composite(&table, &tangents, opacity as f64, layers);
+    let region = |kinds: &[Kind]| {
+        let (pixels, _) = render_lit(
+            &model,
+            &table,
+            ViewTransparency::layered(),
+            kinds,
+            RES,
+            RES,
+        )
+        .unwrap();
+        at_pixel(&pixels)
+    };
+    let got = region(&[Kind::Region]);
+    println!("layered view, region light: got {got:?}, layered {want:?}, over {over:?}");
+    assert_close(got, want, 1e-3, "layered view, region light");
+    let mixed = region(&[Kind::Region, Kind::Directional, Kind::Region]);
+    let mixed_want: [f64; 4] = std::array::from_fn(|c| 2.0 * want[c] + over[c]);
+    println!("layered view, region, sun, region: got {mixed:?}, want {mixed_want:?}");
+    let rgb = |p: [f64; 4]| [p[0], p[1], p[2], 0.0];
+    assert_close(rgb(mixed), rgb(mixed_want), 3e-3, "layered view, mixed lights");
 }
 
 #[test]
