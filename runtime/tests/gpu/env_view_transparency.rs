@@ -130,7 +130,14 @@ fn render_sized(
     width: u32,
     height: u32,
 ) -> Result<(Vec<[f32; 4]>, Option<FragmentCounts>), EnvRenderError> {
-    render_lit(model, table, transparency, &[Kind::Directional], width, height)
+    render_lit(
+        model,
+        table,
+        transparency,
+        &[Kind::Directional],
+        width,
+        height,
+    )
 }
 
 /// The light of a test frame: directional (a compact source), directional standing for a region
@@ -413,15 +420,8 @@ fn layered_view_shades_lights_standing_for_regions_per_layer() {
     let want = layered(&table, &tangents, opacity as f64, 4);
     let over = composite(&table, &tangents, opacity as f64, layers);
     let region = |kinds: &[Kind]| {
-        let (pixels, _) = render_lit(
-            &model,
-            &table,
-            ViewTransparency::layered(),
-            kinds,
-            RES,
-            RES,
-        )
-        .unwrap();
+        let (pixels, _) =
+            render_lit(&model, &table, ViewTransparency::layered(), kinds, RES, RES).unwrap();
         at_pixel(&pixels)
     };
     let got = region(&[Kind::Region]);
@@ -431,7 +431,12 @@ fn layered_view_shades_lights_standing_for_regions_per_layer() {
     let mixed_want: [f64; 4] = std::array::from_fn(|c| 2.0 * want[c] + over[c]);
     println!("layered view, region, sun, region: got {mixed:?}, want {mixed_want:?}");
     let rgb = |p: [f64; 4]| [p[0], p[1], p[2], 0.0];
-    assert_close(rgb(mixed), rgb(mixed_want), 3e-3, "layered view, mixed lights");
+    assert_close(
+        rgb(mixed),
+        rgb(mixed_want),
+        3e-3,
+        "layered view, mixed lights",
+    );
 }
 
 #[test]
