@@ -466,9 +466,55 @@ pub struct BenchReport {
     /// Maps the plan named that were not found, with why.
     pub skipped: Vec<String>,
     /// Where this report merges several runs ([`BenchReport::merged`]): each run's `bench`
-    /// arguments, to say how to measure it again. Empty for one run.
+    /// arguments, to say how to measure it again, and its machine. Empty for one run.
     #[serde(default)]
-    pub runs: Vec<String>,
+    pub runs: Vec<BenchRun>,
+}
+
+/// One run of a merged report. Its frames were timed against each other on one machine, so
+/// every speed-up a map's section gives is that run's; runs on different machines can share a
+/// page as long as each names its own.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(from = "RecordedRun")]
+pub struct BenchRun {
+    /// The `bench` arguments that measure it again.
+    pub args: String,
+    pub machine: String,
+    pub adapter: String,
+}
+
+/// A run as reports store it: reports merged before runs named their machine hold only the
+/// arguments (their runs all shared the report's machine, which merging then required).
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum RecordedRun {
+    Args(String),
+    Run {
+        args: String,
+        machine: String,
+        adapter: String,
+    },
+}
+
+impl From<RecordedRun> for BenchRun {
+    fn from(recorded: RecordedRun) -> Self {
+        match recorded {
+            RecordedRun::Args(args) => BenchRun {
+                args,
+                machine: String::new(),
+                adapter: String::new(),
+            },
+            RecordedRun::Run {
+                args,
+                machine,
+                adapter,
+            } => BenchRun {
+                args,
+                machine,
+                adapter,
+            },
+        }
+    }
 }
 
 impl BenchReport {
@@ -499,15 +545,6 @@ impl BenchReport {
                     "the reports measured different plans (apart from maps, modes and reference budget): {:?} and {:?}",
                     shared_part(&merged.plan),
                     shared_part(&report.plan)
-                );
-            }
-            if (&report.machine, &report.adapter) != (&merged.machine, &merged.adapter) {
-                anyhow::bail!(
-                    "the reports were measured on different machines: {} ({}) and {} ({})",
-                    merged.machine,
-                    merged.adapter,
-                    report.machine,
-                    report.adapter
                 );
             }
             let env_lit_key = |r: &EnvLitResult| (r.map.clone(), r.mode.clone());
@@ -564,6 +601,8 @@ impl BenchReport {
             first_date = first_date.min(report.date.clone());
             last_date = last_date.max(report.date);
         }
+        merged.machine = distinct_joined(merged.runs.iter().map(|r| &r.machine));
+        merged.adapter = distinct_joined(merged.runs.iter().map(|r| &r.adapter));
         if merged.runs.len() == 1 {
             merged.runs.clear();
         }
@@ -572,6 +611,13 @@ impl BenchReport {
         }
         merged.git_revision = revisions.join(", ");
         Ok(merged)
+    }
+
+    /// Whether its runs were measured on more than one machine or adapter.
+    pub fn spans_machines(&self) -> bool {
+        self.runs
+            .windows(2)
+            .any(|w| (&w[0].machine, &w[0].adapter) != (&w[1].machine, &w[1].adapter))
     }
 }
 
@@ -586,12 +632,43 @@ fn repeated_key<T>(
         .find(|k| merged.iter().any(|m| &key(m) == k))
 }
 
-/// The `bench` arguments of the runs `report` holds: its own, or those it was merged from.
-fn runs_of(report: &BenchReport) -> Vec<String> {
+/// The runs `report` holds: itself, or those it was merged from.
+fn runs_of(report: &BenchReport) -> Vec<BenchRun> {
+    let this_run = || BenchRun {
+        args: report.plan.regenerate_args(),
+        machine: report.machine.clone(),
+        adapter: report.adapter.clone(),
+    };
     match report.runs.is_empty() {
-        true => vec![report.plan.regenerate_args()],
-        false => report.runs.clone(),
+        true => vec![this_run()],
+        false => report
+            .runs
+            .iter()
+            .map(|run| BenchRun {
+                args: run.args.clone(),
+                machine: or_else(&run.machine, &report.machine),
+                adapter: or_else(&run.adapter, &report.adapter),
+            })
+            .collect(),
     }
+}
+
+fn or_else(recorded: &str, fallback: &str) -> String {
+    match recorded.is_empty() {
+        true => fallback.to_string(),
+        false => recorded.to_string(),
+    }
+}
+
+/// The runs' values, each once, in the runs' order: one machine, or "A and B".
+fn distinct_joined<'a>(values: impl Iterator<Item = &'a String>) -> String {
+    let mut distinct: Vec<&str> = Vec::new();
+    for value in values {
+        if !distinct.contains(&value.as_str()) {
+            distinct.push(value);
+        }
+    }
+    distinct.join(" and ")
 }
 
 /// The compare settings a bench scene of `map` is built with.
@@ -1263,7 +1340,7 @@ mod tests {
             merged
                 .runs
                 .iter()
-                .all(|r| r.starts_with(" --quick --maps "))
+                .all(|r| r.args.starts_with(" --quick --maps "))
         );
     }
 
@@ -1284,7 +1361,11 @@ mod tests {
         assert_eq!(modes, ["single", "full"]);
         // The map's fit sweep once, from its first run.
         assert_eq!(merged.fits.len(), 1);
-        assert!(merged.runs[1].contains("--modes full --reference-max-lights 6144"));
+        assert!(
+            merged.runs[1]
+                .args
+                .contains("--modes full --reference-max-lights 6144")
+        );
         // Merged again with a third run, the first two runs are still named.
         let again = BenchReport::merged(vec![merged, report("b.hdr", "d5", "r3")]).unwrap();
         assert_eq!(again.runs.len(), 3);
@@ -1303,7 +1384,7 @@ mod tests {
         assert_eq!(merged.decompositions.len(), 2);
         assert!(!merged.plan.decomposition_only, "the page holds sweeps");
         assert!(
-            merged.runs[2].ends_with("--decomposition-only"),
+            merged.runs[2].args.ends_with("--decomposition-only"),
             "{:?}",
             merged.runs
         );
@@ -1315,17 +1396,14 @@ mod tests {
     }
 
     #[test]
-    fn reports_of_different_plans_machines_or_the_same_map_and_mode_do_not_merge() {
+    fn reports_of_different_plans_or_the_same_map_and_mode_do_not_merge() {
         let mut other_plan = report("b.hdr", "d", "r");
         other_plan.plan.size = (320, 240);
-        let mut other_machine = report("b.hdr", "d", "r");
-        other_machine.adapter = "b".into();
         let mut other_view = report("b.hdr", "d", "r");
         other_view.plan.transparency = EnvTransparency::Occupancy;
         for (second, says) in [
             (other_plan, "different plans"),
             (other_view, "different plans"),
-            (other_machine, "different machines"),
             (report("a.hdr", "d", "r"), "more than one report"),
         ] {
             let error = BenchReport::merged(vec![report("a.hdr", "d", "r"), second]).unwrap_err();
@@ -1333,6 +1411,38 @@ mod tests {
         }
         let none = BenchReport::merged(Vec::new()).unwrap_err().to_string();
         assert!(none.contains("no report to merge"), "{none}");
+    }
+
+    #[test]
+    fn runs_on_different_machines_merge_and_each_names_its_own() {
+        let mut elsewhere = report("b.hdr", "d2", "r");
+        elsewhere.machine = "n".into();
+        let merged = BenchReport::merged(vec![report("a.hdr", "d1", "r"), elsewhere]).unwrap();
+        let machines: Vec<&str> = merged.runs.iter().map(|r| r.machine.as_str()).collect();
+        assert_eq!(machines, ["m", "n"]);
+        assert_eq!(merged.machine, "m and n");
+        assert_eq!(merged.adapter, "a");
+        assert!(merged.spans_machines());
+        let page = crate::bench_report::section(&merged, "bench");
+        assert!(page.contains("(on n; a)"), "{page}");
+        assert!(page.contains("each run's machine and adapter"), "{page}");
+    }
+
+    #[test]
+    fn a_merged_report_whose_runs_hold_only_arguments_reads_them_as_its_machines() {
+        let mut old = serde_json::to_value(report("a.hdr", "d", "r")).unwrap();
+        old["runs"] = serde_json::json!([" --maps a.hdr", " --maps b.hdr"]);
+        let old: BenchReport = serde_json::from_value(old).unwrap();
+        let again = BenchReport::merged(vec![old]).unwrap();
+        assert_eq!(again.runs.len(), 2);
+        assert!(
+            again
+                .runs
+                .iter()
+                .all(|r| (r.machine.as_str(), r.adapter.as_str()) == ("m", "a"))
+        );
+        assert_eq!(again.runs[1].args, " --maps b.hdr");
+        assert!(!again.spans_machines());
     }
 
     #[test]

@@ -282,19 +282,34 @@ fn env_lit_table(out: &mut String, r: &EnvLitResult, plots: &str, baseline: &str
     );
 }
 
-/// The commands of a merged report's runs, as the page names them.
+/// The commands of a merged report's runs, as the page names them, each with its machine
+/// where they differ.
 fn run_commands(report: &BenchReport) -> String {
+    let machines = report.spans_machines();
     report
         .runs
         .iter()
-        .map(|run| format!("`bench{run}`"))
+        .map(|run| match machines {
+            true => format!("`bench{}` (on {}; {})", run.args, run.machine, run.adapter),
+            false => format!("`bench{}`", run.args),
+        })
         .collect::<Vec<_>>()
         .join(", ")
+}
+
+/// Where the page's frames were timed: a merged page's runs may each have had their own machine;
+/// a speed-up compares frames of one run.
+fn timed_on(report: &BenchReport) -> &'static str {
+    match report.spans_machines() {
+        true => "each run's machine and adapter (a map's speed-ups compare frames of its own run)",
+        false => "this machine's adapter",
+    }
 }
 
 /// The generated section, `plot_dir` relative to the Markdown file (e.g. `bench`).
 pub fn section(report: &BenchReport, plot_dir: &str) -> String {
     let mut out = String::new();
+    let timed_on = timed_on(report);
     let plan = &report.plan;
     let args = report.plan.regenerate_args();
     // One run reruns with its own arguments; a merged page names each run instead.
@@ -319,7 +334,7 @@ pub fn section(report: &BenchReport, plot_dir: &str) -> String {
     };
     let _ = writeln!(
         out,
-        "{BEGIN}\n## Speed against error (`strandlight bench{heading_args}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and {}; errors are over the reference's hair pixels (compact sources exact, the rest one light per cube texel; the reference climbs N = 96, 384, … until N and 4N lights agree within 1% relative RMSE, {budget}: each map below says whether it converged); ms are frame times on this machine's adapter, {} (lavapipe: ratios only).\n",
+        "{BEGIN}\n## Speed against error (`strandlight bench{heading_args}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and {}; errors are over the reference's hair pixels (compact sources exact, the rest one light per cube texel; the reference climbs N = 96, 384, … until N and 4N lights agree within 1% relative RMSE, {budget}: each map below says whether it converged); ms are frame times on {timed_on}, {} (lavapipe: ratios only).\n",
         report.date,
         report.git_revision,
         report.machine,
@@ -458,6 +473,7 @@ fn view_phrase(transparency: EnvTransparency) -> &'static str {
 
 pub fn truth_section(report: &BenchReport, plot_dir: &str) -> String {
     let mut out = String::new();
+    let timed_on = timed_on(report);
     let plan = &report.plan;
     let regenerate = match report.runs.is_empty() {
         true => format!(
@@ -472,7 +488,7 @@ pub fn truth_section(report: &BenchReport, plot_dir: &str) -> String {
     };
     let _ = writeln!(
         out,
-        "{TRUTH_BEGIN}\n## Against the path-traced ground truth (`strandlight bench --truth`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data` and Mitsuba 3: `pip install mitsuba`).\n\n**What is measured.** straight.hair under each shared map at {}×{} (default front camera), shaded with the `brown` Chiang fiber (Chiang et al. 2016: eumelanin 1.3, longitudinal and azimuthal roughness 0.3, IOR 1.55, scale tilt 2°). Fibers are opaque cylinders of the file's width in both renderers: straight.hair's transparency field (0.36) is ignored. **The ground truth** is Mitsuba 3's path tracer with its own `hair` BSDF (the same model, written by others), `bsplinecurve` fibers through the strands' points and the map as its `envmap`, hidden from the camera: single scattering at `max_depth` 2, full scattering at the first depth D where 2D moves the image by < 1%. Its samples climb ×4 from 1024 per pixel until N and 4N agree within 1% or the budget ({} spp single, {} full) is reached; the kept image averages both, and its noise (relative RMSE, from the last N-vs-4N difference) is given. **Errors** are relative RMSE over the truth's hair pixels, raw and with the truth's noise removed in quadrature (\"n.c.\"), and HDR-FLIP. The **DOM reference** is the project's own reference (the map as directional lights, each shadowed by a deep opacity map, 1536 of them unless the light ladder converged sooner; each map's section says whether it converged): its error against the truth is what it shares with the method and so cannot show. **× median cut** is the SRBF default's speed-up over median cut at equal error, both measured against the truth (log-log interpolated along median cut's measured front). ms are frame times on this machine's adapter (lavapipe: ratios only); Mitsuba's seconds are its render time on the same 2 cores. Every strandlight frame uses {}. Mitsuba has no Marschner BSDF: the Marschner figures (\"Speed against error\", at the end of this page) stay measured against the DOM reference.\n",
+        "{TRUTH_BEGIN}\n## Against the path-traced ground truth (`strandlight bench --truth`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data` and Mitsuba 3: `pip install mitsuba`).\n\n**What is measured.** straight.hair under each shared map at {}×{} (default front camera), shaded with the `brown` Chiang fiber (Chiang et al. 2016: eumelanin 1.3, longitudinal and azimuthal roughness 0.3, IOR 1.55, scale tilt 2°). Fibers are opaque cylinders of the file's width in both renderers: straight.hair's transparency field (0.36) is ignored. **The ground truth** is Mitsuba 3's path tracer with its own `hair` BSDF (the same model, written by others), `bsplinecurve` fibers through the strands' points and the map as its `envmap`, hidden from the camera: single scattering at `max_depth` 2, full scattering at the first depth D where 2D moves the image by < 1%. Its samples climb ×4 from 1024 per pixel until N and 4N agree within 1% or the budget ({} spp single, {} full) is reached; the kept image averages both, and its noise (relative RMSE, from the last N-vs-4N difference) is given. **Errors** are relative RMSE over the truth's hair pixels, raw and with the truth's noise removed in quadrature (\"n.c.\"), and HDR-FLIP. The **DOM reference** is the project's own reference (the map as directional lights, each shadowed by a deep opacity map, 1536 of them unless the light ladder converged sooner; each map's section says whether it converged): its error against the truth is what it shares with the method and so cannot show. **× median cut** is the SRBF default's speed-up over median cut at equal error, both measured against the truth (log-log interpolated along median cut's measured front). ms are frame times on {timed_on} (lavapipe: ratios only); Mitsuba's seconds are its render time on the same 2 cores. Every strandlight frame uses {}. Mitsuba has no Marschner BSDF: the Marschner figures (\"Speed against error\", at the end of this page) stay measured against the DOM reference.\n",
         report.date,
         report.git_revision,
         report.machine,
@@ -819,9 +835,14 @@ mod tests {
     #[test]
     fn a_merged_page_names_every_run_instead_of_one_command() {
         let mut merged = report_of(BenchPlan::full());
+        let run = |args: &str| crate::bench::BenchRun {
+            args: args.into(),
+            machine: "m".into(),
+            adapter: "a".into(),
+        };
         merged.runs = vec![
-            " --modes single".into(),
-            " --maps quarry_01_1k.hdr --modes single --reference-max-lights 6144".into(),
+            run(" --modes single"),
+            run(" --maps quarry_01_1k.hdr --modes single --reference-max-lights 6144"),
         ];
         let page = section(&merged, "bench");
         assert!(page.contains("Measured in 2 runs, `bench --modes single`, `bench --maps quarry_01_1k.hdr --modes single --reference-max-lights 6144`"), "{page}");
