@@ -528,7 +528,7 @@ impl BenchReport {
         let mut reports = reports.into_iter();
         let mut merged = reports.next().context("no report to merge")?;
         // Dates are "YYYY-MM-DD HH:MM UTC": their order as text is their order in time.
-        let (mut first_date, mut last_date) = (merged.date.clone(), merged.date.clone());
+        let (mut first_date, mut last_date) = date_range(&merged.date);
         let mut revisions = vec![merged.git_revision.clone()];
         merged.runs = runs_of(&merged);
         // What a run may change of the plan it shares with the others.
@@ -598,8 +598,9 @@ impl BenchReport {
             if !revisions.contains(&report.git_revision) {
                 revisions.push(report.git_revision);
             }
-            first_date = first_date.min(report.date.clone());
-            last_date = last_date.max(report.date);
+            let (first, last) = date_range(&report.date);
+            first_date = first_date.min(first);
+            last_date = last_date.max(last);
         }
         merged.machine = distinct_joined(merged.runs.iter().map(|r| &r.machine));
         merged.adapter = distinct_joined(merged.runs.iter().map(|r| &r.adapter));
@@ -657,6 +658,14 @@ fn or_else(recorded: &str, fallback: &str) -> String {
     match recorded.is_empty() {
         true => fallback.to_string(),
         false => recorded.to_string(),
+    }
+}
+
+/// A report's first and last date: a merged report's are "FIRST to LAST".
+fn date_range(date: &str) -> (String, String) {
+    match date.split_once(" to ") {
+        Some((first, last)) => (first.to_string(), last.to_string()),
+        None => (date.to_string(), date.to_string()),
     }
 }
 
@@ -1369,6 +1378,7 @@ mod tests {
         // Merged again with a third run, the first two runs are still named.
         let again = BenchReport::merged(vec![merged, report("b.hdr", "d5", "r3")]).unwrap();
         assert_eq!(again.runs.len(), 3);
+        assert_eq!(again.date, "d1 to d5", "a merged report's range, widened");
     }
 
     #[test]
