@@ -72,7 +72,8 @@ pub struct BenchArgs {
     /// Measure nothing: write the plots and the page again from report JSONs earlier runs
     /// wrote (after a change to how they are drawn, without the hour of measuring). Several
     /// reports of the same plan on different maps or modes (a sweep run map by map, each with
-    /// the reference budget its map needs) make one page.
+    /// the reference budget its map needs) make one page; runs measured on different machines
+    /// may share it, each naming its own.
     #[arg(long, value_name = "REPORT_JSON", num_args = 1.., conflicts_with_all = ["quick", "truth", "maps", "data", "modes", "reference_max_lights", "baseline_lights", "baseline", "decomposition_only", "head"])]
     pub from_report: Vec<PathBuf>,
 }
