@@ -312,7 +312,10 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
         String::from_utf8_lossy(&out.stderr)
     );
     let report: serde_json::Value = serde_json::from_str(&report_text).unwrap();
-    eprintln!("page report: {}", report["timing"]);
+    eprintln!(
+        "page report: {}; harness phases (ms since launch): {}",
+        report["timing"], report["phasesMs"]
+    );
     assert!(report["title"].as_str().unwrap().ends_with("converged"));
 
     let browser = read_frame(&shots.join("frame.f32"), &native);

@@ -21,15 +21,19 @@ const browser = await chromium.launch({
     '--no-first-run', '--disable-sync', '--disable-quic', ...(process.env.CHROMIUM_LOG ? ['--enable-logging=stderr', '--v=0'] : []),
   ],
 });
-const report = { console: [] };
+const report = { console: [], phasesMs: {} };
+const t0 = Date.now();
+const phase = (name) => { report.phasesMs[name] = Date.now() - t0; };
 try {
   const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
   page.on('console', (m) => report.console.push(`${m.type()}: ${m.text()}`));
   page.on('pageerror', (e) => report.console.push(`pageerror: ${e.message}`));
+  phase('browser');
   await page.goto(url);
   const ending = (t) => t.endsWith('converged') || t.includes('error:');
   await page.waitForFunction(() => document.title.endsWith('converged') || document.title.includes('error:'),
     null, { timeout, polling: 250 });
+  phase('first converged');
   report.title = await page.title();
   if (!ending(report.title) || report.title.includes('error:')) throw new Error(report.title);
   report.timing = await page.evaluate(() => window.strandlight.report);
@@ -40,6 +44,7 @@ try {
   await page.locator('#view').screenshot({ path: join(out, 'page.png') });
   await page.screenshot({ path: join(out, 'whole-page.png') });
 
+  phase('first frame read, screenshots');
   // A bad file dropped on the picture: a message, and the last good scene.
   await page.evaluate(() => {
     const file = new File([new Uint8Array([1, 2, 3, 4, 5])], 'broken.hair');
@@ -54,6 +59,7 @@ try {
   const after = await page.evaluate(() => window.strandlight.frame());
   report.frameKeptAfterBadFile = after === frame;
 
+  phase('bad file');
   // Orbit (a drag across the picture) and zoom (two wheel steps), then converge again.
   const box = await page.locator('#view').boundingBox();
   const [cx, cy] = [box.x + box.width / 2, box.y + box.height / 2];
@@ -67,6 +73,7 @@ try {
     const now = window.strandlight.frame();
     return now !== null && now !== old && window.strandlight.status() === 'converged';
   }, frame, { timeout, polling: 250 });
+  phase('orbited converged');
   writeFileSync(join(out, 'orbited.f32'), Buffer.from(await page.evaluate(() => window.strandlight.frame()), 'base64'));
   writeFileSync(join(out, 'orbited.json'), await page.evaluate(() => window.strandlight.page.settings_json()));
 
@@ -77,6 +84,7 @@ try {
     const now = window.strandlight.frame();
     return now !== null && now !== old && window.strandlight.status() === 'converged';
   }, orbited, { timeout, polling: 250 });
+  phase('single converged');
   writeFileSync(join(out, 'single.f32'), Buffer.from(await page.evaluate(() => window.strandlight.frame()), 'base64'));
   writeFileSync(join(out, 'single.json'), await page.evaluate(() => window.strandlight.page.settings_json()));
 } finally {

@@ -1,13 +1,16 @@
 //! The browser side: a WebGPU device, the [`Session`] behind it, and the calls `index.html`
 //! makes. The page's script drives it: one [`Page::tick`] per animation frame encodes at most
 //! one step and collects the readbacks the browser has mapped — nothing here waits for the GPU,
-//! so the main thread never blocks. The picture reaches the canvas as 8-bit RGBA through a 2D
+//! so the main thread never blocks. A step is encoded only once the GPU has finished the one
+//! before: on a slow device (SwiftShader) ticks outpace the GPU, and a drag that restarts the
+//! frame at every mouse move would otherwise queue steps for cameras already left behind. The picture reaches the canvas as 8-bit RGBA through a 2D
 //! context: headless Chromium's SwiftShader loses its device presenting a WebGPU canvas, and
 //! the picture is read back anyway (exposure is metered on it).
 
 use crate::session::{BundleFiles, Readback, Session, Stage};
 use std::cell::RefCell;
 use std::rc::Rc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_scene::exposure::Exposure;
@@ -33,6 +36,9 @@ pub struct Page {
     session: Session,
     in_flight: Option<InFlight>,
     march_in_flight: Option<MarchInFlight>,
+    /// Whether the GPU is still running the last step encoded (cleared by wgpu's
+    /// submitted-work-done callback, which it asks to be `Send`).
+    step_running: Arc<AtomicBool>,
     /// A GPU validation error reported after the step that caused it.
     gpu_error: Rc<RefCell<Option<String>>>,
     /// The last problem (a bad file, an out-of-range value): shown, the scene kept.
@@ -87,6 +93,7 @@ impl Page {
             session,
             in_flight: None,
             march_in_flight: None,
+            step_running: Arc::new(AtomicBool::new(false)),
             gpu_error: Rc::new(RefCell::new(None)),
             message: None,
             failed: None,
@@ -103,13 +110,20 @@ impl Page {
         if let Some(error) = self.gpu_error.borrow_mut().take() {
             self.failed = Some(format!("the GPU reported an error: {error}"));
         }
-        if self.failed.is_none() && self.session.refining() {
+        let gpu_free = !self.step_running.load(Ordering::Acquire);
+        if self.failed.is_none() && self.session.refining() && gpu_free {
             let scope = self
                 .session
                 .gpu()
                 .device
                 .push_error_scope(wgpu::ErrorFilter::Validation);
             let stepped = self.session.step();
+            self.step_running.store(true, Ordering::Release);
+            let running = self.step_running.clone();
+            self.session
+                .gpu()
+                .queue
+                .on_submitted_work_done(move || running.store(false, Ordering::Release));
             let report = self.gpu_error.clone();
             wasm_bindgen_futures::spawn_local(async move {
                 if let Some(error) = scope.pop().await {
