@@ -86,6 +86,8 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
         missing_tool("xvfb-run", "apt-get install -y xvfb");
         return;
     };
+    let started = std::time::Instant::now();
+    let phase = |what: &str| eprintln!("[{:6.1} s] {what}", started.elapsed().as_secs_f64());
     let dir = std::env::temp_dir().join(format!("strandlight-view-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
@@ -147,6 +149,7 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
         .expect("xvfb-run runs");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "view failed:\n{stderr}");
+    phase("the scripted window exited");
     let report: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
     println!("{}", serde_json::to_string_pretty(&report).unwrap());
@@ -226,6 +229,7 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
     println!("screenshot against its replay: relative RMSE {error:.2e}");
     // The viewer sums its light batches on the CPU, `render` on the GPU: rounding only.
     assert!(error < 1e-4, "replay differs: relative RMSE {error}");
+    phase("the screenshot replayed");
 
     // Point lights: the sidecar holds them, the picture changed, and it replays.
     let sidecar: Value =
@@ -246,6 +250,7 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
         "the point lights did not change the picture: {change}"
     );
     let error = replay_error(&dir, "points");
+    phase("the point-lit screenshot replayed");
     println!("point-lit screenshot against its replay: relative RMSE {error:.2e}");
     // The same frame function on the same device, but sorted transparency bins its segments with
     // atomics and blends each bin in whatever order they give (sorted_blend.wgsl), so two runs of
