@@ -50,7 +50,7 @@ pub enum LobeVisibilityArg {
     /// The volume, or light maps in a frame with a head: the volume's voxels (about 2 units on
     /// straight.hair) cannot resolve the hair lying on the scalp, and the skin under it read
     /// far too bright (venice with the fitted ellipsoid: 0.76 against the truth, light maps
-    /// 0.17; docs/BENCHMARKS.md, "A head under the hair").
+    /// 0.17; docs/history/benchmarks-2026-11-28-to-12-01.md, "A head under the hair").
     #[default]
     Auto,
     /// Ren 2010: each lobe's own convolution optical depth map, read at its centre.
@@ -97,7 +97,8 @@ pub struct LookArgs {
 pub struct ViewArgs {
     /// Where SRBF lobes' visibility comes from: auto (the volume; light maps in a frame with a
     /// head), their light maps (Ren 2010) or the groom's visibility volume integrated over each
-    /// lobe (docs/BENCHMARKS.md, "Lobe visibility", "A head under the hair").
+    /// lobe (docs/BENCHMARKS.md, "Lobe visibility"; docs/history/benchmarks-2026-11-28-to-12-01.md,
+    /// "A head under the hair").
     #[cfg_attr(
         any(feature = "cli", test),
         arg(long, value_enum, default_value = "auto")
