@@ -41,8 +41,17 @@ pub struct LoadedHair {
     pub source: String,
 }
 
+/// The hair of `settings` as its fiber model renders it. Chiang fibers are the path tracer's
+/// opaque cylinders, so a file's transparency is dropped for them, as `compare` and `truth` drop
+/// it: `render` must reproduce the frames they measure.
 pub fn load_settings_hair(settings: &FrameSettings) -> anyhow::Result<LoadedHair> {
     let (model, source) = load_hair(settings.hair.as_deref())?;
+    if settings.shading().physical_fibers() && model.transparency().is_some() {
+        return Ok(LoadedHair {
+            model: model.without_transparency(),
+            source: format!("{source} (opaque fibers: its transparency is ignored by the Chiang model)"),
+        });
+    }
     Ok(LoadedHair { model, source })
 }
 
@@ -504,4 +513,50 @@ fn render_env_part(
             fragments: rendered.fragments,
         },
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::point_shading::Shading;
+    use strandlight_runtime::hair::{Attribute, HairWriteOptions, write_hair};
+
+    /// A `.hair` file of two half-transparent strands, under a fresh name in the temp folder.
+    fn half_transparent_hair() -> std::path::PathBuf {
+        let strand = |x: f32| [Vec3::new(x, 0.0, 0.0), Vec3::new(x, -1.0, 0.0)];
+        let model = HairModel::new(
+            [strand(0.0), strand(0.1)].concat(),
+            vec![0, 2, 4],
+            Some(Attribute::Uniform(0.01)),
+            Some(Attribute::Uniform(0.5)),
+            None,
+        )
+        .expect("a valid model");
+        let path = std::env::temp_dir().join(format!(
+            "strandlight-physical-fibers-{}.hair",
+            std::process::id()
+        ));
+        write_hair(&model, &path, &HairWriteOptions::default()).expect("written");
+        path
+    }
+
+    #[test]
+    fn chiang_fibers_are_opaque_and_the_others_keep_the_files_transparency() {
+        let path = half_transparent_hair();
+        let mut settings = FrameSettings::new(
+            Lighting::Environment(EnvLighting::new("procedural:studio")),
+            [8, 8],
+        );
+        settings.hair = Some(path.clone());
+        let transparency = |shading: Shading, settings: &mut FrameSettings| {
+            settings.shading = Some(shading);
+            let hair = load_settings_hair(settings).expect("loads");
+            hair.model.transparency().cloned()
+        };
+        let chiang = transparency(Shading::Chiang, &mut settings);
+        let marschner = transparency(Shading::Marschner, &mut settings);
+        std::fs::remove_file(&path).ok();
+        assert_eq!(chiang, None);
+        assert_eq!(marschner, Some(Attribute::Uniform(0.5)));
+    }
 }

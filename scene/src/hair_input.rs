@@ -1,7 +1,7 @@
 //! A scene's hair and image size as a user names them: a hair file (or the procedural groom when
 //! none is given) and `WxH`.
 
-use crate::scene_tables::EnvShading;
+use crate::point_shading::Shading;
 use anyhow::{Context, bail};
 use std::path::Path;
 use strandlight_runtime::hair::{self, GroomParams, HairModel};
@@ -53,9 +53,13 @@ pub fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
 /// The hair as `shading` renders it, and the hash that identifies it in the caches: the Chiang
 /// fiber is the path tracer's, whose fibers are opaque cylinders, so a file's transparency is
 /// dropped for it (and the hash says so).
-pub fn fibers_for(shading: EnvShading, hair: HairModel, sha256: String) -> (HairModel, String) {
+pub fn fibers_for(
+    shading: impl Into<Shading>,
+    hair: HairModel,
+    sha256: String,
+) -> (HairModel, String) {
     match hair.transparency() {
-        Some(_) if shading.physical_fibers() => (
+        Some(_) if shading.into().physical_fibers() => (
             hair.without_transparency(),
             format!("{sha256}+opaque fibers"),
         ),

@@ -24,6 +24,14 @@ pub enum Shading {
     Chiang,
 }
 
+impl Shading {
+    /// Whether fibers are physical, opaque cylinders (a file's transparency ignored), as the
+    /// path tracer renders them.
+    pub fn physical_fibers(self) -> bool {
+        self == Shading::Chiang
+    }
+}
+
 /// What a point-lit frame's fiber model is made from.
 pub struct PointShadingRequest<'a> {
     pub shading: Shading,

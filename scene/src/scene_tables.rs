@@ -1,6 +1,7 @@
 //! The tables a scene's frames read: which ones each fiber model and scattering mode needs, and
 //! their bake (cached by content) for the λ range a fit actually uses.
 
+use crate::point_shading::Shading;
 use anyhow::{Context, bail};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -42,6 +43,16 @@ impl ScatteringMode {
     }
 }
 
+impl From<EnvShading> for Shading {
+    fn from(shading: EnvShading) -> Self {
+        match shading {
+            EnvShading::Marschner => Shading::Marschner,
+            EnvShading::Artist => Shading::Artist,
+            EnvShading::Chiang => Shading::Chiang,
+        }
+    }
+}
+
 impl EnvShading {
     fn model(self) -> Model {
         match self {
@@ -51,10 +62,8 @@ impl EnvShading {
         }
     }
 
-    /// Whether fibers are physical, opaque cylinders (a file's transparency ignored), as the
-    /// path tracer renders them.
     pub fn physical_fibers(self) -> bool {
-        self == EnvShading::Chiang
+        Shading::from(self).physical_fibers()
     }
 
     /// The convolution table of SRBF lights in `mode` (the artist model has no d_b·S_back

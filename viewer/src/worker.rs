@@ -138,7 +138,7 @@ type BakeResult = Result<PreparedEnv, String>;
 struct WorkerState {
     cache_dir: PathBuf,
     shared: Arc<Shared>,
-    hair: Option<(Option<PathBuf>, Arc<LoadedHair>)>,
+    hair: Option<((Option<PathBuf>, bool), Arc<LoadedHair>)>,
     point: Option<(String, Arc<PreparedPoint>)>,
     env: Option<(TablesKey, Arc<PreparedEnv>)>,
     baking: Option<(TablesKey, Receiver<BakeResult>)>,
@@ -270,13 +270,15 @@ impl WorkerState {
     }
 
     fn hair(&mut self, settings: &FrameSettings) -> anyhow::Result<Arc<LoadedHair>> {
-        if let Some((path, hair)) = &self.hair
-            && *path == settings.hair
+        // Whether the fibers are physical decides whether the file's transparency is kept.
+        let key = (settings.hair.clone(), settings.shading().physical_fibers());
+        if let Some((k, hair)) = &self.hair
+            && *k == key
         {
             return Ok(hair.clone());
         }
         let hair = Arc::new(load_settings_hair(settings)?);
-        self.hair = Some((settings.hair.clone(), hair.clone()));
+        self.hair = Some((key, hair.clone()));
         Ok(hair)
     }
 
