@@ -33,7 +33,8 @@ pub struct TruthArgs {
     /// Scattering modes: single (direct light, max_depth 2) and full (path traced).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "single,full")]
     pub modes: Vec<ScatteringMode>,
-    /// Most samples per pixel of one image (the ladder climbs ×4 from 1024).
+    /// Most samples per pixel of one image (the ladder climbs ×4 from 1024, or from a quarter of
+    /// this when that is less).
     #[arg(long, default_value_t = TruthSettings::default().max_spp)]
     pub truth_max_spp: u32,
     /// N and 4N samples (and depths D and 2D) within this relative RMSE are converged.
@@ -67,11 +68,8 @@ pub fn run(args: TruthArgs) -> anyhow::Result<()> {
         rotate_degrees: args.rotate,
         preset: args.preset.clone(),
         modes: args.modes.clone(),
-        settings: TruthSettings {
-            max_spp: args.truth_max_spp,
-            tolerance: args.reference_tolerance,
-            ..TruthSettings::default()
-        },
+        // As `compare` and `bench` ask for it, so a budget under 4096 (640×480) is cached once.
+        settings: TruthSettings::with_budget(args.truth_max_spp, args.reference_tolerance),
         cache: args.cache.clone(),
     };
     let mut steps = Steps::new(false);

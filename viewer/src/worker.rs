@@ -135,10 +135,13 @@ struct Job {
 
 type BakeResult = Result<PreparedEnv, String>;
 
+/// What a loaded hair depends on: its file, and whether its fibers are physical (opaque).
+type HairKey = (Option<PathBuf>, bool);
+
 struct WorkerState {
     cache_dir: PathBuf,
     shared: Arc<Shared>,
-    hair: Option<((Option<PathBuf>, bool), Arc<LoadedHair>)>,
+    hair: Option<(HairKey, Arc<LoadedHair>)>,
     point: Option<(String, Arc<PreparedPoint>)>,
     env: Option<(TablesKey, Arc<PreparedEnv>)>,
     baking: Option<(TablesKey, Receiver<BakeResult>)>,
