@@ -49,7 +49,9 @@ pub fn load_settings_hair(settings: &FrameSettings) -> anyhow::Result<LoadedHair
     if settings.shading().physical_fibers() && model.transparency().is_some() {
         return Ok(LoadedHair {
             model: model.without_transparency(),
-            source: format!("{source} (opaque fibers: its transparency is ignored by the Chiang model)"),
+            source: format!(
+                "{source} (opaque fibers: its transparency is ignored by the Chiang model)"
+            ),
         });
     }
     Ok(LoadedHair { model, source })
