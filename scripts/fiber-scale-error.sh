@@ -5,7 +5,7 @@
 #     view's coverage and the shading are measured with little self-shadowing or overlap.
 #  2. straight.hair rendered at 160x120, 320x240 and 640x480, each box-filtered to 160x120
 #     (supersampled), against the 640x480 truth box-filtered to 160x120 (5120 spp a pixel).
-# Then each frame's error per pixel and over blocks (scripts/fiber_scale_error.py). About 8 min
+# Then each frame's error per pixel and over blocks (scripts/fiber_scale_error.py). About 4 min
 # on 2 cores with the truths cached (first run: + ~3 min for Mitsuba).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -20,7 +20,9 @@ SCENE=(--shading chiang --env "$ENV")
 
 "$PY" scripts/fiber_scale_error.py thin "$DATA/hair/straight.hair" "$OUT/thin20.hair" 20
 "$BIN" compare "${SCENE[@]}" --hair "$OUT/thin20.hair" --size 160x120 --modes single \
-  --reference-lights 96 --ground-truth render --truth-max-spp 4096 --out "$OUT/thin" >/dev/null
+  --reference-lights 1536 --ground-truth render --truth-max-spp 4096 --out "$OUT/thin" >/dev/null
+"$BIN" render env "${SCENE[@]}" --hair "$OUT/thin20.hair" --size 160x120 --scattering single \
+  --lobe-visibility light-maps --kappa 1 --out "$OUT/thin/light-maps-kappa-1" >/dev/null 2>&1
 
 "$BIN" truth --env "$ENV" --hair "$DATA/hair/straight.hair" --size 640x480 --modes single \
   --truth-max-spp 256 --out "$OUT/dense" >/dev/null
@@ -37,6 +39,6 @@ done
 
 echo "sparse groom, 160x120:"
 "$PY" scripts/fiber_scale_error.py blocks "$OUT/thin/single-truth.exr" 160 \
-  "$OUT/thin/single-srbf.exr" "$OUT/thin/single-reference.exr" "$OUT/thin/single-baseline.exr"
+  "$OUT/thin/single-srbf.exr" "$OUT/thin/light-maps-kappa-1.exr" "$OUT/thin/single-reference.exr"
 echo "straight.hair, box-filtered to 160x120:"
 "$PY" scripts/fiber_scale_error.py blocks "$OUT/dense/single-truth.exr" 160 "${frames[@]}"
