@@ -15,10 +15,11 @@ ENV=$DATA/envmaps/piz_compressed.exr
 PY=${STRANDLIGHT_PYTHON:-python3}
 mkdir -p "$OUT"
 cargo build --release -p strandlight
+cargo build --release -p strandlight-eval --example thin_groom
 BIN=${CARGO_TARGET_DIR:-target}/release/strandlight
 SCENE=(--shading chiang --env "$ENV")
 
-"$PY" scripts/fiber_scale_error.py thin "$DATA/hair/straight.hair" "$OUT/thin20.hair" 20
+"${CARGO_TARGET_DIR:-target}/release/examples/thin_groom" "$DATA/hair/straight.hair" "$OUT/thin20.hair" 20
 "$BIN" compare "${SCENE[@]}" --hair "$OUT/thin20.hair" --size 160x120 --modes single \
   --reference-lights 1536 --ground-truth render --truth-max-spp 4096 --out "$OUT/thin" >/dev/null
 "$BIN" render env "${SCENE[@]}" --hair "$OUT/thin20.hair" --size 160x120 --scattering single \

@@ -1,9 +1,6 @@
 #!/usr/bin/env python3
 """Where a frame's error against the path-traced truth lives: per pixel or over blocks.
 
-  fiber_scale_error.py thin IN.hair OUT.hair N
-      OUT.hair: every N-th strand of IN.hair (a sparse groom: little self-shadowing, few fibers
-      per pixel), its transparency and colour dropped (the Chiang fiber ignores both).
   fiber_scale_error.py blocks TRUTH.exr WIDTH FRAME.exr...
       Each frame box-filtered to WIDTH pixels across (frames rendered at 2x or 4x WIDTH are thus
       supersampled), against the truth box-filtered to the same width, then over 2..16-pixel
@@ -12,47 +9,9 @@
 Used by scripts/fiber-scale-error.sh (docs/BENCHMARKS.md, "Fiber scale"). Reads EXR through
 Mitsuba 3's Bitmap, which the ground truth already needs.
 """
-import struct
 import sys
 
 import numpy as np
-
-HEADER = 128
-FLAG_SEGMENTS, FLAG_POINTS, FLAG_THICKNESS = 1, 2, 4
-
-
-def thin(src, dst, every):
-    data = open(src, "rb").read()
-    if data[:4] != b"HAIR":
-        sys.exit(f"{src}: not a .hair file (no HAIR signature)")
-    strands, points, flags, default_segments, thickness = struct.unpack("<IIIIf", data[4:24])
-    offset = HEADER
-    if flags & FLAG_SEGMENTS:
-        segments = np.frombuffer(data, "<u2", strands, offset).astype(np.int64)
-        offset += 2 * strands
-    else:
-        segments = np.full(strands, default_segments, np.int64)
-    if not flags & FLAG_POINTS:
-        sys.exit(f"{src}: no points array")
-    xyz = np.frombuffer(data, "<f4", 3 * points, offset).reshape(-1, 3)
-    offset += 12 * points
-    widths = np.frombuffer(data, "<f4", points, offset) if flags & FLAG_THICKNESS else None
-    starts = np.concatenate([[0], np.cumsum(segments + 1)])
-    if starts[-1] != points:
-        sys.exit(f"{src}: segments add up to {starts[-1]} points, header says {points}")
-    keep = range(0, strands, every)
-    pick = lambda a: np.concatenate([a[starts[i] : starts[i + 1]] for i in keep])
-    kept_xyz = pick(xyz).astype("<f4")
-    out_flags = FLAG_SEGMENTS | FLAG_POINTS | (FLAG_THICKNESS if widths is not None else 0)
-    info = f"every {every}th strand of {src.split('/')[-1]}".encode()[:87]
-    header = struct.pack("<4sIIIIff3f", b"HAIR", len(keep), len(kept_xyz), out_flags,
-                         default_segments, thickness, 0.0, 1.0, 1.0, 1.0) + info
-    body = segments[list(keep)].astype("<u2").tobytes() + kept_xyz.tobytes()
-    if widths is not None:
-        body += pick(widths).astype("<f4").tobytes()
-    with open(dst, "wb") as f:
-        f.write(header.ljust(HEADER, b"\0") + body)
-    print(f"wrote {dst}: {len(keep)} of {strands} strands, {len(kept_xyz)} points")
 
 
 def load(path):
@@ -101,9 +60,7 @@ def blocks(truth_path, width, frames):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) == 5 and sys.argv[1] == "thin":
-        thin(sys.argv[2], sys.argv[3], int(sys.argv[4]))
-    elif len(sys.argv) >= 5 and sys.argv[1] == "blocks":
+    if len(sys.argv) >= 5 and sys.argv[1] == "blocks":
         blocks(sys.argv[2], int(sys.argv[3]), sys.argv[4:])
     else:
         sys.exit(__doc__)

@@ -10,7 +10,7 @@ use crate::environment::{LoadedEnv, load_env};
 use crate::frame_settings::{
     EnvLighting, FrameSettings, Lighting, PointLighting, Shadows, Transparency, up_choice,
 };
-use crate::hair_input::load_hair;
+use crate::hair_input::{load_hair, opaque_if_physical};
 use crate::head_input::load_head;
 use crate::image_metrics::Image;
 use crate::look::EnvLook;
@@ -46,14 +46,12 @@ pub struct LoadedHair {
 /// it: `render` must reproduce the frames they measure.
 pub fn load_settings_hair(settings: &FrameSettings) -> anyhow::Result<LoadedHair> {
     let (model, source) = load_hair(settings.hair.as_deref())?;
-    if settings.shading().physical_fibers() && model.transparency().is_some() {
-        return Ok(LoadedHair {
-            model: model.without_transparency(),
-            source: format!(
-                "{source} (opaque fibers: its transparency is ignored by the Chiang model)"
-            ),
-        });
-    }
+    let (model, dropped) = opaque_if_physical(settings.shading(), model);
+    let source = if dropped {
+        format!("{source} (opaque fibers: its transparency is ignored by the Chiang model)")
+    } else {
+        source
+    };
     Ok(LoadedHair { model, source })
 }
 

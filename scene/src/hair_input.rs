@@ -50,19 +50,25 @@ pub fn parse_size(text: &str) -> anyhow::Result<(u32, u32)> {
     Ok((parse(w)?, parse(h)?))
 }
 
-/// The hair as `shading` renders it, and the hash that identifies it in the caches: the Chiang
-/// fiber is the path tracer's, whose fibers are opaque cylinders, so a file's transparency is
-/// dropped for it (and the hash says so).
+/// `hair` as `shading` renders it: the Chiang fiber is the path tracer's, whose fibers are opaque
+/// cylinders, so a file's transparency is dropped for it. The flag says whether it was dropped.
+pub fn opaque_if_physical(shading: impl Into<Shading>, hair: HairModel) -> (HairModel, bool) {
+    if hair.transparency().is_some() && shading.into().physical_fibers() {
+        (hair.without_transparency(), true)
+    } else {
+        (hair, false)
+    }
+}
+
+/// [`opaque_if_physical`], with the hash that identifies the hair in the caches (it says when
+/// the transparency was dropped).
 pub fn fibers_for(
     shading: impl Into<Shading>,
     hair: HairModel,
     sha256: String,
 ) -> (HairModel, String) {
-    match hair.transparency() {
-        Some(_) if shading.into().physical_fibers() => (
-            hair.without_transparency(),
-            format!("{sha256}+opaque fibers"),
-        ),
-        _ => (hair, sha256),
+    match opaque_if_physical(shading, hair) {
+        (hair, true) => (hair, format!("{sha256}+opaque fibers")),
+        (hair, false) => (hair, sha256),
     }
 }

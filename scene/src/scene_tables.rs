@@ -62,10 +62,6 @@ impl EnvShading {
         }
     }
 
-    pub fn physical_fibers(self) -> bool {
-        Shading::from(self).physical_fibers()
-    }
-
     /// The convolution table of SRBF lights in `mode` (the artist model has no d_b·S_back
     /// variant: its full mode adds only I_G).
     pub fn srbf_table(self, mode: ScatteringMode) -> &'static str {
