@@ -265,6 +265,103 @@ pub fn light_camera(toward_light: Vec3, bounds: Aabb) -> Camera {
     }
 }
 
+/// What a directional light's map must hold: the hair's points, and their box. A fitted map's
+/// square holds the points' projection across the light ([`Self::light_camera`]) rather than the
+/// box's bounding sphere ([`light_camera`]): on straight.hair it has 1.4–2× more texels across
+/// the hair per side (median 1.53× over directions), so a sun's sharp shadow gets that much finer
+/// for the same map (docs/BENCHMARKS.md, "Compact sources' maps fitted to the hair").
+#[derive(Clone, Debug)]
+pub struct LightFootprint {
+    pub bounds: Aabb,
+    points: std::sync::Arc<[Vec3]>,
+}
+
+/// Room left around the points' projection, as a fraction of the bounding sphere's radius:
+/// fibers are drawn at their width (widened up to 1/√κ in simplified maps) and at least a
+/// texel wide around their centre lines, and the lobes' box filter reads a few texels past them.
+const FOOTPRINT_MARGIN: f32 = 0.02;
+
+impl LightFootprint {
+    pub fn of(model: &HairModel) -> Self {
+        Self::new(model.bounds(), model.points().into())
+    }
+
+    pub fn new(bounds: Aabb, points: std::sync::Arc<[Vec3]>) -> Self {
+        Self { bounds, points }
+    }
+
+    /// The orthographic camera toward `toward_light` whose square just holds every point (with
+    /// [`FOOTPRINT_MARGIN`]); its depth range is [`light_camera`]'s, which holds the box.
+    pub fn light_camera(&self, toward_light: Vec3) -> Camera {
+        let sphere = light_camera(toward_light, self.bounds);
+        let Some((lo, hi)) = self.projected_extent(&sphere) else {
+            return sphere;
+        };
+        let Projection::Orthographic {
+            half_height: radius,
+        } = sphere.projection
+        else {
+            return sphere;
+        };
+        let half = 0.5 * (hi - lo).max_element() + FOOTPRINT_MARGIN * radius;
+        if !(half.is_finite() && half < radius) {
+            return sphere;
+        }
+        let centre = 0.5 * (lo + hi);
+        let shift = sphere
+            .view()
+            .inverse()
+            .transform_vector3(centre.extend(0.0));
+        Camera {
+            eye: sphere.eye + shift,
+            target: sphere.target + shift,
+            projection: Projection::Orthographic { half_height: half },
+            ..sphere
+        }
+    }
+
+    /// The points' least and greatest (x, y) in `camera`'s view space (None without points).
+    fn projected_extent(&self, camera: &Camera) -> Option<(glam::Vec2, glam::Vec2)> {
+        use rayon::prelude::*;
+        let view = camera.view();
+        let (x, y) = (view.row(0).truncate(), view.row(1).truncate());
+        let empty = || (glam::Vec2::INFINITY, glam::Vec2::NEG_INFINITY);
+        let (lo, hi) = self
+            .points
+            .par_chunks(8192)
+            .map(|chunk| {
+                chunk.iter().fold(empty(), |(lo, hi), &p| {
+                    let q = glam::Vec2::new(x.dot(p), y.dot(p));
+                    (lo.min(q), hi.max(q))
+                })
+            })
+            .reduce(empty, |(a, b), (c, d)| (a.min(c), b.max(d)));
+        // The view's translation moves both ends alike; it cancels in the extent but not the centre.
+        let t = glam::Vec2::new(view.w_axis.x, view.w_axis.y);
+        (lo.is_finite() && hi.is_finite()).then_some((lo + t, hi + t))
+    }
+}
+
+/// How a batch's directional maps are framed: around the box's bounding sphere, or fitted to
+/// the hair's points. Compact sources are fitted: their shadows are sharp at fiber scale, and
+/// texels are what they lack. SRBF lobes and region lights keep the sphere: their shadows are
+/// box-filtered over many texels, whose room past the hair's edge the sphere leaves (fitted
+/// lobes measured mixed: quarry 0.288 → 0.266, spruit 0.252 → 0.269 against the truth).
+#[derive(Clone, Copy, Debug)]
+pub enum LightFraming<'a> {
+    Sphere(Aabb),
+    Fitted(&'a LightFootprint),
+}
+
+impl LightFraming<'_> {
+    pub fn light_camera(&self, toward_light: Vec3) -> Camera {
+        match self {
+            LightFraming::Sphere(bounds) => light_camera(toward_light, *bounds),
+            LightFraming::Fitted(footprint) => footprint.light_camera(toward_light),
+        }
+    }
+}
+
 /// A point or spot light inside (or too close to) the hair's bounding box: no single
 /// perspective shadow map sees all of the hair from there.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -587,6 +684,76 @@ mod tests {
         assert_eq!(
             UpAxis::detect(&hanging(Vec3::new(0.0, 0.0, 1.0))),
             UpAxis::Y
+        );
+    }
+
+    /// The fitted light camera holds every point (checked in a camera basis built by hand),
+    /// with its margin, inside a square no larger than the bounding sphere's; a long thin groom
+    /// seen end-on fills its square, where the sphere's leaves most of it empty.
+    #[test]
+    fn a_fitted_light_camera_holds_every_point_and_is_tight_around_a_long_groom_seen_end_on() {
+        let points: Vec<Vec3> = (0..200)
+            .map(|i| {
+                let t = i as f32 / 199.0;
+                Vec3::new(0.2 * (7.0 * t).sin(), 10.0 * t - 3.0, 0.5 * (3.0 * t).cos())
+            })
+            .collect();
+        let footprint = LightFootprint::new(Aabb::from_points(&points), points.clone().into());
+        let radius = 0.5 * footprint.bounds.diagonal();
+        for (k, toward_light) in [
+            Vec3::X,
+            Vec3::Z,
+            Vec3::new(1.0, 0.2, -0.7),
+            Vec3::new(-0.3, 1.0, 0.1),
+            Vec3::Y,
+            Vec3::new(0.0, -1.0, 0.0),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let camera = footprint.light_camera(toward_light);
+            assert!(
+                camera.toward_eye().dot(toward_light.normalize()) > 0.9999,
+                "light {k}"
+            );
+            let Projection::Orthographic { half_height } = camera.projection else {
+                panic!("light {k}: {camera:?}");
+            };
+            assert!(
+                half_height <= radius * 1.0001,
+                "light {k}: {half_height} > {radius}"
+            );
+            let mut widest = 0.0f32;
+            for &p in &points {
+                let c = camera_space(&camera, p);
+                assert!(
+                    c.z > camera.near && c.z < camera.far,
+                    "light {k}: {p} at depth {}",
+                    c.z
+                );
+                widest = widest.max(c.x.abs()).max(c.y.abs());
+            }
+            assert!(
+                widest <= half_height,
+                "light {k}: a point at {widest} outside {half_height}"
+            );
+            // The square's room beyond the farthest point is the margin, at most.
+            assert!(
+                half_height - widest <= FOOTPRINT_MARGIN * radius + 1e-4,
+                "light {k}: {widest} in {half_height}"
+            );
+        }
+        // Along the groom (light along y) the square holds its 1-unit-wide cross-section, against
+        // the sphere's half diagonal of 5.
+        let end_on = footprint.light_camera(Vec3::Y);
+        let Projection::Orthographic { half_height } = end_on.projection else {
+            unreachable!()
+        };
+        assert!(half_height < 0.6, "{half_height} vs {radius}");
+        let none = LightFootprint::new(footprint.bounds, Vec::new().into());
+        assert_eq!(
+            none.light_camera(Vec3::X),
+            light_camera(Vec3::X, footprint.bounds)
         );
     }
 }

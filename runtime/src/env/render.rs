@@ -8,12 +8,12 @@ use strandlight_tables::table_axes::{
     AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_SIGMA_F, AXIS_U_DOT_WO, AXIS_U_DOT_XI,
 };
 
-use crate::camera::Camera;
+use crate::camera::{Camera, LightFootprint, LightFraming};
 use crate::env_light::{EnvLight, ShadowGroup, shadow_groups};
 use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels, fit_within};
 use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::gpu::{AdapterReport, GpuContext};
-use crate::hair::{Aabb, HairModel};
+use crate::hair::HairModel;
 use crate::head::Head;
 use crate::multiple::{ForwardScatteringGrid, ForwardScatteringSource};
 use crate::passes::convolution_depth::{
@@ -565,7 +565,7 @@ struct FrameResources {
     /// draw, and the next light's window.
     simplified: Option<SimplifiedSegments>,
     next_window: u32,
-    bounds: Aabb,
+    footprint: LightFootprint,
     /// The light maps of every-strand SRBFs and directional lights, at the DODM resolution
     /// (None where the frame has only simplified SRBFs).
     full_maps: Option<LightMaps>,
@@ -1128,7 +1128,7 @@ impl EnvRenderer {
             light_geometry,
             simplified,
             next_window: 0,
-            bounds,
+            footprint: LightFootprint::new(bounds, model.points().into()),
             full_maps,
             simplified_maps,
             occupancy,
@@ -1293,7 +1293,7 @@ impl EnvRenderer {
         let FrameResources {
             geometry,
             light_geometry,
-            bounds,
+            footprint,
             full_maps,
             simplified_maps,
             head,
@@ -1301,6 +1301,10 @@ impl EnvRenderer {
         } = frame;
         let geometry = if simplified { light_geometry } else { geometry };
         let maps = LightMaps::choose(simplified, full_maps, simplified_maps);
+        let framing = match batch.has_sharp_shadows() {
+            true => LightFraming::Fitted(footprint),
+            false => LightFraming::Sphere(footprint.bounds),
+        };
         timings.time(gpu, "light pass", || {
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
             self.depth.encode_windows(
@@ -1309,7 +1313,7 @@ impl EnvRenderer {
                 geometry,
                 &directions,
                 &windows,
-                *bounds,
+                framing,
                 [tau_scale, enlargement],
                 &mut maps.dodm,
             );

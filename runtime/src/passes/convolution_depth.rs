@@ -17,7 +17,7 @@ use wgpu::util::DeviceExt;
 use super::frame_params::{FrameParams, KajiyaKay};
 use super::strand_geometry::{StrandGeometry, segment_table};
 use super::strand_quads::{strand_bind_group_layout_for, strand_bind_group_scaled};
-use crate::camera::{Camera, Projection, light_camera};
+use crate::camera::{Camera, LightFraming, Projection};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{
     bind_group, pipeline_layout, storage_entry, storage_texture_entry, uniform_entry,
@@ -455,7 +455,7 @@ impl ConvolutionDepthPass {
         encoder: &mut wgpu::CommandEncoder,
         geometry: &StrandGeometry,
         toward_lights: &[Vec3],
-        bounds: Aabb,
+        framing: LightFraming<'_>,
         tau_scale: f32,
         width_scale: f32,
         batch: &mut DodmBatch,
@@ -468,7 +468,7 @@ impl ConvolutionDepthPass {
             geometry,
             toward_lights,
             &windows,
-            bounds,
+            framing,
             [tau_scale, width_scale],
             batch,
         );
@@ -486,7 +486,7 @@ impl ConvolutionDepthPass {
         geometry: &StrandGeometry,
         toward_lights: &[Vec3],
         windows: &[Vec<Range<u32>>],
-        bounds: Aabb,
+        framing: LightFraming<'_>,
         [tau_scale, width_scale]: [f32; 2],
         batch: &mut DodmBatch,
     ) {
@@ -495,7 +495,7 @@ impl ConvolutionDepthPass {
         let res = batch.resolution;
         batch.cameras = toward_lights
             .iter()
-            .map(|&l| light_camera(l, bounds))
+            .map(|&l| framing.light_camera(l))
             .collect();
         let scratch = LightPassScratch::new(gpu, res);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {

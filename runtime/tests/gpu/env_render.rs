@@ -5,7 +5,7 @@
 use crate::common::*;
 
 use glam::{DVec3, Vec2, Vec3};
-use strandlight_runtime::camera::{Camera, Projection, light_camera};
+use strandlight_runtime::camera::{Camera, LightFraming, Projection, light_camera};
 use strandlight_runtime::env::TransmittanceFilter;
 use strandlight_runtime::env::{
     EnvFrame, EnvRenderOptions, EnvRenderer, EnvTables, render_env_frame,
@@ -212,7 +212,7 @@ fn slab_maps(gpu: &GpuContext, gap: &Gap) -> SlabMaps {
         &mut encoder,
         &geometry,
         &[Vec3::Z, Vec3::Z],
-        model.bounds(),
+        LightFraming::Sphere(model.bounds()),
         1.0,
         1.0,
         &mut batch,
@@ -986,7 +986,7 @@ fn stochastic_simplification_keeps_the_mean_optical_depth() {
             &mut encoder,
             &drawn,
             &[Vec3::Z],
-            model.bounds(),
+            LightFraming::Sphere(model.bounds()),
             1.0 / kappa,
             1.0 / kappa,
             &mut batch,
@@ -1182,7 +1182,7 @@ fn light_map_toward_z(
         encoder,
         &geometry,
         &[Vec3::Z],
-        model.bounds(),
+        LightFraming::Sphere(model.bounds()),
         1.0,
         1.0,
         &mut batch,
@@ -1263,7 +1263,7 @@ fn simplification_enlarges_fibers_so_points_keep_their_texel() {
             &mut encoder,
             &drawn,
             &[toward_light],
-            bounds,
+            LightFraming::Sphere(bounds),
             1.0 / kappa,
             width_scale,
             &mut batch,
