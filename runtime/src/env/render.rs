@@ -13,7 +13,7 @@ use crate::env_light::{EnvLight, ShadowGroup, shadow_groups};
 use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels, fit_within};
 use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::gpu::{AdapterReport, GpuContext};
-use crate::hair::HairModel;
+use crate::hair::{Aabb, HairModel};
 use crate::head::Head;
 use crate::multiple::{ForwardScatteringGrid, ForwardScatteringSource};
 use crate::passes::convolution_depth::{
@@ -1128,7 +1128,7 @@ impl EnvRenderer {
             light_geometry,
             simplified,
             next_window: 0,
-            footprint: LightFootprint::new(bounds, model.points().into()),
+            footprint: light_footprint(model, head, bounds),
             full_maps,
             simplified_maps,
             occupancy,
@@ -1335,6 +1335,16 @@ impl EnvRenderer {
             gpu.queue.submit([encoder.finish()]);
         });
     }
+}
+
+/// What a compact source's map must hold: the hair, and the head whose skin it shadows and
+/// which shadows the hair (outside a map a point reads as lit).
+fn light_footprint(model: &HairModel, head: Option<&Head>, bounds: Aabb) -> LightFootprint {
+    let mut points = model.points().to_vec();
+    if let Some(head) = head {
+        points.extend_from_slice(&head.triangles().positions);
+    }
+    LightFootprint::new(bounds, points.into())
 }
 
 /// One batch: lights of one kind (at most the batch size of shadow groups) and their kind's
