@@ -426,6 +426,14 @@ impl LightKinds {
         !(self.directional.is_empty() && self.directional_thinned.is_empty())
     }
 
+    /// Whether any light is a compact source, whose maps are fitted to the hair
+    /// ([`LightFraming::Fitted`]).
+    fn has_sharp_shadows(&self) -> bool {
+        (self.directional.iter())
+            .chain(&self.directional_thinned)
+            .any(EnvLight::has_sharp_shadow)
+    }
+
     /// The kinds whose maps κ thins.
     fn thinned(&self) -> [&Vec<EnvLight>; 2] {
         [&self.srbf, &self.directional_thinned]
@@ -1128,7 +1136,7 @@ impl EnvRenderer {
             light_geometry,
             simplified,
             next_window: 0,
-            footprint: light_footprint(model, head, bounds),
+            footprint: light_footprint(model, head, bounds, kinds.has_sharp_shadows()),
             full_maps,
             simplified_maps,
             occupancy,
@@ -1338,8 +1346,17 @@ impl EnvRenderer {
 }
 
 /// What a compact source's map must hold: the hair, and the head whose skin it shadows and
-/// which shadows the hair (outside a map a point reads as lit).
-fn light_footprint(model: &HairModel, head: Option<&Head>, bounds: Aabb) -> LightFootprint {
+/// which shadows the hair (outside a map a point reads as lit). Without compact sources no map
+/// is fitted, and the points are not copied.
+fn light_footprint(
+    model: &HairModel,
+    head: Option<&Head>,
+    bounds: Aabb,
+    has_compact_sources: bool,
+) -> LightFootprint {
+    if !has_compact_sources {
+        return LightFootprint::new(bounds, Vec::new().into());
+    }
     let mut points = model.points().to_vec();
     if let Some(head) = head {
         points.extend_from_slice(&head.triangles().positions);
