@@ -12,6 +12,7 @@ use strandlight_eval::baseline::Baseline;
 use strandlight_eval::compare::{CompareSettings, execute, prepare};
 use strandlight_eval::ground_truth::TruthUse;
 use strandlight_scene::env_frame::{env_adapter, render_lights};
+use strandlight_scene::hair_input::parse_size;
 use strandlight_scene::look::{EnvTransparency, ForwardDevice, LobeVisibilityArg};
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
 use strandlight_scene::steps::Steps;
@@ -142,7 +143,7 @@ fn base_settings(path: Option<&PathBuf>) -> anyhow::Result<CompareSettings> {
     let value: serde_json::Value = serde_json::from_str(&text)
         .with_context(|| format!("--settings {}: not JSON", path.display()))?;
     let settings = value.get("settings").cloned().unwrap_or(value);
-    serde_json::from_value(settings).with_context(|| {
+    CompareSettings::from_json(settings).with_context(|| {
         format!(
             "--settings {}: not compare settings (or a `compare --json` report holding them)",
             path.display()
@@ -162,14 +163,27 @@ impl CompareArgs {
     pub fn settings(self) -> anyhow::Result<CompareSettings> {
         let mut s = base_settings(self.settings.as_ref())?;
         let (scene, measure, look) = (self.scene, self.measure, self.look);
-        set(&mut s.hair, scene.hair);
-        set(&mut s.env, scene.env);
-        set(&mut s.rotate, scene.rotate);
-        s.sanitize |= scene.sanitize;
-        set(&mut s.size, scene.size);
-        set(&mut s.shading, scene.shading);
-        set(&mut s.preset, scene.preset);
-        set(&mut s.head, scene.head);
+        let frame = &mut s.frame;
+        if scene.hair.is_some() {
+            frame.hair = scene.hair;
+        }
+        if let Some(size) = &scene.size {
+            let (w, h) = parse_size(size)?;
+            frame.size = [w, h];
+        }
+        set(&mut frame.shading, scene.shading.map(|s| Some(s.into())));
+        set(&mut frame.preset, scene.preset);
+        set(&mut frame.head, scene.head);
+        let env = s.env_mut();
+        set(&mut env.map, scene.env);
+        set(&mut env.rotation_deg, scene.rotate.map(|r| r as f32));
+        env.sanitize |= scene.sanitize;
+        set(&mut env.kappa, look.kappa);
+        set(&mut env.dodm_size, look.light_map_size);
+        set(&mut env.transparency, look.transparency);
+        set(&mut env.view.lobe_visibility, look.lobe_visibility);
+        set(&mut env.view.visibility_cutoff, look.visibility_cutoff);
+        set(&mut env.view.forward_scattering, look.forward_scattering);
         set(&mut s.modes, measure.modes);
         set(&mut s.reference_lights, measure.reference_lights.map(Some));
         set(&mut s.baseline, measure.baseline);
@@ -179,12 +193,6 @@ impl CompareArgs {
         set(&mut s.out, measure.out);
         set(&mut s.cache, measure.cache);
         s.json |= measure.json;
-        set(&mut s.kappa, look.kappa);
-        set(&mut s.light_map_size, look.light_map_size);
-        set(&mut s.look.transparency, look.transparency);
-        set(&mut s.look.view.lobe_visibility, look.lobe_visibility);
-        set(&mut s.look.view.visibility_cutoff, look.visibility_cutoff);
-        set(&mut s.look.view.forward_scattering, look.forward_scattering);
         Ok(s)
     }
 }
@@ -240,18 +248,18 @@ mod tests {
             "--json",
         ])
         .unwrap();
-        let expected = CompareSettings {
-            hair: "h.hair".into(),
-            env: "e.hdr".into(),
-            size: "64x48".into(),
+        let mut expected = CompareSettings {
             modes: vec![ScatteringMode::Single],
-            kappa: 0.5,
             reference_lights: Some(96),
             json: true,
             ..CompareSettings::default()
         };
-        let mut expected = expected;
-        expected.look.view.lobe_visibility = LobeVisibilityArg::LightMaps;
+        expected.frame.hair = Some("h.hair".into());
+        expected.frame.size = [64, 48];
+        let env = expected.env_mut();
+        env.map = "e.hdr".into();
+        env.kappa = 0.5;
+        env.view.lobe_visibility = LobeVisibilityArg::LightMaps;
         assert_eq!(s, expected);
     }
 
@@ -259,13 +267,13 @@ mod tests {
     fn a_settings_file_or_report_is_the_base_and_flags_override_it() {
         let dir = std::env::temp_dir().join(format!("strandlight-compare-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let file = CompareSettings {
-            env: "from-file.hdr".into(),
-            max_lobes: 8,
+        let mut file = CompareSettings {
             reference_max_lights: 1536,
             timing_runs: 1,
             ..CompareSettings::default()
         };
+        file.env_mut().map = "from-file.hdr".into();
+        file.env_mut().fit.max_lobes = 8;
         let plain = dir.join("settings.json");
         std::fs::write(&plain, serde_json::to_string(&file).unwrap()).unwrap();
         let report = dir.join("report.json");
@@ -274,12 +282,12 @@ mod tests {
         for path in [&plain, &report] {
             let s = settings(&["--settings", path.to_str().unwrap(), "--env", "flag.hdr"]).unwrap();
             assert_eq!(
-                (s.max_lobes, s.reference_max_lights, s.timing_runs),
+                (s.env().fit.max_lobes, s.reference_max_lights, s.timing_runs),
                 (8, 1536, 1)
             );
-            assert_eq!(s.env, "flag.hdr", "the flag overrides the file");
+            assert_eq!(s.env().map, "flag.hdr", "the flag overrides the file");
         }
-        std::fs::write(&plain, r#"{"max_lobes": 8, "no_such_field": 1}"#).unwrap();
+        std::fs::write(&plain, r#"{"timing_runs": 8, "no_such_field": 1}"#).unwrap();
         let e = format!(
             "{:#}",
             settings(&["--settings", plain.to_str().unwrap()]).unwrap_err()

@@ -5,15 +5,14 @@
 
 use anyhow::Context;
 use std::path::Path;
-use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_scene::env_frame::{env_adapter, light_summary};
-use strandlight_scene::env_scene::{EnvSceneRequest, prepare_env_scene};
-use strandlight_scene::environment::{LoadedEnv, ensure_procedural_envmap, load_env};
+use strandlight_scene::env_scene::{AlsoServe, prepare_env};
+use strandlight_scene::environment::{ensure_procedural_envmap, load_env};
 use strandlight_scene::exposure::{Exposure, exposure_problem};
 use strandlight_scene::frame_render::{
-    FrameDetails, FramePart, LoadedHair, Prepared, PreparedEnv, load_settings_hair, render_frame,
+    FrameDetails, FramePart, Prepared, load_settings_hair, render_frame,
 };
-use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting, up_choice};
+use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting};
 use strandlight_scene::look::EnvTransparency;
 use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
@@ -45,15 +44,17 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let mut steps = Steps::new(false);
     // Before minutes of fit and bake: a machine without a usable GPU device is told at once.
     steps.run("GPU", env_adapter, |adapter| adapter.clone())?;
-    let (env, env_path) = steps
+    let env_path = steps
         .run(
             "environment",
             || {
                 let (path, written) =
                     ensure_procedural_envmap(Path::new(ENVMAP_DIR), DEMO_ENVIRONMENT)?;
-                Ok((load_env(&path.to_string_lossy(), false)?, path, written))
+                // Read back here, so that a map that did not write is told before the groom.
+                load_env(&path.to_string_lossy(), false)?;
+                Ok((path, written))
             },
-            |(_, p, w)| {
+            |(p, w)| {
                 format!(
                     "{} ({}, read back)",
                     p.display(),
@@ -65,14 +66,21 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
                 )
             },
         )
-        .map(|(env, path, _)| (env, path))?;
+        .map(|(path, _)| path)?;
     let settings = demo_settings(&env_path.to_string_lossy(), args.transparency);
     let hair = steps.run(
         "groom",
         || load_settings_hair(&settings),
         |h| format!("{}, {} strands", h.source, h.model.strand_count()),
     )?;
-    let prepared = prepare_demo_scene(&settings, env, &hair, &mut steps)?;
+    let prepared = prepare_env(
+        &settings,
+        &hair.model,
+        Path::new(CACHE_DIR),
+        AlsoServe::default(),
+        &mut steps,
+        &mut |_| {},
+    )?;
     let rendered = steps.run(
         "render",
         || {
@@ -135,6 +143,7 @@ fn demo_settings(map: &str, transparency: EnvTransparency) -> FrameSettings {
     let lighting = EnvLighting {
         scattering: ScatteringMode::Full,
         transparency,
+        table_resolution: Some(DEMO_TABLE_NODES),
         ..EnvLighting::new(map)
     };
     FrameSettings {
@@ -142,33 +151,4 @@ fn demo_settings(map: &str, transparency: EnvTransparency) -> FrameSettings {
         preset: DEMO_PRESET.into(),
         ..FrameSettings::new(Lighting::Environment(lighting), [DEMO_SIZE.0, DEMO_SIZE.1])
     }
-}
-
-/// The fit and the demo's reduced tables (`DEMO_TABLE_NODES`), both cached under `CACHE_DIR`.
-fn prepare_demo_scene(
-    settings: &FrameSettings,
-    env: LoadedEnv,
-    hair: &LoadedHair,
-    steps: &mut Steps,
-) -> anyhow::Result<PreparedEnv> {
-    let fiber = FiberDescription::preset(DEMO_PRESET)?;
-    let shading = settings.env_shading()?;
-    let up = up_choice(settings).axis(&hair.model);
-    let request = EnvSceneRequest {
-        env: &env,
-        fiber: &fiber,
-        shading,
-        scattering: ScatteringMode::Full,
-        resolution: BakeResolution::reduced(DEMO_TABLE_NODES),
-        cache_dir: Path::new(CACHE_DIR),
-        table_set: "demo",
-        up,
-    };
-    let scene = prepare_env_scene(&request, steps)?;
-    Ok(PreparedEnv {
-        env,
-        scene,
-        shading,
-        up,
-    })
 }

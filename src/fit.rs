@@ -1,10 +1,10 @@
 //! `strandlight fit ENVMAP`: environment map in, SRBF lights out (or the median-cut baseline
-//! with `--directional N`). Parsing, progress and printing only; the work is in
-//! `strandlight_precompute`.
+//! with `--directional N`), in the map's own frame: a frame turns the map (`render --rotate`),
+//! not its fit. Parsing, progress and printing only; the work is in `strandlight_precompute`.
 
 use anyhow::Context;
 use std::path::{Path, PathBuf};
-use strandlight_precompute::srbf_set::{SrbfSet, unrotated};
+use strandlight_precompute::srbf_set::SrbfSet;
 use strandlight_precompute::{FitOptions, preview};
 use strandlight_scene::environment::load_env;
 
@@ -30,9 +30,6 @@ pub struct FitArgs {
     /// Width of the prefiltered grid the fit runs on (height = width/2); λ_max ≤ width²/64.
     #[arg(long, default_value_t = 256)]
     pub grid_width: usize,
-    /// Rotate the environment about +Y (up) by this many degrees.
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
-    pub rotate: f64,
     /// Most compact bright sources (suns, lamps) taken out as directional lights before the
     /// fit; 0 fits SRBFs alone, as the paper.
     #[arg(long, default_value_t = strandlight_precompute::compact_sources::SourceOptions::default().max_sources)]
@@ -76,7 +73,6 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
         lambda_min: args.lambda_min,
         lambda_max: args.lambda_max,
         grid_width: args.grid_width,
-        rotate_degrees: args.rotate,
         sources: strandlight_precompute::compact_sources::SourceOptions {
             max_sources: if args.directional.is_some() {
                 0
@@ -122,7 +118,7 @@ pub fn run(args: FitArgs) -> anyhow::Result<()> {
     });
     set.save(&out)?;
     if let Some(png) = &args.preview {
-        preview::write_preview(map, &unrotated(&set.lobes, args.rotate), 512, png)
+        preview::write_preview(map, &set.lobes, 512, png)
             .with_context(|| format!("writing {}", png.display()))?;
         eprintln!("preview: {} (tonemap: {})", png.display(), preview::TONEMAP);
     }

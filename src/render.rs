@@ -9,10 +9,11 @@ use std::path::{Path, PathBuf};
 use strandlight_runtime::render::PassTiming;
 use strandlight_scene::camera_choice::{CameraChoice, CameraKind, UpChoice};
 use strandlight_scene::env_frame::{env_adapter, light_summary};
+use strandlight_scene::env_scene::{AlsoServe, prepare_env};
 use strandlight_scene::exposure::{Exposure, ExposureProblem, exposure_problem};
 use strandlight_scene::frame_render::{
-    FrameDetails, FramePart, LoadedHair, Prepared, RenderedFrame, load_settings_hair, prepare_env,
-    prepare_point, render_frame,
+    FrameDetails, FrameHair, FramePart, Prepared, RenderedFrame, load_settings_hair, prepare_point,
+    render_frame,
 };
 use strandlight_scene::frame_settings::{
     CameraSettings, DEFAULT_LIGHT, EnvLighting, FrameSettings, Lighting, PointLighting, Shadows,
@@ -332,12 +333,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             )?;
             Prepared::Point(&point)
         }
-        Lighting::Environment(lighting) => {
+        Lighting::Environment(_) => {
             env = prepare_env(
                 &settings,
-                lighting,
                 &hair.model,
                 Path::new("out/cache"),
+                AlsoServe::default(),
                 &mut steps,
                 &mut |_| {},
             )?;
@@ -405,7 +406,7 @@ struct Written {
 fn write_outputs(
     output: &OutputArgs,
     settings: &FrameSettings,
-    hair: &LoadedHair,
+    hair: &FrameHair,
     prepared: Prepared,
     rendered: &RenderedFrame,
 ) -> anyhow::Result<Written> {
@@ -462,7 +463,7 @@ fn write_outputs(
 
 fn json_report(
     settings: &FrameSettings,
-    hair: &LoadedHair,
+    hair: &FrameHair,
     rendered: &RenderedFrame,
     written: &Written,
 ) -> anyhow::Result<serde_json::Value> {
@@ -512,7 +513,7 @@ fn json_report(
     Ok(report)
 }
 
-fn text_report(hair: &LoadedHair, rendered: &RenderedFrame) -> Vec<String> {
+fn text_report(hair: &FrameHair, rendered: &RenderedFrame) -> Vec<String> {
     let mut lines = vec![format!("adapter: {}", rendered.adapter)];
     match &rendered.details {
         FrameDetails::Point(stats) => {

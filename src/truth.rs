@@ -7,29 +7,42 @@ use clap::Args;
 use std::path::PathBuf;
 use strandlight_eval::ground_truth::mitsuba_scene::MitsubaRun;
 use strandlight_eval::ground_truth::{
-    TruthRequest, TruthScene, TruthSettings, TruthUse, export, ground_truth, write_truth_image,
+    TruthScene, TruthSettings, TruthUse, export, ground_truth, write_truth_image,
 };
+use strandlight_scene::env_lighting::EnvLighting;
+use strandlight_scene::frame_settings::{FrameSettings, Lighting};
 use strandlight_scene::hair_input::parse_size;
+use strandlight_scene::head_input::HeadChoice;
+use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 
 #[derive(Args, Debug)]
 pub struct TruthArgs {
-    /// Hair file (.hair, .tfx, .data, .ply, USD .usda/.usdc/.usdz BasisCurves, Alembic .abc ICurves); rendered with opaque fibers of the file's width.
+    /// The frame's settings (a `render` or viewer screenshot's STEM.json, a page's
+    /// settings.json): its hair, camera, map, rotation and head, with the Chiang fiber. The
+    /// scene flags below are then not taken.
+    #[arg(long, value_name = "SETTINGS_JSON", conflicts_with_all = ["hair", "env", "size", "rotate", "preset", "head"])]
+    pub settings: Option<PathBuf>,
+    /// Hair file (.hair, .tfx, .data, .ply, USD .usda/.usdc/.usdz BasisCurves, Alembic .abc ICurves); rendered with opaque fibers of the file's width. The procedural groom when omitted.
     #[arg(long)]
-    pub hair: PathBuf,
+    pub hair: Option<PathBuf>,
     /// Environment map (.hdr, .exr) or procedural:NAME.
-    #[arg(long)]
-    pub env: String,
+    #[arg(long, required_unless_present = "settings")]
+    pub env: Option<String>,
     /// Image size WxH (as `compare --size`).
     #[arg(long, default_value = "640x480")]
     pub size: String,
-    /// Turn the map about the hair's up axis, degrees (as `compare --rotate`).
+    /// Turn the map about the hair's up axis, degrees (as `render --rotate` and
+    /// `compare --rotate`).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub rotate: f64,
     /// Melanin preset of the fiber: white, blonde, red, auburn, brown, dark.
     #[arg(long, default_value = "brown")]
     pub preset: String,
+    /// The head under the hair: none, ellipsoid (fitted to the strand roots) or FILE.obj.
+    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE.obj")]
+    pub head: HeadChoice,
     /// Scattering modes: single (direct light, max_depth 2) and full (path traced).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "single,full")]
     pub modes: Vec<ScatteringMode>,
@@ -58,27 +71,47 @@ pub struct TruthArgs {
     pub spp: u32,
 }
 
-pub fn run(args: TruthArgs) -> anyhow::Result<()> {
-    let size = parse_size(&args.size)?;
-    let request = TruthRequest {
+/// The frame the flags (or the settings file) describe: what `compare` measures with the same
+/// flags, so both find the same cached truths.
+fn frame_settings(args: &TruthArgs) -> anyhow::Result<FrameSettings> {
+    if let Some(path) = &args.settings {
+        let mut frame = FrameSettings::read(path)?;
+        if let Lighting::Environment(env) = &mut frame.lighting {
+            env.sanitize |= args.sanitize;
+        }
+        return Ok(frame);
+    }
+    let (width, height) = parse_size(&args.size)?;
+    let mut env = EnvLighting::new(args.env.clone().unwrap_or_default());
+    env.rotation_deg = args.rotate as f32;
+    env.sanitize = args.sanitize;
+    Ok(FrameSettings {
         hair: args.hair.clone(),
-        env: args.env.clone(),
-        sanitize: args.sanitize,
-        size,
-        rotate_degrees: args.rotate,
+        shading: Some(Shading::Chiang),
         preset: args.preset.clone(),
-        modes: args.modes.clone(),
-        // As `compare` and `bench` ask for it, so a budget under 4096 (640×480) is cached once.
-        settings: TruthSettings::with_budget(args.truth_max_spp, args.reference_tolerance),
-        cache: args.cache.clone(),
-    };
+        head: args.head.clone(),
+        ..FrameSettings::new(Lighting::Environment(env), [width, height])
+    })
+}
+
+pub fn run(args: TruthArgs) -> anyhow::Result<()> {
+    let frame = frame_settings(&args)?;
+    // As `compare` and `bench` ask for it, so a budget under 4096 (640×480) is cached once.
+    let settings = TruthSettings::with_budget(args.truth_max_spp, args.reference_tolerance);
     let mut steps = Steps::new(false);
     let scene = steps.run(
         "scene",
-        || TruthScene::load(&request),
-        |s| format!("{} strands, map {}", s.hair.strand_count(), args.env),
+        || TruthScene::load(&frame),
+        |s| {
+            format!(
+                "{} ({} strands), map {}",
+                s.hair.source,
+                s.hair.model.strand_count(),
+                s.map.name
+            )
+        },
     )?;
-    let inputs = scene.inputs(size, args.rotate);
+    let inputs = scene.inputs()?;
     if let Some(dir) = &args.export {
         for &mode in &args.modes {
             let run = MitsubaRun {
@@ -106,17 +139,17 @@ pub fn run(args: TruthArgs) -> anyhow::Result<()> {
         let truth = ground_truth(
             &inputs,
             mode,
-            &request.settings,
+            &settings,
             TruthUse::Render,
-            &request.cache,
+            &args.cache,
             &mut steps,
         )?
         .expect("TruthUse::Render always renders");
         let stem = args.out.join(format!("{}-truth", mode.name()));
         let description = format!(
             "strandlight truth: {} under {}, {} scattering, Mitsuba {} {} spp depth {}",
-            args.hair.display(),
-            args.env,
+            scene.hair.source,
+            scene.map.name,
             mode.name(),
             truth.mitsuba,
             truth.spp,

@@ -6,8 +6,9 @@ use crate::demo::{CACHE_DIR, DEMO_ENVIRONMENT, DEMO_PRESET, ENVMAP_DIR};
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 use strandlight_runtime::hair::yuksel::{HairWriteOptions, encode_hair};
+use strandlight_scene::env_scene::{AlsoServe, PreparedEnv, prepare_env};
 use strandlight_scene::environment::ensure_procedural_envmap;
-use strandlight_scene::frame_render::{PreparedEnv, load_settings_hair, prepare_env};
+use strandlight_scene::frame_render::load_settings_hair;
 use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting};
 use strandlight_scene::look::{ForwardDevice, LobeVisibilityArg};
 use strandlight_scene::point_shading::Shading;
@@ -83,7 +84,6 @@ pub fn run(args: WebArgs) -> anyhow::Result<()> {
         );
         env.view.forward_scattering = ForwardDevice::Gpu;
     }
-    let env = &env.clone();
     let hair = steps.run(
         "hair",
         || load_settings_hair(&settings),
@@ -91,14 +91,14 @@ pub fn run(args: WebArgs) -> anyhow::Result<()> {
     )?;
     let mut prepared = Vec::new();
     for preset in &args.preset {
-        let scene = prepare_preset(&settings, env, &hair.model, preset, &mut steps)?;
+        let scene = prepare_preset(&settings, &hair.model, preset, &mut steps)?;
         prepared.push((preset.clone(), scene));
     }
     let first_preset = &args.preset[0];
     settings.preset = first_preset.clone();
     let presets: Vec<(String, &PreparedEnv)> =
         prepared.iter().map(|(p, s)| (p.clone(), s)).collect();
-    let (scene, tables) = bundle_scene(&prepared[0].1.env.name, &presets)?;
+    let (scene, tables) = bundle_scene(&prepared[0].1.map()?.name, &presets)?;
     let out = &args.out;
     let written = steps.run(
         "site",
@@ -157,7 +157,6 @@ fn parse_size(text: &str) -> anyhow::Result<[u32; 2]> {
 /// bundle's settings draws with the bundle's tables.
 fn prepare_preset(
     settings: &FrameSettings,
-    env: &EnvLighting,
     hair: &strandlight_runtime::hair::HairModel,
     preset: &str,
     steps: &mut Steps,
@@ -169,9 +168,9 @@ fn prepare_preset(
     };
     prepare_env(
         &settings,
-        env,
         hair,
         Path::new(CACHE_DIR),
+        AlsoServe::default(),
         steps,
         &mut |_| {},
     )

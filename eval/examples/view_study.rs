@@ -9,16 +9,15 @@
 //! default `strandlight truth`'s, falling back to the cached pair of a smaller budget such as
 //! `--truth-max-spp 4096`), REFERENCE=n (the DOM reference's 6n² lights instead of the SRBF frame).
 use anyhow::Context;
-use strandlight_eval::compare::{
-    CompareSettings, ReferenceLighting, frame, prepare, timed_render, truth_of,
-};
+use strandlight_eval::compare::{CompareSettings, frame, prepare, timed_render, truth_of};
 use strandlight_eval::ground_truth::TruthUse;
 use strandlight_eval::hdr_flip::hdr_flip;
-use strandlight_scene::env_frame::FrameRole;
 use strandlight_scene::env_frame::render_lights;
+use strandlight_scene::env_lighting::{EnvLightSet, ReferenceLighting};
+use strandlight_scene::hair_input::parse_size;
 use strandlight_scene::image_metrics::relative_rmse;
 use strandlight_scene::look::{EnvTransparency, LobeVisibilityArg};
-use strandlight_scene::scene_tables::EnvShading;
+use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 
@@ -30,22 +29,23 @@ fn main() -> anyhow::Result<()> {
         _ => ScatteringMode::Single,
     };
     let mut settings = CompareSettings {
-        hair: "../shared/data/hair/straight.hair".into(),
-        env: map.clone(),
-        size: std::env::var("SIZE").unwrap_or("160x120".into()),
-        shading: EnvShading::Chiang,
         modes: vec![mode],
         ground_truth: TruthUse::Cached,
         ..Default::default()
     };
+    let (w, h) = parse_size(&std::env::var("SIZE").unwrap_or("160x120".into()))?;
+    settings.frame.size = [w, h];
+    settings.frame.hair = Some("../shared/data/hair/straight.hair".into());
+    settings.frame.shading = Some(Shading::Chiang);
+    settings.env_mut().map = map.clone();
     if let Ok(n) = std::env::var("LIGHT_MAP_SIZE") {
-        settings.light_map_size = n.parse()?;
+        settings.env_mut().dodm_size = n.parse()?;
     }
     if let Ok(spp) = std::env::var("TRUTH_MAX_SPP") {
         settings.truth_max_spp = spp.parse()?;
     }
     if let Ok(k) = std::env::var("KAPPA") {
-        settings.kappa = k.parse()?;
+        settings.env_mut().kappa = k.parse()?;
     }
     // REFERENCE=n: the DOM reference's lights for n×n texels per cube face (6n² lights).
     let reference_face: Option<usize> = std::env::var("REFERENCE")
@@ -79,27 +79,24 @@ fn main() -> anyhow::Result<()> {
             .split_once('/')
             .context("LOOK = TRANSPARENCY/VISIBILITY")?;
         let mut s = settings.clone();
-        s.look.transparency = match t {
+        s.env_mut().transparency = match t {
             "occupancy" => EnvTransparency::Occupancy,
             "layered" => EnvTransparency::Layered,
             _ => EnvTransparency::Opaque,
         };
-        s.look.view.lobe_visibility = match v {
+        s.env_mut().view.lobe_visibility = match v {
             "volume" => LobeVisibilityArg::Volume,
             _ => LobeVisibilityArg::LightMaps,
         };
-        let reference_lights;
-        let f = match reference_face {
-            Some(face) => {
-                reference_lights =
-                    scene.reference_set(face, None, s.rotate, ReferenceLighting::Map)?;
-                strandlight_scene::env_frame::EnvFrame {
-                    role: FrameRole::Reference,
-                    ..frame(&scene, &s, &reference_lights, mode)
-                }
-            }
-            None => frame(&scene, &s, &scene.srbf, mode),
+        let light_set = match reference_face {
+            Some(face) => EnvLightSet::Reference {
+                face,
+                shading_face: None,
+                lighting: ReferenceLighting::Map,
+            },
+            None => EnvLightSet::Fit,
         };
+        let f = frame(&scene, &s.frame_of(mode, light_set))?;
         let _warm = render_lights(&f)?;
         let r = timed_render(&render_lights, &f, runs)?;
         let e = relative_rmse(&r.image, &truth.image)?;
@@ -113,8 +110,8 @@ fn main() -> anyhow::Result<()> {
             "{}",
             serde_json::json!({"map": map, "mode": mode.name(), "look": look, "ms": r.milliseconds,
                 "rel_rmse": e, "rel_rmse_nc": nc, "hdr_flip": flip, "truth_noise": truth.noise,
-                "truth_seconds": truth.seconds, "light_map_size": s.light_map_size,
-                "size": s.size, "reference_face": reference_face})
+                "truth_seconds": truth.seconds, "light_map_size": s.env().dodm_size,
+                "size": s.frame.size, "reference_face": reference_face})
         );
         let stem = out.join(format!(
             "{}-{}-{t}-{v}",

@@ -6,11 +6,7 @@
 //! second baseline separates that handicap from what the SRBF lobes buy on the rest of the map.
 
 use serde::{Deserialize, Serialize};
-use strandlight_precompute::EnvMap;
-use strandlight_precompute::compact_sources::SourceOptions;
-use strandlight_precompute::env_lights::{
-    LightSpec, median_cut_lights, median_cut_lights_with_sources,
-};
+use strandlight_scene::env_lighting::EnvLightSet;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
@@ -24,20 +20,12 @@ pub enum Baseline {
 }
 
 impl Baseline {
-    /// `count` directional lights for `map` (with exact sources: every source and at least one
-    /// more, so possibly more than `count`), turned by `rotate_degrees` like every light set.
-    pub fn lights(
-        self,
-        map: &EnvMap,
-        count: usize,
-        rotate_degrees: f64,
-        sources: &SourceOptions,
-    ) -> Vec<LightSpec> {
-        match self {
-            Baseline::MedianCut => median_cut_lights(map, count, rotate_degrees),
-            Baseline::MedianCutSources => {
-                median_cut_lights_with_sources(map, count, rotate_degrees, sources)
-            }
+    /// The light set of a budget of `count` directional lights (with exact sources: every
+    /// source and at least one more, so possibly more than `count`).
+    pub fn light_set(self, count: usize) -> EnvLightSet {
+        EnvLightSet::MedianCut {
+            lights: count,
+            exact_sources: self == Baseline::MedianCutSources,
         }
     }
 

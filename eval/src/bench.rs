@@ -25,14 +25,14 @@ use strandlight_precompute::FitOptions;
 use strandlight_precompute::bake::bake_job;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription, Model, PlanOptions};
 use strandlight_precompute::baked_tables_check::check_asset;
-use strandlight_runtime::env_light::EnvLight;
-use strandlight_runtime::passes::convolution_depth::DodmSettings;
-use strandlight_scene::env_frame::{EnvFrame, FrameRole, render_lights};
+use strandlight_scene::env_frame::render_lights;
+use strandlight_scene::env_lighting::{EnvLightSet, EnvLighting};
 use strandlight_scene::environment::load_env;
 use strandlight_scene::fit_cache::fit_cached;
+use strandlight_scene::frame_settings::{FrameSettings, Lighting};
 use strandlight_scene::head_input::HeadChoice;
 use strandlight_scene::image_metrics::{Image, relative_rmse};
-use strandlight_scene::look::{EnvTransparency, LobeVisibilityArg, LookArgs, ViewArgs};
+use strandlight_scene::look::{EnvTransparency, LobeVisibilityArg, ViewArgs};
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
 use strandlight_scene::steps::Steps;
 
@@ -330,7 +330,7 @@ impl BenchPlan {
         }
         let probe = compare_args(
             &self,
-            Path::new("map"),
+            (Path::new(BENCH_HAIR), Path::new("map")),
             Path::new("cache"),
             Path::new("out"),
         );
@@ -680,15 +680,38 @@ fn distinct_joined<'a>(values: impl Iterator<Item = &'a String>) -> String {
     distinct.join(" and ")
 }
 
+/// The hair every bench frame draws, under the shared data folder.
+pub const BENCH_HAIR: &str = "hair/straight.hair";
+
 /// The compare settings a bench scene of `map` is built with.
-fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> CompareSettings {
+fn compare_args(
+    plan: &BenchPlan,
+    (hair, map): (&Path, &Path),
+    cache: &Path,
+    out: &Path,
+) -> CompareSettings {
+    let mut env = EnvLighting::new(map.display().to_string());
+    env.fit.max_lobes = plan.lobes[0];
+    env.kappa = plan.kappas[0];
+    env.dodm_size = plan.dodm_sizes[0];
+    env.transparency = plan.transparency;
+    env.view = ViewArgs {
+        // Every SRBF frame of the sweep sets its own ([`srbf_configs`]); the error
+        // decomposition against the DOM reference takes Ren's light maps apart (one
+        // visibility per lobe, κ), so they are what these arguments leave in place.
+        lobe_visibility: LobeVisibilityArg::LightMaps,
+        ..ViewArgs::default()
+    };
+    let frame = FrameSettings {
+        hair: Some(hair.to_path_buf()),
+        shading: Some(plan.shading.into()),
+        head: plan.head.clone(),
+        ..FrameSettings::new(Lighting::Environment(env), [plan.size.0, plan.size.1])
+    };
     CompareSettings {
-        env: map.display().to_string(),
-        max_lobes: plan.lobes[0],
-        size: format!("{}x{}", plan.size.0, plan.size.1),
+        frame,
         json: true,
         reference_max_lights: plan.reference_max_lights,
-        shading: plan.shading,
         out: out.to_path_buf(),
         cache: cache.to_path_buf(),
         // The tables every mode measured needs, and single scattering's for full scattering's
@@ -697,21 +720,8 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
             .into_iter()
             .filter(|m| *m == ScatteringMode::Single || plan.modes.contains(m))
             .collect(),
-        kappa: plan.kappas[0],
         timing_runs: plan.timing_runs,
         baseline: plan.baseline,
-        light_map_size: plan.dodm_sizes[0],
-        head: plan.head.clone(),
-        look: LookArgs {
-            transparency: plan.transparency,
-            view: ViewArgs {
-                // Every SRBF frame of the sweep sets its own ([`srbf_configs`]); the error
-                // decomposition against the DOM reference takes Ren's light maps apart (one
-                // visibility per lobe, κ), so they are what these arguments leave in place.
-                lobe_visibility: LobeVisibilityArg::LightMaps,
-                ..ViewArgs::default()
-            },
-        },
         ground_truth: match plan.ground_truth {
             true => TruthUse::Render,
             false => TruthUse::Off,
@@ -719,19 +729,6 @@ fn compare_args(plan: &BenchPlan, map: &Path, cache: &Path, out: &Path) -> Compa
         truth_max_spp: plan.truth_max_spp[0],
         ..CompareSettings::default()
     }
-}
-
-/// The `n` most powerful SRBF lobes of the scene and every compact source.
-fn strongest_lights(scene: &CompareScene, n: usize) -> Vec<EnvLight> {
-    let mut lights = scene.srbf.clone();
-    lights.sort_by(|a, b| b.luminous_power().total_cmp(&a.luminous_power()));
-    let mut kept = 0;
-    lights.retain(|l| {
-        let keep = l.lambda.is_none() || kept < n;
-        kept += usize::from(l.lambda.is_some() && keep);
-        keep
-    });
-    lights
 }
 
 /// The yardsticks a frame is measured against: the DOM reference, and the ground truth where
@@ -858,14 +855,15 @@ fn srbf_points(
 ) -> anyhow::Result<Vec<Point>> {
     let mut points = Vec::new();
     for config in srbf_configs(plan) {
-        let lights = strongest_lights(scene, config.lobes);
-        let mut frame: EnvFrame = compare::frame(scene, args, &lights, mode);
-        frame.role = FrameRole::Interactive {
-            kappa: config.kappa,
-        };
-        frame.look.dodm = DodmSettings::at_resolution(config.dodm);
-        frame.look.lobe_visibility = config.lobe_visibility.settings(false);
-        frame.look.light_maps_under_a_head = config.lobe_visibility == LobeVisibilityArg::Auto;
+        let mut settings = args.frame_of(mode, EnvLightSet::Fit);
+        if let Lighting::Environment(env) = &mut settings.lighting {
+            env.lobes = Some(config.lobes);
+            env.kappa = config.kappa;
+            env.dodm_size = config.dodm;
+            env.view.lobe_visibility = config.lobe_visibility;
+        }
+        let frame = compare::frame(scene, &settings)?;
+        let lights = frame.lights.len();
         let r = steps.run(
             &format!("{}: SRBF {}", mode.name(), config.label),
             || compare::timed_render(&render_lights, &frame, args.timing_runs),
@@ -874,7 +872,7 @@ fn srbf_points(
         points.push(measure(
             "srbf",
             config.label,
-            lights.len(),
+            lights,
             r.milliseconds,
             &r.image,
             against,
@@ -909,30 +907,32 @@ struct MapResults {
 fn env_lit(
     plan: &BenchPlan,
     map: &Path,
-    hair: &(strandlight_runtime::hair::HairModel, String),
+    hair: &(PathBuf, strandlight_runtime::hair::HairModel, String),
     cache: &Path,
     scratch: &Path,
     steps: &mut Steps,
 ) -> anyhow::Result<MapResults> {
-    let args = compare_args(plan, map, cache, scratch);
-    let scene = compare::prepare_with_hair(&args, hair.0.clone(), hair.1.clone(), steps)?;
+    let args = compare_args(plan, (&hair.0, map), cache, scratch);
+    let scene = compare::prepare_with_hair(&args, hair.1.clone(), hair.2.clone(), steps)?;
     // The first frame compiles the driver's shader variants: not a frame's cost.
-    let lights = strongest_lights(&scene, plan.lobes[0]);
-    render_lights(&compare::frame(&scene, &args, &lights, plan.modes[0]))?;
+    render_lights(&compare::frame(
+        &scene,
+        &args.frame_of(plan.modes[0], EnvLightSet::Fit),
+    )?)?;
     let name = map_stem(map);
     let mut out = Vec::new();
     let mut decompositions = Vec::new();
-    let unshadowed_args = CompareSettings {
-        unshadowed: true,
+    let mut unshadowed_args = CompareSettings {
         reference_max_lights: unshadowed_max_lights(plan.reference_max_lights),
-        ..compare_args(plan, map, cache, scratch)
+        ..compare_args(plan, (&hair.0, map), cache, scratch)
     };
+    unshadowed_args.env_mut().shadowed = false;
     let inputs = DecompositionInputs {
         render: &render_lights,
         scene: &scene,
         args: &args,
         unshadowed_args: &unshadowed_args,
-        lights: &lights,
+        lobes: plan.lobes[0],
         kappa: plan.kappas[0],
     };
     let mut single_truth = None;
@@ -962,7 +962,7 @@ fn env_lit(
         }
         let truth_args = CompareSettings {
             truth_max_spp: plan.truth_max_spp_of(mode),
-            ..compare_args(plan, map, cache, scratch)
+            ..compare_args(plan, (&hair.0, map), cache, scratch)
         };
         let truth = compare::truth_of(&scene, &truth_args, mode, steps)?;
         if let Some(truth) = &truth {
@@ -989,7 +989,7 @@ fn env_lit(
                 || compare::render_baseline(&render_lights, &scene, &args, mode, n),
                 |r| format!("{:.0} ms", r.milliseconds),
             )?;
-            let count = compare::baseline_set(&scene, &args, n).len();
+            let count = compare::baseline_set(&scene, &args, n)?.len();
             points.push(measure(
                 family,
                 format!("{count} lights"),
@@ -1171,11 +1171,15 @@ pub struct BenchPaths {
 /// Runs `plan`. Maps absent from `paths.data` are skipped and listed.
 pub fn run(plan: &BenchPlan, paths: &BenchPaths, steps: &mut Steps) -> anyhow::Result<BenchReport> {
     let start = std::time::Instant::now();
-    let hair_path = paths.data.join("hair/straight.hair");
+    let hair_path = paths.data.join(BENCH_HAIR);
     let bytes =
         std::fs::read(&hair_path).with_context(|| format!("reading {}", hair_path.display()))?;
     let (model, _) = strandlight_scene::hair_input::load_hair(Some(&hair_path))?;
-    let hair = (model, strandlight_tables::checksum::sha256_hex(&bytes));
+    let hair = (
+        hair_path.clone(),
+        model,
+        strandlight_tables::checksum::sha256_hex(&bytes),
+    );
     let mut report = BenchReport {
         plan: plan.clone(),
         machine: machine(),

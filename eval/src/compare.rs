@@ -14,70 +14,43 @@ use anyhow::{Context, bail};
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 use std::path::PathBuf;
-use strandlight_precompute::FitOptions;
-use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
-use strandlight_precompute::compact_sources::wider_radius;
-use strandlight_precompute::env_lights::{
-    LightSpec, face_resolution_for, fitted_reference_lights, reference_lights_shaded,
-    srbf_set_lights,
-};
-use strandlight_runtime::camera::{Camera, UpAxis};
+use strandlight_precompute::env_lights::{face_resolution_for, srbf_set_lights};
 use strandlight_runtime::env::EnvRenderOptions;
 use strandlight_runtime::env_light::{EnvLight, shadow_groups};
 use strandlight_runtime::hair::HairModel;
-use strandlight_runtime::passes::convolution_depth::{DodmSettings, MAX_DODM_RESOLUTION};
+use strandlight_runtime::passes::convolution_depth::MAX_DODM_RESOLUTION;
 use strandlight_runtime::passes::view_visibility::ViewTransparency;
-use strandlight_scene::camera_choice::front_camera;
 use strandlight_scene::env_frame::{
     EnvFrame, FrameRole, RenderedEnv, fit_summary, forward_settings,
 };
-use strandlight_scene::environment::load_env;
-use strandlight_scene::fit_cache::fit_cached;
-use strandlight_scene::hair_input::{fibers_for, load_hair, parse_size};
-use strandlight_scene::head_input::{HeadChoice, default_skin_albedo, load_head};
-use strandlight_scene::image_metrics::{Image, error_legend, relative_rmse, write_side_by_side};
-use strandlight_scene::look::{EnvLook, LookArgs};
-use strandlight_scene::scene_tables::{
-    EnvShading, ScatteringMode, SceneTables, bake_scene_tables, lambda_range_of_set, wanted_tables,
+use strandlight_scene::env_light_sets::{frame_lights, reference_sources};
+pub use strandlight_scene::env_lighting::ReferenceLighting;
+use strandlight_scene::env_lighting::{EnvLightSet, EnvLighting};
+use strandlight_scene::env_scene::{AlsoServe, PreparedEnv, prepare_env};
+use strandlight_scene::frame_render::{
+    FramePart, env_frame, env_look, load_settings_hair, settings_camera,
 };
+use strandlight_scene::frame_settings::{FrameSettings, Lighting};
+use strandlight_scene::hair_input::fibers_for;
+use strandlight_scene::head_input::load_head;
+use strandlight_scene::image_metrics::{Image, error_legend, relative_rmse, write_side_by_side};
+use strandlight_scene::look::EnvLook;
+use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
 use strandlight_scene::steps::Steps;
-use strandlight_scene::world_lights::to_env_lights;
 use strandlight_tables::checksum::sha256_hex;
 use strandlight_tables::image_out::{write_exr, write_png};
 
-/// Everything one comparison is set by: a plain value that the command line builds, `bench`
-/// and the tests build directly, and every `compare --json` report records, so
-/// `compare --settings REPORT.json` measures the same thing again. The help of `compare`
-/// documents the fields it exposes as flags; the others (the fit's knobs, the reference's
-/// convergence, diagnostics) are set in a settings file.
+/// Everything one comparison is set by: the frame it measures (a [`FrameSettings`], exactly
+/// what `render replay` draws) and what measuring adds. A plain value that the command line
+/// builds, `bench` and the tests build directly, and every `compare --json` report records, so
+/// `compare --settings REPORT.json` measures the same thing again. The reference and the
+/// baseline are the same frame lit by their own light sets ([`EnvLightSet`]).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CompareSettings {
-    /// Hair file (.hair, .tfx, .data, .ply, USD .usda/.usdc/.usdz BasisCurves, Alembic .abc ICurves).
-    pub hair: PathBuf,
-    /// Environment: a Radiance .hdr / OpenEXR equirectangular map, or procedural:NAME.
-    pub env: String,
-    /// Most SRBF lobes the fit may use.
-    pub max_lobes: usize,
-    /// The fit's target relative MSE Σw‖fit−map‖²/Σw‖map‖² (lobes are added until it is met
-    /// or max_lobes is reached; default: the paper's 15%).
-    pub target_error: f64,
-    /// The fit's largest SRBF bandwidth λ (its narrowest lobe; the tables' 1/λ axis follows
-    /// the lobes the fit uses).
-    pub lambda_max: f64,
-    /// Most compact bright sources (suns, lamps) the fit takes out as directional lights
-    /// rendered beside the SRBFs; 0: SRBFs alone, as the paper.
-    pub sources: usize,
-    /// Angular radius of a compact source's disc, degrees (the fit's; the reference always
-    /// takes the default sources out, so its cache holds across fit settings).
-    pub source_radius: f64,
-    /// Least share of the remaining map's squared norm a compact source must hold (the fit's).
-    pub source_min_share: f64,
-    /// The fit takes its sources at this wider radius (degrees) where they hold ≥ 10 points
-    /// more of the map's power (extended lamps, a wide sun; 0: never; docs/BENCHMARKS.md).
-    pub wider_source_radius: f64,
-    /// Image size WxH (the paper's 640x480).
-    pub size: String,
+    /// The SRBF frame: hair, camera, fiber, map, rotation, head, look (its light set is the
+    /// fit; its scattering is set per mode of `modes`).
+    pub frame: FrameSettings,
     /// Print one JSON object on stdout (progress goes to stderr).
     pub json: bool,
     /// Lights of the brute-force reference, 6n² for n×n texels per cube face (6144 = the
@@ -95,24 +68,12 @@ pub struct CompareSettings {
     /// reference cube's shadow maps (precompute/src/env_lights.rs): the light passes stay the
     /// reference's, the shading costs more (docs/BENCHMARKS.md, "Shading the reference finer").
     pub reference_shading_lights: usize,
-    pub shading: EnvShading,
-    /// Melanin preset of the fiber: white, blonde, red, auburn, brown, dark.
-    pub preset: String,
     /// Folder for the images.
     pub out: PathBuf,
     /// Cache folder (fits, tables, reference images).
     pub cache: PathBuf,
-    /// Rotate the environment about its up axis by this many degrees.
-    pub rotate: f64,
-    /// Replace NaN/negative map values by 0 and +Inf by the largest finite value.
-    pub sanitize: bool,
-    /// Nodes per direction axis of the tables (default: the paper's resolution).
-    pub table_resolution: Option<usize>,
     /// Which modes to compare: single scattering, full (single + multiple), or both.
     pub modes: Vec<ScatteringMode>,
-    /// Stochastic simplification of the SRBF light pass (Ren §7): the fraction of strands drawn
-    /// into the light maps (1 = all). The reference and the baseline always draw all.
-    pub kappa: f32,
     /// Renders per timing (the median is reported).
     pub timing_runs: usize,
     /// Also search the fewest median-cut lights whose error is at most the SRBF frame's
@@ -124,18 +85,6 @@ pub struct CompareSettings {
     pub baseline: Baseline,
     /// The error --equal-error matches: relative RMSE, or HDR-FLIP over the hair.
     pub equal_error_metric: ErrorMetric,
-    /// Diagnostic: every single-scattering transmittance 1 in all three renders, so the error
-    /// left is the lighting (fit, median cut) and table error without the shadowing error.
-    pub unshadowed: bool,
-    /// Texels across every light map (DODM) of all three renders, the reference's included:
-    /// the reference converges in its light count at this size, and light maps of another size
-    /// shadow each strand differently (docs/BENCHMARKS.md, "Light-map size").
-    pub light_map_size: u32,
-    /// The look of all three renders.
-    pub look: LookArgs,
-    /// The head in every frame (issue 40): none, an ellipsoid fitted to the roots, an OBJ.
-    #[serde(skip_serializing_if = "HeadChoice::is_none")]
-    pub head: HeadChoice,
     /// The path-traced ground truth (Mitsuba 3; the Chiang fiber only, which is Mitsuba's
     /// `hair`): `cached` measures every frame against it where `strandlight truth` or an
     /// earlier run rendered it, `render` renders what is missing (minutes), `off` never.
@@ -150,85 +99,69 @@ impl Default for CompareSettings {
     /// The paper's comparison: 640×480, Marschner `brown`, a converged reference of up to
     /// 6144 lights, the default fit and look, the ground truth where it is cached.
     fn default() -> Self {
-        let fit = FitOptions::default();
-        let sources = strandlight_precompute::compact_sources::SourceOptions::default();
+        let lighting = Lighting::Environment(EnvLighting::new(""));
         Self {
-            hair: PathBuf::new(),
-            env: String::new(),
-            max_lobes: 64,
-            target_error: fit.target_relative_mse,
-            lambda_max: fit.lambda_max,
-            sources: sources.max_sources,
-            source_radius: sources.radius_degrees,
-            source_min_share: sources.min_norm_share,
-            wider_source_radius:
-                strandlight_precompute::compact_sources::DEFAULT_WIDER_RADIUS_DEGREES,
-            size: "640x480".to_string(),
+            frame: FrameSettings::new(lighting, [640, 480]),
             json: false,
             reference_lights: None,
             reference_tolerance: 0.01,
             reference_max_lights: 6144,
             reference_shading_lights: 0,
-            shading: EnvShading::Marschner,
-            preset: "brown".to_string(),
             out: PathBuf::from("out/compare"),
             cache: PathBuf::from("out/cache"),
-            rotate: 0.0,
-            sanitize: false,
-            table_resolution: None,
             modes: vec![ScatteringMode::Single, ScatteringMode::Full],
-            kappa: 0.1,
             timing_runs: 3,
             equal_error: false,
             baseline: Baseline::MedianCut,
             equal_error_metric: ErrorMetric::RelativeRmse,
-            unshadowed: false,
-            light_map_size: DodmSettings::default().resolution,
-            look: LookArgs::default(),
             ground_truth: TruthUse::Cached,
             truth_max_spp: TruthSettings::default().max_spp,
-            head: HeadChoice::None,
         }
     }
 }
 
-/// Everything fixed before the first render.
-pub struct CompareScene {
-    pub hair: HairModel,
-    pub hair_sha256: String,
-    pub camera: Camera,
-    pub up: UpAxis,
-    pub size: (u32, u32),
-    pub tables: SceneTables,
-    pub srbf: Vec<EnvLight>,
-    /// The compact sources the reference takes out as exact directional lights (the fit's).
-    pub reference_sources: strandlight_precompute::compact_sources::SourceOptions,
-    /// The map (unrotated: every light set turns by `--rotate`) for the reference and the
-    /// median-cut baseline.
-    pub map: strandlight_precompute::EnvMap,
-    pub map_sha256: String,
-    pub fiber: FiberDescription,
-    /// The fit's relative L2 error against the map without its compact sources (what the SRBF
-    /// path starts from).
-    pub fit_relative_l2_error: f64,
-    /// The compact sources the fit took out (rendered as directional lights in the SRBF frame).
-    pub compact_sources: Vec<strandlight_precompute::compact_sources::CompactSource>,
-    /// The fitted set's lights in the map's frame (what `srbf` holds in the world's), for a
-    /// reference of the fit's own lighting ([`ReferenceLighting::Fit`]).
-    pub fit_lights: Vec<LightSpec>,
-    /// The head (`--head`), in every frame: the SRBF path's, the reference's and the baseline's.
-    pub head: Option<strandlight_runtime::head::Head>,
-}
+impl CompareSettings {
+    /// The frame's environment lighting (`validate` refuses point-lit frames).
+    pub fn env(&self) -> &EnvLighting {
+        match &self.frame.lighting {
+            Lighting::Environment(env) => env,
+            Lighting::Lights(_) => panic!("compare settings are validated to be env-lit"),
+        }
+    }
 
-/// What a brute-force reference lights the hair with.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ReferenceLighting {
-    /// The map: every error figure is against it.
-    Map,
-    /// The fit's own lighting ([`fitted_reference_lights`]): against the map's reference it
-    /// measures the fit alone, and the SRBF frame against it the tables and the renderer
-    /// (`bench`'s error decomposition). Shaded at the texel lights only.
-    Fit,
+    pub fn env_mut(&mut self) -> &mut EnvLighting {
+        match &mut self.frame.lighting {
+            Lighting::Environment(env) => env,
+            Lighting::Lights(_) => panic!("compare settings are validated to be env-lit"),
+        }
+    }
+
+    /// The fiber model of every frame.
+    pub fn shading(&self) -> EnvShading {
+        self.frame
+            .env_shading()
+            .expect("compare settings are validated to have an env fiber")
+    }
+
+    /// The frame of `mode` lit by `light_set`: what `render replay` of its JSON draws.
+    pub fn frame_of(&self, mode: ScatteringMode, light_set: EnvLightSet) -> FrameSettings {
+        let mut frame = self.frame.clone();
+        if let Lighting::Environment(env) = &mut frame.lighting {
+            env.scattering = mode;
+            env.light_set = light_set;
+        }
+        frame
+    }
+
+    /// Reads settings JSON: the current form, or the flat one `compare --json` reports
+    /// recorded before the frame was a [`FrameSettings`] (5 Dec 2026).
+    pub fn from_json(value: Value) -> anyhow::Result<Self> {
+        match serde_json::from_value::<Self>(value.clone()) {
+            Ok(settings) => Ok(settings),
+            Err(current) => crate::compare_settings_legacy::read(value)
+                .map_err(|legacy| anyhow::anyhow!("{current} (nor the older form: {legacy})")),
+        }
+    }
 }
 
 /// The settings checked together, before any work (for callers that build them).
@@ -237,47 +170,25 @@ pub(crate) fn check_args(args: &CompareSettings) -> anyhow::Result<()> {
 }
 
 fn validate(args: &CompareSettings) -> anyhow::Result<ReferenceChoice> {
-    if args.env.is_empty() {
+    let Lighting::Environment(env) = &args.frame.lighting else {
+        bail!("compare measures env-lit frames: the settings' lighting must be an environment");
+    };
+    if env.map.is_empty() {
         bail!("--env: no environment given (on the command line or in --settings)");
     }
-    if args.max_lobes == 0 {
-        bail!("max_lobes 0: at least one SRBF lobe is needed");
+    if !env.light_set.is_fit() {
+        bail!("the compared frame is the SRBF fit's (its light set must be `fit`)");
     }
     if args.timing_runs == 0 {
         bail!("timing_runs 0: at least one render per timing");
     }
-    args.look.look()?;
-    light_maps(args).check().with_context(|| {
-        format!(
+    if !(1..=MAX_DODM_RESOLUTION).contains(&env.dodm_size) {
+        bail!(
             "--light-map-size {}: texels across a light map, 1 to {MAX_DODM_RESOLUTION}",
-            args.light_map_size
-        )
-    })?;
-    if let Some(n) = args.table_resolution
-        && !(2..=256).contains(&n)
-    {
-        bail!("table_resolution {n}: use 2 to 256 nodes per direction axis");
-    }
-    if !(args.source_radius > 0.0 && args.source_radius <= 20.0) {
-        bail!(
-            "source_radius {}: a compact source's angular radius in degrees, in (0, 20]",
-            args.source_radius
+            env.dodm_size
         );
     }
-    if let Some(r) = wider_radius(args.wider_source_radius)
-        && !(r > args.source_radius && r <= 20.0)
-    {
-        bail!(
-            "wider_source_radius {r}: must be wider than source_radius ({}) and at most 20 degrees (0: never)",
-            args.source_radius
-        );
-    }
-    if !(args.source_min_share > 0.0 && args.source_min_share <= 1.0) {
-        bail!(
-            "source_min_share {}: a share of the map's squared norm, in (0, 1]",
-            args.source_min_share
-        );
-    }
+    args.frame.check()?;
     if !(args.reference_tolerance > 0.0 && args.reference_tolerance < 1.0) {
         bail!(
             "reference_tolerance {}: must be in (0, 1)",
@@ -354,25 +265,41 @@ impl ReferenceChoice {
     }
 }
 
-/// Loads the hair file, fits, bakes and builds the light sets (every step timed into `steps`).
-pub fn prepare(args: &CompareSettings, steps: &mut Steps) -> anyhow::Result<CompareScene> {
-    if args.hair.as_os_str().is_empty() {
-        bail!("--hair: no hair file given (on the command line or in --settings)");
+/// Everything fixed before the first render: the hair and the prepared environment (fit,
+/// tables, map) every frame of the comparison is built from.
+pub struct CompareScene {
+    pub hair: HairModel,
+    /// Identifies the hair in the reference and truth caches.
+    pub hair_sha256: String,
+    pub prepared: PreparedEnv,
+}
+
+impl CompareScene {
+    /// The map's content hash.
+    pub fn map_sha256(&self) -> &str {
+        &self
+            .prepared
+            .map()
+            .expect("compare prepares the map")
+            .sha256
     }
+
+    /// The map.
+    pub fn map(&self) -> &strandlight_precompute::EnvMap {
+        &self.prepared.map().expect("compare prepares the map").map
+    }
+}
+
+/// Loads the hair (the settings' file, or the procedural groom), fits, bakes and builds the
+/// light sets (every step timed into `steps`).
+pub fn prepare(args: &CompareSettings, steps: &mut Steps) -> anyhow::Result<CompareScene> {
     validate(args)?;
-    let (hair, hair_sha256) = steps.run(
+    let hair = steps.run(
         "hair",
-        || {
-            let bytes = std::fs::read(&args.hair)
-                .with_context(|| format!("--hair {}", args.hair.display()))?;
-            let (model, _) = load_hair(Some(&args.hair))?;
-            Ok((model, sha256_hex(&bytes)))
-        },
-        |(m, _): &(HairModel, String)| {
-            format!("{} ({} strands)", args.hair.display(), m.strand_count())
-        },
+        || load_settings_hair(&args.frame),
+        |h| format!("{} ({} strands)", h.source, h.model.strand_count()),
     )?;
-    prepare_with_hair(args, hair, hair_sha256, steps)
+    prepare_with_hair(args, hair.model, hair.identity, steps)
 }
 
 /// [`prepare`] for a hair already loaded (`hair_sha256` identifies it in the reference cache).
@@ -383,105 +310,17 @@ pub fn prepare_with_hair(
     steps: &mut Steps,
 ) -> anyhow::Result<CompareScene> {
     validate(args)?;
-    let (hair, hair_sha256) = fibers_for(args.shading, hair, hair_sha256);
-    let (width, height) = parse_size(&args.size)?;
-    let fiber = FiberDescription::preset(&args.preset)
-        .with_context(|| format!("--preset {:?}", args.preset))?;
-    let env = steps.run(
-        "environment",
-        || load_env(&args.env, args.sanitize),
-        |e| format!("{} {}x{}", e.name, e.map.width(), e.map.height()),
-    )?;
-    let sources = strandlight_precompute::compact_sources::SourceOptions {
-        max_sources: args.sources,
-        radius_degrees: args.source_radius,
-        min_norm_share: args.source_min_share,
+    let (hair, hair_sha256) = fibers_for(args.shading(), hair, hair_sha256);
+    let also = AlsoServe {
+        full_scattering: args.modes.contains(&ScatteringMode::Full),
+        directional_sets: true,
     };
-    let options = FitOptions {
-        max_lobes: args.max_lobes,
-        initial_lobes: args.max_lobes.min(FitOptions::default().initial_lobes),
-        rotate_degrees: args.rotate,
-        sources,
-        wider_source_radius: wider_radius(args.wider_source_radius),
-        target_relative_mse: args.target_error,
-        lambda_max: args.lambda_max,
-        ..FitOptions::default()
-    };
-    let fit = steps.run(
-        "fit",
-        || fit_cached(&env, &options, &args.cache),
-        |f| {
-            format!(
-                "{}{} → {}",
-                fit_summary(&f.set),
-                if f.cached { " (cached)" } else { "" },
-                f.path.display()
-            )
-        },
-    )?;
-    let set = fit.set.clone();
-    let lambda_range = lambda_range_of_set(&set)?;
-    let resolution = args
-        .table_resolution
-        .map(BakeResolution::reduced)
-        .unwrap_or_default();
-    let wanted = wanted_tables(args.shading, &args.modes, !set.lobes.is_empty(), true);
-    // A resolution of its own gets a folder of its own: runs of other resolutions would
-    // otherwise rebake over each other's tables.
-    let resolution_suffix = args
-        .table_resolution
-        .map_or(String::new(), |n| format!("-n{n}"));
-    let table_dir = args
-        .cache
-        .join("tables")
-        .join(format!("{}-{:?}{resolution_suffix}", args.preset, args.shading).to_lowercase());
-    let tables = steps.run(
-        "bake",
-        || {
-            bake_scene_tables(
-                &fiber,
-                args.shading,
-                resolution,
-                lambda_range,
-                &wanted,
-                &table_dir,
-                &mut |_| {},
-            )
-        },
-        |t| {
-            format!(
-                "{} tables ({} cached), λ ∈ [{:.1}, {:.1}] → {}",
-                t.baked.len(),
-                t.baked.iter().filter(|b| b.cached).count(),
-                lambda_range.0,
-                lambda_range.1,
-                table_dir.display()
-            )
-        },
-    )?;
-    let (up, camera) = front_camera(&hair, (width, height));
-    let fit_lights = srbf_set_lights(&set);
-    let srbf = to_env_lights(&fit_lights, up);
-    let fit_relative_l2_error = fit.set.relative_l2_error;
-    let head = load_head(&args.head, &hair, default_skin_albedo())?;
+    let prepared = prepare_env(&args.frame, &hair, &args.cache, also, steps, &mut |_| {})?;
+    steps.say(fit_summary(&prepared.scene.fit));
     Ok(CompareScene {
         hair,
         hair_sha256,
-        camera,
-        up,
-        size: (width, height),
-        tables,
-        srbf,
-        // The reference's discretization, not the method's: any choice converges to the same
-        // image, and a fixed one keeps the cached ladders valid whatever the fit is given.
-        reference_sources: strandlight_precompute::compact_sources::SourceOptions::default(),
-        map: env.map,
-        map_sha256: env.sha256,
-        fiber,
-        fit_relative_l2_error,
-        compact_sources: fit.set.sources.clone(),
-        fit_lights,
-        head,
+        prepared,
     })
 }
 
@@ -507,32 +346,6 @@ pub fn timed_render(
     Ok(r)
 }
 
-impl CompareScene {
-    /// The reference's lights for n×n texels per cube face: the compact sources exactly, the
-    /// rest of the map one light per cube texel.
-    /// Shaded over a `shading_face`² cube per face when that is finer (see
-    /// [`CompareSettings::reference_shading_lights`]).
-    pub fn reference_set(
-        &self,
-        face: usize,
-        shading_face: Option<usize>,
-        rotate: f64,
-        lighting: ReferenceLighting,
-    ) -> anyhow::Result<Vec<EnvLight>> {
-        if lighting == ReferenceLighting::Fit {
-            // The fit's lobes are already turned by the rotation the scene was fitted with.
-            let (w, h) = (self.map.width(), self.map.height());
-            let specs = fitted_reference_lights(&self.fit_lights, w, h, face)?;
-            return Ok(to_env_lights(&specs, self.up));
-        }
-        let shading = shading_face.unwrap_or(face).max(face);
-        let specs =
-            reference_lights_shaded(&self.map, face, shading, rotate, &self.reference_sources)
-                .with_context(|| format!("reference_shading_lights {}", 6 * shading * shading))?;
-        Ok(to_env_lights(&specs, self.up))
-    }
-}
-
 /// One reference image, rendered or from the cache.
 pub struct ReferenceImage {
     pub image: Image,
@@ -553,6 +366,7 @@ pub struct Reference {
 /// One mode's results.
 struct ModeResult {
     srbf: RenderedEnv,
+    srbf_lights: usize,
     srbf_flip: HdrFlip,
     baseline_flip: HdrFlip,
     reference: Reference,
@@ -583,11 +397,16 @@ impl EqualErrorResult {
 
 /// The baseline's (`--baseline`) lights for a budget of `count`: exactly `count`, except that
 /// median cut with exact sources keeps every source and at least one light for the rest.
-pub fn baseline_set(scene: &CompareScene, args: &CompareSettings, count: usize) -> Vec<EnvLight> {
-    let specs = args
-        .baseline
-        .lights(&scene.map, count, args.rotate, &scene.reference_sources);
-    to_env_lights(&specs, scene.up)
+pub fn baseline_set(
+    scene: &CompareScene,
+    args: &CompareSettings,
+    count: usize,
+) -> anyhow::Result<Vec<EnvLight>> {
+    let settings = args.frame_of(ScatteringMode::Single, args.baseline.light_set(count));
+    let Lighting::Environment(env) = &settings.lighting else {
+        unreachable!("compare frames are env-lit")
+    };
+    frame_lights(&scene.prepared, env)
 }
 
 /// The baseline (`--baseline`) with a budget of `lights` directional lights ([`baseline_set`]).
@@ -598,8 +417,8 @@ pub fn render_baseline(
     mode: ScatteringMode,
     lights: usize,
 ) -> anyhow::Result<RenderedEnv> {
-    let lights = baseline_set(scene, args, lights);
-    timed_render(render, &frame(scene, args, &lights, mode), args.timing_runs)
+    let settings = args.frame_of(mode, args.baseline.light_set(lights));
+    timed_render(render, &frame(scene, &settings)?, args.timing_runs)
 }
 
 /// Median-cut baselines of growing size (up to `most` lights) until one is as accurate as
@@ -645,11 +464,13 @@ pub fn truth_settings(args: &CompareSettings) -> TruthSettings {
 /// Mitsuba's `hair` parameters of the scene's fiber, where the shading model is the one the
 /// path tracer has (Chiang et al. 2016); None for the others, which the DOM reference measures.
 pub fn truth_fiber(scene: &CompareScene, args: &CompareSettings) -> Option<Value> {
-    (args.shading == EnvShading::Chiang)
-        .then(|| serde_json::to_value(&scene.fiber.chiang).expect("fiber parameters serialize"))
+    (args.shading() == EnvShading::Chiang).then(|| {
+        serde_json::to_value(&scene.prepared.fiber.chiang).expect("fiber parameters serialize")
+    })
 }
 
-/// The path-traced ground truth of `mode` (cached, rendered or none: `--ground-truth`).
+/// The path-traced ground truth of `mode` (cached, rendered or none: `--ground-truth`): the
+/// scene `truth --export` writes for the same frame settings.
 pub fn truth_of(
     scene: &CompareScene,
     args: &CompareSettings,
@@ -659,20 +480,17 @@ pub fn truth_of(
     let Some(fiber) = truth_fiber(scene, args) else {
         return Ok(None);
     };
+    let head = load_head(&args.frame.head, &scene.hair, args.frame.skin_albedo)?;
     let inputs = TruthInputs {
-        scene: MitsubaScene {
-            hair: &scene.hair,
-            up: scene.up,
-            camera: scene.camera,
-            size: scene.size,
-            map: Some(&scene.map),
-            rotate_degrees: args.rotate,
-            directional: &[],
-            fiber: &fiber,
-            head: scene.head.as_ref(),
-        },
+        scene: MitsubaScene::of_frame(
+            &args.frame,
+            &scene.hair,
+            (scene.map(), scene.prepared.up),
+            &fiber,
+            head.as_ref(),
+        )?,
         hair_sha256: &scene.hair_sha256,
-        map_sha256: &scene.map_sha256,
+        map_sha256: scene.map_sha256(),
     };
     ground_truth(
         &inputs,
@@ -684,51 +502,24 @@ pub fn truth_of(
     )
 }
 
+/// The frame of `settings` (one of `args.frame_of`'s) over the comparison's scene: built by the
+/// one env-lit frame builder, as `render replay` of the same settings builds it.
 pub fn frame<'a>(
     scene: &'a CompareScene,
-    args: &CompareSettings,
-    lights: &'a [EnvLight],
-    mode: ScatteringMode,
-) -> EnvFrame<'a> {
-    EnvFrame {
-        hair: &scene.hair,
-        camera: scene.camera,
-        width: scene.size.0,
-        height: scene.size.1,
-        lights,
-        tables: &scene.tables,
-        shading: args.shading,
-        mode,
-        role: FrameRole::Interactive { kappa: args.kappa },
-        look: look(args),
-        head: scene.head.clone(),
-    }
+    settings: &FrameSettings,
+) -> anyhow::Result<EnvFrame<'a>> {
+    env_frame(
+        settings,
+        &scene.hair,
+        &scene.prepared,
+        FramePart::Whole,
+        false,
+    )
 }
 
-/// The light maps of every frame (checked by `validate`).
-fn light_maps(args: &CompareSettings) -> DodmSettings {
-    DodmSettings::at_resolution(args.light_map_size)
-}
-
-/// The renderer choices of every frame (checked by `validate`).
+/// The look of every frame of `args` (checked by `validate`).
 fn look(args: &CompareSettings) -> EnvLook {
-    EnvLook {
-        shadowed: !args.unshadowed,
-        dodm: light_maps(args),
-        ..args.look.look().expect("checked by validate")
-    }
-}
-
-fn reference_frame<'a>(
-    scene: &'a CompareScene,
-    args: &CompareSettings,
-    lights: &'a [EnvLight],
-    mode: ScatteringMode,
-) -> EnvFrame<'a> {
-    EnvFrame {
-        role: FrameRole::Reference,
-        ..frame(scene, args, lights, mode)
-    }
+    env_look(args.env()).expect("checked by validate")
 }
 
 /// The multiple-scattering tables a directional reference reads (`srbf_spread` serves SRBF
@@ -744,23 +535,27 @@ fn reference_inputs(
     mode: ScatteringMode,
     lighting: ReferenceLighting,
 ) -> anyhow::Result<Value> {
-    let direct = scene.tables.get(args.shading.direct_table(mode))?;
+    let prepared = &scene.prepared;
+    let tables = &prepared.scene.tables;
+    let direct = tables.get(args.shading().direct_table(mode))?;
+    let env = args.env();
+    let [width, height] = args.frame.size;
     let mut inputs = json!({
         "hair_sha256": scene.hair_sha256,
-        "camera": format!("{:?}", scene.camera),
-        "size": [scene.size.0, scene.size.1],
-        "map_sha256": scene.map_sha256,
-        "rotate": args.rotate,
+        "camera": format!("{:?}", settings_camera(&args.frame, &scene.hair)?),
+        "size": [width, height],
+        "map_sha256": scene.map_sha256(),
+        "rotate": env.rotation_deg as f64,
         "reference_lights": lights,
         "reference_placement": "compact sources exact, texel lights at texel centres",
-        "reference_sources": scene.reference_sources,
+        "reference_sources": reference_sources(),
         "mode": mode.name(),
-        "shading": args.shading,
-        "fiber": scene.fiber,
+        "shading": args.shading(),
+        "fiber": prepared.fiber,
         "direct_table_inputs": direct.metadata.description.inputs_key,
-        "multiple_tables_inputs": REFERENCE_MULTIPLE_TABLES.iter().filter(|_| mode == ScatteringMode::Full).filter_map(|n| scene.tables.assets.get(*n)).map(|a| a.metadata.description.inputs_key.clone()).collect::<Vec<_>>(),
+        "multiple_tables_inputs": REFERENCE_MULTIPLE_TABLES.iter().filter(|_| mode == ScatteringMode::Full).filter_map(|n| tables.assets.get(*n)).map(|a| a.metadata.description.inputs_key.clone()).collect::<Vec<_>>(),
         "generator": env!("CARGO_PKG_VERSION"),
-        "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: !args.unshadowed, transparency: look(args).transparency, dodm: look(args).dodm, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
+        "renderer": format!("{:?} / {:?}", EnvRenderOptions { kappa: 1.0, shadowed: env.shadowed, transparency: look(args).transparency, dodm: look(args).dodm, ..EnvRenderOptions::default() }, forward_settings(FrameRole::Reference)),
     });
     // Occupancy references rendered before the view's weights were rescaled to each pixel's
     // coverage are not this renderer's: the key tells them apart (opaque ones keep theirs).
@@ -774,12 +569,13 @@ fn reference_inputs(
     }
     // Only the fit's lighting adds a key, so the map's references keep their cache entries.
     // Only with a head: the references rendered before it keep their keys.
-    if let Some(head) = &scene.head {
+    if let Some(head) = load_head(&args.frame.head, &scene.hair, args.frame.skin_albedo)? {
         inputs["head"] = json!(format!("{:016x}", head.fingerprint()));
     }
     if lighting == ReferenceLighting::Fit {
+        let fit_lights = srbf_set_lights(&prepared.scene.fit);
         inputs["reference_lighting"] = json!({
-            "fit_lights": sha256_hex(format!("{:?}", scene.fit_lights).as_bytes()),
+            "fit_lights": sha256_hex(format!("{fit_lights:?}").as_bytes()),
             "placement": "fit's sources exact, its lobes' radiance sampled on the map's grid, texel lights at texel centres",
         });
     }
@@ -800,22 +596,12 @@ fn run_mode(
     steps: &mut Steps,
 ) -> anyhow::Result<ModeResult> {
     let m = mode.name();
+    let srbf_frame = frame(scene, &args.frame_of(mode, EnvLightSet::Fit))?;
+    let srbf_lights = srbf_frame.lights.len();
     let srbf = steps.run(
         &format!("{m}: SRBF"),
-        || {
-            timed_render(
-                render,
-                &frame(scene, args, &scene.srbf, mode),
-                args.timing_runs,
-            )
-        },
-        |r| {
-            format!(
-                "{:.2} ms/frame, {} lights",
-                r.milliseconds,
-                scene.srbf.len()
-            )
-        },
+        || timed_render(render, &srbf_frame, args.timing_runs),
+        |r| format!("{:.2} ms/frame, {srbf_lights} lights", r.milliseconds),
     )?;
     let reference = reference(render, scene, args, mode, steps)?;
     let truth = truth_of(scene, args, mode, steps)?;
@@ -895,7 +681,8 @@ fn run_mode(
         baseline_flip,
         reference,
         baseline,
-        baseline_lights: baseline_set(scene, args, found.lights).len(),
+        srbf_lights,
+        baseline_lights: baseline_set(scene, args, found.lights)?.len(),
         baseline_search: found.measurements,
         equal_error,
         truth,
@@ -904,7 +691,7 @@ fn run_mode(
 
 /// What the steps call a reference of `lighting` under `args`.
 fn reference_name(lighting: ReferenceLighting, args: &CompareSettings) -> &'static str {
-    match (lighting, args.unshadowed) {
+    match (lighting, !args.env().shadowed) {
         (ReferenceLighting::Map, false) => "reference",
         (ReferenceLighting::Map, true) => "unshadowed reference",
         (ReferenceLighting::Fit, false) => "reference of the fit",
@@ -922,9 +709,14 @@ fn reference_with_face(
     lighting: ReferenceLighting,
     steps: &mut Steps,
 ) -> anyhow::Result<ReferenceImage> {
-    let lights = scene.reference_set(face, shading_face(args)?, args.rotate, lighting)?;
+    let light_set = EnvLightSet::Reference {
+        face,
+        shading_face: shading_face(args)?,
+        lighting,
+    };
+    let reference_frame = frame(scene, &args.frame_of(mode, light_set))?;
     // What a reference costs is its shadow maps: one per compact source and per texel.
-    let maps = shadow_groups(&lights).len();
+    let maps = shadow_groups(&reference_frame.lights).len();
     let cache = ReferenceCache::new(args.cache.join("reference"));
     let inputs = reference_inputs(scene, args, face, maps, mode, lighting)?;
     let what = reference_name(lighting, args);
@@ -937,7 +729,7 @@ fn reference_with_face(
                 cached: true,
             }),
             None => {
-                let r = render(&reference_frame(scene, args, &lights, mode))?;
+                let r = render(&reference_frame)?;
                 let record = ReferenceRecord {
                     inputs: inputs.clone(),
                     lights: maps,
@@ -1089,18 +881,20 @@ pub fn execute(
     let mut report = serde_json::Map::new();
     // What `compare --settings REPORT.json` reads back to measure the same thing again.
     report.insert("settings".into(), serde_json::to_value(args)?);
+    let env = args.env();
+    let hair_name = hair_name(&args.frame);
     let description = format!(
-        "strandlight compare: {} under {} ({:?}, preset {})",
-        args.hair.display(),
-        args.env,
-        args.shading,
-        args.preset
+        "strandlight compare: {hair_name} under {} ({:?}, preset {})",
+        env.map,
+        args.shading(),
+        args.frame.preset
     );
     if let Some(&first) = args.modes.first() {
         // Drivers compile shader variants at their first draw (lavapipe: seconds): not a frame's cost.
+        let warm_up = frame(scene, &args.frame_of(first, EnvLightSet::Fit))?;
         steps.run(
             "warm-up",
-            || render(&frame(scene, args, &scene.srbf, first)),
+            || render(&warm_up),
             |r| format!("{:.0} ms, untimed", r.milliseconds),
         )?;
     }
@@ -1118,7 +912,7 @@ pub fn execute(
             .map(|&(lights, ms, d)| json!({"lights": lights, "ms": ms, "relative_rmse_vs_4x": d}))
             .collect();
         let mut entry = json!({
-                "srbf": { "lights": scene.srbf.len(), "ms": r.srbf.milliseconds, "relative_rmse": srbf_error, "hdr_flip": r.srbf_flip.mean_over_hair },
+                "srbf": { "lights": r.srbf_lights, "ms": r.srbf.milliseconds, "relative_rmse": srbf_error, "hdr_flip": r.srbf_flip.mean_over_hair },
                 "baseline": { "lights": r.baseline_lights, "ms": r.baseline.milliseconds, "relative_rmse": baseline_error, "hdr_flip": r.baseline_flip.mean_over_hair, "search": r.baseline_search },
                 "hdr_flip_exposures": { "start": r.srbf_flip.start_exposure, "stop": r.srbf_flip.stop_exposure, "count": r.srbf_flip.exposures },
                 "reference": { "lights": reference.record.lights, "ms": reference_ms, "cached": reference.cached, "converged": r.reference.converged, "convergence": ladder },
@@ -1153,11 +947,12 @@ pub fn execute(
     report.insert(
         "scene".into(),
         json!({
-            "hair": args.hair, "env": args.env, "size": [scene.size.0, scene.size.1], "shading": args.shading,
-            "preset": args.preset, "baseline": args.baseline, "lambda_max": args.lambda_max, "sources": args.sources, "source_radius": args.source_radius, "source_min_share": args.source_min_share, "wider_source_radius": args.wider_source_radius, "light_map_size": args.light_map_size, "kappa": args.kappa, "timing_runs": args.timing_runs, "unshadowed": args.unshadowed,
-            "transparency": args.look.transparency, "visibility_cutoff": args.look.view.visibility_cutoff, "lobe_visibility": args.look.view.lobe_visibility, "forward_scattering": args.look.view.forward_scattering,
-            "fit_relative_l2_error": scene.fit_relative_l2_error,
-            "compact_sources": scene.compact_sources,
+            "hair": hair_name, "env": env.map, "size": args.frame.size, "shading": args.shading(),
+            "preset": args.frame.preset, "baseline": args.baseline, "lambda_max": env.fit.lambda_max, "sources": env.fit.sources, "source_radius": env.fit.source_radius, "source_min_share": env.fit.source_min_share, "wider_source_radius": env.fit.wider_source_radius, "light_map_size": env.dodm_size, "kappa": env.kappa, "timing_runs": args.timing_runs, "unshadowed": !env.shadowed,
+            "rotate": env.rotation_deg, "head": args.frame.head,
+            "transparency": env.transparency, "visibility_cutoff": env.view.visibility_cutoff, "lobe_visibility": env.view.lobe_visibility, "forward_scattering": env.view.forward_scattering,
+            "fit_relative_l2_error": scene.prepared.scene.fit.relative_l2_error,
+            "compact_sources": scene.prepared.scene.fit.sources,
         }),
     );
     report.insert(
@@ -1171,6 +966,14 @@ pub fn execute(
         ),
     );
     Ok(Value::Object(report))
+}
+
+/// The hair file's name, or the procedural groom's.
+pub fn hair_name(frame: &FrameSettings) -> String {
+    match &frame.hair {
+        Some(path) => path.display().to_string(),
+        None => "the procedural groom".into(),
+    }
 }
 
 /// The ground truth's record and each frame's error against it (raw, and with the truth's
@@ -1230,14 +1033,15 @@ fn truth_line(mode: ScatteringMode, truth: &GroundTruth, figures: &Value) -> Str
 #[cfg(test)]
 mod tests {
     use super::*;
+    use strandlight_scene::environment::load_env;
+    use strandlight_scene::fit_cache::fit_cached;
+    use strandlight_scene::point_shading::Shading;
 
     /// Settings for hair `h` under map `e`, changed by `change`.
     fn settings(change: impl FnOnce(&mut CompareSettings)) -> CompareSettings {
-        let mut s = CompareSettings {
-            hair: "h".into(),
-            env: "e".into(),
-            ..CompareSettings::default()
-        };
+        let mut s = CompareSettings::default();
+        s.frame.hair = Some("h".into());
+        s.env_mut().map = "e".into();
         change(&mut s);
         s
     }
@@ -1246,8 +1050,13 @@ mod tests {
     fn settings_default_to_the_issue_and_bad_values_are_named() {
         let a = settings(|_| {});
         assert_eq!(
-            (a.max_lobes, a.size.as_str(), a.reference_lights, a.shading),
-            (64, "640x480", None, EnvShading::Marschner)
+            (
+                a.env().fit.max_lobes,
+                a.frame.size,
+                a.reference_lights,
+                a.shading()
+            ),
+            (64, [640, 480], None, EnvShading::Marschner)
         );
         assert_eq!(
             validate(&a).unwrap(),
@@ -1283,32 +1092,40 @@ mod tests {
             (
                 "--light-map-size 0",
                 "1 to 2048",
-                Box::new(|s| s.light_map_size = 0),
+                Box::new(|s| s.env_mut().dodm_size = 0),
             ),
             (
                 "--light-map-size 4096",
                 "1 to 2048",
-                Box::new(|s| s.light_map_size = 4096),
+                Box::new(|s| s.env_mut().dodm_size = 4096),
             ),
             (
                 "--truth-max-spp 3",
                 "at least 4",
                 Box::new(|s| s.truth_max_spp = 3),
             ),
-            ("max_lobes 0", "at least one", Box::new(|s| s.max_lobes = 0)),
+            (
+                "max_lobes 0",
+                "at least one",
+                Box::new(|s| s.env_mut().fit.max_lobes = 0),
+            ),
             (
                 "--reference-lights 100",
                 "6n²",
                 Box::new(|s| s.reference_lights = Some(100)),
             ),
-            ("--env", "no environment", Box::new(|s| s.env.clear())),
+            (
+                "--env",
+                "no environment",
+                Box::new(|s| s.env_mut().map.clear()),
+            ),
         ];
         for (named, wanted, change) in cases {
             let e = validate(&settings(change)).unwrap_err().to_string();
             assert!(e.contains(named) && e.contains(wanted), "{named}: {e}");
         }
         let a = settings(|s| {
-            s.shading = EnvShading::Artist;
+            s.frame.shading = Some(Shading::Artist);
             s.reference_lights = Some(96);
         });
         assert_eq!(validate(&a).unwrap(), ReferenceChoice::Fixed(4));
@@ -1317,18 +1134,18 @@ mod tests {
             validate(&a).unwrap(),
             ReferenceChoice::Converged { most_face: 32 }
         );
-        let no_hair = settings(|s| s.hair = PathBuf::new());
-        let e = prepare(&no_hair, &mut Steps::new(true))
-            .err()
-            .expect("must fail");
-        assert!(format!("{e:#}").contains("--hair"), "{e:#}");
+        let point_lit = settings(|s| {
+            s.frame.lighting = Lighting::Lights(Default::default());
+        });
+        let e = validate(&point_lit).unwrap_err().to_string();
+        assert!(e.contains("env-lit"), "{e}");
     }
 
     #[test]
     fn a_missing_hair_file_is_named_before_any_work() {
         let a = settings(|s| {
-            s.hair = "/nonexistent/straight.hair".into();
-            s.env = "procedural:studio".into();
+            s.frame.hair = Some("/nonexistent/straight.hair".into());
+            s.env_mut().map = "procedural:studio".into();
             s.reference_lights = Some(96);
         });
         let e = prepare(&a, &mut Steps::new(true)).err().expect("must fail");
@@ -1336,6 +1153,15 @@ mod tests {
             format!("{e:#}").contains("/nonexistent/straight.hair"),
             "{e:#}"
         );
+    }
+
+    /// The procedural studio at `size` over a hair of the caller's, with a fit of 8 lobes and
+    /// tables of 4 nodes an axis: quick to prepare.
+    fn small_frame(size: [u32; 2]) -> FrameSettings {
+        let mut env = EnvLighting::new("procedural:studio");
+        env.fit.max_lobes = 8;
+        env.table_resolution = Some(4);
+        FrameSettings::new(Lighting::Environment(env), size)
     }
 
     /// A stand-in renderer whose picture is known without a GPU: every pixel of a central
@@ -1408,12 +1234,8 @@ mod tests {
                 dir.join("cache").display().to_string(),
             );
             let a = CompareSettings {
-                hair: "groom".into(),
-                env: "procedural:studio".into(),
-                max_lobes: 8,
-                size: "16x12".into(),
+                frame: small_frame([16, 12]),
                 reference_tolerance: tolerance.parse().unwrap(),
-                table_resolution: Some(4),
                 timing_runs: 1,
                 modes: vec![ScatteringMode::Single],
                 out: (&out).into(),
@@ -1452,12 +1274,8 @@ mod tests {
             dir.join("cache").display().to_string(),
         );
         let a = CompareSettings {
-            hair: "groom".into(),
-            env: "procedural:studio".into(),
-            max_lobes: 8,
-            size: "32x24".into(),
+            frame: small_frame([32, 24]),
             reference_lights: Some(96),
-            table_resolution: Some(4),
             timing_runs: 1,
             out: (&out).into(),
             cache: (&cache).into(),
@@ -1479,22 +1297,18 @@ mod tests {
         // integral exactly, the SRBFs carry it times the fit's own measured power ratio.
         let fit = fit_cached(
             &load_env("procedural:studio", false).unwrap(),
-            &FitOptions {
-                max_lobes: 8,
-                initial_lobes: 8,
-                ..FitOptions::default()
-            },
+            &a.env().fit.options(),
             &dir.join("cache"),
         )
         .unwrap();
         assert!(fit.cached, "compare stored its fit in the cache");
-        let integral = scene.map.integral();
+        let integral = scene.map().integral();
         let num: f64 = (0..3)
             .map(|c| ((fit.set.power_ratio[c] - 1.0) * integral[c]).powi(2))
             .sum();
         let den: f64 = integral.iter().map(|v| v * v).sum();
         let want_srbf = (num / den).sqrt();
-        let n_srbf = scene.srbf.len();
+        let n_srbf = frame(&scene, &a.frame).unwrap().lights.len();
         for mode in ["single", "full"] {
             let m = &report[mode];
             let srbf = m["srbf"]["relative_rmse"].as_f64().unwrap();

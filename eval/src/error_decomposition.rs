@@ -24,13 +24,13 @@
 //! as the DOM reference of the fit's lights, and the tables are not apart from the one
 //! visibility per lobe there.
 
-use crate::compare::{self, CompareScene, CompareSettings, Reference, ReferenceLighting};
+use crate::compare::{self, CompareScene, CompareSettings, Reference};
 use crate::ground_truth::GroundTruth;
 use crate::hdr_flip::hdr_flip;
 use serde::{Deserialize, Serialize};
-use strandlight_runtime::env_light::EnvLight;
-use strandlight_runtime::passes::convolution_depth::DodmSettings;
-use strandlight_scene::env_frame::{EnvFrame, FrameRole, RenderedEnv};
+use strandlight_scene::env_frame::RenderedEnv;
+use strandlight_scene::env_lighting::{EnvLightSet, EnvLighting, ReferenceLighting};
+use strandlight_scene::frame_settings::{FrameSettings, Lighting};
 use strandlight_scene::image_metrics::{Image, relative_rmse, relative_rmse_of_part};
 use strandlight_scene::look::LobeVisibilityArg;
 use strandlight_scene::scene_tables::ScatteringMode;
@@ -100,17 +100,18 @@ pub const TRUTH_SHARP_SOURCES: &str = "the default, compact sources' maps at 4×
 pub const SHARP_SOURCE_MAP_SCALE: u32 = 4;
 
 /// What a decomposition renders with: the scene, the run's compare settings (`args`) and the
-/// same with `unshadowed` set, the SRBF default's lights and κ.
+/// same with the frame unshadowed, the SRBF default's lobe count and κ.
 pub struct DecompositionInputs<'a> {
     pub render: compare::Renderer<'a>,
     pub scene: &'a CompareScene,
     pub args: &'a CompareSettings,
     pub unshadowed_args: &'a CompareSettings,
-    pub lights: &'a [EnvLight],
+    pub lobes: usize,
     pub kappa: f32,
 }
 
 impl DecompositionInputs<'_> {
+    /// The SRBF frame of `args` in `mode` with κ `kappa` (and the look of `args`).
     fn srbf(
         &self,
         args: &CompareSettings,
@@ -119,44 +120,60 @@ impl DecompositionInputs<'_> {
         label: &str,
         steps: &mut Steps,
     ) -> anyhow::Result<Image> {
-        let mut frame: EnvFrame = compare::frame(self.scene, args, self.lights, mode);
-        frame.role = FrameRole::Interactive { kappa };
-        self.render_srbf(&frame, mode, label, steps)
+        let settings = self.srbf_settings(args, mode, |env| env.kappa = kappa);
+        self.render_srbf(&settings, mode, label, steps)
     }
 
     /// The product's default frame (lobes read the visibility volume), with compact sources'
-    /// light maps of `dodm`.
+    /// light maps `dodm_size` texels across.
     fn srbf_volume(
         &self,
         mode: ScatteringMode,
-        dodm: DodmSettings,
+        dodm_size: u32,
         label: &str,
         steps: &mut Steps,
     ) -> anyhow::Result<Image> {
-        let mut frame: EnvFrame = compare::frame(self.scene, self.args, self.lights, mode);
-        frame.role = FrameRole::Interactive { kappa: self.kappa };
-        frame.look.lobe_visibility = LobeVisibilityArg::Volume.settings(false);
-        frame.look.dodm = dodm;
-        self.render_srbf(&frame, mode, label, steps)
+        let settings = self.srbf_settings(self.args, mode, |env| {
+            env.kappa = self.kappa;
+            env.view.lobe_visibility = LobeVisibilityArg::Volume;
+            env.dodm_size = dodm_size;
+        });
+        self.render_srbf(&settings, mode, label, steps)
+    }
+
+    /// The SRBF frame of `args` in `mode` with the default's lobes, then `change`d.
+    fn srbf_settings(
+        &self,
+        args: &CompareSettings,
+        mode: ScatteringMode,
+        change: impl FnOnce(&mut EnvLighting),
+    ) -> FrameSettings {
+        let mut settings = args.frame_of(mode, EnvLightSet::Fit);
+        if let Lighting::Environment(env) = &mut settings.lighting {
+            env.lobes = Some(self.lobes);
+            change(env);
+        }
+        settings
     }
 
     fn render_srbf(
         &self,
-        frame: &EnvFrame,
+        settings: &FrameSettings,
         mode: ScatteringMode,
         label: &str,
         steps: &mut Steps,
     ) -> anyhow::Result<Image> {
+        let frame = compare::frame(self.scene, settings)?;
         let r = steps.run(
             &format!("{}: decomposition, SRBF {label}", mode.name()),
-            || (self.render)(frame),
+            || (self.render)(&frame),
             |r: &RenderedEnv| format!("{:.0} ms", r.milliseconds),
         )?;
         Ok(r.image)
     }
 
     fn has_compact_sources(&self) -> bool {
-        self.lights.iter().any(|l| l.lambda.is_none())
+        !self.scene.prepared.scene.fit.sources.is_empty()
     }
 }
 
@@ -339,8 +356,8 @@ pub fn single_scattering_against_truth(
     )?;
     let every_strand = inputs.srbf(inputs.args, mode, 1.0, "light maps, κ 1", steps)?;
     let light_maps = inputs.srbf(inputs.args, mode, inputs.kappa, "light maps", steps)?;
-    let size = inputs.args.light_map_size;
-    let volume = inputs.srbf_volume(mode, DodmSettings::at_resolution(size), "volume", steps)?;
+    let size = inputs.args.env().dodm_size;
+    let volume = inputs.srbf_volume(mode, size, "volume", steps)?;
     let mut measured = vec![
         truth_step(TRUTH_MAP_LIGHTS, &reference.chosen.image, truth)?,
         truth_step(TRUTH_FIT_LIGHTS, &fit.chosen.image, truth)?,
@@ -349,8 +366,8 @@ pub fn single_scattering_against_truth(
         truth_step(TRUTH_VOLUME, &volume, truth)?,
     ];
     if inputs.has_compact_sources() {
-        let sharp = DodmSettings::at_resolution(SHARP_SOURCE_MAP_SCALE * size);
-        let label = format!("volume, compact sources' maps {}²", sharp.resolution);
+        let sharp = SHARP_SOURCE_MAP_SCALE * size;
+        let label = format!("volume, compact sources' maps {sharp}²");
         let image = inputs.srbf_volume(mode, sharp, &label, steps)?;
         measured.push(truth_step(TRUTH_SHARP_SOURCES, &image, truth)?);
     }
@@ -377,7 +394,7 @@ pub fn full_scattering_against_truth(
     full: &GroundTruth,
     steps: &mut Steps,
 ) -> anyhow::Result<ErrorDecomposition> {
-    let dodm = DodmSettings::at_resolution(inputs.args.light_map_size);
+    let dodm = inputs.args.env().dodm_size;
     let srbf_single = inputs.srbf_volume(ScatteringMode::Single, dodm, "volume", steps)?;
     let srbf_full = inputs.srbf_volume(ScatteringMode::Full, dodm, "volume", steps)?;
     let (t_single, t_full) = (&single.image, &full.image);

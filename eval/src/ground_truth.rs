@@ -22,8 +22,15 @@ use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
+use strandlight_precompute::bake_plan::FiberDescription;
+use strandlight_runtime::camera::UpAxis;
+use strandlight_runtime::head::Head;
+use strandlight_scene::environment::{LoadedEnv, load_env};
+use strandlight_scene::frame_render::{FrameHair, load_settings_hair};
+use strandlight_scene::frame_settings::{FrameSettings, Lighting, up_choice};
+use strandlight_scene::head_input::load_head;
 use strandlight_scene::image_metrics::{Image, relative_rmse};
-use strandlight_scene::scene_tables::ScatteringMode;
+use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
 use strandlight_scene::steps::Steps;
 use strandlight_tables::checksum::sha256_hex;
 use strandlight_tables::outside_tools::{PYTHON_VAR, python};
@@ -159,9 +166,9 @@ impl TruthInputs<'_> {
             "renderer": "mitsuba3 scalar_rgb path, hair BSDF, bsplinecurve through the strand points, envmap (hidden from the camera), box filter",
             "hair_sha256": self.hair_sha256,
             "map_sha256": self.map_sha256,
-            "rotate": self.scene.rotate_degrees,
+            "rotate": self.scene.orientation.rotation_deg,
             "directional": self.scene.directional,
-            "up": format!("{:?}", self.scene.up),
+            "up": format!("{:?}", self.scene.orientation.up),
             "camera": format!("{:?}", self.scene.camera),
             "size": [self.scene.size.0, self.scene.size.1],
             "fiber": self.scene.fiber,
@@ -493,71 +500,58 @@ pub fn export(inputs: &TruthInputs, run: MitsubaRun, dir: &Path) -> anyhow::Resu
     write_scene(&inputs.scene, run, dir, &dir.join("render.exr"))
 }
 
-/// What `strandlight truth` renders (or exports): the scene exactly as `compare` sets it up,
-/// so that `compare`, `image-error` and `bench` find the cached images.
-pub struct TruthRequest {
-    pub hair: PathBuf,
-    pub env: String,
-    pub sanitize: bool,
-    pub size: (u32, u32),
-    pub rotate_degrees: f64,
-    pub preset: String,
-    pub modes: Vec<ScatteringMode>,
-    pub settings: TruthSettings,
-    pub cache: PathBuf,
-}
-
-/// A loaded [`TruthRequest`]: the hair (opaque fibers), map, camera and fiber.
+/// What `strandlight truth` renders (or exports): the frame of a [`FrameSettings`] exactly as
+/// `compare` sets it up for the same settings, so that `compare`, `image-error` and `bench` find
+/// the cached images, and a viewer screenshot's settings export the scene the viewer showed.
 pub struct TruthScene {
-    pub hair: strandlight_runtime::hair::HairModel,
-    pub hair_sha256: String,
-    pub map: strandlight_precompute::EnvMap,
-    pub map_sha256: String,
-    pub up: strandlight_runtime::camera::UpAxis,
-    pub camera: strandlight_runtime::camera::Camera,
+    pub hair: FrameHair,
+    pub map: LoadedEnv,
+    pub up: UpAxis,
+    /// The fiber's Chiang parameters (Mitsuba's `hair`).
     pub fiber: Value,
+    pub head: Option<Head>,
+    pub frame: FrameSettings,
 }
 
 impl TruthScene {
-    pub fn load(request: &TruthRequest) -> anyhow::Result<Self> {
-        use strandlight_scene::camera_choice::front_camera;
-        use strandlight_scene::hair_input::fibers_for;
-        use strandlight_scene::scene_tables::EnvShading;
-        let bytes = std::fs::read(&request.hair)
-            .with_context(|| format!("--hair {}", request.hair.display()))?;
-        let (hair, _) = strandlight_scene::hair_input::load_hair(Some(&request.hair))?;
-        let (hair, hair_sha256) = fibers_for(EnvShading::Chiang, hair, sha256_hex(&bytes));
-        let env = strandlight_scene::environment::load_env(&request.env, request.sanitize)?;
-        let (up, camera) = front_camera(&hair, request.size);
-        let fiber = strandlight_precompute::bake_plan::FiberDescription::preset(&request.preset)
-            .with_context(|| format!("--preset {:?}", request.preset))?;
+    /// The scene of `frame`, an env-lit frame of the Chiang fiber (the path tracer's).
+    pub fn load(frame: &FrameSettings) -> anyhow::Result<Self> {
+        frame.check()?;
+        let Lighting::Environment(env) = &frame.lighting else {
+            bail!("the path-traced truth is of env-lit frames: give an environment");
+        };
+        if frame.env_shading()? != EnvShading::Chiang {
+            bail!(
+                "the path-traced truth renders the Chiang fiber (Mitsuba's `hair`): use --shading chiang"
+            );
+        }
+        let hair = load_settings_hair(frame)?;
+        let map = load_env(&env.map, env.sanitize)?;
+        let fiber = FiberDescription::preset(&frame.preset)
+            .with_context(|| format!("--preset {:?}", frame.preset))?;
+        let head = load_head(&frame.head, &hair.model, frame.skin_albedo)?;
         Ok(Self {
+            up: up_choice(frame).axis(&hair.model),
             hair,
-            hair_sha256,
-            map: env.map,
-            map_sha256: env.sha256,
-            up,
-            camera,
+            map,
             fiber: serde_json::to_value(&fiber.chiang)?,
+            head,
+            frame: frame.clone(),
         })
     }
 
-    pub fn inputs(&self, size: (u32, u32), rotate_degrees: f64) -> TruthInputs<'_> {
-        TruthInputs {
-            scene: MitsubaScene {
-                hair: &self.hair,
-                up: self.up,
-                camera: self.camera,
-                size,
-                map: Some(&self.map),
-                rotate_degrees,
-                directional: &[],
-                fiber: &self.fiber,
-                head: None,
-            },
-            hair_sha256: &self.hair_sha256,
-            map_sha256: &self.map_sha256,
-        }
+    pub fn inputs(&self) -> anyhow::Result<TruthInputs<'_>> {
+        Ok(TruthInputs {
+            scene: MitsubaScene::of_frame(
+                &self.frame,
+                &self.hair.model,
+                (&self.map.map, self.up),
+                &self.fiber,
+                self.head.as_ref(),
+            )?,
+            hair_sha256: &self.hair.identity,
+            map_sha256: &self.map.sha256,
+        })
     }
 }
 
@@ -618,6 +612,7 @@ mod tests {
     use super::*;
     use strandlight_runtime::hair::{GroomParams, generate_groom};
     use strandlight_scene::camera_choice::front_camera;
+    use strandlight_scene::env_orientation::EnvOrientation;
 
     fn scratch(name: &str) -> PathBuf {
         let dir =
@@ -693,11 +688,10 @@ mod tests {
         let inputs = TruthInputs {
             scene: MitsubaScene {
                 hair: &hair,
-                up,
+                orientation: EnvOrientation::upright(up),
                 camera,
                 size: (8, 6),
                 map: None,
-                rotate_degrees: 0.0,
                 directional: &[],
                 fiber: &fiber,
                 head: None,

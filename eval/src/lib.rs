@@ -10,6 +10,7 @@ pub mod bench;
 pub mod bench_plots;
 pub mod bench_report;
 pub mod compare;
+mod compare_settings_legacy;
 pub mod compare_table;
 pub mod equal_time;
 pub mod error_decomposition;

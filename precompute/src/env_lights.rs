@@ -3,13 +3,14 @@
 //! the runtime): the fitted SRBFs, the brute-force cube-texel reference and the median-cut
 //! baseline.
 //!
-//! Directions are in the map's frame of [`crate::envmap`] (+Y up, image center toward −Z),
-//! turned by `rotate_degrees` about +Y exactly as [`crate::srbf_set::SrbfSet`] stores its
-//! lobes, so all three sets of one map agree.
+//! Directions are in the map's own frame of [`crate::envmap`] (+Y up, image center toward −Z),
+//! as [`crate::srbf_set::SrbfSet`] stores its lobes, so all three sets of one map agree. Where
+//! the map sits in a hair's world, turned or not, is the frame's business
+//! (`strandlight_scene::env_orientation`), applied to every set alike.
 
 use crate::compact_sources::{self, SourceOptions};
 use crate::cube_lights::{CubeLightsError, CubeTexel, cube_face_lights, texel_center_direction};
-use crate::envmap::{EnvMap, rotate_about_up};
+use crate::envmap::EnvMap;
 use crate::median_cut::{DirectionalLight, median_cut};
 use crate::srbf_set::{LightKind, SrbfSet};
 use glam::DVec3;
@@ -96,15 +97,11 @@ pub fn srbf_set_lights(set: &SrbfSet) -> Vec<LightSpec> {
 
 /// Point lights along `lights`' directions; `stands_for_region`: each stands for a region of
 /// the map ([`LightSpec::stands_for_region`]), not a compact source.
-fn directional(
-    lights: Vec<DirectionalLight>,
-    rotate_degrees: f64,
-    stands_for_region: bool,
-) -> Vec<LightSpec> {
+fn directional(lights: Vec<DirectionalLight>, stands_for_region: bool) -> Vec<LightSpec> {
     lights
         .into_iter()
         .map(|l| LightSpec {
-            direction: rotate_about_up(l.direction, rotate_degrees).normalize(),
+            direction: l.direction.normalize(),
             lambda: None,
             rgb: l.power,
             shadowed_from: None,
@@ -125,16 +122,9 @@ fn directional(
 pub fn reference_lights(
     map: &EnvMap,
     face_resolution: usize,
-    rotate_degrees: f64,
     sources: &SourceOptions,
 ) -> Result<Vec<LightSpec>, CubeLightsError> {
-    reference_lights_shaded(
-        map,
-        face_resolution,
-        face_resolution,
-        rotate_degrees,
-        sources,
-    )
+    reference_lights_shaded(map, face_resolution, face_resolution, sources)
 }
 
 /// [`reference_lights`] with each cube texel's light shaded over finer sub-texels: the map
@@ -155,7 +145,6 @@ pub fn reference_lights_shaded(
     map: &EnvMap,
     face_resolution: usize,
     shading_face_resolution: usize,
-    rotate_degrees: f64,
     sources: &SourceOptions,
 ) -> Result<Vec<LightSpec>, CubeLightsError> {
     let (n, fine) = (face_resolution, shading_face_resolution);
@@ -173,10 +162,10 @@ pub fn reference_lights_shaded(
         direction: DVec3::from(s.direction),
         power: s.power,
     });
-    let mut lights = directional(source_lights.collect(), rotate_degrees, false);
+    let mut lights = directional(source_lights.collect(), false);
     let texel_lights = cube_face_lights(&residual, fine)?;
     if fine == n {
-        lights.extend(directional(texel_lights, rotate_degrees, true));
+        lights.extend(directional(texel_lights, true));
         return Ok(lights);
     }
     let m = fine / n;
@@ -184,11 +173,11 @@ pub fn reference_lights_shaded(
         for (j, i) in (0..n).flat_map(|j| (0..n).map(move |i| (j, i))) {
             let texel = CubeTexel { face, i, j };
             let shadow = texel_center_direction(texel, n);
-            let shadowed_from = Some(rotate_about_up(shadow, rotate_degrees).normalize());
+            let shadowed_from = Some(shadow.normalize());
             let samples = tent_samples(texel, n, m).filter_map(|(t, w)| {
                 let l = &texel_lights[t.index(fine)];
                 (luminance(l.power) > 0.0).then(|| LightSpec {
-                    direction: rotate_about_up(l.direction, rotate_degrees).normalize(),
+                    direction: l.direction.normalize(),
                     lambda: None,
                     rgb: l.power.map(|p| p * w),
                     shadowed_from,
@@ -276,15 +265,14 @@ pub fn fitted_reference_lights(
     let mut lights: Vec<LightSpec> = sources.collect();
     lights.extend(directional(
         cube_face_lights(&radiance, face_resolution)?,
-        0.0,
         true,
     ));
     Ok(lights)
 }
 
 /// The equal-cost baseline: `count` median-cut directional lights (Debevec 2005).
-pub fn median_cut_lights(map: &EnvMap, count: usize, rotate_degrees: f64) -> Vec<LightSpec> {
-    directional(median_cut(map, count.max(1)), rotate_degrees, true)
+pub fn median_cut_lights(map: &EnvMap, count: usize) -> Vec<LightSpec> {
+    directional(median_cut(map, count.max(1)), true)
 }
 
 /// The median-cut baseline given the same exact compact sources as the reference and the SRBF
@@ -298,7 +286,6 @@ pub fn median_cut_lights(map: &EnvMap, count: usize, rotate_degrees: f64) -> Vec
 pub fn median_cut_lights_with_sources(
     map: &EnvMap,
     count: usize,
-    rotate_degrees: f64,
     sources: &SourceOptions,
 ) -> Vec<LightSpec> {
     let (found, residual) = compact_sources::extract(map, sources);
@@ -307,8 +294,8 @@ pub fn median_cut_lights_with_sources(
         power: s.power,
     });
     let rest = median_cut(&residual, count.saturating_sub(found.len()).max(1));
-    let mut lights = directional(exact.collect(), rotate_degrees, false);
-    lights.extend(directional(rest, rotate_degrees, true));
+    let mut lights = directional(exact.collect(), false);
+    lights.extend(directional(rest, true));
     lights
 }
 
@@ -429,7 +416,7 @@ mod tests {
             let sources = SourceOptions::default();
             let (found, _) = compact_sources::extract(&map, &sources);
             assert_eq!(found.len(), 1, "the procedural sun is taken out");
-            let lights = reference_lights(&map, n, 30.0, &sources).unwrap();
+            let lights = reference_lights(&map, n, &sources).unwrap();
             assert_eq!(lights.len(), 1 + 6 * n * n);
             let gap = relative_gap(total_power(&lights), truth);
             println!(
@@ -439,7 +426,7 @@ mod tests {
             assert!(gap < 1e-9, "{gap}");
         }
         for count in [1, 17, 64] {
-            let lights = median_cut_lights(&map, count, -45.0);
+            let lights = median_cut_lights(&map, count);
             assert_eq!(lights.len(), count);
             let gap = relative_gap(total_power(&lights), truth);
             println!("median cut {count}: relative power gap {gap:.2e}");
@@ -458,9 +445,9 @@ mod tests {
         let truth = pixel_sum_integral(&map);
         let sources = SourceOptions::default();
         let (found, _) = compact_sources::extract(&map, &sources);
-        let sun = rotate_about_up(DVec3::from(found[0].direction), 20.0).normalize();
+        let sun = DVec3::from(found[0].direction).normalize();
         for count in [1, 2, 16, 64] {
-            let lights = median_cut_lights_with_sources(&map, count, 20.0, &sources);
+            let lights = median_cut_lights_with_sources(&map, count, &sources);
             // One light for the sun plus at least one for the sky.
             assert_eq!(lights.len(), count.max(2));
             let gap = relative_gap(total_power(&lights), truth);
@@ -469,20 +456,6 @@ mod tests {
             // median cut spreads it over the centroids of the regions it is cut into.
             assert!((lights[0].direction - sun).length() < 1e-12);
             assert_eq!(lights[0].rgb, found[0].power);
-        }
-    }
-
-    #[test]
-    fn rotation_moves_the_reference_lights_about_up() {
-        let map = procedural_env::by_name("studio", 128).unwrap();
-        let a = reference_lights(&map, 4, 0.0, &SourceOptions::default()).unwrap();
-        let b = reference_lights(&map, 4, 90.0, &SourceOptions::default()).unwrap();
-        for (x, y) in a.iter().zip(&b) {
-            // +90° about +Y takes azimuth φ to φ + 90°: with ω = (sinθ sinφ, cosθ, −sinθ cosφ),
-            // (x, y, z) ↦ (−z, y, x).
-            let want = DVec3::new(-x.direction.z, x.direction.y, x.direction.x);
-            assert!((y.direction - want).length() < 1e-12);
-            assert_eq!(x.rgb, y.rgb);
         }
     }
 
@@ -573,7 +546,7 @@ mod tests {
         let truth = pixel_sum_integral(&map);
         let sources = SourceOptions::default();
         for (n, fine) in [(2, 8), (4, 8), (4, 4)] {
-            let lights = reference_lights_shaded(&map, n, fine, 15.0, &sources).unwrap();
+            let lights = reference_lights_shaded(&map, n, fine, &sources).unwrap();
             let gap = relative_gap(total_power(&lights), truth);
             let maps = lights
                 .chunk_by(|a, b| a.shadowed_from.is_some() && a.shadowed_from == b.shadowed_from)
@@ -593,7 +566,7 @@ mod tests {
                 false => assert!(lights[1..].iter().all(|l| l.shadowed_from.is_some())),
             }
         }
-        let e = reference_lights_shaded(&map, 4, 6, 0.0, &sources).unwrap_err();
+        let e = reference_lights_shaded(&map, 4, 6, &sources).unwrap_err();
         assert!(e.to_string().contains("multiple of 4"), "{e}");
     }
 

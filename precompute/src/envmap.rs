@@ -15,11 +15,9 @@
 //! So u = ½ is −Z, u = ¾ is +X, u = 0 (the left/right seam) is +Z and u = ¼ is −X: a person
 //! standing at the origin facing −Z sees the image as printed, the right half to their right.
 //!
-//! `--rotate DEG` rotates the environment about +Y by DEG degrees so that content found at
-//! azimuth φ appears at φ + DEG ([`rotate_about_up`]). The fit applies it to the lobe centers
-//! (exact; no resampling) and records it in the output, so a renderer that samples the map
-//! itself must apply [`rotate_about_up`] with the same angle to the map's directions
-//! (equivalently, look up `radiance(rotate_about_up(ω, −DEG))`).
+//! Everything precompute makes of a map (fits, reference and median-cut light sets) stays in
+//! this frame. Where the map sits in a hair's world (the hair's up axis, and `--rotate`) is
+//! written once, in `strandlight_scene::env_orientation`.
 
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -293,12 +291,6 @@ pub fn row_solid_angle(y: usize, width: usize, height: usize) -> f64 {
     2.0 * PI / width as f64 * 2.0 * (0.5 * (t0 + t1)).sin() * (0.5 * (t1 - t0)).sin()
 }
 
-/// Rotates `w` about +Y so that azimuth φ becomes φ + `degrees` (module documentation).
-pub fn rotate_about_up(w: DVec3, degrees: f64) -> DVec3 {
-    let (s, c) = degrees.to_radians().sin_cos();
-    DVec3::new(w.x * c - w.z * s, w.y, w.z * c + w.x * s)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -359,14 +351,6 @@ mod tests {
                 "{u},{v} → {u2},{v2}"
             );
         }
-    }
-
-    #[test]
-    fn rotation_moves_azimuth_by_the_angle() {
-        let w = uv_to_direction(0.5, 0.4);
-        let r = rotate_about_up(w, 90.0);
-        let (u, v) = direction_to_uv(r);
-        assert!((u - 0.75).abs() < 1e-12 && (v - 0.4).abs() < 1e-12);
     }
 
     #[test]

@@ -20,7 +20,7 @@ pub enum PreviewError {
 }
 
 /// Writes the three panels at `panel_width × panel_width/2` each, `map` being the original.
-/// `lobes` are in the map's own frame (undo any rotation before calling).
+/// `lobes` are in the map's own frame, as every fit is.
 pub fn write_preview(
     map: &EnvMap,
     lobes: &[SrbfLobe],

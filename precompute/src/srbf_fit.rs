@@ -21,7 +21,7 @@
 //! round and the previous best is kept). Results do not depend on the thread count: all
 //! parallel sums are reduced in a fixed order.
 
-use crate::envmap::{EnvMap, rotate_about_up};
+use crate::envmap::EnvMap;
 use crate::srbf_objective::{FitGrid, evaluate, power_matched_amplitudes, relative_mse_of};
 use argmin::core::{CostFunction, Error as ArgminError, Executor, Gradient};
 use argmin::solver::linesearch::MoreThuenteLineSearch;
@@ -69,8 +69,6 @@ pub struct FitOptions {
     pub iterations_per_round: u64,
     /// L-BFGS iterations of the final polish of the best state.
     pub final_iterations: u64,
-    /// Environment rotation about +Y in degrees, applied to the fitted lobe centers.
-    pub rotate_degrees: f64,
     /// Re-solve the final amplitudes so the lobes carry exactly the map's power per channel
     /// (see [`crate::srbf_objective::power_matched_amplitudes`]). On by default: rendering
     /// integrates light, so power matters more than the last digits of the L2 error.
@@ -107,7 +105,6 @@ impl Default for FitOptions {
             grid_width: 256,
             iterations_per_round: 10,
             final_iterations: 100,
-            rotate_degrees: 0.0,
             preserve_power: true,
             sources: Default::default(),
             wider_source_radius: Some(crate::compact_sources::DEFAULT_WIDER_RADIUS_DEGREES),
@@ -156,7 +153,6 @@ impl FitOptions {
             |v| v <= (self.grid_width * self.grid_width) as f64 / 64.0,
             "must be ≤ grid_width²/64 (a narrower lobe falls between the fit grid's pixels; raise the grid width)",
         )?;
-        check("rotate", self.rotate_degrees, |_| true, "")?;
         check(
             "max_sources",
             self.sources.max_sources as f64,
@@ -202,12 +198,12 @@ pub struct RoundRecord {
 /// A finished fit.
 #[derive(Debug, Clone)]
 pub struct SrbfFit {
-    /// In radiance units, centers rotated by `rotate_degrees`.
+    /// In radiance units, centers in the map's own frame.
     pub lobes: Vec<SrbfLobe>,
     /// The objective (closed-form Gram, grid projections) at the returned lobes.
     pub objective_relative_mse: f64,
     pub history: Vec<RoundRecord>,
-    /// The prefiltered map the fit saw (unrotated).
+    /// The prefiltered map the fit saw.
     pub grid_map: EnvMap,
 }
 
@@ -336,7 +332,7 @@ pub fn fit(
         .zip(&ev.amplitudes)
         .filter(|(_, a)| a.iter().any(|&v| v > 0.0))
         .map(|((xi, lambda), a)| SrbfLobe {
-            center: rotate_about_up(*xi, options.rotate_degrees).to_array(),
+            center: xi.to_array(),
             lambda: *lambda,
             amplitude: a.map(|v| v * grid.scale),
         })

@@ -1,7 +1,7 @@
 //! The fitted light set as a file: what the runtime loads. JSON (serde), written atomically.
 //!
-//! Directions follow [`crate::envmap`]'s convention (+Y up, image center toward −Z), already
-//! rotated by `options.rotate_degrees`. A lobe's radiance is `amplitude · exp(λ(ω·ξ − 1))`.
+//! Directions follow [`crate::envmap`]'s convention (+Y up, image center toward −Z), in the
+//! map's own frame (a frame turns the map, not its fit: `strandlight_scene::env_orientation`). A lobe's radiance is `amplitude · exp(λ(ω·ξ − 1))`.
 //! For `kind = "directional"` (the median-cut baseline) each light is stored as a very narrow
 //! lobe (λ = [`DIRECTIONAL_LAMBDA`]) whose integral `amplitude · srbf::integral(λ)` is the
 //! light's power (∫ L dω of its region), so one format serves both; a renderer that wants delta
@@ -36,8 +36,8 @@ pub struct SrbfSet {
     pub version: u32,
     pub kind: LightKind,
     pub lobes: Vec<SrbfLobe>,
-    /// Compact sources taken out of the map before the fit, as directional lights (directions
-    /// rotated like the lobes); the lobes fit the map without them.
+    /// Compact sources taken out of the map before the fit, as directional lights; the lobes
+    /// fit the map without them.
     #[serde(default)]
     pub sources: Vec<CompactSource>,
     /// The environment map's file name (no directories) and the SHA-256 of its bytes.
@@ -220,17 +220,6 @@ pub struct Source<'a> {
     pub sanitized: BadPixelCounts,
 }
 
-/// Lobes back in the map's own frame (undoing `rotate_degrees`), for error checks and previews.
-pub fn unrotated(lobes: &[SrbfLobe], rotate_degrees: f64) -> Vec<SrbfLobe> {
-    lobes
-        .iter()
-        .map(|l| SrbfLobe {
-            center: crate::envmap::rotate_about_up(l.center(), -rotate_degrees).to_array(),
-            ..*l
-        })
-        .collect()
-}
-
 impl SrbfSet {
     /// Takes the compact sources out of the map (`options.sources`), runs the adaptive fit on
     /// the rest and measures its error independently (direct pixel sums, on the fit grid and on
@@ -258,17 +247,6 @@ impl SrbfSet {
             Err(e) => return Err(e),
         };
         let seconds = start.elapsed().as_secs_f64();
-        let rotated = sources
-            .iter()
-            .map(|s| CompactSource {
-                direction: crate::envmap::rotate_about_up(
-                    s.direction.into(),
-                    options.rotate_degrees,
-                )
-                .to_array(),
-                ..*s
-            })
-            .collect();
         let residual_source = Source {
             map: &residual,
             ..source.clone()
@@ -282,7 +260,7 @@ impl SrbfSet {
             history,
             seconds,
         );
-        set.sources = rotated;
+        set.sources = sources;
         set.power_ratio = power_ratio(source.map, &set.lobes, &set.sources);
         Ok(set)
     }
@@ -295,8 +273,7 @@ impl SrbfSet {
         let lobes = lights
             .iter()
             .map(|l| SrbfLobe {
-                center: crate::envmap::rotate_about_up(l.direction, options.rotate_degrees)
-                    .to_array(),
+                center: l.direction.to_array(),
                 lambda: DIRECTIONAL_LAMBDA,
                 amplitude: l.power.map(|p| p / norm),
             })
@@ -326,9 +303,8 @@ impl SrbfSet {
         seconds: f64,
     ) -> SrbfSet {
         use crate::srbf_objective::relative_mse_by_pixels;
-        let own_frame = unrotated(&lobes, options.rotate_degrees);
-        let relative_mse = relative_mse_by_pixels(grid_map, &own_frame);
-        let full_resolution_relative_mse = relative_mse_by_pixels(source.map, &own_frame);
+        let relative_mse = relative_mse_by_pixels(grid_map, &lobes);
+        let full_resolution_relative_mse = relative_mse_by_pixels(source.map, &lobes);
         let power_ratio = power_ratio(source.map, &lobes, &[]);
         SrbfSet {
             format: FORMAT.into(),

@@ -55,13 +55,14 @@ pub fn fit_summary(set: &SrbfSet) -> String {
 }
 
 /// One frame for the environment-lit renderer: a hair, a camera and one set of lights (all
-/// SRBFs, directional lights, or SRBFs with a fit's compact sources as directional lights), shaded in `mode` with `tables`.
+/// SRBFs, directional lights, or SRBFs with a fit's compact sources as directional lights),
+/// shaded in `mode` with `tables`. Built from settings by `crate::frame_render::env_frame` only.
 pub struct EnvFrame<'a> {
     pub hair: &'a HairModel,
     pub camera: Camera,
     pub width: u32,
     pub height: u32,
-    pub lights: &'a [EnvLight],
+    pub lights: Vec<EnvLight>,
     pub tables: &'a SceneTables,
     pub shading: EnvShading,
     pub mode: ScatteringMode,
@@ -296,7 +297,7 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
             &frame.camera,
             frame.width,
             frame.height,
-            (frame.lights, frame.look.simplified_lights_before),
+            (&frame.lights, frame.look.simplified_lights_before),
             tables,
             &call.options,
             multiple,

@@ -5,27 +5,24 @@
 //! changes, and renders its preview and light batches through the same [`render_frame`].
 
 use crate::env_frame::{EnvFrame, FrameRole, env_adapter, render_lights, shared_gpu};
-use crate::env_scene::{EnvScene, EnvSceneRequest, PrepareProgress, prepare_env_scene_reporting};
-use crate::environment::{LoadedEnv, load_env};
+use crate::env_light_sets::frame_lights;
+use crate::env_scene::PreparedEnv;
 use crate::frame_settings::{
-    EnvLighting, FrameSettings, Lighting, PointLighting, Shadows, Transparency, up_choice,
+    EnvLighting, FrameSettings, Lighting, PointLighting, Shadows, Transparency,
 };
-use crate::hair_input::{load_hair, opaque_if_physical};
+use crate::hair_input::{OPAQUE_FIBERS, fibers_for, load_hair};
 use crate::head_input::load_head;
 use crate::image_metrics::Image;
 use crate::look::EnvLook;
 use crate::point_shading::{PointShadingRequest, point_shading_model};
-use crate::scene_tables::{EnvShading, ScatteringMode};
-use crate::steps::Steps;
+use crate::scene_tables::ScatteringMode;
 use anyhow::Context;
-use glam::{Quat, Vec3};
-use std::path::Path;
-use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
-use strandlight_runtime::camera::{Camera, UpAxis};
+use strandlight_runtime::camera::Camera;
 use strandlight_runtime::env::{FragmentCounts, ViewTransparency};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
+use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
 use strandlight_runtime::passes::fiber_shading::ShadingModel;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
@@ -33,26 +30,40 @@ use strandlight_runtime::render::{
     self, PassTiming, RenderOptions, RenderStats, ShadowMaps, TIMING_METHOD, render_frame_with_head,
 };
 use strandlight_tables::checksum::sha256_hex;
-use strandlight_tables::colour::luminance_f32;
 
-/// A loaded hair and a line naming where it came from.
-pub struct LoadedHair {
+/// The hair of a frame, a line naming where it came from, and what identifies it in the
+/// reference and truth caches.
+pub struct FrameHair {
     pub model: HairModel,
     pub source: String,
+    /// SHA-256 of the file's bytes (of the procedural groom's points), marked where the fibers
+    /// were made opaque.
+    pub identity: String,
 }
 
 /// The hair of `settings` as its fiber model renders it. Chiang fibers are the path tracer's
 /// opaque cylinders, so a file's transparency is dropped for them, as `compare` and `truth` drop
 /// it: `render` must reproduce the frames they measure.
-pub fn load_settings_hair(settings: &FrameSettings) -> anyhow::Result<LoadedHair> {
+pub fn load_settings_hair(settings: &FrameSettings) -> anyhow::Result<FrameHair> {
     let (model, source) = load_hair(settings.hair.as_deref())?;
-    let (model, dropped) = opaque_if_physical(settings.shading(), model);
-    let source = if dropped {
-        format!("{source} (opaque fibers: its transparency is ignored by the Chiang model)")
-    } else {
-        source
+    let content = match &settings.hair {
+        Some(path) => {
+            sha256_hex(&std::fs::read(path).with_context(|| format!("--hair {}", path.display()))?)
+        }
+        None => sha256_hex(model.points_bytes()),
     };
-    Ok(LoadedHair { model, source })
+    let (model, identity) = fibers_for(settings.shading(), model, content);
+    let source = match model.transparency().is_none() && identity.ends_with(OPAQUE_FIBERS) {
+        true => {
+            format!("{source} (opaque fibers: its transparency is ignored by the Chiang model)")
+        }
+        false => source,
+    };
+    Ok(FrameHair {
+        model,
+        source,
+        identity,
+    })
 }
 
 /// The camera of `settings` for `hair`.
@@ -177,126 +188,59 @@ fn render_point(
     )?)
 }
 
-/// An environment's fit and tables, ready to light frames.
-pub struct PreparedEnv {
-    pub env: LoadedEnv,
-    pub scene: EnvScene,
-    pub shading: EnvShading,
-    /// The hair's up axis, onto which the map's +y is turned.
-    pub up: UpAxis,
-}
-
-/// The cache folder of a fiber's tables: custom artist controls get one of their own, named by
-/// their hash, so switching back and forth serves both from the cache.
-pub fn env_table_set(settings: &FrameSettings, shading: EnvShading) -> String {
-    let base = format!("{}-{:?}", settings.preset, shading).to_lowercase();
-    match (shading, settings.artist) {
-        (EnvShading::Artist, Some(params)) => {
-            let json = serde_json::to_vec(&params).expect("artist controls serialize");
-            format!("{base}-{}", &sha256_hex(&json)[..12])
-        }
-        _ => base,
-    }
-}
-
-/// Loads the map, fits it and bakes the fiber's tables (both cached under `cache_dir`).
-pub fn prepare_env(
-    settings: &FrameSettings,
-    env: &EnvLighting,
-    hair: &HairModel,
-    cache_dir: &Path,
-    steps: &mut Steps,
-    progress: &mut dyn FnMut(PrepareProgress),
-) -> anyhow::Result<PreparedEnv> {
-    let shading = settings.env_shading()?;
-    let loaded = steps.run(
-        "environment",
-        || load_env(&env.map, false),
-        |e| format!("{} {}x{}", e.name, e.map.width(), e.map.height()),
-    )?;
-    let mut fiber = FiberDescription::preset(&settings.preset)
-        .with_context(|| format!("--preset {:?}", settings.preset))?;
-    if let Some(artist) = settings.artist {
-        fiber.artist = artist;
-    }
-    let up = up_choice(settings).axis(hair);
-    let table_set = env_table_set(settings, shading);
-    let request = EnvSceneRequest {
-        env: &loaded,
-        fiber: &fiber,
-        shading,
-        scattering: env.scattering,
-        resolution: BakeResolution::default(),
-        cache_dir,
-        table_set: &table_set,
-        up,
-    };
-    let scene = prepare_env_scene_reporting(&request, steps, progress)?;
-    Ok(PreparedEnv {
-        env: loaded,
-        scene,
-        shading,
-        up,
+/// How an env-lit frame of `env` looks.
+pub fn env_look(env: &EnvLighting) -> anyhow::Result<EnvLook> {
+    Ok(EnvLook {
+        shadowed: env.shadowed,
+        dodm: DodmSettings::at_resolution(env.dodm_size),
+        ..env.look_args().look()?
     })
 }
 
-/// The lights of a frame: the `env.lobes` most powerful SRBFs (all when None) and every
-/// compact source, turned `env.rotation_deg` about the up axis, most powerful first.
-pub fn frame_lights(prepared: &PreparedEnv, env: &EnvLighting) -> Vec<EnvLight> {
-    select_lights(&prepared.scene.lights, prepared.up, env)
-}
-
-/// [`frame_lights`] from a scene's `lights` and the hair's `up` axis (a web page has no
-/// [`PreparedEnv`], only the fit's lights).
-pub fn select_lights(lights: &[EnvLight], up: UpAxis, env: &EnvLighting) -> Vec<EnvLight> {
-    let luminance = light_luminance;
-    let mut lights = lights.to_vec();
-    lights.sort_by(|a, b| luminance(b).total_cmp(&luminance(a)));
-    let mut srbf_kept = 0;
-    lights.retain(|l| {
-        let keep = l.lambda.is_none() || env.lobes.is_none_or(|n| srbf_kept < n);
-        srbf_kept += usize::from(l.lambda.is_some() && keep);
-        keep
-    });
-    let turn = Quat::from_axis_angle(up.vector(), env.rotation_deg.to_radians());
-    for light in &mut lights {
-        light.direction = (turn * light.direction).normalize_or(Vec3::Y);
+/// The renderer's settings for a frame of `env`: the brute-force reference's, or the method's.
+pub fn frame_role(env: &EnvLighting) -> FrameRole {
+    match env.light_set.is_reference() {
+        true => FrameRole::Reference,
+        false => FrameRole::Interactive { kappa: env.kappa },
     }
-    lights
 }
 
-/// The luminance of a light's power (Rec. 709 weights).
-pub fn light_luminance(light: &EnvLight) -> f32 {
-    luminance_f32(light.power())
+/// The scattering a frame of `env` renders: single where it asks for single or where the
+/// scene has no multiple-scattering table (dark hair).
+pub fn frame_mode(env: &EnvLighting, prepared: &PreparedEnv) -> ScatteringMode {
+    match (env.scattering, prepared.scene.mode) {
+        (ScatteringMode::Full, ScatteringMode::Full) => ScatteringMode::Full,
+        _ => ScatteringMode::Single,
+    }
 }
 
-/// How an env-lit frame of `env` looks.
-pub fn env_look(env: &EnvLighting) -> anyhow::Result<EnvLook> {
-    let mut look = env.look_args().look()?;
-    look.dodm.resolution = env.dodm_size;
-    Ok(look)
-}
-
-/// An env-lit frame of `settings` under `lights` (all or some of [`frame_lights`]) at `size`.
-fn env_frame<'a>(
+/// THE env-lit frame: `part` of the frame of `settings` for `hair`, lit as `prepared` (from the
+/// same settings' [`prepare_env`], or a web page's bundle). Everything an env-lit frame is drawn
+/// from is built here: `render`, `compare`, `bench`, the viewer and the page.
+pub fn env_frame<'a>(
     settings: &FrameSettings,
-    env: &EnvLighting,
     hair: &'a HairModel,
     prepared: &'a PreparedEnv,
-    lights: &'a [EnvLight],
-    size: [u32; 2],
-    look: EnvLook,
+    part: FramePart,
+    count_fragments: bool,
 ) -> anyhow::Result<EnvFrame<'a>> {
+    let Lighting::Environment(env) = &settings.lighting else {
+        anyhow::bail!("an env-lit frame needs environment lighting");
+    };
+    let all = frame_lights(prepared, env)?;
+    let mode = frame_mode(env, prepared);
+    let EnvPart { lights, look, mode } = env_part(env, all, mode, part, count_fragments)?;
+    let [width, height] = part.size(settings.size);
     Ok(EnvFrame {
         hair,
         camera: settings_camera(settings, hair)?,
-        width: size[0],
-        height: size[1],
+        width,
+        height,
         lights,
         tables: &prepared.scene.tables,
         shading: prepared.shading,
-        mode: prepared.scene.mode,
-        role: FrameRole::Interactive { kappa: env.kappa },
+        mode,
+        role: frame_role(env),
         look,
         head: load_head(&settings.head, hair, settings.skin_albedo)?,
     })
@@ -407,8 +351,8 @@ pub fn render_frame(
                 details: FrameDetails::Point(frame.stats),
             })
         }
-        (Lighting::Environment(env), Prepared::Env(prepared)) => {
-            render_env_part(settings, env, hair, prepared, part, count_fragments)
+        (Lighting::Environment(_), Prepared::Env(prepared)) => {
+            render_env_part(settings, hair, prepared, part, count_fragments)
         }
         _ => anyhow::bail!("the frame's lighting was prepared for other settings"),
     }
@@ -487,18 +431,12 @@ pub fn env_part(
 
 fn render_env_part(
     settings: &FrameSettings,
-    env: &EnvLighting,
     hair: &HairModel,
     prepared: &PreparedEnv,
     part: FramePart,
     count_fragments: bool,
 ) -> anyhow::Result<RenderedFrame> {
-    let all = frame_lights(prepared, env);
-    let EnvPart { lights, look, mode } =
-        env_part(env, all, prepared.scene.mode, part, count_fragments)?;
-    let size = part.size(settings.size);
-    let mut frame = env_frame(settings, env, hair, prepared, &lights, size, look)?;
-    frame.mode = mode;
+    let frame = env_frame(settings, hair, prepared, part, count_fragments)?;
     let rendered = render_lights(&frame)?;
     Ok(RenderedFrame {
         image: rendered.image,
@@ -508,8 +446,8 @@ fn render_env_part(
         adapter: env_adapter()?,
         timing_method: TIMING_METHOD.into(),
         details: FrameDetails::Env {
-            lights,
-            mode,
+            lights: frame.lights,
+            mode: frame.mode,
             fragments: rendered.fragments,
         },
     })
@@ -519,6 +457,7 @@ fn render_env_part(
 mod tests {
     use super::*;
     use crate::point_shading::Shading;
+    use glam::Vec3;
     use strandlight_runtime::hair::{Attribute, HairWriteOptions, write_hair};
 
     /// A `.hair` file of two half-transparent strands, under a fresh name in the temp folder.

@@ -3,10 +3,10 @@
 //! `render replay` reads back to reproduce that screenshot.
 
 use crate::camera_choice::{CameraChoice, UpChoice};
+pub use crate::env_lighting::{EnvLightSet, EnvLighting, FitSettings, ReferenceLighting};
 use crate::head_input::{HeadChoice, default_skin_albedo};
-use crate::look::{EnvTransparency, LookArgs, ViewArgs};
 use crate::point_shading::Shading;
-use crate::scene_tables::{EnvShading, ScatteringMode};
+use crate::scene_tables::EnvShading;
 use anyhow::{Context, bail};
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
@@ -14,7 +14,6 @@ use std::path::{Path, PathBuf};
 use strandlight_runtime::camera::{Camera, MAX_FOV_Y_DEGREES, Projection};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::lights::Light;
-use strandlight_runtime::passes::convolution_depth::{DodmSettings, MAX_DODM_RESOLUTION};
 use strandlight_tables::artist::{ArtistModel, ArtistParams};
 
 /// One picture: hair, camera, fiber and lighting.
@@ -308,48 +307,6 @@ impl Default for PointLighting {
     }
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct EnvLighting {
-    /// A .hdr/.exr map or `procedural:NAME`.
-    pub map: String,
-    pub scattering: ScatteringMode,
-    /// Fraction of the strands drawn into the light maps (Ren §7).
-    pub kappa: f32,
-    /// Use only the N most powerful SRBF lobes (a fit's compact sources are always kept);
-    /// None: all of them.
-    pub lobes: Option<usize>,
-    /// The environment turned about the hair's up axis, degrees: the fitted lobes are rotated
-    /// exactly, nothing is refitted.
-    pub rotation_deg: f32,
-    /// Convolution optical depth map resolution (square).
-    pub dodm_size: u32,
-    pub transparency: EnvTransparency,
-    pub view: ViewArgs,
-}
-
-impl EnvLighting {
-    pub fn new(map: impl Into<String>) -> Self {
-        Self {
-            map: map.into(),
-            scattering: ScatteringMode::Full,
-            kappa: 0.1,
-            lobes: None,
-            rotation_deg: 0.0,
-            dodm_size: DodmSettings::default().resolution,
-            transparency: EnvTransparency::default(),
-            view: ViewArgs::default(),
-        }
-    }
-
-    pub fn look_args(&self) -> LookArgs {
-        LookArgs {
-            transparency: self.transparency,
-            view: self.view,
-        }
-    }
-}
-
 impl FrameSettings {
     /// The procedural groom, framed from the front, at `size`, under `lighting`.
     pub fn new(lighting: Lighting, size: [u32; 2]) -> Self {
@@ -478,28 +435,6 @@ impl PointLighting {
             .iter()
             .map(|s| Light::parse(s))
             .collect::<Result<Vec<_>, _>>()?)
-    }
-}
-
-impl EnvLighting {
-    fn check(&self) -> anyhow::Result<()> {
-        if !(self.kappa > 0.0 && self.kappa <= 1.0) {
-            bail!("--kappa {}: must lie in (0, 1]", self.kappa);
-        }
-        if self.lobes == Some(0) {
-            bail!("--strongest-lobes 0: use at least one SRBF lobe (or leave it out for all)");
-        }
-        if !self.rotation_deg.is_finite() {
-            bail!("--rotate {}: must be a finite angle", self.rotation_deg);
-        }
-        if !(16..=MAX_DODM_RESOLUTION).contains(&self.dodm_size) {
-            bail!(
-                "--light-map-size {}: must lie in 16..={MAX_DODM_RESOLUTION} texels",
-                self.dodm_size
-            );
-        }
-        self.look_args().look()?;
-        Ok(())
     }
 }
 

@@ -60,6 +60,9 @@ pub fn opaque_if_physical(shading: impl Into<Shading>, hair: HairModel) -> (Hair
     }
 }
 
+/// What marks a hair's cache identity where its fibers were made opaque.
+pub const OPAQUE_FIBERS: &str = "+opaque fibers";
+
 /// [`opaque_if_physical`], with the hash that identifies the hair in the caches (it says when
 /// the transparency was dropped).
 pub fn fibers_for(
@@ -68,7 +71,7 @@ pub fn fibers_for(
     sha256: String,
 ) -> (HairModel, String) {
     match opaque_if_physical(shading, hair) {
-        (hair, true) => (hair, format!("{sha256}+opaque fibers")),
+        (hair, true) => (hair, format!("{sha256}{OPAQUE_FIBERS}")),
         (hair, false) => (hair, sha256),
     }
 }

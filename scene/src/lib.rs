@@ -9,6 +9,9 @@
 
 pub mod camera_choice;
 pub mod env_frame;
+pub mod env_light_sets;
+pub mod env_lighting;
+pub mod env_orientation;
 pub mod env_scene;
 pub mod environment;
 pub mod exposure;
@@ -26,4 +29,3 @@ pub mod scene_tables;
 pub mod sealed_file;
 pub mod steps;
 pub mod web_bundle;
-pub mod world_lights;

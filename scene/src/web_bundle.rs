@@ -8,20 +8,20 @@
 //! - `tables/*.sltab`: the baked tables, checksummed assets, half floats where their error
 //!   allows ([`BundledTable::max_relative_error`]).
 //!
-//! The page recomputes the lights from the fit exactly as `prepare_env_scene` does
-//! ([`BundleScene::lights`]), so a bundle never holds a derived copy that could disagree.
+//! The page makes a [`PreparedEnv`] of the bundle ([`BundleScene::prepared`]) and builds its
+//! frames from it and its settings as every other front end does
+//! (`crate::frame_render::env_frame`), so a bundle never holds a derived copy (lights, turned
+//! or not) that could disagree.
 
-use crate::frame_render::PreparedEnv;
+use crate::env_scene::{EnvScene, PreparedEnv};
 use crate::scene_tables::{EnvShading, MULTIPLE_TABLES, ScatteringMode, SceneTables};
-use crate::world_lights::to_env_lights;
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
-use strandlight_precompute::env_lights::srbf_set_lights;
+use strandlight_precompute::bake_plan::FiberDescription;
 use strandlight_precompute::srbf_set::SrbfSet;
 use strandlight_runtime::camera::UpAxis;
-use strandlight_runtime::env_light::EnvLight;
 use strandlight_tables::asset::{Storage, TableAsset, read_asset_bytes, write_asset_to};
 
 pub const SETTINGS_FILE: &str = "settings.json";
@@ -71,9 +71,28 @@ impl BundleScene {
         Ok(scene)
     }
 
-    /// The scene's lights, as `prepare_env_scene` makes them from the same fit.
-    pub fn lights(&self, up: UpAxis) -> Vec<EnvLight> {
-        to_env_lights(&srbf_set_lights(&self.fit), up)
+    /// The scene of `preset`'s tables over a hair with `up`, as `prepare_env` makes it from the
+    /// same fit (without the map: the page draws the fit's frames only).
+    pub fn prepared(
+        &self,
+        preset: &str,
+        up: UpAxis,
+        fetched: impl Fn(&str) -> Option<Vec<u8>>,
+    ) -> anyhow::Result<PreparedEnv> {
+        let tables = self.scene_tables(preset, fetched)?;
+        let fiber =
+            FiberDescription::preset(preset).with_context(|| format!("preset {preset:?}"))?;
+        Ok(PreparedEnv {
+            env: None,
+            scene: EnvScene {
+                fit: self.fit.clone(),
+                tables,
+                mode: self.mode,
+            },
+            shading: self.shading,
+            fiber,
+            up,
+        })
     }
 
     /// The tables the page reads: the SRBF table, and the direct table where the fit took
@@ -184,7 +203,7 @@ pub fn bundle_scene(
     let mut scene = BundleScene {
         format: FORMAT,
         environment: environment.into(),
-        fit: first.scene.fit.set.clone(),
+        fit: first.scene.fit.clone(),
         shading: first.shading,
         mode: first.scene.mode,
         presets: BTreeMap::new(),
@@ -192,7 +211,7 @@ pub fn bundle_scene(
     let mut files = Vec::new();
     for (preset, prepared) in presets {
         anyhow::ensure!(
-            prepared.scene.fit.set == scene.fit && prepared.scene.mode == scene.mode,
+            prepared.scene.fit == scene.fit && prepared.scene.mode == scene.mode,
             "preset {preset}: prepared under another fit or scattering mode than the first"
         );
         let mut entries = Vec::new();

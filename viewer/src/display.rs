@@ -5,10 +5,10 @@
 
 use crate::frame::LinearImage;
 use crate::recompute::Backdrop;
-use glam::{DVec3, Quat, Vec4};
+use glam::{DVec3, Vec4};
 use strandlight_precompute::envmap::EnvMap;
 use strandlight_runtime::camera::{Camera, UpAxis};
-use strandlight_scene::world_lights::world_to_env;
+use strandlight_scene::env_orientation::EnvOrientation;
 use strandlight_tables::image_out::tonemap_channel;
 
 /// The world direction through each pixel of `camera` at `size`, in the map's frame (the map
@@ -21,7 +21,7 @@ fn pixel_directions(
 ) -> impl Iterator<Item = DVec3> {
     let [w, h] = size;
     let clip_to_world = (camera.projection_matrix(w as f32 / h as f32) * camera.view()).inverse();
-    let unturn = Quat::from_axis_angle(up.vector(), -rotation_deg.to_radians());
+    let orientation = EnvOrientation::new(up, rotation_deg as f64);
     (0..h).flat_map(move |y| {
         (0..w).map(move |x| {
             let ndc_x = 2.0 * (x as f32 + 0.5) / w as f32 - 1.0;
@@ -29,8 +29,7 @@ fn pixel_directions(
             let far = clip_to_world * Vec4::new(ndc_x, ndc_y, 1.0, 1.0);
             let near = clip_to_world * Vec4::new(ndc_x, ndc_y, 0.0, 1.0);
             let ray = far.truncate() / far.w - near.truncate() / near.w;
-            let world = unturn * ray.normalize_or_zero();
-            world_to_env(world.as_dvec3(), up)
+            orientation.to_env(ray.normalize_or_zero().as_dvec3())
         })
     })
 }

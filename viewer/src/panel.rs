@@ -190,7 +190,7 @@ fn lighting(ui: &mut egui::Ui, state: &mut ViewState, lobes: &mut usize, status:
         .shown
         .as_ref()
         .and_then(|sh| sh.env.as_ref())
-        .map_or(64, |e| e.scene.fit.set.lobes.len());
+        .map_or(64, |e| e.scene.fit.lobes.len());
     match &mut s.lighting {
         Lighting::Environment(e) => env_controls(ui, e, lobes, total_lobes),
         Lighting::Lights(p) => point_controls(ui, p),

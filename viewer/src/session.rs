@@ -449,17 +449,18 @@ impl Session {
         if self.state.display.backdrop == Backdrop::Black {
             return None;
         }
-        let (env, Lighting::Environment(lighting)) =
+        let (prepared, Lighting::Environment(lighting)) =
             (shown.env.as_ref()?, &shown.settings.lighting)
         else {
             return None;
         };
+        let env = prepared.env.as_ref()?;
         let key = BackgroundKey {
             backdrop: self.state.display.backdrop,
             camera: ExactCamera::of(&shown.camera),
             size: [image.width, image.height],
             rotation_deg: lighting.rotation_deg,
-            map: env.env.sha256.clone(),
+            map: env.sha256.clone(),
         };
         if let Some((cached, pixels)) = &self.background
             && *cached == key
@@ -469,18 +470,18 @@ impl Session {
         let blurred = match &self.soft_map {
             Some((sha, map)) if *sha == key.map => map.clone(),
             _ => {
-                let map = Arc::new(soft_backdrop_map(&env.env.map));
+                let map = Arc::new(soft_backdrop_map(&env.map));
                 self.soft_map = Some((key.map.clone(), map.clone()));
                 map
             }
         };
         let pixels = Arc::new(backdrop_pixels(
             key.backdrop,
-            &env.env.map,
+            &env.map,
             &blurred,
             &shown.camera,
             key.size,
-            env.up,
+            prepared.up,
             key.rotation_deg,
         )?);
         self.background = Some((key, pixels.clone()));

@@ -12,14 +12,13 @@ use std::sync::mpsc::{Receiver, TryRecvError, channel};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 use strandlight_runtime::camera::Camera;
-use strandlight_scene::env_scene::PrepareProgress;
+use strandlight_scene::env_light_sets::{frame_lights, light_luminance};
+use strandlight_scene::env_scene::{AlsoServe, PrepareProgress, PreparedEnv, prepare_env};
 use strandlight_scene::frame_render::{
-    LoadedHair, Prepared, PreparedEnv, PreparedPoint, env_look, frame_lights, light_luminance,
-    load_settings_hair, prepare_env, prepare_point, render_frame, settings_camera,
+    FrameHair, Prepared, PreparedPoint, env_look, load_settings_hair, prepare_point, render_frame,
+    settings_camera,
 };
-use strandlight_scene::frame_settings::{
-    EnvLighting, FrameSettings, Lighting, PointLighting, up_choice,
-};
+use strandlight_scene::frame_settings::{FrameSettings, Lighting, PointLighting, up_choice};
 use strandlight_scene::steps::Steps;
 
 use crate::frame::{FrameStats, LinearImage, Stage};
@@ -141,7 +140,7 @@ type HairKey = (Option<PathBuf>, bool);
 struct WorkerState {
     cache_dir: PathBuf,
     shared: Arc<Shared>,
-    hair: Option<(HairKey, Arc<LoadedHair>)>,
+    hair: Option<(HairKey, Arc<FrameHair>)>,
     point: Option<(String, Arc<PreparedPoint>)>,
     env: Option<(TablesKey, Arc<PreparedEnv>)>,
     baking: Option<(TablesKey, Receiver<BakeResult>)>,
@@ -258,21 +257,22 @@ impl WorkerState {
                 let key = tables_key(settings);
                 let current = self.env.as_ref().is_some_and(|(k, _)| *k == key);
                 if !current && self.baking.as_ref().is_none_or(|(k, _)| *k != key) {
-                    self.start_bake(settings.clone(), env.clone(), hair, key);
+                    self.start_bake(settings.clone(), hair, key);
                 }
-                Ok(self.env.as_ref().map(|(_, prepared)| {
-                    let powers: Vec<f32> = frame_lights(prepared, env)
-                        .iter()
-                        .map(light_luminance)
-                        .collect();
-                    let batch = env_look(env).map_or(16, |l| l.dodm.batch_size) as usize;
-                    (plan_steps(Some((&powers, batch))), !current)
-                }))
+                let Some((_, prepared)) = &self.env else {
+                    return Ok(None);
+                };
+                let powers: Vec<f32> = frame_lights(prepared, env)?
+                    .iter()
+                    .map(light_luminance)
+                    .collect();
+                let batch = env_look(env)?.dodm.batch_size as usize;
+                Ok(Some((plan_steps(Some((&powers, batch))), !current)))
             }
         }
     }
 
-    fn hair(&mut self, settings: &FrameSettings) -> anyhow::Result<Arc<LoadedHair>> {
+    fn hair(&mut self, settings: &FrameSettings) -> anyhow::Result<Arc<FrameHair>> {
         // Whether the fibers are physical decides whether the file's transparency is kept.
         let key = (settings.hair.clone(), settings.shading().physical_fibers());
         if let Some((k, hair)) = &self.hair
@@ -302,17 +302,15 @@ impl WorkerState {
         Ok(prepared)
     }
 
-    fn start_bake(
-        &mut self,
-        settings: FrameSettings,
-        env: EnvLighting,
-        hair: Arc<LoadedHair>,
-        key: TablesKey,
-    ) {
+    fn start_bake(&mut self, settings: FrameSettings, hair: Arc<FrameHair>, key: TablesKey) {
         let (send, receive) = channel();
         let shared = self.shared.clone();
         let cache_dir = self.cache_dir.clone();
-        let what = format!("{} ({:?})", env.map, settings.shading());
+        let map = match &settings.lighting {
+            Lighting::Environment(env) => env.map.clone(),
+            Lighting::Lights(_) => String::new(),
+        };
+        let what = format!("{map} ({:?})", settings.shading());
         self.publish(|s| {
             s.bake = Some(BakeStatus {
                 what: format!("fitting {what}"),
@@ -338,9 +336,9 @@ impl WorkerState {
             };
             let prepared = prepare_env(
                 &settings,
-                &env,
                 &hair.model,
                 &cache_dir,
+                AlsoServe::default(),
                 &mut steps,
                 &mut progress,
             )

@@ -17,20 +17,17 @@ use strandlight_runtime::hair::yuksel::parse_hair;
 use strandlight_runtime::multiple::{
     CpuForwardScattering, ForwardScatteringSource, GpuForwardScattering, MarchedForwardScattering,
 };
-use strandlight_scene::env_frame::{
-    EnvFrame, FrameRole, gpu_march_volume, lights_call_without_source,
-};
+use strandlight_scene::env_frame::{EnvFrame, gpu_march_volume, lights_call_without_source};
+use strandlight_scene::env_light_sets::{frame_lights, light_luminance};
+use strandlight_scene::env_scene::PreparedEnv;
 use strandlight_scene::exposure::Exposure;
-use strandlight_scene::frame_render::{
-    env_look, env_part, light_luminance, select_lights, settings_camera,
-};
+use strandlight_scene::frame_render::{env_frame, env_look, settings_camera};
 use strandlight_scene::frame_settings::{
     CameraSettings, EnvLighting, ExactCamera, FrameSettings, Lighting, up_choice,
 };
-use strandlight_scene::head_input::load_head;
 use strandlight_scene::orbit::Orbit;
 use strandlight_scene::progressive::{Step, plan_steps};
-use strandlight_scene::scene_tables::{ScatteringMode, SceneTables};
+use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::web_bundle::{BundleScene, HAIR_FILE, SCENE_FILE, SETTINGS_FILE};
 use strandlight_tables::image_out::tonemap_channel;
 
@@ -78,7 +75,8 @@ pub struct Session {
     accumulate: AccumulatePass,
     bundle: BundleScene,
     files: BundleFiles,
-    tables: SceneTables,
+    /// The bundle's fit and the current preset's tables, as every front end prepares them.
+    prepared: PreparedEnv,
     pub settings: FrameSettings,
     hair: HairModel,
     orbit: Orbit,
@@ -138,7 +136,8 @@ impl Session {
             serde_json::from_slice(file(SETTINGS_FILE)?).context(SETTINGS_FILE)?;
         settings.check().context(SETTINGS_FILE)?;
         let hair = parse_hair(file(HAIR_FILE)?, Path::new(HAIR_FILE))?.model;
-        let tables = bundle.scene_tables(&settings.preset, |f| files.get(f).cloned())?;
+        let up = up_choice(&settings).axis(&hair);
+        let prepared = bundle.prepared(&settings.preset, up, |f| files.get(f).cloned())?;
         let renderer = EnvRenderer::new(&gpu);
         let accumulate = AccumulatePass::new(&gpu.device);
         let orbit = orbit_of(&settings, &hair)?;
@@ -148,7 +147,7 @@ impl Session {
             accumulate,
             bundle,
             files,
-            tables,
+            prepared,
             settings,
             hair,
             orbit,
@@ -209,8 +208,9 @@ impl Session {
     /// the canvas until the new preview replaces it.
     fn restart(&mut self) -> anyhow::Result<()> {
         let env = self.env()?.clone();
-        let up = up_choice(&self.settings).axis(&self.hair);
-        self.lights = select_lights(&self.bundle.lights(up), up, &env);
+        // A dropped hair may stand on another axis than the bundle's.
+        self.prepared.up = up_choice(&self.settings).axis(&self.hair);
+        self.lights = frame_lights(&self.prepared, &env)?;
         let powers: Vec<f32> = self.lights.iter().map(light_luminance).collect();
         let batch = env_look(&env)?.dodm.batch_size as usize;
         self.plan = plan_steps(Some((&powers, batch)));
@@ -301,28 +301,14 @@ impl Session {
         let Some(&step) = self.plan.get(self.next) else {
             return Ok(());
         };
-        let env = self.env()?.clone();
-        let part = env_part(
-            &env,
-            self.lights.clone(),
-            self.scattering(),
+        let frame = env_frame(
+            &self.settings,
+            &self.hair,
+            &self.prepared,
             step.part(),
             false,
         )?;
-        let [width, height] = step.part().size(self.settings.size);
-        let frame = EnvFrame {
-            hair: &self.hair,
-            camera: settings_camera(&self.settings, &self.hair)?,
-            width,
-            height,
-            lights: &part.lights,
-            tables: &self.tables,
-            shading: self.bundle.shading,
-            mode: part.mode,
-            role: FrameRole::Interactive { kappa: env.kappa },
-            look: part.look,
-            head: load_head(&self.settings.head, &self.hair, self.settings.skin_albedo)?,
-        };
+        let [width, height] = [frame.width, frame.height];
         // Multiple scattering's grid is marched for all the frame's lights before the first
         // batch that needs it; until the page has read it back, the step waits.
         let marched = match frame.mode {
@@ -345,7 +331,7 @@ impl Session {
             &frame.camera,
             width,
             height,
-            (frame.lights, frame.look.simplified_lights_before),
+            (&frame.lights, frame.look.simplified_lights_before),
             &call.tables,
             &call.options,
             source,
@@ -494,15 +480,6 @@ impl Session {
         Ok(())
     }
 
-    /// The scattering the frame renders: single, or single + multiple where the settings ask
-    /// for it and the bundle has the tables.
-    fn scattering(&self) -> ScatteringMode {
-        match (self.env().map(|e| e.scattering), self.bundle.mode) {
-            (Ok(ScatteringMode::Full), ScatteringMode::Full) => ScatteringMode::Full,
-            _ => ScatteringMode::Single,
-        }
-    }
-
     /// Single or single + multiple scattering (the latter where the bundle has its tables).
     pub fn set_scattering(&mut self, mode: ScatteringMode) -> anyhow::Result<()> {
         anyhow::ensure!(
@@ -554,9 +531,10 @@ impl Session {
     /// Switches to another fiber preset baked into the bundle.
     pub fn set_preset(&mut self, preset: &str) -> anyhow::Result<()> {
         let files = &self.files;
-        self.tables = self
+        let up = self.prepared.up;
+        self.prepared = self
             .bundle
-            .scene_tables(preset, |f| files.get(f).cloned())?;
+            .prepared(preset, up, |f| files.get(f).cloned())?;
         self.settings.preset = preset.into();
         self.restart()
     }

@@ -15,8 +15,9 @@
 //! **The map's frame.** strandlight's map frame (`precompute/src/envmap.rs`) puts texel column u
 //! at azimuth 2π(u − ½) from −Z, Mitsuba's `envmap` at 2πu: the same picture half a turn apart
 //! about +Y, so Mitsuba's local frame is strandlight's turned by π about +Y
-//! ([`MITSUBA_MAP_FROM_OURS`]). Then the map is turned by the scene's rotation about +Y and
-//! carried into the hair's world ([`strandlight_scene::world_lights::env_to_world`]).
+//! ([`MITSUBA_MAP_FROM_OURS`]). Then the map is placed in the hair's world exactly as every
+//! frame places it ([`strandlight_scene::env_orientation::EnvOrientation`]: up axis and
+//! rotation).
 
 use anyhow::Context;
 use glam::{DMat3, DVec3};
@@ -24,12 +25,13 @@ use serde::Serialize;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use strandlight_precompute::EnvMap;
-use strandlight_precompute::envmap::rotate_about_up;
 use strandlight_runtime::camera::{Camera, Projection, UpAxis};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::head::Head;
 use strandlight_runtime::passes::strand_geometry::default_thickness;
-use strandlight_scene::world_lights::env_to_world;
+use strandlight_scene::env_orientation::EnvOrientation;
+use strandlight_scene::frame_render::settings_camera;
+use strandlight_scene::frame_settings::{FrameSettings, Lighting};
 use strandlight_tables::atomic_write::write_atomically;
 use strandlight_tables::image_out::write_exr;
 
@@ -46,12 +48,12 @@ pub const MITSUBA_MAP_FROM_OURS: [[f64; 3]; 3] =
 #[derive(Clone, Copy)]
 pub struct MitsubaScene<'a> {
     pub hair: &'a HairModel,
-    pub up: UpAxis,
+    /// Where the map sits in the hair's world (and the hair's up axis).
+    pub orientation: EnvOrientation,
     pub camera: Camera,
     pub size: (u32, u32),
     /// The environment; None for a scene lit by `directional` lights only.
     pub map: Option<&'a EnvMap>,
-    pub rotate_degrees: f64,
     /// Directional lights in the world: (unit direction toward the light, RGB irradiance).
     pub directional: &'a [([f64; 3], [f64; 3])],
     /// Mitsuba's `hair` parameters under this project's names (`ChiangParams` serialized):
@@ -72,13 +74,38 @@ pub struct MitsubaRun {
     pub seed: u32,
 }
 
+impl<'a> MitsubaScene<'a> {
+    /// The path-traced scene of the env-lit frame `settings` describe over `hair` (loaded from
+    /// them): its camera and size, `map` placed as the frame places it over a hair with `up`,
+    /// its head, and `fiber` (its Chiang parameters, [`Self::fiber`]).
+    pub fn of_frame(
+        settings: &FrameSettings,
+        hair: &'a HairModel,
+        (map, up): (&'a EnvMap, UpAxis),
+        fiber: &'a serde_json::Value,
+        head: Option<&'a Head>,
+    ) -> anyhow::Result<Self> {
+        let Lighting::Environment(env) = &settings.lighting else {
+            anyhow::bail!("the path-traced truth is of env-lit frames");
+        };
+        let [width, height] = settings.size;
+        Ok(Self {
+            hair,
+            orientation: EnvOrientation::new(up, env.rotation_deg as f64),
+            camera: settings_camera(settings, hair)?,
+            size: (width, height),
+            map: Some(map),
+            directional: &[],
+            fiber,
+            head,
+        })
+    }
+}
+
 /// The matrix (rows) that takes Mitsuba's map frame into the hair's world.
-pub fn map_to_world(up: UpAxis, rotate_degrees: f64) -> [[f64; 3]; 3] {
+pub fn map_to_world(orientation: EnvOrientation) -> [[f64; 3]; 3] {
     let ours_from_mitsuba = DMat3::from_cols_array_2d(&MITSUBA_MAP_FROM_OURS).transpose();
-    let column = |axis: DVec3| {
-        let ours = ours_from_mitsuba * axis;
-        env_to_world(rotate_about_up(ours, rotate_degrees), up)
-    };
+    let column = |axis: DVec3| orientation.to_world(ours_from_mitsuba * axis);
     let (x, y, z) = (column(DVec3::X), column(DVec3::Y), column(DVec3::Z));
     [[x.x, y.x, z.x], [x.y, y.y, z.y], [x.z, y.z, z.z]]
 }
@@ -147,7 +174,7 @@ pub fn scene_json(
         "environment": match scene.map {
             Some(_) => serde_json::json!({
                 "map": absolute(map)?,
-                "to_world": map_to_world(scene.up, scene.rotate_degrees),
+                "to_world": map_to_world(scene.orientation),
             }),
             None => serde_json::Value::Null,
         },
@@ -338,10 +365,11 @@ mod tests {
     fn a_texel_lands_where_strandlight_puts_it() {
         for up in [UpAxis::Y, UpAxis::Z] {
             for rotate in [0.0, 37.0, -120.0] {
-                let m = DMat3::from_cols_array_2d(&map_to_world(up, rotate)).transpose();
+                let orientation = EnvOrientation::new(up, rotate);
+                let m = DMat3::from_cols_array_2d(&map_to_world(orientation)).transpose();
                 for &(u, v) in &[(0.1, 0.3), (0.5, 0.5), (0.93, 0.71), (0.26, 0.05)] {
                     // Where strandlight puts texel (u, v) in the world ...
-                    let world = env_to_world(rotate_about_up(uv_to_direction(u, v), rotate), up);
+                    let world = orientation.to_world(uv_to_direction(u, v));
                     // ... Mitsuba must look up the same texel.
                     let local = m.transpose() * world;
                     let (mu, mv) = mitsuba_uv(local);

@@ -22,11 +22,11 @@ use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::hair::{Attribute, GroomParams, HairModel, generate_groom};
 use strandlight_scene::camera_choice::front_camera;
 use strandlight_scene::env_frame::{EnvFrame, FrameRole, env_adapter, render_lights};
+use strandlight_scene::env_orientation::EnvOrientation;
 use strandlight_scene::environment::map_pixels_sha256;
 use strandlight_scene::image_metrics::{HAIR_ALPHA, Image};
 use strandlight_scene::look::{EnvLook, LookArgs};
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode, SceneTables, bake_scene_tables};
-use strandlight_scene::world_lights::env_to_world;
 use strandlight_tables::outside_tools::require_python_modules;
 
 /// Mitsuba and a GPU device, or the reason to skip (printed).
@@ -85,7 +85,7 @@ fn ours(
         camera,
         width: size.0,
         height: size.1,
-        lights,
+        lights: lights.to_vec(),
         tables,
         shading: EnvShading::Chiang,
         mode: ScatteringMode::Single,
@@ -110,11 +110,10 @@ fn mitsuba_scene<'a>(
     let (up, camera) = front_camera(hair, size);
     MitsubaScene {
         hair,
-        up,
+        orientation: EnvOrientation::upright(up),
         camera,
         size,
         map,
-        rotate_degrees: 0.0,
         directional,
         fiber,
         head: None,
@@ -291,7 +290,7 @@ fn one_bright_texel_lights_the_same_side() {
         let mut pixels = vec![[0f32; 3]; w * h];
         pixels[y * w + x] = [radiance; 3];
         let map = EnvMap::from_pixels(w, h, pixels);
-        let toward = env_to_world(pixel_direction(x, y, w, h), up);
+        let toward = EnvOrientation::upright(up).to_world(pixel_direction(x, y, w, h));
         let power = radiance as f64 * map.row_solid_angle(y);
         let light = EnvLight::directional(toward.as_vec3(), [power as f32; 3]);
         let a = ours(&hair, size, &[light], &tables, true);

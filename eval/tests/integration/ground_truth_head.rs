@@ -23,6 +23,7 @@ use strandlight_runtime::hair::{Attribute, GroomParams, HairModel, generate_groo
 use strandlight_runtime::head::Head;
 use strandlight_scene::camera_choice::front_camera;
 use strandlight_scene::env_frame::{EnvFrame, FrameRole, env_adapter, render_lights};
+use strandlight_scene::env_orientation::EnvOrientation;
 use strandlight_scene::head_input::{HeadChoice, load_head};
 use strandlight_scene::image_metrics::Image;
 use strandlight_scene::look::{EnvLook, LookArgs};
@@ -83,11 +84,10 @@ fn mitsuba(
     let (up, camera) = front_camera(hair, SIZE);
     let scene = MitsubaScene {
         hair,
-        up,
+        orientation: EnvOrientation::upright(up),
         camera,
         size: SIZE,
         map: None,
-        rotate_degrees: 0.0,
         directional: light,
         fiber,
         head,
@@ -157,7 +157,7 @@ fn mitsuba_draws_and_shadows_the_head_where_the_geometry_says() {
         camera,
         width: SIZE.0,
         height: SIZE.1,
-        lights: &lights,
+        lights: lights.to_vec(),
         tables: &tables,
         shading: EnvShading::Chiang,
         mode: ScatteringMode::Single,

@@ -12,7 +12,6 @@
 //! Sizes (800 strands, 128×96, 384 reference lights, 256² light maps) keep both tests at ~36 s
 //! on 2 cores with lavapipe; without a GPU device they print why and pass.
 
-use glam::DVec3;
 use std::collections::BTreeMap;
 use std::sync::{Arc, OnceLock};
 use std::time::Instant;
@@ -36,6 +35,7 @@ use strandlight_runtime::multiple::{
     CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering,
     VoxelSettings,
 };
+use strandlight_scene::env_orientation::EnvOrientation;
 use strandlight_tables::asset::{Storage, read_asset};
 use strandlight_tables::table::Table;
 
@@ -84,27 +84,9 @@ struct Scene {
     tables: BTreeMap<String, Arc<Table>>,
 }
 
-/// A direction of the map's frame (+Y up, image centre toward −Z) in the world of a hair with
-/// `up`, as `src/env_lights.rs::env_to_world` (the CLI's binary crate cannot be linked).
-fn env_to_world(d: DVec3, up: UpAxis) -> DVec3 {
-    match up {
-        UpAxis::Y => d,
-        UpAxis::Z => DVec3::new(-d.x, d.z, d.y),
-    }
-}
-
+/// The runtime lights of `specs` over a hair with `up`, placed as every frame places them.
 fn to_env_lights(specs: &[LightSpec], up: UpAxis) -> Vec<EnvLight> {
-    specs
-        .iter()
-        .map(|s| {
-            let direction = env_to_world(s.direction, up).as_vec3();
-            let rgb = s.rgb.map(|c| c as f32);
-            match s.lambda {
-                Some(lambda) => EnvLight::srbf(direction, lambda as f32, rgb),
-                None => EnvLight::directional(direction, rgb),
-            }
-        })
-        .collect()
+    EnvOrientation::upright(up).lights(specs)
 }
 
 /// The scene, or the reason there is none (no GPU device).
@@ -149,12 +131,11 @@ fn build_scene() -> Result<Scene, String> {
     let set = SrbfSet::fit(&source, &options, &mut |_| {}).expect("fit");
     let srbf_specs = srbf_set_lights(&set);
     let reference_specs =
-        reference_lights(&map, REFERENCE_FACE, 0.0, &options.sources).expect("reference lights");
+        reference_lights(&map, REFERENCE_FACE, &options.sources).expect("reference lights");
     // The reference of the fitted lobes themselves: separates the fit's error from the method's.
     let fitted_map = procedural_env::from_srbf_lobes(256, &set.lobes);
     let fitted_reference_specs =
-        reference_lights(&fitted_map, REFERENCE_FACE, 0.0, &options.sources)
-            .expect("reference lights");
+        reference_lights(&fitted_map, REFERENCE_FACE, &options.sources).expect("reference lights");
     eprintln!(
         "fit: {} lobes in {:.2} s (relative MSE {:.4} on the fit grid, {:.4} at full resolution); reference: {} lights",
         srbf_specs.len(),
