@@ -20,9 +20,7 @@ use strandlight_runtime::env_light::{EnvLight, shadow_groups};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::passes::convolution_depth::MAX_DODM_RESOLUTION;
 use strandlight_runtime::passes::view_visibility::ViewTransparency;
-use strandlight_scene::env_frame::{
-    EnvFrame, FrameRole, RenderedEnv, fit_summary, forward_settings,
-};
+use strandlight_scene::env_frame::{EnvFrame, FrameRole, fit_summary, forward_settings};
 use strandlight_scene::env_light_sets::{frame_lights, reference_sources};
 pub use strandlight_scene::env_lighting::ReferenceLighting;
 use strandlight_scene::env_lighting::{EnvLightSet, EnvLighting};
@@ -35,6 +33,7 @@ use strandlight_scene::hair_input::fibers_for;
 use strandlight_scene::head_input::load_head;
 use strandlight_scene::image_metrics::{Image, error_legend, relative_rmse, write_side_by_side};
 use strandlight_scene::look::EnvLook;
+use strandlight_scene::rendered_frame::RenderedFrame;
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
 use strandlight_scene::steps::Steps;
 use strandlight_tables::checksum::sha256_hex;
@@ -325,14 +324,14 @@ pub fn prepare_with_hair(
 }
 
 /// The function that renders a frame: [`render_lights`] in the program, a stand-in in tests.
-pub type Renderer<'r> = &'r dyn Fn(&EnvFrame) -> anyhow::Result<RenderedEnv>;
+pub type Renderer<'r> = &'r dyn Fn(&EnvFrame) -> anyhow::Result<RenderedFrame>;
 
 /// Renders `runs` times and keeps the last image with the median time.
 pub fn timed_render(
     render: Renderer,
     frame: &EnvFrame,
     runs: usize,
-) -> anyhow::Result<RenderedEnv> {
+) -> anyhow::Result<RenderedFrame> {
     let mut times = Vec::with_capacity(runs);
     let mut last = None;
     for _ in 0..runs {
@@ -365,12 +364,12 @@ pub struct Reference {
 
 /// One mode's results.
 struct ModeResult {
-    srbf: RenderedEnv,
+    srbf: RenderedFrame,
     srbf_lights: usize,
     srbf_flip: HdrFlip,
     baseline_flip: HdrFlip,
     reference: Reference,
-    baseline: RenderedEnv,
+    baseline: RenderedFrame,
     baseline_lights: usize,
     baseline_search: Vec<(usize, f64)>,
     equal_error: Option<EqualErrorResult>,
@@ -416,7 +415,7 @@ pub fn render_baseline(
     args: &CompareSettings,
     mode: ScatteringMode,
     lights: usize,
-) -> anyhow::Result<RenderedEnv> {
+) -> anyhow::Result<RenderedFrame> {
     let settings = args.frame_of(mode, args.baseline.light_set(lights));
     timed_render(render, &frame(scene, &settings)?, args.timing_runs)
 }
@@ -611,7 +610,7 @@ fn run_mode(
         ..EqualTimeSearch::new(srbf.milliseconds)
     };
     // Every image the search renders is kept, so the chosen count need not be rendered again.
-    let mut searched: std::collections::HashMap<usize, RenderedEnv> =
+    let mut searched: std::collections::HashMap<usize, RenderedFrame> =
         std::collections::HashMap::new();
     let found = steps.run(
         &format!("{m}: baseline"),
@@ -1036,6 +1035,7 @@ mod tests {
     use strandlight_scene::environment::load_env;
     use strandlight_scene::fit_cache::fit_cached;
     use strandlight_scene::point_shading::Shading;
+    use strandlight_scene::rendered_frame::FrameDetails;
 
     /// Settings for hair `h` under map `e`, changed by `change`.
     fn settings(change: impl FnOnce(&mut CompareSettings)) -> CompareSettings {
@@ -1167,7 +1167,7 @@ mod tests {
     /// A stand-in renderer whose picture is known without a GPU: every pixel of a central
     /// block (alpha 1) holds the set's total power Σ power() per channel, the rest is empty;
     /// a frame costs 1 ms + 0.01 ms per light.
-    fn power_renderer(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
+    fn power_renderer(frame: &EnvFrame) -> anyhow::Result<RenderedFrame> {
         let total = frame.lights.iter().fold([0f32; 3], |a, l| {
             let p = l.power();
             [a[0] + p[0], a[1] + p[1], a[2] + p[2]]
@@ -1183,18 +1183,24 @@ mod tests {
                 }
             })
             .collect();
-        Ok(RenderedEnv {
+        Ok(RenderedFrame {
             image: Image::new(w, h, pixels),
             milliseconds: 1.0 + 0.01 * frame.lights.len() as f64,
             passes: Vec::new(),
-            fragments: None,
-            memory_per_batch: Vec::new(),
+            memory: Vec::new(),
+            adapter: "a stand-in".into(),
+            timing_method: "a stand-in's cost model".into(),
+            details: FrameDetails::Env {
+                lights: frame.lights.clone(),
+                mode: frame.mode,
+                fragments: None,
+            },
         })
     }
 
     /// [`power_renderer`] whose reference frames carry a discretization error of 1/N for N
     /// lights: the N- and 4N-light references differ by (3/4N)/(1 + 1/4N).
-    fn converging_renderer(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
+    fn converging_renderer(frame: &EnvFrame) -> anyhow::Result<RenderedFrame> {
         let mut r = power_renderer(frame)?;
         if frame.role == FrameRole::Reference {
             let scale = 1.0 + 1.0 / frame.lights.len() as f32;

@@ -28,11 +28,11 @@ use crate::compare::{self, CompareScene, CompareSettings, Reference};
 use crate::ground_truth::GroundTruth;
 use crate::hdr_flip::hdr_flip;
 use serde::{Deserialize, Serialize};
-use strandlight_scene::env_frame::RenderedEnv;
 use strandlight_scene::env_lighting::{EnvLightSet, EnvLighting, ReferenceLighting};
 use strandlight_scene::frame_settings::{FrameSettings, Lighting};
 use strandlight_scene::image_metrics::{Image, relative_rmse, relative_rmse_of_part};
 use strandlight_scene::look::LobeVisibilityArg;
+use strandlight_scene::rendered_frame::RenderedFrame;
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 
@@ -167,7 +167,7 @@ impl DecompositionInputs<'_> {
         let r = steps.run(
             &format!("{}: decomposition, SRBF {label}", mode.name()),
             || (self.render)(&frame),
-            |r: &RenderedEnv| format!("{:.0} ms", r.milliseconds),
+            |r: &RenderedFrame| format!("{:.0} ms", r.milliseconds),
         )?;
         Ok(r.image)
     }

@@ -3,14 +3,13 @@
 
 use crate::image_metrics::Image;
 use crate::look::{EnvLook, ForwardDevice};
+use crate::rendered_frame::{FrameDetails, RenderedFrame};
 use crate::scene_tables::{EnvShading, ScatteringMode, SceneTables};
 use anyhow::Context;
 use std::sync::OnceLock;
 use strandlight_precompute::srbf_set::SrbfSet;
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env::{
-    EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables, FragmentCounts,
-};
+use strandlight_runtime::env::{EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
@@ -19,7 +18,6 @@ use strandlight_runtime::multiple::ForwardScatteringSource;
 use strandlight_runtime::multiple::{
     CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering,
 };
-use strandlight_runtime::render::PassTiming;
 use strandlight_runtime::visibility::LobeVisibility;
 
 /// "N SRBF lights" or "N SRBF lights + k directional" for a frame's lights.
@@ -70,18 +68,6 @@ pub struct EnvFrame<'a> {
     pub look: EnvLook,
     /// The head (issue 40): hides the fibers behind it, drawn as skin, opaque to every light.
     pub head: Option<Head>,
-}
-
-/// A rendered frame and its GPU time.
-pub struct RenderedEnv {
-    pub image: Image,
-    pub milliseconds: f64,
-    /// Per pass (summed over batches); empty for stand-in renderers.
-    pub passes: Vec<PassTiming>,
-    /// With [`EnvLook::count_fragments`].
-    pub fragments: Option<FragmentCounts>,
-    /// GPU memory held while one batch renders, per resource (bytes); empty for stand-ins.
-    pub memory_per_batch: Vec<(String, u64)>,
 }
 
 /// The process's GPU device: created on first use by whichever frame needs it first (an
@@ -286,7 +272,7 @@ pub fn lights_call_without_source<'g>(frame: &EnvFrame) -> anyhow::Result<Lights
 /// THE call into the environment-lit renderer. The SRBF path reads
 /// `tables.get(shading.srbf_table(mode))`, directional lights `tables.get(shading.direct_table(mode))`
 /// (4 axes, the 1/λ axis a single node), and the full mode also [`MULTIPLE_TABLES`].
-pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
+pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedFrame> {
     let (gpu, renderer) = env_renderer()?;
     let call = lights_call(frame, gpu)?;
     let (tables, multiple) = (&call.tables, call.source.as_deref());
@@ -310,15 +296,21 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedEnv> {
                 frame.mode.name()
             )
         })?;
-    Ok(RenderedEnv {
+    Ok(RenderedFrame {
         milliseconds: frame_milliseconds(&out.stats),
         passes: out.stats.timings.clone(),
-        fragments: out.stats.fragments,
-        memory_per_batch: out.stats.memory_per_batch.clone(),
+        memory: out.stats.memory_per_batch.clone(),
+        adapter: gpu.report.to_string(),
+        timing_method: out.stats.timing_method.into(),
         image: Image {
             width: out.width,
             height: out.height,
             pixels: out.pixels,
+        },
+        details: FrameDetails::Env {
+            lights: frame.lights.clone(),
+            mode: frame.mode,
+            fragments: out.stats.fragments,
         },
     })
 }

@@ -4,7 +4,7 @@
 //! demo do both once; the viewer prepares again only when a setting that preparation depends on
 //! changes, and renders its preview and light batches through the same [`render_frame`].
 
-use crate::env_frame::{EnvFrame, FrameRole, env_adapter, render_lights, shared_gpu};
+use crate::env_frame::{EnvFrame, FrameRole, render_lights, shared_gpu};
 use crate::env_light_sets::frame_lights;
 use crate::env_scene::PreparedEnv;
 use crate::frame_settings::{
@@ -15,10 +15,11 @@ use crate::head_input::load_head;
 use crate::image_metrics::Image;
 use crate::look::EnvLook;
 use crate::point_shading::{PointShadingRequest, point_shading_model};
+pub use crate::rendered_frame::{FrameDetails, RenderedFrame};
 use crate::scene_tables::ScatteringMode;
 use anyhow::Context;
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env::{FragmentCounts, ViewTransparency};
+use strandlight_runtime::env::ViewTransparency;
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
@@ -27,7 +28,7 @@ use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
 use strandlight_runtime::passes::fiber_shading::ShadingModel;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
 use strandlight_runtime::render::{
-    self, PassTiming, RenderOptions, RenderStats, ShadowMaps, TIMING_METHOD, render_frame_with_head,
+    self, PassTiming, RenderOptions, ShadowMaps, render_frame_with_head,
 };
 use strandlight_tables::checksum::sha256_hex;
 
@@ -282,43 +283,6 @@ impl FramePart {
     }
 }
 
-/// A rendered frame (or part of one) and what it cost.
-pub struct RenderedFrame {
-    pub image: Image,
-    /// Frame time without the one-time setup passes.
-    pub milliseconds: f64,
-    pub passes: Vec<PassTiming>,
-    /// GPU memory per resource while it renders (per light batch for an environment), bytes.
-    pub memory: Vec<(String, u64)>,
-    pub adapter: String,
-    pub timing_method: String,
-    pub details: FrameDetails,
-}
-
-/// What only one kind of lighting reports.
-pub enum FrameDetails {
-    Point(RenderStats),
-    Env {
-        /// The lights drawn, in the hair's world frame.
-        lights: Vec<EnvLight>,
-        /// The scattering rendered (dark hair without a multiple table falls back to single).
-        mode: ScatteringMode,
-        /// With `count_fragments`.
-        fragments: Option<FragmentCounts>,
-    },
-}
-
-impl RenderedFrame {
-    /// Lights drawn: point lights, or SRBF lobes and directional sources.
-    pub fn light_count(&self, settings: &FrameSettings) -> usize {
-        match (&self.details, &settings.lighting) {
-            (FrameDetails::Env { lights, .. }, _) => lights.len(),
-            (FrameDetails::Point(_), Lighting::Lights(point)) => point.lights.len(),
-            (FrameDetails::Point(_), _) => 0,
-        }
-    }
-}
-
 /// THE frame function: `part` of the frame of `settings` for `hair`, lit as `prepared` (from
 /// the same settings' [`prepare_point`] or [`prepare_env`]). `count_fragments` asks an env-lit
 /// frame to count its rasterized and shaded fragments (slower; reports only).
@@ -436,21 +400,7 @@ fn render_env_part(
     part: FramePart,
     count_fragments: bool,
 ) -> anyhow::Result<RenderedFrame> {
-    let frame = env_frame(settings, hair, prepared, part, count_fragments)?;
-    let rendered = render_lights(&frame)?;
-    Ok(RenderedFrame {
-        image: rendered.image,
-        milliseconds: rendered.milliseconds,
-        passes: rendered.passes,
-        memory: rendered.memory_per_batch,
-        adapter: env_adapter()?,
-        timing_method: TIMING_METHOD.into(),
-        details: FrameDetails::Env {
-            lights: frame.lights,
-            mode: frame.mode,
-            fragments: rendered.fragments,
-        },
-    })
+    render_lights(&env_frame(settings, hair, prepared, part, count_fragments)?)
 }
 
 #[cfg(test)]

@@ -25,6 +25,7 @@ pub mod look;
 pub mod orbit;
 pub mod point_shading;
 pub mod progressive;
+pub mod rendered_frame;
 pub mod scene_tables;
 pub mod sealed_file;
 pub mod steps;

@@ -3,12 +3,12 @@
 //! ([`PNG_TONEMAP`](strandlight_tables::image_out::PNG_TONEMAP)) so the window and a screenshot
 //! show the same thing.
 
-use crate::frame::LinearImage;
 use crate::recompute::Backdrop;
 use glam::{DVec3, Vec4};
 use strandlight_precompute::envmap::EnvMap;
 use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_scene::env_orientation::EnvOrientation;
+use strandlight_scene::image_metrics::Image;
 use strandlight_tables::image_out::tonemap_channel;
 
 /// The world direction through each pixel of `camera` at `size`, in the map's frame (the map
@@ -91,11 +91,7 @@ pub fn backdrop_pixels(
 
 /// The hair scaled by `2^stops` over the (equally exposed) background, as linear RGB + alpha 1
 /// where there is a background.
-pub fn composite(
-    image: &LinearImage,
-    stops: f32,
-    background: Option<&[[f32; 3]]>,
-) -> Vec<[f32; 4]> {
+pub fn composite(image: &Image, stops: f32, background: Option<&[[f32; 3]]>) -> Vec<[f32; 4]> {
     let scale = stops.exp2();
     image
         .pixels
@@ -200,7 +196,7 @@ mod tests {
 
     #[test]
     fn composite_puts_the_hair_over_the_background_with_one_exposure() {
-        let image = LinearImage {
+        let image = Image {
             width: 2,
             height: 1,
             pixels: vec![[0.5, 0.5, 0.5, 0.5], [0.0; 4]],

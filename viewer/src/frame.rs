@@ -1,16 +1,8 @@
-//! A rendered frame as the window shows it: the linear image, how far its refinement is, and
-//! what it cost. The render thread produces it, progressive refinement sums it, the window and
-//! screenshots read it.
+//! A rendered frame as the window shows it: how far its refinement is and what it cost (the
+//! image is the scene's `Image`, linear pre-multiplied RGBA). The render thread produces it,
+//! progressive refinement sums it, the window and screenshots read it.
 
 use strandlight_runtime::render::PassTiming;
-
-/// A frame in linear, pre-multiplied RGBA.
-#[derive(Clone, Debug, PartialEq)]
-pub struct LinearImage {
-    pub width: u32,
-    pub height: u32,
-    pub pixels: Vec<[f32; 4]>,
-}
 
 /// How far the shown image is.
 #[derive(Clone, Copy, Debug, PartialEq)]

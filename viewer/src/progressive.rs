@@ -3,15 +3,16 @@
 //! gives that frame; before the last batch the window shows the running sum scaled by the share
 //! of the lights' power it holds (lights are drawn most powerful first).
 
-use crate::frame::{FrameStats, LinearImage, Stage};
+use crate::frame::{FrameStats, Stage};
 use std::sync::Arc;
+use strandlight_scene::image_metrics::Image;
 pub use strandlight_scene::progressive::{Step, plan_steps};
 
 /// Sums the steps of one request into the image the window shows.
 #[derive(Default)]
 pub struct Accumulator {
-    sum: Option<LinearImage>,
-    shown: Option<(Arc<LinearImage>, FrameStats)>,
+    sum: Option<Image>,
+    shown: Option<(Arc<Image>, FrameStats)>,
     stats: FrameStats,
     batches_done: usize,
     batches_total: usize,
@@ -19,7 +20,7 @@ pub struct Accumulator {
 
 impl Accumulator {
     /// Adds one step's image; returns the stage the shown image is at.
-    pub fn add(&mut self, step: Step, image: LinearImage, stats: FrameStats) -> Stage {
+    pub fn add(&mut self, step: Step, image: Image, stats: FrameStats) -> Stage {
         match step {
             Step::Preview => {
                 self.shown = Some((Arc::new(image), stats));
@@ -38,8 +39,8 @@ impl Accumulator {
         self.batches_total = total;
     }
 
-    fn add_batch(&mut self, image: LinearImage, stats: FrameStats, power_after: f32) -> Stage {
-        let sum = self.sum.get_or_insert_with(|| LinearImage {
+    fn add_batch(&mut self, image: Image, stats: FrameStats, power_after: f32) -> Stage {
+        let sum = self.sum.get_or_insert_with(|| Image {
             width: image.width,
             height: image.height,
             pixels: vec![[0.0; 4]; image.pixels.len()],
@@ -58,7 +59,7 @@ impl Accumulator {
         } else {
             1.0
         };
-        let estimate = LinearImage {
+        let estimate = Image {
             width: sum.width,
             height: sum.height,
             pixels: sum
@@ -78,7 +79,7 @@ impl Accumulator {
         }
     }
 
-    pub fn shown(&self) -> (Arc<LinearImage>, FrameStats) {
+    pub fn shown(&self) -> (Arc<Image>, FrameStats) {
         self.shown.clone().expect("a step was added")
     }
 }
@@ -99,8 +100,8 @@ fn add_stats(total: &mut FrameStats, batch: FrameStats) {
 mod tests {
     use super::*;
 
-    fn image(value: f32) -> LinearImage {
-        LinearImage {
+    fn image(value: f32) -> Image {
+        Image {
             width: 2,
             height: 1,
             pixels: vec![[value, 2.0 * value, 0.0, 0.5]; 2],

@@ -3,11 +3,11 @@
 //! settings also go into both images' metadata. The whole window, panel included, is captured
 //! beside them when the window next paints (`window_capture`).
 
-use crate::frame::LinearImage;
 use crate::recompute::Display;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 use strandlight_scene::frame_settings::FrameSettings;
+use strandlight_scene::image_metrics::Image;
 use strandlight_tables::atomic_write::write_atomically;
 use strandlight_tables::image_out::{write_exr, write_png};
 
@@ -43,7 +43,7 @@ pub fn save(
     settings: &FrameSettings,
     display: &Display,
     exposure_stops: f32,
-    frame: &LinearImage,
+    frame: &Image,
     shown: &[[f32; 4]],
 ) -> anyhow::Result<ScreenshotFiles> {
     let files = ScreenshotFiles::at(stem);

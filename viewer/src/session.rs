@@ -3,7 +3,7 @@
 //! the renderer.
 
 use crate::display::{backdrop_pixels, composite, soft_backdrop_map, to_rgba8};
-use crate::frame::{LinearImage, Stage};
+use crate::frame::Stage;
 use crate::orbit::Orbit;
 use crate::panel::{Panel, PanelOutcome};
 use crate::recompute::{Backdrop, Display, Recompute, ViewState, recompute};
@@ -19,6 +19,7 @@ use strandlight_scene::camera_choice::CameraChoice;
 use strandlight_scene::exposure::metered_stops;
 use strandlight_scene::frame_settings::{CameraSettings, ExactCamera, FrameSettings, Lighting};
 use strandlight_scene::head_input::HeadChoice;
+use strandlight_scene::image_metrics::Image;
 
 /// Changes that need a rebake wait this long after the last edit (a slider being dragged).
 const REBAKE_SETTLE: Duration = Duration::from_millis(400);
@@ -73,7 +74,7 @@ struct OnScreen {
     job: u64,
     stage: Stage,
     display: Display,
-    image: Arc<LinearImage>,
+    image: Arc<Image>,
     exposure_stops: f32,
     composited: Vec<[f32; 4]>,
 }
@@ -398,7 +399,7 @@ impl Session {
         self.submitted = Some((job, self.state.settings.clone()));
     }
 
-    fn exposure_for(&self, image: &LinearImage) -> f32 {
+    fn exposure_for(&self, image: &Image) -> f32 {
         match self.state.display.exposure_stops {
             Some(stops) => stops,
             None => metered_stops(&image.pixels).unwrap_or(0.0),
@@ -445,7 +446,7 @@ impl Session {
 
     /// The map behind the hair, computed once per view (the refinement steps of one request
     /// share it).
-    fn background_of(&mut self, shown: &Shown, image: &LinearImage) -> Option<Arc<Vec<[f32; 3]>>> {
+    fn background_of(&mut self, shown: &Shown, image: &Image) -> Option<Arc<Vec<[f32; 3]>>> {
         if self.state.display.backdrop == Backdrop::Black {
             return None;
         }

@@ -21,15 +21,16 @@ use strandlight_scene::frame_render::{
 use strandlight_scene::frame_settings::{FrameSettings, Lighting, PointLighting, up_choice};
 use strandlight_scene::steps::Steps;
 
-use crate::frame::{FrameStats, LinearImage, Stage};
+use crate::frame::{FrameStats, Stage};
 use crate::recompute::{TablesKey, tables_key};
+use strandlight_scene::image_metrics::Image;
 
 /// The worker's latest image of a request.
 #[derive(Clone)]
 pub struct Shown {
     pub job: u64,
     pub settings: FrameSettings,
-    pub image: Arc<LinearImage>,
+    pub image: Arc<Image>,
     pub stage: Stage,
     pub stats: FrameStats,
     /// Rendered with the previous tables while this request's tables bake.
@@ -422,7 +423,7 @@ impl WorkerState {
             adapter: rendered.adapter,
             timing_method: rendered.timing_method,
         };
-        let image = LinearImage {
+        let image = Image {
             width: rendered.image.width,
             height: rendered.image.height,
             pixels: rendered.image.pixels,

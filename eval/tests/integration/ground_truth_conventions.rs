@@ -12,21 +12,30 @@
 use glam::{DVec3, Vec3};
 use std::path::{Path, PathBuf};
 use strandlight_eval::ground_truth::mitsuba_scene::{MitsubaRun, MitsubaScene};
-use strandlight_eval::ground_truth::{INSTALL_HINT, TruthInputs, render_cached};
+use strandlight_eval::ground_truth::{INSTALL_HINT, TruthInputs, TruthScene, render_cached};
 use strandlight_eval::reference_cache::ReferenceCache;
 use strandlight_precompute::EnvMap;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
-use strandlight_precompute::envmap::pixel_direction;
+use strandlight_precompute::envmap::direction_to_uv;
 use strandlight_runtime::camera::UpAxis;
 use strandlight_runtime::env_light::EnvLight;
-use strandlight_runtime::hair::{Attribute, GroomParams, HairModel, generate_groom};
+use strandlight_runtime::hair::{
+    Attribute, GroomParams, HairModel, HairWriteOptions, generate_groom, write_hair,
+};
 use strandlight_scene::camera_choice::front_camera;
 use strandlight_scene::env_frame::{EnvFrame, FrameRole, env_adapter, render_lights};
+use strandlight_scene::env_lighting::EnvLighting;
 use strandlight_scene::env_orientation::EnvOrientation;
+use strandlight_scene::env_scene::{AlsoServe, prepare_env};
 use strandlight_scene::environment::map_pixels_sha256;
+use strandlight_scene::frame_render::{FramePart, Prepared, load_settings_hair, render_frame};
+use strandlight_scene::frame_settings::{FrameSettings, Lighting};
 use strandlight_scene::image_metrics::{HAIR_ALPHA, Image};
 use strandlight_scene::look::{EnvLook, LookArgs};
+use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode, SceneTables, bake_scene_tables};
+use strandlight_scene::steps::Steps;
+use strandlight_tables::image_out::write_exr;
 use strandlight_tables::outside_tools::require_python_modules;
 
 /// Mitsuba and a GPU device, or the reason to skip (printed).
@@ -266,53 +275,211 @@ fn lit_side(image: &Image) -> (f64, f64) {
     (lx / lum - cx / cov, ly / lum - cy / cov)
 }
 
-/// The map's frame: a map black but for one bright texel lights the groom from the same side
-/// in both renderers, for texels left, right, above and below the groom as the camera sees it.
+/// A map black but for one bright texel at (x, y), written as an EXR the product reads like any
+/// user's map.
+fn one_texel_map(dir: &Path, (x, y): (usize, usize), (w, h): (usize, usize)) -> PathBuf {
+    let mut pixels = vec![[0f32; 4]; w * h];
+    pixels[y * w + x] = [4000.0, 4000.0, 4000.0, 1.0];
+    let path = dir.join(format!("one-texel-{x}-{y}.exr"));
+    write_exr(&path, w as u32, h as u32, &pixels, "one bright texel").unwrap();
+    path
+}
+
+/// The texel of a `w`×`h` map that a frame turned by `orientation` shows along `world`.
+fn texel_toward(
+    orientation: EnvOrientation,
+    world: DVec3,
+    (w, h): (usize, usize),
+) -> (usize, usize) {
+    let (u, v) = direction_to_uv(orientation.to_env(world.normalize()));
+    let x = ((u * w as f64) as usize).min(w - 1);
+    let y = ((v * h as f64) as usize).min(h - 1);
+    (x, y)
+}
+
+/// A groom of realistic fibers (0.3 mm, a tenth of a pixel at 64×48): the light maps' shadows
+/// and the path tracer's agree in total there, where a few thick fibers shadow themselves in a
+/// light map (measured: 0.56 of Mitsuba's light with 2.5 cm tubes, 0.96 with these).
+fn fine_groom() -> HairModel {
+    generate_groom(&GroomParams {
+        strand_count: 3000,
+        points_per_strand: 16,
+        clump_count: 60,
+        thickness: 0.03,
+        ..GroomParams::default()
+    })
+    .unwrap()
+}
+
+/// The map's frame, through the product's own path: a map black but for one bright texel is
+/// fitted (as SRBF lobes, and as a compact source: the two ways a fit lights a frame), turned
+/// by the frame's rotation, placed over a Y-up or a Z-up groom, and rendered by `render_frame`;
+/// Mitsuba renders the scene [`TruthScene`] writes for the same settings. The texel is the one
+/// the frame shows along a chosen world direction (left of the camera, or above), so its lit
+/// side is known: both renderers must light that side of the groom (the lit side: the luminance
+/// centroid less the coverage centroid), agree on it, and carry the same light.
 #[test]
-fn one_bright_texel_lights_the_same_side() {
+fn one_bright_texel_lights_the_same_side_through_the_fit_at_any_rotation_and_up_axis() {
     if !tools() {
         return;
     }
     let dir = scratch("texel");
-    let (tables, fiber) = chiang(&dir);
-    let hair = small_groom();
-    let size = (64, 48);
-    let (up, _) = front_camera(&hair, size);
-    let (w, h) = (64usize, 32usize);
-    // Texels of the map's frame: the map's centre (−Z) is behind the hair, seen from the front.
-    for (name, x, y) in [
-        ("left of the camera", 40, 14),
-        ("right of the camera", 24, 14),
-        ("above", 4, 4),
-        ("below", 60, 26),
-    ] {
-        let radiance = 4000.0;
-        let mut pixels = vec![[0f32; 3]; w * h];
-        pixels[y * w + x] = [radiance; 3];
-        let map = EnvMap::from_pixels(w, h, pixels);
-        let toward = EnvOrientation::upright(up).to_world(pixel_direction(x, y, w, h));
-        let power = radiance as f64 * map.row_solid_angle(y);
-        let light = EnvLight::directional(toward.as_vec3(), [power as f32; 3]);
-        let a = ours(&hair, size, &[light], &tables, true);
-        let b = theirs(
-            mitsuba_scene(&hair, size, Some(&map), &[], &fiber),
-            256,
-            &dir,
-        );
-        let (sa, sb) = (lit_side(&a), lit_side(&b));
-        let cosine = (sa.0 * sb.0 + sa.1 * sb.1) / (sa.0.hypot(sa.1) * sb.0.hypot(sb.1));
-        let total = |i: &Image| i.pixels.iter().map(|p| p[1] as f64).sum::<f64>();
-        println!(
-            "texel {name} ({x}, {y}) toward {toward:.2}: lit side ours {sa:.2?} Mitsuba {sb:.2?} px, cosine {cosine:.3}; green sum ours {:.4} Mitsuba {:.4}",
-            total(&a),
-            total(&b)
-        );
-        assert!(
-            cosine > 0.8,
-            "texel {name}: the lit sides disagree (cosine {cosine:.3})"
-        );
+    std::fs::create_dir_all(&dir).unwrap();
+    let y_up = fine_groom();
+    let hair_files = [("Y-up", &y_up), ("Z-up", &z_up(&y_up))].map(|(name, model)| {
+        let path = dir.join(format!("{name}.hair"));
+        write_hair(model, &path, &HairWriteOptions::default()).unwrap();
+        (name, path)
+    });
+    let size = [64, 48];
+    let map_size = (128, 64);
+    let mut failures = Vec::new();
+    let (mut worst_cosine, mut worst_energy) = (1.0f64, 0.0f64);
+    for (hair, rotation) in [(0, 0.0), (0, 211.0), (1, 149.0)] {
+        let (up_name, hair_path) = &hair_files[hair];
+        let up = if hair == 0 { UpAxis::Y } else { UpAxis::Z };
+        let orientation = EnvOrientation::new(up, rotation as f64);
+        let (front, world_up) = (up.toward_front().as_dvec3(), up.vector().as_dvec3());
+        // The camera looks along −front; its right is (−front) × up.
+        let right = (-front).cross(world_up);
+        for (texel, toward, screen) in [
+            (
+                "left of the camera",
+                -right + 0.4 * world_up + 0.3 * front,
+                (-1.0, -0.4),
+            ),
+            ("above", world_up + 0.4 * front, (0.0, -1.0)),
+        ] {
+            let at = texel_toward(orientation, toward, map_size);
+            let map = one_texel_map(&dir, at, map_size);
+            let settings = |sources: usize| {
+                let mut env = EnvLighting::new(map.to_string_lossy());
+                env.scattering = ScatteringMode::Single;
+                env.rotation_deg = rotation;
+                env.fit.sources = sources;
+                FrameSettings {
+                    hair: Some(hair_path.clone()),
+                    shading: Some(Shading::Chiang),
+                    ..FrameSettings::new(Lighting::Environment(env), size)
+                }
+            };
+            let theirs = truth_of(&settings(0), &dir);
+            for (fit, sources) in [("SRBF lobes", 0), ("a compact source", 1)] {
+                let ours = render_settings(&settings(sources), &dir);
+                let (sa, sb) = (lit_side(&ours), lit_side(&theirs));
+                let cosine = cosine_2d(sa, sb);
+                let toward_light = cosine_2d(sb, screen);
+                let energy = total(&ours) / total(&theirs);
+                let case = format!(
+                    "{up_name} groom, map turned {rotation}°, texel {at:?} {texel} as {fit}"
+                );
+                println!(
+                    "{case}: lit side ours {sa:.2?} Mitsuba {sb:.2?} px, cosine {cosine:.4}, toward the light {toward_light:.2}; light ours / Mitsuba {energy:.4}"
+                );
+                if cosine <= 0.98 {
+                    failures.push(format!(
+                        "{case}: the lit sides disagree (cosine {cosine:.4})"
+                    ));
+                }
+                if toward_light <= 0.7 {
+                    failures.push(format!(
+                        "{case}: the lit side is not toward the light (cosine {toward_light:.2})"
+                    ));
+                }
+                if (energy - 1.0).abs() >= ENERGY_TOLERANCE {
+                    failures.push(format!(
+                        "{case}: ours carries {energy:.4} of Mitsuba's light"
+                    ));
+                }
+                worst_cosine = worst_cosine.min(cosine);
+                worst_energy = worst_energy.max((energy - 1.0).abs());
+            }
+        }
     }
+    println!("worst cosine {worst_cosine:.4}, worst light ratio off by {worst_energy:.4}");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+fn cosine_2d(a: (f64, f64), b: (f64, f64)) -> f64 {
+    (a.0 * b.0 + a.1 * b.1) / (a.0.hypot(a.1) * b.0.hypot(b.1))
+}
+
+/// How far the light one bright texel puts on the groom may be from Mitsuba's: the frame's
+/// shadows come from light maps where Mitsuba traces each fiber, a fit's lobes spread the
+/// texel's light over a few degrees, and coverage is sampled at pixel centres (issue 64's
+/// terms). Measured on this groom (5 Dec 2026): 0.90–0.99 as a compact source, 0.995–1.11 as
+/// SRBF lobes, the same at every rotation and on both axes.
+const ENERGY_TOLERANCE: f64 = 0.13;
+
+/// Σ RGB over the frame.
+fn total(image: &Image) -> f64 {
+    image
+        .pixels
+        .iter()
+        .map(|p| (p[0] + p[1] + p[2]) as f64)
+        .sum()
+}
+
+/// `model` turned onto Z-up: (x, y, z) ↦ (−x, z, y), the map's own placement in a Z-up world.
+fn z_up(model: &HairModel) -> HairModel {
+    let points = model
+        .points()
+        .iter()
+        .map(|p| Vec3::new(-p.x, p.z, p.y))
+        .collect();
+    HairModel::new(
+        points,
+        model.strand_offsets().to_vec(),
+        model.thickness().cloned(),
+        None,
+        None,
+    )
+    .unwrap()
+}
+
+/// The frame of `settings` as `render` draws it (fit and tables cached under `dir`).
+fn render_settings(settings: &FrameSettings, dir: &Path) -> Image {
+    let hair = load_settings_hair(settings).unwrap();
+    let prepared = prepare_env(
+        settings,
+        &hair.model,
+        &dir.join("cache"),
+        AlsoServe::default(),
+        &mut Steps::new(true),
+        &mut |_| {},
+    )
+    .unwrap();
+    render_frame(
+        settings,
+        &hair.model,
+        Prepared::Env(&prepared),
+        FramePart::Whole,
+        false,
+    )
+    .unwrap()
+    .image
+}
+
+/// Mitsuba's direct-light image of the scene `strandlight truth` writes for `settings`.
+fn truth_of(settings: &FrameSettings, dir: &Path) -> Image {
+    let scene = TruthScene::load(settings).unwrap();
+    let run = MitsubaRun {
+        max_depth: 2,
+        spp: 256,
+        seed: 1,
+    };
+    let cache = ReferenceCache::new(dir.join("truth"));
+    render_cached(
+        &scene.inputs().unwrap(),
+        run,
+        &cache,
+        &dir.join("work"),
+        true,
+    )
+    .unwrap()
+    .expect("rendering is allowed")
+    .0
 }
 
 /// The fiber frame and units: one straight fiber, several pixels wide, under one directional
