@@ -23,10 +23,10 @@ use strandlight_precompute::env_lights::{
 };
 use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::EnvRenderOptions;
+use strandlight_runtime::env::ViewTransparency;
 use strandlight_runtime::env_light::{EnvLight, shadow_groups};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::passes::convolution_depth::{DodmSettings, MAX_DODM_RESOLUTION};
-use strandlight_runtime::passes::view_visibility::ViewTransparency;
 use strandlight_scene::camera_choice::front_camera;
 use strandlight_scene::env_frame::{
     EnvFrame, FrameRole, RenderedEnv, fit_summary, forward_settings,

@@ -9,6 +9,7 @@ pub mod head;
 pub mod lights;
 pub mod multiple;
 pub mod passes;
-pub mod render;
+pub mod point_frame;
+pub mod shaders;
 pub mod shadow_layout;
 pub mod visibility;

@@ -19,7 +19,7 @@ use strandlight_runtime::multiple::ForwardScatteringSource;
 use strandlight_runtime::multiple::{
     CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering,
 };
-use strandlight_runtime::render::PassTiming;
+use strandlight_runtime::point_frame::PassTiming;
 use strandlight_runtime::visibility::LobeVisibility;
 
 /// "N SRBF lights" or "N SRBF lights + k directional" for a frame's lights.

@@ -2,7 +2,7 @@
 //! what it cost. The render thread produces it, progressive refinement sums it, the window and
 //! screenshots read it.
 
-use strandlight_runtime::render::PassTiming;
+use strandlight_runtime::point_frame::PassTiming;
 
 /// A frame in linear, pre-multiplied RGBA.
 #[derive(Clone, Debug, PartialEq)]

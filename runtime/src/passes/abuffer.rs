@@ -31,7 +31,8 @@ use crate::passes::shadow_slots::{
 };
 use crate::passes::strand_geometry::StrandGeometry;
 use crate::passes::strand_quads::{strand_bind_group, strand_bind_group_layout};
-use crate::passes::strands::shading_source;
+use crate::passes::strands::strand_shading_module;
+use crate::shaders::Wgsl;
 
 #[derive(Debug, thiserror::Error)]
 pub enum ABufferError {
@@ -447,11 +448,11 @@ impl ABufferPass {
     /// Fragments shaded with `model`; its tables and constants are uploaded once, here.
     pub fn with_model(gpu: &GpuContext, shading: &ShadingModel) -> Self {
         let device = &gpu.device;
-        let shader = wgsl_module(
-            device,
-            "abuffer.wgsl",
-            &shading_source(shading, include_str!("abuffer.wgsl")),
-        );
+        let top = Wgsl {
+            file: "abuffer.wgsl",
+            source: include_str!("abuffer.wgsl"),
+        };
+        let shader = strand_shading_module(device, &top, shading);
         let model = ModelBinding::new(gpu, shading);
         let layouts = ABufferLayouts::new(device);
         let model_layout = model.as_ref().map(|m| &m.layout);

@@ -23,6 +23,7 @@ use wgpu::util::DeviceExt;
 
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{bind_group, storage_entry, uniform_entry};
+use crate::shaders::Wgsl;
 
 /// `cos²θ_d` floor of the Marschner division (`strandlight_tables::marschner::MIN_COS2_THETA_D`).
 pub const MIN_COS2_THETA_D: f32 = 1e-8;
@@ -51,27 +52,25 @@ impl ShadingModel {
         }
     }
 
-    /// The WGSL that defines `fiber_radiance` (appended after `strands.wgsl`).
-    pub(crate) fn wgsl(&self) -> &'static str {
-        match self {
-            ShadingModel::KajiyaKay => include_str!("fiber_kajiya_kay.wgsl"),
-            ShadingModel::MarschnerLut(_) => concat!(
-                include_str!("fiber_frame.wgsl"),
-                include_str!("table_axis.wgsl"),
-                include_str!("fiber_lut.wgsl"),
-                include_str!("fiber_marschner_lut.wgsl")
+    /// The WGSL that defines `fiber_radiance`, composed as
+    /// [`FIBER_MODEL`](crate::shaders::FIBER_MODEL) into the strand shading passes.
+    pub(crate) fn wgsl(&self) -> Wgsl {
+        let (file, source) = match self {
+            ShadingModel::KajiyaKay => (
+                "fiber_kajiya_kay.wgsl",
+                include_str!("fiber_kajiya_kay.wgsl"),
             ),
-            ShadingModel::ChiangLut(_) => concat!(
-                include_str!("fiber_frame.wgsl"),
-                include_str!("table_axis.wgsl"),
-                include_str!("fiber_lut.wgsl"),
-                include_str!("fiber_chiang_lut.wgsl")
+            ShadingModel::MarschnerLut(_) => (
+                "fiber_marschner_lut.wgsl",
+                include_str!("fiber_marschner_lut.wgsl"),
             ),
-            ShadingModel::Artist(_) => concat!(
-                include_str!("fiber_frame.wgsl"),
-                include_str!("fiber_artist.wgsl")
+            ShadingModel::ChiangLut(_) => (
+                "fiber_chiang_lut.wgsl",
+                include_str!("fiber_chiang_lut.wgsl"),
             ),
-        }
+            ShadingModel::Artist(_) => ("fiber_artist.wgsl", include_str!("fiber_artist.wgsl")),
+        };
+        Wgsl { file, source }
     }
 }
 

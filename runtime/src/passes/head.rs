@@ -10,7 +10,7 @@ use wgpu::util::DeviceExt;
 
 use super::attachments::cleared_depth;
 use super::render_target::DEPTH_FORMAT;
-use super::view_visibility::NEAREST_SURFACE_FORMAT;
+use super::render_target::NEAREST_SURFACE_FORMAT;
 use crate::camera::Camera;
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{pipeline_layout, uniform_entry};

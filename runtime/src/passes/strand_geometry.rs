@@ -11,7 +11,7 @@ use crate::hair::HairModel;
 /// Hair colour where the file has none (linear RGB, a mid brown).
 pub const DEFAULT_HAIR_COLOR: [f32; 3] = [0.35, 0.22, 0.12];
 
-/// The hair's arrays on the GPU, laid out as `strands.wgsl` reads them (a clone shares the
+/// The hair's arrays on the GPU, laid out as `strand_quads.wgsl` reads them (a clone shares the
 /// buffers).
 #[derive(Clone)]
 pub struct StrandGeometry {
