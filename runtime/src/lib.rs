@@ -10,6 +10,8 @@ pub mod lights;
 pub mod multiple;
 pub mod passes;
 pub mod point_frame;
+#[cfg(test)]
+mod shader_layout;
 pub mod shaders;
 pub mod shadow_layout;
 pub mod visibility;

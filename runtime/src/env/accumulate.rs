@@ -175,3 +175,23 @@ impl AccumulatePass {
         );
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "accumulate.wgsl",
+                source: include_str!("accumulate.wgsl"),
+            },
+            None,
+            "AccumulateParams",
+            &rust_layout!(AccumulateParams { width, height }),
+        );
+    }
+}

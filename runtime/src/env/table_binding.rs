@@ -154,3 +154,39 @@ impl TableCache {
         binding
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+    use strandlight_tables::table::AxisGpu;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "table_lookup.wgsl",
+                source: include_str!("table_lookup.wgsl"),
+            },
+            None,
+            "TableLayout",
+            &rust_layout!(TableLayoutUniform { axes, strides }),
+        );
+        assert_same_layout(
+            &Wgsl {
+                file: "table_axis.wgsl",
+                source: include_str!("../passes/table_axis.wgsl"),
+            },
+            None,
+            "TableAxis",
+            &rust_layout!(AxisGpu {
+                min,
+                inv_range,
+                last_index,
+                inv_exponent,
+                warp
+            }),
+        );
+    }
+}

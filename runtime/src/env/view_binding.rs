@@ -173,3 +173,33 @@ pub fn view_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         ],
     })
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "view_binding.wgsl",
+                source: include_str!("view_binding.wgsl"),
+            },
+            None,
+            "ViewParams",
+            &rust_layout!(ViewUniform {
+                origin,
+                spacing,
+                dims,
+                width,
+                height,
+                visibility_cutoff,
+                record_words,
+                skin,
+                clip_to_world
+            }),
+        );
+    }
+}

@@ -154,3 +154,27 @@ impl VolumeCache {
         Ok(buffers)
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "visibility_volume.wgsl",
+                source: include_str!("visibility_volume.wgsl"),
+            },
+            None,
+            "VolumeParams",
+            &rust_layout!(VolumeUniform {
+                origin,
+                dims,
+                spacing
+            }),
+        );
+    }
+}

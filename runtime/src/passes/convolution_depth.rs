@@ -798,3 +798,32 @@ mod tests {
         assert!(strand_window(&[0], 0.5, 0).is_empty());
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "convolution_depth.wgsl",
+                source: include_str!("convolution_depth.wgsl"),
+            },
+            None,
+            "DodmParams",
+            &rust_layout!(DodmUniform {
+                near,
+                far,
+                first_layer,
+                tau_scale,
+                resolution,
+                segment_count,
+                window_count,
+                row_length
+            }),
+        );
+    }
+}

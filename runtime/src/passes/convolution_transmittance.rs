@@ -259,3 +259,60 @@ fn slot_lights(
     }
     (gpu_lights, samples)
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "convolution_transmittance.wgsl",
+                source: include_str!("convolution_transmittance.wgsl"),
+            },
+            None,
+            "EnvLightGpu",
+            &rust_layout!(EnvLightGpu {
+                view_proj,
+                direction,
+                rgb,
+                near,
+                far,
+                first_layer,
+                texels_per_unit,
+                first_sample,
+                sample_count
+            }),
+        );
+        assert_same_layout(
+            &Wgsl {
+                file: "convolution_transmittance.wgsl",
+                source: include_str!("convolution_transmittance.wgsl"),
+            },
+            None,
+            "ShadingSample",
+            &rust_layout!(ShadingSampleGpu {
+                direction,
+                rgb,
+                power
+            }),
+        );
+        assert_same_layout(
+            &Wgsl {
+                file: "convolution_transmittance.wgsl",
+                source: include_str!("convolution_transmittance.wgsl"),
+            },
+            None,
+            "BatchParams",
+            &rust_layout!(BatchUniform {
+                light_count,
+                resolution,
+                max_half_size,
+                flags
+            }),
+        );
+    }
+}

@@ -579,3 +579,30 @@ fn array_layer_view(texture: &wgpu::Texture, layer: u32) -> wgpu::TextureView {
         ..Default::default()
     })
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "deep_opacity.wgsl",
+                source: include_str!("deep_opacity.wgsl"),
+            },
+            None,
+            "DomParams",
+            &rust_layout!(DomUniform {
+                near,
+                far,
+                spacing,
+                layers,
+                perspective,
+                first_layer
+            }),
+        );
+    }
+}

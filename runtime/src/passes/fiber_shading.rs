@@ -407,3 +407,47 @@ mod tests {
         assert!(e.to_string().contains("4 nodes, expected 3"), "{e}");
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "fiber_lut.wgsl",
+                source: include_str!("fiber_lut.wgsl"),
+            },
+            None,
+            "LutParams",
+            &rust_layout!(LutUniform {
+                m_axes,
+                n_axes,
+                m_strides,
+                n_strides,
+                half_phi,
+                min_cos2_theta_d
+            }),
+        );
+        assert_same_layout(
+            &Wgsl {
+                file: "fiber_artist.wgsl",
+                source: include_str!("fiber_artist.wgsl"),
+            },
+            None,
+            "ArtistLobes",
+            &rust_layout!(ArtistUniform {
+                weight,
+                alpha,
+                beta,
+                gamma_tt,
+                gamma_glint,
+                glint_half_angle,
+                min_cos_theta_d
+            }),
+        );
+    }
+}

@@ -317,3 +317,27 @@ impl HeadPass {
         }
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "head.wgsl",
+                source: include_str!("head.wgsl"),
+            },
+            None,
+            "HeadCamera",
+            &rust_layout!(HeadCameraUniform {
+                view_proj,
+                eye,
+                toward_eye
+            }),
+        );
+    }
+}

@@ -319,3 +319,38 @@ struct KBufferBuffers {
     slots_group: wgpu::BindGroup,
     resolve_group: wgpu::BindGroup,
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    /// Any fiber model composes the strand shading module; Kajiya-Kay binds nothing.
+    const KAJIYA_KAY: Wgsl = Wgsl {
+        file: "fiber_kajiya_kay.wgsl",
+        source: include_str!("fiber_kajiya_kay.wgsl"),
+    };
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "kbuffer.wgsl",
+                source: include_str!("kbuffer.wgsl"),
+            },
+            Some(&KAJIYA_KAY),
+            "KBufferParams",
+            &rust_layout!(Params { width, second => "k" }),
+        );
+        assert_same_layout(
+            &Wgsl {
+                file: "kbuffer_resolve.wgsl",
+                source: include_str!("kbuffer_resolve.wgsl"),
+            },
+            None,
+            "ResolveParams",
+            &rust_layout!(Params { width, second => "height", third => "k" }),
+        );
+    }
+}

@@ -252,3 +252,29 @@ pub fn composite_over(hair: &mut [[f32; 4]], skin: &[[f32; 4]]) {
         }
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    /// Any fiber model composes the strand shading module; Kajiya-Kay binds nothing.
+    const KAJIYA_KAY: Wgsl = Wgsl {
+        file: "fiber_kajiya_kay.wgsl",
+        source: include_str!("fiber_kajiya_kay.wgsl"),
+    };
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "point_skin.wgsl",
+                source: include_str!("point_skin.wgsl"),
+            },
+            Some(&KAJIYA_KAY),
+            "SkinParams",
+            &rust_layout!(SkinUniform { albedo }),
+        );
+    }
+}

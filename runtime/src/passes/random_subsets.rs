@@ -302,3 +302,27 @@ fn layer_view(texture: &wgpu::Texture, layer: u32) -> wgpu::TextureView {
         ..Default::default()
     })
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "random_subsets_resolve.wgsl",
+                source: include_str!("random_subsets_resolve.wgsl"),
+            },
+            None,
+            "ResolveParams",
+            &rust_layout!(ResolveParams {
+                width,
+                height,
+                subsets
+            }),
+        );
+    }
+}

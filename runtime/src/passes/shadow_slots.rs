@@ -338,3 +338,56 @@ impl HeadViews {
         ]
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    /// Any fiber model composes the strand shading module; Kajiya-Kay binds nothing.
+    const KAJIYA_KAY: Wgsl = Wgsl {
+        file: "fiber_kajiya_kay.wgsl",
+        source: include_str!("fiber_kajiya_kay.wgsl"),
+    };
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "strand_shading.wgsl",
+                source: include_str!("strand_shading.wgsl"),
+            },
+            Some(&KAJIYA_KAY),
+            "ShadowParams",
+            &rust_layout!(ShadowUniform {
+                view_proj,
+                cube,
+                near,
+                far,
+                spacing,
+                layers,
+                light_index,
+                resolution,
+                lookup,
+                perspective,
+                kernel,
+                bias,
+                adsm_alpha,
+                adsm_spacing,
+                face_array_layers,
+                head_layer,
+                texel_world
+            }),
+        );
+        assert_same_layout(
+            &Wgsl {
+                file: "strand_shading.wgsl",
+                source: include_str!("strand_shading.wgsl"),
+            },
+            Some(&KAJIYA_KAY),
+            "HeadView",
+            &rust_layout!(HeadViewUniform { in_view }),
+        );
+    }
+}

@@ -308,3 +308,30 @@ impl IndexedStrandDraw {
         pass.draw(0..6, positions);
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "sorted_blend.wgsl",
+                source: include_str!("sorted_blend.wgsl"),
+            },
+            None,
+            "SortParams",
+            &rust_layout!(SortUniform {
+                eye,
+                forward,
+                nearest,
+                farthest,
+                bins,
+                segment_count
+            }),
+        );
+    }
+}

@@ -176,3 +176,32 @@ impl TransmittanceProbe {
         Ok(self.run(gpu, batch, &[], boxes)?.1)
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "transmittance_probe.wgsl",
+                source: include_str!("transmittance_probe.wgsl"),
+            },
+            None,
+            "ProbePoint",
+            &rust_layout!(ProbePoint { position }),
+        );
+        assert_same_layout(
+            &Wgsl {
+                file: "transmittance_probe.wgsl",
+                source: include_str!("transmittance_probe.wgsl"),
+            },
+            None,
+            "ProbeBox",
+            &rust_layout!(ProbeBox { corners, slot }),
+        );
+    }
+}
