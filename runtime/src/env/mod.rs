@@ -7,7 +7,7 @@
 //! always of one kind.
 //!
 //! A frame ([`EnvRenderer`], `renderer.rs`) checks its inputs (`checks.rs`), creates its
-//! resources once (`frame_resources.rs`), draws the view's visibility once (`visibility.rs`),
+//! resources once (`frame_resources.rs`), draws the view's visibility once (`frame_visibility.rs`),
 //! then per batch of lights (`light_kinds.rs`, `batch.rs`): the light maps, DODM and summed-area
 //! tables (`light_maps.rs`), the view shading into two images (`view_shading.rs`, binding
 //! groups 1–3 in `passes/convolution_transmittance.rs`, `table_binding.rs`, `view_binding.rs`),
@@ -19,6 +19,7 @@ mod batch;
 mod checks;
 mod error;
 mod frame_resources;
+mod frame_visibility;
 mod image;
 mod light_kinds;
 mod light_maps;
@@ -31,7 +32,6 @@ mod view_binding;
 mod view_shading;
 mod view_targets;
 mod view_visibility;
-mod visibility;
 mod volume;
 
 pub use crate::passes::transmittance_filter::TransmittanceFilter;
