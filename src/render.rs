@@ -6,7 +6,7 @@ use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use strandlight_runtime::render::PassTiming;
+use strandlight_runtime::point_frame::PassTiming;
 use strandlight_scene::camera_choice::{CameraChoice, CameraKind, UpChoice};
 use strandlight_scene::env_frame::{env_adapter, light_summary};
 use strandlight_scene::env_scene::{AlsoServe, prepare_env};

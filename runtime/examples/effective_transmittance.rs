@@ -23,7 +23,7 @@ use std::time::Instant;
 use glam::Vec3;
 use strandlight_runtime::camera::{Camera, UpAxis};
 use strandlight_runtime::env::{
-    EnvFrame, EnvRenderOptions, EnvRenderer, EnvTables, TransmittanceFilter,
+    EnvImage, EnvRenderOptions, EnvRenderer, EnvTables, TransmittanceFilter,
 };
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
@@ -160,7 +160,7 @@ fn reference_lights(xi: Vec3, lambda: f32, n: usize) -> Vec<EnvLight> {
     lights
 }
 
-fn frame_ms(frame: &EnvFrame) -> f64 {
+fn frame_ms(frame: &EnvImage) -> f64 {
     frame
         .stats
         .timings
@@ -255,7 +255,7 @@ fn main() -> Result<(), BoxError> {
             )?;
             let reference_ms = frame_ms(&reference);
             let stem = format!("{dir_tag}_lambda{lambda}");
-            let write = |name: &str, frame: &EnvFrame, what: &str| {
+            let write = |name: &str, frame: &EnvImage, what: &str| {
                 write_png(
                     &args.out_dir.join(format!("{stem}_{name}.png")),
                     width,

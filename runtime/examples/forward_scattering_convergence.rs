@@ -223,157 +223,160 @@ fn main() {
     let only: Vec<String> = std::env::args().skip(1).collect();
     let want = |section: &str| only.is_empty() || only.iter().any(|s| s == section);
 
-    // --- Voxelization time (dynamic hair rebuilds it every frame).
     if want("voxels") {
-        println!("\n## Voxelization (median of 5)");
-        println!(
-            "| voxels (longest side) | grid | occupied | voxel side | max σ_t⊥·h | mean σ_t⊥·h (occupied) | median ms |"
-        );
-        println!("|---|---|---|---|---|---|---|");
-        for &n in &[32u32, 64, 90, 128] {
-            let settings = VoxelSettings {
-                voxels_longest_side: n,
-                default_diameter: None,
-            };
-            let mut times = Vec::new();
-            let mut volume = None;
-            for _ in 0..5 {
-                let t = Instant::now();
-                volume = Some(HairVolume::build(&model, &settings, 1.0).expect("voxelization"));
-                times.push(t.elapsed().as_secs_f64() * 1e3);
-            }
-            let v = volume.unwrap();
-            let h = v.grid.voxel_size;
-            let occ: Vec<f32> = v.sigma_perp.iter().copied().filter(|&s| s > 0.0).collect();
-            let max = occ.iter().cloned().fold(0.0, f32::max) * h;
-            let mean =
-                occ.iter().map(|&s| s as f64).sum::<f64>() / occ.len().max(1) as f64 * h as f64;
-            println!(
-                "| {n} | {:?} | {} | {h:.4} | {max:.3} | {mean:.3} | {:.1} |",
-                v.grid.dims,
-                occ.len(),
-                median(times)
-            );
-        }
+        voxelization_times(&model);
     }
-
-    // --- Shadow-path time per light batch.
     if want("paths") {
-        println!(
-            "\n## Shadow paths (grid() for a batch; median of 3, one run for the slow per-vertex dense case)"
-        );
-        println!(
-            "| voxels | coarse factor | method | step | lights | kind | sample vertices | batch ms | ms / light |"
-        );
-        println!("|---|---|---|---|---|---|---|---|---|");
-        let timing_cases = [
-            (64u32, 4u32, 2u32, 0.5f32, false),
-            (64, 4, 1, 0.5, false),
-            (64, 4, 1, 0.5, true),
-            (90, 4, 2, 0.5, false),
-            (90, 4, 1, 0.5, true),
-            (64, 1, 1, 0.25, true),
-            (90, 1, 1, 0.25, true),
-            (64, 1, 2, 0.25, false),
-        ];
-        for &(voxels, coarse, taps, step, sweep) in &timing_cases {
-            let settings = ForwardScatteringSettings {
-                voxels: VoxelSettings {
-                    voxels_longest_side: voxels,
-                    default_diameter: None,
-                },
-                coarse_factor: coarse,
-                step_fraction: step,
-                filter_taps: taps,
-                light_sweep: sweep,
-                ..Default::default()
-            };
-            let source =
-                CpuForwardScattering::new(&model, tables.clone(), settings).expect("source");
-            for &count in &[16usize, 50] {
-                if coarse == 1 && !sweep && count == 50 {
-                    continue; // per-vertex marching of the dense grid is timed with 16 lights only
-                }
-                for srbf in [true, false] {
-                    let lights: Vec<EnvLight> = sphere_directions(count)
-                        .into_iter()
-                        .map(|d| {
-                            if srbf {
-                                EnvLight::srbf(d, 32.0, [1.0; 3])
-                            } else {
-                                EnvLight::directional(d, [1.0; 3])
-                            }
-                        })
-                        .collect();
-                    let mut times = Vec::new();
-                    let reps = if coarse == 1 && !sweep { 1 } else { 3 };
-                    for _ in 0..reps {
-                        let t = Instant::now();
-                        let grid = source.grid(&lights).expect("grid");
-                        times.push(t.elapsed().as_secs_f64() * 1e3);
-                        assert!(grid.values.iter().all(|v| v.iter().all(|x| x.is_finite())));
-                    }
-                    let ms = median(times);
-                    let method = if sweep {
-                        "light sweep".to_string()
-                    } else {
-                        format!("march, {taps}³ taps")
-                    };
-                    println!(
-                        "| {voxels} | {coarse} | {method} | {step} | {count} | {} | {} | {ms:.1} | {:.2} |",
-                        if srbf { "SRBF λ=32" } else { "directional" },
-                        source.sample_grid().vertex_count(),
-                        ms / count as f64
-                    );
-                }
-            }
-        }
+        shadow_path_times(&model, &tables);
     }
-
-    // --- The same march on the GPU (compute shader) vs rayon: which source the device wants.
+    // The same march on the GPU (compute shader) vs rayon: which source the device wants.
     if want("gpu") {
         compare_devices(&model, &tables);
     }
-
-    // --- Where a light's time goes: the per-voxel table lookups (LightMedium) vs the paths.
     if want("medium") {
-        println!("\n## Per-light table lookups (LightMedium::new, median of 5)");
-        println!("| voxels | occupied | ms |");
-        println!("|---|---|---|");
-        for &voxels in &[64u32, 90] {
-            let settings = VoxelSettings {
+        medium_times(&model, &tables);
+    }
+    if want("convergence") {
+        convergence(&model, &tables);
+    }
+}
+
+/// Voxelization time (dynamic hair rebuilds it every frame).
+fn voxelization_times(model: &HairModel) {
+    println!("\n## Voxelization (median of 5)");
+    println!(
+        "| voxels (longest side) | grid | occupied | voxel side | max σ_t⊥·h | mean σ_t⊥·h (occupied) | median ms |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for &n in &[32u32, 64, 90, 128] {
+        let settings = VoxelSettings {
+            voxels_longest_side: n,
+            default_diameter: None,
+        };
+        let mut times = Vec::new();
+        let mut volume = None;
+        for _ in 0..5 {
+            let t = Instant::now();
+            volume = Some(HairVolume::build(model, &settings, 1.0).expect("voxelization"));
+            times.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+        let v = volume.unwrap();
+        let h = v.grid.voxel_size;
+        let occ: Vec<f32> = v.sigma_perp.iter().copied().filter(|&s| s > 0.0).collect();
+        let max = occ.iter().cloned().fold(0.0, f32::max) * h;
+        let mean = occ.iter().map(|&s| s as f64).sum::<f64>() / occ.len().max(1) as f64 * h as f64;
+        println!(
+            "| {n} | {:?} | {} | {h:.4} | {max:.3} | {mean:.3} | {:.1} |",
+            v.grid.dims,
+            occ.len(),
+            median(times)
+        );
+    }
+}
+
+/// Shadow-path time per light batch.
+fn shadow_path_times(model: &HairModel, tables: &ForwardScatteringTables) {
+    println!(
+        "\n## Shadow paths (grid() for a batch; median of 3, one run for the slow per-vertex dense case)"
+    );
+    println!(
+        "| voxels | coarse factor | method | step | lights | kind | sample vertices | batch ms | ms / light |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    let timing_cases = [
+        (64u32, 4u32, 2u32, 0.5f32, false),
+        (64, 4, 1, 0.5, false),
+        (64, 4, 1, 0.5, true),
+        (90, 4, 2, 0.5, false),
+        (90, 4, 1, 0.5, true),
+        (64, 1, 1, 0.25, true),
+        (90, 1, 1, 0.25, true),
+        (64, 1, 2, 0.25, false),
+    ];
+    for &(voxels, coarse, taps, step, sweep) in &timing_cases {
+        let settings = ForwardScatteringSettings {
+            voxels: VoxelSettings {
                 voxels_longest_side: voxels,
                 default_diameter: None,
-            };
-            let volume = HairVolume::build(&model, &settings, 1.0).expect("voxelization");
-            let light = EnvLight::srbf(Vec3::new(0.3, 0.5, 0.8), 32.0, [1.0; 3]);
-            let times: Vec<f64> = (0..5)
-                .map(|_| {
+            },
+            coarse_factor: coarse,
+            step_fraction: step,
+            filter_taps: taps,
+            light_sweep: sweep,
+            ..Default::default()
+        };
+        let source = CpuForwardScattering::new(model, tables.clone(), settings).expect("source");
+        for &count in &[16usize, 50] {
+            if coarse == 1 && !sweep && count == 50 {
+                continue; // per-vertex marching of the dense grid is timed with 16 lights only
+            }
+            for srbf in [true, false] {
+                let lights: Vec<EnvLight> = sphere_directions(count)
+                    .into_iter()
+                    .map(|d| {
+                        if srbf {
+                            EnvLight::srbf(d, 32.0, [1.0; 3])
+                        } else {
+                            EnvLight::directional(d, [1.0; 3])
+                        }
+                    })
+                    .collect();
+                let mut times = Vec::new();
+                let reps = if coarse == 1 && !sweep { 1 } else { 3 };
+                for _ in 0..reps {
                     let t = Instant::now();
-                    let m = LightMedium::new(&volume, &tables, &light);
-                    std::hint::black_box(&m);
-                    t.elapsed().as_secs_f64() * 1e3
-                })
-                .collect();
-            println!(
-                "| {voxels} | {} | {:.1} |",
-                volume.occupied_voxels(),
-                median(times)
-            );
+                    let grid = source.grid(&lights).expect("grid");
+                    times.push(t.elapsed().as_secs_f64() * 1e3);
+                    assert!(grid.values.iter().all(|v| v.iter().all(|x| x.is_finite())));
+                }
+                let ms = median(times);
+                let method = if sweep {
+                    "light sweep".to_string()
+                } else {
+                    format!("march, {taps}³ taps")
+                };
+                println!(
+                    "| {voxels} | {coarse} | {method} | {step} | {count} | {} | {} | {ms:.1} | {:.2} |",
+                    if srbf { "SRBF λ=32" } else { "directional" },
+                    source.sample_grid().vertex_count(),
+                    ms / count as f64
+                );
+            }
         }
     }
+}
 
-    // --- Convergence at fixed points on the hair.
-    if !want("convergence") {
-        return;
+/// Where a light's time goes: the per-voxel table lookups (LightMedium) vs the paths.
+fn medium_times(model: &HairModel, tables: &ForwardScatteringTables) {
+    println!("\n## Per-light table lookups (LightMedium::new, median of 5)");
+    println!("| voxels | occupied | ms |");
+    println!("|---|---|---|");
+    for &voxels in &[64u32, 90] {
+        let settings = VoxelSettings {
+            voxels_longest_side: voxels,
+            default_diameter: None,
+        };
+        let volume = HairVolume::build(model, &settings, 1.0).expect("voxelization");
+        let light = EnvLight::srbf(Vec3::new(0.3, 0.5, 0.8), 32.0, [1.0; 3]);
+        let times: Vec<f64> = (0..5)
+            .map(|_| {
+                let t = Instant::now();
+                let m = LightMedium::new(&volume, tables, &light);
+                std::hint::black_box(&m);
+                t.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        println!(
+            "| {voxels} | {} | {:.1} |",
+            volume.occupied_voxels(),
+            median(times)
+        );
     }
-    let probes = probe_points(&model, 1000);
-    let lights: Vec<EnvLight> = sphere_directions(8)
-        .into_iter()
-        .map(|d| EnvLight::directional(d, [1.0; 3]))
-        .collect();
-    let base = ForwardScatteringSettings::default();
-    let with = |voxels: u32, coarse: u32, step: f32, taps: u32| ForwardScatteringSettings {
+}
+
+/// The march settings of a convergence row (marched per sample vertex, no light sweep).
+fn march(voxels: u32, coarse: u32, step: f32, taps: u32) -> ForwardScatteringSettings {
+    ForwardScatteringSettings {
         voxels: VoxelSettings {
             voxels_longest_side: voxels,
             default_diameter: None,
@@ -382,118 +385,157 @@ fn main() {
         step_fraction: step,
         filter_taps: taps,
         light_sweep: false,
-        ..base
-    };
-    let swept = |voxels: u32, coarse: u32, step: f32| ForwardScatteringSettings {
+        ..ForwardScatteringSettings::default()
+    }
+}
+
+/// [`march`] with the light sweep.
+fn swept(voxels: u32, coarse: u32, step: f32) -> ForwardScatteringSettings {
+    ForwardScatteringSettings {
         light_sweep: true,
-        ..with(voxels, coarse, step, 1)
-    };
-    let probe_values = |source: &CpuForwardScattering| -> Vec<[f32; 4]> {
-        lights
-            .iter()
-            .flat_map(|l| source.values_at(l, &probes))
+        ..march(voxels, coarse, step, 1)
+    }
+}
+
+/// Fixed points on the hair and directional lights, where the convergence sections compare
+/// sources.
+struct Probe<'a> {
+    model: &'a HairModel,
+    tables: &'a ForwardScatteringTables,
+    points: Vec<Vec3>,
+    lights: Vec<EnvLight>,
+}
+
+impl Probe<'_> {
+    fn source(&self, settings: ForwardScatteringSettings) -> CpuForwardScattering {
+        CpuForwardScattering::new(self.model, self.tables.clone(), settings).expect("source")
+    }
+
+    /// `settings`' values evaluated at the points themselves.
+    fn values(&self, settings: ForwardScatteringSettings) -> Vec<[f32; 4]> {
+        let source = self.source(settings);
+        (self.lights.iter())
+            .flat_map(|l| source.values_at(l, &self.points))
             .collect()
-    };
-    let grid_values = |source: &CpuForwardScattering| -> Vec<[f32; 4]> {
-        let grid = source.grid(&lights).expect("grid");
-        (0..lights.len())
-            .flat_map(|l| probes.iter().map(move |&p| (l, p)))
+    }
+
+    /// The source's grid interpolated at the points.
+    fn grid_values(&self, source: &CpuForwardScattering) -> Vec<[f32; 4]> {
+        let grid = source.grid(&self.lights).expect("grid");
+        (0..self.lights.len())
+            .flat_map(|l| self.points.iter().map(move |&p| (l, p)))
             .map(|(l, p)| interpolate_grid(&grid, l, p).expect("light index within the batch"))
             .collect()
-    };
+    }
 
+    /// A table's rows: per setting, its values' differences from `reference`.
+    fn rows<T: std::fmt::Display>(
+        &self,
+        settings: impl IntoIterator<Item = (T, ForwardScatteringSettings)>,
+        reference: &[[f32; 4]],
+    ) {
+        for (name, settings) in settings {
+            let (a, b, c, d) = differences(&self.values(settings), reference);
+            println!("| {name} | {a:.4} | {b:.4} | {c:.4} | {d:.4} |");
+        }
+    }
+}
+
+/// Convergence at fixed points on the hair.
+fn convergence(model: &HairModel, tables: &ForwardScatteringTables) {
+    let probe = Probe {
+        model,
+        tables,
+        points: probe_points(model, 1000),
+        lights: sphere_directions(8)
+            .into_iter()
+            .map(|d| EnvLight::directional(d, [1.0; 3]))
+            .collect(),
+    };
+    let exact = grid_densities(&probe);
+    light_sweep_grids(&probe, &exact);
+    step_sizes(&probe);
+    voxel_resolutions(&probe);
+    box_filters(&probe);
+}
+
+/// Grids of several densities against the march evaluated at each point itself (an infinitely
+/// dense sample grid), which it returns.
+fn grid_densities(probe: &Probe) -> Vec<[f32; 4]> {
     println!(
         "\n## Convergence vs sample-grid density ({} hair points × {} directional lights, 64 voxels, step 0.5, taps 2)",
-        probes.len(),
-        lights.len()
+        probe.points.len(),
+        probe.lights.len()
     );
     println!(
         "Reference: the march evaluated at each point itself (an infinitely dense sample grid)."
     );
-    let source =
-        CpuForwardScattering::new(&model, tables.clone(), with(64, 4, 0.5, 2)).expect("source");
-    let exact = probe_values(&source);
+    let exact = probe.values(march(64, 4, 0.5, 2));
     let (mt, ms) = mean_t(&exact);
     println!("mean T_f at the probes {mt:.4}, mean σ̄_f {ms:.4} rad");
     println!("| coarse factor | vertices | RMS ΔT_f | max ΔT_f | RMS Δσ̄_f | max Δσ̄_f |");
     println!("|---|---|---|---|---|---|");
     for &coarse in &[8u32, 4, 2, 1] {
-        let s = CpuForwardScattering::new(&model, tables.clone(), with(64, coarse, 0.5, 2))
-            .expect("source");
-        let (a, b, c, d) = differences(&grid_values(&s), &exact);
+        let s = probe.source(march(64, coarse, 0.5, 2));
+        let (a, b, c, d) = differences(&probe.grid_values(&s), &exact);
         println!(
             "| {coarse} | {} | {a:.4} | {b:.4} | {c:.4} | {d:.4} |",
             s.sample_grid().vertex_count()
         );
     }
+    exact
+}
 
+fn light_sweep_grids(probe: &Probe, exact: &[[f32; 4]]) {
     println!("\n## Light-sweep grids vs the same per-point reference (64 voxels, step 0.5)");
     println!("| coarse factor | vertices | RMS ΔT_f | max ΔT_f | RMS Δσ̄_f | max Δσ̄_f |");
     println!("|---|---|---|---|---|---|");
     for &coarse in &[4u32, 2, 1] {
-        let s = CpuForwardScattering::new(&model, tables.clone(), swept(64, coarse, 0.5))
-            .expect("source");
-        let (a, b, c, d) = differences(&grid_values(&s), &exact);
+        let s = probe.source(swept(64, coarse, 0.5));
+        let (a, b, c, d) = differences(&probe.grid_values(&s), exact);
         println!(
             "| {coarse} | {} | {a:.4} | {b:.4} | {c:.4} | {d:.4} |",
             s.sample_grid().vertex_count()
         );
     }
     println!("light sweep evaluated at the probes themselves (no grid):");
-    let s = CpuForwardScattering::new(&model, tables.clone(), swept(64, 4, 0.5)).expect("source");
-    let (a, b, c, d) = differences(&probe_values(&s), &exact);
+    let (a, b, c, d) = differences(&probe.values(swept(64, 4, 0.5)), exact);
     println!("| at probes | - | {a:.4} | {b:.4} | {c:.4} | {d:.4} |");
+}
 
+fn step_sizes(probe: &Probe) {
     println!(
         "\n## Convergence vs step size (values at the probes, 64 voxels, taps 2; reference step 1/16 voxel)"
     );
-    let reference = probe_values(
-        &CpuForwardScattering::new(&model, tables.clone(), with(64, 4, 1.0 / 16.0, 2))
-            .expect("source"),
-    );
+    let reference = probe.values(march(64, 4, 1.0 / 16.0, 2));
     println!("| step (voxels) | RMS ΔT_f | max ΔT_f | RMS Δσ̄_f | max Δσ̄_f |");
     println!("|---|---|---|---|---|");
-    for &step in &[1.0f32, 0.5, 0.25, 0.125] {
-        let v = probe_values(
-            &CpuForwardScattering::new(&model, tables.clone(), with(64, 4, step, 2))
-                .expect("source"),
-        );
-        let (a, b, c, d) = differences(&v, &reference);
-        println!("| {step} | {a:.4} | {b:.4} | {c:.4} | {d:.4} |");
-    }
+    let steps = [1.0f32, 0.5, 0.25, 0.125].map(|step| (step, march(64, 4, step, 2)));
+    probe.rows(steps, &reference);
+}
 
+fn voxel_resolutions(probe: &Probe) {
     println!(
         "\n## Convergence vs voxel resolution (values at the probes, step 0.25, taps 2; reference 128 voxels)"
     );
-    let reference = probe_values(
-        &CpuForwardScattering::new(&model, tables.clone(), with(128, 4, 0.25, 2)).expect("source"),
-    );
+    let reference = probe.values(march(128, 4, 0.25, 2));
     println!("| voxels | RMS ΔT_f | max ΔT_f | RMS Δσ̄_f | max Δσ̄_f | mean T_f |");
     println!("|---|---|---|---|---|---|");
     for &voxels in &[32u32, 64, 90] {
-        let v = probe_values(
-            &CpuForwardScattering::new(&model, tables.clone(), with(voxels, 4, 0.25, 2))
-                .expect("source"),
-        );
+        let v = probe.values(march(voxels, 4, 0.25, 2));
         let (a, b, c, d) = differences(&v, &reference);
         println!(
             "| {voxels} | {a:.4} | {b:.4} | {c:.4} | {d:.4} | {:.4} |",
             mean_t(&v).0
         );
     }
+}
 
+fn box_filters(probe: &Probe) {
     println!("\n## Box filter (values at the probes, 64 voxels, step 0.25): taps vs taps 4");
-    let reference = probe_values(
-        &CpuForwardScattering::new(&model, tables.clone(), with(64, 4, 0.25, 4)).expect("source"),
-    );
+    let reference = probe.values(march(64, 4, 0.25, 4));
     println!("| taps per axis | RMS ΔT_f | max ΔT_f | RMS Δσ̄_f | max Δσ̄_f |");
     println!("|---|---|---|---|---|");
-    for &taps in &[1u32, 2, 3] {
-        let v = probe_values(
-            &CpuForwardScattering::new(&model, tables.clone(), with(64, 4, 0.25, taps))
-                .expect("source"),
-        );
-        let (a, b, c, d) = differences(&v, &reference);
-        println!("| {taps} | {a:.4} | {b:.4} | {c:.4} | {d:.4} |");
-    }
+    let taps = [1u32, 2, 3].map(|taps| (taps, march(64, 4, 0.25, taps)));
+    probe.rows(taps, &reference);
 }

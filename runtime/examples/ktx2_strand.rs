@@ -10,7 +10,7 @@
 //! TABLE (default `marschner`) is a convolution table I(u·ξ, u·ω_o, cos Δφ, 1/λ). A helical
 //! strand of 48 segments is shaded at each segment's midpoint under three SRBF lobes, without
 //! visibility: L_o = Σ_j I(u·ξ_j, u·ω_o, cos(φ_ξj − φ_o), 1/λ_j) · L_j, the single-scattering sum
-//! of the runtime's env view pass (`env_view.wgsl`). The reference is that sum with the
+//! of the runtime's env view shading (`env_shading.wgsl`). The reference is that sum with the
 //! runtime's lookup, `Table::lookup` on the `.sltab` beside the export (the GPU view pass
 //! interpolates the same way), in f64.
 

@@ -18,7 +18,9 @@ use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::abuffer::NODE_BYTES;
 use strandlight_runtime::passes::deep_opacity::DomSettings;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{Frame, RenderOptions, ShadowMaps, Transparency, render_frame};
+use strandlight_runtime::point_frame::{
+    Frame, RenderOptions, ShadowMaps, Transparency, render_frame,
+};
 
 const WIDTH: u32 = 656;
 const HEIGHT: u32 = 861;
@@ -224,25 +226,7 @@ fn main() -> Result<(), BoxError> {
     let model = loaded.model;
     let bounds = model.bounds();
     let up = UpAxis::detect(&model);
-    let aspect = WIDTH as f32 / HEIGHT as f32;
-    let camera = Camera::framing_front(bounds, aspect, false, up);
-    // One directional light from the viewer's upper right front, as the CLI's default light is
-    // for a Y-up file: 0.5 right, 0.7 up, 1 toward the eye.
-    let toward_eye = camera.toward_eye();
-    let right = (camera.target - camera.eye).cross(camera.up).normalize();
-    let screen_up = right.cross(camera.target - camera.eye).normalize();
-    let light_direction: Vec3 = (0.5 * right + 0.7 * screen_up + toward_eye).normalize();
-    let frame = FrameParams {
-        camera,
-        width: WIDTH,
-        height: HEIGHT,
-        lights: vec![Light::Directional {
-            direction: light_direction,
-            intensity: 2.0,
-        }],
-        shading: KajiyaKay::default(),
-        width_override_px: None,
-    };
+    let frame = directionally_lit_frame(&model, up);
     let diagonal = bounds.diagonal();
     // The CLI's defaults: 4 layers 1% of the diagonal apart at 512², DBK Δ 5% of the diagonal.
     let dom = DomSettings {
@@ -262,6 +246,13 @@ fn main() -> Result<(), BoxError> {
         bounds.min,
         bounds.max
     );
+    let Light::Directional {
+        direction: light_direction,
+        ..
+    } = frame.lights[0]
+    else {
+        unreachable!("directionally_lit_frame has one directional light")
+    };
     println!(
         "camera: perspective {:.0}° vertical, eye {}, looking at {}, up {}; light toward {light_direction}",
         strandlight_runtime::camera::DEFAULT_FOV_Y_DEGREES,
@@ -269,23 +260,62 @@ fn main() -> Result<(), BoxError> {
         frame.camera.target,
         frame.camera.up
     );
+    let [abuffer_npp, dbk_npp] = list_sizes(&gpu, &model, &frame, delta)?;
+    println!(
+        "runs: 1 warm-up + {timed_runs} timed per configuration, interleaved (round-robin); medians; timing = CPU wall clock around submit + wait for idle"
+    );
+    let configs = configs(dom, abuffer_npp, dbk_npp, delta);
+    let results = measure_interleaved(&gpu, &model, &frame, configs, timed_runs)?;
+    print_table(&results);
+    print_ratios(&results);
+    Ok(())
+}
 
-    // Size the node buffers from a probe with the largest buffer the adapter allows.
+/// The hair from the front under one directional light from the viewer's upper right front,
+/// as the CLI's default light is for a Y-up file: 0.5 right, 0.7 up, 1 toward the eye.
+fn directionally_lit_frame(model: &HairModel, up: UpAxis) -> FrameParams {
+    let aspect = WIDTH as f32 / HEIGHT as f32;
+    let camera = Camera::framing_front(model.bounds(), aspect, false, up);
+    let toward_eye = camera.toward_eye();
+    let right = (camera.target - camera.eye).cross(camera.up).normalize();
+    let screen_up = right.cross(camera.target - camera.eye).normalize();
+    let light_direction: Vec3 = (0.5 * right + 0.7 * screen_up + toward_eye).normalize();
+    FrameParams {
+        camera,
+        width: WIDTH,
+        height: HEIGHT,
+        lights: vec![Light::Directional {
+            direction: light_direction,
+            intensity: 2.0,
+        }],
+        shading: KajiyaKay::default(),
+        width_override_px: None,
+    }
+}
+
+/// Nodes per pixel of the A-buffer and the DBK-buffer (Δ `delta`), sized from a probe with the
+/// largest node buffer the adapter allows.
+fn list_sizes(
+    gpu: &GpuContext,
+    model: &HairModel,
+    frame: &FrameParams,
+    delta: f32,
+) -> Result<[u32; 2], BoxError> {
     let max_npp = (gpu.device.limits().max_storage_buffer_binding_size / NODE_BYTES)
         / (WIDTH as u64 * HEIGHT as u64);
     let max_npp = max_npp.max(1) as u32;
     let all = probe_fragments(
-        &gpu,
-        &model,
-        &frame,
+        gpu,
+        model,
+        frame,
         Transparency::ABuffer {
             nodes_per_pixel: Some(max_npp),
         },
     )?;
     let dbk = probe_fragments(
-        &gpu,
-        &model,
-        &frame,
+        gpu,
+        model,
+        frame,
         Transparency::Dbk {
             nodes_per_pixel: Some(max_npp),
             delta,
@@ -296,11 +326,17 @@ fn main() -> Result<(), BoxError> {
     println!(
         "probe (node buffer for {max_npp} nodes/pixel): A-buffer {all} fragments → {abuffer_npp} nodes/pixel; DBK (Δ = {delta:.4}, 5% of the diagonal) {dbk} fragments → {dbk_npp} nodes/pixel"
     );
-    println!(
-        "runs: 1 warm-up + {timed_runs} timed per configuration, interleaved (round-robin); medians; timing = CPU wall clock around submit + wait for idle"
-    );
+    Ok([abuffer_npp, dbk_npp])
+}
 
-    let configs: Vec<(String, RenderOptions)> = [
+/// Opaque, A-buffer and DBK, each without shadows and with the CLI's deep opacity maps.
+fn configs(
+    dom: DomSettings,
+    abuffer_npp: u32,
+    dbk_npp: u32,
+    delta: f32,
+) -> Vec<(String, RenderOptions)> {
+    [
         None,
         Some(ShadowMaps::Deep {
             settings: dom,
@@ -337,11 +373,7 @@ fn main() -> Result<(), BoxError> {
             )
         })
     })
-    .collect();
-    let results = measure_interleaved(&gpu, &model, &frame, configs, timed_runs)?;
-    print_table(&results);
-    print_ratios(&results);
-    Ok(())
+    .collect()
 }
 
 fn pass_ms(m: &Measured, pass: &str) -> Option<f64> {

@@ -20,7 +20,9 @@ use strandlight_runtime::hair::{self, HairModel};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{Frame, RenderOptions, ShadowMaps, Transparency, render_frame};
+use strandlight_runtime::point_frame::{
+    Frame, RenderOptions, ShadowMaps, Transparency, render_frame,
+};
 
 const WIDTH: u32 = 656;
 const HEIGHT: u32 = 861;
@@ -62,7 +64,7 @@ fn is_light_map(pass: &str) -> bool {
 }
 
 /// GPU ms where the pass recorded GPU work, else its wall clock (readbacks).
-fn pass_ms(t: &strandlight_runtime::render::PassTiming) -> f64 {
+fn pass_ms(t: &strandlight_runtime::point_frame::PassTiming) -> f64 {
     t.gpu_milliseconds.unwrap_or(t.milliseconds)
 }
 
@@ -174,25 +176,8 @@ fn main() -> Result<(), BoxError> {
         return Ok(());
     }
     let model: HairModel = hair::load(&path)?.model;
-    let bounds = model.bounds();
-    let diagonal = bounds.diagonal();
-    let up = UpAxis::detect(&model);
-    let camera = Camera::framing_front(bounds, WIDTH as f32 / HEIGHT as f32, false, up);
-    // From the viewer's upper right front, 2.5 bounding radii from the centre; irradiance 2 there.
-    let toward = (0.5 * Vec3::X + up.toward_front() + 0.7 * up.vector()).normalize();
-    let distance = 2.5 * diagonal * 0.5;
-    let position = bounds.center() + toward * distance;
-    let frame = FrameParams {
-        camera,
-        width: WIDTH,
-        height: HEIGHT,
-        lights: vec![Light::Point {
-            position,
-            intensity: 2.0 * distance * distance,
-        }],
-        shading: KajiyaKay::default(),
-        width_override_px: None,
-    };
+    let diagonal = model.bounds().diagonal();
+    let frame = point_lit_frame(&model);
     let gpu = GpuContext::new_headless()?;
     let render = |options: RenderOptions| render_frame(&gpu, &model, &frame, &options);
 
@@ -207,6 +192,68 @@ fn main() -> Result<(), BoxError> {
     let coarser = render(reference_options(1195, 7, 32))?;
     let half_layers = render(reference_options(1536, 9, 16))?;
 
+    let mut configs = configs(diagonal);
+    for round in 0..=runs {
+        for c in configs.iter_mut() {
+            let frame = render(c.options)?;
+            if round > 0 {
+                c.record_times(&frame);
+            }
+            c.last = Some(frame);
+        }
+        eprintln!("round {round} of {runs} done");
+    }
+
+    let adapter = &reference.stats.adapter;
+    let Light::Point { position, .. } = frame.lights[0] else {
+        unreachable!("point_lit_frame has one point light")
+    };
+    println!(
+        "adapter: {} ({:?}, {:?}); {} segments; point light at {position} (irradiance 2 at the hair's centre); camera eye {}",
+        adapter.name,
+        adapter.backend,
+        adapter.device_type,
+        reference.stats.segments,
+        frame.camera.eye
+    );
+    println!(
+        "reference: A-buffer + DOM 32 layers {:.3} apart at 1536² with 9×9 PCF; the same at 1195² with 7×7 PCF differs from it by relative RMSE {:.4}, 16 layers twice as thick by {:.4}",
+        diagonal * 0.01,
+        relative_rmse(&coarser, &reference),
+        relative_rmse(&half_layers, &reference)
+    );
+    println!(
+        "runs: 1 warm-up + {runs} timed per configuration, interleaved; medians; GPU ms from timestamp queries (readback: wall clock)\n"
+    );
+    print_table(&configs, &reference);
+    print_passes(&configs);
+    Ok(())
+}
+
+/// The frame measured: straight.hair from the front, lit by a point light from the viewer's
+/// upper right front, 2.5 bounding radii from the centre, irradiance 2 there.
+fn point_lit_frame(model: &HairModel) -> FrameParams {
+    let bounds = model.bounds();
+    let up = UpAxis::detect(model);
+    let camera = Camera::framing_front(bounds, WIDTH as f32 / HEIGHT as f32, false, up);
+    let toward = (0.5 * Vec3::X + up.toward_front() + 0.7 * up.vector()).normalize();
+    let distance = 2.5 * bounds.diagonal() * 0.5;
+    let position = bounds.center() + toward * distance;
+    FrameParams {
+        camera,
+        width: WIDTH,
+        height: HEIGHT,
+        lights: vec![Light::Point {
+            position,
+            intensity: 2.0 * distance * distance,
+        }],
+        shading: KajiyaKay::default(),
+        width_override_px: None,
+    }
+}
+
+/// Every shadow choice with every transparency choice.
+fn configs(diagonal: f32) -> Vec<Config> {
     let mut configs = Vec::new();
     for (shadows, shadow) in shadow_choices(diagonal) {
         for (transparency, t) in transparency_choices(diagonal) {
@@ -225,47 +272,34 @@ fn main() -> Result<(), BoxError> {
             });
         }
     }
-    for round in 0..=runs {
-        for c in configs.iter_mut() {
-            let frame = render(c.options)?;
-            if round > 0 {
-                let timings = &frame.stats.timings;
-                let work = || timings.iter().filter(|t| !is_setup(&t.pass));
-                c.map_ms
-                    .push(work().filter(|t| is_light_map(&t.pass)).map(pass_ms).sum());
-                c.hair_ms
-                    .push(work().filter(|t| !is_light_map(&t.pass)).map(pass_ms).sum());
-                if c.passes.is_empty() {
-                    c.passes = work().map(|t| (t.pass.clone(), Vec::new())).collect();
-                }
-                for (slot, t) in c.passes.iter_mut().zip(work()) {
-                    slot.1.push(pass_ms(t));
-                }
-            }
-            c.last = Some(frame);
-        }
-        eprintln!("round {round} of {runs} done");
-    }
+    configs
+}
 
-    let adapter = &reference.stats.adapter;
-    println!(
-        "adapter: {} ({:?}, {:?}); {} segments; point light at {position} (irradiance 2 at the hair's centre); camera eye {}",
-        adapter.name, adapter.backend, adapter.device_type, reference.stats.segments, camera.eye
-    );
-    println!(
-        "reference: A-buffer + DOM 32 layers {:.3} apart at 1536² with 9×9 PCF; the same at 1195² with 7×7 PCF differs from it by relative RMSE {:.4}, 16 layers twice as thick by {:.4}",
-        diagonal * 0.01,
-        relative_rmse(&coarser, &reference),
-        relative_rmse(&half_layers, &reference)
-    );
-    println!(
-        "runs: 1 warm-up + {runs} timed per configuration, interleaved; medians; GPU ms from timestamp queries (readback: wall clock)\n"
-    );
+impl Config {
+    /// Adds a timed run's light-map, hair and per-pass times.
+    fn record_times(&mut self, frame: &Frame) {
+        let timings = &frame.stats.timings;
+        let work = || timings.iter().filter(|t| !is_setup(&t.pass));
+        self.map_ms
+            .push(work().filter(|t| is_light_map(&t.pass)).map(pass_ms).sum());
+        self.hair_ms
+            .push(work().filter(|t| !is_light_map(&t.pass)).map(pass_ms).sum());
+        if self.passes.is_empty() {
+            self.passes = work().map(|t| (t.pass.clone(), Vec::new())).collect();
+        }
+        for (slot, t) in self.passes.iter_mut().zip(work()) {
+            slot.1.push(pass_ms(t));
+        }
+    }
+}
+
+/// One row per configuration: times, memory, fragments and errors.
+fn print_table(configs: &[Config], reference: &Frame) {
     println!(
         "| shadows | transparency | light map GPU ms | hair GPU ms (incl. readback) | frame ms | GPU MB | fragments kept / dropped | relative RMSE vs A-buffer, same shadows | relative RMSE vs reference |"
     );
     println!("|---|---|---:|---:|---:|---:|---:|---:|---:|");
-    for c in &configs {
+    for c in configs {
         let same_shadows = configs
             .iter()
             .find(|a| a.shadows == c.shadows && a.transparency == "A-buffer")
@@ -293,11 +327,14 @@ fn main() -> Result<(), BoxError> {
             mb,
             fragments,
             relative_rmse(frame, same_shadows),
-            relative_rmse(frame, &reference)
+            relative_rmse(frame, reference)
         );
     }
+}
+
+fn print_passes(configs: &[Config]) {
     println!("\nPasses of each configuration (median GPU ms):\n");
-    for c in &configs {
+    for c in configs {
         let passes: Vec<String> = c
             .passes
             .iter()
@@ -310,5 +347,4 @@ fn main() -> Result<(), BoxError> {
             passes.join(", ")
         );
     }
-    Ok(())
 }

@@ -29,14 +29,14 @@ pub struct EnvLight {
     /// Directional lights only: per-axis variance (rad²) of the directions the light stands
     /// for (an extended compact source: a softbox, a sun's disc). Its visibility is averaged
     /// over a box matched to it, as an SRBF's is over its lobe
-    /// ([`TransmittanceFilter`](crate::env::render::TransmittanceFilter)); 0 reads one texel.
+    /// ([`TransmittanceFilter`](crate::env::TransmittanceFilter)); 0 reads one texel.
     pub angular_variance: f32,
     /// Directional lights only: it stands for a region of the map (a reference's cube texel, a
     /// median-cut region), not a compact source (a sun, a lamp). A region's own shadow is soft at
     /// fiber scale, so the layered view shades it per layer, as it does SRBF lobes; a compact
     /// source's is sharp, so per fragment ([`ViewTransparency::for_batch`]).
     ///
-    /// [`ViewTransparency::for_batch`]: crate::passes::view_visibility::ViewTransparency::for_batch
+    /// [`ViewTransparency::for_batch`]: crate::env::ViewTransparency::for_batch
     pub stands_for_region: bool,
 }
 

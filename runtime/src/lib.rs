@@ -9,6 +9,9 @@ pub mod head;
 pub mod lights;
 pub mod multiple;
 pub mod passes;
-pub mod render;
+pub mod point_frame;
+#[cfg(test)]
+mod shader_layout;
+pub mod shaders;
 pub mod shadow_layout;
 pub mod visibility;

@@ -200,3 +200,27 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "strand_quads.wgsl",
+                source: include_str!("passes/strand_quads.wgsl"),
+            },
+            None,
+            "Light",
+            &rust_layout!(GpuLight {
+                position_or_direction,
+                intensity,
+                spot
+            }),
+        );
+    }
+}

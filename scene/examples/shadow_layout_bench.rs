@@ -16,7 +16,7 @@ use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair;
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{RenderOptions, render_frame};
+use strandlight_runtime::point_frame::{RenderOptions, render_frame};
 use strandlight_runtime::shadow_layout::{PointLayoutChoice, ShadowLayout};
 use strandlight_scene::frame_render::point_render_options;
 use strandlight_scene::frame_settings::{PointLighting, Shadows};

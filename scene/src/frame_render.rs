@@ -27,7 +27,7 @@ use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
 use strandlight_runtime::passes::fiber_shading::ShadingModel;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{
+use strandlight_runtime::point_frame::{
     self, PassTiming, RenderOptions, ShadowMaps, render_frame_with_head,
 };
 use strandlight_tables::checksum::sha256_hex;
@@ -136,18 +136,18 @@ pub fn point_render_options(point: &PointLighting, hair: &HairModel) -> RenderOp
         }
     };
     let transparency = match point.transparency {
-        Transparency::None | Transparency::Occupancy => render::Transparency::Opaque,
-        Transparency::Sorted => render::Transparency::Sorted {
+        Transparency::None | Transparency::Occupancy => point_frame::Transparency::Opaque,
+        Transparency::Sorted => point_frame::Transparency::Sorted {
             bins: point.sort_bins,
         },
-        Transparency::Subsets => render::Transparency::RandomSubsets {
+        Transparency::Subsets => point_frame::Transparency::RandomSubsets {
             subsets: point.subsets,
         },
-        Transparency::Kbuffer => render::Transparency::KBuffer { k: point.kbuffer_k },
-        Transparency::Abuffer => render::Transparency::ABuffer {
+        Transparency::Kbuffer => point_frame::Transparency::KBuffer { k: point.kbuffer_k },
+        Transparency::Abuffer => point_frame::Transparency::ABuffer {
             nodes_per_pixel: point.abuffer_nodes_per_pixel,
         },
-        Transparency::Dbk => render::Transparency::Dbk {
+        Transparency::Dbk => point_frame::Transparency::Dbk {
             nodes_per_pixel: point.abuffer_nodes_per_pixel,
             delta: point.dbk_delta.unwrap_or(diagonal * 0.05),
         },
@@ -167,7 +167,7 @@ fn render_point(
     hair: &HairModel,
     prepared: &PreparedPoint,
     size: [u32; 2],
-) -> anyhow::Result<render::Frame> {
+) -> anyhow::Result<point_frame::Frame> {
     let camera = settings_camera(settings, hair)?;
     let frame = FrameParams {
         camera,

@@ -6,7 +6,7 @@ use crate::image_metrics::Image;
 use crate::scene_tables::ScatteringMode;
 use strandlight_runtime::env::FragmentCounts;
 use strandlight_runtime::env_light::EnvLight;
-use strandlight_runtime::render::{PassTiming, RenderStats};
+use strandlight_runtime::point_frame::{PassTiming, RenderStats};
 
 /// A rendered frame (or part of one) and what it cost.
 pub struct RenderedFrame {

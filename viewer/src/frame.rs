@@ -2,7 +2,7 @@
 //! image is the scene's `Image`, linear pre-multiplied RGBA). The render thread produces it,
 //! progressive refinement sums it, the window and screenshots read it.
 
-use strandlight_runtime::render::PassTiming;
+use strandlight_runtime::point_frame::PassTiming;
 
 /// How far the shown image is.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -3,12 +3,11 @@
 //! holds no browser types, so it runs natively too (its test sums the steps on lavapipe and
 //! compares them with `render_frame`).
 
-use crate::accumulate::AccumulatePass;
 use anyhow::Context;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use strandlight_runtime::env::{EnvRenderError, EnvRenderer};
+use strandlight_runtime::env::{EnvRenderError, EnvRenderer, FrameSums};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::gpu::LimitError;
@@ -72,7 +71,6 @@ struct ShownSums {
 pub struct Session {
     gpu: GpuContext,
     renderer: EnvRenderer,
-    accumulate: AccumulatePass,
     bundle: BundleScene,
     files: BundleFiles,
     /// The bundle's fit and the current preset's tables, as every front end prepares them.
@@ -88,7 +86,8 @@ pub struct Session {
     plan: Vec<Step>,
     next: usize,
     lights: Vec<EnvLight>,
-    total: Option<wgpu::Buffer>,
+    /// The running sum of the frame's light batches (the preview is a frame of its own).
+    sums: Option<FrameSums>,
     shown: Option<ShownSums>,
     /// (generation, steps) of the picture last metered.
     metered: Option<(u64, usize)>,
@@ -139,12 +138,10 @@ impl Session {
         let up = up_choice(&settings).axis(&hair);
         let prepared = bundle.prepared(&settings.preset, up, |f| files.get(f).cloned())?;
         let renderer = EnvRenderer::new(&gpu);
-        let accumulate = AccumulatePass::new(&gpu.device);
         let orbit = orbit_of(&settings, &hair)?;
         let mut session = Self {
             gpu,
             renderer,
-            accumulate,
             bundle,
             files,
             prepared,
@@ -157,7 +154,7 @@ impl Session {
             plan: Vec::new(),
             next: 0,
             lights: Vec::new(),
-            total: None,
+            sums: None,
             shown: None,
             metered: None,
             remeter: false,
@@ -216,7 +213,7 @@ impl Session {
         self.plan = plan_steps(Some((&powers, batch)));
         self.next = 0;
         self.generation += 1;
-        self.total = None;
+        self.sums = None;
         self.converged = None;
         Ok(())
     }
@@ -325,46 +322,53 @@ impl Session {
         let source = marched
             .as_deref()
             .map(|m| m as &dyn ForwardScatteringSource);
-        let encoded = self.renderer.encode_part(
-            &self.gpu,
-            frame.hair,
-            &frame.camera,
-            width,
-            height,
-            (&frame.lights, frame.look.simplified_lights_before),
-            &call.tables,
-            &call.options,
-            source,
-            frame.head.as_ref(),
-        )?;
-        self.last_memory = encoded.stats.memory_per_batch.clone();
+        let light_part = (frame.lights.as_slice(), frame.look.simplified_lights_before);
         let shown = match step {
             Step::Batch { power_after, .. } => {
-                let total = self.total.get_or_insert_with(|| {
-                    self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("page sum"),
-                        size: encoded.sums.size(),
-                        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                        mapped_at_creation: false,
-                    })
-                });
-                let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-                self.accumulate
-                    .encode(&self.gpu.device, &mut encoder, &encoded.sums, total);
-                self.gpu.queue.submit([encoder.finish()]);
+                let sums = match &mut self.sums {
+                    Some(sums) => sums,
+                    None => self.sums.insert(FrameSums::new(&self.gpu, width, height)?),
+                };
+                let stats = self.renderer.encode_part_into(
+                    &self.gpu,
+                    frame.hair,
+                    &frame.camera,
+                    light_part,
+                    &call.tables,
+                    &call.options,
+                    source,
+                    frame.head.as_ref(),
+                    sums,
+                )?;
+                self.last_memory = stats.memory_per_batch;
                 ShownSums {
-                    buffer: total.clone(),
+                    buffer: sums.buffer().clone(),
                     size: [width, height],
-                    with_multiple: encoded.with_multiple,
+                    with_multiple: source.is_some(),
                     power: power_after,
                 }
             }
-            Step::Preview | Step::Full => ShownSums {
-                buffer: encoded.sums,
-                size: [width, height],
-                with_multiple: encoded.with_multiple,
-                power: 1.0,
-            },
+            Step::Preview | Step::Full => {
+                let encoded = self.renderer.encode_part(
+                    &self.gpu,
+                    frame.hair,
+                    &frame.camera,
+                    width,
+                    height,
+                    light_part,
+                    &call.tables,
+                    &call.options,
+                    source,
+                    frame.head.as_ref(),
+                )?;
+                self.last_memory = encoded.stats.memory_per_batch;
+                ShownSums {
+                    buffer: encoded.sums,
+                    size: [width, height],
+                    with_multiple: encoded.with_multiple,
+                    power: 1.0,
+                }
+            }
         };
         self.shown = Some(shown);
         self.next += 1;

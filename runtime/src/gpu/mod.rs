@@ -1,6 +1,7 @@
 //! GPU plumbing shared by the passes: the device, and reading textures back to the CPU.
 
 pub mod bind_layout;
+pub mod buffer;
 pub mod device;
 pub mod limits;
 pub mod pass_timer;

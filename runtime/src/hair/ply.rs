@@ -104,108 +104,27 @@ impl Element {
 pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
     let (elements, body_start) = parse_header(data, file)?;
     let bytes = FileBytes::new(data, file);
-    let unsupported = |why: String| HairError::Unsupported {
-        file: file.into(),
-        format: FORMAT,
-        why,
-    };
-    let find = |name: &str| elements.iter().position(|e| e.name == name);
-    let vertex_index = find("vertex").ok_or_else(|| unsupported("no `vertex` element".into()))?;
-    let strand_index = find("strand")
-        .ok_or_else(|| unsupported("no `strand` element (segment counts per strand)".into()))?;
-    let vertex = &elements[vertex_index];
-    let strand = &elements[strand_index];
-    let xyz: Vec<usize> = ["x", "y", "z"]
-        .iter()
-        .filter_map(|n| vertex.property(n))
-        .collect();
-    if xyz.len() != 3 {
-        return Err(unsupported("`vertex` lacks one of x, y, z".into()));
-    }
-    let rgb: Vec<usize> = ["red", "green", "blue"]
-        .iter()
-        .filter_map(|n| vertex.property(n))
-        .collect();
-    let nsegs = ["nsegs", "num_segments", "segments"]
-        .iter()
-        .find_map(|n| strand.property(n))
-        .ok_or_else(|| unsupported("`strand` has no `nsegs` property".into()))?;
-    if [vertex, strand]
-        .iter()
-        .any(|e| e.properties.iter().any(|p| p.list_count.is_some()))
-    {
-        return Err(unsupported(
-            "list properties in `vertex` or `strand`".into(),
-        ));
-    }
-
+    let layout = StrandLayout::find(&elements, file)?;
     // Absurd counts: every element's instances must fit in what follows the header.
     let body = FileBytes::new(&data[body_start..], file);
     for e in &elements {
-        body.check_count_fits(
-            if e.name == "vertex" {
-                "vertex"
-            } else {
-                "element"
-            },
-            e.count,
-            e.min_bytes().max(1),
-        )?;
+        let what = if e.name == "vertex" {
+            "vertex"
+        } else {
+            "element"
+        };
+        body.check_count_fits(what, e.count, e.min_bytes().max(1))?;
     }
-
+    let mut rows = StrandRows::default();
     let mut offset = body_start as u64;
-    let mut points = Vec::new();
-    let mut colors = Vec::new();
-    let mut counts = Vec::new();
     for (index, element) in elements.iter().enumerate() {
         let stride = element.min_bytes();
         let fixed = element.properties.iter().all(|p| p.list_count.is_none());
-        if index == vertex_index || index == strand_index {
+        if index == layout.vertex || index == layout.strand {
             let all = bytes.slice(offset, stride * element.count, || {
                 format!("{} {} elements", element.count, element.name)
             })?;
-            let field_offsets: Vec<usize> = element
-                .properties
-                .iter()
-                .scan(0usize, |at, p| {
-                    let here = *at;
-                    *at += p.kind.size() as usize;
-                    Some(here)
-                })
-                .collect();
-            let value =
-                |row: &[u8], p: usize| element.properties[p].kind.read(&row[field_offsets[p]..]);
-            for row in all.chunks_exact(stride as usize) {
-                if index == vertex_index {
-                    points.push(Vec3::new(
-                        value(row, xyz[0]) as f32,
-                        value(row, xyz[1]) as f32,
-                        value(row, xyz[2]) as f32,
-                    ));
-                    if rgb.len() == 3 {
-                        let scale = |p: usize| {
-                            if element.properties[p].kind == Scalar::U8 {
-                                1.0 / 255.0
-                            } else {
-                                1.0
-                            }
-                        };
-                        let c = |i: usize| (value(row, rgb[i]) * scale(rgb[i])) as f32;
-                        colors.push(Vec3::new(c(0), c(1), c(2)));
-                    }
-                } else {
-                    let n = value(row, nsegs);
-                    if !(0.0..u32::MAX as f64).contains(&n) {
-                        return Err(HairError::BadValue {
-                            file: file.into(),
-                            what: format!("nsegs of strand {}", counts.len()),
-                            value: n.to_string(),
-                            why: "must be a count ≥ 0",
-                        });
-                    }
-                    counts.push(n as u32 + 1);
-                }
-            }
+            rows.read(element, index == layout.vertex, &layout, all, file)?;
             offset += stride * element.count;
         } else if fixed {
             offset = offset.saturating_add(stride * element.count);
@@ -213,24 +132,12 @@ pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
             offset = skip_with_lists(&bytes, element, offset)?;
         }
     }
-    // Every element was walked, so the file must end exactly here.
-    if offset != bytes.len() {
-        let what = format!("{} elements after the header", elements.len());
-        return Err(if offset > bytes.len() {
-            HairError::Truncated {
-                file: file.into(),
-                what,
-                needed: offset,
-                actual: bytes.len(),
-            }
-        } else {
-            HairError::SizeMismatch {
-                file: file.into(),
-                expected: offset,
-                actual: bytes.len(),
-            }
-        });
-    }
+    check_walked_to_the_end(offset, &bytes, elements.len(), file)?;
+    let StrandRows {
+        points,
+        colors,
+        counts,
+    } = rows;
     let counted: u64 = counts.iter().map(|&c| c as u64).sum();
     if counted != points.len() as u64 {
         return Err(HairError::CountMismatch {
@@ -240,7 +147,7 @@ pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
             actual: counted,
         });
     }
-    let color = (rgb.len() == 3).then_some(Attribute::PerPoint(colors));
+    let color = layout.rgb.is_some().then_some(Attribute::PerPoint(colors));
     finish(
         RawHair {
             points,
@@ -253,6 +160,144 @@ pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
         HairFormat::Ply,
         String::new(),
     )
+}
+
+/// Where a strand file's data is: the `vertex` and `strand` elements (by index) and the
+/// properties read from them (by index within their element).
+struct StrandLayout {
+    vertex: usize,
+    strand: usize,
+    xyz: [usize; 3],
+    rgb: Option<[usize; 3]>,
+    nsegs: usize,
+}
+
+impl StrandLayout {
+    fn find(elements: &[Element], file: &Path) -> Result<Self, HairError> {
+        let unsupported = |why: String| HairError::Unsupported {
+            file: file.into(),
+            format: FORMAT,
+            why,
+        };
+        let find = |name: &str| elements.iter().position(|e| e.name == name);
+        let vertex_index =
+            find("vertex").ok_or_else(|| unsupported("no `vertex` element".into()))?;
+        let strand_index = find("strand")
+            .ok_or_else(|| unsupported("no `strand` element (segment counts per strand)".into()))?;
+        let (vertex, strand) = (&elements[vertex_index], &elements[strand_index]);
+        let properties = |names: [&str; 3]| -> Option<[usize; 3]> {
+            let [a, b, c] = names.map(|n| vertex.property(n));
+            Some([a?, b?, c?])
+        };
+        let xyz = properties(["x", "y", "z"])
+            .ok_or_else(|| unsupported("`vertex` lacks one of x, y, z".into()))?;
+        let nsegs = ["nsegs", "num_segments", "segments"]
+            .iter()
+            .find_map(|n| strand.property(n))
+            .ok_or_else(|| unsupported("`strand` has no `nsegs` property".into()))?;
+        if [vertex, strand]
+            .iter()
+            .any(|e| e.properties.iter().any(|p| p.list_count.is_some()))
+        {
+            return Err(unsupported(
+                "list properties in `vertex` or `strand`".into(),
+            ));
+        }
+        Ok(Self {
+            vertex: vertex_index,
+            strand: strand_index,
+            xyz,
+            rgb: properties(["red", "green", "blue"]),
+            nsegs,
+        })
+    }
+}
+
+/// The strand data read so far: points (and colours) from `vertex` rows, the points per
+/// strand from `strand` rows.
+#[derive(Default)]
+struct StrandRows {
+    points: Vec<Vec3>,
+    colors: Vec<Vec3>,
+    counts: Vec<u32>,
+}
+
+impl StrandRows {
+    /// Reads every row of `element` (`all`, fixed-size rows), a `vertex` or a `strand` one.
+    fn read(
+        &mut self,
+        element: &Element,
+        is_vertex: bool,
+        layout: &StrandLayout,
+        all: &[u8],
+        file: &Path,
+    ) -> Result<(), HairError> {
+        let field_offsets: Vec<usize> = element
+            .properties
+            .iter()
+            .scan(0usize, |at, p| {
+                let here = *at;
+                *at += p.kind.size() as usize;
+                Some(here)
+            })
+            .collect();
+        let value =
+            |row: &[u8], p: usize| element.properties[p].kind.read(&row[field_offsets[p]..]);
+        // Colours of 8-bit channels are 0..255.
+        let scale = |p: usize| match element.properties[p].kind {
+            Scalar::U8 => 1.0 / 255.0,
+            _ => 1.0,
+        };
+        for row in all.chunks_exact(element.min_bytes() as usize) {
+            if is_vertex {
+                let [x, y, z] = layout.xyz.map(|p| value(row, p) as f32);
+                self.points.push(Vec3::new(x, y, z));
+                if let Some(rgb) = layout.rgb {
+                    let [r, g, b] = rgb.map(|p| (value(row, p) * scale(p)) as f32);
+                    self.colors.push(Vec3::new(r, g, b));
+                }
+                continue;
+            }
+            let n = value(row, layout.nsegs);
+            if !(0.0..u32::MAX as f64).contains(&n) {
+                return Err(HairError::BadValue {
+                    file: file.into(),
+                    what: format!("nsegs of strand {}", self.counts.len()),
+                    value: n.to_string(),
+                    why: "must be a count ≥ 0",
+                });
+            }
+            self.counts.push(n as u32 + 1);
+        }
+        Ok(())
+    }
+}
+
+/// Every element was walked, so the file must end exactly at `offset`.
+fn check_walked_to_the_end(
+    offset: u64,
+    bytes: &FileBytes,
+    elements: usize,
+    file: &Path,
+) -> Result<(), HairError> {
+    if offset == bytes.len() {
+        return Ok(());
+    }
+    let what = format!("{elements} elements after the header");
+    Err(if offset > bytes.len() {
+        HairError::Truncated {
+            file: file.into(),
+            what,
+            needed: offset,
+            actual: bytes.len(),
+        }
+    } else {
+        HairError::SizeMismatch {
+            file: file.into(),
+            expected: offset,
+            actual: bytes.len(),
+        }
+    })
 }
 
 /// Reads past an element that has list properties, one instance at a time.

@@ -359,3 +359,33 @@ impl ForwardScatteringSource for MarchedForwardScattering {
         "GPU"
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "gpu_shadow_paths.wgsl",
+                source: include_str!("gpu_shadow_paths.wgsl"),
+            },
+            None,
+            "MarchParams",
+            &rust_layout!(MarchParams {
+                origin,
+                voxel_size,
+                dims,
+                samples,
+                lights,
+                taps,
+                step_fraction,
+                density_forward,
+                include_direct
+            }),
+        );
+    }
+}

@@ -31,7 +31,8 @@ use crate::passes::shadow_slots::{
 };
 use crate::passes::strand_geometry::StrandGeometry;
 use crate::passes::strand_quads::{strand_bind_group, strand_bind_group_layout};
-use crate::passes::strands::shading_source;
+use crate::passes::strands::strand_shading_module;
+use crate::shaders::Wgsl;
 
 #[derive(Debug, thiserror::Error)]
 pub enum ABufferError {
@@ -76,6 +77,17 @@ struct Params {
     a: u32,
     b: u32,
     _pad: [u32; 2],
+}
+
+/// The view's depth range and Δ of the DBK-buffer (`DbkParams` in `abuffer.wgsl`).
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct DbkUniform {
+    near: f32,
+    far: f32,
+    delta: f32,
+    /// 1: a perspective camera (view depth from the depth buffer's hyperbolic value).
+    perspective: u32,
 }
 
 /// Which fragments go into the lists.
@@ -355,14 +367,14 @@ impl ABufferResources {
             ListMode::Dbk { delta } => delta,
             ListMode::All => 0.0,
         };
-        let dbk = [
-            camera.near,
-            camera.far,
+        let dbk = DbkUniform {
+            near: camera.near,
+            far: camera.far,
             delta,
-            f32::from_bits(camera.is_perspective() as u32),
-        ];
+            perspective: camera.is_perspective() as u32,
+        };
         gpu.queue
-            .write_buffer(&self.dbk_params, 0, bytemuck::cast_slice(&dbk));
+            .write_buffer(&self.dbk_params, 0, bytemuck::bytes_of(&dbk));
         encoder.clear_buffer(&self.counters, 0, None);
         encoder.clear_buffer(&self.truncated, 0, None);
         encoder.clear_buffer(&self.resolved, 0, None);
@@ -447,11 +459,11 @@ impl ABufferPass {
     /// Fragments shaded with `model`; its tables and constants are uploaded once, here.
     pub fn with_model(gpu: &GpuContext, shading: &ShadingModel) -> Self {
         let device = &gpu.device;
-        let shader = wgsl_module(
-            device,
-            "abuffer.wgsl",
-            &shading_source(shading, include_str!("abuffer.wgsl")),
-        );
+        let top = Wgsl {
+            file: "abuffer.wgsl",
+            source: include_str!("abuffer.wgsl"),
+        };
+        let shader = strand_shading_module(device, &top, shading);
         let model = ModelBinding::new(gpu, shading);
         let layouts = ABufferLayouts::new(device);
         let model_layout = model.as_ref().map(|m| &m.layout);
@@ -717,5 +729,54 @@ impl ABufferPass {
         pass.set_pipeline(&self.resolve);
         pass.set_bind_group(0, &resources.resolve, &[]);
         pass.dispatch_workgroups(resources.width.div_ceil(8), resources.height.div_ceil(8), 1);
+    }
+}
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    /// Any fiber model composes the strand shading module; Kajiya-Kay binds nothing.
+    const KAJIYA_KAY: Wgsl = Wgsl {
+        file: "fiber_kajiya_kay.wgsl",
+        source: include_str!("fiber_kajiya_kay.wgsl"),
+    };
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "abuffer.wgsl",
+                source: include_str!("abuffer.wgsl"),
+            },
+            Some(&KAJIYA_KAY),
+            "ABufferParams",
+            &rust_layout!(Params { a => "width", b => "capacity" }),
+        );
+        assert_same_layout(
+            &Wgsl {
+                file: "abuffer.wgsl",
+                source: include_str!("abuffer.wgsl"),
+            },
+            Some(&KAJIYA_KAY),
+            "DbkParams",
+            &rust_layout!(DbkUniform {
+                near,
+                far,
+                delta,
+                perspective
+            }),
+        );
+        assert_same_layout(
+            &Wgsl {
+                file: "abuffer_resolve.wgsl",
+                source: include_str!("abuffer_resolve.wgsl"),
+            },
+            None,
+            "ResolveParams",
+            &rust_layout!(Params { a => "width", b => "height" }),
+        );
     }
 }

@@ -1,7 +1,15 @@
-// A-buffer build (appended to strand_quads.wgsl + strands.wgsl + the fiber model, which holds
+// A-buffer build (the strands shaded by strand_shading.wgsl and the fiber model, which holds
 // group 2, so the lists are group 3): every shaded fragment goes into
 // a per-pixel linked list in storage buffers (WebGPU has no fragment interlock, so lists are
 // built with atomics and sorted at resolve). A full node buffer drops the fragment and counts it.
+
+#import strandlight::strand_quads::{VertexOut, strand_draw_vertex}
+#import strandlight::strand_shading::{behind_head, shade}
+
+@vertex
+fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> VertexOut {
+    return strand_draw_vertex(vertex, instance);
+}
 
 struct Node {
     color: vec4<f32>,

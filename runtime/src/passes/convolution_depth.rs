@@ -22,9 +22,10 @@ use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{
     bind_group, pipeline_layout, storage_entry, storage_texture_entry, uniform_entry,
 };
-use crate::gpu::pipeline::{compute_pipeline, wgsl_module};
+use crate::gpu::pipeline::compute_pipeline;
 use crate::gpu::texture::texture_2d;
 use crate::hair::{Aabb, HairModel};
+use crate::shaders::{Wgsl, shader_module};
 
 /// The largest DODM side the SAT's u32 fixed point is specified for (see `summed_area`).
 pub const MAX_DODM_RESOLUTION: u32 = 2048;
@@ -398,14 +399,11 @@ pub struct ConvolutionDepthPass {
 impl ConvolutionDepthPass {
     pub fn new(gpu: &GpuContext) -> Self {
         let device = &gpu.device;
-        let shader = wgsl_module(
-            device,
-            "convolution_depth.wgsl",
-            concat!(
-                include_str!("strand_quads.wgsl"),
-                include_str!("convolution_depth.wgsl")
-            ),
-        );
+        let top = Wgsl {
+            file: "convolution_depth.wgsl",
+            source: include_str!("convolution_depth.wgsl"),
+        };
+        let shader = shader_module(device, &top, None);
         let compute = wgpu::ShaderStages::COMPUTE;
         let strand_layout = strand_bind_group_layout_for(device, compute);
         let splat_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -798,5 +796,34 @@ mod tests {
         // κ = 1: every window is the whole order; no strands: nothing.
         assert_eq!(strand_window(&before, 1.0, 5), vec![0..total]);
         assert!(strand_window(&[0], 0.5, 0).is_empty());
+    }
+}
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "convolution_depth.wgsl",
+                source: include_str!("convolution_depth.wgsl"),
+            },
+            None,
+            "DodmParams",
+            &rust_layout!(DodmUniform {
+                near,
+                far,
+                first_layer,
+                tau_scale,
+                resolution,
+                segment_count,
+                window_count,
+                row_length
+            }),
+        );
     }
 }

@@ -1,4 +1,4 @@
-// Deep opacity depth map (DODM) of Ren 2010 §5 (eq. 10), appended to strand_quads.wgsl: one
+// Deep opacity depth map (DODM) of Ren 2010 §5 (eq. 10) of the strand quads (strand_quads.wgsl): one
 // light's orthographic map, rasterized in compute. Each invocation takes one segment's quad
 // (the two triangles `quad_corner_of` gives every pass that draws strands) and visits the texel
 // centres it covers, interpolating depth and alpha in the covering triangle as the fixed-function
@@ -17,6 +17,8 @@
 //    out). WGSL has no float atomics: the depths are summed in fixed point.
 // 3. resolve: the scratch into the slot's layer of the two textures the view pass and the
 //    summed-area tables read, zeroing the scratch for the next light.
+
+#import strandlight::strand_quads::{SegmentFrame, quad_corner_of, segment_frame}
 
 struct DodmParams {
     near: f32,

@@ -10,6 +10,7 @@
 // through the SAT; l(δ) interpolates linearly between (0, 0) and the boundaries (z_k, l̄_k); T̃ = exp(−l).
 // Directional lights (tan α = 0) read the single texel: a plain per-light deep opacity map.
 // With the visibility volume (visibility_volume.wgsl), SRBF lights do not come here.
+#define_import_path strandlight::convolution_transmittance
 
 struct EnvLightGpu {
     view_proj: mat4x4<f32>,
@@ -25,8 +26,8 @@ struct EnvLightGpu {
     // The lights shaded with this slot's visibility: shading_samples[first_sample ..+ count].
     first_sample: u32,
     sample_count: u32,
-    _pad0: u32,
-    _pad1: u32,
+    _pad_a: u32,
+    _pad_b: u32,
 };
 
 // One light as the view pass shades it (the slot's light itself, or one of the sub-texel lights

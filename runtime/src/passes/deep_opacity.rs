@@ -29,10 +29,11 @@ use super::strand_geometry::StrandGeometry;
 use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{bind_group, depth_texture_entry, uniform_entry};
-use crate::gpu::pipeline::{ADDITIVE, StrandDraw, color_target, depth_test, wgsl_module};
+use crate::gpu::pipeline::{ADDITIVE, StrandDraw, color_target, depth_test};
 use crate::gpu::readback::{ReadbackError, read_texture_layer_rgba};
 use crate::gpu::texture::texture_2d;
 use crate::hair::Aabb;
+use crate::shaders::{Wgsl, shader_module};
 use crate::shadow_layout::{CUBE_FACES, ShadowLayout};
 
 /// At most this many layers (eight RGBA array layers; the layer pass fills them
@@ -393,14 +394,11 @@ pub struct DeepOpacityPass {
 impl DeepOpacityPass {
     pub fn new(gpu: &GpuContext) -> Self {
         let device = &gpu.device;
-        let shader = wgsl_module(
-            device,
-            "deep_opacity.wgsl",
-            concat!(
-                include_str!("strand_quads.wgsl"),
-                include_str!("deep_opacity.wgsl")
-            ),
-        );
+        let top = Wgsl {
+            file: "deep_opacity.wgsl",
+            source: include_str!("deep_opacity.wgsl"),
+        };
+        let shader = shader_module(device, &top, None);
         let strand_layout = strand_bind_group_layout(device);
         let dom_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("dom"),
@@ -580,4 +578,31 @@ fn array_layer_view(texture: &wgpu::Texture, layer: u32) -> wgpu::TextureView {
         array_layer_count: Some(1),
         ..Default::default()
     })
+}
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "deep_opacity.wgsl",
+                source: include_str!("deep_opacity.wgsl"),
+            },
+            None,
+            "DomParams",
+            &rust_layout!(DomUniform {
+                near,
+                far,
+                spacing,
+                layers,
+                perspective,
+                first_layer
+            }),
+        );
+    }
 }

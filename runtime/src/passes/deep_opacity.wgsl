@@ -1,10 +1,17 @@
-// Deep opacity map layers (Yuksel & Keyser; Svoboda §4, Hunz §4), appended to strand_quads.wgsl
-// and drawn from the light's camera after a depth prepass that left the nearest
+// Deep opacity map layers (Yuksel & Keyser; Svoboda §4, Hunz §4): the strand quads
+// (strand_quads.wgsl) drawn from the light's camera after a depth prepass that left the nearest
 // fiber depth z0 per texel. Each fragment adds its optical depth τ = −ln(1 − α) (α: coverage ×
 // opacity) to layer k = floor((d − d0) / spacing), the last layer taking everything beyond, so
 // the transmittance in front of layer k is exp(−Σ_{j<k} layer_j) = Π(1 − α) of the fibers there.
 // One pass fills the 8 layers first_layer.. (two RGBA targets, additive blending); more layers
 // take more passes.
+
+#import strandlight::strand_quads::{VertexOut, strand_draw_vertex}
+
+@vertex
+fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> VertexOut {
+    return strand_draw_vertex(vertex, instance);
+}
 
 struct DomParams {
     near: f32,

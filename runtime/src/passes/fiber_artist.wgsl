@@ -1,9 +1,11 @@
 // The artist-friendly model of Sadeghi et al. 2010 (eqs. 5–12) in closed form, as the fiber model
-// of strands.wgsl:
+// of strand_shading.wgsl:
 //   S = Σ_X C_X I_X g'(β_X², θ_h − α_X) N'_X(φ) / max(|cos θ_d|, 1e-4)²
 // with g'(σ², x) = exp(−x²/(2σ²)) of unit height, N'_R = N'_TRT−G = cos(φ/2),
 // N'_TT = g'(γ_TT², π − |φ|), N'_G = g'(γ_G², G_angle − |φ|) (I_g and C_G folded into its weight),
 // θ_h = (θ_i + θ_o)/2, θ_d = (θ_o − θ_i)/2, φ ∈ [0, π].
+
+#import strandlight::fiber_frame::{FiberFrame, fiber_frame}
 
 struct ArtistLobes {
     // Per lobe (R, TT, TRT − G, glints): colour × intensity in xyz.
@@ -51,7 +53,7 @@ fn artist_s(f: FiberFrame) -> vec3<f32> {
     return s / (cos_d * cos_d);
 }
 
-// Outgoing radiance per unit irradiance E of the light (strands.wgsl multiplies by E):
+// Outgoing radiance per unit irradiance E of the light (strand_shading.wgsl multiplies by E):
 // L = S · cos θ_i. The per-strand colour is not used: the artist's colours are the model's.
 fn fiber_radiance(t: vec3<f32>, l: vec3<f32>, e: vec3<f32>, color: vec3<f32>) -> vec3<f32> {
     let f = fiber_frame(t, l, e);

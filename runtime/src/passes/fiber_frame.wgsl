@@ -3,6 +3,8 @@
 // between the projections of l and e on the normal plane. Where either projection vanishes
 // (a direction along the fiber) φ is undefined; cos φ = 1 there, as the CPU's
 // atan2(0, 0) = 0 gives.
+#define_import_path strandlight::fiber_frame
+
 struct FiberFrame {
     sin_theta_i: f32,
     sin_theta_o: f32,

@@ -1,4 +1,7 @@
-// Kajiya-Kay as the fiber model of strands.wgsl (uses the Frame constants kd, ks, shininess).
+// Kajiya-Kay as the fiber model of strand_shading.wgsl (uses the Frame constants kd, ks,
+// shininess).
+
+#import strandlight::strand_quads::frame
 
 // Kajiya-Kay with t the tangent, l toward the light, e toward the eye:
 //   L = E · (kd · color · sin(t, l) + ks · max(0, sin(t, l) sin(t, e) − (t·l)(t·e))^p),
@@ -12,7 +15,7 @@ fn kajiya_kay(t: vec3<f32>, l: vec3<f32>, e: vec3<f32>, color: vec3<f32>) -> vec
     return frame.kd * color * sin_tl + vec3<f32>(frame.ks * pow(cone, frame.shininess));
 }
 
-// Outgoing radiance per unit light irradiance E (strands.wgsl multiplies by E): for Kajiya-Kay the
+// Outgoing radiance per unit light irradiance E (strand_shading.wgsl multiplies by E): for Kajiya-Kay the
 // diffuse term's sin(t, l) is the cos θ_i of the other models.
 fn fiber_radiance(t: vec3<f32>, l: vec3<f32>, e: vec3<f32>, color: vec3<f32>) -> vec3<f32> {
     return kajiya_kay(t, l, e, color);

@@ -6,6 +6,10 @@
 // interpolated. The model's own file (fiber_marschner_lut.wgsl, fiber_chiang_lut.wgsl) says
 // how S is assembled from them.
 
+#define_import_path strandlight::fiber_lut
+
+#import strandlight::table_axis::{TableAxis, table_cell}
+
 struct LutParams {
     // M: sin θ_i, sin θ_o. N: azimuth (cos φ or cos(φ/2)), then cos θ_d (Marschner) or sin θ_o
     // (Chiang).
@@ -18,8 +22,8 @@ struct LutParams {
     half_phi: u32,
     // Marschner's floor of cos²θ_d (unused by Chiang).
     min_cos2_theta_d: f32,
-    _pad0: u32,
-    _pad1: u32,
+    _pad_a: u32,
+    _pad_b: u32,
 };
 
 @group(2) @binding(0) var<uniform> lut: LutParams;

@@ -1,7 +1,10 @@
 // Marschner through its two point-light lookup tables (fiber_lut.wgsl; Hunz 2016 Algorithm 2),
-// as the fiber model of strands.wgsl:
+// as the fiber model of strand_shading.wgsl:
 //   S = Σ_p M_p(sin θ_i, sin θ_o) · N_p(cos φ, cos θ_d) / max(cos²θ_d, 1e-8),
 // cos θ_d being the M table's fourth quantity.
+
+#import strandlight::fiber_frame::{FiberFrame, fiber_frame}
+#import strandlight::fiber_lut::{bilinear, lut, lut_azimuth, m_value, n_value}
 
 // S (1/sr, RGB) at a fiber frame.
 fn marschner_lut_s(f: FiberFrame) -> vec3<f32> {
@@ -15,7 +18,7 @@ fn marschner_lut_s(f: FiberFrame) -> vec3<f32> {
     return s / max(cos_d * cos_d, lut.min_cos2_theta_d);
 }
 
-// Outgoing radiance per unit irradiance E of the light (strands.wgsl multiplies by E):
+// Outgoing radiance per unit irradiance E of the light (strand_shading.wgsl multiplies by E):
 // L = S · cos θ_i, the integrand of L_o = ∫ S L_i cos θ_i dω_i for a light from one direction.
 // The per-strand colour is not used: the fiber's colour is its absorption, baked in N.
 fn fiber_radiance(t: vec3<f32>, l: vec3<f32>, e: vec3<f32>, color: vec3<f32>) -> vec3<f32> {

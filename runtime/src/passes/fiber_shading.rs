@@ -23,6 +23,7 @@ use wgpu::util::DeviceExt;
 
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{bind_group, storage_entry, uniform_entry};
+use crate::shaders::Wgsl;
 
 /// `cos²θ_d` floor of the Marschner division (`strandlight_tables::marschner::MIN_COS2_THETA_D`).
 pub const MIN_COS2_THETA_D: f32 = 1e-8;
@@ -51,27 +52,25 @@ impl ShadingModel {
         }
     }
 
-    /// The WGSL that defines `fiber_radiance` (appended after `strands.wgsl`).
-    pub(crate) fn wgsl(&self) -> &'static str {
-        match self {
-            ShadingModel::KajiyaKay => include_str!("fiber_kajiya_kay.wgsl"),
-            ShadingModel::MarschnerLut(_) => concat!(
-                include_str!("fiber_frame.wgsl"),
-                include_str!("table_axis.wgsl"),
-                include_str!("fiber_lut.wgsl"),
-                include_str!("fiber_marschner_lut.wgsl")
+    /// The WGSL that defines `fiber_radiance`, composed as
+    /// [`FIBER_MODEL`](crate::shaders::FIBER_MODEL) into the strand shading passes.
+    pub(crate) fn wgsl(&self) -> Wgsl {
+        let (file, source) = match self {
+            ShadingModel::KajiyaKay => (
+                "fiber_kajiya_kay.wgsl",
+                include_str!("fiber_kajiya_kay.wgsl"),
             ),
-            ShadingModel::ChiangLut(_) => concat!(
-                include_str!("fiber_frame.wgsl"),
-                include_str!("table_axis.wgsl"),
-                include_str!("fiber_lut.wgsl"),
-                include_str!("fiber_chiang_lut.wgsl")
+            ShadingModel::MarschnerLut(_) => (
+                "fiber_marschner_lut.wgsl",
+                include_str!("fiber_marschner_lut.wgsl"),
             ),
-            ShadingModel::Artist(_) => concat!(
-                include_str!("fiber_frame.wgsl"),
-                include_str!("fiber_artist.wgsl")
+            ShadingModel::ChiangLut(_) => (
+                "fiber_chiang_lut.wgsl",
+                include_str!("fiber_chiang_lut.wgsl"),
             ),
-        }
+            ShadingModel::Artist(_) => ("fiber_artist.wgsl", include_str!("fiber_artist.wgsl")),
+        };
+        Wgsl { file, source }
     }
 }
 
@@ -406,5 +405,49 @@ mod tests {
         let wrong_lobes = table([AXIS_COS_PHI, AXIS_COS_THETA_D, AXIS_LOBE], [7, 8, 4], 3);
         let e = MarschnerLuts::new(m, wrong_lobes).unwrap_err();
         assert!(e.to_string().contains("4 nodes, expected 3"), "{e}");
+    }
+}
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "fiber_lut.wgsl",
+                source: include_str!("fiber_lut.wgsl"),
+            },
+            None,
+            "LutParams",
+            &rust_layout!(LutUniform {
+                m_axes,
+                n_axes,
+                m_strides,
+                n_strides,
+                half_phi,
+                min_cos2_theta_d
+            }),
+        );
+        assert_same_layout(
+            &Wgsl {
+                file: "fiber_artist.wgsl",
+                source: include_str!("fiber_artist.wgsl"),
+            },
+            None,
+            "ArtistLobes",
+            &rust_layout!(ArtistUniform {
+                weight,
+                alpha,
+                beta,
+                gamma_tt,
+                gamma_glint,
+                glint_half_angle,
+                min_cos_theta_d
+            }),
+        );
     }
 }

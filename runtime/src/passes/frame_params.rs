@@ -91,3 +91,35 @@ impl FrameParams {
         }
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "strand_quads.wgsl",
+                source: include_str!("strand_quads.wgsl"),
+            },
+            None,
+            "Frame",
+            &rust_layout!(FrameUniform {
+                view_proj,
+                eye,
+                toward_eye,
+                viewport,
+                focal_px,
+                width_override_px,
+                kd,
+                ks,
+                shininess,
+                light_count,
+                width_scale
+            }),
+        );
+    }
+}

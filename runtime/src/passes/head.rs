@@ -10,7 +10,7 @@ use wgpu::util::DeviceExt;
 
 use super::attachments::cleared_depth;
 use super::render_target::DEPTH_FORMAT;
-use super::view_visibility::NEAREST_SURFACE_FORMAT;
+use super::render_target::NEAREST_SURFACE_FORMAT;
 use crate::camera::Camera;
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{pipeline_layout, uniform_entry};
@@ -315,5 +315,29 @@ impl HeadPass {
             pass.set_bind_group(0, &group, &[]);
             head.draw(&mut pass);
         }
+    }
+}
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "head.wgsl",
+                source: include_str!("head.wgsl"),
+            },
+            None,
+            "HeadCamera",
+            &rust_layout!(HeadCameraUniform {
+                view_proj,
+                eye,
+                toward_eye
+            }),
+        );
     }
 }

@@ -16,11 +16,12 @@ use super::render_target::RenderTarget;
 use super::shadow_slots::{HeadInput, ShadowInput, TooManyShadowMaps, shadow_bind_group_for};
 use super::strand_geometry::StrandGeometry;
 use super::strand_quads::strand_bind_group;
-use super::strands::{ShadedStrandLayouts, shading_source};
+use super::strands::{ShadedStrandLayouts, strand_shading_module};
 use crate::gpu::bind_layout::{bind_group, pipeline_layout, storage_entry, uniform_entry};
 use crate::gpu::pipeline::{StrandDraw, compute_pipeline, wgsl_module};
 use crate::gpu::readback::{ReadbackError, read_buffer};
 use crate::gpu::{GpuContext, GpuLimits, LimitError};
+use crate::shaders::Wgsl;
 
 /// Hunz §6 keeps 8 fragments per pixel.
 pub const DEFAULT_K: u32 = 8;
@@ -83,11 +84,11 @@ impl KBufferPass {
         });
         let layouts = ShadedStrandLayouts::new(gpu, shading);
         let build_layout = layouts.pipeline_layout(device, "kbuffer build", Some(&slots_layout));
-        let shader = wgsl_module(
-            device,
-            "kbuffer.wgsl",
-            &shading_source(shading, include_str!("kbuffer.wgsl")),
-        );
+        let top = Wgsl {
+            file: "kbuffer.wgsl",
+            source: include_str!("kbuffer.wgsl"),
+        };
+        let shader = strand_shading_module(device, &top, shading);
         let build = |label, entry| {
             StrandDraw {
                 label,
@@ -154,6 +155,47 @@ impl KBufferPass {
         limits.check_storage_buffer("resolved image", pixels * 16, |_| {
             "render a smaller image".into()
         })?;
+        let buffers = self.buffers(gpu, (width, height), k);
+        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows, head)?;
+        let strands = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
+        let mut encoder = device.create_command_encoder(&Default::default());
+        self.encode(
+            gpu,
+            &mut encoder,
+            geometry,
+            [&strands, &shadow_group],
+            &buffers,
+            (width, height),
+        );
+        gpu.queue.submit([encoder.finish()]);
+        let KBufferBuffers {
+            depths,
+            colors,
+            counters,
+            resolved,
+            ..
+        } = buffers;
+        let image = read_buffer(gpu, &resolved)?;
+        let counts = read_buffer(gpu, &counters)?;
+        let counts: &[u32] = bytemuck::cast_slice(&counts);
+        Ok(KBufferFrame {
+            pixels: bytemuck::cast_slice::<u8, [f32; 4]>(&image).to_vec(),
+            fragments_dropped: u64::from(counts[0]),
+            fragments_kept: u64::from(counts[1]),
+            memory_bytes: vec![
+                ("kbuffer depths".into(), depths.size()),
+                ("kbuffer colours".into(), colors.size()),
+                ("kbuffer resolved image".into(), resolved.size()),
+                ("kbuffer pass depth".into(), pixels * 4),
+            ],
+        })
+    }
+
+    /// A frame's slots (k per pixel), counters and resolved image, bound for the build and
+    /// the resolve.
+    fn buffers(&self, gpu: &GpuContext, (width, height): (u32, u32), k: u32) -> KBufferBuffers {
+        let device = &gpu.device;
+        let pixels = width as u64 * height as u64;
         let storage = |label, contents: &[u8]| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
@@ -214,12 +256,29 @@ impl KBufferPass {
                 resolve_params.as_entire_binding(),
             ],
         );
-        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows, head)?;
-        let strands = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
+        KBufferBuffers {
+            depths,
+            colors,
+            counters,
+            resolved,
+            slots_group,
+            resolve_group,
+        }
+    }
+
+    /// The two build passes over the strands (`groups`: strands, shadows), then the resolve.
+    fn encode(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &StrandGeometry,
+        [strands, shadow_group]: [&wgpu::BindGroup; 2],
+        buffers: &KBufferBuffers,
+        (width, height): (u32, u32),
+    ) {
         // Only to give the build passes a size: every fragment passes its test.
         let target = RenderTarget::new(gpu, width, height);
         let depth_view = target.depth.create_view(&Default::default());
-        let mut encoder = device.create_command_encoder(&Default::default());
         for (label, pipeline) in [
             ("kbuffer depths", &self.depths),
             ("kbuffer colours", &self.colors),
@@ -233,37 +292,65 @@ impl KBufferPass {
                 multiview_mask: None,
             });
             pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &strands, &[]);
-            pass.set_bind_group(1, &shadow_group, &[]);
+            pass.set_bind_group(0, strands, &[]);
+            pass.set_bind_group(1, shadow_group, &[]);
             if let Some(model) = &self.layouts.model {
                 pass.set_bind_group(2, &model.group, &[]);
             }
-            pass.set_bind_group(3, &slots_group, &[]);
+            pass.set_bind_group(3, &buffers.slots_group, &[]);
             pass.draw(0..6, 0..geometry.segment_count);
         }
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("kbuffer resolve"),
-                timestamp_writes: gpu.compute_timestamps(),
-            });
-            pass.set_pipeline(&self.resolve);
-            pass.set_bind_group(0, &resolve_group, &[]);
-            pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
-        }
-        gpu.queue.submit([encoder.finish()]);
-        let image = read_buffer(gpu, &resolved)?;
-        let counts = read_buffer(gpu, &counters)?;
-        let counts: &[u32] = bytemuck::cast_slice(&counts);
-        Ok(KBufferFrame {
-            pixels: bytemuck::cast_slice::<u8, [f32; 4]>(&image).to_vec(),
-            fragments_dropped: u64::from(counts[0]),
-            fragments_kept: u64::from(counts[1]),
-            memory_bytes: vec![
-                ("kbuffer depths".into(), depths.size()),
-                ("kbuffer colours".into(), colors.size()),
-                ("kbuffer resolved image".into(), resolved.size()),
-                ("kbuffer pass depth".into(), pixels * 4),
-            ],
-        })
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("kbuffer resolve"),
+            timestamp_writes: gpu.compute_timestamps(),
+        });
+        pass.set_pipeline(&self.resolve);
+        pass.set_bind_group(0, &buffers.resolve_group, &[]);
+        pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+    }
+}
+
+/// One frame's K-buffer on the GPU.
+struct KBufferBuffers {
+    depths: wgpu::Buffer,
+    colors: wgpu::Buffer,
+    counters: wgpu::Buffer,
+    resolved: wgpu::Buffer,
+    slots_group: wgpu::BindGroup,
+    resolve_group: wgpu::BindGroup,
+}
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    /// Any fiber model composes the strand shading module; Kajiya-Kay binds nothing.
+    const KAJIYA_KAY: Wgsl = Wgsl {
+        file: "fiber_kajiya_kay.wgsl",
+        source: include_str!("fiber_kajiya_kay.wgsl"),
+    };
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "kbuffer.wgsl",
+                source: include_str!("kbuffer.wgsl"),
+            },
+            Some(&KAJIYA_KAY),
+            "KBufferParams",
+            &rust_layout!(Params { width, second => "k" }),
+        );
+        assert_same_layout(
+            &Wgsl {
+                file: "kbuffer_resolve.wgsl",
+                source: include_str!("kbuffer_resolve.wgsl"),
+            },
+            None,
+            "ResolveParams",
+            &rust_layout!(Params { width, second => "height", third => "k" }),
+        );
     }
 }

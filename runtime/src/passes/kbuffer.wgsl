@@ -1,5 +1,5 @@
-// K-buffer build (Hunz §5.2, Vasilakis & Fudos' k+-buffer; appended to strand_quads.wgsl +
-// strands.wgsl + the fiber model, which holds group 2, so the buffer is group 3). WebGPU has no
+// K-buffer build (Hunz §5.2, Vasilakis & Fudos' k+-buffer; the strands shaded by
+// strand_shading.wgsl and the fiber model, which holds group 2, so the buffer is group 3). WebGPU has no
 // fragment interlock, so the k nearest fragments are found without one, in two passes:
 // 1. `fs_kbuffer_depths` inserts each fragment's depth into its pixel's k slots, kept sorted, by
 //    a cascade of atomicMin: the slot keeps the smaller value and the larger one moves on to the
@@ -8,6 +8,14 @@
 //    the slot by setting its depth's sign bit (so two fragments of equal depth take two slots, or
 //    the second is dropped when only one of them made the k); the others (beyond the k nearest)
 //    are dropped and counted, as the k+-buffer drops them.
+
+#import strandlight::strand_quads::{VertexOut, strand_draw_vertex}
+#import strandlight::strand_shading::{behind_head, shade}
+
+@vertex
+fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> VertexOut {
+    return strand_draw_vertex(vertex, instance);
+}
 
 struct KBufferParams {
     width: u32,

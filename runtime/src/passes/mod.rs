@@ -3,8 +3,8 @@
 pub mod abuffer;
 pub mod attachments;
 pub mod convolution_depth;
+pub mod convolution_transmittance;
 pub mod deep_opacity;
-pub mod env_view;
 pub mod fiber_shading;
 pub mod frame_params;
 pub mod head;
@@ -20,4 +20,3 @@ pub mod strands;
 pub mod summed_area;
 pub mod transmittance_filter;
 pub mod transmittance_probe;
-pub mod view_visibility;

@@ -10,20 +10,21 @@ use wgpu::util::DeviceExt;
 use super::fiber_shading::ShadingModel;
 use super::frame_params::FrameParams;
 use super::head::{HeadDepthMaps, HeadGeometry, HeadPass};
+use super::render_target::NEAREST_SURFACE_FORMAT;
 use super::render_target::{DEPTH_FORMAT, RenderTarget};
 use super::shadow_slots::{
     HeadInput, ShadowInput, TooManyShadowMaps, shadow_bind_group_for, shadow_bind_group_layout,
 };
 use super::strand_geometry::StrandGeometry;
 use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
-use super::strands::shading_source;
-use super::view_visibility::NEAREST_SURFACE_FORMAT;
+use super::strands::strand_shading_module;
 use crate::camera::Camera;
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{bind_group, float_texture_entry, pipeline_layout, uniform_entry};
-use crate::gpu::pipeline::{color_target, wgsl_module};
+use crate::gpu::pipeline::color_target;
 use crate::gpu::texture::texture_2d;
 use crate::head::Head;
+use crate::shaders::Wgsl;
 
 /// One frame's head on the GPU: its triangles, its depth in the lights' faces and its view.
 pub struct PointHead {
@@ -78,8 +79,11 @@ impl PointSkinPass {
         let device = &gpu.device;
         // The skin reads the lights and maps as the fibers do; the module needs some fiber model
         // to compile `shade`, and Kajiya-Kay binds nothing (group 2 stays empty).
-        let source = shading_source(&ShadingModel::KajiyaKay, include_str!("point_skin.wgsl"));
-        let shader = wgsl_module(device, "point_skin.wgsl", &source);
+        let top = Wgsl {
+            file: "point_skin.wgsl",
+            source: include_str!("point_skin.wgsl"),
+        };
+        let shader = strand_shading_module(device, &top, &ShadingModel::KajiyaKay);
         let strand_layout = strand_bind_group_layout(device);
         let shadow_layout = shadow_bind_group_layout(device);
         let fragment = wgpu::ShaderStages::FRAGMENT;
@@ -246,5 +250,31 @@ pub fn composite_over(hair: &mut [[f32; 4]], skin: &[[f32; 4]]) {
         for k in 0..4 {
             h[k] += behind * s[k];
         }
+    }
+}
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    /// Any fiber model composes the strand shading module; Kajiya-Kay binds nothing.
+    const KAJIYA_KAY: Wgsl = Wgsl {
+        file: "fiber_kajiya_kay.wgsl",
+        source: include_str!("fiber_kajiya_kay.wgsl"),
+    };
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "point_skin.wgsl",
+                source: include_str!("point_skin.wgsl"),
+            },
+            Some(&KAJIYA_KAY),
+            "SkinParams",
+            &rust_layout!(SkinUniform { albedo }),
+        );
     }
 }

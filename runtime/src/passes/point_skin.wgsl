@@ -1,9 +1,12 @@
-// The head's skin in the point-lit frame (appended after strands.wgsl and the fiber model): a
+// The head's skin in the point-lit frame (with strand_shading.wgsl's lights and maps): a
 // Lambertian surface of albedo `skin.albedo.rgb` under the frame's lights, each seen through the
 // hair's map and the head's own depth in it (shadow_transmittance, looked up two texels off the
 // surface so that the head's depth does not shadow the skin it was drawn from). Radiance =
 // albedo/π · Σ_i T_i · E_i · max(n·l_i, 0), with E_i and l_i as light_at gives them (falloff, spot
-// cone) for the fibers. The hair composites over it (render.rs).
+// cone) for the fibers. The hair composites over it (point_frame.rs).
+
+#import strandlight::strand_quads::{frame, lights}
+#import strandlight::strand_shading::{light_at, shadow_texel_at, shadow_transmittance}
 
 struct SkinParams {
     albedo: vec4<f32>,

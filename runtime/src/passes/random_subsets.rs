@@ -13,7 +13,7 @@ use super::fiber_shading::ShadingModel;
 use super::frame_params::FrameParams;
 use super::render_target::DEPTH_FORMAT;
 use super::shadow_slots::{HeadInput, ShadowInput, TooManyShadowMaps};
-use super::sorted_blend::IndexedStrandDraw;
+use super::sorted_blend::{IndexedStrandDraw, IndexedStrandGroups};
 use super::strand_geometry::StrandGeometry;
 use crate::gpu::bind_layout::{
     bind_group, pipeline_layout, storage_entry, texture_entry, uniform_entry,
@@ -170,94 +170,22 @@ impl RandomSubsetsPass {
             contents: bytemuck::cast_slice(if order.is_empty() { &[0u32] } else { &order }),
             usage: wgpu::BufferUsages::STORAGE,
         });
-        let size = wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: subsets,
-        };
-        let colors = texture_2d(
-            gpu,
-            "subset colours",
-            size,
-            SUBSET_COLOR_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        );
-        let depths = texture_2d(
-            gpu,
-            "subset depths",
-            size,
-            DEPTH_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        );
+        let layers = SubsetLayers::new(gpu, (width, height), subsets);
         let resolved = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("random subsets resolved"),
             size: pixels * 16,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("random subsets params"),
-            contents: bytemuck::bytes_of(&ResolveParams {
-                width,
-                height,
-                subsets,
-                _pad: 0,
-            }),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
         let groups = self
             .draw
             .groups(gpu, geometry, frame, shadows, head, &order)?;
-        let layer_view = |texture: &wgpu::Texture, layer| {
-            texture.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2),
-                base_array_layer: layer,
-                array_layer_count: Some(1),
-                ..Default::default()
-            })
-        };
         let mut encoder = device.create_command_encoder(&Default::default());
-        for subset in 0..subsets {
-            let color_view = layer_view(&colors, subset);
-            let depth_view = layer_view(&depths, subset);
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("random subset"),
-                color_attachments: &[cleared_color(&color_view)],
-                depth_stencil_attachment: cleared_depth(&depth_view, true),
-                timestamp_writes: gpu.render_timestamps(),
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            let (start, end) = (bounds[subset as usize], bounds[subset as usize + 1]);
-            self.draw.record(&mut pass, &groups, start..end);
+        for subset in 0..subsets as usize {
+            let segments = bounds[subset]..bounds[subset + 1];
+            self.encode_subset(gpu, &mut encoder, &groups, &layers, subset as u32, segments);
         }
-        let array_view = |texture: &wgpu::Texture| {
-            texture.create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            })
-        };
-        let (color_array, depth_array) = (array_view(&colors), array_view(&depths));
-        let resolve_group = bind_group(
-            device,
-            "random subsets resolve",
-            &self.resolve_layout,
-            &[
-                wgpu::BindingResource::TextureView(&color_array),
-                wgpu::BindingResource::TextureView(&depth_array),
-                resolved.as_entire_binding(),
-                params.as_entire_binding(),
-            ],
-        );
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("random subsets resolve"),
-                timestamp_writes: gpu.compute_timestamps(),
-            });
-            pass.set_pipeline(&self.resolve);
-            pass.set_bind_group(0, &resolve_group, &[]);
-            pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
-        }
+        self.encode_resolve(gpu, &mut encoder, &layers, &resolved);
         gpu.queue.submit([encoder.finish()]);
         let image = read_buffer(gpu, &resolved)?;
         let texel = SUBSET_COLOR_FORMAT.block_copy_size(None).unwrap_or(8) as u64;
@@ -270,5 +198,131 @@ impl RandomSubsetsPass {
                 ("random subsets resolved image".into(), resolved.size()),
             ],
         })
+    }
+
+    /// Subset `subset` (its segments `segments` of the subset order) drawn depth-tested into
+    /// its layer.
+    fn encode_subset(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        groups: &IndexedStrandGroups,
+        layers: &SubsetLayers,
+        subset: u32,
+        segments: std::ops::Range<u32>,
+    ) {
+        let color_view = layer_view(&layers.colors, subset);
+        let depth_view = layer_view(&layers.depths, subset);
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("random subset"),
+            color_attachments: &[cleared_color(&color_view)],
+            depth_stencil_attachment: cleared_depth(&depth_view, true),
+            timestamp_writes: gpu.render_timestamps(),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        self.draw.record(&mut pass, groups, segments);
+    }
+
+    /// Every pixel's fragments of all the layers, sorted and composited into `resolved`.
+    fn encode_resolve(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        layers: &SubsetLayers,
+        resolved: &wgpu::Buffer,
+    ) {
+        let device = &gpu.device;
+        let (width, height) = (layers.colors.width(), layers.colors.height());
+        let params = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("random subsets params"),
+            contents: bytemuck::bytes_of(&ResolveParams {
+                width,
+                height,
+                subsets: layers.colors.depth_or_array_layers(),
+                _pad: 0,
+            }),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let array_view = |texture: &wgpu::Texture| {
+            texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            })
+        };
+        let (color_array, depth_array) = (array_view(&layers.colors), array_view(&layers.depths));
+        let resolve_group = bind_group(
+            device,
+            "random subsets resolve",
+            &self.resolve_layout,
+            &[
+                wgpu::BindingResource::TextureView(&color_array),
+                wgpu::BindingResource::TextureView(&depth_array),
+                resolved.as_entire_binding(),
+                params.as_entire_binding(),
+            ],
+        );
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("random subsets resolve"),
+            timestamp_writes: gpu.compute_timestamps(),
+        });
+        pass.set_pipeline(&self.resolve);
+        pass.set_bind_group(0, &resolve_group, &[]);
+        pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+    }
+}
+
+/// One colour and one depth layer per subset.
+struct SubsetLayers {
+    colors: wgpu::Texture,
+    depths: wgpu::Texture,
+}
+
+impl SubsetLayers {
+    fn new(gpu: &GpuContext, (width, height): (u32, u32), subsets: u32) -> Self {
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: subsets,
+        };
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        Self {
+            colors: texture_2d(gpu, "subset colours", size, SUBSET_COLOR_FORMAT, usage),
+            depths: texture_2d(gpu, "subset depths", size, DEPTH_FORMAT, usage),
+        }
+    }
+}
+
+/// Layer `layer` of an array texture as a 2D attachment.
+fn layer_view(texture: &wgpu::Texture, layer: u32) -> wgpu::TextureView {
+    texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2),
+        base_array_layer: layer,
+        array_layer_count: Some(1),
+        ..Default::default()
+    })
+}
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "random_subsets_resolve.wgsl",
+                source: include_str!("random_subsets_resolve.wgsl"),
+            },
+            None,
+            "ResolveParams",
+            &rust_layout!(ResolveParams {
+                width,
+                height,
+                subsets
+            }),
+        );
     }
 }

@@ -11,6 +11,11 @@ pub struct RenderTarget {
 
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 
+/// The format of the view's nearest-surface targets (the env view's nearest fiber, the head
+/// seen from the view): f32, so that a deferred pass shades the very point the rasterizer
+/// interpolated.
+pub const NEAREST_SURFACE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
 impl RenderTarget {
     pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Self {
         let size = wgpu::Extent3d {

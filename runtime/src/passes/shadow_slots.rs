@@ -1,4 +1,4 @@
-//! Group 1 of the shading passes (`strands.wgsl`): up to [`MAX_SHADOWED_LIGHTS`] light maps
+//! Group 1 of the shading passes (`strand_shading.wgsl`): up to [`MAX_SHADOWED_LIGHTS`] light maps
 //! (deep opacity, opacity shadow, shadow maps or ADSM), each shadowing one light of the frame, in
 //! fixed slots; unused slots hold 1×1 placeholders that shadow no light. A slot holds one light's
 //! maps whatever their [`ShadowLayout`]: a frustum's one face or a cube's six, as array layers,
@@ -39,7 +39,7 @@ pub struct HeadInput<'a> {
     pub view_depth: &'a wgpu::Texture,
 }
 
-/// `NO_HEAD_LAYER` in `strands.wgsl`: a slot whose maps hold no head.
+/// `NO_HEAD_LAYER` in `strand_shading.wgsl`: a slot whose maps hold no head.
 const NO_HEAD_LAYER: u32 = u32::MAX;
 
 /// Directional lights the strand pass shadows at once (one deep opacity map each).
@@ -96,7 +96,7 @@ const HEAD_LIGHT_DEPTH_BINDING: u32 = SHADOW_PARAMS_BINDING + 1;
 const HEAD_VIEW_DEPTH_BINDING: u32 = SHADOW_PARAMS_BINDING + 2;
 const HEAD_VIEW_BINDING: u32 = SHADOW_PARAMS_BINDING + 3;
 
-/// `ShadowParams.lookup` in `strands.wgsl`.
+/// `ShadowParams.lookup` in `strand_shading.wgsl`.
 fn lookup_code(lookup: &ShadowLookup) -> u32 {
     match lookup {
         ShadowLookup::Layers { .. } => 0,
@@ -336,5 +336,58 @@ impl HeadViews {
                 resource: self.params.as_entire_binding(),
             },
         ]
+    }
+}
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    /// Any fiber model composes the strand shading module; Kajiya-Kay binds nothing.
+    const KAJIYA_KAY: Wgsl = Wgsl {
+        file: "fiber_kajiya_kay.wgsl",
+        source: include_str!("fiber_kajiya_kay.wgsl"),
+    };
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "strand_shading.wgsl",
+                source: include_str!("strand_shading.wgsl"),
+            },
+            Some(&KAJIYA_KAY),
+            "ShadowParams",
+            &rust_layout!(ShadowUniform {
+                view_proj,
+                cube,
+                near,
+                far,
+                spacing,
+                layers,
+                light_index,
+                resolution,
+                lookup,
+                perspective,
+                kernel,
+                bias,
+                adsm_alpha,
+                adsm_spacing,
+                face_array_layers,
+                head_layer,
+                texel_world
+            }),
+        );
+        assert_same_layout(
+            &Wgsl {
+                file: "strand_shading.wgsl",
+                source: include_str!("strand_shading.wgsl"),
+            },
+            Some(&KAJIYA_KAY),
+            "HeadView",
+            &rust_layout!(HeadViewUniform { in_view }),
+        );
     }
 }

@@ -15,13 +15,14 @@ use super::render_target::RenderTarget;
 use super::shadow_slots::{HeadInput, ShadowInput, TooManyShadowMaps, shadow_bind_group_for};
 use super::strand_geometry::StrandGeometry;
 use super::strand_quads::strand_bind_group;
-use super::strands::{ShadedStrandLayouts, shading_source};
+use super::strands::{ShadedStrandLayouts, strand_shading_module};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{bind_group, pipeline_layout, storage_entry, uniform_entry};
 use crate::gpu::pipeline::{
     PREMULTIPLIED_OVER, StrandDraw, color_target, compute_pipeline, wgsl_module,
 };
 use crate::hair::Aabb;
+use crate::shaders::Wgsl;
 
 /// Kim 2003 and Hunz use a few hundred depth bins.
 pub const DEFAULT_SORT_BINS: u32 = 256;
@@ -247,11 +248,11 @@ impl IndexedStrandDraw {
             entries: &[storage_entry(0, wgpu::ShaderStages::VERTEX, true)],
         });
         let layout = layouts.pipeline_layout(device, label, Some(&order_layout));
-        let shader = wgsl_module(
-            device,
-            label,
-            &shading_source(shading, include_str!("sorted_blend_draw.wgsl")),
-        );
+        let top = Wgsl {
+            file: "sorted_blend_draw.wgsl",
+            source: include_str!("sorted_blend_draw.wgsl"),
+        };
+        let shader = strand_shading_module(device, &top, shading);
         let pipeline = StrandDraw {
             label,
             layout: &layout,
@@ -305,5 +306,32 @@ impl IndexedStrandDraw {
         }
         pass.set_bind_group(3, &groups.order, &[]);
         pass.draw(0..6, positions);
+    }
+}
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "sorted_blend.wgsl",
+                source: include_str!("sorted_blend.wgsl"),
+            },
+            None,
+            "SortParams",
+            &rust_layout!(SortUniform {
+                eye,
+                forward,
+                nearest,
+                farthest,
+                bins,
+                segment_count
+            }),
+        );
     }
 }

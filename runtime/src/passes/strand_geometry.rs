@@ -11,7 +11,7 @@ use crate::hair::HairModel;
 /// Hair colour where the file has none (linear RGB, a mid brown).
 pub const DEFAULT_HAIR_COLOR: [f32; 3] = [0.35, 0.22, 0.12];
 
-/// The hair's arrays on the GPU, laid out as `strands.wgsl` reads them (a clone shares the
+/// The hair's arrays on the GPU, laid out as `strand_quads.wgsl` reads them (a clone shares the
 /// buffers).
 #[derive(Clone)]
 pub struct StrandGeometry {
@@ -138,6 +138,30 @@ mod tests {
                 1 | LAST_SEGMENT_BIT,
                 3 | FIRST_SEGMENT_BIT | LAST_SEGMENT_BIT
             ]
+        );
+    }
+}
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "strand_quads.wgsl",
+                source: include_str!("strand_quads.wgsl"),
+            },
+            None,
+            "PointAttributes",
+            &rust_layout!(PointAttributes {
+                color,
+                thickness,
+                opacity
+            }),
         );
     }
 }

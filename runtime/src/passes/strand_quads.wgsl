@@ -1,5 +1,6 @@
 // Strands as camera-facing quads expanded from segments (wgpu lines are one pixel wide): the
-// vertex stage shared by the passes that draw strands (prepended to their fragment shaders).
+// vertex stage shared by the passes that draw strands (their vertex entry points call
+// `strand_draw_vertex`).
 //
 // Six vertices (two triangles) per segment, drawn either as one instance per segment
 // (`draw(0..6, segments)`) or as one instance of six vertices per segment (`draw(6·first ..
@@ -8,6 +9,8 @@
 // max(width, 1) pixels wide; a fiber thinner than a pixel keeps the one-pixel quad and carries
 // its coverage width/1px in alpha (Svoboda §1.2.3), so the alpha summed across the strand equals
 // its width in pixels.
+
+#define_import_path strandlight::strand_quads
 
 struct Frame {
     view_proj: mat4x4<f32>,
@@ -34,9 +37,9 @@ struct PointAttributes {
     thickness: f32,
     // 1 − the file's transparency.
     opacity: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
+    _pad_a: f32,
+    _pad_b: f32,
+    _pad_c: f32,
 };
 
 struct Light {
@@ -82,12 +85,12 @@ fn corner(k: u32) -> vec2<f32> {
 // screen-space normal its quad is widened along.
 struct SegmentFrame {
     index: u32,
-    p0: vec3<f32>,
-    p1: vec3<f32>,
-    t0: vec3<f32>,
-    t1: vec3<f32>,
-    clip0: vec4<f32>,
-    clip1: vec4<f32>,
+    start: vec3<f32>,
+    end: vec3<f32>,
+    start_tangent: vec3<f32>,
+    end_tangent: vec3<f32>,
+    start_clip: vec4<f32>,
+    end_clip: vec4<f32>,
     // Unit perpendicular of the segment on screen (isotropic pixels).
     normal: vec2<f32>,
 };
@@ -123,14 +126,14 @@ fn segment_frame(segment: u32) -> SegmentFrame {
 // Corner (end `at_end`, side `side` = ±1) of the quad of segment `f`.
 fn quad_corner_of(f: SegmentFrame, at_end: bool, side: f32) -> VertexOut {
     var index = f.index;
-    var clip = f.clip0;
-    var world = f.p0;
-    var tangent = f.t0;
+    var clip = f.start_clip;
+    var world = f.start;
+    var tangent = f.start_tangent;
     if (at_end) {
         index = f.index + 1u;
-        clip = f.clip1;
-        world = f.p1;
-        tangent = f.t1;
+        clip = f.end_clip;
+        world = f.end;
+        tangent = f.end_tangent;
     }
     let attr = attributes[index];
     var width_px = attr.thickness * frame.focal_px / clip.w;
@@ -167,7 +170,8 @@ fn strand_vertex(vertex: u32, segment: u32) -> VertexOut {
     return quad_corner_of(segment_frame(segment), c.x > 0.5, c.y);
 }
 
-@vertex
-fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) segment: u32) -> VertexOut {
+// Vertex `vertex` of instance `segment` of either way of drawing the quads (six vertices per
+// instance, or six per segment in one instance).
+fn strand_draw_vertex(vertex: u32, segment: u32) -> VertexOut {
     return strand_vertex(vertex % 6u, segment + vertex / 6u);
 }

@@ -15,7 +15,8 @@ use super::strand_geometry::StrandGeometry;
 use super::strand_quads::{strand_bind_group, strand_bind_group_layout};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::pipeline_layout;
-use crate::gpu::pipeline::{PREMULTIPLIED_OVER, StrandDraw, color_target, depth_test, wgsl_module};
+use crate::gpu::pipeline::{PREMULTIPLIED_OVER, StrandDraw, color_target, depth_test};
+use crate::shaders::{Wgsl, shader_module};
 
 /// The compiled pipeline; reusable across frames and models.
 pub struct StrandPass {
@@ -32,8 +33,11 @@ impl StrandPass {
     /// Shading with `model`; its tables and constants are uploaded once, here.
     pub fn with_model(gpu: &GpuContext, model: &ShadingModel) -> Self {
         let device = &gpu.device;
-        let source = shading_source(model, "");
-        let shader = wgsl_module(device, "strands.wgsl", &source);
+        let top = Wgsl {
+            file: "strands.wgsl",
+            source: include_str!("strands.wgsl"),
+        };
+        let shader = strand_shading_module(device, &top, model);
         let layouts = ShadedStrandLayouts::new(gpu, model);
         let pipeline_layout = layouts.pipeline_layout(device, "strands", None);
         let pipeline = StrandDraw {
@@ -142,14 +146,13 @@ impl ShadedStrandLayouts {
     }
 }
 
-/// The WGSL of a pass that shades strand quads with `model`: the quads, `shade` with its shadow
-/// group 1, the model's `fiber_radiance` (group 2), then `tail` (the pass's own entry points).
-pub(crate) fn shading_source(model: &ShadingModel, tail: &str) -> String {
-    [
-        include_str!("strand_quads.wgsl"),
-        include_str!("strands.wgsl"),
-        model.wgsl(),
-        tail,
-    ]
-    .concat()
+/// The shader of a pass that shades strand quads with `model`: `top` (the pass's own entry
+/// points) composed with `strand_shading.wgsl`'s `shade` and its shadow group 1, and the model's
+/// `fiber_radiance` (group 2).
+pub(crate) fn strand_shading_module(
+    device: &wgpu::Device,
+    top: &Wgsl,
+    model: &ShadingModel,
+) -> wgpu::ShaderModule {
+    shader_module(device, top, Some(&model.wgsl()))
 }

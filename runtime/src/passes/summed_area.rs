@@ -225,3 +225,23 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "summed_area.wgsl",
+                source: include_str!("summed_area.wgsl"),
+            },
+            None,
+            "SatParams",
+            &rust_layout!(SatUniform { resolution, slots }),
+        );
+    }
+}

@@ -1,6 +1,7 @@
 // One axis of a strandlight `Table` as the GPU reads it, and the cell a coordinate falls in:
 // the WGSL twin of `Axis::cell`, shared by every shader that interpolates a table (the env view's
 // 4D convolution tables, the point-light lookup textures).
+#define_import_path strandlight::table_axis
 
 struct TableAxis {
     min: f32,
@@ -9,9 +10,9 @@ struct TableAxis {
     inv_exponent: f32,
     // 0: x itself; 1: asin(x); 2: −acos(x).
     warp: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    _pad_a: u32,
+    _pad_b: u32,
+    _pad_c: u32,
 };
 
 // The lower node of the cell holding x and the upper node's weight.

@@ -5,11 +5,12 @@
 use glam::Vec3;
 use wgpu::util::DeviceExt;
 
-use super::env_view::{BatchBinding, transmittance_bind_group_layout};
+use super::convolution_transmittance::{BatchBinding, transmittance_bind_group_layout};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::storage_entry;
-use crate::gpu::pipeline::{compute_pipeline, wgsl_module};
+use crate::gpu::pipeline::compute_pipeline;
 use crate::gpu::readback::{ReadbackError, read_buffer};
+use crate::shaders::{Wgsl, shader_module};
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -47,12 +48,11 @@ pub struct TransmittanceProbe {
 impl TransmittanceProbe {
     pub fn new(gpu: &GpuContext) -> Self {
         let device = &gpu.device;
-        let source = [
-            include_str!("convolution_transmittance.wgsl"),
-            include_str!("transmittance_probe.wgsl"),
-        ]
-        .concat();
-        let shader = wgsl_module(device, "transmittance_probe.wgsl", &source);
+        let top = Wgsl {
+            file: "transmittance_probe.wgsl",
+            source: include_str!("transmittance_probe.wgsl"),
+        };
+        let shader = shader_module(device, &top, None);
         let compute = wgpu::ShaderStages::COMPUTE;
         let probe_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("probe"),
@@ -174,5 +174,34 @@ impl TransmittanceProbe {
         boxes: &[ProbeBox],
     ) -> Result<Vec<[u32; 4]>, ReadbackError> {
         Ok(self.run(gpu, batch, &[], boxes)?.1)
+    }
+}
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "transmittance_probe.wgsl",
+                source: include_str!("transmittance_probe.wgsl"),
+            },
+            None,
+            "ProbePoint",
+            &rust_layout!(ProbePoint { position }),
+        );
+        assert_same_layout(
+            &Wgsl {
+                file: "transmittance_probe.wgsl",
+                source: include_str!("transmittance_probe.wgsl"),
+            },
+            None,
+            "ProbeBox",
+            &rust_layout!(ProbeBox { corners, slot }),
+        );
     }
 }

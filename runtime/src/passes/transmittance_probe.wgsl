@@ -1,5 +1,7 @@
-// Test hook: evaluates the view pass's own effective_transmittance and sat_box_sum (appended
-// after convolution_transmittance.wgsl) at given points / boxes.
+// Test hook: evaluates the view pass's own effective_transmittance and sat_box_sum
+// (convolution_transmittance.wgsl) at given points / boxes.
+
+#import strandlight::convolution_transmittance::{effective_transmittance, sat_box_sum}
 
 struct ProbePoint {
     // xyz: world position; w: light slot (as f32).

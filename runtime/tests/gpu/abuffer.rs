@@ -388,7 +388,7 @@ fn abuffer_and_dbk_shade_like_the_opaque_pass_for_every_model() {
 /// those from a generous fixed pool.
 #[test]
 fn an_unsized_pool_holds_exactly_what_each_technique_stores() {
-    use strandlight_runtime::render::{RenderOptions, Transparency, render_frame};
+    use strandlight_runtime::point_frame::{RenderOptions, Transparency, render_frame};
     let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
     let front = (0.2f32, Vec3::new(0.8, 0.2, 0.1));
     let back = (-0.2f32, Vec3::new(0.1, 0.3, 0.9));

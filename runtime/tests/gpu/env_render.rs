@@ -8,7 +8,7 @@ use glam::{DVec3, Vec2, Vec3};
 use strandlight_runtime::camera::{Camera, LightFraming, Projection, light_camera};
 use strandlight_runtime::env::TransmittanceFilter;
 use strandlight_runtime::env::{
-    EnvFrame, EnvRenderOptions, EnvRenderer, EnvTables, render_env_frame,
+    EnvImage, EnvRenderOptions, EnvRenderer, EnvTables, FrameSums, render_env_frame,
 };
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::{GpuContext, read_texture_rgba};
@@ -19,7 +19,7 @@ use strandlight_runtime::multiple::{ForwardScatteringGrid, ForwardScatteringSour
 use strandlight_runtime::passes::convolution_depth::{
     ConvolutionDepthPass, DodmBatch, DodmSettings, OPTICAL_DEPTH_FORMAT, SimplifiedSegments,
 };
-use strandlight_runtime::passes::env_view::BatchBinding;
+use strandlight_runtime::passes::convolution_transmittance::BatchBinding;
 use strandlight_runtime::passes::strand_geometry::StrandGeometry;
 use strandlight_runtime::passes::summed_area::{
     MAX_BOX_HALF_SIZE, SummedAreaPass, SummedAreaTables, quantize_optical_depth,
@@ -238,6 +238,45 @@ fn jittered(sites: &[Vec3], jitter: &[f32]) -> Vec<Vec3> {
         .collect()
 }
 
+/// Sites behind the slab's first row, between rows, behind the slab, and near its top
+/// (y = 0.9) and right (x ≈ 0.99) edges.
+fn slab_sites() -> Vec<Vec3> {
+    let mut sites = Vec::new();
+    for z in [0.25f32, 0.15, 0.05, -0.2, -0.4] {
+        for y in [0.0f32, 0.5, 0.8, 0.86] {
+            for x in [-0.52f32, -0.11, 0.23, 0.61, 0.9, 0.94] {
+                sites.push(Vec3::new(x, y, z));
+            }
+        }
+    }
+    sites
+}
+
+/// Per column of estimates (paper box, matched box, centre texel, directional map, centre
+/// ray; `per_site` jittered points per site, in site order), its relative RMSE against `truth`
+/// over the sites' means; every fifth site printed.
+fn site_errors(sites: &[Vec3], per_site: usize, truth: &[f64], columns: &[Vec<f64>]) -> Vec<f64> {
+    let n = per_site;
+    let site_mean = |v: &[f64], i: usize| v[i * n..(i + 1) * n].iter().sum::<f64>() / n as f64;
+    let mut errors = vec![0.0; columns.len()];
+    let mut norm = 0.0;
+    for (i, p) in sites.iter().enumerate() {
+        let t = site_mean(truth, i);
+        let values: Vec<f64> = columns.iter().map(|e| site_mean(e, i)).collect();
+        for (e, v) in errors.iter_mut().zip(&values) {
+            *e += (v - t).powi(2);
+        }
+        norm += t * t;
+        if i % 5 == 0 {
+            println!(
+                "site ({:5.2}, {:4.2}, {:5.2}): cone integral {t:.3}, paper box {:.3}, matched box {:.3}, centre texel {:.3}, directional map {:.3}, centre ray {:.3}",
+                p.x, p.y, p.z, values[0], values[1], values[2], values[3], values[4]
+            );
+        }
+    }
+    errors.iter().map(|e| (e / norm).sqrt()).collect()
+}
+
 #[test]
 fn slab_convolution_transmittance_follows_the_cone_integral() {
     let gpu = gpu();
@@ -251,28 +290,18 @@ fn slab_convolution_transmittance_follows_the_cone_integral() {
         EnvLight::srbf(Vec3::Z, lambda, [1.0; 3]),
         EnvLight::directional(Vec3::Z, [1.0; 3]),
     ];
-    // Sites behind the first row, between rows, behind the slab, and near its top (y = 0.9)
-    // and right (x ≈ 0.99) edges. The map has 1.35 fibers per texel, so nothing drawn from it can
-    // follow the transmittance's structure below one fiber spacing (whether the few rays near
-    // the centre graze a fiber or not): every estimate and the reference are averaged over 8
-    // points spread across 1.5 fiber spacings in x around each site.
+    // The map has 1.35 fibers per texel, so nothing drawn from it can follow the
+    // transmittance's structure below one fiber spacing (whether the few rays near the centre
+    // graze a fiber or not): every estimate and the reference are averaged over 8 points spread
+    // across 1.5 fiber spacings in x around each site.
     let jitter = slab_jitter();
-    let mut sites = Vec::new();
-    for z in [0.25f32, 0.15, 0.05, -0.2, -0.4] {
-        for y in [0.0f32, 0.5, 0.8, 0.86] {
-            for x in [-0.52f32, -0.11, 0.23, 0.61, 0.9, 0.94] {
-                sites.push(Vec3::new(x, y, z));
-            }
-        }
-    }
+    let sites = slab_sites();
     let points = jittered(&sites, &jitter);
     let filters = [
         TransmittanceFilter::PaperSupport,
         TransmittanceFilter::MatchedVariance,
         TransmittanceFilter::Centre,
     ];
-    let n = jitter.len();
-    let site_mean = |v: &[f64], i: usize| v[i * n..(i + 1) * n].iter().sum::<f64>() / n as f64;
     let to64 = |v: &[f32]| v.iter().map(|&x| x as f64).collect::<Vec<f64>>();
     let estimates: Vec<Vec<f64>> = filters
         .iter()
@@ -312,25 +341,10 @@ fn slab_convolution_transmittance_follows_the_cone_integral() {
         .iter()
         .map(|p| ray_visible(p.as_dvec3(), DVec3::Z, rows, thickness, &NO_GAP) as u8 as f64)
         .collect();
-    let mut errors = vec![0.0; filters.len() + 2];
-    let mut norm = 0.0;
-    for (i, p) in sites.iter().enumerate() {
-        let t = site_mean(&truth, i);
-        let mut values: Vec<f64> = estimates.iter().map(|e| site_mean(e, i)).collect();
-        values.push(site_mean(&centre_map, i));
-        values.push(site_mean(&centre_ray, i));
-        for (e, v) in errors.iter_mut().zip(&values) {
-            *e += (v - t).powi(2);
-        }
-        norm += t * t;
-        if i % 5 == 0 {
-            println!(
-                "site ({:5.2}, {:4.2}, {:5.2}): cone integral {t:.3}, paper box {:.3}, matched box {:.3}, centre texel {:.3}, directional map {:.3}, centre ray {:.3}",
-                p.x, p.y, p.z, values[0], values[1], values[2], values[3], values[4]
-            );
-        }
-    }
-    let rel: Vec<f64> = errors.iter().map(|e| (e / norm).sqrt()).collect();
+    let mut columns = estimates;
+    columns.push(centre_map);
+    columns.push(centre_ray);
+    let rel = site_errors(&sites, jitter.len(), &truth, &columns);
     println!(
         "relative RMSE over {} sites vs the cone integral (2000 directions, λ = {lambda}): paper support box {:.4}, \
          matched-variance box {:.4}, centre texel {:.4}, directional deep opacity map {:.4}, exact centre-direction ray {:.4}",
@@ -828,22 +842,37 @@ fn multiple_scattering_is_power_times_attenuation_times_the_spread_table() {
     });
 }
 
-#[test]
-fn bad_inputs_are_typed_errors() {
-    use strandlight_runtime::env::{EnvRenderError, EnvTableError};
-    let gpu = gpu();
+/// The error of rendering the three strands at 16² under `lights`.
+fn render_error(
+    gpu: &GpuContext,
+    lights: &[EnvLight],
+    tables: &EnvTables,
+    options: &EnvRenderOptions,
+) -> strandlight_runtime::env::EnvRenderError {
     let (model, _) = three_strands();
     let camera = ortho_camera();
+    render_env_frame(gpu, &model, &camera, 16, 16, lights, tables, options, None)
+        .expect_err("an error")
+}
+
+/// The SRBF table of the bad-input tests, alone.
+fn srbf_only_tables() -> EnvTables {
     let srbf = synthetic_table(Axis::uniform(AXIS_INV_LAMBDA, 1.0 / 64.0, 1.0 / 8.0, 3));
-    let tables = EnvTables {
-        srbf: Some(srbf.clone().into()),
+    EnvTables {
+        srbf: Some(srbf.into()),
         ..Default::default()
-    };
+    }
+}
+
+#[test]
+fn bad_settings_and_tables_are_typed_errors() {
+    use strandlight_runtime::env::{EnvRenderError, EnvTableError};
+    let gpu = gpu();
+    let tables = srbf_only_tables();
     let light = [EnvLight::srbf(Vec3::Z, 20.0, [1.0; 3])];
     let options = EnvRenderOptions::default();
     let render = |lights: &[EnvLight], tables: &EnvTables, options: &EnvRenderOptions| {
-        render_env_frame(&gpu, &model, &camera, 16, 16, lights, tables, options, None)
-            .expect_err("an error")
+        render_error(&gpu, lights, tables, options)
     };
     assert!(matches!(
         render(&[], &tables, &options),
@@ -900,41 +929,6 @@ fn bad_inputs_are_typed_errors() {
         ),
         "{e}"
     );
-    let e = render(
-        &[EnvLight::srbf(Vec3::Z, f32::NAN, [1.0; 3])],
-        &tables,
-        &options,
-    );
-    assert!(
-        matches!(e, EnvRenderError::BadLight { index: 0, .. }),
-        "{e}"
-    );
-    let shared_srbf = EnvLight {
-        shadowed_from: Some(Vec3::Y),
-        ..EnvLight::srbf(Vec3::Z, 8.0, [1.0; 3])
-    };
-    let bad_from = EnvLight::directional_shadowed_from(Vec3::Z, [1.0; 3], Vec3::NAN);
-    let spread_srbf = EnvLight {
-        angular_variance: 1e-3,
-        ..EnvLight::srbf(Vec3::Z, 8.0, [1.0; 3])
-    };
-    for (index, lights) in [
-        (0, vec![shared_srbf]),
-        (1, vec![light[0], bad_from]),
-        (0, vec![EnvLight::extended(Vec3::Z, [1.0; 3], f32::NAN)]),
-        (
-            1,
-            vec![light[0], EnvLight::extended(Vec3::Z, [1.0; 3], -1e-3)],
-        ),
-        (0, vec![spread_srbf]),
-    ] {
-        let e = render(&lights, &tables, &options);
-        assert!(
-            matches!(e, EnvRenderError::BadLight { index: i, .. } if i == index),
-            "{e}"
-        );
-        println!("{e}");
-    }
     // More SAT bytes than the adapter binds: a batch of 2048² maps sized past the limit (κ 1:
     // simplified lobes' maps would be smaller).
     let limit = gpu.device.limits().max_storage_buffer_binding_size;
@@ -952,6 +946,40 @@ fn bad_inputs_are_typed_errors() {
     let e = render(&many, &tables, &big);
     assert!(matches!(e, EnvRenderError::Limit(_)), "{e}");
     println!("{e}");
+}
+
+#[test]
+fn bad_lights_are_typed_errors_naming_the_light() {
+    use strandlight_runtime::env::EnvRenderError;
+    let gpu = gpu();
+    let tables = srbf_only_tables();
+    let options = EnvRenderOptions::default();
+    let good = EnvLight::srbf(Vec3::Z, 20.0, [1.0; 3]);
+    let nan_lambda = EnvLight::srbf(Vec3::Z, f32::NAN, [1.0; 3]);
+    let shared_srbf = EnvLight {
+        shadowed_from: Some(Vec3::Y),
+        ..EnvLight::srbf(Vec3::Z, 8.0, [1.0; 3])
+    };
+    let bad_from = EnvLight::directional_shadowed_from(Vec3::Z, [1.0; 3], Vec3::NAN);
+    let spread_srbf = EnvLight {
+        angular_variance: 1e-3,
+        ..EnvLight::srbf(Vec3::Z, 8.0, [1.0; 3])
+    };
+    for (index, lights) in [
+        (0, vec![nan_lambda]),
+        (0, vec![shared_srbf]),
+        (1, vec![good, bad_from]),
+        (0, vec![EnvLight::extended(Vec3::Z, [1.0; 3], f32::NAN)]),
+        (1, vec![good, EnvLight::extended(Vec3::Z, [1.0; 3], -1e-3)]),
+        (0, vec![spread_srbf]),
+    ] {
+        let e = render_error(&gpu, &lights, &tables, &options);
+        assert!(
+            matches!(e, EnvRenderError::BadLight { index: i, .. } if i == index),
+            "{e}"
+        );
+        println!("{e}");
+    }
 }
 
 #[test]
@@ -1062,7 +1090,7 @@ fn render_occluder(
     (model, tables): (&HairModel, &EnvTables),
     lights: &[EnvLight],
     batch_size: u32,
-) -> (EnvFrame, [f32; 4]) {
+) -> (EnvImage, [f32; 4]) {
     let options = EnvRenderOptions {
         dodm: DodmSettings {
             resolution: 64,
@@ -1641,6 +1669,60 @@ fn srbf_and_directional_lights_in_one_frame_add_and_directional_ignores_kappa() 
         worst_kappa, 0.0,
         "a directional light's map must not depend on κ"
     );
+}
+
+/// A progressive frame's parts encoded into one caller-held [`FrameSums`] add up to the frame
+/// rendered at once: the strongest lobe first (window 0), then the weaker lobe (window 1, the
+/// one simplified light before it) with a sun; coverage is every part's.
+#[test]
+fn parts_encoded_into_one_running_sum_equal_the_whole_frame() {
+    let gpu = gpu();
+    let (model, camera, tables) = groom_scene();
+    let [strong, weak] = groom_lobes();
+    assert!(strong.luminous_power() > weak.luminous_power());
+    let sun = EnvLight::directional(Vec3::new(0.5, 0.7, 0.6), [2.0, 1.8, 1.5]);
+    let options = EnvRenderOptions {
+        dodm: DodmSettings {
+            resolution: 128,
+            first_layer: None,
+            batch_size: 2,
+        },
+        kappa: 0.5,
+        ..Default::default()
+    };
+    let renderer = EnvRenderer::new(&gpu);
+    let whole = renderer
+        .render(
+            &gpu,
+            &model,
+            &camera,
+            RES,
+            RES,
+            &[strong, weak, sun],
+            &tables,
+            &options,
+            None,
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+    let sums = FrameSums::new(&gpu, RES, RES).unwrap();
+    let parts: [(&[EnvLight], u32); 2] = [(&[strong], 0), (&[weak, sun], 1)];
+    for part in parts {
+        renderer
+            .encode_part_into(
+                &gpu, &model, &camera, part, &tables, &options, None, None, &sums,
+            )
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
+    let bytes = strandlight_runtime::gpu::readback::read_buffer(&gpu, sums.buffer()).unwrap();
+    let single: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+    let summed = &single[..(RES * RES) as usize];
+    let worst = worst_relative(summed, &whole.pixels);
+    let lit = whole.pixels.iter().filter(|p| p[0] > 0.0).count();
+    println!("{lit} lit pixels; parts summed vs whole frame: worst relative {worst:.2e}");
+    assert!(lit > 100, "the lights must light the groom");
+    assert!(worst < 1e-4, "parts summed vs whole frame: {worst}");
+    let alpha = |p: &[[f32; 4]]| p.iter().map(|p| p[3]).collect::<Vec<_>>();
+    assert_eq!(alpha(summed), alpha(&whole.pixels));
 }
 
 /// A compact source not drawing every strand (`EnvLight::every_strand` false) is shadowed through a κ

@@ -20,7 +20,7 @@ use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::fiber_shading::{MarschnerLuts, ShadingModel};
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{Frame, RenderOptions, render_frame_with_model};
+use strandlight_runtime::point_frame::{Frame, RenderOptions, render_frame_with_model};
 use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::artist::{ArtistModel, ArtistParams};
 use strandlight_tables::marschner::{Marschner, MarschnerParams};

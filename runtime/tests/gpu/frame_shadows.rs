@@ -26,7 +26,7 @@ use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{RenderOptions, ShadowMaps, render_frame};
+use strandlight_runtime::point_frame::{RenderOptions, ShadowMaps, render_frame};
 use strandlight_runtime::shadow_layout::{PointLayoutChoice, ShadowLayout};
 
 const RECEIVER_Y: f32 = -0.6;

@@ -15,7 +15,7 @@ use strandlight_runtime::passes::abuffer::{ABufferError, ABufferPass, ListMode};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
 use strandlight_runtime::passes::strand_geometry::StrandGeometry;
-use strandlight_runtime::render::{RenderError, RenderOptions, render_frame};
+use strandlight_runtime::point_frame::{RenderError, RenderOptions, render_frame};
 use strandlight_tables::table::{Axis, Table};
 use strandlight_tables::table_axes::{
     AXIS_COS_DPHI, AXIS_INV_LAMBDA, AXIS_U_DOT_WO, AXIS_U_DOT_XI,

@@ -32,7 +32,7 @@ use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
 use strandlight_runtime::passes::fiber_shading::ShadingModel;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{
+use strandlight_runtime::point_frame::{
     RenderOptions, ShadowMaps, Transparency, render_frame_with_head,
 };
 use strandlight_runtime::shadow_layout::{PointLayoutChoice, ShadowLayout};

@@ -8,7 +8,7 @@ use glam::Vec3;
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::DomSettings;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{RenderOptions, ShadowMaps, render_frame};
+use strandlight_runtime::point_frame::{RenderOptions, ShadowMaps, render_frame};
 
 #[test]
 fn gpu_pass_times_are_reported_where_supported_and_fit_inside_the_wall_clock() {

@@ -9,7 +9,7 @@ use strandlight_runtime::camera::{Camera, Projection};
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{RenderOptions, render_frame};
+use strandlight_runtime::point_frame::{RenderOptions, render_frame};
 
 const SIZE: u32 = 64;
 
@@ -33,7 +33,7 @@ fn straight_strand(
     .unwrap()
 }
 
-fn pixel(frame: &strandlight_runtime::render::Frame, x: u32, y: u32) -> [f32; 4] {
+fn pixel(frame: &strandlight_runtime::point_frame::Frame, x: u32, y: u32) -> [f32; 4] {
     frame.pixels[(y * frame.width + x) as usize]
 }
 
@@ -62,6 +62,74 @@ fn normalize(v: [f64; 3]) -> [f64; 3] {
     v.map(|x| x / n)
 }
 
+/// The strand's colour and the Kajiya-Kay constants of the three-light test.
+const STRAND_COLOR: [f64; 3] = [0.5, 0.3, 0.2];
+const THREE_LIGHT_SHADING: KajiyaKay = KajiyaKay {
+    kd: 0.6,
+    ks: 0.4,
+    shininess: 20.0,
+};
+/// The spot light of the three-light test: position, axis and half-angle in degrees.
+const SPOT_POSITION: [f64; 3] = [-1.0, 0.0, 2.0];
+const SPOT_AXIS: [f64; 3] = [1.0, 0.0, -2.0];
+const SPOT_HALF_ANGLE_DEGREES: f64 = 12.0;
+
+/// A directional, a point and a spot light; the spot lights part of the strand.
+fn three_lights() -> Vec<Light> {
+    let [x, y, z] = SPOT_POSITION.map(|c| c as f32);
+    let [ax, ay, az] = SPOT_AXIS.map(|c| c as f32);
+    vec![
+        Light::Directional {
+            direction: Vec3::new(1.0, 0.5, 1.0).normalize(),
+            intensity: 1.0,
+        },
+        Light::Point {
+            position: Vec3::new(1.5, 1.0, 2.0),
+            intensity: 6.0,
+        },
+        Light::Spot {
+            position: Vec3::new(x, y, z),
+            direction: Vec3::new(ax, ay, az).normalize(),
+            half_angle: SPOT_HALF_ANGLE_DEGREES.to_radians() as f32,
+            intensity: 4.0,
+        },
+    ]
+}
+
+/// The CPU's radiance of [`three_lights`] at `world` on a strand of tangent `dir` seen along
+/// +z, and whether the spot lights it; None on the spot cone's hard edge, where either answer
+/// is right.
+fn three_light_radiance(dir: [f64; 3], world: [f64; 3]) -> Option<([f64; 3], bool)> {
+    let e = [0.0, 0.0, 1.0];
+    let KajiyaKay { kd, ks, shininess } = THREE_LIGHT_SHADING;
+    let (kd, ks, p) = (kd as f64, ks as f64, shininess as f64);
+    let kk = |l: [f64; 3]| kajiya_kay_f64(dir, l, e, STRAND_COLOR, kd, ks, p);
+    let mut expected = kk(normalize([1.0, 0.5, 1.0]));
+    let point_to = [1.5 - world[0], 1.0 - world[1], 2.0 - world[2]];
+    let d2 = point_to.iter().map(|x| x * x).sum::<f64>();
+    let point = kk(normalize(point_to));
+    for k in 0..3 {
+        expected[k] += 6.0 / d2 * point[k];
+    }
+    let spot_to: [f64; 3] = std::array::from_fn(|k| SPOT_POSITION[k] - world[k]);
+    let s2 = spot_to.iter().map(|x| x * x).sum::<f64>();
+    let l = normalize(spot_to);
+    let axis = normalize(SPOT_AXIS);
+    let cos_off_axis = -(l[0] * axis[0] + l[1] * axis[1] + l[2] * axis[2]);
+    let cos_half_angle = SPOT_HALF_ANGLE_DEGREES.to_radians().cos();
+    if (cos_off_axis - cos_half_angle).abs() < 2e-3 {
+        return None;
+    }
+    let spot_lit = cos_off_axis >= cos_half_angle;
+    if spot_lit {
+        let spot = kk(l);
+        for k in 0..3 {
+            expected[k] += 4.0 / s2 * spot[k];
+        }
+    }
+    Some((expected, spot_lit))
+}
+
 #[test]
 fn a_single_strand_matches_cpu_kajiya_kay_under_three_lights() {
     let gpu = gpu();
@@ -76,42 +144,17 @@ fn a_single_strand_matches_cpu_kajiya_kay_under_three_lights() {
         -(half_len * dir[2]) as f32,
     );
     let b = -a;
-    let color = [0.5, 0.3, 0.2];
-    let model = straight_strand(a, b, 9, None, Vec3::new(0.5, 0.3, 0.2));
-    let spot_position = [-1.0, 0.0, 2.0];
-    let spot_half_angle = 12f64.to_radians();
-    let lights = vec![
-        Light::Directional {
-            direction: Vec3::new(1.0, 0.5, 1.0).normalize(),
-            intensity: 1.0,
-        },
-        Light::Point {
-            position: Vec3::new(1.5, 1.0, 2.0),
-            intensity: 6.0,
-        },
-        Light::Spot {
-            position: Vec3::new(-1.0, 0.0, 2.0),
-            direction: Vec3::new(1.0, 0.0, -2.0).normalize(),
-            half_angle: spot_half_angle as f32,
-            intensity: 4.0,
-        },
-    ];
-    let shading = KajiyaKay {
-        kd: 0.6,
-        ks: 0.4,
-        shininess: 20.0,
-    };
+    let [r, g, b_] = STRAND_COLOR.map(|c| c as f32);
+    let model = straight_strand(a, b, 9, None, Vec3::new(r, g, b_));
     let frame = FrameParams {
         camera: ortho_camera(),
         width: SIZE,
         height: SIZE,
-        lights,
-        shading,
+        lights: three_lights(),
+        shading: THREE_LIGHT_SHADING,
         width_override_px: Some(4.0),
     };
     let out = render_frame(&gpu, &model, &frame, &RenderOptions::default()).unwrap();
-    let e = [0.0, 0.0, 1.0];
-    let (kd, ks, p) = (0.6, 0.4, 20.0);
     let mut worst = 0.0f64;
     let mut compared = 0;
     let mut spot_lit_rows = 0;
@@ -119,33 +162,10 @@ fn a_single_strand_matches_cpu_kajiya_kay_under_three_lights() {
         // Pixel centre's world y, and the strand point there.
         let y = 1.0 - (row as f64 + 0.5) / 32.0;
         let s = y / dir[1];
-        let world = [0.0, y, s * dir[2]];
-        let mut expected = kajiya_kay_f64(dir, normalize([1.0, 0.5, 1.0]), e, color, kd, ks, p);
-        let point_to = [1.5 - world[0], 1.0 - world[1], 2.0 - world[2]];
-        let d2 = point_to.iter().map(|x| x * x).sum::<f64>();
-        let kk = kajiya_kay_f64(dir, normalize(point_to), e, color, kd, ks, p);
-        for k in 0..3 {
-            expected[k] += 6.0 / d2 * kk[k];
-        }
-        let spot_to = [
-            spot_position[0] - world[0],
-            spot_position[1] - world[1],
-            spot_position[2] - world[2],
-        ];
-        let s2 = spot_to.iter().map(|x| x * x).sum::<f64>();
-        let l = normalize(spot_to);
-        let axis = normalize([1.0, 0.0, -2.0]);
-        let cos_off_axis = -(l[0] * axis[0] + l[1] * axis[1] + l[2] * axis[2]);
-        if (cos_off_axis - spot_half_angle.cos()).abs() < 2e-3 {
-            continue; // on the hard edge of the cone: either answer is right
-        }
-        if cos_off_axis >= spot_half_angle.cos() {
-            spot_lit_rows += 1;
-            let kk = kajiya_kay_f64(dir, l, e, color, kd, ks, p);
-            for k in 0..3 {
-                expected[k] += 4.0 / s2 * kk[k];
-            }
-        }
+        let Some((expected, spot_lit)) = three_light_radiance(dir, [0.0, y, s * dir[2]]) else {
+            continue;
+        };
+        spot_lit_rows += spot_lit as usize;
         for column in [31u32, 32] {
             let got = pixel(&out, column, row);
             assert!(
@@ -188,7 +208,7 @@ fn a_single_strand_matches_cpu_kajiya_kay_under_three_lights() {
 
 /// Mean over interior rows of the alpha summed along each row.
 fn mean_row_alpha(
-    out: &strandlight_runtime::render::Frame,
+    out: &strandlight_runtime::point_frame::Frame,
     rows: std::ops::Range<u32>,
 ) -> (f64, f64) {
     let sums: Vec<f64> = rows

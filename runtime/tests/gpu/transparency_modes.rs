@@ -17,7 +17,7 @@ use strandlight_runtime::camera::Camera;
 use strandlight_runtime::hair::{GroomParams, HairModel, generate_groom};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::render::{Frame, RenderOptions, Transparency, render_frame};
+use strandlight_runtime::point_frame::{Frame, RenderOptions, Transparency, render_frame};
 
 const SIZE: u32 = 96;
 

@@ -1,6 +1,26 @@
-// The occupancy map's build (two fragment passes over the hair, once per frame) and its read by
-// the transparent view pass. Appended to the env view module (env_view.wgsl declares
-// `occupancy_map` and `view`) so that the build rasterizes exactly the view pass's fragments.
+// The frame's visibility (view_visibility.rs), drawn once before its batches: the opaque view's
+// depth prepass and coverage, the occupancy map's build (three fragment passes over the hair,
+// occupancy_map.wgsl) and the layered view's gathering (view_layers.wgsl), and the fragment
+// counts of the benchmarks. Its strands are rasterized by the same vertex stage as the view
+// shading pass's (strand_quads.wgsl, whose clip position is @invariant), so that both see the
+// same fragments.
+
+#import strandlight::fullscreen::fullscreen_triangle
+#import strandlight::head_view::behind_head
+#import strandlight::occupancy_map::{OCC_SLICES_PER_SLAB, OCC_TAU_SCALE, OCC_WEIGHT_SCALE, fragment_optical_depth, occupancy_record, occupancy_slice, occupancy_visibility, occupancy_weight, ordered_depth, pixel_depth_range, view_depth}
+#import strandlight::strand_quads::{VertexOut, strand_draw_vertex}
+#import strandlight::view_binding::{view, occupancy_map}
+#import strandlight::view_layers::{OCC_LAYERS, add_fixed, layer_word, load_fixed, pixel_coverage}
+
+@vertex
+fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> VertexOut {
+    return strand_draw_vertex(vertex, instance);
+}
+
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) vertex: u32) -> @builtin(position) vec4<f32> {
+    return fullscreen_triangle(vertex);
+}
 
 // Opaque view: the optical depth of all of a pixel's fragments (additive blending). Capped so
 // that one opaque fiber covers its pixel to 1e-6, not to the light pass's 0.999.
@@ -29,18 +49,6 @@ fn fs_occupancy_range(in: VertexOut) {
     let key = ordered_depth(view_depth(in.world));
     atomicMax(&occupancy_map[r], ~key);
     atomicMax(&occupancy_map[r + 1u], key);
-}
-
-struct DepthRange {
-    nearest: f32,
-    farthest: f32,
-};
-
-fn pixel_depth_range(r: u32) -> DepthRange {
-    return DepthRange(
-        unordered_depth(~atomicLoad(&occupancy_map[r])),
-        unordered_depth(atomicLoad(&occupancy_map[r + 1u])),
-    );
 }
 
 // Pass 2: each fragment marks its slice and adds its optical depth to its slab.
@@ -86,35 +94,32 @@ fn fs_count_visible(in: VertexOut) -> @location(0) vec4<f32> {
     return vec4<f32>(0.0, 1.0, 0.0, 0.0);
 }
 
-// What the viewer sees of this fragment through the fragments in front of it: exp(−τ in front),
-// τ in front = the slabs before its own + its own slab's optical depth × the share of the slab's
-// occupied slices that lie before its slice.
-fn occupancy_visibility(in: VertexOut) -> f32 {
+// Pass 4 of the build (after the weights): each fragment the view would shade adds itself to
+// its layer.
+@fragment
+fn fs_view_layers(in: VertexOut) {
+    if (behind_head(in)) { discard; }
+    let seen = occupancy_visibility(in);
+    if (seen < view.visibility_cutoff) { discard; }
     let r = occupancy_record(in.clip.xy, view.width);
-    let range = pixel_depth_range(r);
-    let s = occupancy_slice(view_depth(in.world), range.nearest, range.farthest);
-    let slab = s / OCC_SLICES_PER_SLAB;
-    var tau = 0.0;
-    for (var k = 0u; k < slab; k++) {
-        tau += f32(atomicLoad(&occupancy_map[r + 6u + k]));
-    }
-    let bits = atomicLoad(&occupancy_map[r + 2u + slab]);
-    let before = countOneBits(bits & ((1u << (s % OCC_SLICES_PER_SLAB)) - 1u));
-    let occupied = max(countOneBits(bits), 1u);
-    tau += f32(atomicLoad(&occupancy_map[r + 6u + slab])) * f32(before) / f32(occupied);
-    return exp(-tau / OCC_TAU_SCALE);
+    let w = occupancy_weight(in, seen);
+    let in_front = (1.0 - seen) / max(pixel_coverage(r), 1e-6);
+    let layer = min(u32(max(in_front, 0.0) * f32(OCC_LAYERS)), OCC_LAYERS - 1u);
+    let t = normalize(in.tangent);
+    add_fixed(layer_word(r, layer, 0u), w);
+    add_fixed(layer_word(r, layer, 1u), w * in.clip.z);
+    add_fixed(layer_word(r, layer, 2u), w * t.x);
+    add_fixed(layer_word(r, layer, 3u), w * t.y);
+    add_fixed(layer_word(r, layer, 4u), w * t.z);
 }
 
-// The fragment's share of its pixel, `seen` its occupancy_visibility: coverage × seen, scaled
-// so that the pixel's shares add up to its coverage 1 − exp(−Σ τ) (pass 3's sum).
-fn occupancy_weight(in: VertexOut, seen: f32) -> f32 {
-    let r = occupancy_record(in.clip.xy, view.width);
-    var tau = 0.0;
-    for (var k = 0u; k < OCC_SLICES / OCC_SLICES_PER_SLAB; k++) {
-        tau += f32(atomicLoad(&occupancy_map[r + 6u + k]));
+// Benchmarks: the layers one batch shades (green), as fs_count_visible counts fragments.
+@fragment
+fn fs_count_layers(@builtin(position) pixel: vec4<f32>) -> @location(0) vec4<f32> {
+    let r = occupancy_record(pixel.xy, view.width);
+    var layers = 0.0;
+    for (var layer = 0u; layer < OCC_LAYERS; layer++) {
+        if (load_fixed(layer_word(r, layer, 0u)) > 0.0) { layers += 1.0; }
     }
-    let coverage = 1.0 - exp(-tau / OCC_TAU_SCALE);
-    let sum = f32(atomicLoad(&occupancy_map[r + 10u])) / OCC_WEIGHT_SCALE;
-    if (!(sum > 0.0)) { return 0.0; }
-    return in.alpha * seen * coverage / sum;
+    return vec4<f32>(0.0, layers, 0.0, 0.0);
 }

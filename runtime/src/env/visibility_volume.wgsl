@@ -1,7 +1,9 @@
-// SRBF lobe visibility from the visibility volume (visibility/volume.rs), appended to the env
-// view pass: the 16 SH coefficients of T(ω) interpolated trilinearly at the shaded point once,
+// SRBF lobe visibility from the visibility volume (visibility/volume.rs) in the env view
+// shading: the 16 SH coefficients of T(ω) interpolated trilinearly at the shaded point once,
 // then per lobe Σ c_lm (i_l/i_0)(λ) Y_lm(ξ) (visibility/spherical_harmonics.rs, same basis,
 // same order, same band ratios).
+
+#define_import_path strandlight::visibility_volume
 
 struct VolumeParams {
     // xyz: world position of vertex (0,0,0); w: 1 when SRBF lobes read the volume.

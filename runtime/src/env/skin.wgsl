@@ -1,4 +1,4 @@
-// The head's skin in the env-lit view (appended to the env view module): a Lambertian surface
+// The head's skin in the env-lit view: a Lambertian surface
 // of albedo `view.skin.rgb` under the batch's lights, each seen through the hair and the head
 // as the fibers see it (effective_transmittance, with the head's depth maps), or through the
 // visibility volume for SRBF lobes that read it. Radiance = albedo/π · Σ_j T_j · E_j(n), with
@@ -8,6 +8,13 @@
 //                "Irradiance from a spherical Gaussian"), mirrored by head::srbf_irradiance in
 //                Rust and tested there against f64 quadrature.
 // Multiple scattering from the hair onto the skin is left out.
+
+#define_import_path strandlight::skin
+
+#import strandlight::convolution_transmittance::{batch, env_lights, shading_samples, effective_transmittance}
+#import strandlight::env_shading::shades_from_volume
+#import strandlight::view_binding::view
+#import strandlight::visibility_volume::{volume_coefficients, volume_lobe_visibility}
 
 // Broad lobes (λ < 3): the zonal harmonics l ≤ 2 (head::srbf_irradiance_sh2).
 fn srbf_irradiance_sh2(c: f32, lambda: f32) -> f32 {
@@ -39,23 +46,6 @@ fn srbf_irradiance(cos_n_xi: f32, inv_lambda: f32) -> f32 {
     }
     let integral = 6.283185307 * inv_lambda * (1.0 - em2l);
     return max(scale * y + bias, 0.0) * integral;
-}
-
-fn frame_has_head() -> bool {
-    return view.skin.w > 0.5;
-}
-
-// The head's position (w: 1 on the head) at `pixel`.
-fn head_at(pixel: vec2<i32>) -> vec4<f32> {
-    if (!frame_has_head()) { return vec4<f32>(0.0); }
-    return textureLoad(head_position, pixel, 0);
-}
-
-// Whether the fiber fragment `in` lies behind the head along its pixel's ray (the occupancy
-// passes and the transparent view have no depth attachment: they test in the shader).
-fn behind_head(in: VertexOut) -> bool {
-    let head = head_at(vec2<i32>(in.clip.xy));
-    return head.w > 0.0 && view_depth(in.world) > view_depth(head.xyz);
 }
 
 // Skin radiance at `world` with normal `n` under the batch's lights.
@@ -90,24 +80,4 @@ fn shade_skin(world: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         }
     }
     return view.skin.rgb * e / 3.141592654;
-}
-
-// Occupancy view: the skin behind all the pixel's fibers, seen through their optical depth
-// (every slab of the occupancy record: its fibers all lie in front of the head).
-@fragment
-fn fs_env_skin(@builtin(position) pixel: vec4<f32>) -> EnvOut {
-    let p = vec2<i32>(pixel.xy);
-    let head = head_at(p);
-    if (head.w == 0.0) { discard; }
-    let r = occupancy_record(pixel.xy, view.width);
-    var tau = 0.0;
-    for (var k = 0u; k < 4u; k++) {
-        tau += f32(atomicLoad(&occupancy_map[r + 6u + k]));
-    }
-    let seen = exp(-tau / OCC_TAU_SCALE);
-    let n = textureLoad(head_normal, p, 0).xyz;
-    var out: EnvOut;
-    out.single = vec4<f32>(shade_skin(head.xyz, n) * seen, seen);
-    out.multiple = vec4<f32>(0.0, 0.0, 0.0, seen);
-    return out;
 }

@@ -1,6 +1,6 @@
 // Occupancy and slab maps of the view (after Sintorn & Assarsson 2009, the transparency of Ren
-// 2010 §8), appended to strand_quads.wgsl. Built once per frame by view_visibility.rs, read by
-// every batch of the env view pass (env_view.wgsl).
+// 2010 §8). Built once per frame by view_visibility.rs (view_visibility.wgsl), read by every
+// batch of the view shading pass (view_shading.wgsl).
 //
 // Per pixel one record of `view.record_words` u32 in `occupancy_map` (group 3, binding 2), of
 // which the first OCC_RECORD are the occupancy map's:
@@ -21,6 +21,11 @@
 // coverage 1 − exp(−Σ τ) by ±15% per pixel on straight.hair at 160×120 (the path tracer's
 // coverage is exact). A third pass sums the weights (word 10) and the view pass scales each
 // fragment's weight by coverage / sum, so every pixel's weights add up to its coverage.
+
+#define_import_path strandlight::occupancy_map
+
+#import strandlight::strand_quads::{frame, VertexOut}
+#import strandlight::view_binding::{view, occupancy_map}
 
 const OCC_RECORD: u32 = 11u;
 const OCC_SLICES: u32 = 128u;
@@ -61,4 +66,49 @@ fn occupancy_slice(z: f32, nearest: f32, farthest: f32) -> u32 {
 
 fn fragment_optical_depth(alpha: f32) -> f32 {
     return -log(1.0 - min(alpha, OCC_MAX_ALPHA));
+}
+
+struct DepthRange {
+    nearest: f32,
+    farthest: f32,
+};
+
+fn pixel_depth_range(r: u32) -> DepthRange {
+    return DepthRange(
+        unordered_depth(~atomicLoad(&occupancy_map[r])),
+        unordered_depth(atomicLoad(&occupancy_map[r + 1u])),
+    );
+}
+
+// What the viewer sees of this fragment through the fragments in front of it: exp(−τ in front),
+// τ in front = the slabs before its own + its own slab's optical depth × the share of the slab's
+// occupied slices that lie before its slice.
+fn occupancy_visibility(in: VertexOut) -> f32 {
+    let r = occupancy_record(in.clip.xy, view.width);
+    let range = pixel_depth_range(r);
+    let s = occupancy_slice(view_depth(in.world), range.nearest, range.farthest);
+    let slab = s / OCC_SLICES_PER_SLAB;
+    var tau = 0.0;
+    for (var k = 0u; k < slab; k++) {
+        tau += f32(atomicLoad(&occupancy_map[r + 6u + k]));
+    }
+    let bits = atomicLoad(&occupancy_map[r + 2u + slab]);
+    let before = countOneBits(bits & ((1u << (s % OCC_SLICES_PER_SLAB)) - 1u));
+    let occupied = max(countOneBits(bits), 1u);
+    tau += f32(atomicLoad(&occupancy_map[r + 6u + slab])) * f32(before) / f32(occupied);
+    return exp(-tau / OCC_TAU_SCALE);
+}
+
+// The fragment's share of its pixel, `seen` its occupancy_visibility: coverage × seen, scaled
+// so that the pixel's shares add up to its coverage 1 − exp(−Σ τ) (pass 3's sum).
+fn occupancy_weight(in: VertexOut, seen: f32) -> f32 {
+    let r = occupancy_record(in.clip.xy, view.width);
+    var tau = 0.0;
+    for (var k = 0u; k < OCC_SLICES / OCC_SLICES_PER_SLAB; k++) {
+        tau += f32(atomicLoad(&occupancy_map[r + 6u + k]));
+    }
+    let coverage = 1.0 - exp(-tau / OCC_TAU_SCALE);
+    let sum = f32(atomicLoad(&occupancy_map[r + 10u])) / OCC_WEIGHT_SCALE;
+    if (!(sum > 0.0)) { return 0.0; }
+    return in.alpha * seen * coverage / sum;
 }

@@ -23,16 +23,12 @@
 //! Outputs: the view's depth, nearest-fiber and coverage textures (opaque) or the occupancy map
 //! (occupancy).
 
-use super::attachments::{cleared_color, cleared_depth, prepassed_depth};
-use super::render_target::{DEPTH_FORMAT, RenderTarget};
 use crate::gpu::GpuContext;
 use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels};
 use crate::gpu::pipeline::{StrandDraw, depth_test};
 use crate::gpu::readback::{ReadbackError, read_texture_rgba};
-
-/// The format of the view's nearest-surface targets (`EnvViewTargets::nearest_position` and
-/// `nearest_tangent`), which this pass writes and the shading pass reads.
-pub const NEAREST_SURFACE_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+use crate::passes::attachments::{cleared_color, cleared_depth, prepassed_depth};
+use crate::passes::render_target::{DEPTH_FORMAT, NEAREST_SURFACE_FORMAT, RenderTarget};
 
 /// How the env view pass weighs the fragments of a pixel.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -16,7 +16,7 @@ use crate::passes::kbuffer::{KBufferError, KBufferPass};
 use crate::passes::point_skin::{PointHead, PointSkinPass, composite_over};
 use crate::passes::random_subsets::{RandomSubsetsPass, SubsetsError};
 use crate::passes::render_target::RenderTarget;
-use crate::passes::shadow_slots::{MAX_SHADOWED_LIGHTS, ShadowInput, TooManyShadowMaps};
+use crate::passes::shadow_slots::{HeadInput, MAX_SHADOWED_LIGHTS, ShadowInput, TooManyShadowMaps};
 use crate::passes::sorted_blend::{BadSortBins, SortedBlendPass};
 use crate::passes::strand_geometry::{StrandGeometry, TooManyPoints};
 use crate::passes::strands::StrandPass;
@@ -404,64 +404,15 @@ pub fn render_frame_with_head(
     shading: &ShadingModel,
     head: Option<&Head>,
 ) -> Result<Frame, RenderError> {
-    // Every light gets a map; every pass shadows them all.
-    let shadowed_lights: Vec<ShadowedLight> = match options.shadows {
-        None => Vec::new(),
-        Some(settings) => {
-            settings.check()?;
-            if frame.lights.is_empty() {
-                return Err(RenderError::NoLight);
-            }
-            if frame.lights.len() > MAX_SHADOWED_LIGHTS {
-                return Err(RenderError::TooManyShadowMaps(TooManyShadowMaps {
-                    maps: frame.lights.len(),
-                }));
-            }
-            let bounds = caster_bounds(model, head);
-            (0..)
-                .zip(&frame.lights)
-                .map(|(index, light)| {
-                    let layout = ShadowLayout::for_light(light, bounds, options.point_layout)
-                        .map_err(ShadowMapError::from)?;
-                    Ok(ShadowedLight {
-                        maps: settings,
-                        index,
-                        layout,
-                    })
-                })
-                .collect::<Result<_, RenderError>>()?
-        }
-    };
+    let shadowed_lights = shadowed_lights(model, frame, options, head)?;
     check_frame_limits(gpu, frame, &shadowed_lights)?;
     let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
-    let mut timings = Vec::new();
-    let geometry = timed(&mut timings, gpu, "upload", || {
+    let mut costs = Costs::default();
+    let geometry = timed(&mut costs.timings, gpu, "upload", || {
         StrandGeometry::upload(gpu, model)
     })?;
-    let mut memory_bytes = geometry.memory();
-    let mut shadow_maps = Vec::new();
-    if !shadowed_lights.is_empty() {
-        let dom_pass = timed(&mut timings, gpu, "light map pipeline", || {
-            DeepOpacityPass::new(gpu)
-        });
-        for &ShadowedLight {
-            maps,
-            index,
-            layout,
-        } in &shadowed_lights
-        {
-            let map = maps.map_for(gpu, layout, model.bounds())?;
-            // One entry per light, so that reports keyed by pass name keep them all; a cube's
-            // says so, since it costs up to six maps.
-            let cube = if layout.is_cube() { ", cube" } else { "" };
-            let label = format!("{} (light {index}{cube})", maps.pass_name());
-            timed(&mut timings, gpu, &label, || {
-                dom_pass.draw(gpu, &geometry, &map)
-            });
-            memory_bytes.extend(map.memory());
-            shadow_maps.push((map, index));
-        }
-    }
+    costs.memory_bytes = geometry.memory();
+    let shadow_maps = draw_light_maps(gpu, model, &geometry, &shadowed_lights, &mut costs)?;
     let shadows: Vec<ShadowInput> = shadow_maps
         .iter()
         .map(|(map, light_index)| ShadowInput {
@@ -469,122 +420,29 @@ pub fn render_frame_with_head(
             light_index: *light_index,
         })
         .collect();
-    let head =
-        head.map(|head| prepare_head(gpu, head, frame, &shadows, &mut timings, &mut memory_bytes));
-    let head_input = head.as_ref().map(|(_, head)| head.input());
-    let mut fragments = None;
-    let mut pixels = match options.transparency {
-        Transparency::Opaque => {
-            let pass = timed(&mut timings, gpu, "strand pipeline", || {
-                StrandPass::with_model(gpu, shading)
-            });
-            let target = RenderTarget::new(gpu, frame.width, frame.height);
-            timed(&mut timings, gpu, "strands", || {
-                pass.draw_shadowed(gpu, &geometry, frame, &target, &shadows, head_input)
-            })?;
-            memory_bytes.extend(target.memory());
-            timed(&mut timings, gpu, "readback", || {
-                read_texture_rgba(gpu, &target.color)
-            })?
-        }
-        Transparency::Sorted { bins } => {
-            let pass = timed(&mut timings, gpu, "sorted blend pipeline", || {
-                SortedBlendPass::with_model(gpu, shading)
-            });
-            let order = timed(&mut timings, gpu, "segment sort", || {
-                pass.sort(gpu, &geometry, frame, model.bounds(), bins)
-            })?;
-            let target = RenderTarget::new(gpu, frame.width, frame.height);
-            timed(&mut timings, gpu, "sorted blend", || {
-                pass.draw(gpu, &geometry, frame, &shadows, head_input, &order, &target)
-            })?;
-            memory_bytes.extend(order.memory());
-            memory_bytes.extend(target.memory());
-            timed(&mut timings, gpu, "readback", || {
-                read_texture_rgba(gpu, &target.color)
-            })?
-        }
-        Transparency::KBuffer { k } => {
-            let pass = timed(&mut timings, gpu, "kbuffer pipeline", || {
-                KBufferPass::with_model(gpu, shading)
-            });
-            let out = timed(
-                &mut timings,
-                gpu,
-                "kbuffer build + resolve + readback",
-                || pass.draw(gpu, &geometry, frame, &shadows, head_input, k),
-            )?;
-            memory_bytes.extend(out.memory_bytes);
-            let slots = frame.width as u64 * frame.height as u64 * k as u64;
-            fragments = Some(FragmentCounts {
-                stored: out.fragments_kept,
-                dropped: out.fragments_dropped,
-                truncated: 0,
-                capacity: slots,
-                requested_capacity: slots,
-            });
-            out.pixels
-        }
-        Transparency::RandomSubsets { subsets } => {
-            let pass = timed(&mut timings, gpu, "random subsets pipeline", || {
-                RandomSubsetsPass::with_model(gpu, shading)
-            });
-            let out = timed(
-                &mut timings,
-                gpu,
-                "random subsets + resolve + readback",
-                || pass.draw(gpu, model, &geometry, frame, &shadows, head_input, subsets),
-            )?;
-            memory_bytes.extend(out.memory_bytes);
-            out.pixels
-        }
-        Transparency::ABuffer { nodes_per_pixel }
-        | Transparency::Dbk {
-            nodes_per_pixel, ..
-        } => {
-            let list_mode = match options.transparency {
-                Transparency::Dbk { delta, .. } => ListMode::Dbk { delta },
-                _ => ListMode::All,
-            };
-            let abuffer = timed(&mut timings, gpu, "abuffer pipeline", || {
-                ABufferPass::with_model(gpu, shading)
-            });
-            let wanted = match nodes_per_pixel {
-                Some(0) => return Err(RenderError::NoListNodes),
-                Some(n) => frame.width as u64 * frame.height as u64 * n as u64,
-                None => timed(&mut timings, gpu, "abuffer count", || {
-                    abuffer.count_fragments(gpu, &geometry, frame, &shadows, head_input, list_mode)
-                })?
-                .max(1),
-            };
-            let capacity = ABufferPass::max_capacity(gpu, wanted);
-            let out = timed(
-                &mut timings,
-                gpu,
-                "abuffer build + resolve + readback",
-                || {
-                    abuffer.draw_shadowed(
-                        gpu, &geometry, frame, &shadows, head_input, capacity, list_mode,
-                    )
-                },
-            )
-            .map_err(RenderError::from)?;
-            memory_bytes.extend(out.memory_bytes);
-            fragments = Some(FragmentCounts {
-                stored: out.fragments_stored,
-                dropped: out.fragments_dropped,
-                truncated: out.fragments_truncated,
-                capacity: capacity as u64,
-                requested_capacity: wanted,
-            });
-            out.pixels
-        }
+    let head = head.map(|head| {
+        let Costs {
+            timings,
+            memory_bytes,
+        } = &mut costs;
+        prepare_head(gpu, head, frame, &shadows, timings, memory_bytes)
+    });
+    let hair = HairDraw {
+        gpu,
+        model,
+        geometry: &geometry,
+        frame,
+        shading,
+        shadows: &shadows,
+        head: head.as_ref().map(|(_, head)| head.input()),
     };
+    let (mut pixels, fragments) = hair.draw(options.transparency, &mut costs)?;
     if let Some((pass, head)) = &head {
-        let skin = timed(&mut timings, gpu, "skin", || {
+        let timings = &mut costs.timings;
+        let skin = timed(timings, gpu, "skin", || {
             pass.shade(gpu, &geometry, frame, &shadows, head)
         })?;
-        let skin = timed(&mut timings, gpu, "skin readback", || {
+        let skin = timed(timings, gpu, "skin readback", || {
             read_texture_rgba(gpu, &skin.color)
         })?;
         composite_over(&mut pixels, &skin);
@@ -598,13 +456,258 @@ pub fn render_frame_with_head(
         pixels,
         stats: RenderStats {
             adapter: gpu.report.clone(),
-            timings,
-            memory_bytes,
+            timings: costs.timings,
+            memory_bytes: costs.memory_bytes,
             segments: geometry.segment_count,
             timing_method: TIMING_METHOD,
             fragments,
         },
     })
+}
+
+/// Every light with its map's layout (every pass shadows them all), checked; none without
+/// shadows.
+fn shadowed_lights(
+    model: &HairModel,
+    frame: &FrameParams,
+    options: &RenderOptions,
+    head: Option<&Head>,
+) -> Result<Vec<ShadowedLight>, RenderError> {
+    let Some(settings) = options.shadows else {
+        return Ok(Vec::new());
+    };
+    settings.check()?;
+    if frame.lights.is_empty() {
+        return Err(RenderError::NoLight);
+    }
+    if frame.lights.len() > MAX_SHADOWED_LIGHTS {
+        return Err(RenderError::TooManyShadowMaps(TooManyShadowMaps {
+            maps: frame.lights.len(),
+        }));
+    }
+    let bounds = caster_bounds(model, head);
+    (0..)
+        .zip(&frame.lights)
+        .map(|(index, light)| {
+            let layout = ShadowLayout::for_light(light, bounds, options.point_layout)
+                .map_err(ShadowMapError::from)?;
+            Ok(ShadowedLight {
+                maps: settings,
+                index,
+                layout,
+            })
+        })
+        .collect()
+}
+
+/// Each shadowed light's map, drawn, with its light's index.
+fn draw_light_maps(
+    gpu: &GpuContext,
+    model: &HairModel,
+    geometry: &StrandGeometry,
+    shadowed_lights: &[ShadowedLight],
+    costs: &mut Costs,
+) -> Result<Vec<(DeepOpacityMap, u32)>, RenderError> {
+    if shadowed_lights.is_empty() {
+        return Ok(Vec::new());
+    }
+    let dom_pass = timed(&mut costs.timings, gpu, "light map pipeline", || {
+        DeepOpacityPass::new(gpu)
+    });
+    let mut shadow_maps = Vec::new();
+    for &ShadowedLight {
+        maps,
+        index,
+        layout,
+    } in shadowed_lights
+    {
+        let map = maps.map_for(gpu, layout, model.bounds())?;
+        // One entry per light, so that reports keyed by pass name keep them all; a cube's
+        // says so, since it costs up to six maps.
+        let cube = if layout.is_cube() { ", cube" } else { "" };
+        let label = format!("{} (light {index}{cube})", maps.pass_name());
+        timed(&mut costs.timings, gpu, &label, || {
+            dom_pass.draw(gpu, geometry, &map)
+        });
+        costs.memory_bytes.extend(map.memory());
+        shadow_maps.push((map, index));
+    }
+    Ok(shadow_maps)
+}
+
+/// Time per pass and memory per resource, gathered over a frame's passes.
+#[derive(Default)]
+struct Costs {
+    timings: Vec<PassTiming>,
+    memory_bytes: Vec<(String, u64)>,
+}
+
+/// What every transparency mode draws the hair with.
+struct HairDraw<'a> {
+    gpu: &'a GpuContext,
+    model: &'a HairModel,
+    geometry: &'a StrandGeometry,
+    frame: &'a FrameParams,
+    shading: &'a ShadingModel,
+    shadows: &'a [ShadowInput<'a>],
+    head: Option<HeadInput<'a>>,
+}
+
+impl HairDraw<'_> {
+    /// The hair's pixels under `transparency`, and the fragments the modes that count them
+    /// stored and dropped.
+    fn draw(
+        &self,
+        transparency: Transparency,
+        costs: &mut Costs,
+    ) -> Result<(Vec<[f32; 4]>, Option<FragmentCounts>), RenderError> {
+        match transparency {
+            Transparency::Opaque => Ok((self.opaque(costs)?, None)),
+            Transparency::Sorted { bins } => Ok((self.sorted(bins, costs)?, None)),
+            Transparency::KBuffer { k } => {
+                let (pixels, counts) = self.kbuffer(k, costs)?;
+                Ok((pixels, Some(counts)))
+            }
+            Transparency::RandomSubsets { subsets } => Ok((self.subsets(subsets, costs)?, None)),
+            Transparency::ABuffer { nodes_per_pixel } => {
+                let (pixels, counts) = self.lists(nodes_per_pixel, ListMode::All, costs)?;
+                Ok((pixels, Some(counts)))
+            }
+            Transparency::Dbk {
+                nodes_per_pixel,
+                delta,
+            } => {
+                let list_mode = ListMode::Dbk { delta };
+                let (pixels, counts) = self.lists(nodes_per_pixel, list_mode, costs)?;
+                Ok((pixels, Some(counts)))
+            }
+        }
+    }
+
+    fn opaque(&self, costs: &mut Costs) -> Result<Vec<[f32; 4]>, RenderError> {
+        let (gpu, frame, timings) = (self.gpu, self.frame, &mut costs.timings);
+        let pass = timed(timings, gpu, "strand pipeline", || {
+            StrandPass::with_model(gpu, self.shading)
+        });
+        let target = RenderTarget::new(gpu, frame.width, frame.height);
+        timed(timings, gpu, "strands", || {
+            pass.draw_shadowed(gpu, self.geometry, frame, &target, self.shadows, self.head)
+        })?;
+        costs.memory_bytes.extend(target.memory());
+        Ok(timed(&mut costs.timings, gpu, "readback", || {
+            read_texture_rgba(gpu, &target.color)
+        })?)
+    }
+
+    fn sorted(&self, bins: u32, costs: &mut Costs) -> Result<Vec<[f32; 4]>, RenderError> {
+        let (gpu, frame, geometry, timings) =
+            (self.gpu, self.frame, self.geometry, &mut costs.timings);
+        let pass = timed(timings, gpu, "sorted blend pipeline", || {
+            SortedBlendPass::with_model(gpu, self.shading)
+        });
+        let order = timed(timings, gpu, "segment sort", || {
+            pass.sort(gpu, geometry, frame, self.model.bounds(), bins)
+        })?;
+        let target = RenderTarget::new(gpu, frame.width, frame.height);
+        timed(timings, gpu, "sorted blend", || {
+            pass.draw(
+                gpu,
+                geometry,
+                frame,
+                self.shadows,
+                self.head,
+                &order,
+                &target,
+            )
+        })?;
+        costs.memory_bytes.extend(order.memory());
+        costs.memory_bytes.extend(target.memory());
+        Ok(timed(&mut costs.timings, gpu, "readback", || {
+            read_texture_rgba(gpu, &target.color)
+        })?)
+    }
+
+    fn kbuffer(
+        &self,
+        k: u32,
+        costs: &mut Costs,
+    ) -> Result<(Vec<[f32; 4]>, FragmentCounts), RenderError> {
+        let (gpu, frame, timings) = (self.gpu, self.frame, &mut costs.timings);
+        let pass = timed(timings, gpu, "kbuffer pipeline", || {
+            KBufferPass::with_model(gpu, self.shading)
+        });
+        let out = timed(timings, gpu, "kbuffer build + resolve + readback", || {
+            pass.draw(gpu, self.geometry, frame, self.shadows, self.head, k)
+        })?;
+        costs.memory_bytes.extend(out.memory_bytes);
+        let slots = frame.width as u64 * frame.height as u64 * k as u64;
+        let counts = FragmentCounts {
+            stored: out.fragments_kept,
+            dropped: out.fragments_dropped,
+            truncated: 0,
+            capacity: slots,
+            requested_capacity: slots,
+        };
+        Ok((out.pixels, counts))
+    }
+
+    fn subsets(&self, subsets: u32, costs: &mut Costs) -> Result<Vec<[f32; 4]>, RenderError> {
+        let (gpu, timings) = (self.gpu, &mut costs.timings);
+        let pass = timed(timings, gpu, "random subsets pipeline", || {
+            RandomSubsetsPass::with_model(gpu, self.shading)
+        });
+        let out = timed(timings, gpu, "random subsets + resolve + readback", || {
+            let (model, geometry, frame) = (self.model, self.geometry, self.frame);
+            pass.draw(
+                gpu,
+                model,
+                geometry,
+                frame,
+                self.shadows,
+                self.head,
+                subsets,
+            )
+        })?;
+        costs.memory_bytes.extend(out.memory_bytes);
+        Ok(out.pixels)
+    }
+
+    /// The A-buffer's or the DBK-buffer's per-pixel lists.
+    fn lists(
+        &self,
+        nodes_per_pixel: Option<u32>,
+        list_mode: ListMode,
+        costs: &mut Costs,
+    ) -> Result<(Vec<[f32; 4]>, FragmentCounts), RenderError> {
+        let (gpu, frame, geometry, timings) =
+            (self.gpu, self.frame, self.geometry, &mut costs.timings);
+        let (shadows, head) = (self.shadows, self.head);
+        let abuffer = timed(timings, gpu, "abuffer pipeline", || {
+            ABufferPass::with_model(gpu, self.shading)
+        });
+        let wanted = match nodes_per_pixel {
+            Some(0) => return Err(RenderError::NoListNodes),
+            Some(n) => frame.width as u64 * frame.height as u64 * n as u64,
+            None => timed(timings, gpu, "abuffer count", || {
+                abuffer.count_fragments(gpu, geometry, frame, shadows, head, list_mode)
+            })?
+            .max(1),
+        };
+        let capacity = ABufferPass::max_capacity(gpu, wanted);
+        let out = timed(timings, gpu, "abuffer build + resolve + readback", || {
+            abuffer.draw_shadowed(gpu, geometry, frame, shadows, head, capacity, list_mode)
+        })
+        .map_err(RenderError::from)?;
+        costs.memory_bytes.extend(out.memory_bytes);
+        let counts = FragmentCounts {
+            stored: out.fragments_stored,
+            dropped: out.fragments_dropped,
+            truncated: out.fragments_truncated,
+            capacity: capacity as u64,
+            requested_capacity: wanted,
+        };
+        Ok((out.pixels, counts))
+    }
 }
 
 /// What the light maps must hold: the hair, and the head, which casts too (a frustum fitted to

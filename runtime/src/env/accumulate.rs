@@ -1,0 +1,197 @@
+//! The running sums of a frame rendered in batches of lights, and the pass that adds a batch's
+//! images into them (`accumulate.wgsl`). A progressive frame keeps one [`FrameSums`] and adds
+//! each part of its lights into it ([`EnvRenderer::encode_part_into`]): pre-multiplied "over"
+//! compositing is linear in colour for a fixed set of fragments, so the sum of the batches'
+//! colours is the colour under all their lights.
+//!
+//! [`EnvRenderer::encode_part_into`]: super::EnvRenderer::encode_part_into
+
+use super::view_targets::EnvViewTargets;
+use crate::gpu::GpuContext;
+use crate::gpu::bind_layout::{
+    bind_group, float_texture_entry, pipeline_layout, storage_entry, uniform_entry,
+};
+use crate::gpu::buffer::init_buffer;
+use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels, fit_within};
+use crate::gpu::pipeline::{compute_pipeline, wgsl_module};
+
+/// Pixels along each side of the accumulate pass's workgroups (`@workgroup_size(8, 8)`).
+const WORKGROUP_SIDE: u32 = 8;
+
+/// Bytes per pixel of the sums: an RGBA f32 for single, one for multiple scattering.
+const BYTES_PER_PIXEL: u64 = 2 * 16;
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct AccumulateParams {
+    width: u32,
+    height: u32,
+    _pad: [u32; 2],
+}
+
+/// A frame's running sums on the GPU: `width·height` RGBA f32 of single scattering, then as many
+/// of multiple scattering; linear, pre-multiplied, row-major from the top. Colour adds up over
+/// the parts added into it; alpha (the coverage, the same under every light) is the latest
+/// part's. Starts at zero.
+pub struct FrameSums {
+    buffer: wgpu::Buffer,
+    params: wgpu::Buffer,
+    width: u32,
+    height: u32,
+}
+
+impl FrameSums {
+    /// Zeroed sums of a `width`×`height` frame, checked against the adapter's limits.
+    pub fn new(gpu: &GpuContext, width: u32, height: u32) -> Result<Self, LimitError> {
+        GpuLimits::of(gpu).check_image(width, height)?;
+        Self::check_limits(gpu, width, height)?;
+        let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("env sums"),
+            size: Self::bytes(width, height),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let params = AccumulateParams {
+            width,
+            height,
+            _pad: [0; 2],
+        };
+        let params = init_buffer(
+            &gpu.device,
+            "env accumulate params",
+            bytemuck::bytes_of(&params),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        Ok(Self {
+            buffer,
+            params,
+            width,
+            height,
+        })
+    }
+
+    /// Bytes of the sums of a `width`×`height` frame.
+    pub fn bytes(width: u32, height: u32) -> u64 {
+        width as u64 * height as u64 * BYTES_PER_PIXEL
+    }
+
+    /// The sums' buffer (STORAGE | COPY_SRC): single scattering, then multiple.
+    pub fn buffer(&self) -> &wgpu::Buffer {
+        &self.buffer
+    }
+
+    pub fn into_buffer(self) -> wgpu::Buffer {
+        self.buffer
+    }
+
+    /// `[width, height]`.
+    pub fn size(&self) -> [u32; 2] {
+        [self.width, self.height]
+    }
+
+    /// The sums' buffer and the accumulate pass's workgroups against the adapter's limits.
+    pub(super) fn check_limits(
+        gpu: &GpuContext,
+        width: u32,
+        height: u32,
+    ) -> Result<(), LimitError> {
+        let limits = GpuLimits::of(gpu);
+        limits.check_storage_buffer("env sums", Self::bytes(width, height), |max| {
+            let (w, h) = fit_pixels(width, height, max / BYTES_PER_PIXEL);
+            format!("render at {w}x{h} or smaller")
+        })?;
+        let groups = [
+            width.div_ceil(WORKGROUP_SIDE),
+            height.div_ceil(WORKGROUP_SIDE),
+            1,
+        ];
+        limits.check_workgroups("env accumulate", groups, |max| {
+            let (w, h) = fit_within(width, height, max as u64 * WORKGROUP_SIDE as u64);
+            format!("render at {w}x{h} or smaller")
+        })
+    }
+}
+
+/// Adds a batch's two images (single, multiple) into a frame's [`FrameSums`].
+pub(super) struct AccumulatePass {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl AccumulatePass {
+    pub(super) fn new(device: &wgpu::Device) -> Self {
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("env accumulate"),
+            entries: &[
+                float_texture_entry(0, compute),
+                float_texture_entry(1, compute),
+                storage_entry(2, compute, false),
+                uniform_entry(3, compute),
+            ],
+        });
+        let shader = wgsl_module(device, "accumulate.wgsl", include_str!("accumulate.wgsl"));
+        let pipeline = compute_pipeline(
+            device,
+            "env accumulate",
+            &pipeline_layout(device, "env accumulate", &[Some(&layout)]),
+            &shader,
+            "accumulate",
+        );
+        Self { pipeline, layout }
+    }
+
+    /// Records `sums += targets` (colour; alpha replaced). `targets` must be the sums' size.
+    pub(super) fn encode(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &EnvViewTargets,
+        sums: &FrameSums,
+    ) {
+        let single = targets.single.create_view(&Default::default());
+        let multiple = targets.multiple.create_view(&Default::default());
+        let group = bind_group(
+            &gpu.device,
+            "env accumulate",
+            &self.layout,
+            &[
+                wgpu::BindingResource::TextureView(&single),
+                wgpu::BindingResource::TextureView(&multiple),
+                sums.buffer.as_entire_binding(),
+                sums.params.as_entire_binding(),
+            ],
+        );
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("env accumulate"),
+            timestamp_writes: gpu.compute_timestamps(),
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.dispatch_workgroups(
+            sums.width.div_ceil(WORKGROUP_SIDE),
+            sums.height.div_ceil(WORKGROUP_SIDE),
+            1,
+        );
+    }
+}
+
+#[cfg(test)]
+mod wgsl_layout {
+    use super::*;
+    use crate::shader_layout::{assert_same_layout, rust_layout};
+    use crate::shaders::Wgsl;
+
+    #[test]
+    fn uploaded_structs_are_laid_out_as_the_wgsl_reads_them() {
+        assert_same_layout(
+            &Wgsl {
+                file: "accumulate.wgsl",
+                source: include_str!("accumulate.wgsl"),
+            },
+            None,
+            "AccumulateParams",
+            &rust_layout!(AccumulateParams { width, height }),
+        );
+    }
+}

@@ -1,0 +1,295 @@
+//! What one env-lit frame is asked for, and the resources it renders into, created once before
+//! its batches.
+
+use std::sync::Arc;
+
+use strandlight_tables::table::Table;
+
+use super::accumulate::FrameSums;
+use super::light_kinds::LightKinds;
+use super::light_maps::LightMaps;
+use super::stats::Timings;
+use super::table_binding::TableBinding;
+use super::tables::check_table_limits;
+use super::view_binding::FrameVisibility;
+use super::view_targets::EnvViewTargets;
+use super::view_visibility::OccupancyMap;
+use super::volume::VolumeBuffers;
+use super::{EnvRenderError, EnvRenderOptions, EnvRenderer, EnvTables};
+use crate::camera::{Camera, LightFootprint};
+use crate::gpu::GpuContext;
+use crate::gpu::limits::GpuLimits;
+use crate::hair::{Aabb, HairModel};
+use crate::head::Head;
+use crate::multiple::ForwardScatteringSource;
+use crate::passes::convolution_depth::{SimplifiedSegments, simplification_order};
+use crate::passes::frame_params::{FrameParams, KajiyaKay};
+use crate::passes::head::{HeadDepthMaps, HeadGeometry};
+use crate::passes::strand_geometry::StrandGeometry;
+use crate::passes::strand_quads::strand_bind_group;
+
+/// What one frame is asked for.
+pub(super) struct FrameRequest<'a> {
+    pub(super) model: &'a HairModel,
+    pub(super) camera: &'a Camera,
+    pub(super) width: u32,
+    pub(super) height: u32,
+    pub(super) tables: &'a EnvTables,
+    pub(super) options: &'a EnvRenderOptions,
+    pub(super) multiple: Option<&'a dyn ForwardScatteringSource>,
+    pub(super) head: Option<&'a Head>,
+}
+
+/// What one frame renders into, created once before its passes: the hair (all of it for the
+/// view and directional lights, the κ-simplified order for SRBF light passes), the DODM batch
+/// (DODM: the convolution optical depth map of Ren 2010 §5, one layer per light) and its
+/// summed-area tables, the view's visibility and targets, and the tables bound
+/// per light kind.
+pub(super) struct FrameResources {
+    pub(super) geometry: StrandGeometry,
+    pub(super) light_geometry: StrandGeometry,
+    /// κ < 1: the strands in simplification order, whose windows the simplified light passes
+    /// draw, and the next light's window.
+    pub(super) simplified: Option<SimplifiedSegments>,
+    pub(super) next_window: u32,
+    pub(super) footprint: LightFootprint,
+    /// The light maps of every-strand SRBFs and directional lights, at the DODM resolution
+    /// (None where the frame has only simplified SRBFs).
+    pub(super) full_maps: Option<LightMaps>,
+    /// The light maps of κ-simplified SRBFs, at [`DodmSettings::simplified_resolution`](crate::passes::convolution_depth::DodmSettings::simplified_resolution)
+    /// (None where that is the full resolution: they share `full_maps`).
+    pub(super) simplified_maps: Option<LightMaps>,
+    pub(super) occupancy: OccupancyMap,
+    pub(super) targets: EnvViewTargets,
+    pub(super) width: u32,
+    pub(super) height: u32,
+    /// Group 0 of every view and visibility pass.
+    pub(super) strands: wgpu::BindGroup,
+    pub(super) coverage_view: wgpu::TextureView,
+    /// [`EnvViewTargets::nearest_position`] and `nearest_tangent`.
+    pub(super) nearest_views: [wgpu::TextureView; 2],
+    pub(super) depth_view: wgpu::TextureView,
+    /// The single-scattering tables of the SRBF and the directional lights (None: no such
+    /// lights), each bound with the multiple-scattering table.
+    pub(super) srbf_tables: Option<Arc<TableBinding>>,
+    pub(super) directional_tables: Option<Arc<TableBinding>>,
+    /// The groom's visibility volume (or its placeholder under Ren's light maps).
+    pub(super) volume: Arc<VolumeBuffers>,
+    /// The head (issue 40), drawn into the view's depth and every light map.
+    pub(super) head: Option<HeadGeometry>,
+    /// The view camera's world to clip space.
+    pub(super) view_proj: glam::Mat4,
+    /// [`EnvViewTargets::head_position`] and `head_normal`.
+    pub(super) head_views: [wgpu::TextureView; 2],
+}
+
+impl FrameResources {
+    /// The light maps a batch draws ([`LightMaps::choose`]).
+    pub(super) fn maps(&mut self, simplified: bool) -> &mut LightMaps {
+        LightMaps::choose(simplified, &mut self.full_maps, &mut self.simplified_maps)
+    }
+
+    /// The visibility input of group 3 for this frame.
+    pub(super) fn visibility(&self, options: &EnvRenderOptions) -> FrameVisibility<'_> {
+        FrameVisibility {
+            volume: &self.volume,
+            map: &self.occupancy,
+            coverage: &self.coverage_view,
+            nearest: [&self.nearest_views[0], &self.nearest_views[1]],
+            transparency: options.transparency,
+            width: self.width,
+            height: self.height,
+            head: [&self.head_views[0], &self.head_views[1]],
+            skin: self.head.as_ref().map(|h| h.albedo),
+            view_proj: self.view_proj,
+        }
+    }
+
+    /// The strand windows of the next `lights` simplified light maps (the frame's κ-thinned
+    /// SRBF lights, counted across batches): each light its own subset
+    /// ([`SimplifiedSegments::window`]).
+    pub(super) fn next_windows(
+        &mut self,
+        lights: usize,
+        kappa: f32,
+    ) -> Vec<Vec<std::ops::Range<u32>>> {
+        let Some(simplified) = &self.simplified else {
+            return vec![vec![0..self.light_geometry.segment_count]; lights];
+        };
+        let first = self.next_window;
+        self.next_window += lights as u32;
+        (first..self.next_window)
+            .map(|k| simplified.window(kappa, k))
+            .collect()
+    }
+
+    /// GPU memory held while one batch renders, per resource (tables and grid added later).
+    pub(super) fn memory(&self) -> Vec<(String, u64)> {
+        let mut memory = self.geometry.memory();
+        if let Some(maps) = &self.full_maps {
+            memory.extend(maps.memory(""));
+        }
+        if let Some(maps) = &self.simplified_maps {
+            memory.extend(maps.memory("simplified "));
+        }
+        memory.extend(self.targets.memory());
+        memory.push(self.occupancy.memory());
+        memory.push(("visibility volume".into(), self.volume.bytes));
+        if let Some(head) = &self.head {
+            memory.push(("head geometry".into(), head.bytes()));
+        }
+        memory
+    }
+}
+
+/// The geometry the SRBF light passes draw: when κ < 1, the strands in simplification order
+/// (with that order, whose windows the passes draw); else all of them as they are.
+fn light_pass_geometry(
+    gpu: &GpuContext,
+    model: &HairModel,
+    geometry: &StrandGeometry,
+    options: &EnvRenderOptions,
+) -> (StrandGeometry, Option<SimplifiedSegments>) {
+    if options.kappa >= 1.0 {
+        return (geometry.clone(), None);
+    }
+    let order = simplification_order(model, options.simplification_seed);
+    let simplified = SimplifiedSegments::in_order(gpu, model, &order);
+    (
+        simplified.geometry(geometry, options.kappa),
+        Some(simplified),
+    )
+}
+
+/// What a compact source's map must hold: the hair, and the head whose skin it shadows and
+/// which shadows the hair (outside a map a point reads as lit). Without compact sources no map
+/// is fitted, and the points are not copied.
+fn light_footprint(
+    model: &HairModel,
+    head: Option<&Head>,
+    bounds: Aabb,
+    has_compact_sources: bool,
+) -> LightFootprint {
+    if !has_compact_sources {
+        return LightFootprint::new(bounds, Vec::new().into());
+    }
+    let mut points = model.points().to_vec();
+    if let Some(head) = head {
+        points.extend_from_slice(&head.triangles().positions);
+    }
+    LightFootprint::new(bounds, points.into())
+}
+
+impl FrameResources {
+    /// Creates the frame's resources, after checking them against the adapter's limits.
+    pub(super) fn new(
+        gpu: &GpuContext,
+        renderer: &EnvRenderer,
+        request: &FrameRequest<'_>,
+        kinds: &LightKinds,
+        timings: &mut Timings,
+    ) -> Result<Self, EnvRenderError> {
+        let FrameRequest {
+            model,
+            camera,
+            width,
+            height,
+            tables,
+            options,
+            multiple,
+            head,
+        } = *request;
+        GpuLimits::of(gpu).check_image(width, height)?;
+        let occupancy = OccupancyMap::new(gpu, options.transparency, width, height)?;
+        FrameSums::check_limits(gpu, width, height)?;
+        let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;
+        // Per hair and settings, not per light or view: setup, as the upload is.
+        let (light_geometry, simplified) = timings.time(gpu, "upload", || {
+            light_pass_geometry(gpu, model, &geometry, options)
+        });
+        let bounds = model.bounds();
+        let first_layer = options.dodm.first_layer_for(bounds);
+        let (mut full_maps, mut simplified_maps) =
+            LightMaps::for_frame(gpu, options, kinds, first_layer)?;
+        let head_geometry =
+            head.map(|h| timings.time(gpu, "upload", || HeadGeometry::upload(gpu, h)));
+        if head_geometry.is_some() {
+            for maps in [&mut full_maps, &mut simplified_maps].into_iter().flatten() {
+                maps.head = Some(HeadDepthMaps::new(
+                    gpu,
+                    maps.dodm.resolution,
+                    maps.dodm.slots,
+                ));
+            }
+        }
+        let targets = EnvViewTargets::new(
+            gpu,
+            width,
+            height,
+            options.transparency,
+            head_geometry.is_some(),
+        );
+        let view_params = FrameParams {
+            camera: *camera,
+            width,
+            height,
+            lights: Vec::new(),
+            shading: KajiyaKay::default(),
+            width_override_px: options.width_override_px,
+        };
+        check_table_limits(gpu, tables, kinds, multiple.is_some())?;
+        let volume = renderer
+            .volume
+            .buffers(gpu, model, head, options, timings)?;
+        let [srbf_tables, directional_tables] = timings.time(gpu, "table upload", || {
+            bind_kind_tables(gpu, renderer, request, kinds)
+        });
+        let head_views = [&targets.head_position, &targets.head_normal]
+            .map(|t| t.create_view(&Default::default()));
+        Ok(Self {
+            strands: strand_bind_group(gpu, &renderer.layouts.strand, &geometry, &view_params),
+            view_proj: view_params.view_proj(),
+            coverage_view: targets.coverage.create_view(&Default::default()),
+            nearest_views: [&targets.nearest_position, &targets.nearest_tangent]
+                .map(|t| t.create_view(&Default::default())),
+            depth_view: targets.depth.create_view(&Default::default()),
+            geometry,
+            light_geometry,
+            simplified,
+            next_window: 0,
+            footprint: light_footprint(model, head, bounds, kinds.has_sharp_shadows()),
+            full_maps,
+            simplified_maps,
+            occupancy,
+            targets,
+            width,
+            height,
+            srbf_tables,
+            directional_tables,
+            volume,
+            head_views,
+            head: head_geometry,
+        })
+    }
+}
+
+/// The single-scattering tables of the SRBF and the directional lights, each bound with the
+/// multiple-scattering table (None: the frame has no lights of that kind).
+fn bind_kind_tables(
+    gpu: &GpuContext,
+    renderer: &EnvRenderer,
+    request: &FrameRequest<'_>,
+    kinds: &LightKinds,
+) -> [Option<Arc<TableBinding>>; 2] {
+    let tables = request.tables;
+    let multiple_table = request.multiple.and(tables.multiple.as_ref());
+    let bind = |needed: bool, t: &Option<Arc<Table>>| {
+        t.as_ref()
+            .filter(|_| needed)
+            .map(|t| (renderer.tables).binding(gpu, &renderer.layouts.table, t, multiple_table))
+    };
+    [
+        bind(kinds.has_srbf(), &tables.srbf),
+        bind(kinds.has_directional(), &tables.direct),
+    ]
+}

@@ -1,0 +1,71 @@
+//! The frame's visibility, drawn once before its batches: the head's depth and surface, then
+//! the depth prepass and coverage (opaque view) or the occupancy map (transparent views) of
+//! [`ViewVisibilityPass`](super::view_visibility::ViewVisibilityPass).
+
+use super::frame_resources::FrameResources;
+use super::stats::Timings;
+use super::view_binding::ViewBinding;
+use super::view_visibility::FragmentCounts;
+use super::{EnvRenderOptions, EnvRenderer};
+use crate::camera::Camera;
+use crate::gpu::GpuContext;
+use crate::gpu::readback::ReadbackError;
+
+/// The frame's visibility (depth prepass and coverage, or the occupancy map), once.
+pub(super) fn encode_visibility(
+    gpu: &GpuContext,
+    renderer: &EnvRenderer,
+    frame: &FrameResources,
+    options: &EnvRenderOptions,
+    camera: &Camera,
+    timings: &mut Timings,
+) {
+    timings.time(gpu, "view visibility", || {
+        let visibility = frame.visibility(options);
+        let view = ViewBinding::new(gpu, &renderer.layouts.view, None, &visibility);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        // The head first: its depth bounds the hair's passes (and clears the depth).
+        renderer.head.encode_view(
+            gpu,
+            &mut encoder,
+            frame.head.as_ref(),
+            camera,
+            (frame.width, frame.height),
+            &frame.depth_view,
+            [&frame.head_views[0], &frame.head_views[1]],
+        );
+        renderer.visibility.encode(
+            gpu,
+            &mut encoder,
+            options.transparency,
+            &frame.strands,
+            &view.group,
+            &frame.depth_view,
+            &frame.coverage_view,
+            [&frame.nearest_views[0], &frame.nearest_views[1]],
+            &frame.occupancy,
+            frame.geometry.segment_count,
+        );
+        gpu.queue.submit([encoder.finish()]);
+    });
+}
+
+/// The fragments one batch's view pass rasterizes and shades (benchmarks).
+pub(super) fn count_fragments(
+    gpu: &GpuContext,
+    renderer: &EnvRenderer,
+    frame: &FrameResources,
+    options: &EnvRenderOptions,
+) -> Result<FragmentCounts, ReadbackError> {
+    let visibility = frame.visibility(options);
+    let view = ViewBinding::new(gpu, &renderer.layouts.view, None, &visibility);
+    renderer.visibility.count_fragments(
+        gpu,
+        options.transparency,
+        &frame.strands,
+        &view.group,
+        &frame.depth_view,
+        (frame.width, frame.height),
+        frame.geometry.segment_count,
+    )
+}

@@ -1,0 +1,221 @@
+//! The light maps of a batch (Ren 2010 §5): each light's convolution optical depth map (DODM,
+//! one array layer per light slot) and its summed-area tables, at the full resolution or the
+//! κ-simplified one, and the pass that draws them.
+
+use super::frame_resources::FrameResources;
+use super::light_kinds::{LightBatch, LightKinds};
+use super::stats::Timings;
+use super::{EnvRenderError, EnvRenderOptions};
+use crate::camera::LightFraming;
+use crate::env_light::{EnvLight, shadow_groups};
+use crate::gpu::GpuContext;
+use crate::gpu::limits::{GpuLimits, LimitError};
+use crate::passes::convolution_depth::{ConvolutionDepthPass, DodmBatch};
+use crate::passes::head::{HeadDepthMaps, HeadPass};
+use crate::passes::summed_area::{SummedAreaPass, SummedAreaTables};
+
+/// A DODM batch (one array layer per light slot) against the adapter's limits; the image is
+/// checked first, the SAT, the occupancy map and the sums when created.
+fn check_light_map_limits(gpu: &GpuContext, resolution: u32, slots: u32) -> Result<(), LimitError> {
+    let limits = GpuLimits::of(gpu);
+    limits.check_texture_2d("DODM", resolution, resolution, |max| {
+        format!("use a DODM resolution of at most {max}")
+    })?;
+    limits.check_texture_layers("DODM light batch", slots, |max| {
+        format!("use a light batch size of at most {max}")
+    })
+}
+
+/// Texels across the light maps bound, unread, by SRBF batches that read the visibility volume.
+pub(super) const PLACEHOLDER_MAP_RESOLUTION: u32 = 8;
+
+/// One resolution's light maps: the batch's DODM and its summed-area tables.
+pub(super) struct LightMaps {
+    pub(super) dodm: DodmBatch,
+    pub(super) sat: SummedAreaTables,
+    /// The head's depth from each slot's light, where the frame has a head.
+    pub(super) head: Option<HeadDepthMaps>,
+}
+
+impl LightMaps {
+    pub(super) fn new(
+        gpu: &GpuContext,
+        resolution: u32,
+        slots: u32,
+        first_layer: f32,
+    ) -> Result<Self, EnvRenderError> {
+        check_light_map_limits(gpu, resolution, slots)?;
+        Ok(Self {
+            sat: SummedAreaTables::new(gpu, resolution, slots)?,
+            dodm: DodmBatch::new(gpu, resolution, slots, first_layer),
+            head: None,
+        })
+    }
+
+    /// A frame's full-resolution maps and its simplified ones (each None where no batch draws
+    /// them), with as many slots as the most maps one batch of their kinds holds.
+    pub(super) fn for_frame(
+        gpu: &GpuContext,
+        options: &EnvRenderOptions,
+        kinds: &LightKinds,
+        first_layer: f32,
+    ) -> Result<(Option<Self>, Option<Self>), EnvRenderError> {
+        if options.shadowed && options.lobe_visibility.volume().is_some() && kinds.has_srbf() {
+            // SRBF lobes read the visibility volume: only the compact sources draw maps, and
+            // SRBF batches bind a small placeholder that nothing reads.
+            let sources = LightKinds {
+                srbf_every_strand: Vec::new(),
+                srbf: Vec::new(),
+                directional: kinds.directional.clone(),
+                directional_thinned: kinds.directional_thinned.clone(),
+            };
+            let placeholder = || Self::new(gpu, PLACEHOLDER_MAP_RESOLUTION, 1, first_layer);
+            if !sources.has_directional() {
+                return Ok((Some(placeholder()?), None));
+            }
+            let (full, simplified) = Self::for_frame(gpu, options, &sources, first_layer)?;
+            let full = match full {
+                Some(maps) => maps,
+                None => placeholder()?,
+            };
+            return Ok((Some(full), simplified));
+        }
+        let dodm = &options.dodm;
+        let slots = |lights: &[&Vec<EnvLight>]| {
+            let most = lights
+                .iter()
+                .map(|k| shadow_groups(k).len())
+                .max()
+                .unwrap_or(0);
+            (dodm.batch_size as usize).min(most) as u32
+        };
+        let simplified_resolution = dodm.simplified_resolution(options.kappa);
+        let full_kinds = [&kinds.srbf_every_strand, &kinds.directional];
+        let thinned = kinds.thinned();
+        if !kinds.has_thinned() || simplified_resolution == dodm.resolution {
+            let all = slots(&[full_kinds[0], full_kinds[1], thinned[0], thinned[1]]);
+            return Ok((
+                Some(Self::new(gpu, dodm.resolution, all, first_layer)?),
+                None,
+            ));
+        }
+        let full = match slots(&full_kinds) {
+            0 => None,
+            n => Some(Self::new(gpu, dodm.resolution, n, first_layer)?),
+        };
+        let simplified = Self::new(gpu, simplified_resolution, slots(&thinned), first_layer)?;
+        Ok((full, Some(simplified)))
+    }
+
+    /// GPU memory per resource, each name after `prefix`.
+    pub(super) fn memory(&self, prefix: &str) -> Vec<(String, u64)> {
+        let named = |(name, bytes): (String, u64)| (format!("{prefix}{name}"), bytes);
+        let mut memory: Vec<_> = self.dodm.memory().into_iter().map(named).collect();
+        memory.extend(self.sat.memory().into_iter().map(named));
+        if let Some(head) = &self.head {
+            memory.push(named(("head light depth".into(), head.memory())));
+        }
+        memory
+    }
+
+    /// The maps a batch draws: the simplified ones for κ-thinned SRBFs where the frame has them.
+    pub(super) fn choose<'a>(
+        simplified: bool,
+        full: &'a mut Option<LightMaps>,
+        simplified_maps: &'a mut Option<LightMaps>,
+    ) -> &'a mut LightMaps {
+        match (simplified, simplified_maps) {
+            (true, Some(maps)) => maps,
+            _ => full
+                .as_mut()
+                .expect("a frame holds full-resolution maps for every batch not simplified"),
+        }
+    }
+}
+
+/// The light maps of a batch: the light pass into the DODM (with the head's depth from each
+/// light), then the summed-area tables of its optical depths.
+pub(super) struct LightMapsPass {
+    depth: ConvolutionDepthPass,
+    sat: SummedAreaPass,
+}
+
+impl LightMapsPass {
+    pub(super) fn new(gpu: &GpuContext) -> Self {
+        Self {
+            depth: ConvolutionDepthPass::new(gpu),
+            sat: SummedAreaPass::new(gpu),
+        }
+    }
+
+    /// The batch's light maps: the light pass into the DODM, then its summed-area tables.
+    pub(super) fn encode(
+        &self,
+        gpu: &GpuContext,
+        frame: &mut FrameResources,
+        batch: &LightBatch<'_>,
+        options: &EnvRenderOptions,
+        head_pass: &HeadPass,
+        timings: &mut Timings,
+    ) {
+        let simplified = batch.is_simplified();
+        let directions: Vec<_> = batch.groups.iter().map(|g| g.direction).collect();
+        let windows = match simplified {
+            true => frame.next_windows(directions.len(), options.kappa),
+            false => vec![vec![0..frame.geometry.segment_count]; directions.len()],
+        };
+        // A simplified map draws 1/κ-times the optical depth of each drawn fiber, enlarged to
+        // the same world width at whatever resolution its maps have.
+        let (tau_scale, enlargement) = match simplified {
+            true => (
+                1.0 / options.kappa,
+                options.dodm.simplified_enlargement(options.kappa),
+            ),
+            false => (1.0, 1.0),
+        };
+        let FrameResources {
+            geometry,
+            light_geometry,
+            footprint,
+            full_maps,
+            simplified_maps,
+            head,
+            ..
+        } = frame;
+        let geometry = if simplified { light_geometry } else { geometry };
+        let maps = LightMaps::choose(simplified, full_maps, simplified_maps);
+        let framing = match batch.has_sharp_shadows() {
+            true => LightFraming::Fitted(footprint),
+            false => LightFraming::Sphere(footprint.bounds),
+        };
+        timings.time(gpu, "light pass", || {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            self.depth.encode_windows(
+                gpu,
+                &mut encoder,
+                geometry,
+                &directions,
+                &windows,
+                framing,
+                [tau_scale, enlargement],
+                &mut maps.dodm,
+            );
+            if let (Some(head), Some(head_maps)) = (head.as_ref(), maps.head.as_ref()) {
+                head_pass.encode_light_depths(
+                    gpu,
+                    &mut encoder,
+                    head,
+                    &maps.dodm.cameras,
+                    head_maps,
+                );
+            }
+            gpu.queue.submit([encoder.finish()]);
+        });
+        timings.time(gpu, "summed-area tables", || {
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            self.sat
+                .encode(gpu, &mut encoder, &maps.dodm.optical_depth, &maps.sat);
+            gpu.queue.submit([encoder.finish()]);
+        });
+    }
+}

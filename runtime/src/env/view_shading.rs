@@ -1,0 +1,198 @@
+//! The env-lit view shading pass (Ren 2010 §3.1, §5–6): each fiber the frame's visibility lets
+//! through ([`ViewTransparency`]: the nearest fiber of each pixel, shaded by a full-screen pass;
+//! every fragment of the strands rasterized again through the occupancy map; or the occupancy
+//! map's layers) loops over a batch's lights and sums T̃ × table lookup × light weight (single
+//! scattering) and, with a forward-scattering grid, power × T_f × I_G (multiple scattering) into
+//! the two targets of [`EnvViewTargets`] (`view_shading.wgsl`, `env_shading.wgsl`).
+//!
+//! Inputs: the strands (group 0), [`BatchBinding`] (group 1: lights, DODM, SATs),
+//! [`TableBinding`] (group 2: the tables), [`ViewBinding`] (group 3: the batch's grid and the
+//! frame's visibility). Output: the batch's single and multiple images in [`EnvViewTargets`].
+
+use super::table_binding::{TableBinding, table_bind_group_layout};
+use super::view_binding::{ViewBinding, view_bind_group_layout};
+use super::view_targets::EnvViewTargets;
+use super::view_visibility::{ViewTransparency, ViewVisibilityPass};
+use crate::gpu::GpuContext;
+use crate::gpu::bind_layout::pipeline_layout;
+use crate::gpu::pipeline::{ADDITIVE, StrandDraw, color_target};
+use crate::passes::attachments::cleared_color;
+use crate::passes::convolution_transmittance::{BatchBinding, transmittance_bind_group_layout};
+use crate::passes::strand_geometry::StrandGeometry;
+use crate::passes::strand_quads::strand_bind_group_layout_vertex_storage;
+use crate::shaders::{Wgsl, shader_module};
+
+/// The bind group layouts of the view passes: strands (0), the batch's lights, DODM and SATs
+/// (1), the tables (2), the grid and the frame's visibility (3).
+pub(super) struct EnvViewLayouts {
+    pub(super) strand: wgpu::BindGroupLayout,
+    pub(super) batch: wgpu::BindGroupLayout,
+    pub(super) table: wgpu::BindGroupLayout,
+    pub(super) view: wgpu::BindGroupLayout,
+}
+
+impl EnvViewLayouts {
+    pub(super) fn new(device: &wgpu::Device) -> Self {
+        Self {
+            strand: strand_bind_group_layout_vertex_storage(device),
+            batch: transmittance_bind_group_layout(device, wgpu::ShaderStages::FRAGMENT),
+            table: table_bind_group_layout(device),
+            view: view_bind_group_layout(device),
+        }
+    }
+}
+
+/// The frame's visibility pass, its shader composed from `view_visibility.wgsl`.
+pub(super) fn view_visibility_pass(
+    gpu: &GpuContext,
+    layouts: &EnvViewLayouts,
+) -> ViewVisibilityPass {
+    let device = &gpu.device;
+    let top = Wgsl {
+        file: "view_visibility.wgsl",
+        source: include_str!("view_visibility.wgsl"),
+    };
+    let shader = shader_module(device, &top, None);
+    let visibility_layout = pipeline_layout(
+        device,
+        "view visibility",
+        &[Some(&layouts.strand), None, None, Some(&layouts.view)],
+    );
+    // The coverage pass writes the texture group 3 reads: it binds the strands alone.
+    let strands_only = pipeline_layout(device, "view coverage", &[Some(&layouts.strand)]);
+    ViewVisibilityPass::new(
+        device,
+        &shader,
+        &visibility_layout,
+        &strands_only,
+        gpu.hdr_format(),
+    )
+}
+
+/// A view pipeline writing the single and multiple targets from vertex entry `vertex` and
+/// fragment entry `entry`.
+fn view_pipeline(
+    gpu: &GpuContext,
+    layout: &wgpu::PipelineLayout,
+    shader: &wgpu::ShaderModule,
+    (label, vertex, entry): (&str, &str, &str),
+    blend: Option<wgpu::BlendState>,
+) -> wgpu::RenderPipeline {
+    let target = color_target(gpu.hdr_format(), blend);
+    StrandDraw {
+        label,
+        layout,
+        shader,
+        vertex_entry: vertex,
+        fragment: Some((entry, &[target.clone(), target])),
+        depth: None,
+    }
+    .build(&gpu.device)
+}
+
+/// The view shading pipelines, one per view transparency, and the skin behind the hair.
+pub(super) struct ViewShadingPass {
+    opaque: wgpu::RenderPipeline,
+    transparent: wgpu::RenderPipeline,
+    layered: wgpu::RenderPipeline,
+    /// Occupancy and layered views: the skin behind the pixel's fibers (`skin.wgsl`), added
+    /// after them.
+    skin_behind_hair: wgpu::RenderPipeline,
+}
+
+/// What one batch's view shading binds and draws into.
+pub(super) struct ViewShadingInputs<'a> {
+    pub(super) geometry: &'a StrandGeometry,
+    pub(super) strands: &'a wgpu::BindGroup,
+    pub(super) transparency: ViewTransparency,
+    pub(super) batch: &'a BatchBinding,
+    pub(super) tables: &'a TableBinding,
+    pub(super) view: &'a ViewBinding,
+    pub(super) with_head: bool,
+}
+
+impl ViewShadingPass {
+    pub(super) fn new(gpu: &GpuContext, layouts: &EnvViewLayouts) -> Self {
+        let top = Wgsl {
+            file: "view_shading.wgsl",
+            source: include_str!("view_shading.wgsl"),
+        };
+        let shader = &shader_module(&gpu.device, &top, None);
+        let layout = pipeline_layout(
+            &gpu.device,
+            "env view",
+            &[
+                Some(&layouts.strand),
+                Some(&layouts.batch),
+                Some(&layouts.table),
+                Some(&layouts.view),
+            ],
+        );
+        let pipeline = |names, blend| view_pipeline(gpu, &layout, shader, names, blend);
+        Self {
+            // The depth prepass left each pixel's nearest fiber in two textures: the opaque
+            // view shades those pixels, rasterizing no strand per batch.
+            opaque: pipeline(
+                ("env view (opaque)", "vs_fullscreen", "fs_env_deferred"),
+                None,
+            ),
+            transparent: pipeline(
+                ("env view (occupancy)", "vs_main", "fs_env_transparent"),
+                Some(ADDITIVE),
+            ),
+            // The layers the frame's visibility gathered: a full-screen pass, added to by the
+            // skin.
+            layered: pipeline(
+                ("env view (layered)", "vs_fullscreen", "fs_env_layered"),
+                Some(ADDITIVE),
+            ),
+            skin_behind_hair: pipeline(
+                (
+                    "env view (skin behind hair)",
+                    "vs_fullscreen",
+                    "fs_env_skin",
+                ),
+                Some(ADDITIVE),
+            ),
+        }
+    }
+
+    /// Encodes one batch's view into `targets` (opaque: a full-screen pass over the nearest
+    /// fibers the frame's depth prepass left; occupancy: the strands rasterized again).
+    pub(super) fn encode(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &ViewShadingInputs<'_>,
+        targets: &EnvViewTargets,
+    ) {
+        let single = targets.single.create_view(&Default::default());
+        let multiple = targets.multiple.create_view(&Default::default());
+        let transparency = inputs.transparency;
+        let (pipeline, vertices, instances) = match transparency {
+            ViewTransparency::Opaque => (&self.opaque, 3, 1),
+            ViewTransparency::Occupancy { .. } => {
+                (&self.transparent, 6, inputs.geometry.segment_count)
+            }
+            ViewTransparency::Layered { .. } => (&self.layered, 3, 1),
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("env view"),
+            color_attachments: &[cleared_color(&single), cleared_color(&multiple)],
+            depth_stencil_attachment: None,
+            timestamp_writes: gpu.render_timestamps(),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, inputs.strands, &[]);
+        pass.set_bind_group(1, &inputs.batch.group, &[]);
+        pass.set_bind_group(2, &inputs.tables.group, &[]);
+        pass.set_bind_group(3, &inputs.view.group, &[]);
+        pass.draw(0..vertices, 0..instances);
+        if transparency.uses_occupancy_map() && inputs.with_head {
+            pass.set_pipeline(&self.skin_behind_hair);
+            pass.draw(0..3, 0..1);
+        }
+    }
+}
