@@ -1,9 +1,11 @@
 //! `strandlight bench`: speed against error on the real data in `../shared/data`. The full run
-//! rewrites the generated section of docs/BENCHMARKS.md and its plots in docs/bench/; `--quick`
-//! (a few minutes) writes its report and plots to out/bench-quick/ and leaves docs/ alone.
-//! `--from-report` draws the plots and the page again from a saved report without measuring.
+//! rewrites the generated section of docs/BENCHMARKS.md, its every-frame page and its report in
+//! docs/bench/, and draws its plots in out/bench/ (the repository keeps pages and data, not
+//! images); `--quick` (a few minutes) writes its report and plots to out/bench-quick/ and leaves
+//! docs/ alone. `--from-report` draws the plots and the pages again from a saved report without
+//! measuring.
 
-use std::path::PathBuf;
+use std::path::{Component, Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
@@ -12,7 +14,7 @@ use strandlight_eval::baseline::Baseline;
 use strandlight_eval::bench::{BenchPaths, BenchPlan, BenchReport, PlanChanges, run as run_bench};
 use strandlight_eval::bench_plots::{Metric, plot};
 use strandlight_eval::bench_report::{
-    details, section, splice, splice_truth, truth_details, truth_section,
+    details, report_file, section, splice, splice_truth, truth_details, truth_section,
 };
 use strandlight_scene::head_input::HeadChoice;
 use strandlight_scene::scene_tables::ScatteringMode;
@@ -33,8 +35,8 @@ pub struct BenchArgs {
     /// The shared data folder (default: $STRANDLIGHT_SHARED_DATA or ../shared/data).
     #[arg(long)]
     pub data: Option<PathBuf>,
-    /// Where the report JSON and the plots go (default: docs/bench, or out/bench-quick with
-    /// --quick).
+    /// Where the report JSON, DETAILS.md and the plots go (default: docs/bench, or
+    /// out/bench-quick with --quick); plots of a folder under docs/ go to its path under out/.
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// The page whose generated section is rewritten (full runs only).
@@ -110,7 +112,9 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         })
     });
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-    let json = out.join(format!("report-{}.json", report.plan.name));
+    let plots = plots_dir(&out);
+    std::fs::create_dir_all(&plots).with_context(|| format!("creating {}", plots.display()))?;
+    let json = out.join(report_file(&report));
     write_atomically(&json, |w| {
         serde_json::to_writer_pretty(w, &report).map_err(std::io::Error::other)
     })
@@ -118,15 +122,26 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     for r in &report.env_lit {
         for metric in Metric::of_result(r) {
             let stem = format!("{}-{}-{}", r.map, r.mode, metric.file_tag());
-            let [png, _] = plot(&out, &stem, r, metric)?;
+            let [png, _] = plot(&plots, &stem, r, metric)?;
             println!("wrote {} (and .svg)", png.display());
         }
     }
     let details_page = out.join("DETAILS.md");
-    let details_text = match report.plan.is_truth() {
-        true => truth_details(&report, "."),
-        false => details(&report, "."),
+    let plots_from_details = relative_path(&plots, &out);
+    let mut details_text = match report.plan.is_truth() {
+        true => truth_details(&report, &plots_from_details),
+        false => details(&report, &plots_from_details),
     };
+    if plots != out {
+        // The command writes into a scratch page and the plots' folder only: run on docs/, it
+        // would rewrite an older report in today's format and a page's generated section.
+        let note = format!(
+            "Its plots are not kept in the repository. `mkdir -p out && cp docs/BENCHMARKS.md out/page.md && strandlight bench --from-report {} --out {plots} --benchmarks out/page.md` draws them into `{plots}/`, where the images below point, without touching docs/.",
+            slashed(&json),
+            plots = slashed(&plots)
+        );
+        details_text = after_title(&details_text, &note);
+    }
     write_atomically(&details_page, |w| {
         std::io::Write::write_all(w, details_text.as_bytes())
     })
@@ -142,10 +157,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     } else {
         let page = std::fs::read_to_string(&args.benchmarks)
             .with_context(|| format!("reading {}", args.benchmarks.display()))?;
-        let relative = pathdiff(
-            &out,
-            args.benchmarks.parent().unwrap_or(&PathBuf::from(".")),
-        );
+        let relative = relative_path(&out, args.benchmarks.parent().unwrap_or(Path::new(".")));
         let updated = match report.plan.is_truth() {
             true => splice_truth(&page, &truth_section(&report, &relative)),
             false => splice(&page, &section(&report, &relative)),
@@ -213,10 +225,110 @@ fn read_report(path: &std::path::Path) -> anyhow::Result<BenchReport> {
     })
 }
 
-/// `path` relative to `base` when it lies below it (docs/bench from docs → "bench"), else as is.
-fn pathdiff(path: &std::path::Path, base: &std::path::Path) -> String {
-    path.strip_prefix(base)
-        .unwrap_or(path)
-        .display()
-        .to_string()
+/// Where the plots of pages written to `out` go. A folder under docs/ keeps what a reader needs
+/// in the repository, the pages and their report, and hundreds of per-map images would crowd it
+/// (issue 61): its plots go to the same path under out/ (ignored by git), where the run and
+/// `--from-report` draw them. Any other folder takes its plots too.
+fn plots_dir(out: &Path) -> PathBuf {
+    let relative: PathBuf = out
+        .components()
+        .skip_while(|c| matches!(c, Component::CurDir))
+        .collect();
+    match relative.strip_prefix("docs") {
+        Ok(rest) => Path::new("out").join(rest),
+        Err(_) => out.to_path_buf(),
+    }
+}
+
+/// `path` relative to the folder `base`, for a Markdown link from a page in `base` (docs/bench
+/// from docs → "bench", out/bench from docs/bench → "../../out/bench").
+fn relative_path(path: &Path, base: &Path) -> String {
+    // An empty parent (a page named without a folder) is the working folder.
+    let absolute = |p: &Path| match p.as_os_str().is_empty() {
+        true => std::path::absolute("."),
+        false => std::path::absolute(p),
+    };
+    let (Ok(path_abs), Ok(base_abs)) = (absolute(path), absolute(base)) else {
+        return slashed(path);
+    };
+    let (to, from) = (normal_components(&path_abs), normal_components(&base_abs));
+    let common = to.iter().zip(&from).take_while(|(a, b)| a == b).count();
+    let parts: Vec<String> = std::iter::repeat_n("..".to_string(), from.len() - common)
+        .chain(
+            to[common..]
+                .iter()
+                .map(|c| c.as_os_str().to_string_lossy().into_owned()),
+        )
+        .collect();
+    match parts.is_empty() {
+        true => ".".into(),
+        false => parts.join("/"),
+    }
+}
+
+fn normal_components(path: &Path) -> Vec<Component<'_>> {
+    path.components()
+        .filter(|c| !matches!(c, Component::CurDir))
+        .collect()
+}
+
+/// A path as Markdown and a shell on any platform write it.
+fn slashed(path: &Path) -> String {
+    path.components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect::<Vec<_>>()
+        .join("/")
+}
+
+/// `page` with the paragraph `note` after its first line (its title).
+fn after_title(page: &str, note: &str) -> String {
+    match page.split_once("\n\n") {
+        Some((title, rest)) => format!("{title}\n\n{note}\n\n{rest}"),
+        None => format!("{page}\n\n{note}\n"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plots_of_a_page_under_docs_go_to_out() {
+        let cases = [
+            ("docs/bench", "out/bench"),
+            ("./docs/bench-truth/layered", "out/bench-truth/layered"),
+            ("out/bench-quick", "out/bench-quick"),
+            ("elsewhere/docs", "elsewhere/docs"),
+        ];
+        for (out, plots) in cases {
+            assert_eq!(plots_dir(Path::new(out)), PathBuf::from(plots), "{out}");
+        }
+    }
+
+    #[test]
+    fn links_between_folders_climb_out_of_the_page() {
+        let cases = [
+            ("docs/bench", "docs", "bench"),
+            (
+                "out/bench-truth/layered",
+                "docs/bench-truth/layered",
+                "../../../out/bench-truth/layered",
+            ),
+            ("out/bench-quick", "out/bench-quick", "."),
+            ("docs/bench", "", "docs/bench"),
+        ];
+        for (path, base, want) in cases {
+            assert_eq!(
+                relative_path(Path::new(path), Path::new(base)),
+                want,
+                "{path} from {base}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_note_goes_under_the_title() {
+        let page = after_title("# Title\n\nGenerated by bench.\n\n## A map\n", "NOTE");
+        assert_eq!(page, "# Title\n\nNOTE\n\nGenerated by bench.\n\n## A map\n");
+    }
 }

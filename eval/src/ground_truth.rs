@@ -160,8 +160,43 @@ pub struct TruthInputs<'a> {
     pub map_sha256: &'a str,
 }
 
+/// Bumped by hand when a change outside the writer's own code (mitsuba_scene.rs, hashed below,
+/// and mitsuba_render.py, hashed whole) changes the files Mitsuba reads for the same inputs: how
+/// an EXR is written, the head's tessellation, the fibers' default thickness.
+pub const SCENE_WRITER_VERSION: u32 = 1;
+
+/// The writer's source, for [`scene_writer`].
+const SCENE_WRITER_SOURCE: &str = include_str!("ground_truth/mitsuba_scene.rs");
+
+/// The scene writer as a truth's cache key names it: its version and a hash of its code (the
+/// source up to its tests, each line trimmed, without comment and blank lines). A hash cannot be
+/// forgotten the way a hand-bumped number can, so a fix to the writer never serves a truth
+/// rendered from the old scene files (issue 61); comments and tests stay out of it because a
+/// truth costs minutes to hours of Mitsuba. Any other edit of the writer's code renders its
+/// truths again, whether or not the files it writes changed: stale by design, as are the truths
+/// cached before the writer was part of the key.
+fn scene_writer(version: u32, source: &str) -> Value {
+    let code = source.split("\n#[cfg(test)]").next().unwrap_or(source);
+    let lines: Vec<&str> = code
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty() && !l.starts_with("//"))
+        .collect();
+    json!({ "version": version, "code_sha256": sha256_hex(lines.join("\n").as_bytes()) })
+}
+
 impl TruthInputs<'_> {
     fn key(&self, run: MitsubaRun) -> Value {
+        self.key_with_writer(run, scene_writer(SCENE_WRITER_VERSION, SCENE_WRITER_SOURCE))
+    }
+
+    fn key_with_writer(&self, run: MitsubaRun, writer: Value) -> Value {
+        // The map's transform as the writer computes it, not only the rotation it is computed
+        // from: a change to the rotation convention (scene/src/env_orientation.rs) moves Mitsuba's map
+        // without touching the writer's code. Rounded so that the last bits of a sine do not
+        // split the cache.
+        let map_to_world = mitsuba_scene::map_to_world(self.scene.orientation)
+            .map(|row| row.map(|v| (v * 1e9).round() / 1e9));
         let mut key = json!({
             "renderer": "mitsuba3 scalar_rgb path, hair BSDF, bsplinecurve through the strand points, envmap (hidden from the camera), box filter",
             "hair_sha256": self.hair_sha256,
@@ -174,6 +209,8 @@ impl TruthInputs<'_> {
             "fiber": self.scene.fiber,
             "run": run,
             "script_sha256": sha256_hex(mitsuba_scene::RENDER_SCRIPT.as_bytes()),
+            "scene_writer": writer,
+            "map_to_world": map_to_world,
         });
         // Only with a head, so that truths rendered before it keep their keys.
         if let Some(head) = self.scene.head {
@@ -640,6 +677,7 @@ mod tests {
         let e = run_mitsuba_with("/nonexistent/python3", &scene, run()).unwrap_err();
         assert!(format!("{e:#}").contains("pip install mitsuba"), "{e:#}");
         if !strandlight_tables::outside_tools::program_exists(&python()) {
+            strandlight_tables::outside_tools::missing_tool(&python(), "install Python 3");
             return;
         }
         let script = dir.join(mitsuba_scene::RENDER_SCRIPT_NAME);
@@ -670,6 +708,56 @@ mod tests {
         );
         assert!(e.contains("Mitsuba's report"), "{e}");
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn a_change_to_the_scene_writer_changes_the_truths_key() {
+        let hair = generate_groom(&GroomParams {
+            strand_count: 4,
+            clump_count: 1,
+            ..GroomParams::default()
+        })
+        .unwrap();
+        let (up, camera) = front_camera(&hair, (8, 6));
+        let fiber = serde_json::json!({ "eumelanin": 1.3 });
+        let inputs = TruthInputs {
+            scene: MitsubaScene {
+                hair: &hair,
+                orientation: EnvOrientation::upright(up),
+                camera,
+                size: (8, 6),
+                map: None,
+                directional: &[],
+                fiber: &fiber,
+                head: None,
+            },
+            hair_sha256: "h",
+            map_sha256: "m",
+        };
+        let source = "pub fn write() {\n    write_map(1);\n}\n";
+        let key = |version, source| inputs.key_with_writer(run(), scene_writer(version, source));
+        let base = key(SCENE_WRITER_VERSION, source);
+        assert_ne!(
+            base,
+            key(SCENE_WRITER_VERSION + 1, source),
+            "a bumped version"
+        );
+        let fixed = source.replace("write_map(1)", "write_map(2)");
+        assert_ne!(base, key(SCENE_WRITER_VERSION, &fixed), "a fix to the code");
+        // What cannot change the files Mitsuba reads keeps the cached truths.
+        let commented = format!(
+            "//! The writer.\n\n{}",
+            source.replace("{\n", "{\n    // why\n")
+        );
+        let tested = format!("{source}\n#[cfg(test)]\nmod tests {{ fn t() {{}} }}\n");
+        assert_eq!(base, key(SCENE_WRITER_VERSION, &commented), "a comment");
+        assert_eq!(base, key(SCENE_WRITER_VERSION, &tested), "a test");
+        // The key in use names this build's writer.
+        assert_eq!(
+            inputs.key(run())["scene_writer"],
+            scene_writer(SCENE_WRITER_VERSION, SCENE_WRITER_SOURCE)
+        );
+        assert!(SCENE_WRITER_SOURCE.contains("pub fn write_scene("));
     }
 
     /// The sample ladder against a cache filled with images whose error is known: an image of

@@ -1,20 +1,22 @@
 //! The programs from outside this project that some tests need (Mitsuba 3 and NVIDIA's
-//! `flip_evaluator` through Python, `xvfb-run`), and the rule for when one is missing.
+//! `flip_evaluator` through Python, `xvfb-run`), and the rule for when something a test needs is
+//! missing: a tool, a GPU device, or the shared data (`shared_data.rs`).
 //!
-//! A test that cannot find its tool prints why and skips, so that a newcomer's `cargo test` runs
-//! without them. `cargo test` hides the output of passing tests, so in CI a skip would be
-//! invisible: `.ci/run` sets `STRANDLIGHT_REQUIRE_TOOLS=1`, under which a missing tool fails the
-//! test instead.
+//! A test that cannot find what it needs prints why and skips ([`skip_or_fail`]), so that a
+//! newcomer's `cargo test` runs without them. `cargo test` hides the output of passing tests, so
+//! in CI a skip would be invisible: `.ci/run` sets `STRANDLIGHT_REQUIRE_TOOLS=1`, under which the
+//! same test fails instead.
 
 use std::process::Command;
 
-/// The variable that turns a missing tool from a skip into a failure.
+/// The variable that turns a missing tool, GPU device or shared data from a skip into a failure.
 pub const REQUIRE_TOOLS_VAR: &str = "STRANDLIGHT_REQUIRE_TOOLS";
 
 /// The variable naming the Python interpreter to run (default `python3`).
 pub const PYTHON_VAR: &str = "STRANDLIGHT_PYTHON";
 
-/// Whether a missing tool must fail the test (`STRANDLIGHT_REQUIRE_TOOLS` set and not `0`).
+/// Whether a missing tool, GPU device or shared data must fail the test
+/// (`STRANDLIGHT_REQUIRE_TOOLS` set and not `0`).
 pub fn tools_required() -> bool {
     std::env::var(REQUIRE_TOOLS_VAR).is_ok_and(|v| !v.is_empty() && v != "0")
 }
@@ -42,14 +44,24 @@ pub fn program_exists(program: &str) -> bool {
     Command::new(program).arg("--help").output().is_ok()
 }
 
-/// Called by a test whose tool is missing: returns (the caller then skips) after printing
-/// `skipped: …`, or panics with the same message under `STRANDLIGHT_REQUIRE_TOOLS=1`.
-pub fn missing_tool(what: &str, install: &str) {
-    let message = format!("{what} is not available ({install})");
-    if tools_required() {
-        panic!("{message}, and {REQUIRE_TOOLS_VAR} is set: a required tool is missing");
+/// Called by a test that cannot run here, with the reason: returns (the caller then returns
+/// early) after printing `skipped: {reason}`, or panics with the reason under
+/// `STRANDLIGHT_REQUIRE_TOOLS=1`. Every test that may skip comes through here, so that CI can
+/// never pass a test that did not run.
+pub fn skip_or_fail(reason: &str) {
+    skip_or_fail_as(tools_required(), reason);
+}
+
+fn skip_or_fail_as(required: bool, reason: &str) {
+    if required {
+        panic!("{reason}, and {REQUIRE_TOOLS_VAR} is set: this test must run here, not skip");
     }
-    eprintln!("skipped: {message}");
+    eprintln!("skipped: {reason}");
+}
+
+/// Called by a test whose tool is missing: [`skip_or_fail`] with how to install it.
+pub fn missing_tool(what: &str, install: &str) {
+    skip_or_fail(&format!("{what} is not available ({install})"));
 }
 
 /// `true` when Python can import `modules`; otherwise [`missing_tool`] and `false`.
@@ -71,6 +83,17 @@ mod tests {
     #[test]
     fn a_module_that_does_not_exist_is_missing() {
         assert!(!python_has_modules(&["strandlight_no_such_module_4711"]));
+    }
+
+    #[test]
+    #[should_panic(expected = "this test must run here")]
+    fn a_required_skip_fails() {
+        skip_or_fail_as(true, "no such tool");
+    }
+
+    #[test]
+    fn a_skip_that_is_not_required_returns() {
+        skip_or_fail_as(false, "no such tool");
     }
 
     #[test]

@@ -1,7 +1,10 @@
 //! Where tests and benchmarks find the real data files of others (`../shared/data` beside the
-//! checkout; see its SOURCES.md). They are never copied into the repository.
+//! checkout; see its SOURCES.md). They are never copied into the repository. A test without
+//! them skips, or fails under `STRANDLIGHT_REQUIRE_TOOLS=1` ([`crate::outside_tools`]).
 
 use std::path::{Path, PathBuf};
+
+use crate::outside_tools::skip_or_fail;
 
 /// The shared data folder: `$STRANDLIGHT_SHARED_DATA` if set, else the first `shared/data`
 /// found beside the workspace root or one of its ancestors. `None` when absent.
@@ -16,17 +19,25 @@ pub fn shared_data_dir() -> Option<PathBuf> {
         .find(|d| d.is_dir())
 }
 
-/// A file below the shared data folder, or `None` after printing why the caller must skip.
-pub fn shared_file(relative: &str) -> Option<PathBuf> {
-    match shared_data_dir() {
-        Some(dir) if dir.join(relative).is_file() => Some(dir.join(relative)),
-        Some(dir) => {
-            eprintln!("skipped: {} is not in {}", relative, dir.display());
-            None
-        }
-        None => {
-            eprintln!("skipped: no ../shared/data folder beside the checkout (needed: {relative})");
-            None
-        }
+/// The shared data folder for a test that needs `what` from it, or `None` after
+/// [`skip_or_fail`] (the caller then skips; under `STRANDLIGHT_REQUIRE_TOOLS=1` it failed).
+pub fn shared_dir_for(what: &str) -> Option<PathBuf> {
+    let dir = shared_data_dir();
+    if dir.is_none() {
+        skip_or_fail(&format!(
+            "no shared data folder (../shared/data beside the checkout, or $STRANDLIGHT_SHARED_DATA) for {what}"
+        ));
     }
+    dir
+}
+
+/// A file below the shared data folder, or `None` after [`skip_or_fail`].
+pub fn shared_file(relative: &str) -> Option<PathBuf> {
+    let dir = shared_dir_for(relative)?;
+    let path = dir.join(relative);
+    if !path.is_file() {
+        skip_or_fail(&format!("{relative} is not in {}", dir.display()));
+        return None;
+    }
+    Some(path)
 }

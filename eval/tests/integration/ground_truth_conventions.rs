@@ -5,9 +5,9 @@
 //! a small scene with strandlight's env-lit renderer and with Mitsuba 3 (`scene/src/
 //! ground_truth.rs`), on the same Chiang fiber (Mitsuba's own `hair` BSDF on its side).
 //!
-//! Mitsuba is installed by `.ci/run`; without it the tests print why and pass, unless
-//! `STRANDLIGHT_REQUIRE_TOOLS=1` (CI) makes a missing tool a failure. Without a GPU device
-//! (not even lavapipe) they print why and pass, as the other GPU tests do.
+//! Mitsuba is installed by `.ci/run`; without it, or without a GPU device (not even lavapipe),
+//! the tests print why and pass, unless `STRANDLIGHT_REQUIRE_TOOLS=1` (CI) makes either a
+//! failure.
 
 use glam::{DVec3, Vec3};
 use std::path::{Path, PathBuf};
@@ -36,7 +36,7 @@ use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode, SceneTables, bake_scene_tables};
 use strandlight_scene::steps::Steps;
 use strandlight_tables::image_out::write_exr;
-use strandlight_tables::outside_tools::require_python_modules;
+use strandlight_tables::outside_tools::{require_python_modules, skip_or_fail};
 
 /// Mitsuba and a GPU device, or the reason to skip (printed).
 fn tools() -> bool {
@@ -44,7 +44,7 @@ fn tools() -> bool {
         return false;
     }
     if let Err(e) = env_adapter() {
-        eprintln!("skipped: no GPU device for the env-lit renderer: {e:#}");
+        skip_or_fail(&format!("no GPU device for the env-lit renderer: {e:#}"));
         return false;
     }
     true

@@ -28,7 +28,7 @@ use strandlight_scene::head_input::{HeadChoice, load_head};
 use strandlight_scene::image_metrics::Image;
 use strandlight_scene::look::{EnvLook, LookArgs};
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode, bake_scene_tables};
-use strandlight_tables::outside_tools::require_python_modules;
+use strandlight_tables::outside_tools::{require_python_modules, skip_or_fail};
 
 const SIZE: (u32, u32) = (48, 36);
 const SKIN: [f32; 3] = [0.6, 0.45, 0.35];
@@ -38,7 +38,7 @@ fn tools() -> bool {
         return false;
     }
     if let Err(e) = env_adapter() {
-        eprintln!("skipped: no GPU device for the env-lit renderer: {e:#}");
+        skip_or_fail(&format!("no GPU device for the env-lit renderer: {e:#}"));
         return false;
     }
     true

@@ -5,7 +5,7 @@ use strandlight_precompute::EnvMapError;
 use strandlight_precompute::envmap::EnvMap;
 use strandlight_precompute::envmap_io::{LoadOptions, decode, load, write_exr};
 use strandlight_precompute::radiance_hdr::encode_for_tests;
-use strandlight_tables::shared_data::shared_data_dir;
+use strandlight_tables::shared_data::shared_file;
 
 const SHARED_MAPS: [&str; 8] = [
     "hdr_overcast_soil_puresky_1k.hdr",
@@ -40,16 +40,10 @@ fn gradient_map(w: usize, h: usize) -> EnvMap {
 
 #[test]
 fn every_shared_map_loads_and_standard_hdr_agrees_with_the_image_crate() {
-    let Some(dir) = shared_data_dir() else {
-        eprintln!("skipped: no ../shared/data");
-        return;
-    };
     for name in SHARED_MAPS {
-        let path = dir.join("envmaps").join(name);
-        if !path.is_file() {
-            eprintln!("skipped: {name} missing");
+        let Some(path) = shared_file(&format!("envmaps/{name}")) else {
             continue;
-        }
+        };
         let loaded = load(&path, LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
         let m = &loaded.map;
         let integral = m.integral();
@@ -93,8 +87,7 @@ fn every_shared_map_loads_and_standard_hdr_agrees_with_the_image_crate() {
 #[test]
 fn exr_channels_are_matched_by_name() {
     // piz_compressed.exr stores B, G, R: red must come from the channel named R.
-    let Some(path) = strandlight_tables::shared_data::shared_file("envmaps/piz_compressed.exr")
-    else {
+    let Some(path) = shared_file("envmaps/piz_compressed.exr") else {
         return;
     };
     let ours = load(&path, LoadOptions::default()).unwrap().map;

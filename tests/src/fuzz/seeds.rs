@@ -1,8 +1,9 @@
 //! Seed corpora: small valid files written by the project's own writers (so the harness runs
-//! without the shared data), plus the shared real samples of each format when
-//! `../shared/data` is there. Real files of more than a few hundred kB are cut down to their
-//! first strands or scanlines by rewriting their headers (their bytes are otherwise kept as
-//! they are), so an execution stays in the millisecond range.
+//! without the shared data), plus the shared real samples of each format from `../shared/data`
+//! (without it a printed skip, or a failure under `STRANDLIGHT_REQUIRE_TOOLS=1`). Real files of
+//! more than a few hundred kB are cut down to their first strands or scanlines by rewriting
+//! their headers (their bytes are otherwise kept as they are), so an execution stays in the
+//! millisecond range.
 
 use std::path::Path;
 
@@ -15,7 +16,7 @@ use strandlight_precompute::srbf_fit::{FitOptions, RoundRecord};
 use strandlight_precompute::srbf_set::{FORMAT, FORMAT_VERSION, LightKind, SrbfSet};
 use strandlight_runtime::hair::{self, GroomParams, HairModel, HairWriteOptions};
 use strandlight_tables::asset::{self, AssetDescription, CreationInfo, Generator, Storage};
-use strandlight_tables::shared_data::shared_data_dir;
+use strandlight_tables::shared_data::shared_dir_for;
 use strandlight_tables::table::{Axis, Table};
 
 /// One seed input.
@@ -407,8 +408,7 @@ fn shared_seeds(name: &str) -> Vec<Seed> {
         "hdr" | "exr" => ("envmaps", name),
         _ => return Vec::new(), // no shared samples of the project's own formats
     };
-    let Some(dir) = shared_data_dir() else {
-        eprintln!("{name}: no ../shared/data beside the checkout; generated seeds only");
+    let Some(dir) = shared_dir_for(&format!("the real {name} seeds (generated seeds only)")) else {
         return Vec::new();
     };
     let mut files: Vec<_> = std::fs::read_dir(dir.join(folder))
