@@ -104,40 +104,7 @@ impl Element {
 pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
     let (elements, body_start) = parse_header(data, file)?;
     let bytes = FileBytes::new(data, file);
-    let unsupported = |why: String| HairError::Unsupported {
-        file: file.into(),
-        format: FORMAT,
-        why,
-    };
-    let find = |name: &str| elements.iter().position(|e| e.name == name);
-    let vertex_index = find("vertex").ok_or_else(|| unsupported("no `vertex` element".into()))?;
-    let strand_index = find("strand")
-        .ok_or_else(|| unsupported("no `strand` element (segment counts per strand)".into()))?;
-    let vertex = &elements[vertex_index];
-    let strand = &elements[strand_index];
-    let xyz: Vec<usize> = ["x", "y", "z"]
-        .iter()
-        .filter_map(|n| vertex.property(n))
-        .collect();
-    if xyz.len() != 3 {
-        return Err(unsupported("`vertex` lacks one of x, y, z".into()));
-    }
-    let rgb: Vec<usize> = ["red", "green", "blue"]
-        .iter()
-        .filter_map(|n| vertex.property(n))
-        .collect();
-    let nsegs = ["nsegs", "num_segments", "segments"]
-        .iter()
-        .find_map(|n| strand.property(n))
-        .ok_or_else(|| unsupported("`strand` has no `nsegs` property".into()))?;
-    if [vertex, strand]
-        .iter()
-        .any(|e| e.properties.iter().any(|p| p.list_count.is_some()))
-    {
-        return Err(unsupported(
-            "list properties in `vertex` or `strand`".into(),
-        ));
-    }
+    let layout = HairLayout::locate(&elements, file)?;
 
     // Absurd counts: every element's instances must fit in what follows the header.
     let body = FileBytes::new(&data[body_start..], file);
@@ -153,58 +120,20 @@ pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
         )?;
     }
 
+    let mut hair = HairData::default();
     let mut offset = body_start as u64;
-    let mut points = Vec::new();
-    let mut colors = Vec::new();
-    let mut counts = Vec::new();
     for (index, element) in elements.iter().enumerate() {
         let stride = element.min_bytes();
         let fixed = element.properties.iter().all(|p| p.list_count.is_none());
-        if index == vertex_index || index == strand_index {
+        if index == layout.vertex || index == layout.strand {
             let all = bytes.slice(offset, stride * element.count, || {
                 format!("{} {} elements", element.count, element.name)
             })?;
-            let field_offsets: Vec<usize> = element
-                .properties
-                .iter()
-                .scan(0usize, |at, p| {
-                    let here = *at;
-                    *at += p.kind.size() as usize;
-                    Some(here)
-                })
-                .collect();
-            let value =
-                |row: &[u8], p: usize| element.properties[p].kind.read(&row[field_offsets[p]..]);
-            for row in all.chunks_exact(stride as usize) {
-                if index == vertex_index {
-                    points.push(Vec3::new(
-                        value(row, xyz[0]) as f32,
-                        value(row, xyz[1]) as f32,
-                        value(row, xyz[2]) as f32,
-                    ));
-                    if rgb.len() == 3 {
-                        let scale = |p: usize| {
-                            if element.properties[p].kind == Scalar::U8 {
-                                1.0 / 255.0
-                            } else {
-                                1.0
-                            }
-                        };
-                        let c = |i: usize| (value(row, rgb[i]) * scale(rgb[i])) as f32;
-                        colors.push(Vec3::new(c(0), c(1), c(2)));
-                    }
-                } else {
-                    let n = value(row, nsegs);
-                    if !(0.0..u32::MAX as f64).contains(&n) {
-                        return Err(HairError::BadValue {
-                            file: file.into(),
-                            what: format!("nsegs of strand {}", counts.len()),
-                            value: n.to_string(),
-                            why: "must be a count ≥ 0",
-                        });
-                    }
-                    counts.push(n as u32 + 1);
-                }
+            let rows = FixedRows::new(element, all);
+            if index == layout.vertex {
+                hair.read_vertices(&rows, &layout);
+            } else {
+                hair.read_segment_counts(&rows, layout.nsegs, file)?;
             }
             offset += stride * element.count;
         } else if fixed {
@@ -213,38 +142,21 @@ pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
             offset = skip_with_lists(&bytes, element, offset)?;
         }
     }
-    // Every element was walked, so the file must end exactly here.
-    if offset != bytes.len() {
-        let what = format!("{} elements after the header", elements.len());
-        return Err(if offset > bytes.len() {
-            HairError::Truncated {
-                file: file.into(),
-                what,
-                needed: offset,
-                actual: bytes.len(),
-            }
-        } else {
-            HairError::SizeMismatch {
-                file: file.into(),
-                expected: offset,
-                actual: bytes.len(),
-            }
-        });
-    }
-    let counted: u64 = counts.iter().map(|&c| c as u64).sum();
-    if counted != points.len() as u64 {
+    check_file_ends_at(offset, &bytes, elements.len(), file)?;
+    let counted: u64 = hair.counts.iter().map(|&c| c as u64).sum();
+    if counted != hair.points.len() as u64 {
         return Err(HairError::CountMismatch {
             file: file.into(),
             what: "vertices (sum of nsegs + 1 over strands)",
-            declared: points.len() as u64,
+            declared: hair.points.len() as u64,
             actual: counted,
         });
     }
-    let color = (rgb.len() == 3).then_some(Attribute::PerPoint(colors));
+    let color = layout.rgb.map(|_| Attribute::PerPoint(hair.colors));
     finish(
         RawHair {
-            points,
-            counts,
+            points: hair.points,
+            counts: hair.counts,
             thickness: None,
             transparency: None,
             color,
@@ -253,6 +165,188 @@ pub fn parse_ply(data: &[u8], file: &Path) -> Result<LoadedHair, HairError> {
         HairFormat::Ply,
         String::new(),
     )
+}
+
+/// Where the hair is among the file's elements: the element of the points and the one of the
+/// per-strand segment counts, and the properties read from each. Everything else is read past.
+struct HairLayout {
+    vertex: usize,
+    strand: usize,
+    xyz: [usize; 3],
+    /// `red green blue`, where the vertices have all three.
+    rgb: Option<[usize; 3]>,
+    nsegs: usize,
+}
+
+impl HairLayout {
+    /// Finds the elements and properties, refusing a file without them or with list properties
+    /// in them (which the fixed-row reader cannot walk).
+    fn locate(elements: &[Element], file: &Path) -> Result<Self, HairError> {
+        let unsupported = |why: String| HairError::Unsupported {
+            file: file.into(),
+            format: FORMAT,
+            why,
+        };
+        let find = |name: &str| elements.iter().position(|e| e.name == name);
+        let vertex_index =
+            find("vertex").ok_or_else(|| unsupported("no `vertex` element".into()))?;
+        let strand_index = find("strand")
+            .ok_or_else(|| unsupported("no `strand` element (segment counts per strand)".into()))?;
+        let vertex = &elements[vertex_index];
+        let strand = &elements[strand_index];
+        let xyz: Vec<usize> = ["x", "y", "z"]
+            .iter()
+            .filter_map(|n| vertex.property(n))
+            .collect();
+        if xyz.len() != 3 {
+            return Err(unsupported("`vertex` lacks one of x, y, z".into()));
+        }
+        let rgb: Vec<usize> = ["red", "green", "blue"]
+            .iter()
+            .filter_map(|n| vertex.property(n))
+            .collect();
+        let nsegs = ["nsegs", "num_segments", "segments"]
+            .iter()
+            .find_map(|n| strand.property(n))
+            .ok_or_else(|| unsupported("`strand` has no `nsegs` property".into()))?;
+        if [vertex, strand]
+            .iter()
+            .any(|e| e.properties.iter().any(|p| p.list_count.is_some()))
+        {
+            return Err(unsupported(
+                "list properties in `vertex` or `strand`".into(),
+            ));
+        }
+        Ok(Self {
+            vertex: vertex_index,
+            strand: strand_index,
+            xyz: [xyz[0], xyz[1], xyz[2]],
+            rgb: (rgb.len() == 3).then(|| [rgb[0], rgb[1], rgb[2]]),
+            nsegs,
+        })
+    }
+}
+
+/// The instances of an element without list properties: rows of one fixed size, each property
+/// at a fixed offset in its row.
+struct FixedRows<'a> {
+    element: &'a Element,
+    bytes: &'a [u8],
+    field_offsets: Vec<usize>,
+}
+
+impl<'a> FixedRows<'a> {
+    fn new(element: &'a Element, bytes: &'a [u8]) -> Self {
+        let field_offsets = element
+            .properties
+            .iter()
+            .scan(0usize, |at, p| {
+                let here = *at;
+                *at += p.kind.size() as usize;
+                Some(here)
+            })
+            .collect();
+        Self {
+            element,
+            bytes,
+            field_offsets,
+        }
+    }
+
+    fn rows(&self) -> std::slice::ChunksExact<'a, u8> {
+        self.bytes.chunks_exact(self.element.min_bytes() as usize)
+    }
+
+    /// Property `p` of `row`, whatever its scalar type.
+    fn value(&self, row: &[u8], p: usize) -> f64 {
+        self.element.properties[p]
+            .kind
+            .read(&row[self.field_offsets[p]..])
+    }
+}
+
+/// What the vertex and strand elements hold, as [`RawHair`] wants it.
+#[derive(Default)]
+struct HairData {
+    points: Vec<Vec3>,
+    colors: Vec<Vec3>,
+    counts: Vec<u32>,
+}
+
+impl HairData {
+    /// Points, and colours where the vertices have them (uchar channels scaled from 0–255).
+    fn read_vertices(&mut self, rows: &FixedRows, layout: &HairLayout) {
+        let xyz = layout.xyz;
+        for row in rows.rows() {
+            self.points.push(Vec3::new(
+                rows.value(row, xyz[0]) as f32,
+                rows.value(row, xyz[1]) as f32,
+                rows.value(row, xyz[2]) as f32,
+            ));
+            if let Some(rgb) = layout.rgb {
+                let scale = |p: usize| {
+                    if rows.element.properties[p].kind == Scalar::U8 {
+                        1.0 / 255.0
+                    } else {
+                        1.0
+                    }
+                };
+                let c = |i: usize| (rows.value(row, rgb[i]) * scale(rgb[i])) as f32;
+                self.colors.push(Vec3::new(c(0), c(1), c(2)));
+            }
+        }
+    }
+
+    /// Points per strand (`nsegs + 1`); a count that is negative, NaN or beyond u32 is a typed
+    /// error naming the strand.
+    fn read_segment_counts(
+        &mut self,
+        rows: &FixedRows,
+        nsegs: usize,
+        file: &Path,
+    ) -> Result<(), HairError> {
+        for row in rows.rows() {
+            let n = rows.value(row, nsegs);
+            if !(0.0..u32::MAX as f64).contains(&n) {
+                return Err(HairError::BadValue {
+                    file: file.into(),
+                    what: format!("nsegs of strand {}", self.counts.len()),
+                    value: n.to_string(),
+                    why: "must be a count ≥ 0",
+                });
+            }
+            self.counts.push(n as u32 + 1);
+        }
+        Ok(())
+    }
+}
+
+/// Every element was walked up to `offset`, so the file must end exactly there: shorter is
+/// truncated, longer has bytes no element accounts for.
+fn check_file_ends_at(
+    offset: u64,
+    bytes: &FileBytes,
+    element_count: usize,
+    file: &Path,
+) -> Result<(), HairError> {
+    if offset == bytes.len() {
+        return Ok(());
+    }
+    let what = format!("{element_count} elements after the header");
+    Err(if offset > bytes.len() {
+        HairError::Truncated {
+            file: file.into(),
+            what,
+            needed: offset,
+            actual: bytes.len(),
+        }
+    } else {
+        HairError::SizeMismatch {
+            file: file.into(),
+            expected: offset,
+            actual: bytes.len(),
+        }
+    })
 }
 
 /// Reads past an element that has list properties, one instance at a time.
