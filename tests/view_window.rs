@@ -14,7 +14,7 @@ use std::path::Path;
 use std::process::Command;
 use strandlight_eval::reference_cache::read_rgba_exr;
 use strandlight_scene::frame_settings::{PointLighting, Shadows, Transparency};
-use strandlight_scene::image_metrics::relative_rmse;
+use strandlight_scene::image_metrics::{Image, relative_rmse};
 use strandlight_tables::artist::ArtistParams;
 use strandlight_tables::outside_tools::{missing_tool, program_exists};
 
@@ -91,11 +91,42 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
     let dir = std::env::temp_dir().join(format!("strandlight-view-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    // The rebake: a brighter, wider primary highlight (the artist table holds the colours).
+    let report = run_scripted_window(xvfb, &dir);
+    phase("the scripted window exited");
+
+    assert_bakes_ran_while_the_window_presented(&report);
+    assert!(lit_share(&dir.join("shot.png")) > 0.02, "blank screenshot");
+    assert_readout_beside_the_image(&report);
+    assert_window_captures_show_the_screenshots(&report, &dir);
+
+    let sidecar: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("shot.json")).unwrap()).unwrap();
+    assert!(
+        sidecar["camera"]["exact"].is_object(),
+        "the drag orbited: {sidecar}"
+    );
+    assert_eq!(sidecar["artist"]["r"]["intensity"], json!(1.5));
+
+    let shot = read_rgba_exr(&dir.join("shot.exr")).unwrap();
+    let error = replay_error(&dir, "shot");
+    println!("screenshot against its replay: relative RMSE {error:.2e}");
+    // The viewer sums its light batches on the CPU, `render` on the GPU: rounding only.
+    assert!(error < 1e-4, "replay differs: relative RMSE {error}");
+    phase("the screenshot replayed");
+
+    assert_point_lit_screenshot_changed_and_replays(&dir, &shot);
+    phase("the point-lit screenshot replayed");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The script of the test: orbit, toggle the overlay keys, change an artist control (which
+/// rebakes a table: a brighter, wider primary highlight, the artist table holding the colours),
+/// screenshot `shot`; then switch to [`point_lighting`], orbit again and screenshot `points`.
+fn viewer_script() -> Value {
     let mut artist = ArtistParams::default();
     artist.r.intensity = 1.5;
     artist.r.width_deg = 8.0;
-    let script = json!([
+    json!([
         {"wait": "converged"},
         {"drag": [[0.5, 0.5], [0.62, 0.42]]},
         {"wait": "converged"},
@@ -118,10 +149,15 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
         {"wait": "converged"},
         {"frames": 2},
         {"screenshot": "points"}
-    ]);
-    std::fs::write(dir.join("script.json"), script.to_string()).unwrap();
+    ])
+}
+
+/// Runs `strandlight view` on [`viewer_script`] in `dir` under `xvfb`; it must exit cleanly.
+/// Returns (and prints) the viewer's report.
+fn run_scripted_window(xvfb: &str, dir: &Path) -> Value {
+    std::fs::write(dir.join("script.json"), viewer_script().to_string()).unwrap();
     let out = Command::new(xvfb)
-        .current_dir(&dir)
+        .current_dir(dir)
         .args([
             "-a",
             "-s",
@@ -149,12 +185,15 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
         .expect("xvfb-run runs");
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "view failed:\n{stderr}");
-    phase("the scripted window exited");
     let report: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
     println!("{}", serde_json::to_string_pretty(&report).unwrap());
+    report
+}
 
-    // The first bake and the rebake both ran while the window presented frames.
+/// The first bake and the rebake both ran while the window presented frames, with no gap near
+/// a bake's length.
+fn assert_bakes_ran_while_the_window_presented(report: &Value) {
     assert!(report["bakes_seen"].as_u64().unwrap() >= 2, "{report}");
     assert!(
         report["frames_presented_during_bakes"].as_u64().unwrap() >= 20,
@@ -164,10 +203,10 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
         .as_f64()
         .unwrap();
     assert!(gap < 1500.0, "the window stalled {gap} ms during a bake");
+}
 
-    assert!(lit_share(&dir.join("shot.png")) > 0.02, "blank screenshot");
-
-    // The timing readout sits beside the image, so it never covers the hair.
+/// The timing readout sits beside the image, so it never covers the hair.
+fn assert_readout_beside_the_image(report: &Value) {
     let rect_of = |v: &Value| -> [f64; 4] {
         let r: Vec<f64> = v
             .as_array()
@@ -185,9 +224,11 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
         overlap_x <= 0.0 || overlap_y <= 0.0,
         "the readout {readout:?} covers the image {image:?}"
     );
+}
 
-    // The whole window, panel included: larger than the frame, and showing the same picture
-    // where the frame sits.
+/// The whole window, panel included: larger than the frame, and showing the same picture where
+/// the frame sits, for both screenshots.
+fn assert_window_captures_show_the_screenshots(report: &Value, dir: &Path) {
     assert_eq!(
         report["window_captures"],
         json!(["shot-window.png", "points-window.png"])
@@ -216,22 +257,11 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
             "{stem}: the window shows another picture: {difference} levels"
         );
     }
-    let sidecar: Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("shot.json")).unwrap()).unwrap();
-    assert!(
-        sidecar["camera"]["exact"].is_object(),
-        "the drag orbited: {sidecar}"
-    );
-    assert_eq!(sidecar["artist"]["r"]["intensity"], json!(1.5));
+}
 
-    let shot = read_rgba_exr(&dir.join("shot.exr")).unwrap();
-    let error = replay_error(&dir, "shot");
-    println!("screenshot against its replay: relative RMSE {error:.2e}");
-    // The viewer sums its light batches on the CPU, `render` on the GPU: rounding only.
-    assert!(error < 1e-4, "replay differs: relative RMSE {error}");
-    phase("the screenshot replayed");
-
-    // Point lights: the sidecar holds them, the picture changed, and it replays.
+/// Point lights: the sidecar holds them, the picture changed from the environment-lit `shot`,
+/// and it replays.
+fn assert_point_lit_screenshot_changed_and_replays(dir: &Path, shot: &Image) {
     let sidecar: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("points.json")).unwrap()).unwrap();
     assert_eq!(
@@ -244,13 +274,12 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
         "blank point-lit screenshot"
     );
     let points = read_rgba_exr(&dir.join("points.exr")).unwrap();
-    let change = relative_rmse(&points, &shot).unwrap();
+    let change = relative_rmse(&points, shot).unwrap();
     assert!(
         change > 0.1,
         "the point lights did not change the picture: {change}"
     );
-    let error = replay_error(&dir, "points");
-    phase("the point-lit screenshot replayed");
+    let error = replay_error(dir, "points");
     println!("point-lit screenshot against its replay: relative RMSE {error:.2e}");
     // The same frame function on the same device, but sorted transparency bins its segments with
     // atomics and blends each bin in whatever order they give (sorted_blend.wgsl), so two runs of
@@ -260,7 +289,6 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
         error < 1e-3,
         "point-lit replay differs: relative RMSE {error}"
     );
-    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// The point lights the script switches to: the default light, shadowed by deep opacity maps,

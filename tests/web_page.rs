@@ -252,40 +252,9 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
     let site = work.join(format!("site-{}", std::process::id()));
     let shots = work.join(format!("page-{}", std::process::id()));
     std::fs::create_dir_all(&shots).unwrap();
-    // The demo's settings with the 8 most powerful lobes (and the 7 compact sources): one light
-    // batch and one march, so that SwiftShader converges in CI's time.
-    let defaults = work.join(format!("defaults-{}", std::process::id()));
-    run(strandlight(&work)
-        .args(["web", "--page"])
-        .arg(&page)
-        .arg("--out")
-        .arg(&defaults));
-    phase("defaults site built (fit and tables)");
-    let mut settings: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(defaults.join("bundle/settings.json")).unwrap())
-            .unwrap();
-    settings["lighting"]["environment"]["lobes"] = 8.into();
-    // SwiftShader draws light maps slowly: 256² (a quarter of the demo's texels) keeps the page's
-    // three convergences within CI's time; the limits check below goes back to 512².
-    settings["lighting"]["environment"]["dodm_size"] = 256.into();
-    let test_settings = work.join(format!("settings-{}.json", std::process::id()));
-    std::fs::write(&test_settings, serde_json::to_vec(&settings).unwrap()).unwrap();
-    let _ = std::fs::remove_dir_all(&defaults);
-    run(strandlight(&work)
-        .args(["web", "--size", "160x120", "--page"])
-        .arg(&page)
-        .arg("--replay")
-        .arg(&test_settings)
-        .arg("--out")
-        .arg(&site));
-    phase("test site built");
+    let test_settings = build_test_site(&work, &page, &site, &phase);
     let settings = site.join("bundle/settings.json");
-    run(strandlight(&work)
-        .args(["render", "replay"])
-        .arg(&settings)
-        .arg("--out")
-        .arg(shots.join("native")));
-    let native = read_rgba_exr(&shots.join("native.exr")).unwrap();
+    let native = replay(&work, &settings, &shots, "native");
 
     phase("native replay rendered");
     let session = native_session(&site.join("bundle"));
@@ -294,16 +263,93 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
     assert!(session_error < NATIVE_SESSION_TOLERANCE, "{session_error}");
 
     phase("native session stepped");
-    let server = Server::start(&site);
+    let report = run_page_harness(&site, &shots);
+    phase("Chromium harness done");
+    assert!(report["title"].as_str().unwrap().ends_with("converged"));
+
+    let browser = read_frame(&shots.join("frame.f32"), &native);
+    assert_matches("the page's first frame", &browser, &native);
+
+    // The orbited and zoomed frame against render replay of the settings the page reports.
+    let orbited_native = replay(&work, &shots.join("orbited.json"), &shots, "orbited-native");
+    let orbited = read_frame(&shots.join("orbited.f32"), &orbited_native);
+    assert!(
+        relative_rmse(&orbited, &browser).unwrap() > 0.3,
+        "the orbit did not change the frame"
+    );
+    assert_matches("the orbited and zoomed frame", &orbited, &orbited_native);
+
+    phase("orbited frame replayed");
+    // Switched to single scattering in the panel: less light, and render replay's frame.
+    let single_native = replay(&work, &shots.join("single.json"), &shots, "single-native");
+    let single = read_frame(&shots.join("single.f32"), &single_native);
+    let multiple_share = 1.0 - total(&single) / total(&orbited);
+    eprintln!("multiple scattering's share of the orbited frame: {multiple_share:.3}");
+    assert!(multiple_share > 0.05, "{multiple_share}");
+    assert_matches("the single-scattering frame", &single, &single_native);
+
+    phase("single frame replayed");
+    assert_bad_file_left_the_page_as_it_was(&report);
+    assert_light_maps_shrink_under_a_binding_limit(&site.join("bundle"), &settings, &native);
+    phase("limited session converged");
+    let _ = std::fs::remove_dir_all(&site);
+    let _ = std::fs::remove_file(&test_settings);
+}
+
+/// Builds the test's site in `site`: the demo's settings with the 8 most powerful lobes (and the
+/// 7 compact sources), one light batch and one march, so that SwiftShader converges in CI's
+/// time, at 160×120. Returns the settings file it was built from (for the caller to remove).
+fn build_test_site(work: &Path, page: &Path, site: &Path, phase: &dyn Fn(&str)) -> PathBuf {
+    let defaults = work.join(format!("defaults-{}", std::process::id()));
+    run(strandlight(work)
+        .args(["web", "--page"])
+        .arg(page)
+        .arg("--out")
+        .arg(&defaults));
+    phase("defaults site built (fit and tables)");
+    let mut settings: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(defaults.join("bundle/settings.json")).unwrap())
+            .unwrap();
+    settings["lighting"]["environment"]["lobes"] = 8.into();
+    // SwiftShader draws light maps slowly: 256² (a quarter of the demo's texels) keeps the page's
+    // three convergences within CI's time; the limits check goes back to 512².
+    settings["lighting"]["environment"]["dodm_size"] = 256.into();
+    let test_settings = work.join(format!("settings-{}.json", std::process::id()));
+    std::fs::write(&test_settings, serde_json::to_vec(&settings).unwrap()).unwrap();
+    let _ = std::fs::remove_dir_all(&defaults);
+    run(strandlight(work)
+        .args(["web", "--size", "160x120", "--page"])
+        .arg(page)
+        .arg("--replay")
+        .arg(&test_settings)
+        .arg("--out")
+        .arg(site));
+    phase("test site built");
+    test_settings
+}
+
+/// `render replay` of `settings` into `shots/STEM.exr`, read back.
+fn replay(work: &Path, settings: &Path, shots: &Path, stem: &str) -> Image {
+    run(strandlight(work)
+        .args(["render", "replay"])
+        .arg(settings)
+        .arg("--out")
+        .arg(shots.join(stem)));
+    read_rgba_exr(&shots.join(format!("{stem}.exr"))).unwrap()
+}
+
+/// Serves `site` and runs the Chromium harness on it, which writes its frames and `report.json`
+/// into `shots`; the harness must succeed. Returns (and prints the timing of) its report.
+fn run_page_harness(site: &Path, shots: &Path) -> serde_json::Value {
+    let server = Server::start(site);
     let harness = repo().join("web/harness/page_check.mjs");
     let out = Command::new("node")
         .arg(&harness)
         .arg(&server.1)
-        .arg(&shots)
+        .arg(shots)
         .arg("600")
         .output()
         .unwrap();
-    phase("Chromium harness done");
     drop(server);
     let report_text = std::fs::read_to_string(shots.join("report.json")).unwrap_or_default();
     assert!(
@@ -316,41 +362,12 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
         "page report: {}; harness phases (ms since launch): {}",
         report["timing"], report["phasesMs"]
     );
-    assert!(report["title"].as_str().unwrap().ends_with("converged"));
+    report
+}
 
-    let browser = read_frame(&shots.join("frame.f32"), &native);
-    assert_matches("the page's first frame", &browser, &native);
-
-    // The orbited and zoomed frame against render replay of the settings the page reports.
-    let orbited_settings = shots.join("orbited.json");
-    run(strandlight(&work)
-        .args(["render", "replay"])
-        .arg(&orbited_settings)
-        .arg("--out")
-        .arg(shots.join("orbited-native")));
-    let orbited_native = read_rgba_exr(&shots.join("orbited-native.exr")).unwrap();
-    let orbited = read_frame(&shots.join("orbited.f32"), &orbited_native);
-    assert!(
-        relative_rmse(&orbited, &browser).unwrap() > 0.3,
-        "the orbit did not change the frame"
-    );
-    assert_matches("the orbited and zoomed frame", &orbited, &orbited_native);
-
-    phase("orbited frame replayed");
-    // Switched to single scattering in the panel: less light, and render replay's frame.
-    run(strandlight(&work)
-        .args(["render", "replay"])
-        .arg(shots.join("single.json"))
-        .arg("--out")
-        .arg(shots.join("single-native")));
-    let single_native = read_rgba_exr(&shots.join("single-native.exr")).unwrap();
-    let single = read_frame(&shots.join("single.f32"), &single_native);
-    let multiple_share = 1.0 - total(&single) / total(&orbited);
-    eprintln!("multiple scattering's share of the orbited frame: {multiple_share:.3}");
-    assert!(multiple_share > 0.05, "{multiple_share}");
-    assert_matches("the single-scattering frame", &single, &single_native);
-
-    phase("single frame replayed");
+/// The file that is not a groom left a message naming it, the title still converged and the
+/// frame as it was.
+fn assert_bad_file_left_the_page_as_it_was(report: &serde_json::Value) {
     let message = report["badFileMessage"].as_str().unwrap();
     assert!(message.contains("broken.hair"), "{message}");
     assert!(message.contains("truncated"), "{message}");
@@ -361,19 +378,22 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
             .ends_with("converged")
     );
     assert_eq!(report["frameKeptAfterBadFile"], true);
+}
 
-    // A device held to 26 MiB storage bindings (WebGPU's default is 128): a batch of the
-    // sun-and-sky's seven compact sources at the demo's 512² needs 28 MiB of summed-area tables,
-    // the largest table 24 MiB. The page shrinks its light maps until a batch fits, says so, and
-    // converges.
+/// A device held to 26 MiB storage bindings (WebGPU's default is 128): a batch of the
+/// sun-and-sky's seven compact sources at the demo's 512² needs 28 MiB of summed-area tables,
+/// the largest table 24 MiB. The page's session (on `bundle`, with `settings` turned back to
+/// 512² light maps) shrinks its light maps until a batch fits, says so, and converges to a
+/// frame with at least half the light of `native`.
+fn assert_light_maps_shrink_under_a_binding_limit(bundle: &Path, settings: &Path, native: &Image) {
     let limits = wgpu::Limits {
         max_storage_buffer_binding_size: 26 << 20,
         ..wgpu::Limits::default()
     };
     let gpu = GpuContext::new_headless_limited(limits).unwrap();
-    let mut files = bundle_files(&site.join("bundle"));
+    let mut files = bundle_files(bundle);
     let mut demo_maps: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(&settings).unwrap()).unwrap();
+        serde_json::from_slice(&std::fs::read(settings).unwrap()).unwrap();
     demo_maps["lighting"]["environment"]["dodm_size"] = 512.into();
     files.insert(
         settings.file_name().unwrap().to_string_lossy().to_string(),
@@ -400,8 +420,5 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
         "{notice}"
     );
     let fitted = converge(session);
-    assert!(total(&fitted) > 0.5 * total(&native));
-    phase("limited session converged");
-    let _ = std::fs::remove_dir_all(&site);
-    let _ = std::fs::remove_file(&test_settings);
+    assert!(total(&fitted) > 0.5 * total(native));
 }

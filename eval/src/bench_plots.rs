@@ -90,6 +90,9 @@ impl Metric {
     }
 }
 
+/// The chart every plot draws on: frame ms against error, both axes logarithmic.
+type LogChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
+
 /// Error against ms for one map and mode, drawn on any plotters backend.
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
@@ -105,25 +108,11 @@ where
         .iter()
         .filter(|p| p.family != "reference")
         .collect();
-    let (mut lo_ms, mut hi_ms) = (f64::INFINITY, 0.0f64);
-    let (mut lo_e, mut hi_e) = (f64::INFINITY, 0.0f64);
-    for p in &r.points {
-        lo_ms = lo_ms.min(p.ms);
-        hi_ms = hi_ms.max(p.ms);
-    }
     let reference = r.points.iter().find(|p| p.family == "reference");
     let reference_point = reference
         .filter(|_| metric.against_truth())
         .map(|p| (p.ms, metric.of(p).max(1e-4)));
-    for p in measured
-        .iter()
-        .copied()
-        .chain(reference.filter(|_| metric.against_truth()))
-    {
-        let e = metric.of(p).max(1e-4);
-        lo_e = lo_e.min(e);
-        hi_e = hi_e.max(e);
-    }
+    let ((lo_ms, hi_ms), (lo_e, hi_e)) = axis_ranges(r, &measured, reference, metric);
     let title = format!("{} ({}): {}", r.map, r.mode, metric.name());
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 18))
@@ -146,25 +135,105 @@ where
         .label_style(("sans-serif", 13))
         .draw()
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    // Labels name what was changed ("8 lobes", "light maps, κ 1", "light maps 256²"); each
-    // series is joined to the frame it varies: the default, or for the κ and size series Ren's
-    // light-map frame ("light maps (κ 0.1, 512²)") where the report has one. Reports written
-    // before the volume was the default label κ frames "κ 1", and vary the default.
-    let series = |family: &str, label: LabelFilter| -> Vec<(f64, f64)> {
-        let mut v: Vec<(f64, f64)> = measured
-            .iter()
-            .filter(|p| p.family == family && label(&p.label))
-            .map(|p| (p.ms, metric.of(p).max(1e-4)))
-            .collect();
-        v.sort_by(|a, b| a.0.total_cmp(&b.0));
-        v
-    };
     let baseline_family = r
         .points
         .iter()
         .find(|p| p.is_baseline())
         .map_or("median cut", |p| p.family.as_str());
-    let baseline = series(baseline_family, &|_| true);
+    draw_baseline(&mut chart, &measured, metric, baseline_family)?;
+    draw_srbf_series(&mut chart, &measured, metric)?;
+    if let Some(default) = measured.iter().find(|p| p.label.starts_with("default")) {
+        draw_default(&mut chart, default, r, metric, baseline_family)?;
+    }
+    if let (Some(reference), Some(at)) = (reference, reference_point) {
+        // Against the ground truth the DOM reference has an error of its own: a point.
+        chart
+            .draw_series([Rectangle::new(
+                [(at.0 / 1.08, at.1 / 1.08), (at.0 * 1.08, at.1 * 1.08)],
+                BLACK.filled(),
+            )])
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?
+            .label(format!("DOM reference, {} lights", reference.lights))
+            .legend(|(x, y)| Rectangle::new([(x + 5, y - 4), (x + 13, y + 4)], BLACK.filled()));
+    } else if let Some(reference) = reference {
+        // The reference has no error of its own: drawn as a vertical line at its cost.
+        chart
+            .draw_series(LineSeries::new(
+                [(reference.ms, lo_e * 0.7), (reference.ms, hi_e * 1.4)],
+                BLACK.mix(0.5).stroke_width(1),
+            ))
+            .map_err(|e| anyhow::anyhow!("{e:?}"))?
+            .label(format!("reference, {} lights", reference.lights))
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.mix(0.5)));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font(("sans-serif", 12))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    root.present().map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    Ok(())
+}
+
+/// The (ms, error) spans the axes must cover: every point's cost, including the reference's;
+/// every measured point's error, and the reference's where it has one under `metric` (against
+/// the ground truth). Errors are floored at 10⁻⁴ so that the log axis never meets a zero.
+fn axis_ranges(
+    r: &EnvLitResult,
+    measured: &[&Point],
+    reference: Option<&Point>,
+    metric: Metric,
+) -> ((f64, f64), (f64, f64)) {
+    let (mut lo_ms, mut hi_ms) = (f64::INFINITY, 0.0f64);
+    let (mut lo_e, mut hi_e) = (f64::INFINITY, 0.0f64);
+    for p in &r.points {
+        lo_ms = lo_ms.min(p.ms);
+        hi_ms = hi_ms.max(p.ms);
+    }
+    for p in measured
+        .iter()
+        .copied()
+        .chain(reference.filter(|_| metric.against_truth()))
+    {
+        let e = metric.of(p).max(1e-4);
+        lo_e = lo_e.min(e);
+        hi_e = hi_e.max(e);
+    }
+    ((lo_ms, hi_ms), (lo_e, hi_e))
+}
+
+/// The (ms, error) points of one series, in order of cost: the measured points of `family`
+/// whose label `label` accepts.
+fn series(
+    measured: &[&Point],
+    metric: Metric,
+    family: &str,
+    label: LabelFilter,
+) -> Vec<(f64, f64)> {
+    let mut v: Vec<(f64, f64)> = measured
+        .iter()
+        .filter(|p| p.family == family && label(&p.label))
+        .map(|p| (p.ms, metric.of(p).max(1e-4)))
+        .collect();
+    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    v
+}
+
+/// The baseline (median cut, or whichever family the report marks as baseline) as a red curve
+/// over its light counts.
+fn draw_baseline<DB: DrawingBackend>(
+    chart: &mut LogChart<'_, DB>,
+    measured: &[&Point],
+    metric: Metric,
+    baseline_family: &str,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let baseline = series(measured, metric, baseline_family, &|_| true);
     chart
         .draw_series(LineSeries::new(baseline.clone(), RED.stroke_width(2)))
         .map_err(|e| anyhow::anyhow!("{e:?}"))?
@@ -173,6 +242,23 @@ where
     chart
         .draw_series(baseline.iter().map(|&p| Circle::new(p, 4, RED.filled())))
         .map_err(|e| anyhow::anyhow!("{e:?}"))?;
+    Ok(())
+}
+
+/// The SRBF method's one-at-a-time variations, one colour of triangles each.
+///
+/// Labels name what was changed ("8 lobes", "light maps, κ 1", "light maps 256²"); each
+/// series is joined to the frame it varies: the default, or for the κ and size series Ren's
+/// light-map frame ("light maps (κ 0.1, 512²)") where the report has one. Reports written
+/// before the volume was the default label κ frames "κ 1", and vary the default.
+fn draw_srbf_series<DB: DrawingBackend>(
+    chart: &mut LogChart<'_, DB>,
+    measured: &[&Point],
+    metric: Metric,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
     let is_light_map_base: LabelFilter = &|l| l.starts_with("light maps (");
     let srbf_series: [(LabelFilter, RGBColor, &str); 8] = [
         (&|l| l.ends_with(" lobes"), BLUE, "SRBF: lobe count"),
@@ -212,16 +298,18 @@ where
             "SRBF: light-pass chord tolerance (removed, in earlier reports)",
         ),
     ];
-    let light_map_base = series("srbf", is_light_map_base);
+    let light_map_base = series(measured, metric, "srbf", is_light_map_base);
     for (matches, colour, label) in srbf_series {
-        let mut points = series("srbf", matches);
+        let mut points = series(measured, metric, "srbf", matches);
         if points.is_empty() {
             continue; // not in this plan (or a report written before it)
         }
         let varies_light_maps = label.starts_with("SRBF light maps") && !light_map_base.is_empty();
         match varies_light_maps {
             true => points.extend(&light_map_base),
-            false => points.extend(series("srbf", &|l| l.starts_with("default"))),
+            false => points.extend(series(measured, metric, "srbf", &|l| {
+                l.starts_with("default")
+            })),
         }
         points.sort_by(|a, b| a.0.total_cmp(&b.0));
         let style = colour.stroke_width(1);
@@ -235,53 +323,36 @@ where
             .label(label)
             .legend(move |(x, y)| TriangleMarker::new((x + 9, y), 6, style.filled()));
     }
-    if let Some(default) = measured.iter().find(|p| p.label.starts_with("default")) {
-        let at = (default.ms, metric.of(default).max(1e-4));
-        let note = match metric.speedup(r) {
-            Some(s) => format!("SRBF default: {s:.1}× {baseline_family} at equal error"),
-            None => match r.speedup_lower_bound() {
-                Some((lights, bound)) => format!(
-                    "SRBF default: > {bound:.1}× {baseline_family} (its {lights} lights still less accurate)"
-                ),
-                None => "SRBF default".into(),
-            },
-        };
-        chart
-            .draw_series([Cross::new(at, 9, BLACK.stroke_width(3))])
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?
-            .label(note)
-            .legend(|(x, y)| Cross::new((x + 9, y), 6, BLACK.stroke_width(2)));
-    }
-    if let (Some(reference), Some(at)) = (reference, reference_point) {
-        // Against the ground truth the DOM reference has an error of its own: a point.
-        chart
-            .draw_series([Rectangle::new(
-                [(at.0 / 1.08, at.1 / 1.08), (at.0 * 1.08, at.1 * 1.08)],
-                BLACK.filled(),
-            )])
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?
-            .label(format!("DOM reference, {} lights", reference.lights))
-            .legend(|(x, y)| Rectangle::new([(x + 5, y - 4), (x + 13, y + 4)], BLACK.filled()));
-    } else if let Some(reference) = reference {
-        // The reference has no error of its own: drawn as a vertical line at its cost.
-        chart
-            .draw_series(LineSeries::new(
-                [(reference.ms, lo_e * 0.7), (reference.ms, hi_e * 1.4)],
-                BLACK.mix(0.5).stroke_width(1),
-            ))
-            .map_err(|e| anyhow::anyhow!("{e:?}"))?
-            .label(format!("reference, {} lights", reference.lights))
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.mix(0.5)));
-    }
+    Ok(())
+}
+
+/// The SRBF default frame as a cross, its legend saying what it buys over the baseline: the
+/// speed-up at equal error, or a lower bound where the baseline never reaches its error.
+fn draw_default<DB: DrawingBackend>(
+    chart: &mut LogChart<'_, DB>,
+    default: &Point,
+    r: &EnvLitResult,
+    metric: Metric,
+    baseline_family: &str,
+) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let at = (default.ms, metric.of(default).max(1e-4));
+    let note = match metric.speedup(r) {
+        Some(s) => format!("SRBF default: {s:.1}× {baseline_family} at equal error"),
+        None => match r.speedup_lower_bound() {
+            Some((lights, bound)) => format!(
+                "SRBF default: > {bound:.1}× {baseline_family} (its {lights} lights still less accurate)"
+            ),
+            None => "SRBF default".into(),
+        },
+    };
     chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 12))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(|e| anyhow::anyhow!("{e:?}"))?;
-    root.present().map_err(|e| anyhow::anyhow!("{e:?}"))?;
+        .draw_series([Cross::new(at, 9, BLACK.stroke_width(3))])
+        .map_err(|e| anyhow::anyhow!("{e:?}"))?
+        .label(note)
+        .legend(|(x, y)| Cross::new((x + 9, y), 6, BLACK.stroke_width(2)));
     Ok(())
 }
 

@@ -306,233 +306,282 @@ fn param_error(context: &'static str) -> impl Fn(ParamError) -> FiberError {
     }
 }
 
+/// The model whose BCSDF multiple scattering uses, with its dual-scattering averages, their
+/// fiber parameters (for the cache key) and the name written into the `multiple` table.
+struct MultipleScatteringSource {
+    single: Arc<dyn ScatteringFunction>,
+    averages: DualScatteringAverages,
+    params: serde_json::Value,
+    name: &'static str,
+}
+
 /// Builds the list of jobs. Cheap: every table is computed only when its job runs.
 pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan, FiberError> {
     fiber.validate()?;
-    let res = options.resolution.clone();
+    let res = &options.resolution;
     let settings: ConvolutionSettings = res.settings.into();
-    let conv_settings = json!({ "resolution": res.convolution, "settings": res.settings });
     let mut jobs = Vec::new();
     let mut skipped = Vec::new();
-    let mut share = None;
 
-    // The physical model whose BCSDF multiple scattering uses: Marschner if baked, else the
-    // artist model's normalized copy (Sadeghi eq. 13).
-    let mut multiple_source: Option<(
-        Arc<dyn ScatteringFunction>,
-        DualScatteringAverages,
-        serde_json::Value,
-        &'static str,
-    )> = None;
+    // The physical model whose BCSDF multiple scattering uses: Marschner if baked, else Chiang,
+    // else the artist model's normalized copy (Sadeghi eq. 13).
+    let mut multiple_source = None;
 
     if options.models.contains(&Model::Marschner) {
-        let m =
-            Arc::new(Marschner::new(fiber.marschner.clone()).map_err(param_error("[marschner]"))?);
-        let params = json!({ "marschner": fiber.marschner });
-        let s = m.clone();
-        jobs.push(TableJob {
-            name: "marschner",
-            quantity: "I_M: ∫ G(ω_i; ξ, λ) S(ω_i, ω_o) cos θ_i dω_i, Marschner single scattering (Ren eq. 8), RGB".into(),
-            scattering_function: "marschner".into(),
-            fiber_parameters: params.clone(),
-            settings: conv_settings.clone(),
-            build: Box::new(move || Ok(bake_convolution_table(&|a: &FiberAngles| s.eval(a), &res.convolution, &settings)?)),
-        });
-        let averages = DualScatteringAverages::new(
-            m.as_ref() as &dyn LobeDecomposition,
-            fiber.dual_scattering,
-        )
-        .map_err(param_error("[marschner] dual-scattering averages"))?;
-        let full_params =
-            json!({ "marschner": fiber.marschner, "dual_scattering": fiber.dual_scattering });
-        let bcsdf = Arc::new(DualScatteringBcsdf {
-            single: (*m).clone(),
-            averages: averages.clone(),
-        });
-        let b = bcsdf.clone();
-        let r2 = options.resolution.clone();
-        jobs.push(TableJob {
-            name: "marschner_full",
-            quantity: "I_M with d_b·S_back: ∫ G (S + d_b S_back) cos θ_i dω_i (Ren §7), RGB".into(),
-            scattering_function: "marschner+dual-scattering-back".into(),
-            fiber_parameters: full_params.clone(),
-            settings: conv_settings.clone(),
-            build: Box::new(move || {
-                Ok(bake_convolution_table(
-                    &|a: &FiberAngles| b.eval(a),
-                    &r2.convolution,
-                    &settings,
-                )?)
-            }),
-        });
-        push_direct(
-            &mut jobs,
-            "marschner_direct",
-            "S(ω_i, ω_o)·cos θ_i of Marschner for a directional light, RGB",
-            "marschner",
-            params.clone(),
-            &options.resolution,
-            m.clone(),
-        );
-        push_direct(
-            &mut jobs,
-            "marschner_full_direct",
-            "(S + d_b S_back)·cos θ_i for a directional light (Ren §7), RGB",
-            "marschner+dual-scattering-back",
-            full_params.clone(),
-            &options.resolution,
-            bcsdf.clone(),
-        );
-        push_fiber_averages(
-            &mut jobs,
-            averages.clone(),
-            full_params.clone(),
-            options.resolution.fiber_average_thetas,
-        );
-        let (mm, mn) = (m.clone(), m.clone());
-        let (luts_m, luts_n) = (options.resolution.luts, options.resolution.luts);
-        jobs.push(TableJob {
-            name: "lut_m",
-            quantity: "Hunz Alg. 2 M texture: M_R, M_TT, M_TRT, cos θ_d over (sin θ_i, sin θ_o)"
-                .into(),
-            scattering_function: "marschner".into(),
-            fiber_parameters: params.clone(),
-            settings: json!({ "luts": luts_m }),
-            build: Box::new(move || bake_lut_m(&mm, &luts_m).map_err(boxed)),
-        });
-        jobs.push(TableJob {
-            name: "lut_n",
-            quantity: "Hunz Alg. 2 N texture: N_R, N_TT, N_TRT over (cos φ, cos θ_d), RGB".into(),
-            scattering_function: "marschner".into(),
-            fiber_parameters: params,
-            settings: json!({ "luts": luts_n }),
-            build: Box::new(move || bake_lut_n(&mn, &luts_n).map_err(boxed)),
-        });
-        multiple_source = Some((
-            m as Arc<dyn ScatteringFunction>,
-            averages,
-            full_params,
-            "marschner",
-        ));
+        multiple_source = Some(push_marschner(&mut jobs, fiber, res, settings)?);
     }
 
     if options.models.contains(&Model::Chiang) {
-        let source = push_chiang(&mut jobs, fiber, &options.resolution, settings)?;
+        let source = push_chiang(&mut jobs, fiber, res, settings)?;
         if multiple_source.is_none() {
             let (single, averages, params) = source;
             push_fiber_averages(
                 &mut jobs,
                 averages.clone(),
                 params.clone(),
-                options.resolution.fiber_average_thetas,
+                res.fiber_average_thetas,
             );
-            multiple_source = Some((single, averages, params, "chiang"));
+            multiple_source = Some(MultipleScatteringSource {
+                single,
+                averages,
+                params,
+                name: "chiang",
+            });
         }
     }
 
     if options.models.contains(&Model::KajiyaKay) {
-        push_kajiya_kay(&mut jobs, fiber, &options.resolution, settings)?;
+        push_kajiya_kay(&mut jobs, fiber, res, settings)?;
     }
 
     if options.models.contains(&Model::Artist) {
-        let a = Arc::new(ArtistModel::new(fiber.artist).map_err(param_error("[artist]"))?);
-        let s = a.clone();
-        let r = options.resolution.clone();
-        jobs.push(TableJob {
-            name: "artist",
-            quantity: "I_A: ∫ G(ω_i; ξ, λ) f'_s(ω_i, ω_o) cos θ_i dω_i, artist-friendly model (Sadeghi eq. 12), RGB".into(),
-            scattering_function: "artist".into(),
-            fiber_parameters: json!({ "artist": fiber.artist }),
-            settings: conv_settings.clone(),
-            build: Box::new(move || Ok(bake_convolution_table(&|x: &FiberAngles| s.eval(x), &r.convolution, &settings)?)),
-        });
-        push_direct(
-            &mut jobs,
-            "artist_direct",
-            "f'_s(ω_i, ω_o)·cos θ_i of the artist-friendly model for a directional light, RGB",
-            "artist",
-            json!({ "artist": fiber.artist }),
-            &options.resolution,
-            a.clone(),
-        );
-        if multiple_source.is_none() {
-            let normalized = a.normalized(Normalization::PeakPerChannel);
-            let averages = DualScatteringAverages::new(
-                &normalized as &dyn LobeDecomposition,
-                fiber.dual_scattering,
-            )
-            .map_err(param_error("[artist] dual-scattering averages"))?;
-            let params = json!({ "artist": fiber.artist, "dual_scattering": fiber.dual_scattering, "normalization": "peak-per-channel" });
-            push_fiber_averages(
-                &mut jobs,
-                averages.clone(),
-                params.clone(),
-                options.resolution.fiber_average_thetas,
-            );
-            multiple_source = Some((
-                Arc::new(normalized) as Arc<dyn ScatteringFunction>,
-                averages,
-                params,
-                "artist-normalized",
-            ));
-        }
+        let artist_source =
+            push_artist(&mut jobs, fiber, res, settings, multiple_source.is_none())?;
+        multiple_source = multiple_source.or(artist_source);
     }
 
-    if let Some((single, averages, params, name)) = multiple_source {
-        let albedo = single_event_albedo(&averages);
-        share = Some(albedo);
-        if albedo < options.multiple_threshold && !options.force_multiple {
-            skipped.push(SkippedTable {
-                name: "multiple".into(),
-                reason: format!(
-                    "multiple scattering carries about {:.1}% of the scattered energy (largest single-event albedo ā_f + ā_b), below the {:.1}% threshold: rendering single scattering only (use --force-multiple to bake it anyway)",
-                    100.0 * albedo,
-                    100.0 * options.multiple_threshold
-                ),
-            });
-        } else {
-            let r = options.resolution.clone();
-            let d_b = averages.config().density_backward;
-            jobs.push(TableJob {
-                name: "multiple",
-                quantity: "I_G: ∫ ψ_f(ξ, ω_i, σ̄_f) (S + d_b S_back) cos θ_i dω_i (Ren eq. 11), σ̄_f = std of θ_i, RGB".into(),
-                scattering_function: format!("{name}+dual-scattering-back"),
-                fiber_parameters: params,
-                settings: json!({ "multiple": r.multiple }),
-                build: Box::new(move || {
-                    let s_d = |a: &FiberAngles| -> Rgb {
-                        let s = single.eval(a);
-                        let b = averages.backward_scattering(a);
-                        std::array::from_fn(|c| s[c] + d_b * b[c])
-                    };
-                    Ok(bake_multiple_scattering_table(&s_d, &r.multiple)?)
-                }),
-            });
-        }
-        let r = options.resolution.clone();
-        jobs.push(TableJob {
-            name: "attenuation_ratio",
-            quantity: "α(ν, θ) = σ_t(ω)/σ_t⊥ for fiber-direction deviation ν (Ren §6)".into(),
-            scattering_function: String::new(),
-            fiber_parameters: json!({}),
-            settings: json!({ "attenuation_ratio": r.attenuation_ratio, "nu_max": r.attenuation_nu_max }),
-            build: Box::new(move || Ok(attenuation_ratio_table(r.attenuation_ratio[0], r.attenuation_ratio[1], r.attenuation_nu_max)?)),
-        });
-        let r = options.resolution.clone();
-        jobs.push(TableJob {
-            name: "srbf_spread",
-            quantity: "first-event longitudinal variance of an SRBF light over (|u·ξ|, λ), rad² (Ren §6)".into(),
-            scattering_function: String::new(),
-            fiber_parameters: json!({}),
-            settings: json!({ "srbf_spread": r.srbf_spread, "lambda": [r.convolution.lambda_min, r.convolution.lambda_max] }),
-            build: Box::new(move || Ok(srbf_spread_table(r.srbf_spread[0], r.srbf_spread[1], r.convolution.lambda_min, r.convolution.lambda_max)?)),
-        });
-    }
+    let share = multiple_source
+        .map(|source| push_multiple_scattering(&mut jobs, &mut skipped, source, options));
     Ok(BakePlan {
         jobs,
         skipped,
         multiple_scattering_share: share,
     })
+}
+
+/// The Marschner jobs: `marschner` (I of S), `marschner_full` (S + d_b S_back), the two direct
+/// tables, the fiber averages and Hunz's point-light textures `lut_m`, `lut_n`. Marschner is the
+/// first choice of multiple-scattering source, so its averages are always tabulated; the source
+/// is returned for the caller.
+fn push_marschner(
+    jobs: &mut Vec<TableJob>,
+    fiber: &FiberDescription,
+    res: &BakeResolution,
+    settings: ConvolutionSettings,
+) -> Result<MultipleScatteringSource, FiberError> {
+    let conv_settings = json!({ "resolution": res.convolution, "settings": res.settings });
+    let m = Arc::new(Marschner::new(fiber.marschner.clone()).map_err(param_error("[marschner]"))?);
+    let params = json!({ "marschner": fiber.marschner });
+    let (s, r) = (m.clone(), res.clone());
+    jobs.push(TableJob {
+        name: "marschner",
+        quantity: "I_M: ∫ G(ω_i; ξ, λ) S(ω_i, ω_o) cos θ_i dω_i, Marschner single scattering (Ren eq. 8), RGB".into(),
+        scattering_function: "marschner".into(),
+        fiber_parameters: params.clone(),
+        settings: conv_settings.clone(),
+        build: Box::new(move || Ok(bake_convolution_table(&|a: &FiberAngles| s.eval(a), &r.convolution, &settings)?)),
+    });
+    let averages =
+        DualScatteringAverages::new(m.as_ref() as &dyn LobeDecomposition, fiber.dual_scattering)
+            .map_err(param_error("[marschner] dual-scattering averages"))?;
+    let full_params =
+        json!({ "marschner": fiber.marschner, "dual_scattering": fiber.dual_scattering });
+    let bcsdf = Arc::new(DualScatteringBcsdf {
+        single: (*m).clone(),
+        averages: averages.clone(),
+    });
+    let (b, r) = (bcsdf.clone(), res.clone());
+    jobs.push(TableJob {
+        name: "marschner_full",
+        quantity: "I_M with d_b·S_back: ∫ G (S + d_b S_back) cos θ_i dω_i (Ren §7), RGB".into(),
+        scattering_function: "marschner+dual-scattering-back".into(),
+        fiber_parameters: full_params.clone(),
+        settings: conv_settings,
+        build: Box::new(move || {
+            Ok(bake_convolution_table(
+                &|a: &FiberAngles| b.eval(a),
+                &r.convolution,
+                &settings,
+            )?)
+        }),
+    });
+    push_direct(
+        jobs,
+        "marschner_direct",
+        "S(ω_i, ω_o)·cos θ_i of Marschner for a directional light, RGB",
+        "marschner",
+        params.clone(),
+        res,
+        m.clone(),
+    );
+    push_direct(
+        jobs,
+        "marschner_full_direct",
+        "(S + d_b S_back)·cos θ_i for a directional light (Ren §7), RGB",
+        "marschner+dual-scattering-back",
+        full_params.clone(),
+        res,
+        bcsdf,
+    );
+    push_fiber_averages(
+        jobs,
+        averages.clone(),
+        full_params.clone(),
+        res.fiber_average_thetas,
+    );
+    let (mm, mn) = (m.clone(), m.clone());
+    let luts = res.luts;
+    jobs.push(TableJob {
+        name: "lut_m",
+        quantity: "Hunz Alg. 2 M texture: M_R, M_TT, M_TRT, cos θ_d over (sin θ_i, sin θ_o)".into(),
+        scattering_function: "marschner".into(),
+        fiber_parameters: params.clone(),
+        settings: json!({ "luts": luts }),
+        build: Box::new(move || bake_lut_m(&mm, &luts).map_err(boxed)),
+    });
+    jobs.push(TableJob {
+        name: "lut_n",
+        quantity: "Hunz Alg. 2 N texture: N_R, N_TT, N_TRT over (cos φ, cos θ_d), RGB".into(),
+        scattering_function: "marschner".into(),
+        fiber_parameters: params,
+        settings: json!({ "luts": luts }),
+        build: Box::new(move || bake_lut_n(&mn, &luts).map_err(boxed)),
+    });
+    Ok(MultipleScatteringSource {
+        single: m,
+        averages,
+        params: full_params,
+        name: "marschner",
+    })
+}
+
+/// The artist-model jobs: `artist` (I of f'_s) and `artist_direct`. When no physical model is
+/// baked (`multiple_source_needed`), the model's normalized copy (Sadeghi eq. 13) becomes the
+/// multiple-scattering source: its fiber averages are tabulated and the source returned.
+fn push_artist(
+    jobs: &mut Vec<TableJob>,
+    fiber: &FiberDescription,
+    res: &BakeResolution,
+    settings: ConvolutionSettings,
+    multiple_source_needed: bool,
+) -> Result<Option<MultipleScatteringSource>, FiberError> {
+    let conv_settings = json!({ "resolution": res.convolution, "settings": res.settings });
+    let a = Arc::new(ArtistModel::new(fiber.artist).map_err(param_error("[artist]"))?);
+    let (s, r) = (a.clone(), res.clone());
+    jobs.push(TableJob {
+        name: "artist",
+        quantity: "I_A: ∫ G(ω_i; ξ, λ) f'_s(ω_i, ω_o) cos θ_i dω_i, artist-friendly model (Sadeghi eq. 12), RGB".into(),
+        scattering_function: "artist".into(),
+        fiber_parameters: json!({ "artist": fiber.artist }),
+        settings: conv_settings,
+        build: Box::new(move || Ok(bake_convolution_table(&|x: &FiberAngles| s.eval(x), &r.convolution, &settings)?)),
+    });
+    push_direct(
+        jobs,
+        "artist_direct",
+        "f'_s(ω_i, ω_o)·cos θ_i of the artist-friendly model for a directional light, RGB",
+        "artist",
+        json!({ "artist": fiber.artist }),
+        res,
+        a.clone(),
+    );
+    if !multiple_source_needed {
+        return Ok(None);
+    }
+    let normalized = a.normalized(Normalization::PeakPerChannel);
+    let averages =
+        DualScatteringAverages::new(&normalized as &dyn LobeDecomposition, fiber.dual_scattering)
+            .map_err(param_error("[artist] dual-scattering averages"))?;
+    let params = json!({ "artist": fiber.artist, "dual_scattering": fiber.dual_scattering, "normalization": "peak-per-channel" });
+    push_fiber_averages(
+        jobs,
+        averages.clone(),
+        params.clone(),
+        res.fiber_average_thetas,
+    );
+    Ok(Some(MultipleScatteringSource {
+        single: Arc::new(normalized),
+        averages,
+        params,
+        name: "artist-normalized",
+    }))
+}
+
+/// The multiple-scattering jobs of `source`: `multiple` (skipped, with the reason recorded,
+/// when the hair is too dark for it to matter and it is not forced), and the two tables the
+/// forward-scattering volume reads with the fiber averages, `attenuation_ratio` and
+/// `srbf_spread`, which are baked either way. Returns the multiple-scattering share the
+/// decision was made on.
+fn push_multiple_scattering(
+    jobs: &mut Vec<TableJob>,
+    skipped: &mut Vec<SkippedTable>,
+    source: MultipleScatteringSource,
+    options: &PlanOptions,
+) -> f64 {
+    let MultipleScatteringSource {
+        single,
+        averages,
+        params,
+        name,
+    } = source;
+    let albedo = single_event_albedo(&averages);
+    if albedo < options.multiple_threshold && !options.force_multiple {
+        skipped.push(SkippedTable {
+            name: "multiple".into(),
+            reason: format!(
+                "multiple scattering carries about {:.1}% of the scattered energy (largest single-event albedo ā_f + ā_b), below the {:.1}% threshold: rendering single scattering only (use --force-multiple to bake it anyway)",
+                100.0 * albedo,
+                100.0 * options.multiple_threshold
+            ),
+        });
+    } else {
+        let r = options.resolution.clone();
+        let d_b = averages.config().density_backward;
+        jobs.push(TableJob {
+            name: "multiple",
+            quantity: "I_G: ∫ ψ_f(ξ, ω_i, σ̄_f) (S + d_b S_back) cos θ_i dω_i (Ren eq. 11), σ̄_f = std of θ_i, RGB".into(),
+            scattering_function: format!("{name}+dual-scattering-back"),
+            fiber_parameters: params,
+            settings: json!({ "multiple": r.multiple }),
+            build: Box::new(move || {
+                let s_d = |a: &FiberAngles| -> Rgb {
+                    let s = single.eval(a);
+                    let b = averages.backward_scattering(a);
+                    std::array::from_fn(|c| s[c] + d_b * b[c])
+                };
+                Ok(bake_multiple_scattering_table(&s_d, &r.multiple)?)
+            }),
+        });
+    }
+    let r = options.resolution.clone();
+    jobs.push(TableJob {
+        name: "attenuation_ratio",
+        quantity: "α(ν, θ) = σ_t(ω)/σ_t⊥ for fiber-direction deviation ν (Ren §6)".into(),
+        scattering_function: String::new(),
+        fiber_parameters: json!({}),
+        settings: json!({ "attenuation_ratio": r.attenuation_ratio, "nu_max": r.attenuation_nu_max }),
+        build: Box::new(move || Ok(attenuation_ratio_table(r.attenuation_ratio[0], r.attenuation_ratio[1], r.attenuation_nu_max)?)),
+    });
+    let r = options.resolution.clone();
+    jobs.push(TableJob {
+        name: "srbf_spread",
+        quantity: "first-event longitudinal variance of an SRBF light over (|u·ξ|, λ), rad² (Ren §6)".into(),
+        scattering_function: String::new(),
+        fiber_parameters: json!({}),
+        settings: json!({ "srbf_spread": r.srbf_spread, "lambda": [r.convolution.lambda_min, r.convolution.lambda_max] }),
+        build: Box::new(move || Ok(srbf_spread_table(r.srbf_spread[0], r.srbf_spread[1], r.convolution.lambda_min, r.convolution.lambda_max)?)),
+    });
+    albedo
 }
 
 /// The Chiang jobs, parallel to Marschner's: `chiang` (I of S), `chiang_full` (S + d_b S_back

@@ -87,8 +87,13 @@ fn check_asset_with(
         path: path.clone(),
         message,
     };
+    let lookup = |source| CheckError::Lookup {
+        path: path.clone(),
+        source,
+    };
     let table = &asset.table;
     let axes = table.axes();
+    let random = || random_points(table, samples, seed);
     let (reference, points): (Reference, Vec<Vec<f64>>) = match name.as_str() {
         "marschner" | "marschner_full" | "artist" | "chiang" | "chiang_full" => {
             let s = scattering_from(&name, params).map_err(bad)?;
@@ -97,18 +102,7 @@ fn check_asset_with(
                 .into_iter()
                 .map(|p| p.to_vec())
                 .collect();
-            let r: Reference = Arc::new(move |x: &[f64]| {
-                let v = convolve_reference(
-                    &|a: &FiberAngles| s.eval(a),
-                    x[0].asin(),
-                    x[1].asin(),
-                    x[2].clamp(-1.0, 1.0).acos(),
-                    1.0 / x[3],
-                    REFERENCE_PANELS,
-                );
-                v.to_vec()
-            });
-            (r, pts)
+            (convolution_reference(s), pts)
         }
         "marschner_direct"
         | "marschner_full_direct"
@@ -127,137 +121,37 @@ fn check_asset_with(
                 Arc::new(move |x: &[f64]| direct_value(&|a: &FiberAngles| s.eval(a), x).to_vec());
             (r, pts)
         }
-        "kk_diffuse" | "kk_specular" => {
-            let exponent = params
-                .get("exponent")
-                .and_then(Value::as_f64)
-                .unwrap_or(KajiyaKayParams::default().exponent);
-            let kk = KajiyaKay::new(KajiyaKayParams {
-                exponent,
-                ..Default::default()
-            })
-            .map_err(|e| bad(e.to_string()))?;
-            let diffuse = name == "kk_diffuse";
-            let r: Reference = Arc::new(move |x: &[f64]| {
-                let (theta_xi, theta_o, inv) = if diffuse {
-                    (x[0].asin(), 0.0, x[1])
-                } else {
-                    (x[0].asin(), x[1].asin(), x[2])
-                };
-                let s = |a: &FiberAngles| {
-                    let v = if diffuse {
-                        1.0
-                    } else {
-                        kk.specular_lobe(a) / a.theta_i.cos()
-                    };
-                    [v, v, v]
-                };
-                vec![convolve_reference(&s, theta_xi, theta_o, 0.0, 1.0 / inv, REFERENCE_PANELS)[0]]
-            });
-            (r, random_points(table, samples, seed))
-        }
-        "multiple" => {
-            let s_d = bcsdf_from(params).map_err(bad)?;
-            let r: Reference = Arc::new(move |x: &[f64]| {
-                multiple_scattering_reference(
-                    &|a: &FiberAngles| s_d.eval(a),
-                    x[0].asin(),
-                    x[1].asin(),
-                    x[2].clamp(-1.0, 1.0).acos(),
-                    x[3].max(1e-4),
-                    24,
-                )
-                .to_vec()
-            });
-            (r, random_points(table, samples, seed))
-        }
+        "kk_diffuse" | "kk_specular" => (
+            kajiya_kay_reference(params, name == "kk_diffuse").map_err(bad)?,
+            random(),
+        ),
+        "multiple" => (
+            multiple_reference(bcsdf_from(params).map_err(bad)?),
+            random(),
+        ),
         "attenuation_ratio" => (
             Arc::new(|x: &[f64]| vec![attenuation_ratio(x[0], x[1])]),
-            random_points(table, samples, seed),
+            random(),
         ),
         "srbf_spread" => (
             Arc::new(|x: &[f64]| vec![srbf_longitudinal_variance(x[0], x[1])]),
-            random_points(table, samples, seed),
+            random(),
         ),
-        "fiber_averages" => {
-            let model = lobes_from(params).map_err(bad)?;
-            let r: Reference = Arc::new(move |x: &[f64]| {
-                let theta = x[0].clamp(-1.0, 1.0).asin();
-                let a = fiber_averages_direct(model.as_lobes(), theta);
-                let q = x[1].round() as usize;
-                (0..3)
-                    .map(|c| {
-                        let (ab, db, sb) = backscatter_series(
-                            a.a_f[c],
-                            a.a_b[c],
-                            a.alpha_f[c],
-                            a.alpha_b[c],
-                            a.beta2_f[c],
-                            a.beta2_b[c],
-                        );
-                        [
-                            a.a_f[c],
-                            a.a_b[c],
-                            a.alpha_f[c],
-                            a.alpha_b[c],
-                            a.beta2_f[c],
-                            a.beta2_b[c],
-                            ab,
-                            db,
-                            sb,
-                        ][q]
-                    })
-                    .collect()
-            });
-            (r, random_points(table, samples, seed))
-        }
+        "fiber_averages" => (
+            fiber_averages_reference(lobes_from(params).map_err(bad)?),
+            random(),
+        ),
         "lut_m" | "lut_n" => {
-            let m = Arc::new(marschner_from(params).map_err(bad)?);
+            let m = marschner_from(params).map_err(bad)?;
             let is_m = name == "lut_m";
-            let azimuth = if is_m {
-                AzimuthAxis::CosPhi
-            } else {
-                AzimuthAxis::of_table(table).map_err(|source| CheckError::Lookup {
-                    path: path.clone(),
-                    source,
-                })?
-            };
-            let r: Reference = Arc::new(move |x: &[f64]| {
-                let lobe = |q: f64| [Lobe::R, Lobe::TT, Lobe::TRT][(q.round() as usize).min(2)];
-                if is_m {
-                    let (ti, to) = (x[0].asin(), x[1].asin());
-                    if x[2].round() as usize == 3 {
-                        vec![((to - ti) / 2.0).cos()]
-                    } else {
-                        vec![m.longitudinal(lobe(x[2]), ti, to)]
-                    }
-                } else {
-                    m.azimuthal(lobe(x[2]), x[1].clamp(0.0, 1.0).acos(), azimuth.phi(x[0]))
-                        .to_vec()
-                }
-            });
-            (r, random_points(table, samples, seed))
+            let azimuth = lut_azimuth_axis(table, is_m).map_err(lookup)?;
+            (marschner_lut_reference(m, is_m, azimuth), random())
         }
         "chiang_lut_m" | "chiang_lut_n" => {
-            let m = Arc::new(chiang_from(params).map_err(bad)?);
+            let m = chiang_from(params).map_err(bad)?;
             let is_m = name == "chiang_lut_m";
-            let azimuth = if is_m {
-                AzimuthAxis::CosPhi
-            } else {
-                AzimuthAxis::of_table(table).map_err(|source| CheckError::Lookup {
-                    path: path.clone(),
-                    source,
-                })?
-            };
-            let r: Reference = Arc::new(move |x: &[f64]| {
-                let p = (x[2].round() as usize).min(LOBES - 1);
-                if is_m {
-                    vec![m.longitudinal(p, x[0].asin(), x[1].asin())]
-                } else {
-                    m.azimuthal_exact(x[1].clamp(-1.0, 1.0).asin(), azimuth.phi(x[0]))[p].to_vec()
-                }
-            });
-            (r, random_points(table, samples, seed))
+            let azimuth = lut_azimuth_axis(table, is_m).map_err(lookup)?;
+            (chiang_lut_reference(m, is_m, azimuth), random())
         }
         _ => {
             return Err(CheckError::UnknownTable {
@@ -272,6 +166,150 @@ fn check_asset_with(
         points
     };
     compare(asset, &name, &reference, &points)
+}
+
+/// The convolution tables' reference, at (u·ξ, u·ω_o, cos Δφ, 1/λ): the SRBF convolution of `s`
+/// by direct quadrature in f64, independent of the bake's harmonic method.
+fn convolution_reference(s: Arc<dyn ScatteringFunction>) -> Reference {
+    Arc::new(move |x: &[f64]| {
+        let v = convolve_reference(
+            &|a: &FiberAngles| s.eval(a),
+            x[0].asin(),
+            x[1].asin(),
+            x[2].clamp(-1.0, 1.0).acos(),
+            1.0 / x[3],
+            REFERENCE_PANELS,
+        );
+        v.to_vec()
+    })
+}
+
+/// The Kajiya-Kay tables' reference, with the model rebuilt from the stored exponent:
+/// `kk_diffuse` at (u·ξ, 1/λ) convolves 1, `kk_specular` at (u·ξ, u·ω_o, 1/λ) convolves the
+/// specular lobe over cos θ_i (the table has no cos θ_i, the convolution engine adds one).
+fn kajiya_kay_reference(params: &Value, diffuse: bool) -> Result<Reference, String> {
+    let exponent = params
+        .get("exponent")
+        .and_then(Value::as_f64)
+        .unwrap_or(KajiyaKayParams::default().exponent);
+    let kk = KajiyaKay::new(KajiyaKayParams {
+        exponent,
+        ..Default::default()
+    })
+    .map_err(|e| e.to_string())?;
+    Ok(Arc::new(move |x: &[f64]| {
+        let (theta_xi, theta_o, inv) = if diffuse {
+            (x[0].asin(), 0.0, x[1])
+        } else {
+            (x[0].asin(), x[1].asin(), x[2])
+        };
+        let s = |a: &FiberAngles| {
+            let v = if diffuse {
+                1.0
+            } else {
+                kk.specular_lobe(a) / a.theta_i.cos()
+            };
+            [v, v, v]
+        };
+        vec![convolve_reference(&s, theta_xi, theta_o, 0.0, 1.0 / inv, REFERENCE_PANELS)[0]]
+    }))
+}
+
+/// The `multiple` table's reference at (u·ξ, u·ω_o, cos Δφ, σ̄_f): the forward-scattering
+/// convolution of the BCSDF `s_d` by direct quadrature.
+fn multiple_reference(s_d: Arc<dyn ScatteringFunction>) -> Reference {
+    Arc::new(move |x: &[f64]| {
+        multiple_scattering_reference(
+            &|a: &FiberAngles| s_d.eval(a),
+            x[0].asin(),
+            x[1].asin(),
+            x[2].clamp(-1.0, 1.0).acos(),
+            x[3].max(1e-4),
+            24,
+        )
+        .to_vec()
+    })
+}
+
+/// The `fiber_averages` reference at (sin θ, quantity): the averages integrated directly from
+/// the model's lobes, and the back-scattering series built from them, in the order of
+/// `FIBER_AVERAGE_QUANTITIES`.
+fn fiber_averages_reference(model: Arc<dyn LobesAndScattering>) -> Reference {
+    Arc::new(move |x: &[f64]| {
+        let theta = x[0].clamp(-1.0, 1.0).asin();
+        let a = fiber_averages_direct(model.as_lobes(), theta);
+        let q = x[1].round() as usize;
+        (0..3)
+            .map(|c| {
+                let (ab, db, sb) = backscatter_series(
+                    a.a_f[c],
+                    a.a_b[c],
+                    a.alpha_f[c],
+                    a.alpha_b[c],
+                    a.beta2_f[c],
+                    a.beta2_b[c],
+                );
+                [
+                    a.a_f[c],
+                    a.a_b[c],
+                    a.alpha_f[c],
+                    a.alpha_b[c],
+                    a.beta2_f[c],
+                    a.beta2_b[c],
+                    ab,
+                    db,
+                    sb,
+                ][q]
+            })
+            .collect()
+    })
+}
+
+/// The azimuth axis of a point-light texture: an N texture names it in its first axis (cos φ
+/// or cos φ/2); an M texture has none, and its reference ignores the value.
+fn lut_azimuth_axis(
+    table: &strandlight_tables::table::Table,
+    is_m: bool,
+) -> Result<AzimuthAxis, strandlight_tables::table::TableError> {
+    if is_m {
+        Ok(AzimuthAxis::CosPhi)
+    } else {
+        AzimuthAxis::of_table(table)
+    }
+}
+
+/// Hunz's point-light textures from Marschner's own lobe functions: `lut_m` at
+/// (sin θ_i, sin θ_o, lobe) with cos θ_d as its fourth "lobe", `lut_n` at (azimuth, cos θ_d,
+/// lobe).
+fn marschner_lut_reference(m: Marschner, is_m: bool, azimuth: AzimuthAxis) -> Reference {
+    Arc::new(move |x: &[f64]| {
+        let lobe = |q: f64| [Lobe::R, Lobe::TT, Lobe::TRT][(q.round() as usize).min(2)];
+        if is_m {
+            let (ti, to) = (x[0].asin(), x[1].asin());
+            if x[2].round() as usize == 3 {
+                vec![((to - ti) / 2.0).cos()]
+            } else {
+                vec![m.longitudinal(lobe(x[2]), ti, to)]
+            }
+        } else {
+            m.azimuthal(lobe(x[2]), x[1].clamp(0.0, 1.0).acos(), azimuth.phi(x[0]))
+                .to_vec()
+        }
+    })
+}
+
+/// Chiang's point-light textures from the model's own lobe functions: `chiang_lut_m` at
+/// (sin θ_i, sin θ_o, lobe), `chiang_lut_n` at (azimuth, sin θ_o, lobe) by quadrature at each
+/// point rather than from the model's own interpolated N̄ grid.
+fn chiang_lut_reference(m: Chiang, is_m: bool, azimuth: AzimuthAxis) -> Reference {
+    Arc::new(move |x: &[f64]| {
+        let p = (x[2].round() as usize).min(LOBES - 1);
+        if is_m {
+            vec![m.longitudinal(p, x[0].asin(), x[1].asin())]
+        } else {
+            m.azimuthal_exact(x[1].clamp(-1.0, 1.0).asin(), azimuth.phi(x[0]))[p].to_vec()
+        }
+    })
 }
 
 /// `count` points at random nodes of every axis.

@@ -235,17 +235,64 @@ pub fn fit(
     let initial = options.initial_lobes.min(options.max_lobes);
     coarse.place_greedily(&grid, &mut lobes, initial, bounds);
 
-    let mut history = Vec::new();
-    let mut evaluations = 0;
+    let mut log = RoundLog {
+        history: Vec::new(),
+        evaluations: 0,
+        progress,
+    };
+    let (best_mse, best_lobes) =
+        optimize_and_insert(&grid, &coarse, lobes, bounds, options, &mut log);
+    let best_lobes = polish(&grid, best_lobes, best_mse, bounds, options, &mut log);
+    let (lobes, objective_relative_mse) =
+        radiance_lobes(&grid, &grid_map, &best_lobes, options.preserve_power);
+    Ok(SrbfFit {
+        lobes,
+        objective_relative_mse,
+        history: log.history,
+        grid_map,
+    })
+}
+
+/// The rounds' history as it grows, with the evaluation count it records and the caller's
+/// progress callback, which hears of every round as it is recorded.
+struct RoundLog<'a> {
+    history: Vec<RoundRecord>,
+    evaluations: usize,
+    progress: &'a mut dyn FnMut(&RoundRecord),
+}
+
+impl RoundLog<'_> {
+    fn record(&mut self, lobes: usize, relative_mse: f64) {
+        let record = RoundRecord {
+            lobes,
+            relative_mse,
+            evaluations: self.evaluations,
+        };
+        self.history.push(record);
+        (self.progress)(&record);
+    }
+}
+
+/// Steps 3 and 4 of the module docs: optimize, drop dead lobes, insert one where it removes the
+/// most residual, until the target error, the lobe budget or stagnation. Returns the best
+/// state seen (its relative MSE and its live lobes), not the last.
+fn optimize_and_insert(
+    grid: &FitGrid,
+    coarse: &CoarseResidual,
+    mut lobes: Vec<(DVec3, f64)>,
+    bounds: (f64, f64),
+    options: &FitOptions,
+    log: &mut RoundLog,
+) -> (f64, Vec<(DVec3, f64)>) {
     let mut best: Option<(f64, Vec<(DVec3, f64)>)> = None;
     let mut stalled_rounds = 0;
     // Where inserted lobes died (NNLS gave them zero): not tried again.
     let mut tabu: Vec<DVec3> = Vec::new();
     let mut inserted: Option<DVec3> = None;
     for _round in 0..3 * options.max_lobes + 3 {
-        let round = optimize_round(&grid, &lobes, bounds, options, &mut evaluations);
+        let round = optimize_round(grid, &lobes, bounds, options, &mut log.evaluations);
         lobes = round.lobes;
-        let ev = evaluate(&grid, &centers(&lobes), &lambdas(&lobes));
+        let ev = evaluate(grid, &centers(&lobes), &lambdas(&lobes));
         // Dead lobes (zero amplitude in every channel) are free slots for insertion.
         let alive: Vec<(DVec3, f64)> = lobes
             .iter()
@@ -258,13 +305,7 @@ pub fn fit(
         {
             tabu.push(xi);
         }
-        let record = RoundRecord {
-            lobes: alive.len(),
-            relative_mse: ev.relative_mse,
-            evaluations,
-        };
-        history.push(record);
-        progress(&record);
+        log.record(alive.len(), ev.relative_mse);
         if best.as_ref().is_none_or(|(e, _)| ev.relative_mse < *e) {
             best = Some((ev.relative_mse, alive.clone()));
         }
@@ -273,6 +314,7 @@ pub fn fit(
         }
         // Stagnation: insertions keep dying or no longer reduce the error (e.g. a sun narrower
         // than λ_max allows dominates the residual). More rounds would only burn time.
+        let history = &log.history;
         let improved = history.len() < 2 || {
             let previous_best = history[..history.len() - 1]
                 .iter()
@@ -286,48 +328,61 @@ pub fn fit(
         }
         lobes = alive;
         // Amplitudes re-solved for the surviving lobes.
-        let amplitudes = evaluate(&grid, &centers(&lobes), &lambdas(&lobes)).amplitudes;
-        let new_lobe = coarse.best_insertion(&grid, &lobes, &amplitudes, bounds, &tabu);
+        let amplitudes = evaluate(grid, &centers(&lobes), &lambdas(&lobes)).amplitudes;
+        let new_lobe = coarse.best_insertion(grid, &lobes, &amplitudes, bounds, &tabu);
         lobes.push(new_lobe);
         inserted = Some(new_lobe.0);
     }
-    let (best_mse, mut best_lobes) = best.expect("at least one round ran");
-    if options.final_iterations > 0 {
-        let polish = FitOptions {
-            iterations_per_round: options.final_iterations,
-            ..options.clone()
-        };
-        let polished = optimize_round(&grid, &best_lobes, bounds, &polish, &mut evaluations).lobes;
-        let ev = evaluate(&grid, &centers(&polished), &lambdas(&polished));
-        if ev.relative_mse < best_mse {
-            let alive = ev
-                .amplitudes
-                .iter()
-                .filter(|a| a.iter().any(|&v| v > 0.0))
-                .count();
-            let record = RoundRecord {
-                lobes: alive,
-                relative_mse: ev.relative_mse,
-                evaluations,
-            };
-            history.push(record);
-            progress(&record);
-            best_lobes = polished;
-        }
+    best.expect("at least one round ran")
+}
+
+/// The final polish: `final_iterations` of L-BFGS from the best state, kept (and recorded as a
+/// round) only if it lowers the error.
+fn polish(
+    grid: &FitGrid,
+    best_lobes: Vec<(DVec3, f64)>,
+    best_mse: f64,
+    bounds: (f64, f64),
+    options: &FitOptions,
+    log: &mut RoundLog,
+) -> Vec<(DVec3, f64)> {
+    if options.final_iterations == 0 {
+        return best_lobes;
     }
-    let mut ev = evaluate(&grid, &centers(&best_lobes), &lambdas(&best_lobes));
-    if options.preserve_power {
+    let polish = FitOptions {
+        iterations_per_round: options.final_iterations,
+        ..options.clone()
+    };
+    let polished = optimize_round(grid, &best_lobes, bounds, &polish, &mut log.evaluations).lobes;
+    let ev = evaluate(grid, &centers(&polished), &lambdas(&polished));
+    if ev.relative_mse < best_mse {
+        let alive = ev
+            .amplitudes
+            .iter()
+            .filter(|a| a.iter().any(|&v| v > 0.0))
+            .count();
+        log.record(alive, ev.relative_mse);
+        polished
+    } else {
+        best_lobes
+    }
+}
+
+/// The fitted lobes in radiance units with their amplitudes solved once more (power-matched if
+/// `preserve_power`), dead ones dropped, and the objective's relative MSE at those amplitudes.
+fn radiance_lobes(
+    grid: &FitGrid,
+    grid_map: &EnvMap,
+    lobes: &[(DVec3, f64)],
+    preserve_power: bool,
+) -> (Vec<SrbfLobe>, f64) {
+    let mut ev = evaluate(grid, &centers(lobes), &lambdas(lobes));
+    if preserve_power {
         let power = grid_map.integral().map(|p| p / grid.scale);
-        ev.amplitudes =
-            power_matched_amplitudes(&grid, &centers(&best_lobes), &lambdas(&best_lobes), power);
-        ev.relative_mse = relative_mse_of(
-            &grid,
-            &centers(&best_lobes),
-            &lambdas(&best_lobes),
-            &ev.amplitudes,
-        );
+        ev.amplitudes = power_matched_amplitudes(grid, &centers(lobes), &lambdas(lobes), power);
+        ev.relative_mse = relative_mse_of(grid, &centers(lobes), &lambdas(lobes), &ev.amplitudes);
     }
-    let lobes = best_lobes
+    let fitted = lobes
         .iter()
         .zip(&ev.amplitudes)
         .filter(|(_, a)| a.iter().any(|&v| v > 0.0))
@@ -337,12 +392,7 @@ pub fn fit(
             amplitude: a.map(|v| v * grid.scale),
         })
         .collect();
-    Ok(SrbfFit {
-        lobes,
-        objective_relative_mse: ev.relative_mse,
-        history,
-        grid_map,
-    })
+    (fitted, ev.relative_mse)
 }
 
 fn centers(lobes: &[(DVec3, f64)]) -> Vec<DVec3> {

@@ -632,7 +632,7 @@ fn describe(v: Option<&Value>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::atomic_write::tests::{entries, scratch_dir};
+    use crate::atomic_write::tests::{ScratchDir, entries, scratch_dir};
     use rand::{RngExt, SeedableRng};
     use rand_pcg::Pcg64;
     use serde_json::json;
@@ -875,112 +875,148 @@ mod tests {
         err
     }
 
+    /// A valid asset, checked to read back, in a scratch folder of its own, for the corruption
+    /// tests to damage one part at a time. Every load names its file in its error ([`load`]).
+    struct Corruptible {
+        dir: ScratchDir,
+        good: Vec<u8>,
+        json_start: usize,
+        payload_start: usize,
+    }
+
+    impl Corruptible {
+        fn new(label: &str) -> Self {
+            let dir = scratch_dir(label);
+            let (good, json_start, payload_start) = valid_bytes();
+            std::fs::write(dir.join("good.sltab"), &good).unwrap();
+            read_asset(&dir.join("good.sltab")).unwrap();
+            Self {
+                dir,
+                good,
+                json_start,
+                payload_start,
+            }
+        }
+
+        fn json(&self) -> &[u8] {
+            let len = u32::from_le_bytes(self.good[12..16].try_into().unwrap()) as usize;
+            &self.good[self.json_start..self.json_start + len]
+        }
+
+        fn payload(&self) -> &[u8] {
+            &self.good[self.payload_start..]
+        }
+
+        /// The error of reading the valid bytes after `change`, written as `name`.
+        fn load_changed(&self, name: &str, change: impl FnOnce(&mut Vec<u8>)) -> AssetError {
+            let mut b = self.good.clone();
+            change(&mut b);
+            load(&self.dir, name, &b)
+        }
+
+        /// The error of reading a file whose metadata is the valid one after `change`, with a
+        /// digest that matches it: what only the metadata's own checks can refuse.
+        fn load_with_metadata(&self, name: &str, change: impl FnOnce(&mut Value)) -> AssetError {
+            let mut m: Value = serde_json::from_slice(self.json()).unwrap();
+            change(&mut m);
+            let b = assemble(
+                FORMAT_VERSION,
+                &serde_json::to_vec(&m).unwrap(),
+                self.payload(),
+            );
+            load(&self.dir, name, &b)
+        }
+    }
+
     #[test]
-    fn every_corruption_has_its_own_error() {
-        let dir = scratch_dir("asset-corrupt");
-        let (good, json_start, payload_start) = valid_bytes();
-        std::fs::write(dir.join("good.sltab"), &good).unwrap();
-        read_asset(&dir.join("good.sltab")).unwrap();
-        let json = &good[json_start
-            ..json_start + u32::from_le_bytes(good[12..16].try_into().unwrap()) as usize];
-        let payload = &good[payload_start..];
-        let metadata: Value = serde_json::from_slice(json).unwrap();
-
-        let mut b = good.clone();
-        b[0] = b'X';
+    fn a_corrupt_header_has_its_own_error() {
+        let c = Corruptible::new("asset-corrupt-header");
         assert!(matches!(
-            load(&dir, "magic.sltab", &b),
+            c.load_changed("magic.sltab", |b| b[0] = b'X'),
             AssetError::BadMagic { .. }
         ));
         assert!(matches!(
-            load(&dir, "png.sltab", b"\x89PNG\r\n\x1a\n rest"),
+            load(&c.dir, "png.sltab", b"\x89PNG\r\n\x1a\n rest"),
             AssetError::BadMagic { .. }
         ));
-
-        let mut b = good.clone();
-        b[8..12].copy_from_slice(&1u32.to_le_bytes());
         assert!(matches!(
-            load(&dir, "version.sltab", &b),
+            c.load_changed("version.sltab", |b| b[8..12]
+                .copy_from_slice(&1u32.to_le_bytes())),
             AssetError::UnsupportedVersion {
                 found: 1,
                 supported: FORMAT_VERSION,
                 ..
             }
         ));
+        assert!(matches!(
+            c.load_changed("metalen.sltab", |b| b[12..16]
+                .copy_from_slice(&u32::MAX.to_le_bytes())),
+            AssetError::MetadataTooLarge { .. }
+        ));
+    }
 
+    #[test]
+    fn a_truncated_file_names_the_section_cut() {
+        let c = Corruptible::new("asset-corrupt-truncated");
         for (name, cut, section) in [
             ("cut-magic.sltab", 5, "magic bytes"),
             ("cut-header.sltab", 12, "header"),
-            ("cut-metadata.sltab", json_start + 40, "metadata"),
-            ("cut-payload.sltab", good.len() - 1, "payload"),
+            ("cut-metadata.sltab", c.json_start + 40, "metadata"),
+            ("cut-payload.sltab", c.good.len() - 1, "payload"),
         ] {
-            let err = load(&dir, name, &good[..cut]);
+            let err = load(&c.dir, name, &c.good[..cut]);
             assert!(
                 matches!(err, AssetError::Truncated { section: s, .. } if s == section),
                 "{name}"
             );
         }
+    }
 
-        let mut b = good.clone();
-        b[json_start] = b'['; // the opening brace of the JSON object
+    #[test]
+    fn corrupt_metadata_has_its_own_error() {
+        let c = Corruptible::new("asset-corrupt-metadata");
+        let json_start = c.json_start;
+        // The opening brace of the JSON object.
         assert!(matches!(
-            load(&dir, "json.sltab", &b),
+            c.load_changed("json.sltab", |b| b[json_start] = b'['),
             AssetError::MetadataChecksumMismatch { .. }
         ));
         // A flipped digit inside a parameter still parses; only the digest catches it.
-        let mut b = good.clone();
-        let digit = json.windows(4).position(|w| w == b"1.55").unwrap() + json_start + 2;
-        b[digit] = b'6';
+        let digit = c.json().windows(4).position(|w| w == b"1.55").unwrap() + json_start + 2;
         assert!(matches!(
-            load(&dir, "digit.sltab", &b),
+            c.load_changed("digit.sltab", |b| b[digit] = b'6'),
             AssetError::MetadataChecksumMismatch { .. }
         ));
         // JSON that is not an asset's metadata, with a valid digest.
         assert!(matches!(
             load(
-                &dir,
+                &c.dir,
                 "notjson.sltab",
-                &assemble(FORMAT_VERSION, b"[1, 2", payload)
+                &assemble(FORMAT_VERSION, b"[1, 2", c.payload())
             ),
             AssetError::BadMetadata { .. }
         ));
-
-        let mut b = good.clone();
-        b[12..16].copy_from_slice(&u32::MAX.to_le_bytes());
         assert!(matches!(
-            load(&dir, "metalen.sltab", &b),
-            AssetError::MetadataTooLarge { .. }
+            c.load_with_metadata("storage.sltab", |m| m["payload"]["storage"] = json!("f64")),
+            AssetError::BadMetadata { .. }
         ));
+    }
 
-        let mut b = good.clone();
-        b[payload_start + 7] ^= 0x10;
-        assert!(matches!(
-            load(&dir, "checksum.sltab", &b),
-            AssetError::ChecksumMismatch { .. }
-        ));
-
-        let mut b = good.clone();
-        b.extend_from_slice(&[0; 4]);
-        assert!(matches!(
-            load(&dir, "trailing.sltab", &b),
-            AssetError::Inconsistent { .. }
-        ));
-
+    #[test]
+    fn metadata_that_disagrees_with_the_payload_has_its_own_error() {
+        let c = Corruptible::new("asset-corrupt-shape");
         // Metadata that disagrees with the payload size it declares.
-        let mut m = metadata.clone();
-        m["payload"]["axes"][0]["count"] = json!(6);
-        let b = assemble(FORMAT_VERSION, &serde_json::to_vec(&m).unwrap(), payload);
         assert!(matches!(
-            load(&dir, "shape.sltab", &b),
+            c.load_with_metadata("shape.sltab", |m| {
+                m["payload"]["axes"][0]["count"] = json!(6)
+            }),
             AssetError::Inconsistent { .. }
         ));
-
         // An absurd axis count is refused from the metadata alone, before any allocation.
-        let mut m = metadata.clone();
-        m["payload"]["axes"][0]["count"] = json!(1u64 << 40);
-        m["payload"]["payload_bytes"] = json!(1u64 << 50);
-        let b = assemble(FORMAT_VERSION, &serde_json::to_vec(&m).unwrap(), payload);
-        let err = load(&dir, "absurd.sltab", &b);
+        let err = c.load_with_metadata("absurd.sltab", |m| {
+            m["payload"]["axes"][0]["count"] = json!(1u64 << 40);
+            m["payload"]["payload_bytes"] = json!(1u64 << 50);
+        });
         assert!(
             matches!(
                 err,
@@ -991,15 +1027,25 @@ mod tests {
             ),
             "{err}"
         );
+    }
 
-        let mut m = metadata.clone();
-        m["payload"]["storage"] = json!("f64");
-        let b = assemble(FORMAT_VERSION, &serde_json::to_vec(&m).unwrap(), payload);
+    #[test]
+    fn a_corrupt_payload_has_its_own_error() {
+        let c = Corruptible::new("asset-corrupt-payload");
+        let payload_start = c.payload_start;
         assert!(matches!(
-            load(&dir, "storage.sltab", &b),
-            AssetError::BadMetadata { .. }
+            c.load_changed("checksum.sltab", |b| b[payload_start + 7] ^= 0x10),
+            AssetError::ChecksumMismatch { .. }
         ));
+        assert!(matches!(
+            c.load_changed("trailing.sltab", |b| b.extend_from_slice(&[0; 4])),
+            AssetError::Inconsistent { .. }
+        ));
+    }
 
+    #[test]
+    fn a_missing_file_is_an_io_error_naming_it() {
+        let dir = scratch_dir("asset-missing");
         let err = read_asset(&dir.join("missing.sltab")).unwrap_err();
         assert!(
             matches!(&err, AssetError::Io { source, .. } if source.kind() == io::ErrorKind::NotFound)

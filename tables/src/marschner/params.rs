@@ -180,139 +180,80 @@ mod tests {
         assert_eq!(p.eta, 1.55);
     }
 
+    /// The defaults with one change.
+    fn changed(change: impl FnOnce(&mut MarschnerParams)) -> MarschnerParams {
+        let mut p = MarschnerParams::default();
+        change(&mut p);
+        p
+    }
+
+    /// `p` fails validation with an error that names `want`: `NotFinite` where `not_finite`,
+    /// else `OutOfRange`.
+    fn assert_rejected(p: MarschnerParams, want: &str, not_finite: bool) {
+        let err = p.validate().unwrap_err();
+        let name = match &err {
+            ParamError::NotFinite { name, .. } => {
+                assert!(not_finite, "{err}");
+                *name
+            }
+            ParamError::OutOfRange { name, .. } => {
+                assert!(!not_finite, "{err}");
+                *name
+            }
+            other => panic!("unexpected {other:?}"),
+        };
+        assert_eq!(name, want, "{err}");
+        eprintln!("rejected: {err}");
+    }
+
     #[test]
     fn invalid_parameters_are_typed_errors_naming_the_parameter() {
-        let base = MarschnerParams::default();
-        let cases: Vec<(MarschnerParams, &str, bool)> = vec![
-            (
-                MarschnerParams {
-                    eta: 1.0,
-                    ..base.clone()
-                },
-                "eta",
-                false,
-            ),
-            (
-                MarschnerParams {
-                    eta: 0.5,
-                    ..base.clone()
-                },
-                "eta",
-                false,
-            ),
-            (
-                MarschnerParams {
-                    eta: f64::NAN,
-                    ..base.clone()
-                },
-                "eta",
-                true,
-            ),
-            (
-                MarschnerParams {
-                    sigma_a: [0.1, -0.2, 0.3],
-                    ..base.clone()
-                },
-                "sigma_a.g",
-                false,
-            ),
-            (
-                MarschnerParams {
-                    sigma_a: [0.1, 0.2, f64::INFINITY],
-                    ..base.clone()
-                },
-                "sigma_a.b",
-                true,
-            ),
-            (
-                MarschnerParams {
-                    beta_deg: [7.5, 0.0, 15.0],
-                    ..base.clone()
-                },
-                "beta_deg.TT",
-                false,
-            ),
-            (
-                MarschnerParams {
-                    beta_deg: [-1.0, 3.0, 15.0],
-                    ..base.clone()
-                },
-                "beta_deg.R",
-                false,
-            ),
-            (
-                MarschnerParams {
-                    alpha_deg: [f64::NAN, 0.0, 0.0],
-                    ..base.clone()
-                },
-                "alpha_deg.R",
-                true,
-            ),
-            (
-                MarschnerParams {
-                    caustic_width_deg: -15.0,
-                    ..base.clone()
-                },
-                "caustic_width_deg",
-                false,
-            ),
-            (
-                MarschnerParams {
-                    glint_scale: -0.5,
-                    ..base.clone()
-                },
-                "glint_scale",
-                false,
-            ),
-            (
-                MarschnerParams {
-                    caustic_fade_range: 0.0,
-                    ..base.clone()
-                },
-                "caustic_fade_range",
-                false,
-            ),
-            (
-                MarschnerParams {
-                    caustic_intensity_limit: -0.1,
-                    ..base.clone()
-                },
-                "caustic_intensity_limit",
-                false,
-            ),
-            (
-                MarschnerParams {
-                    eccentricity: 0.6,
-                    ..base.clone()
-                },
-                "eccentricity",
-                false,
-            ),
-            (
-                MarschnerParams {
-                    eccentricity: 1.2,
-                    ..base.clone()
-                },
-                "eccentricity",
-                false,
-            ),
-        ];
-        for (p, want, not_finite) in cases {
-            let err = p.validate().unwrap_err();
-            let name = match &err {
-                ParamError::NotFinite { name, .. } => {
-                    assert!(not_finite, "{err}");
-                    *name
-                }
-                ParamError::OutOfRange { name, .. } => {
-                    assert!(!not_finite, "{err}");
-                    *name
-                }
-                other => panic!("unexpected {other:?}"),
-            };
-            assert_eq!(name, want, "{err}");
-            eprintln!("rejected: {err}");
-        }
+        assert_rejected(changed(|p| p.eta = 1.0), "eta", false);
+        assert_rejected(changed(|p| p.eta = 0.5), "eta", false);
+        assert_rejected(changed(|p| p.eta = f64::NAN), "eta", true);
+        assert_rejected(
+            changed(|p| p.sigma_a = [0.1, -0.2, 0.3]),
+            "sigma_a.g",
+            false,
+        );
+        assert_rejected(
+            changed(|p| p.sigma_a = [0.1, 0.2, f64::INFINITY]),
+            "sigma_a.b",
+            true,
+        );
+        assert_rejected(
+            changed(|p| p.beta_deg = [7.5, 0.0, 15.0]),
+            "beta_deg.TT",
+            false,
+        );
+        assert_rejected(
+            changed(|p| p.beta_deg = [-1.0, 3.0, 15.0]),
+            "beta_deg.R",
+            false,
+        );
+        assert_rejected(
+            changed(|p| p.alpha_deg = [f64::NAN, 0.0, 0.0]),
+            "alpha_deg.R",
+            true,
+        );
+        assert_rejected(
+            changed(|p| p.caustic_width_deg = -15.0),
+            "caustic_width_deg",
+            false,
+        );
+        assert_rejected(changed(|p| p.glint_scale = -0.5), "glint_scale", false);
+        assert_rejected(
+            changed(|p| p.caustic_fade_range = 0.0),
+            "caustic_fade_range",
+            false,
+        );
+        assert_rejected(
+            changed(|p| p.caustic_intensity_limit = -0.1),
+            "caustic_intensity_limit",
+            false,
+        );
+        assert_rejected(changed(|p| p.eccentricity = 0.6), "eccentricity", false);
+        assert_rejected(changed(|p| p.eccentricity = 1.2), "eccentricity", false);
     }
 
     #[test]

@@ -158,21 +158,86 @@ impl Errors {
     }
 }
 
-#[test]
-fn near_field_matches_mitsuba_hair_bsdf() {
-    if !require_python_modules(&["mitsuba"], "pip install mitsuba") {
-        return;
+/// Both tallies over every set, and how many values were left out and why.
+#[derive(Default)]
+struct Comparison {
+    /// With pbrt's and Mitsuba's I₀ approximations.
+    approx: Errors,
+    /// With the exact d'Eon term.
+    exact: Errors,
+    tiny: usize,
+    near_switch: usize,
+    total: usize,
+}
+
+impl Comparison {
+    /// Compares one parameter set's values with Mitsuba's (`theirs`, in the order of `cases`),
+    /// adds them to the totals and prints the set's own errors. Every value of ours must be
+    /// finite and non-negative, compared or not.
+    fn add_set(
+        &mut self,
+        name: &str,
+        model: &Chiang,
+        cases: &[(DVec3, DVec3)],
+        theirs: &[[f64; 3]],
+    ) {
+        let peak: [f64; 3] =
+            std::array::from_fn(|c| theirs.iter().map(|v| v[c]).fold(0.0, f64::max));
+        let (mut set_approx, mut set_exact) = (Errors::default(), Errors::default());
+        for (&(view, light), want) in cases.iter().zip(theirs) {
+            let ours = model.near_field_local(view, light, BesselForm::PbrtMitsuba);
+            let ours_exact = model.near_field_local(view, light, BesselForm::Exact);
+            let switch = near_bessel_switch(model, view, light);
+            for c in 0..3 {
+                self.total += 1;
+                assert!(
+                    ours[c].is_finite() && ours[c] >= 0.0,
+                    "{name}: {ours:?} at {view}, {light}"
+                );
+                if want[c] < TINY * peak[c] {
+                    self.tiny += 1;
+                    continue;
+                }
+                if switch {
+                    self.near_switch += 1;
+                    continue;
+                }
+                let what = |v: f64| {
+                    move || {
+                        format!(
+                            "{name}, channel {c}, view {view}, light {light}: ours {v:.6e}, Mitsuba {:.6e}",
+                            want[c]
+                        )
+                    }
+                };
+                let e = (ours[c] - want[c]).abs() / want[c];
+                set_approx.add(e, what(ours[c]));
+                self.approx.add(e, what(ours[c]));
+                let e = (ours_exact[c] - want[c]).abs() / want[c];
+                set_exact.add(e, what(ours_exact[c]));
+                self.exact.add(e, what(ours_exact[c]));
+            }
+        }
+        eprintln!(
+            "{name}: {} values compared; pbrt/Mitsuba I₀: max {:.2e} rms {:.2e}; exact d'Eon: max {:.2e} rms {:.2e}",
+            set_approx.compared,
+            set_approx.max,
+            set_approx.rms(),
+            set_exact.max,
+            set_exact.rms()
+        );
     }
-    let sets = parameter_sets();
-    let mut rng = SplitMix64::new(2016);
-    let models: Vec<Chiang> = sets
-        .iter()
-        .map(|(_, p)| Chiang::new(p.clone()).unwrap())
-        .collect();
-    let cases: Vec<Vec<(DVec3, DVec3)>> = models.iter().map(|m| pairs(m, &mut rng)).collect();
+}
+
+/// Mitsuba's RGB value of every case of every set, from `mitsuba_hair_eval.py` through a
+/// scratch folder, and the Mitsuba version that computed them.
+fn mitsuba_values(
+    sets: &[(&str, ChiangParams)],
+    cases: &[Vec<(DVec3, DVec3)>],
+) -> (String, Vec<Vec<[f64; 3]>>) {
     let groups: Vec<Value> = sets
         .iter()
-        .zip(&cases)
+        .zip(cases)
         .map(|((_, params), pairs)| {
             json!({
                 "params": params,
@@ -209,63 +274,46 @@ fn near_field_matches_mitsuba_hair_bsdf() {
     let result: Value = serde_json::from_slice(&std::fs::read(&output).unwrap()).unwrap();
     std::fs::remove_dir_all(&dir).unwrap();
     let version = result["mitsuba"].as_str().unwrap_or("?").to_string();
-    let values = result["values"].as_array().unwrap();
+    let values = result["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|set| {
+            set.as_array()
+                .unwrap()
+                .iter()
+                .map(|v| std::array::from_fn(|c| v[c].as_f64().unwrap()))
+                .collect()
+        })
+        .collect();
+    (version, values)
+}
 
-    let (mut approx, mut exact) = (Errors::default(), Errors::default());
-    let (mut tiny, mut near_switch, mut total) = (0usize, 0usize, 0usize);
-    for (s, ((name, _), model)) in sets.iter().zip(&models).enumerate() {
-        let theirs: Vec<[f64; 3]> = values[s]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| std::array::from_fn(|c| v[c].as_f64().unwrap()))
-            .collect();
-        let peak: [f64; 3] =
-            std::array::from_fn(|c| theirs.iter().map(|v| v[c]).fold(0.0, f64::max));
-        let (mut set_approx, mut set_exact) = (Errors::default(), Errors::default());
-        for (&(view, light), want) in cases[s].iter().zip(&theirs) {
-            let ours = model.near_field_local(view, light, BesselForm::PbrtMitsuba);
-            let ours_exact = model.near_field_local(view, light, BesselForm::Exact);
-            let switch = near_bessel_switch(model, view, light);
-            for c in 0..3 {
-                total += 1;
-                assert!(
-                    ours[c].is_finite() && ours[c] >= 0.0,
-                    "{name}: {ours:?} at {view}, {light}"
-                );
-                if want[c] < TINY * peak[c] {
-                    tiny += 1;
-                    continue;
-                }
-                if switch {
-                    near_switch += 1;
-                    continue;
-                }
-                let what = |v: f64| {
-                    move || {
-                        format!(
-                            "{name}, channel {c}, view {view}, light {light}: ours {v:.6e}, Mitsuba {:.6e}",
-                            want[c]
-                        )
-                    }
-                };
-                let e = (ours[c] - want[c]).abs() / want[c];
-                set_approx.add(e, what(ours[c]));
-                approx.add(e, what(ours[c]));
-                let e = (ours_exact[c] - want[c]).abs() / want[c];
-                set_exact.add(e, what(ours_exact[c]));
-                exact.add(e, what(ours_exact[c]));
-            }
-        }
-        eprintln!(
-            "{name}: {} values compared; pbrt/Mitsuba I₀: max {:.2e} rms {:.2e}; exact d'Eon: max {:.2e} rms {:.2e}",
-            set_approx.compared,
-            set_approx.max,
-            set_approx.rms(),
-            set_exact.max,
-            set_exact.rms()
-        );
+#[test]
+fn near_field_matches_mitsuba_hair_bsdf() {
+    if !require_python_modules(&["mitsuba"], "pip install mitsuba") {
+        return;
     }
+    let sets = parameter_sets();
+    let mut rng = SplitMix64::new(2016);
+    let models: Vec<Chiang> = sets
+        .iter()
+        .map(|(_, p)| Chiang::new(p.clone()).unwrap())
+        .collect();
+    let cases: Vec<Vec<(DVec3, DVec3)>> = models.iter().map(|m| pairs(m, &mut rng)).collect();
+    let (version, values) = mitsuba_values(&sets, &cases);
+
+    let mut all = Comparison::default();
+    for (s, ((name, _), model)) in sets.iter().zip(&models).enumerate() {
+        all.add_set(name, model, &cases[s], &values[s]);
+    }
+    let Comparison {
+        approx,
+        exact,
+        tiny,
+        near_switch,
+        total,
+    } = all;
     eprintln!(
         "Mitsuba {version}, {total} values ({} cases × RGB): {} compared, {tiny} tiny (< {TINY:e} of the set's max), {near_switch} excluded within 10⁻⁵ of the I₀ switch at 12",
         total / 3,

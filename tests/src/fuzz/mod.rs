@@ -480,7 +480,7 @@ pub fn run_with_seeds(target: &Target, seeds: Vec<Seed>) -> Report {
     std::fs::create_dir_all(&out_dir).expect("target/ is writable");
     let current = out_dir.join("current.bin");
     *CURRENT_INPUT.lock().unwrap_or_else(|e| e.into_inner()) = Some(current.clone());
-    let mut report = Report {
+    let report = Report {
         target: target.name.into(),
         round_trip: target.round_trip,
         seeds: seeds
@@ -491,17 +491,58 @@ pub fn run_with_seeds(target: &Target, seeds: Vec<Seed>) -> Report {
     };
     let mut rng = SplitMix64::new(stream_seed(target.name));
 
-    let mut current_file = std::fs::File::create(&current).expect("target/ is writable");
-    let mut round_tripped = HashSet::new();
-    let mut record = |report: &mut Report, data: &[u8], origin: String| {
-        let (outcome, largest) = execute(target, data, &mut current_file, &mut round_tripped);
+    let current_file = std::fs::File::create(&current).expect("target/ is writable");
+    let mut session = Session {
+        target,
+        report,
+        out_dir,
+        current_file,
+        round_tripped: HashSet::new(),
+    };
+    session.run_seeds(&seeds);
+    if target.prefixes_fail {
+        session.run_prefixes(&seeds, &mut rng);
+    }
+    session.run_mutants(&seeds, &mut rng);
+    let Session {
+        mut report,
+        current_file,
+        ..
+    } = session;
+    drop(current_file); // closed before it is removed
+    let _ = std::fs::remove_file(&current);
+    report.seconds = started.elapsed().as_secs_f64();
+    report
+}
+
+/// One target's fuzzing under way: the report it fills, the folder its findings go to, and
+/// what every execution shares (the open file that keeps the current input on disk, the
+/// fingerprints of the loads that round-tripped already).
+struct Session<'a> {
+    target: &'a Target,
+    report: Report,
+    out_dir: PathBuf,
+    current_file: std::fs::File,
+    round_tripped: HashSet<u64>,
+}
+
+impl Session<'_> {
+    /// Executes one input, counts its outcome and saves it if it found a problem. Returns
+    /// whether the input loaded.
+    fn record(&mut self, data: &[u8], origin: String) -> bool {
+        let (outcome, largest) = execute(
+            self.target,
+            data,
+            &mut self.current_file,
+            &mut self.round_tripped,
+        );
+        let report = &mut self.report;
         report.executions += 1;
         if data.len() >= 1024 {
             report.largest_allocation_per_byte = report
                 .largest_allocation_per_byte
                 .max(largest as f64 / data.len() as f64);
         }
-        // Returns whether the input loaded.
         let problem = match outcome {
             Outcome::Ok { repeated } => {
                 report.ok += 1;
@@ -524,32 +565,37 @@ pub fn run_with_seeds(target: &Target, seeds: Vec<Seed>) -> Report {
         };
         let loaded = matches!(problem, Problem::RoundTrip { .. });
         report.ok += loaded as usize;
-        save_finding(report, &out_dir, data, problem, origin);
+        self.save_finding(data, problem, origin);
         loaded
-    };
+    }
 
-    // Every seed loads (the generated ones must; a shared one that does not is reported).
-    for seed in &seeds {
-        let loaded = record(&mut report, &seed.bytes, format!("seed {}", seed.name));
-        if !loaded && seed.generated && report.findings.is_empty() {
-            save_finding(
-                &mut report,
-                &out_dir,
-                &seed.bytes,
-                Problem::SeedRefused,
-                format!("seed {}", seed.name),
-            );
+    fn save_finding(&mut self, data: &[u8], problem: Problem, origin: String) {
+        save_finding(&mut self.report, &self.out_dir, data, problem, origin);
+    }
+
+    /// Every seed loads (the generated ones must; a shared one that does not is reported).
+    fn run_seeds(&mut self, seeds: &[Seed]) {
+        for seed in seeds {
+            let loaded = self.record(&seed.bytes, format!("seed {}", seed.name));
+            if !loaded && seed.generated && self.report.findings.is_empty() {
+                self.save_finding(
+                    &seed.bytes,
+                    Problem::SeedRefused,
+                    format!("seed {}", seed.name),
+                );
+            }
         }
     }
 
-    // Strict prefixes: all of the smallest generated seed's, a sample of every other seed's.
-    if target.prefixes_fail {
+    /// Strict prefixes must be refused: all of the smallest generated seed's, a sample of
+    /// every other seed's. For formats that fix their own size ([`Target::prefixes_fail`]).
+    fn run_prefixes(&mut self, seeds: &[Seed], rng: &mut SplitMix64) {
         let smallest = seeds
             .iter()
             .filter(|s| s.generated)
             .min_by_key(|s| s.bytes.len())
             .map(|s| s.name.clone());
-        for seed in &seeds {
+        for seed in seeds {
             let cuts: Vec<usize> = if Some(&seed.name) == smallest.as_ref() {
                 (0..seed.bytes.len()).collect()
             } else {
@@ -559,16 +605,10 @@ pub fn run_with_seeds(target: &Target, seeds: Vec<Seed>) -> Report {
             };
             for cut in cuts {
                 let prefix = &seed.bytes[..cut];
-                let loaded = record(
-                    &mut report,
-                    prefix,
-                    format!("seed {}, first {cut} bytes", seed.name),
-                );
-                report.prefixes_checked += 1;
+                let loaded = self.record(prefix, format!("seed {}, first {cut} bytes", seed.name));
+                self.report.prefixes_checked += 1;
                 if loaded {
-                    save_finding(
-                        &mut report,
-                        &out_dir,
+                    self.save_finding(
                         prefix,
                         Problem::PrefixLoaded {
                             prefix: cut,
@@ -581,60 +621,77 @@ pub fn run_with_seeds(target: &Target, seeds: Vec<Seed>) -> Report {
         }
     }
 
-    // Mutants, and now and then junk behind a seed's first bytes (its magic and header start).
-    let executions = (target.execs as f64 * execs_multiplier()).round() as usize;
-    for i in 0..executions {
-        let seed = &seeds[rng.below(seeds.len())];
-        if i % JUNK_EVERY == JUNK_EVERY - 1 {
-            // Mostly behind this format's own head; one time in four behind another format's
-            // signature, so that every reader also meets its neighbours' files.
-            let (head_bytes, head_name): (&[u8], String) = if rng.below(4) > 0 {
-                let head = rng.below(seed.bytes.len().min(64) + 1);
-                (
-                    &seed.bytes[..head],
-                    format!("the first {head} bytes of seed {}", seed.name),
-                )
+    /// Mutants, and now and then junk behind a seed's first bytes (its magic and header start):
+    /// `execs × STRANDLIGHT_FUZZ_EXECS` executions in all.
+    fn run_mutants(&mut self, seeds: &[Seed], rng: &mut SplitMix64) {
+        let executions = (self.target.execs as f64 * execs_multiplier()).round() as usize;
+        for i in 0..executions {
+            let seed = &seeds[rng.below(seeds.len())];
+            let (data, origin) = if i % JUNK_EVERY == JUNK_EVERY - 1 {
+                junk(seed, rng)
             } else {
-                let magic = SIGNATURES[rng.below(SIGNATURES.len())];
-                (
-                    magic,
-                    format!("the signature {:?}", magic.escape_ascii().to_string()),
-                )
+                mutant(self.target, seeds, seed, i, rng)
             };
-            let mut junk = head_bytes.to_vec();
-            let len = rng.below(JUNK_MAX + 1);
-            junk.extend((0..len).map(|_| rng.next_u64() as u8));
-            let origin = format!("junk: {head_name} and {len} random bytes");
-            record(&mut report, &junk, origin);
-            continue;
+            self.record(&data, origin);
         }
-        let other = &seeds[rng.below(seeds.len())];
-        let (mut data, edits) = mutate::mutate(&seed.bytes, &other.bytes, &mut rng);
-        let resealed = match target.reseal {
-            Some(reseal) if rng.below(2) == 0 => {
-                reseal(&mut data);
-                true
-            }
-            _ => false,
-        };
-        let origin = format!(
-            "seed {}, edits {edits:?}{}{} (mutant {i} of stream {:#x}, STRANDLIGHT_FUZZ_EXECS={})",
-            seed.name,
-            if edits.contains(&mutate::Edit::Splice) {
-                format!(" (splice partner {})", other.name)
-            } else {
-                String::new()
-            },
-            if resealed { ", resealed" } else { "" },
-            stream_seed(target.name),
-            execs_multiplier(),
-        );
-        record(&mut report, &data, origin);
     }
-    drop(current_file); // closed before it is removed
-    let _ = std::fs::remove_file(&current);
-    report.seconds = started.elapsed().as_secs_f64();
-    report
+}
+
+/// Random bytes behind a head: mostly this format's own (the first bytes of `seed`), one time
+/// in four another format's signature, so that every reader also meets its neighbours' files.
+/// Returns the input and where it came from.
+fn junk(seed: &Seed, rng: &mut SplitMix64) -> (Vec<u8>, String) {
+    let (head_bytes, head_name): (&[u8], String) = if rng.below(4) > 0 {
+        let head = rng.below(seed.bytes.len().min(64) + 1);
+        (
+            &seed.bytes[..head],
+            format!("the first {head} bytes of seed {}", seed.name),
+        )
+    } else {
+        let magic = SIGNATURES[rng.below(SIGNATURES.len())];
+        (
+            magic,
+            format!("the signature {:?}", magic.escape_ascii().to_string()),
+        )
+    };
+    let mut junk = head_bytes.to_vec();
+    let len = rng.below(JUNK_MAX + 1);
+    junk.extend((0..len).map(|_| rng.next_u64() as u8));
+    (junk, format!("junk: {head_name} and {len} random bytes"))
+}
+
+/// Mutant `i` of `seed` (the edits may splice in a random partner seed), resealed half the
+/// time where the target can fix up its integrity check, so that the mutation reaches the
+/// parser behind it. Returns the input and an origin that names how it was made.
+fn mutant(
+    target: &Target,
+    seeds: &[Seed],
+    seed: &Seed,
+    i: usize,
+    rng: &mut SplitMix64,
+) -> (Vec<u8>, String) {
+    let other = &seeds[rng.below(seeds.len())];
+    let (mut data, edits) = mutate::mutate(&seed.bytes, &other.bytes, rng);
+    let resealed = match target.reseal {
+        Some(reseal) if rng.below(2) == 0 => {
+            reseal(&mut data);
+            true
+        }
+        _ => false,
+    };
+    let origin = format!(
+        "seed {}, edits {edits:?}{}{} (mutant {i} of stream {:#x}, STRANDLIGHT_FUZZ_EXECS={})",
+        seed.name,
+        if edits.contains(&mutate::Edit::Splice) {
+            format!(" (splice partner {})", other.name)
+        } else {
+            String::new()
+        },
+        if resealed { ", resealed" } else { "" },
+        stream_seed(target.name),
+        execs_multiplier(),
+    );
+    (data, origin)
 }
 
 /// Findings of one target saved to disk at most (a bug hit by many mutants is still counted).

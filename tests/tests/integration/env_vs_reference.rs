@@ -109,10 +109,49 @@ fn build_scene() -> Result<Scene, String> {
         t0.elapsed().as_secs_f64(),
         gpu.report.name
     );
+    let lights = fit_lights();
+    let tables = bake_tables(&lights.srbf);
 
+    let hair = generate_groom(&GroomParams {
+        strand_count: 800,
+        points_per_strand: 12,
+        clump_count: 40,
+        ..GroomParams::default()
+    })
+    .expect("groom");
+    let up = UpAxis::detect(&hair);
+    let camera = Camera::framing_front(hair.bounds(), WIDTH as f32 / HEIGHT as f32, false, up);
+    Ok(Scene {
+        gpu,
+        renderer,
+        srbf: to_env_lights(&lights.srbf, up),
+        reference: to_env_lights(&lights.reference, up),
+        fitted_reference: to_env_lights(&lights.fitted_reference, up),
+        srbf_specs: lights.srbf,
+        reference_specs: lights.reference,
+        hair,
+        camera,
+        up,
+        tables,
+    })
+}
+
+/// The three light sets of the studio map that the tests compare.
+struct LightSets {
+    /// The fitted SRBF lobes.
+    srbf: Vec<LightSpec>,
+    /// One directional light per cube texel of the map.
+    reference: Vec<LightSpec>,
+    /// One directional light per cube texel of the map the fitted lobes draw.
+    fitted_reference: Vec<LightSpec>,
+}
+
+/// Fits the studio map with a small SRBF set (the paper's pure fit, no compact source taken
+/// out: this test measures its method) and builds the cube-texel references of the map and of
+/// the fitted lobes, which separate the fit's error from the method's.
+fn fit_lights() -> LightSets {
     let t = Instant::now();
     let map = procedural_env::by_name("studio", 256).expect("studio is a procedural map");
-    // The paper's pure SRBF fit (no compact source taken out): this test measures its method.
     let options = FitOptions {
         initial_lobes: 8,
         max_lobes: 24,
@@ -134,7 +173,6 @@ fn build_scene() -> Result<Scene, String> {
     let srbf_specs = srbf_set_lights(&set);
     let reference_specs =
         reference_lights(&map, REFERENCE_FACE, &options.sources).expect("reference lights");
-    // The reference of the fitted lobes themselves: separates the fit's error from the method's.
     let fitted_map = procedural_env::from_srbf_lobes(256, &set.lobes);
     let fitted_reference_specs =
         reference_lights(&fitted_map, REFERENCE_FACE, &options.sources).expect("reference lights");
@@ -146,7 +184,17 @@ fn build_scene() -> Result<Scene, String> {
         set.full_resolution_relative_mse,
         reference_specs.len()
     );
+    LightSets {
+        srbf: srbf_specs,
+        reference: reference_specs,
+        fitted_reference: fitted_reference_specs,
+    }
+}
 
+/// Bakes the blonde Marschner tables the tests read ([`SINGLE_TABLES`] at
+/// [`SINGLE_TABLE_NODES`], [`MULTIPLE_TABLES`] at [`MULTIPLE_TABLE_NODES`]), their 1/λ axis
+/// spanning the bandwidths of `srbf_specs` with a 10% margin.
+fn bake_tables(srbf_specs: &[LightSpec]) -> BTreeMap<String, Arc<Table>> {
     let t = Instant::now();
     let (lo, hi) = srbf_specs
         .iter()
@@ -197,29 +245,7 @@ fn build_scene() -> Result<Scene, String> {
         "bake (λ ∈ [{lo:.1}, {hi:.1}]): {:.2} s",
         t.elapsed().as_secs_f64()
     );
-
-    let hair = generate_groom(&GroomParams {
-        strand_count: 800,
-        points_per_strand: 12,
-        clump_count: 40,
-        ..GroomParams::default()
-    })
-    .expect("groom");
-    let up = UpAxis::detect(&hair);
-    let camera = Camera::framing_front(hair.bounds(), WIDTH as f32 / HEIGHT as f32, false, up);
-    Ok(Scene {
-        gpu,
-        renderer,
-        srbf: to_env_lights(&srbf_specs, up),
-        reference: to_env_lights(&reference_specs, up),
-        fitted_reference: to_env_lights(&fitted_reference_specs, up),
-        srbf_specs,
-        reference_specs,
-        hair,
-        camera,
-        up,
-        tables,
-    })
+    tables
 }
 
 /// Renders `lights` (all of one kind) with κ = 1; `full` adds multiple scattering from
@@ -318,25 +344,20 @@ fn table(scene: &Scene, name: &str) -> Arc<Table> {
     scene.tables[name].clone()
 }
 
-#[test]
-fn srbf_single_scattering_matches_the_directional_reference() {
-    let start = Instant::now();
-    let scene = match scene() {
-        Ok(s) => s,
-        Err(reason) => {
-            skip_or_fail(&format!("no GPU device ({reason})"));
-            return;
-        }
-    };
-    eprintln!(
-        "scene ready after {:.2} s; groom up axis {:?}, {} SRBF lights, {} reference lights",
-        start.elapsed().as_secs_f64(),
-        scene.up,
-        scene.srbf.len(),
-        scene.reference.len()
-    );
+/// The relative RMSEs of one shadowing mode, against the map's reference.
+struct SingleScatteringErrors {
+    shadowed: bool,
+    /// The SRBF image.
+    total: f64,
+    /// The SRBF lights turned 90° about up: must exceed the bound, or the test is blind.
+    turned: f64,
+    /// The SRBF image against the reference of the fitted lobes: the method alone.
+    method: f64,
+}
 
-    // The fit preserves the map's power; the cube texels integrate the same map.
+/// The fit preserves the map's power; the cube texels integrate the same map: the two light
+/// sets' total powers agree to 10⁻³ in every channel.
+fn assert_srbf_power_matches_the_reference(scene: &Scene) {
     let (ps, pr) = (
         total_power(&scene.srbf_specs),
         total_power(&scene.reference_specs),
@@ -354,7 +375,12 @@ fn srbf_single_scattering_matches_the_directional_reference() {
             pr[c]
         );
     }
+}
 
+/// Renders the SRBF image, the map's reference, the fitted lobes' reference and the turned
+/// SRBF lights in one shadowing mode; checks that all are finite and that the paths rasterize
+/// the same hair, and returns the errors for the caller's bounds.
+fn single_scattering_errors(scene: &Scene, shadowed: bool) -> SingleScatteringErrors {
     let srbf_tables = EnvTables {
         srbf: Some(table(scene, "marschner")),
         ..EnvTables::default()
@@ -363,62 +389,95 @@ fn srbf_single_scattering_matches_the_directional_reference() {
         direct: Some(table(scene, "marschner_direct")),
         ..EnvTables::default()
     };
-    let mut errors = Vec::new();
-    for shadowed in [false, true] {
-        let (a, ta) = render(scene, &scene.srbf, srbf_tables.clone(), shadowed, None);
-        let (r, tr) = render(
-            scene,
-            &scene.reference,
-            direct_tables.clone(),
-            shadowed,
-            None,
-        );
-        assert_finite("SRBF image", &a);
-        assert_finite("reference image", &r);
-        assert_eq!(
-            coverage(&a),
-            coverage(&r),
-            "both paths rasterize the same hair"
-        );
-        assert!(
-            coverage(&r) > 500,
-            "the groom covers {} pixels",
-            coverage(&r)
-        );
-        let e = relative_rmse(&a, &r);
-        let (f, tf) = render(
-            scene,
-            &scene.fitted_reference,
-            direct_tables.clone(),
-            shadowed,
-            None,
-        );
-        let e_method = relative_rmse(&a, &f);
-        let e_fit = relative_rmse(&f, &r);
-        eprintln!(
-            "shadowed {shadowed:5}: SRBF vs reference of the fitted lobes {e_method:.4}; fitted-lobe reference vs map reference {e_fit:.4} ({tf:.2} s)"
-        );
-        eprintln!(
-            "shadowed {shadowed:5}: relative RMSE {e:.4} over {} hair pixels; mean SRBF {:.4e}, reference {:.4e}; SRBF {ta:.2} s, reference {tr:.2} s",
-            coverage(&r),
-            mean_hair(&a),
-            mean_hair(&r)
-        );
-        let (turned, _) = render(
-            scene,
-            &rotated(&scene.srbf, scene.up, 90.0),
-            srbf_tables.clone(),
-            shadowed,
-            None,
-        );
-        let e_turned = relative_rmse(&turned, &r);
-        eprintln!(
-            "shadowed {shadowed:5}: SRBF lights turned 90° about up: relative RMSE {e_turned:.4}"
-        );
-        errors.push((shadowed, e, e_turned, e_method));
+    let (a, ta) = render(scene, &scene.srbf, srbf_tables.clone(), shadowed, None);
+    let (r, tr) = render(
+        scene,
+        &scene.reference,
+        direct_tables.clone(),
+        shadowed,
+        None,
+    );
+    assert_finite("SRBF image", &a);
+    assert_finite("reference image", &r);
+    assert_eq!(
+        coverage(&a),
+        coverage(&r),
+        "both paths rasterize the same hair"
+    );
+    assert!(
+        coverage(&r) > 500,
+        "the groom covers {} pixels",
+        coverage(&r)
+    );
+    let e = relative_rmse(&a, &r);
+    let (f, tf) = render(
+        scene,
+        &scene.fitted_reference,
+        direct_tables.clone(),
+        shadowed,
+        None,
+    );
+    let e_method = relative_rmse(&a, &f);
+    let e_fit = relative_rmse(&f, &r);
+    eprintln!(
+        "shadowed {shadowed:5}: SRBF vs reference of the fitted lobes {e_method:.4}; fitted-lobe reference vs map reference {e_fit:.4} ({tf:.2} s)"
+    );
+    eprintln!(
+        "shadowed {shadowed:5}: relative RMSE {e:.4} over {} hair pixels; mean SRBF {:.4e}, reference {:.4e}; SRBF {ta:.2} s, reference {tr:.2} s",
+        coverage(&r),
+        mean_hair(&a),
+        mean_hair(&r)
+    );
+    let (turned, _) = render(
+        scene,
+        &rotated(&scene.srbf, scene.up, 90.0),
+        srbf_tables.clone(),
+        shadowed,
+        None,
+    );
+    let e_turned = relative_rmse(&turned, &r);
+    eprintln!(
+        "shadowed {shadowed:5}: SRBF lights turned 90° about up: relative RMSE {e_turned:.4}"
+    );
+    SingleScatteringErrors {
+        shadowed,
+        total: e,
+        turned: e_turned,
+        method: e_method,
     }
+}
+
+#[test]
+fn srbf_single_scattering_matches_the_directional_reference() {
+    let start = Instant::now();
+    let scene = match scene() {
+        Ok(s) => s,
+        Err(reason) => {
+            skip_or_fail(&format!("no GPU device ({reason})"));
+            return;
+        }
+    };
+    eprintln!(
+        "scene ready after {:.2} s; groom up axis {:?}, {} SRBF lights, {} reference lights",
+        start.elapsed().as_secs_f64(),
+        scene.up,
+        scene.srbf.len(),
+        scene.reference.len()
+    );
+    assert_srbf_power_matches_the_reference(scene);
+
+    let errors: Vec<SingleScatteringErrors> = [false, true]
+        .into_iter()
+        .map(|shadowed| single_scattering_errors(scene, shadowed))
+        .collect();
     eprintln!("total {:.2} s", start.elapsed().as_secs_f64());
-    for (shadowed, e, e_turned, e_method) in errors {
+    for SingleScatteringErrors {
+        shadowed,
+        total: e,
+        turned: e_turned,
+        method: e_method,
+    } in errors
+    {
         let method_bound = if shadowed {
             METHOD_SHADOWED_BOUND
         } else {
