@@ -118,8 +118,8 @@ struct EnvArgs {
     /// Only the N most powerful SRBF lobes (a fit's compact sources are kept); default: all.
     #[arg(long, value_name = "N")]
     strongest_lobes: Option<usize>,
-    /// The environment turned about the hair's up axis, degrees (the fitted lobes are rotated
-    /// exactly; nothing is refitted).
+    /// The environment turned about the hair's up axis, degrees: map azimuth φ moves to φ + DEG
+    /// (scene/src/env_orientation.rs; the fitted lobes are turned exactly, nothing is refitted).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     rotate: f32,
     /// Side of each light's convolution optical depth map, texels.

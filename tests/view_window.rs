@@ -4,7 +4,8 @@
 //! - the window kept presenting frames while the rebake ran (no gap near the bake's length);
 //! - the screenshot is not blank, and its sidecar holds the orbited camera and the new control;
 //! - the capture of the whole window shows the screenshot's picture where the image sits;
-//! - `render replay` of the sidecar reproduces the screenshot's linear EXR;
+//! - `render replay` of the sidecar reproduces the screenshot's linear EXR, also after the
+//!   panel turns the map;
 //! - switched to point lights (DOM shadows, sorted transparency) as the panel's radio button
 //!   does, and orbited again, the window converges to another picture whose screenshot
 //!   `render replay` also reproduces.
@@ -110,18 +111,26 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
     let shot = read_rgba_exr(&dir.join("shot.exr")).unwrap();
     let error = replay_error(&dir, "shot");
     println!("screenshot against its replay: relative RMSE {error:.2e}");
-    // The viewer sums its light batches on the CPU, `render` on the GPU: rounding only.
+    // The viewer adds its light batches into one running sum, `render` draws them at once, both
+    // on the GPU: rounding only.
     assert!(error < 1e-4, "replay differs: relative RMSE {error}");
     phase("the screenshot replayed");
+
+    assert_rotated_screenshot_changed_and_replays(&dir, &shot);
+    phase("the rotated screenshot replayed");
 
     assert_point_lit_screenshot_changed_and_replays(&dir, &shot);
     phase("the point-lit screenshot replayed");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// The map's turn the script sets in the panel, away from 0 and 180 so that a turn the wrong
+/// way draws another frame.
+const ROTATION_DEG: f32 = 211.0;
+
 /// The script of the test: orbit, toggle the overlay keys, change an artist control (which
 /// rebakes a table: a brighter, wider primary highlight, the artist table holding the colours),
-/// screenshot `shot`; then switch to [`point_lighting`], orbit again and screenshot `points`.
+/// screenshot `shot`; turn the map by [`ROTATION_DEG`], screenshot `rotated`; then switch to [`point_lighting`], orbit again and screenshot `points`.
 fn viewer_script() -> Value {
     let mut artist = ArtistParams::default();
     artist.r.intensity = 1.5;
@@ -143,6 +152,9 @@ fn viewer_script() -> Value {
         {"key": "O"},
         {"frames": 2},
         {"screenshot": "shot"},
+        {"settings": {"lighting": {"environment": {"rotation_deg": ROTATION_DEG}}}},
+        {"wait": "converged"},
+        {"screenshot": "rotated"},
         {"settings": {"lighting": {"environment": null, "lights": point_lighting()}}},
         {"wait": "converged"},
         {"drag": [[0.5, 0.5], [0.4, 0.55]]},
@@ -288,6 +300,30 @@ fn assert_point_lit_screenshot_changed_and_replays(dir: &Path, shot: &Image) {
     assert!(
         error < 1e-3,
         "point-lit replay differs: relative RMSE {error}"
+    );
+}
+
+/// The map turned in the viewer draws what `render` draws at that turn: the sidecar names it,
+/// the picture changed, and `render replay` of the sidecar reproduces it.
+fn assert_rotated_screenshot_changed_and_replays(dir: &Path, shot: &Image) {
+    let sidecar: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("rotated.json")).unwrap()).unwrap();
+    assert_eq!(
+        sidecar["lighting"]["environment"]["rotation_deg"],
+        json!(ROTATION_DEG),
+        "{sidecar}"
+    );
+    let rotated = read_rgba_exr(&dir.join("rotated.exr")).unwrap();
+    let change = relative_rmse(&rotated, shot).unwrap();
+    assert!(
+        change > 0.1,
+        "turning the map did not change the picture: {change}"
+    );
+    let error = replay_error(dir, "rotated");
+    println!("rotated screenshot against its replay: relative RMSE {error:.2e}");
+    assert!(
+        error < 1e-4,
+        "rotated replay differs: relative RMSE {error}"
     );
 }
 

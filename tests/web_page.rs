@@ -12,6 +12,13 @@
 //! - after an orbit (a mouse drag) and a zoom (the wheel) the page converges to a new frame,
 //!   which matches `render replay` of the settings the page reports for it, and so does the
 //!   frame after the panel switches from single + multiple to single scattering;
+//! - the picture on the canvas (`page.png`, the screenshot) is the frame exposed at the stops
+//!   the page metered and tonemapped as `render` writes PNGs, the browser's own frame to the
+//!   8-bit level and the native frame over blocks; the page meters the stops `render` would;
+//! - the camera after the scripted drag and wheel turned, tilted and came closer by what the
+//!   orbit promises per pixel and per step;
+//! - after the panel's slider turns the map, the page's frame is `render replay`'s of the
+//!   settings it reports;
 //! - on a device held to less than WebGPU's storage-binding limit the page shrinks its light
 //!   maps, says so, and converges.
 
@@ -19,9 +26,14 @@ use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use strandlight_eval::reference_cache::read_rgba_exr;
+use strandlight_runtime::camera::Camera;
 use strandlight_runtime::gpu::GpuContext;
-use strandlight_scene::frame_settings::Lighting;
+use strandlight_runtime::hair::yuksel::parse_hair;
+use strandlight_scene::exposure::metered_stops;
+use strandlight_scene::frame_render::settings_camera;
+use strandlight_scene::frame_settings::{FrameSettings, Lighting};
 use strandlight_scene::image_metrics::{Image, relative_rmse};
+use strandlight_tables::image_out::tonemap_channel;
 use strandlight_tables::outside_tools::{missing_tool, program_exists};
 use strandlight_web::session::{BundleFiles, Session};
 
@@ -40,6 +52,16 @@ const TOTAL_TOLERANCE: f64 = 5e-3;
 /// half-float tables: 4.6e-5. (1.8e-3 while the bundle held the demo's coarser tables and the
 /// replay baked `render`'s: the difference once blamed on the split into batches.)
 const NATIVE_SESSION_TOLERANCE: f64 = 5e-4;
+/// The canvas against the browser's own frame, exposed and tonemapped here: the same numbers
+/// through the same tonemap, so the mean 8-bit difference per channel is rounding.
+const PICTURE_LEVELS_OWN_FRAME: f64 = 0.5;
+/// The canvas against the native frame over 8×8 blocks (the rasterizers differ at fiber edges,
+/// see PIXEL_TOLERANCE), in mean 8-bit levels per channel.
+const PICTURE_LEVELS_NATIVE: f64 = 2.0;
+/// The orbit's promise (scene/src/orbit.rs): 0.3° of turn or tilt per pixel dragged, and a
+/// wheel step toward the hair brings the eye e^-0.1 closer.
+const DEGREES_PER_PIXEL: f32 = 0.3;
+const ZOOM_PER_STEP: f32 = 0.1;
 
 fn repo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -269,6 +291,7 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
 
     let browser = read_frame(&shots.join("frame.f32"), &native);
     assert_matches("the page's first frame", &browser, &native);
+    assert_picture_is_the_frame_at_the_metered_exposure(&report, &shots, &browser, &native);
 
     // The orbited and zoomed frame against render replay of the settings the page reports.
     let orbited_native = replay(&work, &shots.join("orbited.json"), &shots, "orbited-native");
@@ -278,6 +301,7 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
         "the orbit did not change the frame"
     );
     assert_matches("the orbited and zoomed frame", &orbited, &orbited_native);
+    assert_the_camera_followed_the_drag(&report, &shots.join("orbited.json"), &site);
 
     phase("orbited frame replayed");
     // Switched to single scattering in the panel: less light, and render replay's frame.
@@ -289,11 +313,204 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
     assert_matches("the single-scattering frame", &single, &single_native);
 
     phase("single frame replayed");
+    // The map turned with the panel's slider: the frame of the settings the page reports.
+    let rotated_settings = shots.join("rotated.json");
+    assert_eq!(
+        env_rotation(&rotated_settings),
+        report["rotation"].as_f64().unwrap() as f32
+    );
+    let rotated_native = replay(&work, &rotated_settings, &shots, "rotated-native");
+    let rotated = read_frame(&shots.join("rotated.f32"), &rotated_native);
+    let turned = relative_rmse(&rotated, &single).unwrap();
+    assert!(
+        turned > 0.1,
+        "turning the map changed the frame by {turned}"
+    );
+    assert_matches("the frame with the map turned", &rotated, &rotated_native);
+
+    phase("rotated frame replayed");
     assert_bad_file_left_the_page_as_it_was(&report);
     assert_light_maps_shrink_under_a_binding_limit(&site.join("bundle"), &settings, &native);
     phase("limited session converged");
     let _ = std::fs::remove_dir_all(&site);
     let _ = std::fs::remove_file(&test_settings);
+}
+
+/// The canvas's picture against `frame` exposed by the page's metered stops over its black
+/// background and tonemapped: the mean 8-bit difference per channel over `block`×`block` means.
+fn picture_levels(picture: &Image, frame: &Image, stops: f32, block: u32) -> f64 {
+    let exposure = stops.exp2();
+    let expected = Image {
+        width: frame.width,
+        height: frame.height,
+        pixels: frame
+            .pixels
+            .iter()
+            .map(|p| {
+                let [r, g, b] = [0, 1, 2].map(|k| tonemap_channel(exposure * p[k]) as f32);
+                [r, g, b, 255.0]
+            })
+            .collect(),
+    };
+    let (a, b) = (blocks(picture, block), blocks(&expected, block));
+    let sum: f64 = a
+        .pixels
+        .iter()
+        .zip(&b.pixels)
+        .map(|(p, q)| (0..3).map(|c| (p[c] - q[c]).abs() as f64).sum::<f64>())
+        .sum();
+    sum / (3 * a.pixels.len()) as f64
+}
+
+/// `page.png` (the canvas in the screenshot) as 8-bit levels.
+fn read_picture(path: &Path) -> Image {
+    let decoder = png::Decoder::new(BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut bytes = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut bytes).unwrap();
+    let channels = info.color_type.samples();
+    assert_eq!(info.bit_depth, png::BitDepth::Eight, "{}", path.display());
+    let pixels = bytes[..info.buffer_size()]
+        .chunks(channels)
+        .map(|p| [p[0] as f32, p[1] as f32, p[2] as f32, 255.0])
+        .collect();
+    Image {
+        width: info.width,
+        height: info.height,
+        pixels,
+    }
+}
+
+fn flipped_upside_down(image: &Image) -> Image {
+    let w = image.width as usize;
+    Image {
+        width: image.width,
+        height: image.height,
+        pixels: image.pixels.chunks(w).rev().flatten().copied().collect(),
+    }
+}
+
+/// What the page shows is the frame it rendered at the stops it metered, as `render` would
+/// expose and tonemap it: the browser's frame to the 8-bit level, the native one over blocks.
+/// An upside-down frame must fail the same check, or it is blind.
+fn assert_picture_is_the_frame_at_the_metered_exposure(
+    report: &serde_json::Value,
+    shots: &Path,
+    browser: &Image,
+    native: &Image,
+) {
+    let stops = report["describe"]["stops"].as_f64().unwrap() as f32;
+    let own_stops = metered_stops(&browser.pixels).unwrap();
+    let native_stops = metered_stops(&native.pixels).unwrap();
+    eprintln!(
+        "exposure: the page {stops:.3} stops, its frame metered {own_stops:.3}, the native frame {native_stops:.3}"
+    );
+    assert!((stops - own_stops).abs() < 1e-3, "{stops} vs {own_stops}");
+    assert!(
+        (stops - native_stops).abs() < 0.1,
+        "{stops} vs {native_stops}"
+    );
+    let picture = read_picture(&shots.join("page.png"));
+    assert_eq!(
+        (picture.width, picture.height),
+        (native.width, native.height)
+    );
+    let own = picture_levels(&picture, browser, stops, 1);
+    let against_native = picture_levels(&picture, native, stops, 8);
+    let flipped = picture_levels(&picture, &flipped_upside_down(native), stops, 8);
+    eprintln!(
+        "page.png: {own:.3} levels from its own frame per pixel, {against_native:.3} from the \
+         native frame over 8×8 blocks ({flipped:.3} from the native frame upside down)"
+    );
+    assert!(own < PICTURE_LEVELS_OWN_FRAME, "{own}");
+    assert!(against_native < PICTURE_LEVELS_NATIVE, "{against_native}");
+    assert!(
+        flipped > PICTURE_LEVELS_NATIVE,
+        "the check cannot see a flip: {flipped}"
+    );
+}
+
+/// The camera of a page's settings file, with the bundle's hair (for an automatic framing).
+fn camera_of(settings: &FrameSettings, site: &Path) -> Camera {
+    let path = site.join("bundle/hair.hair");
+    let hair = parse_hair(&std::fs::read(&path).unwrap(), &path)
+        .unwrap()
+        .model;
+    settings_camera(settings, &hair).unwrap()
+}
+
+fn read_settings(path: &Path) -> FrameSettings {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn env_rotation(path: &Path) -> f32 {
+    match read_settings(path).lighting {
+        Lighting::Environment(env) => env.rotation_deg,
+        Lighting::Lights(_) => panic!("{}: not env-lit", path.display()),
+    }
+}
+
+/// (turn about up, elevation) of the eye seen from the target, in degrees, and its distance.
+fn eye_angles(camera: &Camera) -> (f32, f32, f32) {
+    let up = camera.up.normalize();
+    let d = camera.eye - camera.target;
+    let horizontal = (d - up * d.dot(up)).normalize();
+    let reference = up.any_orthonormal_vector();
+    let turn = up
+        .dot(reference.cross(horizontal))
+        .atan2(reference.dot(horizontal));
+    let elevation = (d.dot(up) / d.length()).asin();
+    (turn.to_degrees(), elevation.to_degrees(), d.length())
+}
+
+/// The scripted drag of (moves · dx, moves · dy) pixels turned the eye about up by −0.3° per
+/// pixel right, lowered it 0.3° per pixel up, and the wheel steps brought it closer, about the
+/// same target.
+fn assert_the_camera_followed_the_drag(report: &serde_json::Value, after: &Path, site: &Path) {
+    let before: FrameSettings =
+        serde_json::from_value(report["settingsBeforeDrag"].clone()).unwrap();
+    let drag = &report["drag"];
+    let moves = drag["moves"].as_f64().unwrap() as f32;
+    let (dx, dy) = (
+        moves * drag["dx"].as_f64().unwrap() as f32,
+        moves * drag["dy"].as_f64().unwrap() as f32,
+    );
+    let steps = drag["wheelSteps"].as_f64().unwrap() as f32;
+    let (c0, c1) = (
+        camera_of(&before, site),
+        camera_of(&read_settings(after), site),
+    );
+    let ((turn0, elevation0, distance0), (turn1, elevation1, distance1)) =
+        (eye_angles(&c0), eye_angles(&c1));
+    let turned = (turn1 - turn0 + 540.0).rem_euclid(360.0) - 180.0;
+    eprintln!(
+        "the drag ({dx}, {dy}) px and {steps} wheel steps: turned {turned:.3}°, elevation \
+         {:.3}°, distance ×{:.4}",
+        elevation1 - elevation0,
+        distance1 / distance0
+    );
+    assert!(
+        (c1.target - c0.target).length() < 1e-4 * distance0,
+        "the target moved"
+    );
+    assert!(
+        c1.up.normalize().dot(c0.up.normalize()) > 1.0 - 1e-6,
+        "up changed"
+    );
+    assert!(
+        (turned + dx * DEGREES_PER_PIXEL).abs() < 0.05,
+        "turned {turned}°"
+    );
+    assert!(
+        (elevation1 - elevation0 - dy * DEGREES_PER_PIXEL).abs() < 0.05,
+        "elevation {elevation0}° -> {elevation1}°"
+    );
+    let closer = (-ZOOM_PER_STEP * steps).exp();
+    assert!(
+        (distance1 / distance0 - closer).abs() < 1e-3,
+        "distance ×{}",
+        distance1 / distance0
+    );
 }
 
 /// Builds the test's site in `site`: the demo's settings with the 8 most powerful lobes (and the

@@ -939,23 +939,7 @@ fn env_lit(
     for &mode in &plan.modes {
         let reference = compare::reference(&render_lights, &scene, &args, mode, steps)?;
         if plan.decomposition {
-            decompositions.push(match mode {
-                ScatteringMode::Single => {
-                    error_decomposition::single_scattering(&name, &inputs, &reference, steps)?
-                }
-                ScatteringMode::Full => {
-                    let single = compare::reference(
-                        &render_lights,
-                        &scene,
-                        &args,
-                        ScatteringMode::Single,
-                        steps,
-                    )?;
-                    error_decomposition::full_scattering(
-                        &name, &inputs, &single, &reference, steps,
-                    )?
-                }
-            });
+            decompositions.push(decomposition(&name, mode, &inputs, &reference, steps)?);
         }
         if plan.decomposition_only {
             continue;
@@ -1009,39 +993,83 @@ fn env_lit(
             hdr_flip: 0.0,
             truth: truth.as_ref().map(|t| truth_error(image, t)).transpose()?,
         });
-        let default = points[0].clone();
-        let baseline: Vec<&Point> = points.iter().filter(|p| p.is_baseline()).collect();
-        let speedup = |metric: &dyn Fn(&Point) -> f64| {
-            curve_ms_at(&baseline, metric(&default), metric).map(|ms| ms / default.ms)
-        };
-        let truth_metric =
-            |f: fn(&TruthError) -> f64| move |p: &Point| p.truth.as_ref().map_or(f64::NAN, f);
-        let (truth_rmse, truth_flip) = match &truth {
-            Some(_) => (
-                speedup(&truth_metric(|t| t.relative_rmse)),
-                speedup(&truth_metric(|t| t.hdr_flip)),
-            ),
-            None => (None, None),
-        };
-        out.push(EnvLitResult {
-            map: name.clone(),
-            mode: mode.name().into(),
-            reference_lights: record.lights,
-            reference_ms: record.milliseconds,
-            reference_converged: reference.converged,
-            reference_ladder: reference.ladder.iter().map(|&(n, _, d)| (n, d)).collect(),
-            speedup_equal_rmse: speedup(&|p| p.relative_rmse),
-            speedup_equal_flip: speedup(&|p| p.hdr_flip),
-            truth: truth.as_ref().map(truth_summary),
-            speedup_equal_rmse_truth: truth_rmse,
-            speedup_equal_flip_truth: truth_flip,
+        out.push(env_lit_result(
+            &name,
+            mode,
+            &reference,
+            truth.as_ref(),
             points,
-        });
+        ));
     }
     Ok(MapResults {
         env_lit: out,
         decompositions,
     })
+}
+
+/// The error decomposition of `reference`'s mode against the DOM reference (full scattering's
+/// needs the single-scattering reference too).
+fn decomposition(
+    name: &str,
+    mode: ScatteringMode,
+    inputs: &DecompositionInputs,
+    reference: &compare::Reference,
+    steps: &mut Steps,
+) -> anyhow::Result<ErrorDecomposition> {
+    match mode {
+        ScatteringMode::Single => {
+            error_decomposition::single_scattering(name, inputs, reference, steps)
+        }
+        ScatteringMode::Full => {
+            let single = compare::reference(
+                &render_lights,
+                inputs.scene,
+                inputs.args,
+                ScatteringMode::Single,
+                steps,
+            )?;
+            error_decomposition::full_scattering(name, inputs, &single, reference, steps)
+        }
+    }
+}
+
+/// One mode's points with the speedups at the default's errors read off the baseline's curve.
+fn env_lit_result(
+    name: &str,
+    mode: ScatteringMode,
+    reference: &compare::Reference,
+    truth: Option<&GroundTruth>,
+    points: Vec<Point>,
+) -> EnvLitResult {
+    let record = &reference.chosen.record;
+    let default = points[0].clone();
+    let baseline: Vec<&Point> = points.iter().filter(|p| p.is_baseline()).collect();
+    let speedup = |metric: &dyn Fn(&Point) -> f64| {
+        curve_ms_at(&baseline, metric(&default), metric).map(|ms| ms / default.ms)
+    };
+    let truth_metric =
+        |f: fn(&TruthError) -> f64| move |p: &Point| p.truth.as_ref().map_or(f64::NAN, f);
+    let (truth_rmse, truth_flip) = match truth {
+        Some(_) => (
+            speedup(&truth_metric(|t| t.relative_rmse)),
+            speedup(&truth_metric(|t| t.hdr_flip)),
+        ),
+        None => (None, None),
+    };
+    EnvLitResult {
+        map: name.into(),
+        mode: mode.name().into(),
+        reference_lights: record.lights,
+        reference_ms: record.milliseconds,
+        reference_converged: reference.converged,
+        reference_ladder: reference.ladder.iter().map(|&(n, _, d)| (n, d)).collect(),
+        speedup_equal_rmse: speedup(&|p| p.relative_rmse),
+        speedup_equal_flip: speedup(&|p| p.hdr_flip),
+        truth: truth.map(truth_summary),
+        speedup_equal_rmse_truth: truth_rmse,
+        speedup_equal_flip_truth: truth_flip,
+        points,
+    }
 }
 
 /// The decomposition of `reference`'s mode against its ground truth `truth`. Full scattering's

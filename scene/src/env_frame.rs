@@ -9,7 +9,9 @@ use anyhow::Context;
 use std::sync::OnceLock;
 use strandlight_precompute::srbf_set::SrbfSet;
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env::{EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables};
+use strandlight_runtime::env::{
+    EnvImage, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables, FrameSums,
+};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
@@ -269,6 +271,33 @@ pub fn lights_call_without_source<'g>(frame: &EnvFrame) -> anyhow::Result<Lights
     })
 }
 
+/// The running sum of a progressive frame on the renderers' device (the viewer's batches).
+pub fn frame_sums(width: u32, height: u32) -> anyhow::Result<FrameSums> {
+    let (gpu, _) = env_renderer()?;
+    Ok(FrameSums::new(gpu, width, height)?)
+}
+
+/// [`render_lights`] adding the frame's lights into `sums`, the one batch-sum pass of the
+/// runtime: the image is the running sum after this part, its stats the part's own.
+pub fn render_lights_into(frame: &EnvFrame, sums: &FrameSums) -> anyhow::Result<RenderedFrame> {
+    let (gpu, renderer) = env_renderer()?;
+    let call = lights_call(frame, gpu)?;
+    let out = renderer
+        .render_part_into(
+            gpu,
+            frame.hair,
+            &frame.camera,
+            (&frame.lights, frame.look.simplified_lights_before),
+            &call.tables,
+            &call.options,
+            call.source.as_deref(),
+            frame.head.as_ref(),
+            sums,
+        )
+        .with_context(|| format!("adding {} lights to the frame", frame.lights.len()))?;
+    Ok(rendered_env(frame, gpu, out))
+}
+
 /// THE call into the environment-lit renderer. The SRBF path reads
 /// `tables.get(shading.srbf_table(mode))`, directional lights `tables.get(shading.direct_table(mode))`
 /// (4 axes, the 1/λ axis a single node), and the full mode also [`MULTIPLE_TABLES`].
@@ -296,7 +325,12 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedFrame> {
                 frame.mode.name()
             )
         })?;
-    Ok(RenderedFrame {
+    Ok(rendered_env(frame, gpu, out))
+}
+
+/// The renderer's image of `frame` as every front end reports it.
+fn rendered_env(frame: &EnvFrame, gpu: &GpuContext, out: EnvImage) -> RenderedFrame {
+    RenderedFrame {
         milliseconds: frame_milliseconds(&out.stats),
         passes: out.stats.timings.clone(),
         memory: out.stats.memory_per_batch.clone(),
@@ -312,5 +346,5 @@ pub fn render_lights(frame: &EnvFrame) -> anyhow::Result<RenderedFrame> {
             mode: frame.mode,
             fragments: out.stats.fragments,
         },
-    })
+    }
 }

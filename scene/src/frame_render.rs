@@ -4,7 +4,7 @@
 //! demo do both once; the viewer prepares again only when a setting that preparation depends on
 //! changes, and renders its preview and light batches through the same [`render_frame`].
 
-use crate::env_frame::{EnvFrame, FrameRole, render_lights, shared_gpu};
+use crate::env_frame::{EnvFrame, FrameRole, render_lights, render_lights_into, shared_gpu};
 use crate::env_light_sets::frame_lights;
 use crate::env_scene::PreparedEnv;
 use crate::frame_settings::{
@@ -19,7 +19,7 @@ pub use crate::rendered_frame::{FrameDetails, RenderedFrame};
 use crate::scene_tables::ScatteringMode;
 use anyhow::Context;
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env::ViewTransparency;
+use strandlight_runtime::env::{FrameSums, ViewTransparency};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
@@ -320,6 +320,19 @@ pub fn render_frame(
         }
         _ => anyhow::bail!("the frame's lighting was prepared for other settings"),
     }
+}
+
+/// [`render_frame`] for a part of an env-lit frame added into `sums`, the running sum a
+/// progressive front end keeps across its batches (see [`crate::env_frame::frame_sums`]): the
+/// image is the sum so far.
+pub fn render_frame_into(
+    settings: &FrameSettings,
+    hair: &HairModel,
+    prepared: &PreparedEnv,
+    part: FramePart,
+    sums: &FrameSums,
+) -> anyhow::Result<RenderedFrame> {
+    render_lights_into(&env_frame(settings, hair, prepared, part, false)?, sums)
 }
 
 /// Milliseconds of a point-lit frame: its passes without the one-time setup (the hair's upload

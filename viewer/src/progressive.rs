@@ -1,17 +1,17 @@
-//! Progressive refinement: what the worker draws for a request, step by step, and how the steps
-//! add up. An env-lit frame is a sum over its lights, so summing the batches of the full frame
-//! gives that frame; before the last batch the window shows the running sum scaled by the share
-//! of the lights' power it holds (lights are drawn most powerful first).
+//! Progressive refinement: what the worker draws for a request, step by step, and what the window
+//! shows of it. An env-lit frame is a sum over its lights: the renderer adds each batch of the
+//! full frame into one running sum on the GPU (`render_frame_into`), which after the last batch
+//! is that frame; before it the window shows the running sum scaled by the share of the lights'
+//! power it holds (lights are drawn most powerful first).
 
 use crate::frame::{FrameStats, Stage};
 use std::sync::Arc;
 use strandlight_scene::image_metrics::Image;
 pub use strandlight_scene::progressive::{Step, plan_steps};
 
-/// Sums the steps of one request into the image the window shows.
+/// The image the window shows of one request's steps, and their stats added up.
 #[derive(Default)]
 pub struct Accumulator {
-    sum: Option<Image>,
     shown: Option<(Arc<Image>, FrameStats)>,
     stats: FrameStats,
     batches_done: usize,
@@ -19,7 +19,8 @@ pub struct Accumulator {
 }
 
 impl Accumulator {
-    /// Adds one step's image; returns the stage the shown image is at.
+    /// Adds one step: a preview or full frame, or a batch's running sum (every batch so far);
+    /// returns the stage the shown image is at.
     pub fn add(&mut self, step: Step, image: Image, stats: FrameStats) -> Stage {
         match step {
             Step::Preview => {
@@ -39,19 +40,7 @@ impl Accumulator {
         self.batches_total = total;
     }
 
-    fn add_batch(&mut self, image: Image, stats: FrameStats, power_after: f32) -> Stage {
-        let sum = self.sum.get_or_insert_with(|| Image {
-            width: image.width,
-            height: image.height,
-            pixels: vec![[0.0; 4]; image.pixels.len()],
-        });
-        for (s, p) in sum.pixels.iter_mut().zip(&image.pixels) {
-            for c in 0..3 {
-                s[c] += p[c];
-            }
-            // Coverage does not depend on the lights: every batch has the same alpha.
-            s[3] = p[3];
-        }
+    fn add_batch(&mut self, sum: Image, stats: FrameStats, power_after: f32) -> Stage {
         self.batches_done += 1;
         add_stats(&mut self.stats, stats);
         let scale = if power_after > 0.0 {
@@ -109,7 +98,7 @@ mod tests {
     }
 
     #[test]
-    fn the_running_sum_is_scaled_by_its_power_share_and_the_last_batch_is_exact() {
+    fn the_running_sum_is_scaled_by_its_power_share_and_the_last_sum_is_shown_as_it_is() {
         let mut acc = Accumulator::default();
         acc.expect_batches(2);
         assert_eq!(
@@ -132,7 +121,7 @@ mod tests {
             power_after: 1.0,
         };
         assert_eq!(
-            acc.add(last, image(1.0), FrameStats::default()),
+            acc.add(last, image(4.0), FrameStats::default()),
             Stage::Converged
         );
         assert_eq!(acc.shown().0.pixels[1], [4.0, 8.0, 0.0, 0.5]);

@@ -12,11 +12,13 @@ use std::sync::mpsc::{Receiver, TryRecvError, channel};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 use strandlight_runtime::camera::Camera;
+use strandlight_runtime::env::FrameSums;
+use strandlight_scene::env_frame::frame_sums;
 use strandlight_scene::env_light_sets::{frame_lights, light_luminance};
 use strandlight_scene::env_scene::{AlsoServe, PrepareProgress, PreparedEnv, prepare_env};
 use strandlight_scene::frame_render::{
     FrameHair, Prepared, PreparedPoint, env_look, load_settings_hair, prepare_point, render_frame,
-    settings_camera,
+    render_frame_into, settings_camera,
 };
 use strandlight_scene::frame_settings::{FrameSettings, Lighting, PointLighting, up_choice};
 use strandlight_scene::steps::Steps;
@@ -130,6 +132,8 @@ struct Job {
     steps: Vec<Step>,
     next: usize,
     accumulator: Accumulator,
+    /// The running sum of the batches drawn so far, on the renderers' device.
+    sums: Option<FrameSums>,
     stale_tables: bool,
 }
 
@@ -225,6 +229,7 @@ impl WorkerState {
                     steps,
                     next: 0,
                     accumulator,
+                    sums: None,
                     stale_tables,
                 });
             }
@@ -237,6 +242,7 @@ impl WorkerState {
                     steps: Vec::new(),
                     next: 0,
                     accumulator: Accumulator::default(),
+                    sums: None,
                     stale_tables: true,
                 })
             }
@@ -414,7 +420,21 @@ impl WorkerState {
             }
             (Lighting::Environment(_), None) => unreachable!("set just above"),
         };
-        let rendered = render_frame(&settings, &hair.model, prepared, step.part(), false)?;
+        let rendered = match (step, prepared) {
+            // Batches add up on the GPU, in the renderer's own batch-sum pass.
+            (Step::Batch { .. }, Prepared::Env(env)) => {
+                let job = self.job.as_mut().expect("a job");
+                let sums = match &mut job.sums {
+                    Some(sums) => sums,
+                    None => {
+                        let [width, height] = step.part().size(settings.size);
+                        job.sums.insert(frame_sums(width, height)?)
+                    }
+                };
+                render_frame_into(&settings, &hair.model, env, step.part(), sums)?
+            }
+            _ => render_frame(&settings, &hair.model, prepared, step.part(), false)?,
+        };
         let stats = FrameStats {
             lights: rendered.light_count(&settings),
             passes: rendered.passes,

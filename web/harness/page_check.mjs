@@ -3,8 +3,9 @@
 // screenshot, drops a file that is not a groom on the picture (the page must say so and keep
 // its scene), then orbits with the mouse and zooms with the wheel and reads the new converged
 // frame and the settings it was rendered with, then switches to single scattering and does
-// the same. Writes OUT/frame.f32, OUT/page.png, OUT/orbited.{f32,json}, OUT/single.{f32,json}
-// and OUT/report.json.
+// the same, then turns the map with the panel's rotation slider and does the same. Writes
+// OUT/frame.f32, OUT/page.png, OUT/orbited.{f32,json}, OUT/single.{f32,json},
+// OUT/rotated.{f32,json} and OUT/report.json (with the settings before the drag).
 //
 //   node page_check.mjs URL OUT [TIMEOUT_S]
 import { chromium } from 'playwright-core';
@@ -60,7 +61,10 @@ try {
   report.frameKeptAfterBadFile = after === frame;
 
   phase('bad file');
-  // Orbit (a drag across the picture) and zoom (two wheel steps), then converge again.
+  // Orbit (a drag of 8 moves of (+10, -3) px across the picture) and zoom (two wheel steps
+  // toward the hair), then converge again. The test checks the camera against this script.
+  report.settingsBeforeDrag = JSON.parse(await page.evaluate(() => window.strandlight.page.settings_json()));
+  report.drag = { moves: 8, dx: 10, dy: -3, wheelSteps: 2 };
   const box = await page.locator('#view').boundingBox();
   const [cx, cy] = [box.x + box.width / 2, box.y + box.height / 2];
   await page.mouse.move(cx, cy);
@@ -87,6 +91,22 @@ try {
   phase('single converged');
   writeFileSync(join(out, 'single.f32'), Buffer.from(await page.evaluate(() => window.strandlight.frame()), 'base64'));
   writeFileSync(join(out, 'single.json'), await page.evaluate(() => window.strandlight.page.settings_json()));
+
+  // The map turned with the panel's slider, as a person drags it to a value.
+  const single = await page.evaluate(() => window.strandlight.frame());
+  report.rotation = 211;
+  await page.evaluate((degrees) => {
+    const slider = document.getElementById('rotation');
+    slider.value = String(degrees);
+    slider.dispatchEvent(new Event('input', { bubbles: true }));
+  }, report.rotation);
+  await page.waitForFunction((old) => {
+    const now = window.strandlight.frame();
+    return now !== null && now !== old && window.strandlight.status() === 'converged';
+  }, single, { timeout, polling: 250 });
+  phase('rotated converged');
+  writeFileSync(join(out, 'rotated.f32'), Buffer.from(await page.evaluate(() => window.strandlight.frame()), 'base64'));
+  writeFileSync(join(out, 'rotated.json'), await page.evaluate(() => window.strandlight.page.settings_json()));
 } finally {
   writeFileSync(join(out, 'report.json'), JSON.stringify(report, null, 2));
   await browser.close();

@@ -132,6 +132,47 @@ impl EnvRenderer {
         })
     }
 
+    /// [`Self::render_part`] adding the part into `sums`, a running sum the caller keeps across
+    /// the parts of a progressive frame (a viewer's batches): the image is the running sum after
+    /// this part, read back; its stats are the part's own.
+    #[allow(clippy::too_many_arguments)]
+    pub fn render_part_into(
+        &self,
+        gpu: &GpuContext,
+        model: &HairModel,
+        camera: &Camera,
+        part: (&[EnvLight], u32),
+        tables: &EnvTables,
+        options: &EnvRenderOptions,
+        multiple: Option<&dyn ForwardScatteringSource>,
+        head: Option<&Head>,
+        sums: &FrameSums,
+    ) -> Result<EnvImage, EnvRenderError> {
+        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let stats = self.encode_part_into(
+            gpu, model, camera, part, tables, options, multiple, head, sums,
+        )?;
+        let mut timings = Timings(stats.timings.clone());
+        let bytes = timings.time(gpu, "readback", || read_buffer(gpu, sums.buffer()))?;
+        if let Some(error) = pollster::block_on(scope.pop()) {
+            return Err(EnvRenderError::Gpu(error.to_string()));
+        }
+        let [width, height] = sums.size();
+        let (pixels, single_pixels, multiple_pixels) =
+            split_sums(&bytes, width, height, multiple.is_some());
+        Ok(EnvImage {
+            width,
+            height,
+            pixels,
+            single_pixels,
+            multiple_pixels,
+            stats: EnvRenderStats {
+                timings: timings.0,
+                ..stats
+            },
+        })
+    }
+
     /// [`Self::render_part`] up to the pixels: every pass submitted, the sums left on the GPU
     /// (a web page cannot wait for a readback; it draws them or maps them later). The caller
     /// owns the error scope.
