@@ -161,15 +161,27 @@ fn light_pass_geometry(
     )
 }
 
-/// What a compact source's map must hold: the hair, and the head whose skin it shadows and
-/// which shadows the hair (outside a map a point reads as lit). Without compact sources no map
-/// is fitted, and the points are not copied.
+/// What a light's map must hold: the hair, and the head whose skin it shadows and which shadows
+/// the hair (outside a map a point reads as lit, and a caster past its depth range casts
+/// nothing). The box holds both, for every map's depth range and a lobe's sphere; a compact
+/// source's map is fitted across the light to the points of both. Without compact sources no
+/// map is fitted, and the points are not copied.
 fn light_footprint(
     model: &HairModel,
     head: Option<&Head>,
-    bounds: Aabb,
     has_compact_sources: bool,
 ) -> LightFootprint {
+    let hair_bounds = model.bounds();
+    let bounds = match head {
+        Some(head) => {
+            let h = head.bounds();
+            Aabb {
+                min: hair_bounds.min.min(h.min),
+                max: hair_bounds.max.max(h.max),
+            }
+        }
+        None => hair_bounds,
+    };
     if !has_compact_sources {
         return LightFootprint::new(bounds, Vec::new().into());
     }
@@ -257,7 +269,7 @@ impl FrameResources {
             light_geometry,
             simplified,
             next_window: 0,
-            footprint: light_footprint(model, head, bounds, kinds.has_sharp_shadows()),
+            footprint: light_footprint(model, head, kinds.has_sharp_shadows()),
             full_maps,
             simplified_maps,
             occupancy,
