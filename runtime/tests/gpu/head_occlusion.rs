@@ -367,7 +367,10 @@ fn a_head_outside_the_hairs_footprint_casts_and_receives_a_suns_shadow() {
     let head = head();
     let toward = DVec3::X;
     let sun = [EnvLight::directional(toward.as_vec3(), [1.0; 3])];
-    assert!(sun[0].has_sharp_shadow(), "a compact source, whose maps are fitted");
+    assert!(
+        sun[0].has_sharp_shadow(),
+        "a compact source, whose maps are fitted"
+    );
     const FIBER_X: f32 = -0.9;
     const HALF_LENGTH: f32 = 0.25;
     let lone = hair(&[[
