@@ -19,7 +19,7 @@ use strandlight_runtime::passes::abuffer::NODE_BYTES;
 use strandlight_runtime::passes::deep_opacity::DomSettings;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
 use strandlight_runtime::point_frame::{
-    Frame, RenderOptions, ShadowMaps, Transparency, render_frame,
+    PointImage, RenderOptions, ShadowMaps, Transparency, render_frame,
 };
 
 const WIDTH: u32 = 656;
@@ -90,7 +90,7 @@ struct Samples {
     per_pass: Vec<(String, Vec<f64>)>,
     frame_ms: Vec<f64>,
     total_ms: Vec<f64>,
-    last: Option<Frame>,
+    last: Option<PointImage>,
 }
 
 impl Samples {
@@ -105,7 +105,7 @@ impl Samples {
         }
     }
 
-    fn record(&mut self, out: Frame) {
+    fn record(&mut self, out: PointImage) {
         let timings = &out.stats.timings;
         if self.per_pass.is_empty() {
             self.per_pass = timings

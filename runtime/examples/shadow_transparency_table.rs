@@ -21,7 +21,7 @@ use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
 use strandlight_runtime::point_frame::{
-    Frame, RenderOptions, ShadowMaps, Transparency, render_frame,
+    PointImage, RenderOptions, ShadowMaps, Transparency, render_frame,
 };
 
 const WIDTH: u32 = 656;
@@ -41,7 +41,7 @@ fn median(mut values: Vec<f64>) -> f64 {
 }
 
 /// Relative RMSE of `a` against `reference` over the reference's hair pixels (alpha > 0).
-fn relative_rmse(a: &Frame, reference: &Frame) -> f64 {
+fn relative_rmse(a: &PointImage, reference: &PointImage) -> f64 {
     let (mut err, mut norm) = (0.0f64, 0.0f64);
     for (p, q) in a.pixels.iter().zip(&reference.pixels) {
         if q[3] <= 0.0 {
@@ -75,7 +75,7 @@ struct Config {
     map_ms: Vec<f64>,
     hair_ms: Vec<f64>,
     passes: Vec<(String, Vec<f64>)>,
-    last: Option<Frame>,
+    last: Option<PointImage>,
 }
 
 fn shadow_choices(diagonal: f32) -> Vec<(&'static str, Option<ShadowMaps>)> {
@@ -277,7 +277,7 @@ fn configs(diagonal: f32) -> Vec<Config> {
 
 impl Config {
     /// Adds a timed run's light-map, hair and per-pass times.
-    fn record_times(&mut self, frame: &Frame) {
+    fn record_times(&mut self, frame: &PointImage) {
         let timings = &frame.stats.timings;
         let work = || timings.iter().filter(|t| !is_setup(&t.pass));
         self.map_ms
@@ -294,7 +294,7 @@ impl Config {
 }
 
 /// One row per configuration: times, memory, fragments and errors.
-fn print_table(configs: &[Config], reference: &Frame) {
+fn print_table(configs: &[Config], reference: &PointImage) {
     println!(
         "| shadows | transparency | light map GPU ms | hair GPU ms (incl. readback) | frame ms | GPU MB | fragments kept / dropped | relative RMSE vs A-buffer, same shadows | relative RMSE vs reference |"
     );

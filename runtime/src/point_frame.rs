@@ -347,7 +347,9 @@ pub struct RenderOptions {
     pub point_layout: PointLayoutChoice,
 }
 
-pub struct Frame {
+/// A point-lit frame: linear, pre-multiplied RGBA, row-major from the top, and its stats (the
+/// env-lit frame's is [`crate::env::EnvImage`]).
+pub struct PointImage {
     pub width: u32,
     pub height: u32,
     /// Linear, pre-multiplied RGBA, row-major from the top.
@@ -377,7 +379,7 @@ pub fn render_frame(
     model: &HairModel,
     frame: &FrameParams,
     options: &RenderOptions,
-) -> Result<Frame, RenderError> {
+) -> Result<PointImage, RenderError> {
     render_frame_with_model(gpu, model, frame, options, &ShadingModel::KajiyaKay)
 }
 
@@ -389,7 +391,7 @@ pub fn render_frame_with_model(
     frame: &FrameParams,
     options: &RenderOptions,
     shading: &ShadingModel,
-) -> Result<Frame, RenderError> {
+) -> Result<PointImage, RenderError> {
     render_frame_with_head(gpu, model, frame, options, shading, None)
 }
 
@@ -403,7 +405,7 @@ pub fn render_frame_with_head(
     options: &RenderOptions,
     shading: &ShadingModel,
     head: Option<&Head>,
-) -> Result<Frame, RenderError> {
+) -> Result<PointImage, RenderError> {
     let shadowed_lights = shadowed_lights(model, frame, options, head)?;
     check_frame_limits(gpu, frame, &shadowed_lights)?;
     let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
@@ -450,7 +452,7 @@ pub fn render_frame_with_head(
     if let Some(error) = pollster::block_on(scope.pop()) {
         return Err(RenderError::Gpu(error.to_string()));
     }
-    Ok(Frame {
+    Ok(PointImage {
         width: frame.width,
         height: frame.height,
         pixels,

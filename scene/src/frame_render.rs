@@ -167,7 +167,7 @@ fn render_point(
     hair: &HairModel,
     prepared: &PreparedPoint,
     size: [u32; 2],
-) -> anyhow::Result<point_frame::Frame> {
+) -> anyhow::Result<point_frame::PointImage> {
     let camera = settings_camera(settings, hair)?;
     let frame = FrameParams {
         camera,

@@ -335,7 +335,8 @@ fn one_bright_texel_lights_the_same_side_through_the_fit_at_any_rotation_and_up_
     let map_size = (128, 64);
     let mut failures = Vec::new();
     let (mut worst_cosine, mut worst_energy) = (1.0f64, 0.0f64);
-    for (hair, rotation) in [(0, 0.0), (0, 211.0), (1, 149.0)] {
+    // Turned, never at 0 (a sign error is invisible there; the other tests here hold 0).
+    for (hair, rotation) in [(0, 211.0), (1, 149.0)] {
         let (up_name, hair_path) = &hair_files[hair];
         let up = if hair == 0 { UpAxis::Y } else { UpAxis::Z };
         let orientation = EnvOrientation::new(up, rotation as f64);

@@ -20,7 +20,7 @@ use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::fiber_shading::{MarschnerLuts, ShadingModel};
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::point_frame::{Frame, RenderOptions, render_frame_with_model};
+use strandlight_runtime::point_frame::{PointImage, RenderOptions, render_frame_with_model};
 use strandlight_tables::angles::FiberAngles;
 use strandlight_tables::artist::{ArtistModel, ArtistParams};
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
@@ -49,7 +49,7 @@ fn strand() -> HairModel {
     .unwrap()
 }
 
-fn render(gpu: &GpuContext, light: Light, shading: &ShadingModel) -> Frame {
+fn render(gpu: &GpuContext, light: Light, shading: &ShadingModel) -> PointImage {
     let frame = FrameParams {
         camera: ortho_camera(),
         width: SIZE,
@@ -85,7 +85,7 @@ impl Sample {
 }
 
 /// Rows 12..52 of columns 31 and 32 (the strand's axis, world x = 0).
-fn samples(frame: &Frame, light: &Light) -> Vec<Sample> {
+fn samples(frame: &PointImage, light: &Light) -> Vec<Sample> {
     let t = tangent();
     (12..52u32)
         .map(|row| {

@@ -33,7 +33,7 @@ fn straight_strand(
     .unwrap()
 }
 
-fn pixel(frame: &strandlight_runtime::point_frame::Frame, x: u32, y: u32) -> [f32; 4] {
+fn pixel(frame: &strandlight_runtime::point_frame::PointImage, x: u32, y: u32) -> [f32; 4] {
     frame.pixels[(y * frame.width + x) as usize]
 }
 
@@ -208,7 +208,7 @@ fn a_single_strand_matches_cpu_kajiya_kay_under_three_lights() {
 
 /// Mean over interior rows of the alpha summed along each row.
 fn mean_row_alpha(
-    out: &strandlight_runtime::point_frame::Frame,
+    out: &strandlight_runtime::point_frame::PointImage,
     rows: std::ops::Range<u32>,
 ) -> (f64, f64) {
     let sums: Vec<f64> = rows

@@ -17,7 +17,7 @@ use strandlight_runtime::camera::Camera;
 use strandlight_runtime::hair::{GroomParams, HairModel, generate_groom};
 use strandlight_runtime::lights::Light;
 use strandlight_runtime::passes::frame_params::{FrameParams, KajiyaKay};
-use strandlight_runtime::point_frame::{Frame, RenderOptions, Transparency, render_frame};
+use strandlight_runtime::point_frame::{PointImage, RenderOptions, Transparency, render_frame};
 
 const SIZE: u32 = 96;
 
@@ -32,7 +32,7 @@ fn groom() -> HairModel {
     .unwrap()
 }
 
-fn render(gpu: &strandlight_runtime::gpu::GpuContext, hair: &HairModel, t: Transparency) -> Frame {
+fn render(gpu: &strandlight_runtime::gpu::GpuContext, hair: &HairModel, t: Transparency) -> PointImage {
     let frame = FrameParams {
         camera: Camera::framing(hair.bounds(), 1.0, false),
         width: SIZE,
@@ -53,7 +53,7 @@ fn render(gpu: &strandlight_runtime::gpu::GpuContext, hair: &HairModel, t: Trans
 }
 
 /// [`relative_rmse`] of two frames.
-fn frame_error(a: &Frame, b: &Frame) -> f64 {
+fn frame_error(a: &PointImage, b: &PointImage) -> f64 {
     relative_rmse(&a.pixels, &b.pixels)
 }
 
