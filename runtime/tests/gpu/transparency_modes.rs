@@ -32,7 +32,11 @@ fn groom() -> HairModel {
     .unwrap()
 }
 
-fn render(gpu: &strandlight_runtime::gpu::GpuContext, hair: &HairModel, t: Transparency) -> PointImage {
+fn render(
+    gpu: &strandlight_runtime::gpu::GpuContext,
+    hair: &HairModel,
+    t: Transparency,
+) -> PointImage {
     let frame = FrameParams {
         camera: Camera::framing(hair.bounds(), 1.0, false),
         width: SIZE,
