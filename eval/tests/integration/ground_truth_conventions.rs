@@ -1,9 +1,12 @@
 //! Before any error figure against the path-traced ground truth is trusted, the two renderers
 //! must agree on what a scene is: the camera and the fibers' width (the silhouette), the
 //! environment map's frame (which side a single bright texel lights), and the fiber frame and
-//! units of the scattering function (one fiber under one directional light). Each test renders
-//! a small scene with strandlight's env-lit renderer and with Mitsuba 3 (`scene/src/
-//! ground_truth.rs`), on the same Chiang fiber (Mitsuba's own `hair` BSDF on its side).
+//! units of the scattering function (one fiber under one directional light), and the map's
+//! frame through the product's own path (a one-texel map fitted, turned, placed over a Y-up or
+//! a Z-up groom and drawn by `render_frame`, against the Mitsuba scene written from the same
+//! `FrameSettings`). Each test renders a small scene with strandlight's env-lit renderer and
+//! with Mitsuba 3 (`eval/src/ground_truth.rs`), on the same Chiang fiber (Mitsuba's own `hair`
+//! BSDF on its side).
 //!
 //! Mitsuba is installed by `.ci/run`; without it, or without a GPU device (not even lavapipe),
 //! the tests print why and pass, unless `STRANDLIGHT_REQUIRE_TOOLS=1` (CI) makes either a
