@@ -239,13 +239,13 @@ fn assert_readout_beside_the_image(report: &Value) {
 }
 
 /// The whole window, panel included: larger than the frame, and showing the same picture where
-/// the frame sits, for both screenshots.
+/// the frame sits, for every screenshot.
 fn assert_window_captures_show_the_screenshots(report: &Value, dir: &Path) {
     assert_eq!(
         report["window_captures"],
-        json!(["shot-window.png", "points-window.png"])
+        json!(["shot-window.png", "rotated-window.png", "points-window.png"])
     );
-    for (i, stem) in ["shot", "points"].into_iter().enumerate() {
+    for (i, stem) in ["shot", "rotated", "points"].into_iter().enumerate() {
         let window = dir.join(format!("{stem}-window.png"));
         let (ww, wh, _) = read_rgb8(&window);
         assert!(ww > 160 + 300 && wh > 120, "window capture {ww}x{wh}");

@@ -212,7 +212,13 @@ fn env_controls(ui: &mut egui::Ui, e: &mut EnvLighting, lobes: &mut usize, total
         ui.radio_value(&mut e.scattering, ScatteringMode::Full, "single + multiple");
     });
     ui.label(Recompute::ShadowMaps.label());
-    ui.add(egui::Slider::new(&mut e.rotation_deg, -180.0..=180.0).text("rotate map °"));
+    // The page's range; a turn outside it (a settings file's −30°) is kept as it is, never
+    // clamped: a slider that clamped drew a replayed 211° at 180°.
+    ui.add(
+        egui::Slider::new(&mut e.rotation_deg, 0.0..=360.0)
+            .clamping(egui::SliderClamping::Never)
+            .text("rotate map °"),
+    );
     let mut all = e.lobes.is_none();
     ui.horizontal(|ui| {
         ui.checkbox(&mut all, "all lobes");

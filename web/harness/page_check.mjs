@@ -71,6 +71,9 @@ try {
   await page.mouse.down();
   for (let i = 1; i <= 8; i++) await page.mouse.move(cx + 10 * i, cy - 3 * i);
   await page.mouse.up();
+  // Back over the picture: the drag may end past its edge (a 160-pixel canvas), where the
+  // wheel scrolls the page instead.
+  await page.mouse.move(cx, cy);
   await page.mouse.wheel(0, -100);
   await page.mouse.wheel(0, -100);
   await page.waitForFunction((old) => {
