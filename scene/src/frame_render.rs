@@ -2,7 +2,9 @@
 //! hair; build the point-light fiber model, or fit and bake the environment's SRBF scene) and
 //! *render* ([`render_frame`]: camera, lights and look → pixels). `strandlight render` and the
 //! demo do both once; the viewer prepares again only when a setting that preparation depends on
-//! changes, and renders its preview and light batches through the same [`render_frame`].
+//! changes, and renders its preview through the same [`render_frame`] and its light batches
+//! through [`render_frame_into`] (the same frame, added into one running sum on the GPU). Every
+//! env-lit frame, whoever draws it, is built by [`env_frame`].
 
 use crate::env_frame::{EnvFrame, FrameRole, render_lights, render_lights_into, shared_gpu};
 use crate::env_light_sets::frame_lights;
