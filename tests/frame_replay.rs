@@ -21,7 +21,6 @@ use glam::Vec3;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use strandlight_eval::reference_cache::read_rgba_exr;
-use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::{
     GroomParams, HairModel, HairWriteOptions, generate_groom, write_hair,
 };
@@ -33,7 +32,9 @@ use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_tables::outside_tools::missing_tool;
 use strandlight_tables::split_mix::SplitMix64;
-use strandlight_web::session::{BundleFiles, Session};
+
+mod page_session;
+use page_session::{blocks, native_session, total};
 
 /// `render replay` against `compare`'s SRBF frame: the same tables, the same frame builder.
 const CLI_TOLERANCE: f64 = 1e-3;
@@ -204,69 +205,7 @@ fn page_frame(dir: &Path, settings: &Path, name: &str, preset: &str) -> Image {
             page.to_str().unwrap(),
         ],
     );
-    let mut files = BundleFiles::new();
-    let bundle = site.join("bundle");
-    for entry in std::fs::read_dir(&bundle)
-        .unwrap()
-        .chain(std::fs::read_dir(bundle.join("tables")).unwrap())
-    {
-        let path = entry.unwrap().path();
-        if path.is_file() {
-            let name = path.file_name().unwrap().to_string_lossy().to_string();
-            files.insert(name, std::fs::read(&path).unwrap());
-        }
-    }
-    let mut session = Session::new(GpuContext::new_headless().unwrap(), files).unwrap();
-    let mut steps = 0;
-    while session.refining() {
-        session.step().unwrap();
-        steps += 1;
-        assert!(steps < 1000, "the session does not advance");
-    }
-    let readback = session.readback().expect("a picture to read back");
-    let slice = readback.buffer.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |r| r.unwrap());
-    session.gpu().wait_idle();
-    let sums: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&slice.get_mapped_range().unwrap());
-    readback.buffer.unmap();
-    session.readback_done(&readback, &sums);
-    let [width, height] = session.settings.size;
-    Image {
-        width,
-        height,
-        pixels: session.converged.take().expect("converged"),
-    }
-}
-
-/// Mean of `k`×`k` blocks.
-fn blocks_of(image: &Image, k: u32) -> Image {
-    let (w, h) = (image.width / k, image.height / k);
-    let pixels = (0..h * w)
-        .map(|b| {
-            let (bx, by) = (b % w, b / w);
-            let mut sum = [0.0f32; 4];
-            for y in by * k..(by + 1) * k {
-                for x in bx * k..(bx + 1) * k {
-                    let p = image.pixels[(y * image.width + x) as usize];
-                    (0..4).for_each(|c| sum[c] += p[c] / (k * k) as f32);
-                }
-            }
-            sum
-        })
-        .collect();
-    Image {
-        width: w,
-        height: h,
-        pixels,
-    }
-}
-
-fn total(image: &Image) -> f64 {
-    image
-        .pixels
-        .iter()
-        .map(|p| (p[0] + p[1] + p[2]) as f64)
-        .sum()
+    native_session(&site.join("bundle"))
 }
 
 #[test]
@@ -308,7 +247,7 @@ fn render_replay_compare_and_the_page_draw_the_same_frame_of_the_same_settings()
     let (y, z) = (&replays[0], &render_replay(&dir, &twin, "twin"));
     let (pixels, blocks) = (
         relative_rmse(z, y).unwrap(),
-        relative_rmse(&blocks_of(z, 4), &blocks_of(y, 4)).unwrap(),
+        relative_rmse(&blocks(z, 4), &blocks(y, 4)).unwrap(),
     );
     let totals = total(z) / total(y);
     eprintln!(

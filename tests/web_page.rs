@@ -35,7 +35,10 @@ use strandlight_scene::frame_settings::{FrameSettings, Lighting};
 use strandlight_scene::image_metrics::{Image, relative_rmse};
 use strandlight_tables::image_out::tonemap_channel;
 use strandlight_tables::outside_tools::{missing_tool, program_exists};
-use strandlight_web::session::{BundleFiles, Session};
+use strandlight_web::session::Session;
+
+mod page_session;
+use page_session::{blocks, bundle_files, converge, native_session, step_to_the_end, total};
 
 /// SwiftShader and lavapipe rasterize a fiber a pixel wide with different rounding, so single
 /// pixels differ where a fiber's edge falls, while the light is the same: the error falls as
@@ -139,99 +142,6 @@ impl Server {
 impl Drop for Server {
     fn drop(&mut self) {
         let _ = self.0.kill();
-    }
-}
-
-/// Mean of `k`×`k` blocks.
-fn blocks(image: &Image, k: u32) -> Image {
-    let (w, h) = (image.width / k, image.height / k);
-    let pixels = (0..h)
-        .flat_map(|by| (0..w).map(move |bx| (bx, by)))
-        .map(|(bx, by)| {
-            let mut sum = [0.0f32; 4];
-            for y in by * k..(by + 1) * k {
-                for x in bx * k..(bx + 1) * k {
-                    let p = image.pixels[(y * image.width + x) as usize];
-                    (0..4).for_each(|c| sum[c] += p[c] / (k * k) as f32);
-                }
-            }
-            sum
-        })
-        .collect();
-    Image {
-        width: w,
-        height: h,
-        pixels,
-    }
-}
-
-fn total(image: &Image) -> f64 {
-    image
-        .pixels
-        .iter()
-        .map(|p| (p[0] + p[1] + p[2]) as f64)
-        .sum()
-}
-
-/// The bundle's files as the page fetches them.
-fn bundle_files(bundle: &Path) -> BundleFiles {
-    let mut files = BundleFiles::new();
-    for entry in std::fs::read_dir(bundle)
-        .unwrap()
-        .chain(std::fs::read_dir(bundle.join("tables")).unwrap())
-    {
-        let path = entry.unwrap().path();
-        if path.is_file() {
-            let name = path.file_name().unwrap().to_string_lossy().to_string();
-            files.insert(name, std::fs::read(&path).unwrap());
-        }
-    }
-    files
-}
-
-/// Every step of the plan, the forward-scattering march read back when the session asks (as
-/// the page's ticks do, but waiting for the GPU).
-fn step_to_the_end(session: &mut Session) {
-    let mut steps = 0;
-    while session.refining() {
-        session.step().unwrap();
-        if let Some((id, buffers)) = session.march_readback() {
-            let values = buffers.iter().map(|b| map_blocking(session, b)).collect();
-            session.march_done(id, values).unwrap();
-        }
-        steps += 1;
-        assert!(steps < 1000, "the session does not advance");
-    }
-}
-
-fn map_blocking(session: &Session, buffer: &wgpu::Buffer) -> Vec<[f32; 4]> {
-    let slice = buffer.slice(..);
-    slice.map_async(wgpu::MapMode::Read, |r| r.unwrap());
-    session.gpu().wait_idle();
-    let values = bytemuck::pod_collect_to_vec(&slice.get_mapped_range().unwrap());
-    buffer.unmap();
-    values
-}
-
-/// The page's steps run natively (lavapipe): every step encoded, the last readback mapped.
-fn native_session(bundle: &Path) -> Image {
-    let session = Session::new(GpuContext::new_headless().unwrap(), bundle_files(bundle)).unwrap();
-    converge(session)
-}
-
-fn converge(mut session: Session) -> Image {
-    step_to_the_end(&mut session);
-    let readback = session.readback().expect("a picture to read back");
-    let sums = map_blocking(&session, &readback.buffer);
-    session.readback_done(&readback, &sums);
-    let [width, height] = session.settings.size;
-    Image {
-        width,
-        height,
-        pixels: session
-            .converged
-            .take()
-            .expect("converged after the last step"),
     }
 }
 

@@ -112,24 +112,15 @@ impl EnvRenderer {
         let encoded = self.encode_part(
             gpu, model, camera, width, height, part, tables, options, multiple, head,
         )?;
-        let mut timings = Timings(encoded.stats.timings.clone());
-        let bytes = timings.time(gpu, "readback", || read_buffer(gpu, &encoded.sums))?;
-        if let Some(error) = pollster::block_on(scope.pop()) {
-            return Err(EnvRenderError::Gpu(error.to_string()));
-        }
-        let (pixels, single_pixels, multiple_pixels) =
-            split_sums(&bytes, width, height, encoded.with_multiple);
-        Ok(EnvImage {
-            width,
-            height,
-            pixels,
-            single_pixels,
-            multiple_pixels,
-            stats: EnvRenderStats {
-                timings: timings.0,
-                ..encoded.stats
-            },
-        })
+        let size = [encoded.width, encoded.height];
+        read_image(
+            gpu,
+            scope,
+            &encoded.sums,
+            size,
+            encoded.with_multiple,
+            encoded.stats,
+        )
     }
 
     /// [`Self::render_part`] adding the part into `sums`, a running sum the caller keeps across
@@ -152,25 +143,14 @@ impl EnvRenderer {
         let stats = self.encode_part_into(
             gpu, model, camera, part, tables, options, multiple, head, sums,
         )?;
-        let mut timings = Timings(stats.timings.clone());
-        let bytes = timings.time(gpu, "readback", || read_buffer(gpu, sums.buffer()))?;
-        if let Some(error) = pollster::block_on(scope.pop()) {
-            return Err(EnvRenderError::Gpu(error.to_string()));
-        }
-        let [width, height] = sums.size();
-        let (pixels, single_pixels, multiple_pixels) =
-            split_sums(&bytes, width, height, multiple.is_some());
-        Ok(EnvImage {
-            width,
-            height,
-            pixels,
-            single_pixels,
-            multiple_pixels,
-            stats: EnvRenderStats {
-                timings: timings.0,
-                ..stats
-            },
-        })
+        read_image(
+            gpu,
+            scope,
+            sums.buffer(),
+            sums.size(),
+            multiple.is_some(),
+            stats,
+        )
     }
 
     /// [`Self::render_part`] up to the pixels: every pass submitted, the sums left on the GPU
@@ -346,4 +326,33 @@ pub fn render_env_frame(
     )?;
     frame.stats.timings.splice(0..0, timings.0);
     Ok(frame)
+}
+
+/// A frame's sums read back (timed as "readback"), once its passes are submitted and the
+/// caller's validation `scope` closes without an error.
+fn read_image(
+    gpu: &GpuContext,
+    scope: wgpu::ErrorScopeGuard,
+    sums: &wgpu::Buffer,
+    [width, height]: [u32; 2],
+    with_multiple: bool,
+    stats: EnvRenderStats,
+) -> Result<EnvImage, EnvRenderError> {
+    let mut timings = Timings(stats.timings.clone());
+    let bytes = timings.time(gpu, "readback", || read_buffer(gpu, sums))?;
+    if let Some(error) = pollster::block_on(scope.pop()) {
+        return Err(EnvRenderError::Gpu(error.to_string()));
+    }
+    let (pixels, single_pixels, multiple_pixels) = split_sums(&bytes, width, height, with_multiple);
+    Ok(EnvImage {
+        width,
+        height,
+        pixels,
+        single_pixels,
+        multiple_pixels,
+        stats: EnvRenderStats {
+            timings: timings.0,
+            ..stats
+        },
+    })
 }
