@@ -205,6 +205,12 @@ impl Camera {
         glam::camera::rh::view::look_at_mat4(self.eye, self.target, self.up)
     }
 
+    /// World to clip space for a `[width, height]` image: what every view pass draws with, and
+    /// what a host that shares the hair's depth buffer projects its own scene with.
+    pub fn view_projection(&self, [width, height]: [u32; 2]) -> Mat4 {
+        self.projection_matrix(width as f32 / height as f32) * self.view()
+    }
+
     /// wgpu clip space (depth 0..1, y up: the "directx" convention).
     pub fn projection_matrix(&self, aspect: f32) -> Mat4 {
         use glam::camera::rh::proj::directx;

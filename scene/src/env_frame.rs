@@ -16,6 +16,7 @@ use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::head::Head;
+use strandlight_runtime::host::HairFrame;
 use strandlight_runtime::multiple::ForwardScatteringSource;
 use strandlight_runtime::multiple::{
     CpuForwardScattering, ForwardScatteringSettings, ForwardScatteringTables, GpuForwardScattering,
@@ -269,6 +270,22 @@ pub fn lights_call_without_source<'g>(frame: &EnvFrame) -> anyhow::Result<Lights
         options: render_options(frame),
         source: None,
     })
+}
+
+/// `frame` as a host application draws it with the runtime's
+/// [`HairRenderer`](strandlight_runtime::host::HairRenderer), with `call`'s tables, options and
+/// forward-scattering source ([`lights_call`]).
+pub fn hair_frame<'a>(frame: &'a EnvFrame, call: &'a LightsCall) -> HairFrame<'a> {
+    HairFrame {
+        model: frame.hair,
+        camera: &frame.camera,
+        size: [frame.width, frame.height],
+        lights: &frame.lights,
+        tables: &call.tables,
+        options: &call.options,
+        multiple: call.source.as_deref(),
+        head: frame.head.as_ref(),
+    }
 }
 
 /// The running sum of a progressive frame on the renderers' device (the viewer's batches).

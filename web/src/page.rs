@@ -73,7 +73,7 @@ impl Page {
             .request_adapter(&Default::default())
             .await
             .map_err(|e| JsValue::from_str(&format!("no WebGPU adapter: {e}")))?;
-        let gpu = GpuContext::for_adapter(instance, adapter, Some(wgpu::Limits::default()))
+        let gpu = GpuContext::for_adapter(adapter, Some(wgpu::Limits::default()))
             .await
             .map_err(|e| JsValue::from_str(&e.to_string()))?;
         gpu.device.set_device_lost_callback(|reason, message| {

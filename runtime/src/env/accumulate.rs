@@ -14,6 +14,8 @@ use crate::gpu::bind_layout::{
 use crate::gpu::buffer::init_buffer;
 use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels, fit_within};
 use crate::gpu::pipeline::{compute_pipeline, wgsl_module};
+use crate::gpu::texture::texture_2d;
+use crate::passes::render_target::DEPTH_FORMAT;
 
 /// Pixels along each side of the accumulate pass's workgroups (`@workgroup_size(8, 8)`).
 const WORKGROUP_SIDE: u32 = 8;
@@ -38,6 +40,9 @@ pub struct FrameSums {
     params: wgpu::Buffer,
     width: u32,
     height: u32,
+    /// The nearest of hair and head per pixel (wgpu's 0..1 depth, 1 where neither is), drawn
+    /// with each part's visibility when asked for: what a host's depth test compares.
+    front_depth: Option<wgpu::Texture>,
 }
 
 impl FrameSums {
@@ -67,7 +72,35 @@ impl FrameSums {
             params,
             width,
             height,
+            front_depth: None,
         })
+    }
+
+    /// [`Self::new`] with the frame's front depth kept beside the sums (a host depth-tests the
+    /// hair with it; `TEXTURE_BINDING | COPY_SRC`, [`DEPTH_FORMAT`]).
+    pub fn with_front_depth(gpu: &GpuContext, width: u32, height: u32) -> Result<Self, LimitError> {
+        let depth = texture_2d(
+            gpu,
+            "env front depth",
+            wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            DEPTH_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+        );
+        Ok(Self {
+            front_depth: Some(depth),
+            ..Self::new(gpu, width, height)?
+        })
+    }
+
+    /// The front depth, when the sums keep one ([`Self::with_front_depth`]).
+    pub fn front_depth(&self) -> Option<&wgpu::Texture> {
+        self.front_depth.as_ref()
     }
 
     /// Bytes of the sums of a `width`×`height` frame.

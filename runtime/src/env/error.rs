@@ -12,6 +12,11 @@ use crate::visibility::VisibilityVolumeError;
 pub enum EnvRenderError {
     #[error("the environment has no lights")]
     NoLights,
+    #[error(
+        "no frame of this size and these lights was prepared: call HairRenderer::prepare with \
+         the frame first"
+    )]
+    NotPrepared,
     #[error("light {index}: {problem}")]
     BadLight { index: usize, problem: String },
     #[error(transparent)]

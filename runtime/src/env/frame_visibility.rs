@@ -11,13 +11,15 @@ use crate::camera::Camera;
 use crate::gpu::GpuContext;
 use crate::gpu::readback::ReadbackError;
 
-/// The frame's visibility (depth prepass and coverage, or the occupancy map), once.
+/// The frame's visibility (depth prepass and coverage, or the occupancy map), once; and the
+/// front depth of head and hair into `front_depth` when the caller keeps one (a host's).
 pub(super) fn encode_visibility(
     gpu: &GpuContext,
     renderer: &EnvRenderer,
     frame: &FrameResources,
     options: &EnvRenderOptions,
     camera: &Camera,
+    front_depth: Option<&wgpu::Texture>,
     timings: &mut Timings,
 ) {
     timings.time(gpu, "view visibility", || {
@@ -46,6 +48,23 @@ pub(super) fn encode_visibility(
             &frame.occupancy,
             frame.geometry.segment_count,
         );
+        if let Some(front_depth) = front_depth {
+            let depth = front_depth.create_view(&Default::default());
+            let size = (frame.width, frame.height);
+            let head_views = [&frame.head_views[0], &frame.head_views[1]];
+            let head = frame.head.as_ref();
+            renderer
+                .head
+                .encode_view(gpu, &mut encoder, head, camera, size, &depth, head_views);
+            let segments = frame.geometry.segment_count;
+            renderer.visibility.encode_front_depth(
+                gpu,
+                &mut encoder,
+                &frame.strands,
+                &depth,
+                segments,
+            );
+        }
         gpu.queue.submit([encoder.finish()]);
     });
 }

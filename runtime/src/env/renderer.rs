@@ -226,6 +226,18 @@ impl EnvRenderer {
         self.finish_part(gpu, &request, lights, frame, &kinds, sums, timings)
     }
 
+    /// `sums` read back as an image (one readback, waiting for the GPU), with `stats` (the last
+    /// part's).
+    pub fn read_sums(
+        gpu: &GpuContext,
+        sums: &FrameSums,
+        with_multiple: bool,
+        stats: EnvRenderStats,
+    ) -> Result<EnvImage, EnvRenderError> {
+        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        read_image(gpu, scope, sums.buffer(), sums.size(), with_multiple, stats)
+    }
+
     /// Checks a part's inputs, then creates its resources (its simplified lights drawing the
     /// strand windows from `first_window` on).
     fn start_part(
@@ -265,7 +277,16 @@ impl EnvRenderer {
         let options = request.options;
         let mut memory = frame.memory();
         memory.push(("env sums".into(), sums.buffer().size()));
-        encode_visibility(gpu, self, &frame, options, request.camera, &mut timings);
+        let front_depth = sums.front_depth();
+        encode_visibility(
+            gpu,
+            self,
+            &frame,
+            options,
+            request.camera,
+            front_depth,
+            &mut timings,
+        );
         let fragments = match options.count_fragments {
             true => Some(count_fragments(gpu, self, &frame, options)?),
             false => None,

@@ -185,6 +185,7 @@ impl OccupancyMap {
 /// fragments the view pass shades (the depth prepass's Equal test needs bit-identical depths).
 pub struct ViewVisibilityPass {
     depth_prepass: wgpu::RenderPipeline,
+    front_depth: wgpu::RenderPipeline,
     coverage: wgpu::RenderPipeline,
     range: wgpu::RenderPipeline,
     slices: wgpu::RenderPipeline,
@@ -262,6 +263,7 @@ impl ViewVisibilityPass {
                 Some("fs_nearest_surface"),
                 Some((Less, true)),
             ),
+            front_depth: pipeline("view front depth", strands_only, None, Some((Less, true))),
             // Against the head's depth alone (the head pass wrote it; the prepass runs after):
             // fibers behind the head add no coverage.
             coverage: pipeline(
@@ -359,6 +361,30 @@ impl ViewVisibilityPass {
             }
             pass.draw(0..6 * segments, 0..1);
         }
+    }
+
+    /// The strands' depth, nearest kept, into `depth` (which holds the head's on entry): the
+    /// frame's front depth that a host's depth test compares with its own scene. The strands
+    /// are the view's quads, so a pixel has a depth exactly where it has coverage.
+    pub fn encode_front_depth(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        strands: &wgpu::BindGroup,
+        depth: &wgpu::TextureView,
+        segments: u32,
+    ) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("view front depth"),
+            color_attachments: &[],
+            depth_stencil_attachment: prepassed_depth(depth),
+            timestamp_writes: gpu.render_timestamps(),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.front_depth);
+        pass.set_bind_group(0, strands, &[]);
+        pass.draw(0..6 * segments, 0..1);
     }
 
     /// Benchmarks: the fragments one batch's view pass rasterizes and shades, counted into a

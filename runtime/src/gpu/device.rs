@@ -16,6 +16,20 @@ pub struct AdapterReport {
     pub is_software: bool,
 }
 
+impl AdapterReport {
+    pub fn of(info: &wgpu::AdapterInfo) -> Self {
+        Self {
+            name: info.name.clone(),
+            backend: format!("{:?}", info.backend),
+            device_type: format!("{:?}", info.device_type),
+            driver: format!("{} {}", info.driver, info.driver_info)
+                .trim()
+                .to_string(),
+            is_software: info.device_type == wgpu::DeviceType::Cpu,
+        }
+    }
+}
+
 impl fmt::Display for AdapterReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
@@ -42,10 +56,10 @@ pub enum DeviceError {
     },
 }
 
-/// A device and queue with the features the passes use.
+/// A device and queue with the features the passes use: one the runtime requested
+/// ([`Self::new_headless`], [`Self::for_adapter`]: the one place it asks for a device), or one a
+/// host application made and lends ([`Self::from_device`]).
 pub struct GpuContext {
-    pub instance: wgpu::Instance,
-    pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub report: AdapterReport,
@@ -56,6 +70,10 @@ pub struct GpuContext {
     pub float32_filterable: bool,
     /// GPU time per pass, on adapters with timestamp queries.
     pub pass_timer: Option<PassTimer>,
+    /// Whether a timed section may wait for the GPU to finish its work (the headless commands
+    /// measure each pass that way). A host's device never waits inside a frame: its sections
+    /// record only the CPU time of encoding.
+    pub waits_to_time: bool,
 }
 
 impl GpuContext {
@@ -100,48 +118,21 @@ impl GpuContext {
                 .await
                 .map_err(|_| DeviceError::NoAdapter { looked_at })?,
         };
-        Self::for_adapter(instance, adapter, limits).await
+        Self::for_adapter(adapter, limits).await
     }
 
     /// A device on `adapter` with the features the passes use: `limits` (a web page asks for
     /// WebGPU's defaults), or the adapter's own. Timestamps are read back by blocking, which a
     /// browser cannot do: there the passes go untimed.
     pub async fn for_adapter(
-        instance: wgpu::Instance,
         adapter: wgpu::Adapter,
         limits: Option<wgpu::Limits>,
     ) -> Result<Self, DeviceError> {
-        let info = adapter.get_info();
-        let report = AdapterReport {
-            name: info.name.clone(),
-            backend: format!("{:?}", info.backend),
-            device_type: format!("{:?}", info.device_type),
-            driver: format!("{} {}", info.driver, info.driver_info)
-                .trim()
-                .to_string(),
-            is_software: info.device_type == wgpu::DeviceType::Cpu,
-        };
-        let float32_blendable = adapter
-            .features()
-            .contains(wgpu::Features::FLOAT32_BLENDABLE);
-        let mut required_features = wgpu::Features::empty();
-        if float32_blendable {
-            required_features |= wgpu::Features::FLOAT32_BLENDABLE;
-        }
-        let float32_filterable = adapter
-            .features()
-            .contains(wgpu::Features::FLOAT32_FILTERABLE);
-        if float32_filterable {
-            required_features |= wgpu::Features::FLOAT32_FILTERABLE;
-        }
-        let timestamps = !cfg!(target_arch = "wasm32");
-        if timestamps && adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
-            required_features |= wgpu::Features::TIMESTAMP_QUERY;
-        }
+        let report = AdapterReport::of(&adapter.get_info());
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("strandlight"),
-                required_features,
+                required_features: Self::wanted_features(adapter.features()),
                 required_limits: limits.unwrap_or_else(|| adapter.limits()),
                 ..Default::default()
             })
@@ -153,14 +144,41 @@ impl GpuContext {
         let pass_timer = PassTimer::new(&device, &queue);
         Ok(Self {
             pass_timer,
-            instance,
-            adapter,
+            waits_to_time: true,
+            ..Self::from_device(device, queue)
+        }
+        .with_report(report))
+    }
+
+    /// The features the passes use where `offered` has them: blendable and filterable f32
+    /// targets, and timestamps outside a browser (which cannot wait to read them).
+    pub fn wanted_features(offered: wgpu::Features) -> wgpu::Features {
+        let mut wanted = wgpu::Features::FLOAT32_BLENDABLE | wgpu::Features::FLOAT32_FILTERABLE;
+        if !cfg!(target_arch = "wasm32") {
+            wanted |= wgpu::Features::TIMESTAMP_QUERY;
+        }
+        offered & wanted
+    }
+
+    /// A context on a device a host application created: the runtime requests no device of its
+    /// own and never waits for the GPU inside a frame (its passes go untimed). It uses what the
+    /// device was created with; ask for [`Self::wanted_features`] of the adapter to get f32
+    /// render targets and filtering, else the passes fall back to f16.
+    pub fn from_device(device: wgpu::Device, queue: wgpu::Queue) -> Self {
+        let features = device.features();
+        Self {
+            report: AdapterReport::of(&device.adapter_info()),
+            float32_blendable: features.contains(wgpu::Features::FLOAT32_BLENDABLE),
+            float32_filterable: features.contains(wgpu::Features::FLOAT32_FILTERABLE),
+            pass_timer: None,
+            waits_to_time: false,
             device,
             queue,
-            report,
-            float32_blendable,
-            float32_filterable,
-        })
+        }
+    }
+
+    fn with_report(self, report: AdapterReport) -> Self {
+        Self { report, ..self }
     }
 
     /// The HDR colour format of render targets.

@@ -12,4 +12,4 @@ pub mod texture;
 pub use device::{AdapterReport, DeviceError, GpuContext};
 pub use limits::{GpuLimits, LimitError};
 pub use pass_timer::PassTimer;
-pub use readback::{read_buffer, read_texture_rgba};
+pub use readback::{read_buffer, read_texture_rgba, readbacks_so_far};

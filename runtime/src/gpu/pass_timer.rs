@@ -151,12 +151,16 @@ impl GpuContext {
 
     /// Runs `work` (which submits passes), waits for the GPU, and returns its result with the
     /// wall-clock milliseconds and, where the adapter has timestamp queries, the GPU
-    /// milliseconds of the passes it recorded.
+    /// milliseconds of the passes it recorded. On a host's device ([`GpuContext::waits_to_time`]
+    /// false) it does not wait: the milliseconds are the encoding's alone.
     pub fn time_passes<T>(&self, work: impl FnOnce() -> T) -> (T, f64, Option<f64>) {
         let mut open = CloseOnUnwind(self.pass_timer.as_ref().filter(|t| t.begin()));
         // std's clock panics in a browser; web-time is std's elsewhere.
         let start = web_time::Instant::now();
         let out = work();
+        if !self.waits_to_time {
+            return (out, start.elapsed().as_secs_f64() * 1e3, None);
+        }
         self.wait_idle();
         let wall_ms = start.elapsed().as_secs_f64() * 1e3;
         let gpu_ms = open.0.take().and_then(|t| t.end(self));

@@ -1,10 +1,35 @@
 //! Copying a colour texture back to the CPU as linear f32 RGBA.
 
 use super::GpuContext;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+/// Copies from the GPU to the CPU so far in this process: every readback of the runtime goes
+/// through [`wait_for_copy`], so a host can check that its frame path makes none.
+static READBACKS: AtomicU64 = AtomicU64::new(0);
+
+/// How many GPU→CPU copies this process has made (textures, buffers, timestamps).
+pub fn readbacks_so_far() -> u64 {
+    READBACKS.load(Ordering::Relaxed)
+}
+
+/// Maps `slice` for reading and waits for it: the one place the runtime blocks on a copy.
+fn wait_for_copy(gpu: &GpuContext, slice: &wgpu::BufferSlice<'_>) -> Result<(), ReadbackError> {
+    READBACKS.fetch_add(1, Ordering::Relaxed);
+    let (sender, receiver) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = sender.send(r);
+    });
+    gpu.wait_idle();
+    receiver.recv().unwrap_or(Err(wgpu::BufferAsyncError))?;
+    Ok(())
+}
 
 #[derive(Debug, thiserror::Error)]
 pub enum ReadbackError {
-    #[error("texture format {0:?} cannot be read back (only Rgba16Float and Rgba32Float)")]
+    #[error(
+        "texture format {0:?} cannot be read back (only Rgba16Float, Rgba32Float and \
+         Depth32Float)"
+    )]
     UnsupportedFormat(wgpu::TextureFormat),
     #[error("mapping the readback buffer failed: {0}")]
     Map(#[from] wgpu::BufferAsyncError),
@@ -69,12 +94,7 @@ pub fn read_texture_layer_rgba(
     );
     gpu.queue.submit([encoder.finish()]);
     let slice = buffer.slice(..);
-    let (sender, receiver) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = sender.send(r);
-    });
-    gpu.wait_idle();
-    receiver.recv().unwrap_or(Err(wgpu::BufferAsyncError))?;
+    wait_for_copy(gpu, &slice)?;
     let data = slice.get_mapped_range()?;
     let mut pixels = Vec::with_capacity((width * height) as usize);
     for y in 0..height as usize {
@@ -112,13 +132,54 @@ pub fn read_buffer(gpu: &GpuContext, source: &wgpu::Buffer) -> Result<Vec<u8>, R
     encoder.copy_buffer_to_buffer(source, 0, &buffer, 0, source.size());
     gpu.queue.submit([encoder.finish()]);
     let slice = buffer.slice(..);
-    let (sender, receiver) = std::sync::mpsc::channel();
-    slice.map_async(wgpu::MapMode::Read, move |r| {
-        let _ = sender.send(r);
-    });
-    gpu.wait_idle();
-    receiver.recv().unwrap_or(Err(wgpu::BufferAsyncError))?;
+    wait_for_copy(gpu, &slice)?;
     let bytes = slice.get_mapped_range()?.to_vec();
     buffer.unmap();
     Ok(bytes)
+}
+
+/// A `Depth32Float` texture's depths, row-major from the top row.
+pub fn read_depth(gpu: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<f32>, ReadbackError> {
+    if texture.format() != wgpu::TextureFormat::Depth32Float {
+        return Err(ReadbackError::UnsupportedFormat(texture.format()));
+    }
+    let (width, height) = (texture.width(), texture.height());
+    let unpadded_row = width * 4;
+    let row = unpadded_row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
+        * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("depth readback"),
+        size: (row * height) as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            aspect: wgpu::TextureAspect::DepthOnly,
+            ..texture.as_image_copy()
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(height),
+            },
+        },
+        texture.size(),
+    );
+    gpu.queue.submit([encoder.finish()]);
+    let slice = buffer.slice(..);
+    wait_for_copy(gpu, &slice)?;
+    let data = slice.get_mapped_range()?;
+    let depths = (0..height as usize)
+        .flat_map(|y| {
+            let start = y * row as usize;
+            bytemuck::cast_slice::<u8, f32>(&data[start..start + unpadded_row as usize]).to_vec()
+        })
+        .collect();
+    drop(data);
+    buffer.unmap();
+    Ok(depths)
 }

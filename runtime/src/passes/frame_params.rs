@@ -59,8 +59,7 @@ pub(crate) struct FrameUniform {
 impl FrameParams {
     /// World to clip space of the camera at this frame's aspect.
     pub(crate) fn view_proj(&self) -> Mat4 {
-        let aspect = self.width as f32 / self.height as f32;
-        self.camera.projection_matrix(aspect) * self.camera.view()
+        self.camera.view_projection([self.width, self.height])
     }
 
     pub(crate) fn uniform(&self, width_scale: f32) -> FrameUniform {

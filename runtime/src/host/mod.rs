@@ -1,0 +1,245 @@
+//! Hair in someone else's renderer: [`HairRenderer`] draws env-lit hair into a host
+//! application's own render pass, on the host's device, depth-tested against what the host drew.
+//!
+//! It is shaped like the wgpu ecosystem's renderers (egui-wgpu's `Renderer`, glyphon):
+//! - [`HairRenderer::new`] takes the host's `Device`, `Queue` and target formats; the runtime
+//!   requests no device of its own.
+//! - [`HairRenderer::prepare`] starts a frame for a groom, camera, lights and tables;
+//!   [`HairRenderer::encode_next_batch`] adds the next batch of lights to it (progressive
+//!   refinement: the host encodes a batch when it has time, and the batches sum to the frame
+//!   rendered at once).
+//! - [`HairRenderer::render`] draws the frame so far into the host's render pass.
+//!
+//! Nothing on that path reads back or waits for the GPU: work is submitted on the host's queue
+//! and the frame stays on the GPU. [`HairRenderer::read_image`] is the one readback, for a
+//! headless host that writes files. GPU validation errors go to the device's own error handler
+//! (the host's).
+//!
+//! The hair's depth is wgpu's 0..1 depth of [`Camera::view_projection`] at the frame's size: a
+//! host that projects its scene with the same matrix shares one depth buffer with the hair.
+
+use crate::camera::Camera;
+use crate::env::{EnvImage, EnvRenderError, EnvRenderOptions, EnvRenderer, EnvTables, FrameSums};
+use crate::env_light::EnvLight;
+use crate::gpu::GpuContext;
+use crate::hair::HairModel;
+use crate::head::Head;
+use crate::multiple::ForwardScatteringSource;
+use composite::{CompositeBinding, CompositePass};
+
+mod composite;
+
+/// The host's render targets that [`HairRenderer::render`] draws into.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HairTargets {
+    /// The colour attachment's format. The hair is linear radiance (times
+    /// [`HairRenderer::set_radiance_scale`]), pre-multiplied: an HDR format keeps it, an 8-bit
+    /// one clips it.
+    pub color: wgpu::TextureFormat,
+    /// The depth attachment's format; `None` for a pass without one (the hair is then drawn
+    /// over everything).
+    pub depth: Option<wgpu::TextureFormat>,
+    /// The pass's samples per pixel (1 without MSAA).
+    pub sample_count: u32,
+}
+
+/// One frame's inputs, borrowed for each call that draws lights: the runtime uploads what a
+/// batch needs as it encodes it.
+#[derive(Clone, Copy)]
+pub struct HairFrame<'a> {
+    /// The groom.
+    pub model: &'a HairModel,
+    /// The view, shared with the host (see the module's note on depth).
+    pub camera: &'a Camera,
+    /// Width and height in pixels: the host's target size.
+    pub size: [u32; 2],
+    /// Every light of the frame, in the order the batches draw them (most powerful first
+    /// gives the best early frames).
+    pub lights: &'a [EnvLight],
+    /// The baked tables the lights are shaded with.
+    pub tables: &'a EnvTables,
+    /// The renderer's settings (κ, light maps, view transparency, …).
+    pub options: &'a EnvRenderOptions,
+    /// Multiple scattering's forward-scattering source; `None` for single scattering.
+    pub multiple: Option<&'a dyn ForwardScatteringSource>,
+    /// A head that hides the fibers behind it, is drawn as skin and shadows the hair.
+    pub head: Option<&'a Head>,
+}
+
+/// How far the frame has come.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BatchProgress {
+    /// Lights drawn into the frame so far.
+    pub lights_drawn: usize,
+    /// Lights of the whole frame.
+    pub lights_total: usize,
+}
+
+impl BatchProgress {
+    /// Every light is drawn: the frame equals the one rendered at once.
+    pub fn converged(self) -> bool {
+        self.lights_drawn >= self.lights_total
+    }
+}
+
+/// A frame being refined: its sums on the GPU and the lights drawn into them.
+struct FrameInProgress {
+    sums: FrameSums,
+    composite: CompositeBinding,
+    progress: BatchProgress,
+    with_multiple: bool,
+    last_stats: Option<crate::env::EnvRenderStats>,
+}
+
+/// Env-lit hair drawn into a host's render pass. See the [module](self) for the frame's path.
+pub struct HairRenderer {
+    gpu: GpuContext,
+    env: EnvRenderer,
+    composite: CompositePass,
+    frame: Option<FrameInProgress>,
+}
+
+impl HairRenderer {
+    /// The renderer's pipelines on the host's `device` and `queue`, drawing into `targets`.
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, targets: HairTargets) -> Self {
+        Self::on(
+            GpuContext::from_device(device.clone(), queue.clone()),
+            targets,
+        )
+    }
+
+    /// [`Self::new`] on a context the caller already has (the headless commands' device, which
+    /// times its passes).
+    pub fn on(gpu: GpuContext, targets: HairTargets) -> Self {
+        Self {
+            env: EnvRenderer::new(&gpu),
+            composite: CompositePass::new(&gpu.device, &targets),
+            frame: None,
+            gpu,
+        }
+    }
+
+    /// The device and queue the hair is drawn with (to build a GPU forward-scattering source
+    /// on the same device, for example).
+    pub fn gpu(&self) -> &GpuContext {
+        &self.gpu
+    }
+
+    /// Starts a new frame of `frame`: no light drawn yet. The frame's buffers are kept across
+    /// frames of one size and zeroed on the GPU.
+    pub fn prepare(&mut self, frame: &HairFrame<'_>) -> Result<(), EnvRenderError> {
+        let [width, height] = frame.size;
+        let progress = BatchProgress {
+            lights_drawn: 0,
+            lights_total: frame.lights.len(),
+        };
+        let with_multiple = frame.multiple.is_some();
+        match &mut self.frame {
+            Some(kept) if kept.sums.size() == frame.size => {
+                let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+                encoder.clear_buffer(kept.sums.buffer(), 0, None);
+                self.gpu.queue.submit([encoder.finish()]);
+                kept.progress = progress;
+                kept.with_multiple = with_multiple;
+                kept.last_stats = None;
+            }
+            _ => {
+                let sums = FrameSums::with_front_depth(&self.gpu, width, height)?;
+                self.frame = Some(FrameInProgress {
+                    composite: self.composite.bind(&self.gpu.device, &sums),
+                    sums,
+                    progress,
+                    with_multiple,
+                    last_stats: None,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Adds the next batch of lights (the options' `dodm.batch_size` of them) to the frame
+    /// [`Self::prepare`] started, submitted on the queue without waiting. `frame` must be the
+    /// one prepared. Returns the progress after this batch; past the last batch it does
+    /// nothing.
+    pub fn encode_next_batch(
+        &mut self,
+        frame: &HairFrame<'_>,
+    ) -> Result<BatchProgress, EnvRenderError> {
+        let Some(kept) = &mut self.frame else {
+            return Err(EnvRenderError::NotPrepared);
+        };
+        if kept.sums.size() != frame.size || kept.progress.lights_total != frame.lights.len() {
+            return Err(EnvRenderError::NotPrepared);
+        }
+        let first = kept.progress.lights_drawn;
+        if first >= frame.lights.len() {
+            return Ok(kept.progress);
+        }
+        let count = (frame.options.dodm.batch_size.max(1) as usize).min(frame.lights.len() - first);
+        let batch = &frame.lights[first..first + count];
+        // κ's strand windows continue from the simplified lights drawn before this batch, so
+        // the batches sum to the frame drawn at once.
+        let windows_before = frame.lights[..first]
+            .iter()
+            .filter(|l| l.is_simplified())
+            .count() as u32;
+        let stats = self.env.encode_part_into(
+            &self.gpu,
+            frame.model,
+            frame.camera,
+            (batch, windows_before),
+            frame.tables,
+            frame.options,
+            frame.multiple,
+            frame.head,
+            &kept.sums,
+        )?;
+        kept.last_stats = Some(stats);
+        kept.progress.lights_drawn += count;
+        Ok(kept.progress)
+    }
+
+    /// The frame's progress; `None` before [`Self::prepare`].
+    pub fn progress(&self) -> Option<BatchProgress> {
+        self.frame.as_ref().map(|f| f.progress)
+    }
+
+    /// Multiplies the radiance drawn by [`Self::render`] by `scale`: an exposure (`2^stops`),
+    /// or a progressive frame's running sum over the share of the power drawn so far.
+    pub fn set_radiance_scale(&self, scale: f32) {
+        if let Some(kept) = &self.frame {
+            kept.composite.set_scale(&self.gpu.queue, scale);
+        }
+    }
+
+    /// Draws the frame so far into the host's `pass`, whose attachments are the
+    /// [`HairTargets`] this renderer was made for and the frame's size: pre-multiplied over
+    /// the host's colour, hidden where the host's depth is nearer. Draws nothing before
+    /// [`Self::prepare`].
+    pub fn render(&self, pass: &mut wgpu::RenderPass<'_>) {
+        if let Some(kept) = &self.frame {
+            self.composite.draw(pass, &kept.composite);
+        }
+    }
+
+    /// The frame so far, read back to the CPU (linear, pre-multiplied; the radiance scale is
+    /// not applied): the one readback, for a headless host that writes files. Waits for the
+    /// GPU.
+    pub fn read_image(&self) -> Result<EnvImage, EnvRenderError> {
+        let Some(kept) = &self.frame else {
+            return Err(EnvRenderError::NotPrepared);
+        };
+        let stats = kept.last_stats.clone().ok_or(EnvRenderError::NotPrepared)?;
+        EnvRenderer::read_sums(&self.gpu, &kept.sums, kept.with_multiple, stats)
+    }
+
+    /// The frame's front depth (wgpu's 0..1, 1 where neither hair nor head is), read back:
+    /// for tests of a host's depth test.
+    pub fn read_front_depth(&self) -> Result<Vec<f32>, EnvRenderError> {
+        let Some(kept) = &self.frame else {
+            return Err(EnvRenderError::NotPrepared);
+        };
+        let depth = kept.sums.front_depth().expect("the host's sums keep one");
+        Ok(crate::gpu::readback::read_depth(&self.gpu, depth)?)
+    }
+}
