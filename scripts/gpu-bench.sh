@@ -4,7 +4,9 @@
 #      in frames per second (median of GPU_BENCH_RUNS `render env` frames; setup excluded);
 #   2. the viewer's time to its first preview and to converged (under Xvfb when there is no
 #      display; skipped with a line when neither exists);
-#   3. the Hunz table's point-light rows (runtime/examples/render_bench.rs).
+#   3. the Hunz table's point-light rows (runtime/examples/render_bench.rs);
+#   4. the host example's frame (runtime/examples/host.rs: the hair drawn into another
+#      application's render pass), on the GPU alone and with the frame read back.
 # Writes OUT/summary.md (the rows BENCHMARKS takes) beside every raw JSON, and prints it.
 #
 #   scripts/gpu-bench.sh [OUT]            # default out/gpu-bench
@@ -33,6 +35,7 @@ fi
 echo "== build (release)" >&2
 cargo build --release --quiet -p strandlight --bin strandlight
 cargo build --release --quiet -p strandlight-runtime --example render_bench
+cargo build --release --quiet -p strandlight-runtime --example host
 BIN=target/release/strandlight
 
 echo "== 1. env-lit frame at $SIZE, $RUNS runs per mode" >&2
@@ -61,6 +64,11 @@ fi
 echo "== 3. the Hunz table's point-light rows" >&2
 target/release/examples/render_bench "$RUNS" >"$OUT/render_bench.txt"
 
+echo "== 4. the host example's frame at $SIZE" >&2
+"$BIN" render env --env "$MAP" "${HAIR_ARGS[@]}" --size "$SIZE" --out "$OUT/host-settings" >/dev/null
+target/release/examples/host --settings "$OUT/host-settings.json" --out "$OUT/host" \
+  --time "$RUNS" | grep "^host frame" >"$OUT/host.txt"
+
 python3 - "$OUT" "$SIZE" "$RUNS" "$MAP" "$(($(date +%s) - started))" <<'EOF' | tee "$OUT/summary.md"
 import json, pathlib, statistics, sys
 out, size, runs, env_map, seconds = pathlib.Path(sys.argv[1]), sys.argv[2], int(sys.argv[3]), sys.argv[4], sys.argv[5]
@@ -84,6 +92,7 @@ if view.exists():
     print(f"\nViewer adapter: {v.get('adapter')}; window: {v.get('window_adapter')}.")
 else:
     print("\nViewer: not measured (no display).")
+print(f"\nHost example (`runtime/examples/host.rs --time {runs}`): " + (out / "host.txt").read_text().strip())
 print("\nPoint-light rows (`cargo run --release -p strandlight-runtime --example render_bench`):\n")
 print("```")
 print((out / "render_bench.txt").read_text().rstrip())

@@ -47,14 +47,25 @@ struct Host {
     device: wgpu::Device,
     queue: wgpu::Queue,
     pipeline: wgpu::RenderPipeline,
-    uniforms: wgpu::Buffer,
     group: wgpu::BindGroup,
     vertices: wgpu::Buffer,
     vertex_count: u32,
 }
 
-/// Renders `settings`' hair into the host's scene (tables cached under `cache`).
-pub fn run(settings: &FrameSettings, cache: &Path) -> anyhow::Result<HostFrame> {
+/// Milliseconds of whole frames (new frame, every batch, the host's pass), each waited for
+/// after submission: the frame on the GPU alone, and the same with the frame's sums read back.
+pub struct FrameTimes {
+    pub on_gpu: Vec<f64>,
+    pub with_readback: Vec<f64>,
+}
+
+/// Renders `settings`' hair into the host's scene (tables cached under `cache`), and times
+/// `timed_frames` more frames each way.
+pub fn run(
+    settings: &FrameSettings,
+    cache: &Path,
+    timed_frames: usize,
+) -> anyhow::Result<(HostFrame, FrameTimes)> {
     // What the application had before it wanted hair: its device, meshes and camera.
     let hair = load_settings_hair(settings)?;
     let prepared = prepare_env(
@@ -82,16 +93,37 @@ pub fn run(settings: &FrameSettings, cache: &Path) -> anyhow::Result<HostFrame> 
     hair_renderer.prepare(&hair_frame)?;
     while !hair_renderer.encode_next_batch(&hair_frame)?.converged() {}
 
+    let mut times = FrameTimes {
+        on_gpu: Vec::new(),
+        with_readback: Vec::new(),
+    };
+    for readback in [false, true].repeat(timed_frames) {
+        let start = std::time::Instant::now();
+        hair_renderer.prepare(&hair_frame)?;
+        while !hair_renderer.encode_next_batch(&hair_frame)?.converged() {}
+        host.draw_pass(settings.size, Some(&hair_renderer));
+        match readback {
+            true => drop(hair_renderer.read_image()?),
+            false => drop(host.device.poll(wgpu::PollType::wait_indefinitely())),
+        }
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        match readback {
+            true => times.with_readback.push(ms),
+            false => times.on_gpu.push(ms),
+        }
+    }
+    // The picture is drawn after the timed frames: each started again on the same sums.
     let with_hair = host.draw(settings.size, Some(&hair_renderer))?;
     let host_only = host.draw(settings.size, None)?;
-    Ok(HostFrame {
+    let frame = HostFrame {
         size: settings.size,
         with_hair,
         host_only,
         triangles,
         camera: frame.camera,
         hair_depth: hair_renderer.read_front_depth()?,
-    })
+    };
+    Ok((frame, times))
 }
 
 impl Host {
@@ -146,16 +178,21 @@ impl Host {
             device,
             queue,
             pipeline,
-            uniforms,
             group,
             vertices,
             vertex_count,
         })
     }
 
-    /// One frame: the host's meshes, then (when given) the hair, in one render pass; read back
-    /// once to write it.
-    fn draw(&self, [w, h]: [u32; 2], hair: Option<&HairRenderer>) -> anyhow::Result<Vec<[f32; 4]>> {
+    /// [`Self::draw_pass`], read back once to write it.
+    fn draw(&self, size: [u32; 2], hair: Option<&HairRenderer>) -> anyhow::Result<Vec<[f32; 4]>> {
+        let colour = self.draw_pass(size, hair);
+        let gpu = GpuContext::from_device(self.device.clone(), self.queue.clone());
+        Ok(read_texture_rgba(&gpu, &colour)?)
+    }
+
+    /// One frame: the host's meshes, then (when given) the hair, in one render pass, submitted.
+    fn draw_pass(&self, [w, h]: [u32; 2], hair: Option<&HairRenderer>) -> wgpu::Texture {
         let target = |format, usage| {
             self.device.create_texture(&wgpu::TextureDescriptor {
                 label: Some("host target"),
@@ -213,9 +250,7 @@ impl Host {
             }
         }
         self.queue.submit([encoder.finish()]);
-        let _ = &self.uniforms;
-        let gpu = GpuContext::from_device(self.device.clone(), self.queue.clone());
-        Ok(read_texture_rgba(&gpu, &colour)?)
+        colour
     }
 }
 
@@ -342,14 +377,17 @@ fn sphere(centre: Vec3, radius: f32, around: u32, down: u32) -> Vec<[Vec3; 3]> {
 
 fn main() -> anyhow::Result<()> {
     let mut args = std::env::args().skip(1);
-    let (mut settings_file, mut out) = (None, PathBuf::from("out/host"));
+    let (mut settings_file, mut out, mut timed) = (None, PathBuf::from("out/host"), 0);
     while let Some(arg) = args.next() {
         match arg.as_str() {
             "--settings" => {
                 settings_file = Some(PathBuf::from(args.next().context("--settings FILE")?))
             }
             "--out" => out = PathBuf::from(args.next().context("--out DIR")?),
-            other => anyhow::bail!("unknown argument {other:?} (use --settings FILE, --out DIR)"),
+            "--time" => timed = args.next().context("--time FRAMES")?.parse()?,
+            other => anyhow::bail!(
+                "unknown argument {other:?} (use --settings FILE, --out DIR, --time FRAMES)"
+            ),
         }
     }
     let settings = match &settings_file {
@@ -359,7 +397,22 @@ fn main() -> anyhow::Result<()> {
             [640, 480],
         ),
     };
-    let frame = run(&settings, Path::new("out/cache"))?;
+    let (frame, times) = run(&settings, Path::new("out/cache"), timed)?;
+    if timed > 0 {
+        let median = |t: &[f64]| {
+            let mut t = t.to_vec();
+            t.sort_by(f64::total_cmp);
+            t[t.len() / 2]
+        };
+        let (gpu, read) = (median(&times.on_gpu), median(&times.with_readback));
+        println!(
+            "host frame {}x{}, median of {timed}: {gpu:.1} ms on the GPU, {read:.1} ms with the \
+             frame read back ({:+.1}%)",
+            frame.size[0],
+            frame.size[1],
+            100.0 * (read / gpu - 1.0)
+        );
+    }
     std::fs::create_dir_all(&out).with_context(|| format!("--out {}", out.display()))?;
     let [w, h] = frame.size;
     let exr = out.join("host.exr");

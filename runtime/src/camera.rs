@@ -297,7 +297,7 @@ impl LightFootprint {
     }
 
     /// The orthographic camera toward `toward_light` whose square just holds every point (with
-    /// [`FOOTPRINT_MARGIN`]); its depth range is [`light_camera`]'s, which holds the box.
+    /// `FOOTPRINT_MARGIN`); its depth range is [`light_camera`]'s, which holds the box.
     pub fn light_camera(&self, toward_light: Vec3) -> Camera {
         let sphere = light_camera(toward_light, self.bounds);
         let Some((lo, hi)) = self.projected_extent(&sphere) else {

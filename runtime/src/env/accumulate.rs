@@ -53,7 +53,10 @@ impl FrameSums {
         let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("env sums"),
             size: Self::bytes(width, height),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            // COPY_DST: a host's next frame zeroes the sums in place.
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let params = AccumulateParams {

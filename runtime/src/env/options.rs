@@ -25,7 +25,7 @@ pub struct EnvRenderOptions {
     /// What the view sees of each pixel's fibers: the nearest one (default) or all of them
     /// through the occupancy map (Ren §8).
     pub transparency: ViewTransparency,
-    /// Count the fragments rasterized and shaded ([`EnvRenderStats::fragments`]; two extra
+    /// Count the fragments rasterized and shaded ([`EnvRenderStats::fragments`](super::EnvRenderStats::fragments); two extra
     /// passes over the hair, outside the timed passes).
     pub count_fragments: bool,
     /// `false`: no self-shadowing (T̃ = 1; for tests and for comparisons).

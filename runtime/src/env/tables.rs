@@ -12,7 +12,7 @@ use crate::gpu::limits::{GpuLimits, LimitError};
 /// The tables a frame shades with. Each is an RGB [`Table`] with axes (u·ξ, u·ω_o, cos Δφ, w):
 /// * `srbf`: the convolution table I (I_M, `marschner_full` or the artist I_A), w = 1/λ;
 /// * `direct`: S(ω_i, ω_o)·cos θ_i for directional lights, w a one-node axis (any name);
-/// * `multiple`: I_G, w = σ̄_f (used only with a [`ForwardScatteringSource`]).
+/// * `multiple`: I_G, w = σ̄_f (used only with a [`ForwardScatteringSource`](crate::multiple::ForwardScatteringSource)).
 #[derive(Clone, Debug, Default)]
 pub struct EnvTables {
     pub srbf: Option<Arc<Table>>,

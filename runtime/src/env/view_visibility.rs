@@ -40,7 +40,7 @@ pub enum ViewTransparency {
     /// Every fiber in front weighs in by coverage × visibility; fragments seen less than
     /// `visibility_cutoff` (in [0, 1)) are not shaded.
     Occupancy { visibility_cutoff: f32 },
-    /// The occupancy view's weights gathered into [`VIEW_LAYERS`] layers of equal coverage per
+    /// The occupancy view's weights gathered into `VIEW_LAYERS` layers of equal coverage per
     /// pixel, each shaded once at its fibers' weighted mean depth and tangent
     /// (`view_layers.wgsl`): the occupancy view's weighting at a few shading loops per pixel.
     /// Compact sources (suns, lamps) are shaded per fragment ([`Self::for_batch`]).
@@ -102,7 +102,7 @@ impl ViewTransparency {
         !matches!(self, Self::Opaque)
     }
 
-    /// u32 per pixel of the [`OccupancyMap`] (`view.record_words`).
+    /// u32 per pixel of the `OccupancyMap` (`view.record_words`).
     pub fn record_words(&self) -> u64 {
         match self {
             Self::Opaque | Self::Occupancy { .. } => RECORD_WORDS,

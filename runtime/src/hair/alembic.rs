@@ -1,7 +1,7 @@
 //! Alembic archives (`.abc`, Ogawa back end) through the `ogawa-rs` crate: every `ICurves`
 //! object (schema `AbcGeom_Curve_v2`) is a batch of strands. Read from each: `P`, `nVertices`,
 //! `curveBasisAndType` (linear, or cubic Bézier / B-spline / Catmull-Rom, evaluated at segment
-//! ends as in [`super::curves`]) and `width` (con, uni, vtx or var scope). Points are taken
+//! ends as in `hair::curves`) and `width` (con, uni, vtx or var scope). Points are taken
 //! through the `IXform` parents' ops (translate, rotate about an axis, rotate x/y/z, scale,
 //! matrix; `inherits` off stops the chain), composed as AbcGeom's `XformSample::getMatrix`.
 //!
@@ -9,7 +9,7 @@
 //! normals, UVs, velocities, `w` weights, variable-order (NURBS) curves, indexed widths,
 //! arbitrary geometry parameters, and time: the first sample of everything.
 //!
-//! The container is checked first ([`super::ogawa`]) and `ogawa-rs` runs under
+//! The container is checked first (`hair::ogawa`) and `ogawa-rs` runs under
 //! `catch_unwind`, so that a damaged archive is refused with a message.
 
 use std::io::{Cursor, Read, Seek, SeekFrom};

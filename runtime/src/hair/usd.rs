@@ -1,7 +1,7 @@
 //! USD stages (`.usda`, `.usdc`, `.usdz`, `.usd`) through the pure-Rust `openusd` crate: every
 //! `BasisCurves` prim that renders (active, defined, not invisible, not a guide or proxy) is a
 //! batch of strands. Read from each prim: `points`, `curveVertexCounts`, `type`, `basis` and
-//! `wrap` (cubic curves are evaluated at their segment ends, see [`super::curves`]), `widths`
+//! `wrap` (cubic curves are evaluated at their segment ends, see `hair::curves`), `widths`
 //! (the fiber diameter) and `primvars:displayColor` (linear RGB), each constant, uniform (per
 //! curve), vertex or varying. Points are taken through the prim's and its ancestors' xform ops
 //! (`!resetXformStack!` honoured), then to strandlight's world: Y up (a Z-up stage is turned so

@@ -18,6 +18,8 @@
 //! The hair's depth is wgpu's 0..1 depth of [`Camera::view_projection`] at the frame's size: a
 //! host that projects its scene with the same matrix shares one depth buffer with the hair.
 
+#![warn(missing_docs)]
+
 use crate::camera::Camera;
 use crate::env::{EnvImage, EnvRenderError, EnvRenderOptions, EnvRenderer, EnvTables, FrameSums};
 use crate::env_light::EnvLight;

@@ -154,13 +154,13 @@ impl ExpectedShadowPath {
         self.expected_hits += mu;
     }
 
-    /// E[T_f] per channel: P₀ + d_f (E[∏ā_f] − P₀).
+    /// E\[T_f\] per channel: P₀ + d_f (E[∏ā_f] − P₀).
     pub fn transmittance(&self, density_forward: f64) -> [f64; 3] {
         self.product
             .map(|m| self.no_hit + density_forward * (m - self.no_hit).max(0.0))
     }
 
-    /// The forward-SCATTERED part of E[T_f]: d_f (E[∏ā_f] − P₀), paths with at least one hit.
+    /// The forward-SCATTERED part of E\[T_f\]: d_f (E[∏ā_f] − P₀), paths with at least one hit.
     /// Zinke 2008's global term is (T_f − direct fraction): the directly transmitted light is
     /// single scattering's (shadowed by the DODM, with d_b·S_back in `marschner_full`, Ren §7),
     /// so counting it again in the multiple term would light every exposed fiber twice.

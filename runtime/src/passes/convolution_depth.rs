@@ -1,5 +1,5 @@
 //! The light pass of the convolution optical depth map (Ren 2010 §5): for a batch of lights, per
-//! light an orthographic camera along its direction around the hair ([`light_camera`]), the
+//! light an orthographic camera along its direction around the hair ([`light_camera`](crate::camera::light_camera)), the
 //! nearest fiber z₀ per texel (one `R32Float` array layer per light slot), then the cumulative
 //! optical depths at the boundaries z_k = k(k+1)d/2, k = 1..3, behind z₀ and everything in the
 //! fourth channel (an `Rgba32Float` array layer). The strands' quads are rasterized in compute

@@ -185,7 +185,7 @@ pub struct DeepOpacityMap {
     pub layers: wgpu::Texture,
 }
 
-/// Array layers holding `layers` optical depth layers: whole passes of [`TARGETS_PER_PASS`].
+/// Array layers holding `layers` optical depth layers: whole passes of `TARGETS_PER_PASS`.
 pub fn array_layers_for(layers: u32) -> u32 {
     layers.max(1).div_ceil(LAYERS_PER_PASS) * TARGETS_PER_PASS
 }

@@ -68,7 +68,7 @@ impl StrandPass {
             .expect("one shadow map is within the limit");
     }
 
-    /// [`StrandPass::draw`] with a deep opacity map for each of up to [`MAX_SHADOWED_LIGHTS`]
+    /// [`StrandPass::draw`] with a deep opacity map for each of up to [`MAX_SHADOWED_LIGHTS`](super::shadow_slots::MAX_SHADOWED_LIGHTS)
     /// lights, and the head hiding and shadowing fibers.
     pub fn draw_shadowed(
         &self,

@@ -78,8 +78,8 @@ pub fn tan_support(light: &EnvLight) -> f32 {
 }
 
 /// Variance of one transverse component (sin γ cos φ) of a direction drawn from the SRBF
-/// G(γ) = exp(λ(cos γ − 1)): with μ = cos γ ∝ e^{λμ} on [−1, 1], E[μ] = coth λ − 1/λ and
-/// E[sin²γ] = 2E[μ]/λ, halved between the two axes.
+/// G(γ) = exp(λ(cos γ − 1)): with μ = cos γ ∝ e^{λμ} on [−1, 1], E\[μ\] = coth λ − 1/λ and
+/// E\[sin²γ\] = 2E\[μ\]/λ, halved between the two axes.
 pub fn transverse_variance(lambda: f64) -> f64 {
     if lambda < 1e-3 {
         // Nearly uniform: E[sin²γ] = 2/3.
