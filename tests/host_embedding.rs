@@ -7,6 +7,9 @@
 //!   hair is nearer, it is the hair over the host's colour;
 //! - `strandlight render replay` of the same settings: where nothing of the host is in front,
 //!   the hair is that frame.
+//!
+//! The host's frame path (a new frame, every batch, its render pass) must make no GPU→CPU copy:
+//! the runtime counts every one it makes.
 
 #[path = "../runtime/examples/host.rs"]
 #[allow(dead_code)]
@@ -131,7 +134,12 @@ fn the_host_hides_the_hair_where_its_mesh_is_nearer_and_shows_the_replayed_frame
     let settings = settings(&dir);
     // One timed frame each way first: the checked picture is then a frame started again on
     // the same sums (each new frame must zero them).
-    let (frame, _) = host::run(&settings, &dir.join("out/cache"), 1).unwrap();
+    let (frame, times) = host::run(&settings, &dir.join("out/cache"), 1).unwrap();
+    // The host's frame path (new frame, every batch, its render pass) copies nothing back.
+    assert_eq!(
+        times.readbacks_on_gpu, 0,
+        "readbacks on the host's frame path"
+    );
     let replay = render_replay(&dir);
     let mesh_depth = cpu_depth(
         &frame.triangles,

@@ -14,7 +14,7 @@ use anyhow::Context;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::gpu::{GpuContext, read_texture_rgba};
+use strandlight_runtime::gpu::{GpuContext, read_texture_rgba, readbacks_so_far};
 use strandlight_runtime::host::{HairRenderer, HairTargets};
 use strandlight_scene::env_frame::{hair_frame, lights_call};
 use strandlight_scene::env_lighting::EnvLighting;
@@ -57,6 +57,8 @@ struct Host {
 pub struct FrameTimes {
     pub on_gpu: Vec<f64>,
     pub with_readback: Vec<f64>,
+    /// GPU→CPU copies the runtime made during the frames on the GPU (none is needed).
+    pub readbacks_on_gpu: u64,
 }
 
 /// Renders `settings`' hair into the host's scene (tables cached under `cache`), and times
@@ -96,15 +98,20 @@ pub fn run(
     let mut times = FrameTimes {
         on_gpu: Vec::new(),
         with_readback: Vec::new(),
+        readbacks_on_gpu: 0,
     };
     for readback in [false, true].repeat(timed_frames) {
+        let readbacks_before = readbacks_so_far();
         let start = std::time::Instant::now();
         hair_renderer.prepare(&hair_frame)?;
         while !hair_renderer.encode_next_batch(&hair_frame)?.converged() {}
         host.draw_pass(settings.size, Some(&hair_renderer));
         match readback {
             true => drop(hair_renderer.read_image()?),
-            false => drop(host.device.poll(wgpu::PollType::wait_indefinitely())),
+            false => {
+                times.readbacks_on_gpu += readbacks_so_far() - readbacks_before;
+                drop(host.device.poll(wgpu::PollType::wait_indefinitely()))
+            }
         }
         let ms = start.elapsed().as_secs_f64() * 1e3;
         match readback {
