@@ -82,6 +82,8 @@ impl FrameSums {
     /// [`Self::new`] with the frame's front depth kept beside the sums (a host depth-tests the
     /// hair with it; `TEXTURE_BINDING | COPY_SRC`, [`DEPTH_FORMAT`]).
     pub fn with_front_depth(gpu: &GpuContext, width: u32, height: u32) -> Result<Self, LimitError> {
+        // Checked (in `new`) before the texture is made: past a limit, wgpu would abort.
+        let sums = Self::new(gpu, width, height)?;
         let depth = texture_2d(
             gpu,
             "env front depth",
@@ -97,7 +99,7 @@ impl FrameSums {
         );
         Ok(Self {
             front_depth: Some(depth),
-            ..Self::new(gpu, width, height)?
+            ..sums
         })
     }
 

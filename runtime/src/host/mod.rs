@@ -55,8 +55,8 @@ pub struct HairFrame<'a> {
     pub camera: &'a Camera,
     /// Width and height in pixels: the host's target size.
     pub size: [u32; 2],
-    /// Every light of the frame, in the order the batches draw them (most powerful first
-    /// gives the best early frames).
+    /// Every light of the frame, in any order: the batches draw the strongest first, in the
+    /// order that makes them sum to the frame drawn at once.
     pub lights: &'a [EnvLight],
     /// The baked tables the lights are shaded with.
     pub tables: &'a EnvTables,
@@ -86,11 +86,35 @@ impl BatchProgress {
 
 /// A frame being refined: its sums on the GPU and the lights drawn into them.
 struct FrameInProgress {
+    /// The frame's lights (indices) in the order the batches draw them ([`drawing_order`]).
+    order: Vec<usize>,
     sums: FrameSums,
     composite: CompositeBinding,
     progress: BatchProgress,
     with_multiple: bool,
     last_stats: Option<crate::env::EnvRenderStats>,
+}
+
+/// The order the batches draw `lights` in: κ gives each simplified light a window of the strands
+/// by its rank in the whole frame (thinned SRBFs by power, strongest first, then thinned
+/// directional lights; `env::light_kinds`), so batches that follow that rank sum to the frame
+/// drawn at once. Lights that draw every strand follow, strongest first. Stable: equal powers
+/// keep the caller's order, as the renderer's own ranking does.
+fn drawing_order(lights: &[EnvLight]) -> Vec<usize> {
+    let class = |l: &EnvLight| match (l.is_simplified(), l.lambda.is_some()) {
+        (true, true) => 0,
+        (true, false) => 1,
+        (false, _) => 2,
+    };
+    let mut order: Vec<usize> = (0..lights.len()).collect();
+    order.sort_by(|&i, &j| {
+        let (a, b) = (&lights[i], &lights[j]);
+        class(a).cmp(&class(b)).then_with(|| match class(a) {
+            1 => std::cmp::Ordering::Equal,
+            _ => b.luminous_power().total_cmp(&a.luminous_power()),
+        })
+    });
+    order
 }
 
 /// Env-lit hair drawn into a host's render pass. See the [module](self) for the frame's path.
@@ -142,12 +166,14 @@ impl HairRenderer {
                 encoder.clear_buffer(kept.sums.buffer(), 0, None);
                 self.gpu.queue.submit([encoder.finish()]);
                 kept.progress = progress;
+                kept.order = drawing_order(frame.lights);
                 kept.with_multiple = with_multiple;
                 kept.last_stats = None;
             }
             _ => {
                 let sums = FrameSums::with_front_depth(&self.gpu, width, height)?;
                 self.frame = Some(FrameInProgress {
+                    order: drawing_order(frame.lights),
                     composite: self.composite.bind(&self.gpu.device, &sums),
                     sums,
                     progress,
@@ -178,18 +204,21 @@ impl HairRenderer {
             return Ok(kept.progress);
         }
         let count = (frame.options.dodm.batch_size.max(1) as usize).min(frame.lights.len() - first);
-        let batch = &frame.lights[first..first + count];
+        let batch: Vec<EnvLight> = kept.order[first..first + count]
+            .iter()
+            .map(|&i| frame.lights[i].clone())
+            .collect();
         // κ's strand windows continue from the simplified lights drawn before this batch, so
         // the batches sum to the frame drawn at once.
-        let windows_before = frame.lights[..first]
+        let windows_before = kept.order[..first]
             .iter()
-            .filter(|l| l.is_simplified())
+            .filter(|&&i| frame.lights[i].is_simplified())
             .count() as u32;
         let stats = self.env.encode_part_into(
             &self.gpu,
             frame.model,
             frame.camera,
-            (batch, windows_before),
+            (&batch, windows_before),
             frame.tables,
             frame.options,
             frame.multiple,

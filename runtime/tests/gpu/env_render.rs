@@ -8,10 +8,10 @@ use glam::{DVec3, Vec2, Vec3};
 use strandlight_runtime::camera::{Camera, LightFraming, Projection, light_camera};
 use strandlight_runtime::env::TransmittanceFilter;
 use strandlight_runtime::env::{
-    EnvImage, EnvRenderOptions, EnvRenderer, EnvTables, FrameSums, render_env_frame,
+    EnvImage, EnvRenderError, EnvRenderOptions, EnvRenderer, EnvTables, FrameSums, render_env_frame,
 };
 use strandlight_runtime::env_light::EnvLight;
-use strandlight_runtime::gpu::{GpuContext, read_texture_rgba};
+use strandlight_runtime::gpu::{GpuContext, LimitError, read_texture_rgba};
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_runtime::multiple::ForwardScatteringError;
@@ -1971,4 +1971,98 @@ fn a_built_visibility_volume_shadows_the_groom_about_as_its_light_maps_do() {
     // The light lost to shadow, by each estimator: the same order of magnitude.
     let ratio = (free - volume) / (free - maps);
     assert!((0.25..4.0).contains(&ratio), "shadow volume/maps {ratio}");
+}
+
+/// The host API (`host::HairRenderer`) on a device it did not create: a frame prepared and
+/// refined batch by batch (two lights a batch, SRBF lobes thinned by κ and a directional light)
+/// equals the frame rendered at once by `render_env_frame`, and so does the next frame started
+/// on the same sums.
+#[test]
+fn a_hosts_batches_sum_to_the_frame_rendered_at_once() {
+    use strandlight_runtime::host::{HairFrame, HairRenderer, HairTargets};
+    let gpu = gpu();
+    let scene = groom_scene();
+    let [a, b] = groom_lobes();
+    let c = EnvLight::srbf(Vec3::new(0.1, 0.6, -0.8), 12.0, [0.3, 0.3, 0.3]);
+    let sun = EnvLight::directional(Vec3::new(0.5, 0.8, 0.3), [0.6, 0.5, 0.4]);
+    let lights = [a, b, c, sun];
+    let kappa = 0.5;
+    let at_once = render_groom(&gpu, &scene, &lights, kappa);
+    let (model, camera, tables) = &scene;
+    let options = EnvRenderOptions {
+        dodm: DodmSettings {
+            resolution: 128,
+            first_layer: None,
+            batch_size: 2,
+        },
+        kappa,
+        ..Default::default()
+    };
+    let frame = HairFrame {
+        model,
+        camera,
+        size: [RES, RES],
+        lights: &lights,
+        tables,
+        options: &options,
+        multiple: None,
+        head: None,
+    };
+    let targets = HairTargets {
+        color: wgpu::TextureFormat::Rgba16Float,
+        depth: Some(wgpu::TextureFormat::Depth32Float),
+        sample_count: 1,
+    };
+    let mut host = HairRenderer::new(&gpu.device, &gpu.queue, targets);
+    for restart in 0..2 {
+        host.prepare(&frame).unwrap();
+        let mut batches = 0;
+        while !host.encode_next_batch(&frame).unwrap().converged() {
+            batches += 1;
+        }
+        assert_eq!(batches + 1, 2, "four lights, two a batch");
+        let pixels = host.read_image().unwrap().pixels;
+        let worst = worst_relative(&pixels, &at_once);
+        eprintln!("frame {restart}: batches vs at once, worst relative {worst:.2e}");
+        assert!(worst < 1e-4, "frame {restart}: {worst}");
+    }
+}
+
+/// A host's frame past the adapter's limits, or a batch of a frame never prepared, is a typed
+/// error naming the problem: never a wgpu abort.
+#[test]
+fn a_hosts_bad_frame_is_a_typed_error() {
+    use strandlight_runtime::host::{HairFrame, HairRenderer, HairTargets};
+    let gpu = gpu();
+    let (model, camera, tables) = groom_scene();
+    let lights = groom_lobes();
+    let options = EnvRenderOptions::default();
+    let max = gpu.device.limits().max_texture_dimension_2d;
+    let frame = |size| HairFrame {
+        model: &model,
+        camera: &camera,
+        size,
+        lights: &lights,
+        tables: &tables,
+        options: &options,
+        multiple: None,
+        head: None,
+    };
+    let targets = HairTargets {
+        color: wgpu::TextureFormat::Rgba16Float,
+        depth: None,
+        sample_count: 1,
+    };
+    let mut host = HairRenderer::new(&gpu.device, &gpu.queue, targets);
+    let unprepared = host.encode_next_batch(&frame([RES, RES])).unwrap_err();
+    assert!(unprepared.to_string().contains("prepare"), "{unprepared}");
+    let too_large = host.prepare(&frame([max + 1, 4])).unwrap_err();
+    assert!(
+        matches!(
+            too_large,
+            EnvRenderError::Limit(LimitError::ImageTooLarge { .. })
+        ),
+        "{too_large}"
+    );
+    assert!(host.read_image().is_err(), "nothing was prepared");
 }
