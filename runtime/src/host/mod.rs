@@ -206,7 +206,7 @@ impl HairRenderer {
         let count = (frame.options.dodm.batch_size.max(1) as usize).min(frame.lights.len() - first);
         let batch: Vec<EnvLight> = kept.order[first..first + count]
             .iter()
-            .map(|&i| frame.lights[i].clone())
+            .map(|&i| frame.lights[i])
             .collect();
         // κ's strand windows continue from the simplified lights drawn before this batch, so
         // the batches sum to the frame drawn at once.
