@@ -52,14 +52,58 @@ pub fn read_texture_layer_rgba(
     texture: &wgpu::Texture,
     layer: u32,
 ) -> Result<Vec<[f32; 4]>, ReadbackError> {
-    let format = texture.format();
-    let bytes_per_pixel = match format {
-        wgpu::TextureFormat::Rgba16Float => 8,
-        wgpu::TextureFormat::Rgba32Float => 16,
+    let bytes = match texture.format() {
+        wgpu::TextureFormat::Rgba16Float | wgpu::TextureFormat::Rgba32Float => {
+            read_texels(gpu, texture, layer, wgpu::TextureAspect::All)?
+        }
         other => return Err(ReadbackError::UnsupportedFormat(other)),
     };
+    // Copied out value by value: a byte vector promises no alignment for a cast.
+    Ok(match texture.format() {
+        wgpu::TextureFormat::Rgba32Float => bytes
+            .chunks_exact(16)
+            .map(|t| std::array::from_fn(|k| f32::from_le_bytes(word(&t[4 * k..]))))
+            .collect(),
+        _ => bytes
+            .chunks_exact(8)
+            .map(|t| {
+                std::array::from_fn(|k| half::f16::from_le_bytes([t[2 * k], t[2 * k + 1]]).to_f32())
+            })
+            .collect(),
+    })
+}
+
+/// The first four bytes of `bytes`.
+fn word(bytes: &[u8]) -> [u8; 4] {
+    [bytes[0], bytes[1], bytes[2], bytes[3]]
+}
+
+/// A `Depth32Float` texture's depths, row-major from the top row.
+pub fn read_depth(gpu: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<f32>, ReadbackError> {
+    if texture.format() != wgpu::TextureFormat::Depth32Float {
+        return Err(ReadbackError::UnsupportedFormat(texture.format()));
+    }
+    let bytes = read_texels(gpu, texture, 0, wgpu::TextureAspect::DepthOnly)?;
+    Ok(bytes
+        .chunks_exact(4)
+        .map(|t| f32::from_le_bytes(word(t)))
+        .collect())
+}
+
+/// Array layer `layer` of `texture` (its `aspect`), row-major from the top row, rows packed
+/// without the copy's padding.
+fn read_texels(
+    gpu: &GpuContext,
+    texture: &wgpu::Texture,
+    layer: u32,
+    aspect: wgpu::TextureAspect,
+) -> Result<Vec<u8>, ReadbackError> {
+    let bytes_per_texel = texture
+        .format()
+        .block_copy_size(Some(aspect))
+        .ok_or(ReadbackError::UnsupportedFormat(texture.format()))?;
     let (width, height) = (texture.width(), texture.height());
-    let unpadded_row = width * bytes_per_pixel;
+    let unpadded_row = width * bytes_per_texel;
     // Buffer copies need rows aligned to 256 bytes.
     let row = unpadded_row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
         * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
@@ -77,6 +121,7 @@ pub fn read_texture_layer_rgba(
                 y: 0,
                 z: layer,
             },
+            aspect,
             ..texture.as_image_copy()
         },
         wgpu::TexelCopyBufferInfo {
@@ -96,28 +141,15 @@ pub fn read_texture_layer_rgba(
     let slice = buffer.slice(..);
     wait_for_copy(gpu, &slice)?;
     let data = slice.get_mapped_range()?;
-    let mut pixels = Vec::with_capacity((width * height) as usize);
-    for y in 0..height as usize {
-        let start = y * row as usize;
-        let line = &data[start..start + unpadded_row as usize];
-        match format {
-            wgpu::TextureFormat::Rgba32Float => {
-                let floats: &[f32] = bytemuck::cast_slice(line);
-                pixels.extend(floats.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]));
-            }
-            _ => {
-                let halves: &[half::f16] = bytemuck::cast_slice(line);
-                pixels.extend(
-                    halves
-                        .chunks_exact(4)
-                        .map(|c| [c[0].to_f32(), c[1].to_f32(), c[2].to_f32(), c[3].to_f32()]),
-                );
-            }
-        }
-    }
+    let texels = (0..height as usize)
+        .flat_map(|y| {
+            let start = y * row as usize;
+            data[start..start + unpadded_row as usize].iter().copied()
+        })
+        .collect();
     drop(data);
     buffer.unmap();
-    Ok(pixels)
+    Ok(texels)
 }
 
 /// A storage buffer's bytes (the buffer needs `COPY_SRC`).
@@ -136,50 +168,4 @@ pub fn read_buffer(gpu: &GpuContext, source: &wgpu::Buffer) -> Result<Vec<u8>, R
     let bytes = slice.get_mapped_range()?.to_vec();
     buffer.unmap();
     Ok(bytes)
-}
-
-/// A `Depth32Float` texture's depths, row-major from the top row.
-pub fn read_depth(gpu: &GpuContext, texture: &wgpu::Texture) -> Result<Vec<f32>, ReadbackError> {
-    if texture.format() != wgpu::TextureFormat::Depth32Float {
-        return Err(ReadbackError::UnsupportedFormat(texture.format()));
-    }
-    let (width, height) = (texture.width(), texture.height());
-    let unpadded_row = width * 4;
-    let row = unpadded_row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT)
-        * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("depth readback"),
-        size: (row * height) as u64,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            aspect: wgpu::TextureAspect::DepthOnly,
-            ..texture.as_image_copy()
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(row),
-                rows_per_image: Some(height),
-            },
-        },
-        texture.size(),
-    );
-    gpu.queue.submit([encoder.finish()]);
-    let slice = buffer.slice(..);
-    wait_for_copy(gpu, &slice)?;
-    let data = slice.get_mapped_range()?;
-    let depths = (0..height as usize)
-        .flat_map(|y| {
-            let start = y * row as usize;
-            bytemuck::cast_slice::<u8, f32>(&data[start..start + unpadded_row as usize]).to_vec()
-        })
-        .collect();
-    drop(data);
-    buffer.unmap();
-    Ok(depths)
 }

@@ -1484,7 +1484,15 @@ fn render_groom(
     lights: &[EnvLight],
     kappa: f32,
 ) -> Vec<[f32; 4]> {
-    let options = EnvRenderOptions {
+    let options = groom_options(kappa);
+    render_env_frame(gpu, model, camera, RES, RES, lights, tables, &options, None)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .pixels
+}
+
+/// The groom tests' settings: κ `kappa`, 128² maps, two lights a batch.
+fn groom_options(kappa: f32) -> EnvRenderOptions {
+    EnvRenderOptions {
         dodm: DodmSettings {
             resolution: 128,
             first_layer: None,
@@ -1492,10 +1500,7 @@ fn render_groom(
         },
         kappa,
         ..Default::default()
-    };
-    render_env_frame(gpu, model, camera, RES, RES, lights, tables, &options, None)
-        .unwrap_or_else(|e| panic!("{e}"))
-        .pixels
+    }
 }
 
 /// The two SRBF lobes of the groom tests.
@@ -1989,15 +1994,7 @@ fn a_hosts_batches_sum_to_the_frame_rendered_at_once() {
     let kappa = 0.5;
     let at_once = render_groom(&gpu, &scene, &lights, kappa);
     let (model, camera, tables) = &scene;
-    let options = EnvRenderOptions {
-        dodm: DodmSettings {
-            resolution: 128,
-            first_layer: None,
-            batch_size: 2,
-        },
-        kappa,
-        ..Default::default()
-    };
+    let options = groom_options(kappa);
     let frame = HairFrame {
         model,
         camera,
