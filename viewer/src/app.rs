@@ -11,6 +11,7 @@ use anyhow::{Context, bail};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
+use strandlight_runtime::gpu::GpuContext;
 use strandlight_scene::frame_settings::FrameSettings;
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
@@ -82,7 +83,8 @@ struct App {
     outcome: anyhow::Result<()>,
 }
 
-/// The window's own device (the renderer has its own; frames cross as pixels).
+/// The window's own device (the renderer has its own; frames cross as pixels: see
+/// `WindowGpu::new` for why).
 struct WindowGpu {
     window: Arc<Window>,
     surface: wgpu::Surface<'static>,
@@ -119,11 +121,11 @@ impl WindowGpu {
         .context("no adapter can present to this window")?;
         let info = adapter.get_info();
         let adapter_name = format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type);
-        let (device, queue) =
-            pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-                label: Some("strandlight window"),
-                ..Default::default()
-            }))?;
+        // Made by the runtime's one device request, as the render thread's is. The window keeps
+        // a device of its own: on one queue, lavapipe runs the window's frames behind the
+        // render thread's passes (a 1.9 s view pass held the window 1.9 s, issue 62).
+        let window_gpu = pollster::block_on(GpuContext::for_adapter(adapter.clone(), None))?;
+        let (device, queue) = (window_gpu.device, window_gpu.queue);
         let physical = window.inner_size();
         let mut config = surface
             .get_default_config(&adapter, physical.width.max(1), physical.height.max(1))
