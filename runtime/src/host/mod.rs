@@ -134,8 +134,8 @@ impl HairRenderer {
         )
     }
 
-    /// [`Self::new`] on a context the caller already has (the headless commands' device, which
-    /// times its passes).
+    /// [`Self::new`] on a context the caller already has (one from
+    /// [`GpuContext::new_headless`], whose passes are timed by waiting for the GPU).
     pub fn on(gpu: GpuContext, targets: HairTargets) -> Self {
         Self {
             env: EnvRenderer::new(&gpu),
@@ -151,38 +151,66 @@ impl HairRenderer {
         &self.gpu
     }
 
-    /// Starts a new frame of `frame`: no light drawn yet. The frame's buffers are kept across
-    /// frames of one size and zeroed on the GPU.
+    /// Starts a new frame of `frame`: no light drawn yet, so [`Self::render`] draws nothing
+    /// until the first batch. The frame's buffers are kept across frames of one size and
+    /// cleared on the GPU. A frame without lights is an error.
     pub fn prepare(&mut self, frame: &HairFrame<'_>) -> Result<(), EnvRenderError> {
+        if frame.lights.is_empty() {
+            return Err(EnvRenderError::NoLights);
+        }
         let [width, height] = frame.size;
-        let progress = BatchProgress {
-            lights_drawn: 0,
-            lights_total: frame.lights.len(),
-        };
-        let with_multiple = frame.multiple.is_some();
-        match &mut self.frame {
-            Some(kept) if kept.sums.size() == frame.size => {
-                let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-                encoder.clear_buffer(kept.sums.buffer(), 0, None);
-                self.gpu.queue.submit([encoder.finish()]);
-                kept.progress = progress;
-                kept.order = drawing_order(frame.lights);
-                kept.with_multiple = with_multiple;
-                kept.last_stats = None;
-            }
+        let kept = match self.frame.take() {
+            Some(kept) if kept.sums.size() == frame.size => kept,
             _ => {
                 let sums = FrameSums::with_front_depth(&self.gpu, width, height)?;
-                self.frame = Some(FrameInProgress {
-                    order: drawing_order(frame.lights),
+                FrameInProgress {
                     composite: self.composite.bind(&self.gpu.device, &sums),
                     sums,
-                    progress,
-                    with_multiple,
+                    order: Vec::new(),
+                    progress: BatchProgress {
+                        lights_drawn: 0,
+                        lights_total: 0,
+                    },
+                    with_multiple: false,
                     last_stats: None,
-                });
+                }
             }
-        }
+        };
+        self.clear(&kept.sums);
+        self.frame = Some(FrameInProgress {
+            order: drawing_order(frame.lights),
+            progress: BatchProgress {
+                lights_drawn: 0,
+                lights_total: frame.lights.len(),
+            },
+            with_multiple: frame.multiple.is_some(),
+            last_stats: None,
+            ..kept
+        });
         Ok(())
+    }
+
+    /// Zeroes `sums` and sets their front depth to the far plane (nothing drawn), on the GPU:
+    /// until its first batch a frame draws nothing into the host's pass, not even depth.
+    fn clear(&self, sums: &FrameSums) {
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        encoder.clear_buffer(sums.buffer(), 0, None);
+        if let Some(depth) = sums.front_depth() {
+            let view = depth.create_view(&Default::default());
+            encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("hair front depth cleared"),
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                ..Default::default()
+            });
+        }
+        self.gpu.queue.submit([encoder.finish()]);
     }
 
     /// Adds the next batch of lights (the options' `dodm.batch_size` of them) to the frame

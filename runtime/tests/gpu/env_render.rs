@@ -2062,4 +2062,101 @@ fn a_hosts_bad_frame_is_a_typed_error() {
         "{too_large}"
     );
     assert!(host.read_image().is_err(), "nothing was prepared");
+    let no_lights = host.prepare(&HairFrame {
+        lights: &[],
+        ..frame([RES, RES])
+    });
+    assert!(
+        matches!(no_lights, Err(EnvRenderError::NoLights)),
+        "{no_lights:?}"
+    );
+}
+
+/// A prepared frame draws nothing into the host's pass before its first batch: the host's
+/// colour and depth stay as they were (a frame's front depth starts at the far plane).
+#[test]
+fn a_host_frame_draws_nothing_before_its_first_batch() {
+    use strandlight_runtime::gpu::readback::read_depth;
+    use strandlight_runtime::host::{HairFrame, HairRenderer, HairTargets};
+    let gpu = gpu();
+    let (model, camera, tables) = groom_scene();
+    let lights = groom_lobes();
+    let options = groom_options(1.0);
+    let frame = HairFrame {
+        model: &model,
+        camera: &camera,
+        size: [RES, RES],
+        lights: &lights,
+        tables: &tables,
+        options: &options,
+        multiple: None,
+        head: None,
+    };
+    let (colour, depth) = (
+        wgpu::TextureFormat::Rgba16Float,
+        wgpu::TextureFormat::Depth32Float,
+    );
+    let targets = HairTargets {
+        color: colour,
+        depth: Some(depth),
+        sample_count: 1,
+    };
+    let mut host = HairRenderer::new(&gpu.device, &gpu.queue, targets);
+    host.prepare(&frame).unwrap();
+    let target = |format, label| {
+        gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: RES,
+                height: RES,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        })
+    };
+    let (colour, depth) = (target(colour, "host colour"), target(depth, "host depth"));
+    let (colour_view, depth_view) = (
+        colour.create_view(&Default::default()),
+        depth.create_view(&Default::default()),
+    );
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("host"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &colour_view,
+                resolve_target: None,
+                depth_slice: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color {
+                        r: 0.25,
+                        g: 0.5,
+                        b: 0.75,
+                        a: 1.0,
+                    }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0.5),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            ..Default::default()
+        });
+        host.render(&mut pass);
+    }
+    gpu.queue.submit([encoder.finish()]);
+    let pixels = read_texture_rgba(&gpu, &colour).unwrap();
+    let depths = read_depth(&gpu, &depth).unwrap();
+    assert!(pixels.iter().all(|p| *p == [0.25, 0.5, 0.75, 1.0]));
+    assert!(depths.iter().all(|&d| d == 0.5));
 }
