@@ -12,8 +12,10 @@
 //!
 //! Nothing on that path reads back or waits for the GPU: work is submitted on the host's queue
 //! and the frame stays on the GPU. [`HairRenderer::read_image`] is the one readback, for a
-//! headless host that writes files. GPU validation errors go to the device's own error handler
-//! (the host's).
+//! headless host that writes files. One exception: multiple scattering from the GPU's
+//! forward-scattering march (`multiple::GpuForwardScattering`) reads its grid back once per
+//! batch; single scattering and the CPU's source read nothing back. GPU validation errors go to
+//! the device's own error handler (the host's).
 //!
 //! The hair's depth is wgpu's 0..1 depth of [`Camera::view_projection`] at the frame's size: a
 //! host that projects its scene with the same matrix shares one depth buffer with the hair.
