@@ -17,16 +17,23 @@
 //! 0.383 against the truth, 0.269 marching every vertex; the build time did not change
 //! measurably, 1.6 s). Between vertices the coefficients are interpolated
 //! trilinearly (on the GPU as here, [`VisibilityVolume::coefficients_at`]).
+//!
+//! The build goes direction by direction: each voxel's extinction along ω is evaluated once,
+//! not at every step of every march through it, and a march leaps over the samples that fall
+//! in empty voxels (a voxel's max-norm distance to the nearest fiber bounds how far): the
+//! coefficients are bit for bit those of marching every sample of every direction alone
+//! (tested). The default groom's volume (64 voxels, 128 directions) took 10.4 s before and
+//! 6.3 s after in the test profile on 2 cores (6 Dec).
 
 use glam::Vec3;
 use rayon::prelude::*;
 
 use super::spherical_harmonics::{
-    SH_COEFFICIENTS, fibonacci_directions, lobe_visibility, project, sh_basis, windowed,
+    SH_COEFFICIENTS, fibonacci_directions, lobe_visibility, sh_basis, windowed,
 };
 use crate::hair::HairModel;
 use crate::head::Head;
-use crate::multiple::{HairVolume, VoxelSettings};
+use crate::multiple::{HairVolume, VoxelGrid, VoxelSettings};
 
 /// How finely the visibility is sampled.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -149,34 +156,55 @@ impl VisibilityVolume {
         Ok(volume)
     }
 
+    /// Direction by direction: each voxel's extinction along ω is computed once for the whole
+    /// grid (not once per step of every march through it), then every vertex marches through
+    /// that one number per voxel. Each vertex still sums its directions in lattice order in
+    /// f64, so the coefficients are those of `project` over per-vertex `march`es, bit for
+    /// bit (tested below).
     fn from_hair_volume(hair: &HairVolume, directions: usize, head: Option<&Head>) -> Self {
         let grid = hair.grid;
         let dims = grid.dims.map(|d| d + 1);
         let lattice = fibonacci_directions(directions);
         let vertex_count = dims.iter().map(|&d| d as usize).product::<usize>();
         let step = 0.5 * grid.voxel_size;
-        let coefficients = (0..vertex_count)
+        let position = |v: usize| {
+            let [i, j, k] = unflatten(v, dims);
+            grid.origin + Vec3::new(i as f32, j as f32, k as f32) * grid.voxel_size
+        };
+        // A vertex inside the head is read only in the cells it shares with vertices
+        // outside, by the skin and the fibers at the scalp: it carries what the surface
+        // sees outward, the hair alone. (Dark in every direction, it darkened the skin
+        // under the hair; the skin's cosine removes the directions into the head.)
+        let inside: Vec<bool> = (0..vertex_count)
             .into_par_iter()
-            .map(|v| {
-                let [i, j, k] = unflatten(v, dims);
-                let p = grid.origin + Vec3::new(i as f32, j as f32, k as f32) * grid.voxel_size;
-                // A vertex inside the head is read only in the cells it shares with vertices
-                // outside, by the skin and the fibers at the scalp: it carries what the surface
-                // sees outward, the hair alone. (Dark in every direction, it darkened the skin
-                // under the hair; the skin's cosine removes the directions into the head.)
-                let inside = head.is_some_and(|h| h.contains(p));
-                let t = lattice.iter().map(|&w| match head {
-                    Some(h) if !inside && h.ray_hit(p, w, f32::INFINITY).is_some() => 0.0,
-                    _ => march(hair, p, w, step),
-                });
-                project(&lattice, t)
-            })
+            .map(|v| head.is_some_and(|h| h.contains(position(v))))
             .collect();
+        let mut sums = vec![[0.0f64; SH_COEFFICIENTS]; vertex_count];
+        let mut extinction_or_reach = vec![0.0f32; grid.voxel_count()];
+        let reach = empty_reach(hair);
+        for &w in &lattice {
+            let basis = sh_basis(w);
+            let medium = MarchMedium::along(hair, &reach, w, &mut extinction_or_reach);
+            sums.par_iter_mut().enumerate().for_each(|(v, sum)| {
+                let p = position(v);
+                let t = match head {
+                    Some(h) if !inside[v] && h.ray_hit(p, w, f32::INFINITY).is_some() => 0.0,
+                    _ => medium.march(p, w, step),
+                };
+                for (s, y) in sum.iter_mut().zip(basis) {
+                    *s += t as f64 * y as f64;
+                }
+            });
+        }
+        let weight = 4.0 * std::f64::consts::PI / lattice.len() as f64;
         Self {
             origin: grid.origin,
             spacing: grid.voxel_size,
             dims,
-            coefficients,
+            coefficients: sums
+                .into_iter()
+                .map(|s| s.map(|c| (c * weight) as f32))
+                .collect(),
         }
     }
 
@@ -242,28 +270,166 @@ fn flatten([i, j, k]: [u32; 3], dims: [u32; 3]) -> usize {
     (k as usize * dims[1] as usize + j as usize) * dims[0] as usize + i as usize
 }
 
-/// exp(−∫σ(w) ds) from `p` along `w` to the grid's border (midpoint rule, steps of `step`).
+/// exp(−∫σ(w) ds) from `p` along `w` to the grid's border: the midpoint rule at
+/// t₀ + (n + ½)·`step`, every sample looked up (the definition [`MarchMedium::march`] must equal
+/// bit for bit: the samples it skips add exactly zero).
+#[cfg(test)]
 fn march(hair: &HairVolume, p: Vec3, w: Vec3, step: f32) -> f32 {
-    let grid = &hair.grid;
-    let Some((t0, t1)) = grid.ray_interval(p, w) else {
+    let Some(ray) = VoxelRay::new(&hair.grid, p, w) else {
         return 1.0;
     };
     let mut depth = 0.0;
-    let mut t = t0 + 0.5 * step;
-    while t < t1 {
-        if let Some(voxel) = grid.voxel_of(p + t * w) {
+    for n in 0.. {
+        let t = ray.t0 + (n as f32 + 0.5) * step;
+        if t >= ray.t1 {
+            break;
+        }
+        if let Some(voxel) = ray.voxel_at(t) {
             depth += extinction_along(hair, voxel, w) * step;
             if depth > OPAQUE_DEPTH {
                 return 0.0;
             }
         }
-        t += step;
     }
     (-depth).exp()
 }
 
+/// A ray p + t·w through the grid, in voxel units (q₀ + t·dq), over its interval [t₀, t₁]
+/// inside the grid.
+struct VoxelRay {
+    q0: Vec3,
+    dq: Vec3,
+    t0: f32,
+    t1: f32,
+    dims: [u32; 3],
+}
+
+impl VoxelRay {
+    fn new(grid: &VoxelGrid, p: Vec3, w: Vec3) -> Option<Self> {
+        let (t0, t1) = grid.ray_interval(p, w)?;
+        let inverse = 1.0 / grid.voxel_size;
+        Some(Self {
+            q0: (p - grid.origin) * inverse,
+            dq: w * inverse,
+            t0,
+            t1,
+            dims: grid.dims,
+        })
+    }
+
+    /// The voxel (linear index) holding the ray's point at `t`, if inside the grid.
+    fn voxel_at(&self, t: f32) -> Option<usize> {
+        let q = self.q0 + t * self.dq;
+        let [nx, ny, nz] = self.dims;
+        let inside =
+            q.cmpge(Vec3::ZERO).all() && q.cmplt(Vec3::new(nx as f32, ny as f32, nz as f32)).all();
+        inside.then(|| (q.z as usize * ny as usize + q.y as usize) * nx as usize + q.x as usize)
+    }
+}
+
+/// What a march along one direction reads, one number per voxel: its extinction along that
+/// direction where it holds fibers, else minus its [`empty_reach`], which lets the march leap
+/// over empty space (every sample it leaps over would have added exactly zero).
+struct MarchMedium<'a> {
+    grid: &'a VoxelGrid,
+    extinction_or_reach: &'a [f32],
+}
+
+impl<'a> MarchMedium<'a> {
+    /// `extinction_or_reach` filled for `w` (sized to the grid by the caller).
+    fn along(
+        hair: &'a HairVolume,
+        reach: &[u8],
+        w: Vec3,
+        extinction_or_reach: &'a mut [f32],
+    ) -> Self {
+        extinction_or_reach
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(voxel, e)| {
+                *e = match reach[voxel] {
+                    0 => extinction_along(hair, voxel, w),
+                    r => -f32::from(r),
+                }
+            });
+        Self {
+            grid: &hair.grid,
+            extinction_or_reach,
+        }
+    }
+
+    /// exp(−∫σ(w) ds) from `p` along `w` to the grid's border: the midpoint rule at
+    /// t₀ + (n + ½)·`step`, samples in empty space skipped.
+    fn march(&self, p: Vec3, w: Vec3, step: f32) -> f32 {
+        let Some(ray) = VoxelRay::new(self.grid, p, w) else {
+            return 1.0;
+        };
+        // Voxels (max-norm) the sample moves per step, a hair over to stay on the safe side.
+        let moved_per_step = step * ray.dq.abs().max_element() * 1.0001;
+        let mut depth = 0.0;
+        let mut n = 0u32;
+        loop {
+            let t = ray.t0 + (n as f32 + 0.5) * step;
+            if t >= ray.t1 {
+                break;
+            }
+            n += 1;
+            let Some(voxel) = ray.voxel_at(t) else {
+                continue;
+            };
+            let e = self.extinction_or_reach[voxel];
+            if e >= 0.0 {
+                depth += e * step;
+                if depth > OPAQUE_DEPTH {
+                    return 0.0;
+                }
+            } else if e < -1.0 {
+                // Samples less than reach − 1 voxels away (max-norm) lie in empty voxels; the
+                // floor of that distance over the margin-widened move is how many.
+                n += ((-e - 1.0) / moved_per_step) as u32;
+            }
+        }
+        (-depth).exp()
+    }
+}
+
+/// The most an empty-space leap is allowed to cover, in voxels.
+const MAX_EMPTY_REACH: u8 = 16;
+
+/// Each voxel's distance in voxels (max-norm, capped at [`MAX_EMPTY_REACH`]) to the nearest
+/// voxel holding fibers: 0 in a voxel with fibers. Any point less than `reach − 1` voxels from
+/// a point of this voxel lies in an empty voxel. Separable: the max-norm distance is a min–max
+/// along x, then y, then z.
+fn empty_reach(hair: &HairVolume) -> Vec<u8> {
+    let grid = &hair.grid;
+    let dims = grid.dims;
+    let mut reach: Vec<u8> = hair
+        .sigma_perp
+        .iter()
+        .map(|&s| if s > 0.0 { 0 } else { MAX_EMPTY_REACH })
+        .collect();
+    for axis in 0..3 {
+        let before = reach.clone();
+        reach.par_iter_mut().enumerate().for_each(|(v, r)| {
+            let [i, j, k] = unflatten(v, dims);
+            let at = [i, j, k][axis] as i64;
+            let span = i64::from(MAX_EMPTY_REACH);
+            let lo = (at - span).max(0);
+            let hi = (at + span).min(dims[axis] as i64 - 1);
+            for other in lo..=hi {
+                let mut idx = [i, j, k];
+                idx[axis] = other as u32;
+                let via = before[grid.linear_index(idx)].max((other - at).unsigned_abs() as u8);
+                *r = (*r).min(via);
+            }
+        });
+    }
+    reach
+}
+
 #[cfg(test)]
 mod tests {
+    use super::super::spherical_harmonics::project;
     use super::*;
     use crate::hair::HairModel;
 
@@ -371,6 +537,67 @@ mod tests {
                 "ξ {xi} λ {lambda}: SH {sh} vs march {brute}"
             );
         }
+    }
+
+    /// Two bundles of fibers with empty space between them, where a march leaps.
+    fn two_bundles() -> HairModel {
+        let (near, far) = (slab(4, 0.06, 1.5, 0.01), slab(4, 0.06, 1.5, 0.01));
+        let offset = Vec3::new(0.0, 1.4, 1.2);
+        let points: Vec<Vec3> = near
+            .points()
+            .iter()
+            .copied()
+            .chain(far.points().iter().map(|&p| p + offset))
+            .collect();
+        let per_strand = 9;
+        let offsets = (0..=points.len() / per_strand)
+            .map(|s| (s * per_strand) as u32)
+            .collect();
+        let d = Some(crate::hair::Attribute::Uniform(0.01));
+        HairModel::new(points, offsets, d, None, None).unwrap()
+    }
+
+    /// The direction-major build with its leaps over empty space is the per-vertex definition,
+    /// reordered: every vertex's directions marched one by one, sampling every step (`march`,
+    /// the head's hit test as documented), and projected (`project`) give the same coefficients
+    /// to the bit, with a head across part of the grid and empty space between two bundles.
+    #[test]
+    fn the_build_equals_each_vertex_marched_and_projected_alone() {
+        let model = two_bundles();
+        let head = crate::head::Head::ellipsoid(Vec3::new(0.7, 0.9, 0.4), Vec3::splat(0.3));
+        let voxels = VoxelSettings {
+            voxels_longest_side: 12,
+            default_diameter: None,
+        };
+        let hair = HairVolume::build(&model, &voxels, 1.0).unwrap();
+        let leaps = empty_reach(&hair).iter().filter(|&&r| r > 2).count();
+        assert!(
+            leaps > 100,
+            "{leaps} voxels to leap from: the test checks no leap"
+        );
+        let directions = 48;
+        let built = VisibilityVolume::from_hair_volume(&hair, directions, Some(&head));
+        let lattice = fibonacci_directions(directions);
+        let step = 0.5 * hair.grid.voxel_size;
+        let mut hidden = 0;
+        for (v, c) in built.coefficients.iter().enumerate() {
+            let [i, j, k] = unflatten(v, built.dims);
+            let p = built.origin + Vec3::new(i as f32, j as f32, k as f32) * built.spacing;
+            let inside = head.contains(p);
+            let t = lattice.iter().map(|&w| {
+                if !inside && head.ray_hit(p, w, f32::INFINITY).is_some() {
+                    hidden += 1;
+                    0.0
+                } else {
+                    march(&hair, p, w, step)
+                }
+            });
+            assert_eq!(*c, project(&lattice, t), "vertex {v} at {p}");
+        }
+        assert!(
+            hidden > 0,
+            "the head hid no direction: the test checks nothing of it"
+        );
     }
 
     #[test]
