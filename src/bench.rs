@@ -65,8 +65,8 @@ pub struct BenchArgs {
     #[arg(long)]
     pub decomposition_only: bool,
     /// The head in every frame, the ground truth's too: none, ellipsoid (fitted to the strand
-    /// roots) or FILE.obj (default: the plan's, none).
-    #[arg(long, value_name = "none|ellipsoid|FILE.obj")]
+    /// roots) or a mesh FILE (.obj, .glb, .gltf, .usd*) (default: the plan's, none).
+    #[arg(long, value_name = "none|ellipsoid|FILE")]
     pub head: Option<HeadChoice>,
     /// Cache folder (fits, tables, reference images), shared with `compare`.
     #[arg(long, default_value = "out/cache")]

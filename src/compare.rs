@@ -57,8 +57,9 @@ struct SceneFlags {
     #[arg(long)]
     preset: Option<String>,
     /// The head in every frame (the SRBF path's, the reference's, the baseline's, the truth's):
-    /// none, ellipsoid (fitted to the strand roots) or FILE.obj (default: none).
-    #[arg(long, value_name = "none|ellipsoid|FILE.obj")]
+    /// none, ellipsoid (fitted to the strand roots) or a mesh FILE (.obj, .glb, .gltf, .usd*)
+    /// (default: none).
+    #[arg(long, value_name = "none|ellipsoid|FILE")]
     head: Option<strandlight_scene::head_input::HeadChoice>,
 }
 

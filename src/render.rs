@@ -80,10 +80,11 @@ struct SceneArgs {
     /// Every fiber this many pixels wide (default: the file's thickness, projected).
     #[arg(long)]
     fiber_width_px: Option<f32>,
-    /// The head the hair grows from: none, ellipsoid (fitted to the strand roots) or FILE.obj (in
-    /// the hair's units and frame); it hides the hair behind it, is drawn as diffuse skin and
-    /// shadows every light.
-    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE.obj")]
+    /// The head the hair grows from: none, ellipsoid (fitted to the strand roots) or a mesh FILE:
+    /// .obj (in the hair's units and frame), .glb/.gltf or .usd/.usda/.usdc/.usdz (every mesh in
+    /// the scene, Y up in centimetres as USD grooms are); it hides the hair behind it, is drawn
+    /// as diffuse skin and shadows every light.
+    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE")]
     head: HeadChoice,
 }
 

@@ -40,8 +40,9 @@ pub struct TruthArgs {
     /// Melanin preset of the fiber: white, blonde, red, auburn, brown, dark.
     #[arg(long, default_value = "brown")]
     pub preset: String,
-    /// The head under the hair: none, ellipsoid (fitted to the strand roots) or FILE.obj.
-    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE.obj")]
+    /// The head under the hair: none, ellipsoid (fitted to the strand roots) or a mesh
+    /// FILE (.obj, .glb, .gltf, .usd, .usda, .usdc, .usdz).
+    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE")]
     pub head: HeadChoice,
     /// Scattering modes: single (direct light, max_depth 2) and full (path traced).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "single,full")]

@@ -30,8 +30,9 @@ pub struct ViewArgs {
     preset: String,
     #[arg(long, value_enum, default_value = "full")]
     scattering: ScatteringMode,
-    /// The head the hair grows from: none, ellipsoid (fitted to the strand roots) or FILE.obj.
-    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE.obj")]
+    /// The head the hair grows from: none, ellipsoid (fitted to the strand roots) or a mesh
+    /// FILE (.obj, .glb, .gltf, .usd, .usda, .usdc, .usdz).
+    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE")]
     head: HeadChoice,
     /// Image size WxH in pixels (the window shows it scaled to fit).
     #[arg(long, default_value = "640x480")]

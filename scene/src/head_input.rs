@@ -1,6 +1,8 @@
 //! The head of a scene (issue 40): none, an ellipsoid fitted to the strand roots, or a mesh
-//! read from an OBJ file (`tobj`). The setting is [`HeadChoice`]; [`load_head`] turns it into
-//! the runtime's [`Head`] for a given groom.
+//! read from a file: Wavefront OBJ (`tobj`, in the hair's units and frame), glTF 2.0
+//! ([`crate::head_gltf`]) or USD `Mesh` prims (the runtime's USD reader); the last two in
+//! strandlight's world, as their grooms are (Y up, centimetres). The setting is
+//! [`HeadChoice`]; [`load_head`] turns it into the runtime's [`Head`] for a given groom.
 //!
 //! The ellipsoid fit: a groom's roots sit on the scalp, which is usually only the top of the
 //! head (a cap), where a free ellipsoid fit is poorly conditioned (on straight.hair the
@@ -19,6 +21,7 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::head::{DEFAULT_SKIN_ALBEDO, Head, HeadSurface, TriangleMesh};
+use strandlight_tables::atomic_write::write_atomically;
 
 /// Which head a scene has.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -29,7 +32,7 @@ pub enum HeadChoice {
     None,
     /// An ellipsoid fitted to the strand roots (see the module's documentation).
     Ellipsoid,
-    /// A triangle mesh from an OBJ file, in the hair's units and frame.
+    /// A triangle mesh from a file ([`MESH_EXTENSIONS`]): every mesh in it, merged.
     Mesh(PathBuf),
 }
 
@@ -38,16 +41,15 @@ impl HeadChoice {
         *self == HeadChoice::None
     }
 
-    /// `none`, `ellipsoid` or a path to an `.obj` file.
+    /// `none`, `ellipsoid` or a path to a mesh file (one of [`MESH_EXTENSIONS`]).
     pub fn parse(text: &str) -> Result<Self, String> {
         match text {
             "none" => Ok(Self::None),
             "ellipsoid" => Ok(Self::Ellipsoid),
-            path if path.to_ascii_lowercase().ends_with(".obj") => {
-                Ok(Self::Mesh(PathBuf::from(path)))
-            }
+            path if is_mesh_file(Path::new(path)) => Ok(Self::Mesh(PathBuf::from(path))),
             other => Err(format!(
-                "`{other}`: give none, ellipsoid or a mesh file ending in .obj"
+                "`{other}`: give none, ellipsoid or a mesh file ending in {}",
+                MESH_EXTENSIONS.map(|e| format!(".{e}")).join(", ")
             )),
         }
     }
@@ -70,6 +72,16 @@ impl std::str::FromStr for HeadChoice {
     }
 }
 
+/// The extensions of the head mesh files read (the format follows the extension).
+pub const MESH_EXTENSIONS: [&str; 7] = ["obj", "glb", "gltf", "usd", "usda", "usdc", "usdz"];
+
+/// Whether `path` names a head mesh file by its extension.
+pub fn is_mesh_file(path: &Path) -> bool {
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| MESH_EXTENSIONS.contains(&e.to_ascii_lowercase().as_str()))
+}
+
 /// The head `choice` asks for, around `hair`, with skin of `albedo`.
 pub fn load_head(
     choice: &HeadChoice,
@@ -86,7 +98,7 @@ pub fn load_head(
                 radii: fit.radii,
             }
         }
-        HeadChoice::Mesh(path) => HeadSurface::Mesh(load_obj(path)?),
+        HeadChoice::Mesh(path) => HeadSurface::Mesh(load_mesh(path)?),
     };
     if albedo.iter().any(|a| !(0.0..=1.0).contains(a)) {
         bail!("skin albedo {albedo:?}: each channel must be in [0, 1]");
@@ -97,6 +109,33 @@ pub fn load_head(
 /// The default skin albedo (linear RGB).
 pub fn default_skin_albedo() -> [f32; 3] {
     DEFAULT_SKIN_ALBEDO
+}
+
+/// The head mesh in the file at `path`, read as its extension says.
+pub fn load_mesh(path: &Path) -> anyhow::Result<TriangleMesh> {
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match extension.as_str() {
+        "obj" => load_obj(path),
+        #[cfg(feature = "scene-files")]
+        "glb" | "gltf" => crate::head_gltf::load_gltf(path),
+        #[cfg(feature = "scene-files")]
+        "usd" | "usda" | "usdc" | "usdz" => {
+            Ok(strandlight_runtime::hair::usd::load_usd_mesh(path)?)
+        }
+        _ if is_mesh_file(path) => bail!(
+            "{}: this build reads only OBJ heads (glTF and USD come with the scene-files feature)",
+            path.display()
+        ),
+        _ => bail!(
+            "{}: not a head mesh file (give one ending in {})",
+            path.display(),
+            MESH_EXTENSIONS.map(|e| format!(".{e}")).join(", ")
+        ),
+    }
 }
 
 /// Every triangle of every model in an OBJ file, merged into one mesh (triangulated, one index
@@ -131,7 +170,7 @@ pub fn load_obj(path: &Path) -> anyhow::Result<TriangleMesh> {
             normals.extend(
                 mesh.normals
                     .chunks_exact(3)
-                    .map(|n| Vec3::new(n[0], n[1], n[2]).normalize_or(Vec3::Y)),
+                    .map(|n| unit(Vec3::new(n[0], n[1], n[2]))),
             );
         } else {
             every_normal = false;
@@ -156,6 +195,36 @@ pub fn load_obj(path: &Path) -> anyhow::Result<TriangleMesh> {
         true => TriangleMesh::new(positions, normals, indices),
         false => TriangleMesh::with_computed_normals(positions, indices),
     })
+}
+
+/// `mesh` as a Wavefront OBJ with per-vertex normals, which [`load_obj`] reads back exactly
+/// (floats in their shortest exact form). Written whole or not at all.
+pub fn write_obj(mesh: &TriangleMesh, path: &Path) -> anyhow::Result<()> {
+    use std::io::Write;
+    write_atomically(path, |out| {
+        for p in &mesh.positions {
+            writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
+        }
+        for n in &mesh.normals {
+            writeln!(out, "vn {} {} {}", n.x, n.y, n.z)?;
+        }
+        for t in mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0] + 1, t[1] + 1, t[2] + 1];
+            writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}")?;
+        }
+        Ok::<(), std::io::Error>(())
+    })
+    .with_context(|| format!("cannot write the head {}", path.display()))
+}
+
+/// `n` made unit length; a normal already unit to f32's rounding is kept as it is, so a mesh
+/// written by [`write_obj`] reads back bit for bit.
+fn unit(n: Vec3) -> Vec3 {
+    if (n.length_squared() - 1.0).abs() <= 4.0 * f32::EPSILON {
+        n
+    } else {
+        n.normalize_or(Vec3::Y)
+    }
 }
 
 /// An axis-aligned ellipsoid.
@@ -184,7 +253,7 @@ pub fn fit_root_ellipsoid(roots: &[Vec3]) -> anyhow::Result<EllipsoidFit> {
         );
     }
     let center = fit_sphere_center(&roots)
-        .context("the strand roots are degenerate (all on a plane or a line): give --head FILE.obj or --head none")?;
+        .context("the strand roots are degenerate (all on a plane or a line): give --head FILE (a mesh) or --head none")?;
     let free = fit_free_ellipsoid(&roots).filter(|(c, r)| {
         roots.iter().all(|p| {
             ((*p - *c) / *r).length_squared().sqrt() - 1.0 < FREE_FIT_TOLERANCE
@@ -195,7 +264,7 @@ pub fn fit_root_ellipsoid(roots: &[Vec3]) -> anyhow::Result<EllipsoidFit> {
         Some((c, r)) => (c, r, true),
         None => {
             let r = fit_radii_about(&roots, center)
-                .context("the strand roots do not bound an ellipsoid about their centre: give --head FILE.obj or --head none")?;
+                .context("the strand roots do not bound an ellipsoid about their centre: give --head FILE (a mesh) or --head none")?;
             (center, r, false)
         }
     };

@@ -19,6 +19,8 @@ pub mod fit_cache;
 pub mod frame_render;
 pub mod frame_settings;
 pub mod hair_input;
+#[cfg(feature = "scene-files")]
+pub mod head_gltf;
 pub mod head_input;
 pub mod image_metrics;
 pub mod look;

@@ -9,13 +9,16 @@ use std::process::Command;
 
 use strandlight_tables::outside_tools::{python, require_python_modules};
 
-/// A Python writer of test grooms.
+/// A Python writer of test grooms (and heads).
 #[derive(Clone, Copy, Debug)]
 pub enum Writer {
     /// `write_usd_groom.py`: groom.usda, groom.usdc, groom.usdz, expected.json.
     UsdCore,
     /// `write_alembic_groom.py`: groom.abc, expected.json.
     Alembic,
+    /// `write_heads.py`: head.glb, head.gltf + head.bin (pygltflib), head.usda, head.usdc,
+    /// head.usdz (usd-core), expected.json.
+    Heads,
 }
 
 impl Writer {
@@ -23,6 +26,7 @@ impl Writer {
         let name = match self {
             Writer::UsdCore => "write_usd_groom.py",
             Writer::Alembic => "write_alembic_groom.py",
+            Writer::Heads => "write_heads.py",
         };
         Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("scripts")
@@ -33,6 +37,10 @@ impl Writer {
         match self {
             Writer::UsdCore => (&["pxr"], "pip install usd-core"),
             Writer::Alembic => (&["alembic3d", "imath"], "pip install alembic3d"),
+            Writer::Heads => (
+                &["pygltflib", "pxr", "numpy"],
+                "pip install pygltflib usd-core numpy",
+            ),
         }
     }
 

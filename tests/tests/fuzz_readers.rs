@@ -30,7 +30,8 @@ fn every_target_has_a_test_here() {
     assert_eq!(
         names,
         [
-            "hair", "tfx", "data", "ply", "hdr", "exr", "sltab", "srbf", "usda", "abc"
+            "hair", "tfx", "data", "ply", "hdr", "exr", "sltab", "srbf", "usda", "abc", "glb",
+            "gltf"
         ]
     );
 }
@@ -137,7 +138,8 @@ fn srbf() {
     fuzz::fuzz_target("srbf");
 }
 
-/// The scene formats' seeds are written by usd-core and PyAlembic: skipped without them.
+/// The scene formats' seeds are written by usd-core, PyAlembic and pygltflib: skipped without
+/// them.
 fn fuzz_scene_target(name: &str) {
     if fuzz::seeds::available(name) {
         fuzz::fuzz_target(name);
@@ -152,6 +154,16 @@ fn usda() {
 #[test]
 fn abc() {
     fuzz_scene_target("abc");
+}
+
+#[test]
+fn glb() {
+    fuzz_scene_target("glb");
+}
+
+#[test]
+fn gltf() {
+    fuzz_scene_target("gltf");
 }
 
 /// One header per format claiming an absurd size (10¹² strands or points, 10⁶ × 10⁶ pixels, a

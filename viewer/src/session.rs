@@ -305,10 +305,11 @@ impl Session {
                 let map = path.display().to_string();
                 self.edit(|s| s.settings.light_with_environment(map));
             }
-            "obj" => self.edit(|s| s.settings.head = HeadChoice::Mesh(path)),
+            // A USD file stays a groom: hair is what a dropped scene file usually brings.
+            "obj" | "glb" | "gltf" => self.edit(|s| s.settings.head = HeadChoice::Mesh(path)),
             _ => {
                 self.message = Some(format!(
-                    "{}: not a hair file (.hair, .tfx, .data, .ply, .usda, .usdc, .usdz, .usd, .abc), an environment map (.hdr, .exr) or a head mesh (.obj)",
+                    "{}: not a hair file (.hair, .tfx, .data, .ply, .usda, .usdc, .usdz, .usd, .abc), an environment map (.hdr, .exr) or a head mesh (.obj, .glb, .gltf)",
                     path.display()
                 ))
             }

@@ -32,6 +32,7 @@ use strandlight_runtime::passes::strand_geometry::default_thickness;
 use strandlight_scene::env_orientation::EnvOrientation;
 use strandlight_scene::frame_render::settings_camera;
 use strandlight_scene::frame_settings::{FrameSettings, Lighting};
+use strandlight_scene::head_input::write_obj;
 use strandlight_tables::atomic_write::write_atomically;
 use strandlight_tables::image_out::write_exr;
 
@@ -127,7 +128,8 @@ pub fn write_scene(
     }
     let head_obj = dir.join("head.obj");
     if let Some(head) = scene.head {
-        write_head_obj(head, &head_obj)?;
+        // Mitsuba's `obj` shape reads it.
+        write_obj(&head.triangles(), &head_obj)?;
     }
     let script = dir.join(RENDER_SCRIPT_NAME);
     std::fs::write(&script, RENDER_SCRIPT)
@@ -188,25 +190,6 @@ pub fn scene_json(
         "seed": run.seed,
         "output": absolute(output)?,
     }))
-}
-
-/// The head's triangles as a Wavefront OBJ with per-vertex normals (Mitsuba's `obj` shape).
-pub fn write_head_obj(head: &Head, path: &Path) -> anyhow::Result<()> {
-    let mesh = head.triangles();
-    write_atomically(path, |out| {
-        for p in &mesh.positions {
-            writeln!(out, "v {} {} {}", p.x, p.y, p.z)?;
-        }
-        for n in &mesh.normals {
-            writeln!(out, "vn {} {} {}", n.x, n.y, n.z)?;
-        }
-        for t in mesh.indices.chunks_exact(3) {
-            let [a, b, c] = [t[0] + 1, t[1] + 1, t[2] + 1];
-            writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}")?;
-        }
-        Ok::<(), std::io::Error>(())
-    })
-    .with_context(|| format!("cannot write the head {}", path.display()))
 }
 
 fn absolute(path: &Path) -> anyhow::Result<String> {

@@ -8,6 +8,8 @@
 //! that its front, −y, faces +z) and centimetres (`metersPerUnit`, USD's fallback 0.01).
 //! Widths scale with the transform.
 //!
+//! The same stages' `Mesh` prims make a head ([`load_usd_mesh`]), in the same world.
+//!
 //! Not read: normals, `st`/UVs, `displayOpacity` and every other primvar, velocities, and time:
 //! an animated attribute gives its earliest sample. Which prims were read and what was changed
 //! or dropped is in [`LoadReport::info`](super::LoadReport::info).
@@ -28,6 +30,7 @@ use super::curves::{
     Basis, CurveBatch, Interpolation, Shape, Values, Wrap, assemble, scene_to_world,
 };
 use super::guard::without_panics;
+use crate::head::TriangleMesh;
 
 const FORMAT: &str = "USD";
 
@@ -36,6 +39,28 @@ const DEFAULT_METERS_PER_UNIT: f64 = 0.01;
 
 /// Reads the `BasisCurves` prims of a USD stage.
 pub fn load_usd(path: &Path) -> Result<LoadedHair, HairError> {
+    let (batches, mut info) = read_usd(path, read_stage)?;
+    let (raw, notes) = assemble(batches, path)?;
+    info.extend(notes);
+    finish(raw, path, HairFormat::Usd, info.join("; "))
+}
+
+/// The `Mesh` prims of a USD stage that a renderer draws (as for curves: active, defined, not
+/// invisible, not a guide or proxy), as one triangle mesh in strandlight's world (Y up,
+/// centimetres), for a head. Read: `points`, `faceVertexCounts`, `faceVertexIndices` (polygons
+/// fanned into triangles) and `orientation`; normals are computed from the faces, wound
+/// outward (a `leftHanded` prim or a mirroring transform turns its faces). Not read: `normals`,
+/// subdivision (the cage is drawn), `holeIndices`, UVs and every other primitive variable.
+pub fn load_usd_mesh(path: &Path) -> Result<TriangleMesh, HairError> {
+    read_usd(path, read_mesh_stage)
+}
+
+/// Opens the stage at `path` and runs `read` on it, with the reader's failures (and panics)
+/// as errors naming the file.
+fn read_usd<T>(
+    path: &Path,
+    read: impl FnOnce(&Stage, &Path) -> Result<T, Read>,
+) -> Result<T, HairError> {
     // openusd reports a missing file as an anyhow error; the project's Io error names the
     // problem the same way for every format.
     std::fs::metadata(path).map_err(|source| HairError::Io {
@@ -52,16 +77,13 @@ pub fn load_usd(path: &Path) -> Result<LoadedHair, HairError> {
         .to_str()
         .ok_or_else(|| decode("the path is not UTF-8".into()))?;
     check_text_prim_names(path)?;
-    let (batches, mut info) = without_panics(path, FORMAT, || {
+    without_panics(path, FORMAT, || {
         let stage = Stage::open(text).map_err(|e| decode(format!("{e:#}")))?;
-        read_stage(&stage, path).map_err(|e| match e {
+        read(&stage, path).map_err(|e| match e {
             Read::Hair(e) => e,
             Read::Usd(e) => decode(format!("{e:#}")),
         })
-    })?;
-    let (raw, notes) = assemble(batches, path)?;
-    info.extend(notes);
-    finish(raw, path, HairFormat::Usd, info.join("; "))
+    })
 }
 
 /// Refuses a text layer whose `def`/`over`/`class` line names a prim with other characters than
@@ -124,8 +146,8 @@ impl From<HairError> for Read {
     }
 }
 
-/// Every rendered `BasisCurves` prim as a batch in strandlight's world, and notes for the report.
-fn read_stage(stage: &Stage, file: &Path) -> Result<(Vec<CurveBatch>, Vec<String>), Read> {
+/// The stage's units and up axis: (to strandlight's world, metersPerUnit, Z up).
+fn stage_to_world(stage: &Stage, file: &Path) -> Result<(DMat4, f64, bool), Read> {
     let meters_per_unit = match stage.stage_metadata("metersPerUnit")? {
         Some(Value::Double(m)) => m,
         Some(Value::Float(m)) => m as f64,
@@ -142,7 +164,12 @@ fn read_stage(stage: &Stage, file: &Path) -> Result<(Vec<CurveBatch>, Vec<String
         }
         .into());
     }
-    let to_world = scene_to_world(z_up, meters_per_unit);
+    Ok((scene_to_world(z_up, meters_per_unit), meters_per_unit, z_up))
+}
+
+/// Every rendered `BasisCurves` prim as a batch in strandlight's world, and notes for the report.
+fn read_stage(stage: &Stage, file: &Path) -> Result<(Vec<CurveBatch>, Vec<String>), Read> {
+    let (to_world, meters_per_unit, z_up) = stage_to_world(stage, file)?;
     let mut paths = Vec::new();
     stage.traverse(PrimPredicate::default(), |p| paths.push(p.clone()))?;
     let mut batches = Vec::new();
@@ -181,6 +208,112 @@ fn read_stage(stage: &Stage, file: &Path) -> Result<(Vec<CurveBatch>, Vec<String
         info.push(format!("not drawn: {}", printable(&skipped.join(", "))));
     }
     Ok((batches, info))
+}
+
+/// Every rendered `Mesh` prim's faces, fanned into triangles, in strandlight's world.
+fn read_mesh_stage(stage: &Stage, file: &Path) -> Result<TriangleMesh, Read> {
+    let (to_world, _, _) = stage_to_world(stage, file)?;
+    let mut paths = Vec::new();
+    stage.traverse(PrimPredicate::default(), |p| paths.push(p.clone()))?;
+    let (mut positions, mut indices) = (Vec::new(), Vec::new());
+    for path in paths {
+        let prim = stage.prim(path.clone());
+        if prim.type_name()?.as_ref().map(|t| t.as_str()) != Some("Mesh")
+            || not_rendered(&prim)?.is_some()
+        {
+            continue;
+        }
+        let to_world = to_world * world_transform(&prim)?;
+        let base = positions.len() as u32;
+        let (points, triangles) = read_mesh_prim(&prim, to_world, file)?;
+        positions.extend(points);
+        indices.extend(triangles.into_iter().map(|i| base + i));
+    }
+    if indices.is_empty() {
+        return Err(HairError::Decode {
+            file: file.into(),
+            format: FORMAT,
+            why: "no rendered Mesh prim with faces, so there is no head to draw".into(),
+        }
+        .into());
+    }
+    Ok(TriangleMesh::with_computed_normals(positions, indices))
+}
+
+/// One `Mesh` prim's points (in the world `to_world` takes them to) and triangles (indices into
+/// those points), wound counter-clockwise seen from outside.
+fn read_mesh_prim(
+    prim: &Prim,
+    to_world: DMat4,
+    file: &Path,
+) -> Result<(Vec<Vec3>, Vec<u32>), Read> {
+    let name = printable(prim.path().as_str());
+    let bad = |problem: String| HairError::BadCurves {
+        file: file.into(),
+        at: name.clone(),
+        problem,
+    };
+    let points = value(prim, "points")?
+        .map(vec3s)
+        .ok_or_else(|| bad("no points".into()))?
+        .ok_or_else(|| bad("points are not an array of 3-vectors".into()))?;
+    let ints = |attribute: &str| -> Result<Vec<i64>, Read> {
+        match value(prim, attribute)? {
+            Some(Value::IntVec(v)) => Ok(v.into_iter().map(i64::from).collect()),
+            Some(Value::Int64Vec(v)) => Ok(v),
+            Some(_) => Err(bad(format!("{attribute} is not an int array")).into()),
+            None => Err(bad(format!("no {attribute}")).into()),
+        }
+    };
+    let (counts, corners) = (ints("faceVertexCounts")?, ints("faceVertexIndices")?);
+    let mirrored = (token(prim, "orientation")?.as_deref() == Some("leftHanded"))
+        != (to_world.determinant() < 0.0);
+    let mut triangles = Vec::new();
+    let mut at = 0usize;
+    for (face, &count) in counts.iter().enumerate() {
+        let Some(face_corners) = usize::try_from(count)
+            .ok()
+            .filter(|&n| n >= 3)
+            .and_then(|n| corners.get(at..at.checked_add(n)?))
+        else {
+            return Err(bad(format!(
+                "face {face} has {count} corners where faceVertexIndices has {} left (a face needs at least 3)",
+                corners.len().saturating_sub(at)
+            ))
+            .into());
+        };
+        at += face_corners.len();
+        let corner = |i: i64| {
+            u32::try_from(i)
+                .ok()
+                .filter(|&i| (i as usize) < points.len())
+                .ok_or_else(|| bad(format!("face {face} names point {i} of {}", points.len())))
+        };
+        let first = corner(face_corners[0])?;
+        for pair in face_corners[1..].windows(2) {
+            let (b, c) = (corner(pair[0])?, corner(pair[1])?);
+            triangles.extend(if mirrored {
+                [first, c, b]
+            } else {
+                [first, b, c]
+            });
+        }
+    }
+    if at != corners.len() {
+        return Err(bad(format!(
+            "faceVertexCounts add up to {at} corners but faceVertexIndices has {}",
+            corners.len()
+        ))
+        .into());
+    }
+    let world: Vec<Vec3> = points
+        .iter()
+        .map(|p| to_world.transform_point3(p.as_dvec3()).as_vec3())
+        .collect();
+    if let Some(p) = world.iter().find(|p| !p.is_finite()) {
+        return Err(bad(format!("a point is not finite in the world ({p})")).into());
+    }
+    Ok((world, triangles))
 }
 
 /// A name for the report: control characters (which a damaged file can put in names) escaped.

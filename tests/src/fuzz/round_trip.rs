@@ -10,6 +10,7 @@
 //! | `hdr`, `exr` | `envmap_io::write_exr` (f32 RGB) | `envmap_io::load`, sanitizing off | size and every pixel; no bad pixel |
 //! | `sltab` | `asset::write_asset_to`, in the storage it was read in | `asset::read_asset` | metadata (descriptions, axes, payload checksum) and every value |
 //! | `srbf` | `SrbfSet::to_json` (what `save` writes) | `SrbfSet::from_json` | every field (the sets are equal and so is their JSON) |
+//! | `glb`, `gltf` | `head_input::write_obj` (the head file the Mitsuba truth reads) | `head_input::load_obj` | every triangle's corners: position and normal (OBJ drops vertices no triangle uses, so corners, not the vertex list) |
 //!
 //! No tolerance anywhere, and none is needed: the writers store what is in memory exactly.
 //! Positions, widths and colours are f32 in the model and f32 in `.hair` and `.data`. Radiance
@@ -30,6 +31,8 @@ use std::path::Path;
 use glam::Vec3;
 use strandlight_precompute::envmap_io::{self, LoadOptions};
 use strandlight_runtime::hair::{self, Attribute, HairError, HairFormat, HairWriteOptions};
+use strandlight_runtime::head::TriangleMesh;
+use strandlight_scene::head_input::{load_obj, write_obj};
 use strandlight_tables::asset;
 
 use super::targets::{Loaded, ScratchFile};
@@ -50,6 +53,7 @@ pub fn describe(target: &str) -> &'static str {
         "hdr" | "exr" => "envmap_io::write_exr (f32) → envmap_io::load",
         "sltab" => "asset::write_asset_to → asset::read_asset",
         "srbf" => "SrbfSet::to_json → SrbfSet::from_json",
+        "glb" | "gltf" => "head_input::write_obj → load_obj",
         other => panic!("no round trip for target {other}"),
     }
 }
@@ -99,6 +103,13 @@ pub fn write_and_reload(first: &Loaded) -> Result<Reloaded, String> {
             )
             .map_err(|e| format!("the set written by to_json does not load: {e}"))?;
             Ok(Reloaded::Loaded(Box::new(Loaded::Srbf(again))))
+        }
+        Loaded::Head(mesh) => {
+            let path = super::scratch_dir().join("fuzz-round-trip.obj");
+            write_obj(mesh, &path).map_err(|e| format!("write_obj refused the head: {e:#}"))?;
+            let again = load_obj(&path)
+                .map_err(|e| format!("the head written by write_obj does not load: {e:#}"))?;
+            Ok(Reloaded::Loaded(Box::new(Loaded::Head(again))))
         }
     }
 }
@@ -160,8 +171,35 @@ pub fn compare(first: &Loaded, second: &Loaded) -> Result<(), String> {
                 y.lines().nth(line).unwrap_or("(end)")
             ))
         }
+        (Loaded::Head(a), Loaded::Head(b)) => compare_heads(a, b),
         _ => Err("loaded again as another kind of data".into()),
     }
+}
+
+/// Every triangle's corners, position and normal, bit for bit.
+fn compare_heads(a: &TriangleMesh, b: &TriangleMesh) -> Result<(), String> {
+    let corners = |m: &TriangleMesh, of: fn(&TriangleMesh) -> &[Vec3]| -> Vec<Vec3> {
+        m.indices.iter().map(|&i| of(m)[i as usize]).collect()
+    };
+    for (what, of) in [
+        (
+            "position",
+            (|m: &TriangleMesh| &m.positions[..]) as fn(&TriangleMesh) -> &[Vec3],
+        ),
+        ("normal", |m: &TriangleMesh| &m.normals[..]),
+    ] {
+        let (x, y) = (corners(a, of), corners(b, of));
+        if let Some(i) = first_difference(&x, &y) {
+            return Err(format!(
+                "head: triangle {} corner {}: {what} {:?} then {:?}",
+                i / 3,
+                i % 3,
+                x.get(i),
+                y.get(i)
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The bit patterns of a value, for comparisons that tell −0 from +0 and see every ulp.
@@ -377,6 +415,12 @@ pub fn corrupt(loaded: &mut Loaded) {
                     .into();
         }
         Loaded::Srbf(s) => s.seconds = f64::from_bits(s.seconds.to_bits() ^ 1),
+        Loaded::Head(m) => {
+            let mut positions = m.positions.clone();
+            let first = m.indices[0] as usize;
+            positions[first].x = flip(positions[first].x);
+            *m = TriangleMesh::new(positions, m.normals.clone(), m.indices.clone());
+        }
     }
 }
 
@@ -424,6 +468,11 @@ pub fn fingerprint(loaded: &Loaded) -> u64 {
             f32_bits(&mut h, a.table.values());
         }
         Loaded::Srbf(s) => (3u8, s.to_json()).hash(&mut h),
+        Loaded::Head(m) => {
+            (4u8, &m.indices).hash(&mut h);
+            m.positions.iter().for_each(|p| p.bits().hash(&mut h));
+            m.normals.iter().for_each(|n| n.bits().hash(&mut h));
+        }
     }
     h.finish()
 }

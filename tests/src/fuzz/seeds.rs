@@ -65,15 +65,15 @@ pub fn seeds(name: &str) -> Vec<Seed> {
         "exr" => exr_seeds(),
         "sltab" => sltab_seeds(),
         "srbf" => vec![generated("2 lobes, 1 source", srbf_json())],
-        "usda" | "abc" => scene_seeds(name),
+        "usda" | "abc" | "glb" | "gltf" => scene_seeds(name),
         other => panic!("no seeds for target {other}"),
     };
     out.extend(shared_seeds(name));
     out
 }
 
-/// Targets whose seeds another project's writer makes (usd-core, PyAlembic).
-pub const SCENE_TARGETS: [&str; 2] = ["usda", "abc"];
+/// Targets whose seeds another project's writer makes (usd-core, PyAlembic, pygltflib).
+pub const SCENE_TARGETS: [&str; 4] = ["usda", "abc", "glb", "gltf"];
 
 /// Whether the seeds of `target` can be made here: always for the project's own formats; for
 /// the scene formats when Python has the writer (otherwise the skip is printed, or under
@@ -82,27 +82,36 @@ pub fn available(target: &str) -> bool {
     !SCENE_TARGETS.contains(&target) || !scene_seeds(target).is_empty()
 }
 
-/// The test grooms of `tests/scripts/` written once per process into the fuzz folder: USD
-/// text from usd-core, Alembic from PyAlembic. Generated at test time, never
+/// The test grooms and heads of `tests/scripts/` written once per process into the fuzz folder:
+/// USD text from usd-core, Alembic from PyAlembic, glTF from pygltflib. Generated at test time, never
 /// checked in; empty when the writer is missing.
 fn scene_seeds(target: &str) -> Vec<Seed> {
     use crate::scene_grooms::Writer;
     use std::sync::OnceLock;
     static USD: OnceLock<bool> = OnceLock::new();
     static ABC: OnceLock<bool> = OnceLock::new();
+    static HEADS: OnceLock<bool> = OnceLock::new();
     let dir = super::fuzz_dir().join("scene-seeds");
-    let (written, writer, name) = match target {
-        "abc" => (&ABC, Writer::Alembic, "PyAlembic"),
-        _ => (&USD, Writer::UsdCore, "usd-core"),
+    // The .gltf seed holds its buffer as a data URI: a fuzzed file stands alone.
+    let (written, writer, name, sub, file) = match target {
+        "abc" => (&ABC, Writer::Alembic, "PyAlembic", "abc", "groom.abc"),
+        "glb" => (&HEADS, Writer::Heads, "pygltflib", "heads", "head.glb"),
+        "gltf" => (
+            &HEADS,
+            Writer::Heads,
+            "pygltflib",
+            "heads",
+            "head-embedded.gltf",
+        ),
+        _ => (&USD, Writer::UsdCore, "usd-core", "usd", "groom.usda"),
     };
-    let sub = dir.join(if target == "abc" { "abc" } else { "usd" });
+    let sub = dir.join(sub);
     if !*written.get_or_init(|| writer.write(&sub, &[])) {
         return Vec::new();
     }
-    let file = sub.join(format!("groom.{target}"));
-    let bytes = std::fs::read(&file).expect("the writer wrote its groom");
+    let bytes = std::fs::read(sub.join(file)).expect("the writer wrote its file");
     vec![Seed {
-        name: format!("{name}: tests/scripts groom.{target}"),
+        name: format!("{name}: tests/scripts {file}"),
         bytes,
         generated: true,
     }]

@@ -11,6 +11,8 @@ use std::sync::{Mutex, OnceLock};
 use strandlight_precompute::SrbfSet;
 use strandlight_precompute::envmap_io::{LoadOptions, LoadedEnvMap, load_bytes};
 use strandlight_runtime::hair;
+use strandlight_runtime::head::TriangleMesh;
+use strandlight_scene::head_gltf::parse_gltf;
 use strandlight_tables::asset;
 
 use super::round_trip::{self, Reloaded};
@@ -29,6 +31,7 @@ pub enum Loaded {
     EnvMap(LoadedEnvMap),
     Asset(asset::TableAsset),
     Srbf(SrbfSet),
+    Head(TriangleMesh),
 }
 
 /// One reader.
@@ -114,6 +117,35 @@ fn run_usda(bytes: &[u8]) -> Result<Loaded, Refusal> {
 
 fn run_abc(bytes: &[u8]) -> Result<Loaded, Refusal> {
     hair_with(hair::alembic::parse_alembic, "fuzz-input.abc", bytes)
+}
+
+/// glTF heads, named as if in the scratch folder: a mutant's relative buffer URI resolves there
+/// (to the fuzzer's own small files at most). The kind of a refusal is its root cause's: the
+/// `gltf` crate's error variant, or the reader's own first words.
+fn run_head(file: &str, bytes: &[u8]) -> Result<Loaded, Refusal> {
+    parse_gltf(bytes, &super::scratch_dir().join(file))
+        .map(Loaded::Head)
+        .map_err(|e| {
+            let root = format!("{:?}", e.root_cause());
+            let kind = root
+                .trim_start_matches('"')
+                .split([' ', '{', '(', ':', '"'])
+                .next()
+                .unwrap_or_default()
+                .to_string();
+            Refusal {
+                kind,
+                message: format!("{e:#}"),
+            }
+        })
+}
+
+fn run_glb(bytes: &[u8]) -> Result<Loaded, Refusal> {
+    run_head("fuzz-input.glb", bytes)
+}
+
+fn run_gltf(bytes: &[u8]) -> Result<Loaded, Refusal> {
+    run_head("fuzz-input.gltf", bytes)
 }
 
 /// Environment maps are loaded with sanitizing on, so that decoded maps with bad pixels go on
@@ -203,6 +235,9 @@ pub fn reseal_asset(data: &mut [u8]) {
 /// CI executions of the USD text and Alembic targets (about 0.5 ms and 0.2 ms each here).
 const USDA_EXECS: usize = 5_000;
 const ABC_EXECS: usize = 10_000;
+/// CI executions of the glTF head targets.
+const GLB_EXECS: usize = 20_000;
+const GLTF_EXECS: usize = 10_000;
 
 /// Every reader, with its CI execution count and the writer its loads round-trip through. The
 /// counts were halved on 2026-11-29 to keep CI under its time budget (the whole fuzz test took
@@ -257,5 +292,12 @@ pub fn all() -> Vec<Target> {
             ..target("usda", "fuzz-input.usda", run_usda, USDA_EXECS)
         },
         target("abc", "fuzz-input.abc", run_abc, ABC_EXECS),
+        // The heads' seeds come from pygltflib (`seeds::scene_seeds`).
+        target("glb", "fuzz-input.glb", run_glb, GLB_EXECS),
+        Target {
+            // JSON cut after its closing brace is whole; so is one missing only trailing spaces.
+            prefixes_fail: false,
+            ..target("gltf", "fuzz-input.gltf", run_gltf, GLTF_EXECS)
+        },
     ]
 }

@@ -4,3 +4,4 @@
 mod bake_and_check;
 mod env_vs_reference;
 mod scene_grooms;
+mod scene_heads;
