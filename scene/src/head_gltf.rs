@@ -11,6 +11,7 @@ use anyhow::{Context, bail};
 use glam::{Mat3, Mat4, Vec3};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::Path;
+use strandlight_runtime::hair::guard::panic_message;
 use strandlight_runtime::head::TriangleMesh;
 
 /// glTF's metres in strandlight's centimetres.
@@ -19,6 +20,10 @@ const CENTIMETRES_PER_METRE: f32 = 100.0;
 /// Nodes deeper than this are refused: a file whose nodes form a cycle (which validation does
 /// not catch) would otherwise recurse until the stack overflows.
 const MAX_NODE_DEPTH: usize = 128;
+
+/// Node visits beyond this are refused: nodes that share children (which validation does not
+/// catch either) make the walk exponential in the depth.
+const MAX_NODE_VISITS: usize = 65_536;
 
 /// The head mesh in the glTF file at `path`.
 pub fn load_gltf(path: &Path) -> anyhow::Result<TriangleMesh> {
@@ -33,14 +38,10 @@ pub fn parse_gltf(bytes: &[u8], path: &Path) -> anyhow::Result<TriangleMesh> {
     // The crate's accessor reads index into the buffers as the file says; a damaged file must
     // give a message naming it, not end the viewer.
     catch_unwind(AssertUnwindSafe(|| read_gltf(path, bytes))).unwrap_or_else(|panic| {
-        let message = panic
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| panic.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "unknown panic".into());
         bail!(
-            "{}: the glTF reader failed on this file ({message})",
-            path.display()
+            "{}: the glTF reader failed on this file ({})",
+            path.display(),
+            panic_message(&*panic)
         )
     })
 }
@@ -135,6 +136,7 @@ struct HeadParts {
     positions: Vec<Vec3>,
     normals: Vec<Vec3>,
     indices: Vec<u32>,
+    nodes_visited: usize,
 }
 
 impl HeadParts {
@@ -147,6 +149,10 @@ impl HeadParts {
     ) -> anyhow::Result<()> {
         if depth > MAX_NODE_DEPTH {
             bail!("nodes nested deeper than {MAX_NODE_DEPTH} (a cycle?)");
+        }
+        self.nodes_visited += 1;
+        if self.nodes_visited > MAX_NODE_VISITS {
+            bail!("more than {MAX_NODE_VISITS} node visits (nodes shared as children?)");
         }
         let local = Mat4::from_cols_array_2d(&node.transform().matrix());
         let to_world = parent * local;

@@ -1,4 +1,5 @@
-//! A panic inside another project's decoder becomes a [`HairError::Decode`] naming the file.
+//! A panic inside another project's decoder becomes a [`HairError::Decode`] naming the file
+//! (the USD and Alembic readers here; the glTF head reader uses [`panic_message`] the same way).
 //!
 //! The USD and Alembic readers are young crates that index and unwrap on what the file says;
 //! a user's damaged file must give a message, not end the viewer. (A panic still prints through
@@ -18,17 +19,24 @@ pub(crate) fn without_panics<T>(
     // Nothing `decode` touches outlives it except through its result, so a half-done decode
     // leaves no broken state behind.
     catch_unwind(AssertUnwindSafe(decode)).unwrap_or_else(|panic| {
-        let message = panic
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| panic.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "unknown panic".into());
         Err(HairError::Decode {
             file: file.into(),
             format,
-            why: format!("the decoder failed on this file ({message})"),
+            why: format!(
+                "the decoder failed on this file ({})",
+                panic_message(&*panic)
+            ),
         })
     })
+}
+
+/// The text a panic carried (`panic!`'s message), for an error that names the file instead.
+pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into())
 }
 
 #[cfg(test)]

@@ -17,7 +17,7 @@ mod curves;
 mod error;
 pub mod groom;
 #[cfg(feature = "scene-files")]
-mod guard;
+pub mod guard;
 mod model;
 #[cfg(feature = "scene-files")]
 mod ogawa;

@@ -253,19 +253,9 @@ fn read_mesh_prim(
         at: name.clone(),
         problem,
     };
-    let points = value(prim, "points")?
-        .map(vec3s)
-        .ok_or_else(|| bad("no points".into()))?
-        .ok_or_else(|| bad("points are not an array of 3-vectors".into()))?;
-    let ints = |attribute: &str| -> Result<Vec<i64>, Read> {
-        match value(prim, attribute)? {
-            Some(Value::IntVec(v)) => Ok(v.into_iter().map(i64::from).collect()),
-            Some(Value::Int64Vec(v)) => Ok(v),
-            Some(_) => Err(bad(format!("{attribute} is not an int array")).into()),
-            None => Err(bad(format!("no {attribute}")).into()),
-        }
-    };
-    let (counts, corners) = (ints("faceVertexCounts")?, ints("faceVertexIndices")?);
+    let points = points(prim, &bad)?;
+    let counts = int_array(prim, "faceVertexCounts", &bad)?;
+    let corners = int_array(prim, "faceVertexIndices", &bad)?;
     let mirrored = (token(prim, "orientation")?.as_deref() == Some("leftHanded"))
         != (to_world.determinant() < 0.0);
     let mut triangles = Vec::new();
@@ -417,16 +407,8 @@ fn read_prim(prim: &Prim, to_world: DMat4, file: &Path) -> Result<CurveBatch, Re
         at: name.clone(),
         problem,
     };
-    let points = value(prim, "points")?
-        .map(vec3s)
-        .ok_or_else(|| bad("no points".into()))?
-        .ok_or_else(|| bad("points are not an array of 3-vectors".into()))?;
-    let counts = match value(prim, "curveVertexCounts")? {
-        Some(Value::IntVec(v)) => v.into_iter().map(i64::from).collect(),
-        Some(Value::Int64Vec(v)) => v,
-        Some(_) => return Err(bad("curveVertexCounts is not an int array".into()).into()),
-        None => return Err(bad("no curveVertexCounts".into()).into()),
-    };
+    let points = points(prim, &bad)?;
+    let counts = int_array(prim, "curveVertexCounts", &bad)?;
     let shape = match token(prim, "type")?.as_deref() {
         None | Some("cubic") => Shape::Cubic(match token(prim, "basis")?.as_deref() {
             None | Some("bezier") => Basis::Bezier,
@@ -467,6 +449,28 @@ fn read_prim(prim: &Prim, to_world: DMat4, file: &Path) -> Result<CurveBatch, Re
         widths,
         colors,
     })
+}
+
+/// A prim's `points`; `bad` says what is wrong with them.
+fn points(prim: &Prim, bad: &impl Fn(String) -> HairError) -> Result<Vec<Vec3>, Read> {
+    Ok(value(prim, "points")?
+        .map(vec3s)
+        .ok_or_else(|| bad("no points".into()))?
+        .ok_or_else(|| bad("points are not an array of 3-vectors".into()))?)
+}
+
+/// An int or int64 array attribute; `bad` says it is missing or of another type.
+fn int_array(
+    prim: &Prim,
+    attribute: &str,
+    bad: &impl Fn(String) -> HairError,
+) -> Result<Vec<i64>, Read> {
+    match value(prim, attribute)? {
+        Some(Value::IntVec(v)) => Ok(v.into_iter().map(i64::from).collect()),
+        Some(Value::Int64Vec(v)) => Ok(v),
+        Some(_) => Err(bad(format!("{attribute} is not an int array")).into()),
+        None => Err(bad(format!("no {attribute}")).into()),
+    }
 }
 
 /// The attribute's earliest time sample, or its default value.

@@ -160,6 +160,25 @@ fn damaged_heads_are_refused_with_the_file_named() {
     std::fs::write(&endless, text.replace("\"head.bin\"", "\"/dev/zero\"")).unwrap();
     assert_refused(&endless, "names /dev/zero, which is not a file");
 
+    // 40 nodes, each a child of the two before it: 10⁸ paths from the root.
+    let shared: Vec<String> = (0..40)
+        .map(|k| match k {
+            38 => r#"{"children":[39]}"#.to_string(),
+            39 => "{}".to_string(),
+            k => format!(r#"{{"children":[{},{}]}}"#, k + 1, k + 2),
+        })
+        .collect();
+    let tangled = dir.join("tangled.gltf");
+    std::fs::write(
+        &tangled,
+        format!(
+            r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{}]}}"#,
+            shared.join(",")
+        ),
+    )
+    .unwrap();
+    assert_refused(&tangled, "node visits");
+
     let usda = |name: &str, body: &str| {
         let path = dir.join(name);
         std::fs::write(&path, format!("#usda 1.0\n\n{body}\n")).unwrap();
