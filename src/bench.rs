@@ -68,6 +68,10 @@ pub struct BenchArgs {
     /// roots) or a mesh FILE (.obj, .glb, .gltf, .usd*) (default: the plan's, none).
     #[arg(long, value_name = "none|ellipsoid|FILE")]
     pub head: Option<HeadChoice>,
+    /// The fiber's melanin preset (white, blonde, red, auburn, brown, dark) in every frame and
+    /// ground truth (default: the plan's, brown).
+    #[arg(long)]
+    pub preset: Option<String>,
     /// Cache folder (fits, tables, reference images), shared with `compare`.
     #[arg(long, default_value = "out/cache")]
     pub cache: PathBuf,
@@ -76,7 +80,7 @@ pub struct BenchArgs {
     /// reports of the same plan on different maps or modes (a sweep run map by map, each with
     /// the reference budget its map needs) make one page; runs measured on different machines
     /// may share it, each naming its own.
-    #[arg(long, value_name = "REPORT_JSON", num_args = 1.., conflicts_with_all = ["quick", "truth", "maps", "data", "modes", "reference_max_lights", "baseline_lights", "baseline", "decomposition_only", "head"])]
+    #[arg(long, value_name = "REPORT_JSON", num_args = 1.., conflicts_with_all = ["quick", "truth", "maps", "data", "modes", "reference_max_lights", "baseline_lights", "baseline", "decomposition_only", "head", "preset"])]
     pub from_report: Vec<PathBuf>,
 }
 
@@ -104,11 +108,16 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         },
     };
     let quick = report.plan.is_quick();
+    // The page's generated section is brown's; a run of another melanin keeps its own page.
+    let own_page = quick || report.plan.preset != "brown";
     let out = args.out.clone().unwrap_or_else(|| {
         PathBuf::from(match report.plan.name.as_str() {
-            "quick" => "out/bench-quick",
-            "truth" => "docs/bench-truth",
-            _ => "docs/bench",
+            "quick" => "out/bench-quick".into(),
+            "truth" if report.plan.preset != "brown" => {
+                format!("docs/bench-truth-{}", report.plan.preset)
+            }
+            "truth" => "docs/bench-truth".into(),
+            _ => "docs/bench".to_string(),
         })
     });
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
@@ -147,12 +156,14 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     })
     .with_context(|| format!("writing {}", details_page.display()))?;
     println!("wrote {}", details_page.display());
-    if quick {
+    if own_page {
         let page = out.join("REPORT.md");
-        write_atomically(&page, |w| {
-            std::io::Write::write_all(w, section(&report, ".").as_bytes())
-        })
-        .with_context(|| format!("writing {}", page.display()))?;
+        let text = match report.plan.is_truth() {
+            true => truth_section(&report, "."),
+            false => section(&report, "."),
+        };
+        write_atomically(&page, |w| std::io::Write::write_all(w, text.as_bytes()))
+            .with_context(|| format!("writing {}", page.display()))?;
         println!("wrote {} and {}", page.display(), json.display());
     } else {
         let page = std::fs::read_to_string(&args.benchmarks)
@@ -204,6 +215,7 @@ fn measure(args: &BenchArgs) -> anyhow::Result<Option<BenchReport>> {
         baseline: args.baseline,
         decomposition_only: args.decomposition_only,
         head: args.head.clone(),
+        preset: args.preset.clone(),
     })?;
     let mut steps = Steps::new(false);
     let paths = BenchPaths {

@@ -89,6 +89,14 @@ pub struct BenchPlan {
     /// before it existed: opaque, the default then.
     #[serde(default = "opaque_view")]
     pub transparency: EnvTransparency,
+    /// The fiber's melanin preset in every frame and truth (issue 65: every melanin measured).
+    /// Reports written before it existed: brown.
+    #[serde(default = "brown")]
+    pub preset: String,
+}
+
+fn brown() -> String {
+    "brown".into()
 }
 
 fn opaque_view() -> EnvTransparency {
@@ -161,6 +169,9 @@ impl BenchPlan {
         if !plan.head.is_none() {
             args += &format!(" --head {}", plan.head);
         }
+        if plan.preset != base.preset {
+            args += &format!(" --preset {}", plan.preset);
+        }
         args
     }
 
@@ -191,6 +202,7 @@ impl BenchPlan {
             decomposition: true,
             head: HeadChoice::None,
             transparency: EnvTransparency::default(),
+            preset: brown(),
         }
     }
 
@@ -260,6 +272,7 @@ impl BenchPlan {
             decomposition: true,
             head: HeadChoice::None,
             transparency: EnvTransparency::default(),
+            preset: brown(),
         }
     }
 }
@@ -276,6 +289,7 @@ pub struct PlanChanges {
     pub baseline: Option<Baseline>,
     pub decomposition_only: bool,
     pub head: Option<HeadChoice>,
+    pub preset: Option<String>,
 }
 
 /// The most median-cut lights a bench frame may ask for (a light map each; the largest
@@ -327,6 +341,10 @@ impl BenchPlan {
         self.decomposition_only |= changes.decomposition_only;
         if let Some(head) = &changes.head {
             self.head = head.clone();
+        }
+        if let Some(preset) = &changes.preset {
+            FiberDescription::preset(preset).with_context(|| format!("--preset {preset}"))?;
+            self.preset = preset.clone();
         }
         let probe = compare_args(
             &self,
@@ -705,6 +723,7 @@ fn compare_args(
     let frame = FrameSettings {
         hair: Some(hair.to_path_buf()),
         shading: Some(plan.shading.into()),
+        preset: plan.preset.clone(),
         head: plan.head.clone(),
         ..FrameSettings::new(Lighting::Environment(env), [plan.size.0, plan.size.1])
     };

@@ -464,6 +464,18 @@ fn splice_between(
 /// the median-cut front, each against the path-traced ground truth, with the equal-error
 /// speed-ups measured against it and the path tracer's time beside the frame's.
 /// The view a plan's frames use, as the page says it.
+/// "eumelanin 1.3" (and the pheomelanin where there is some) of a preset's Chiang fiber.
+fn melanin_phrase(preset: &str) -> String {
+    match strandlight_precompute::bake_plan::FiberDescription::preset(preset) {
+        Ok(fiber) if fiber.chiang.pheomelanin > 0.0 => format!(
+            "eumelanin {}, pheomelanin {}",
+            fiber.chiang.eumelanin, fiber.chiang.pheomelanin
+        ),
+        Ok(fiber) => format!("eumelanin {}", fiber.chiang.eumelanin),
+        Err(_) => "an unknown preset".into(),
+    }
+}
+
 fn view_phrase(transparency: EnvTransparency) -> &'static str {
     match transparency {
         EnvTransparency::Opaque => {
@@ -497,7 +509,7 @@ pub fn truth_section(report: &BenchReport, page_dir: &str) -> String {
     };
     let _ = writeln!(
         out,
-        "{TRUTH_BEGIN}\n## Against the path-traced ground truth (`strandlight bench --truth`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data` and Mitsuba 3: `pip install mitsuba`).\n\n**What is measured.** straight.hair under each shared map at {}×{} (default front camera), shaded with the `brown` Chiang fiber (Chiang et al. 2016: eumelanin 1.3, longitudinal and azimuthal roughness 0.3, IOR 1.55, scale tilt 2°). Fibers are opaque cylinders of the file's width in both renderers: straight.hair's transparency field (0.36) is ignored. **The ground truth** is Mitsuba 3's path tracer with its own `hair` BSDF (the same model, written by others), `bsplinecurve` fibers through the strands' points and the map as its `envmap`, hidden from the camera: single scattering at `max_depth` 2, full scattering at the first depth D where 2D moves the image by < 1%. Its samples climb ×4 from 1024 per pixel until N and 4N agree within 1% or the budget ({} spp single, {} full) is reached; the kept image averages both, and its noise (relative RMSE, from the last N-vs-4N difference) is given. **Errors** are relative RMSE over the truth's hair pixels, raw and with the truth's noise removed in quadrature (\"n.c.\"), and HDR-FLIP. The **DOM reference** is the project's own reference (the map as directional lights, each shadowed by a deep opacity map, 1536 of them unless the light ladder converged sooner; each map's section says whether it converged): its error against the truth is what it shares with the method and so cannot show. **× median cut** is the SRBF default's speed-up over median cut at equal error, both measured against the truth (log-log interpolated along median cut's measured front). ms are frame times on {timed_on} (lavapipe: ratios only); Mitsuba's seconds are its render time on the same 2 cores. Every strandlight frame uses {}. Mitsuba has no Marschner BSDF: the Marschner figures (\"Speed against error\", at the end of this page) stay measured against the DOM reference.\n",
+        "{TRUTH_BEGIN}\n## Against the path-traced ground truth (`strandlight bench --truth`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data` and Mitsuba 3: `pip install mitsuba`).\n\n**What is measured.** straight.hair under each shared map at {}×{} (default front camera), shaded with the `{}` Chiang fiber (Chiang et al. 2016: {}, longitudinal and azimuthal roughness 0.3, IOR 1.55, scale tilt 2°). Fibers are opaque cylinders of the file's width in both renderers: straight.hair's transparency field (0.36) is ignored. **The ground truth** is Mitsuba 3's path tracer with its own `hair` BSDF (the same model, written by others), `bsplinecurve` fibers through the strands' points and the map as its `envmap`, hidden from the camera: single scattering at `max_depth` 2, full scattering at the first depth D where 2D moves the image by < 1%. Its samples climb ×4 from 1024 per pixel until N and 4N agree within 1% or the budget ({} spp single, {} full) is reached; the kept image averages both, and its noise (relative RMSE, from the last N-vs-4N difference) is given. **Errors** are relative RMSE over the truth's hair pixels, raw and with the truth's noise removed in quadrature (\"n.c.\"), and HDR-FLIP. The **DOM reference** is the project's own reference (the map as directional lights, each shadowed by a deep opacity map, 1536 of them unless the light ladder converged sooner; each map's section says whether it converged): its error against the truth is what it shares with the method and so cannot show. **× median cut** is the SRBF default's speed-up over median cut at equal error, both measured against the truth (log-log interpolated along median cut's measured front). ms are frame times on {timed_on} (lavapipe: ratios only); Mitsuba's seconds are its render time on the same 2 cores. Every strandlight frame uses {}. Mitsuba has no Marschner BSDF: the Marschner figures (\"Speed against error\", at the end of this page) stay measured against the DOM reference.\n",
         report.date,
         report.git_revision,
         report.machine,
@@ -505,6 +517,8 @@ pub fn truth_section(report: &BenchReport, page_dir: &str) -> String {
         report.seconds,
         plan.size.0,
         plan.size.1,
+        plan.preset,
+        melanin_phrase(&plan.preset),
         plan.truth_max_spp[0],
         plan.truth_max_spp[1],
         view_phrase(plan.transparency),
@@ -981,12 +995,13 @@ mod tests {
             baseline: Some(Baseline::MedianCutSources),
             decomposition_only: true,
             head: Some(HeadChoice::Ellipsoid),
+            preset: Some("blonde".into()),
         };
         let plan = BenchPlan::quick().changed(&changes).unwrap();
         assert_eq!(plan.baseline_lights, [16, 64, 256]);
         assert_eq!(
             plan.regenerate_args(),
-            " --quick --maps quarry_01_1k.hdr --modes full --reference-max-lights 6144 --baseline-lights 16,64,256 --baseline median-cut-sources --decomposition-only --head ellipsoid"
+            " --quick --maps quarry_01_1k.hdr --modes full --reference-max-lights 6144 --baseline-lights 16,64,256 --baseline median-cut-sources --decomposition-only --head ellipsoid --preset blonde"
         );
         let unchanged = PlanChanges {
             modes: BenchPlan::full().modes,
@@ -1019,5 +1034,10 @@ mod tests {
             not_a_cube.contains("--reference-max-lights 1000"),
             "{not_a_cube}"
         );
+        let no_such_fiber = bad(PlanChanges {
+            preset: Some("green".into()),
+            ..PlanChanges::default()
+        });
+        assert!(no_such_fiber.contains("--preset green"), "{no_such_fiber}");
     }
 }

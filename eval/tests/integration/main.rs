@@ -5,3 +5,4 @@ mod docs_links;
 mod ground_truth_conventions;
 mod ground_truth_head;
 mod hdr_flip_vs_nvidia;
+mod multiple_scattering_slab;
