@@ -12,7 +12,7 @@
 #import strandlight::strand_quads::frame
 #import strandlight::table_lookup::{single_lookup, multiple_lookup}
 #import strandlight::view_binding::{view, grid_values}
-#import strandlight::visibility_volume::{Sh16, volume_enabled, volume_coefficients, volume_lobe_visibility}
+#import strandlight::visibility_volume::{volume_enabled, volume_lobe_visibility}
 
 fn grid_vertex(slot: u32, i: vec3<u32>) -> vec4<f32> {
     let d = view.dims.xyz;
@@ -62,13 +62,11 @@ fn shade(world: vec3<f32>, tangent: vec3<f32>, weight: f32) -> EnvOut {
     var multiple = vec3<f32>(0.0);
     let with_grid = (batch.flags & FLAG_GRID) != 0u;
     let with_volume = shades_from_volume();
-    var sh: Sh16;
-    if (with_volume) { sh = volume_coefficients(world); }
     for (var slot = 0u; slot < batch.light_count; slot++) {
         let light = env_lights[slot];
         var visible: f32;
         if (with_volume && light.direction.w > 0.0) {
-            visible = volume_lobe_visibility(sh, light.direction.xyz, light.direction.w);
+            visible = volume_lobe_visibility(world, light.direction.xyz, light.direction.w);
         } else {
             visible = effective_transmittance(slot, world);
         }

@@ -14,7 +14,7 @@
 #import strandlight::convolution_transmittance::{batch, env_lights, shading_samples, effective_transmittance}
 #import strandlight::env_shading::shades_from_volume
 #import strandlight::view_binding::view
-#import strandlight::visibility_volume::{volume_coefficients, volume_lobe_visibility}
+#import strandlight::visibility_volume::volume_lobe_visibility
 
 // Broad lobes (λ < 3): the zonal harmonics l ≤ 2 (head::srbf_irradiance_sh2).
 fn srbf_irradiance_sh2(c: f32, lambda: f32) -> f32 {
@@ -61,7 +61,7 @@ fn shade_skin(world: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
             // No lift: the volume's vertices inside the head hold what the surface sees outward
             // (visibility/volume.rs). The light maps of volume batches are placeholders, whose
             // texel size would lift the point out of the hair altogether.
-            visible = volume_lobe_visibility(volume_coefficients(world), light.direction.xyz, light.direction.w);
+            visible = volume_lobe_visibility(world, light.direction.xyz, light.direction.w);
         } else {
             let lift = 2.0 / max(light.texels_per_unit, 1e-6);
             visible = effective_transmittance(slot, world + n * lift);

@@ -1,7 +1,9 @@
 // SRBF lobe visibility from the visibility volume (visibility/volume.rs) in the env view
-// shading: the 16 SH coefficients of T(ω) interpolated trilinearly at the shaded point once,
-// then per lobe Σ c_lm (i_l/i_0)(λ) Y_lm(ξ) (visibility/spherical_harmonics.rs, same basis,
-// same order, same band ratios).
+// shading: per lobe, each of the 8 vertices around the shaded point gives Σ c_lm (i_l/i_0)(λ)
+// Y_lm(ξ) (visibility/spherical_harmonics.rs, same basis, same order, same band ratios), and
+// the point takes their trilinear mean in the logarithm (VisibilityVolume::lobe_visibility:
+// transmittance falls exponentially into the hair, and a mean of the values themselves lit the
+// surface fibers as if half outside).
 
 #define_import_path strandlight::visibility_volume
 
@@ -29,28 +31,6 @@ fn volume_enabled() -> bool {
 fn volume_vertex_index(i: vec3<u32>) -> u32 {
     let d = volume.dims.xyz;
     return (i.z * d.y + i.y) * d.x + i.x;
-}
-
-// Trilinear, clamped at the border (VisibilityVolume::coefficients_at).
-fn volume_coefficients(world: vec3<f32>) -> Sh16 {
-    let last = vec3<f32>(volume.dims.xyz) - vec3<f32>(1.0);
-    let f = clamp((world - volume.origin.xyz) / volume.spacing.x, vec3<f32>(0.0), last);
-    let lower = min(floor(f), max(last - vec3<f32>(1.0), vec3<f32>(0.0)));
-    let w = min(f - lower, vec3<f32>(1.0));
-    let base = vec3<u32>(lower);
-    var out: Sh16;
-    for (var corner = 0u; corner < 8u; corner++) {
-        let bits = vec3<u32>(corner & 1u, (corner >> 1u) & 1u, (corner >> 2u) & 1u);
-        let wb = select(vec3<f32>(1.0) - w, w, bits == vec3<u32>(1u));
-        let weight = wb.x * wb.y * wb.z;
-        if (weight == 0.0) { continue; }
-        let idx = min(base + bits, volume.dims.xyz - vec3<u32>(1u));
-        let v = volume_vertex_index(idx) * 4u;
-        for (var k = 0u; k < 4u; k++) {
-            out.c[k] += weight * volume_sh[v + k];
-        }
-    }
-    return out;
 }
 
 fn sh_basis16(d: vec3<f32>) -> Sh16 {
@@ -87,17 +67,43 @@ fn srbf_band_ratios(lambda_in: f32) -> vec4<f32> {
     return vec4<f32>(1.0, r1, r2, r3);
 }
 
-// The lobe-weighted visibility of the SRBF (ξ, 1/λ) from the point's coefficients, in [0, 1].
-fn volume_lobe_visibility(c: Sh16, xi: vec3<f32>, inv_lambda: f32) -> f32 {
+// The SRBF (ξ, 1/λ) as SH weights: Y_lm(ξ) (i_l/i_0)(λ). Coefficient bands:
+// 0 | 1 1 1 | 2 2 2 2 2 | 3 3 3 3 3 3 3.
+fn lobe_weights(xi: vec3<f32>, inv_lambda: f32) -> Sh16 {
     let r = srbf_band_ratios(1.0 / inv_lambda);
-    let y = sh_basis16(normalize(xi));
-    // Coefficient bands: 0 | 1 1 1 | 2 2 2 2 2 | 3 3 3 3 3 3 3.
-    let b0 = c.c[0] * y.c[0];
-    let b1 = c.c[1] * y.c[1];
-    let b2 = c.c[2] * y.c[2];
-    let b3 = c.c[3] * y.c[3];
-    let v = r.x * b0.x + r.y * (b0.y + b0.z + b0.w)
-        + r.z * (b1.x + b1.y + b1.z + b1.w + b2.x)
-        + r.w * (b2.y + b2.z + b2.w + b3.x + b3.y + b3.z + b3.w);
-    return clamp(v, 0.0, 1.0);
+    var y = sh_basis16(normalize(xi));
+    y.c[0] *= vec4<f32>(r.x, r.y, r.y, r.y);
+    y.c[1] *= vec4<f32>(r.z);
+    y.c[2] *= vec4<f32>(r.z, r.w, r.w, r.w);
+    y.c[3] *= vec4<f32>(r.w);
+    return y;
+}
+
+// The smallest visibility a vertex brings to the logarithmic blend (visibility/volume.rs,
+// MIN_VERTEX_VISIBILITY).
+const MIN_VERTEX_VISIBILITY: f32 = 1.2e-4;
+
+// The lobe-weighted visibility of the SRBF (ξ, 1/λ) at `world`, in [0, 1]: the vertices'
+// visibilities blended trilinearly in the logarithm, clamped at the border as
+// volume_vertex_index's callers (VisibilityVolume::lobe_visibility).
+fn volume_lobe_visibility(world: vec3<f32>, xi: vec3<f32>, inv_lambda: f32) -> f32 {
+    let y = lobe_weights(xi, inv_lambda);
+    let last = vec3<f32>(volume.dims.xyz) - vec3<f32>(1.0);
+    let f = clamp((world - volume.origin.xyz) / volume.spacing.x, vec3<f32>(0.0), last);
+    let lower = min(floor(f), max(last - vec3<f32>(1.0), vec3<f32>(0.0)));
+    let w = min(f - lower, vec3<f32>(1.0));
+    let base = vec3<u32>(lower);
+    var log_v = 0.0;
+    for (var corner = 0u; corner < 8u; corner++) {
+        let bits = vec3<u32>(corner & 1u, (corner >> 1u) & 1u, (corner >> 2u) & 1u);
+        let wb = select(vec3<f32>(1.0) - w, w, bits == vec3<u32>(1u));
+        let weight = wb.x * wb.y * wb.z;
+        if (weight == 0.0) { continue; }
+        let idx = min(base + bits, volume.dims.xyz - vec3<u32>(1u));
+        let v = volume_vertex_index(idx) * 4u;
+        let d = dot(volume_sh[v], y.c[0]) + dot(volume_sh[v + 1u], y.c[1])
+            + dot(volume_sh[v + 2u], y.c[2]) + dot(volume_sh[v + 3u], y.c[3]);
+        log_v += weight * log(clamp(d, MIN_VERTEX_VISIBILITY, 1.0));
+    }
+    return exp(log_v);
 }
