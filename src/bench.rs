@@ -111,14 +111,15 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     // The page's generated section is brown's; a run of another melanin keeps its own page.
     let own_page = quick || report.plan.preset != "brown";
     let out = args.out.clone().unwrap_or_else(|| {
-        PathBuf::from(match report.plan.name.as_str() {
-            "quick" => "out/bench-quick".into(),
-            "truth" if report.plan.preset != "brown" => {
-                format!("docs/bench-truth-{}", report.plan.preset)
-            }
-            "truth" => "docs/bench-truth".into(),
-            _ => "docs/bench".to_string(),
-        })
+        let folder = match report.plan.name.as_str() {
+            "quick" => return PathBuf::from("out/bench-quick"),
+            "truth" => "docs/bench-truth",
+            _ => "docs/bench",
+        };
+        match report.plan.preset.as_str() {
+            "brown" => PathBuf::from(folder),
+            other => PathBuf::from(format!("{folder}-{other}")),
+        }
     });
     std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
     let plots = plots_dir(&out);

@@ -1167,7 +1167,8 @@ fn fits(
 }
 
 fn tables(plan: &BenchPlan, scratch: &Path, steps: &mut Steps) -> anyhow::Result<Vec<TablePoint>> {
-    let fiber = FiberDescription::preset("brown").context("the brown preset")?;
+    let fiber = FiberDescription::preset(&plan.preset)
+        .with_context(|| format!("the {} preset", plan.preset))?;
     let mut out = Vec::new();
     for &nodes in &plan.table_nodes {
         let dir = scratch.join(format!("tables-{nodes}"));

@@ -341,12 +341,13 @@ pub fn section(report: &BenchReport, page_dir: &str) -> String {
     };
     let _ = writeln!(
         out,
-        "{BEGIN}\n## Speed against error (`strandlight bench{heading_args}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `brown` Marschner fiber at {}×{} with the default front camera and {}; errors are over the reference's hair pixels (compact sources exact, the rest one light per cube texel; the reference climbs N = 96, 384, … until N and 4N lights agree within 1% relative RMSE, {budget}: each map below says whether it converged); ms are frame times on {timed_on}, {} (lavapipe: ratios only).\n",
+        "{BEGIN}\n## Speed against error (`strandlight bench{heading_args}`)\n\nGenerated {} at git revision {} on {}; adapter {}; {:.0} s in all. {regenerate} (needs `../shared/data`; skips with a message without it). Everything is straight.hair under the `{}` Marschner fiber at {}×{} with the default front camera and {}; errors are over the reference's hair pixels (compact sources exact, the rest one light per cube texel; the reference climbs N = 96, 384, … until N and 4N lights agree within 1% relative RMSE, {budget}: each map below says whether it converged); ms are frame times on {timed_on}, {} (lavapipe: ratios only).\n",
         report.date,
         report.git_revision,
         report.machine,
         report.adapter,
         report.seconds,
+        plan.preset,
         plan.size.0,
         plan.size.1,
         view_phrase(plan.transparency),
