@@ -15,7 +15,7 @@
 use glam::{DVec3, Vec3};
 use std::path::{Path, PathBuf};
 use strandlight_eval::ground_truth::mitsuba_scene::{MitsubaRun, MitsubaScene};
-use strandlight_eval::ground_truth::{INSTALL_HINT, TruthInputs, TruthScene, render_cached};
+use strandlight_eval::ground_truth::{TruthInputs, TruthScene, render_cached};
 use strandlight_eval::reference_cache::ReferenceCache;
 use strandlight_precompute::EnvMap;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
@@ -26,7 +26,7 @@ use strandlight_runtime::hair::{
     Attribute, GroomParams, HairModel, HairWriteOptions, generate_groom, write_hair,
 };
 use strandlight_scene::camera_choice::front_camera;
-use strandlight_scene::env_frame::{EnvFrame, FrameRole, env_adapter, render_lights};
+use strandlight_scene::env_frame::{EnvFrame, FrameRole, render_lights};
 use strandlight_scene::env_lighting::EnvLighting;
 use strandlight_scene::env_orientation::EnvOrientation;
 use strandlight_scene::env_scene::{AlsoServe, prepare_env};
@@ -39,19 +39,6 @@ use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode, SceneTables, bake_scene_tables};
 use strandlight_scene::steps::Steps;
 use strandlight_tables::image_out::write_exr;
-use strandlight_tables::outside_tools::{require_python_modules, skip_or_fail};
-
-/// Mitsuba and a GPU device, or the reason to skip (printed).
-fn tools() -> bool {
-    if !require_python_modules(&["mitsuba"], INSTALL_HINT) {
-        return false;
-    }
-    if let Err(e) = env_adapter() {
-        skip_or_fail(&format!("no GPU device for the env-lit renderer: {e:#}"));
-        return false;
-    }
-    true
-}
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("strandlight-truth-{name}-{}", std::process::id()));
@@ -211,7 +198,7 @@ fn silhouette_iou(a: &Image, b: &Image, flip_x: bool, flip_y: bool) -> (f64, usi
 /// not match).
 #[test]
 fn the_silhouettes_match() {
-    if !tools() {
+    if !crate::mitsuba_and_gpu() {
         return;
     }
     let dir = scratch("silhouette");
@@ -323,7 +310,7 @@ fn fine_groom() -> HairModel {
 /// centroid less the coverage centroid), agree on it, and carry the same light.
 #[test]
 fn one_bright_texel_lights_the_same_side_through_the_fit_at_any_rotation_and_up_axis() {
-    if !tools() {
+    if !crate::mitsuba_and_gpu() {
         return;
     }
     let dir = scratch("texel");
@@ -495,7 +482,7 @@ fn truth_of(settings: &FrameSettings, dir: &Path) -> Image {
 /// do not occlude rays leaving their own inside.
 #[test]
 fn one_fiber_under_one_directional_light() {
-    if !tools() {
+    if !crate::mitsuba_and_gpu() {
         return;
     }
     let dir = scratch("fiber");

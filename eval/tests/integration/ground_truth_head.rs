@@ -17,7 +17,7 @@
 use glam::{DVec3, Vec3};
 use std::path::PathBuf;
 use strandlight_eval::ground_truth::mitsuba_scene::{MitsubaRun, MitsubaScene};
-use strandlight_eval::ground_truth::{INSTALL_HINT, TruthInputs, render_cached};
+use strandlight_eval::ground_truth::{TruthInputs, render_cached};
 use strandlight_eval::reference_cache::ReferenceCache;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_runtime::env_light::EnvLight;
@@ -25,13 +25,12 @@ use strandlight_runtime::hair::{Attribute, GroomParams, HairModel, generate_groo
 use strandlight_runtime::head::Head;
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_scene::camera_choice::front_camera;
-use strandlight_scene::env_frame::{EnvFrame, FrameRole, env_adapter, render_lights};
+use strandlight_scene::env_frame::{EnvFrame, FrameRole, render_lights};
 use strandlight_scene::env_orientation::EnvOrientation;
 use strandlight_scene::head_input::{HeadChoice, load_head};
 use strandlight_scene::image_metrics::Image;
 use strandlight_scene::look::{EnvLook, LookArgs};
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode, SceneTables, bake_scene_tables};
-use strandlight_tables::outside_tools::{require_python_modules, skip_or_fail};
 
 const SIZE: (u32, u32) = (48, 36);
 const SKIN: [f32; 3] = [0.6, 0.45, 0.35];
@@ -46,17 +45,6 @@ const SHADOW_TOLERANCE: f64 = 0.25;
 /// self-shadowing by less than a percent (at the default 512², the hair out of the head's shadow
 /// kept 0.872 of its light with the head).
 const DODM_RESOLUTION: u32 = 2048;
-
-fn tools() -> bool {
-    if !require_python_modules(&["mitsuba"], INSTALL_HINT) {
-        return false;
-    }
-    if let Err(e) = env_adapter() {
-        skip_or_fail(&format!("no GPU device for the env-lit renderer: {e:#}"));
-        return false;
-    }
-    true
-}
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("strandlight-head-{name}-{}", std::process::id()));
@@ -136,7 +124,7 @@ fn eye_ray(hair: &HairModel, x: usize, y: usize) -> (Vec3, Vec3) {
 
 #[test]
 fn mitsuba_draws_and_shadows_the_head_where_the_geometry_says() {
-    if !tools() {
+    if !crate::mitsuba_and_gpu() {
         return;
     }
     let dir = scratch("truth");

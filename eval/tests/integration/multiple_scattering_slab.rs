@@ -23,32 +23,20 @@
 use glam::{DVec3, Vec3};
 use std::path::{Path, PathBuf};
 use strandlight_eval::ground_truth::mitsuba_scene::{MitsubaRun, MitsubaScene};
-use strandlight_eval::ground_truth::{INSTALL_HINT, TruthInputs, render_cached};
+use strandlight_eval::ground_truth::{TruthInputs, render_cached};
 use strandlight_eval::reference_cache::ReferenceCache;
 use strandlight_precompute::bake_plan::{BakeResolution, FiberDescription};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::hair::{Attribute, HairModel};
 use strandlight_scene::camera_choice::front_camera;
-use strandlight_scene::env_frame::{EnvFrame, FrameRole, env_adapter, render_lights};
+use strandlight_scene::env_frame::{EnvFrame, FrameRole, render_lights};
 use strandlight_scene::env_orientation::EnvOrientation;
 use strandlight_scene::image_metrics::Image;
 use strandlight_scene::look::LookArgs;
 use strandlight_scene::scene_tables::{
     EnvShading, ScatteringMode, SceneTables, bake_scene_tables, wanted_tables,
 };
-use strandlight_tables::outside_tools::{require_python_modules, skip_or_fail};
 use strandlight_tables::split_mix::SplitMix64;
-
-fn tools() -> bool {
-    if !require_python_modules(&["mitsuba"], INSTALL_HINT) {
-        return false;
-    }
-    if let Err(e) = env_adapter() {
-        skip_or_fail(&format!("no GPU device for the env-lit renderer: {e:#}"));
-        return false;
-    }
-    true
-}
 
 /// A slab of `per_cm2` straight vertical fibers per cm² of its (x, z) cross-section, each of
 /// `diameter` cm, `width` × `height` × `depth` cm, centred on the origin.
@@ -235,7 +223,7 @@ const DENSITY_TOLERANCE: f64 = 0.05;
 
 #[test]
 fn a_slab_of_fibers_scatters_as_the_path_tracer_says() {
-    if !tools() {
+    if !crate::mitsuba_and_gpu() {
         return;
     }
     let dir = scratch();
