@@ -13,6 +13,7 @@ use strandlight_scene::frame_render::{
     FrameDetails, FramePart, Prepared, load_settings_hair, render_frame,
 };
 use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting};
+use strandlight_scene::head_input::HeadChoice;
 use strandlight_scene::look::EnvTransparency;
 use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
@@ -24,6 +25,11 @@ pub const DEMO_ENVIRONMENT: &str = "sun_and_sky";
 pub const ENVMAP_DIR: &str = "envmaps";
 /// Fiber preset (bright enough that multiple scattering is baked and rendered).
 pub const DEMO_PRESET: &str = "blonde";
+/// The demo's fiber: Chiang's, the model the path-traced truth renders, so the demo shows what
+/// `bench --truth` measures (Marschner's has no path-traced twin).
+pub const DEMO_SHADING: Shading = Shading::Chiang;
+/// The demo's head: the ellipsoid the procedural groom grows from (fitted to its roots).
+pub const DEMO_HEAD: HeadChoice = HeadChoice::Ellipsoid;
 /// Nodes per direction axis of the demo's tables (1/λ gets twice as many): chosen so the bake
 /// fits the two-minute budget on 2 cores (docs/BENCHMARKS.md has the timing and the accuracy).
 pub const DEMO_TABLE_NODES: usize = 32;
@@ -105,14 +111,16 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let out = Path::new(OUT_DIR);
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let description = format!(
-        "strandlight demo: procedural groom under procedural:{DEMO_ENVIRONMENT}, {}, Marschner ({DEMO_PRESET}), {} scattering",
+        "strandlight demo: {} under procedural:{DEMO_ENVIRONMENT}, {}, {DEMO_SHADING:?} ({DEMO_PRESET}), {} scattering",
+        hair.source,
         light_summary(lights),
         mode.name()
     );
     let (exr, png) = (out.join("demo.exr"), out.join("demo.png"));
     let image = &rendered.image;
     write_exr(&exr, image.width, image.height, &image.pixels, &description)?;
-    // Metered on the hair, as the viewer and `render` do: the sun and sky would wash it out.
+    // Metered on the hair and skin, as the viewer and `render` do: the sun and sky would wash
+    // them out.
     let stops = Exposure::Auto.stops_for(&image.pixels);
     write_png_exposed(
         &png,
@@ -137,8 +145,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The demo as frame settings: the procedural groom framed from the front, Marschner
-/// `DEMO_PRESET` fibers, single and multiple scattering under the map at `map`.
+/// The demo as frame settings: the procedural groom's default style on its head, framed from
+/// the front, `DEMO_SHADING` `DEMO_PRESET` fibers, single and multiple scattering under the map
+/// at `map`.
 fn demo_settings(map: &str, transparency: EnvTransparency) -> FrameSettings {
     let lighting = EnvLighting {
         scattering: ScatteringMode::Full,
@@ -147,8 +156,9 @@ fn demo_settings(map: &str, transparency: EnvTransparency) -> FrameSettings {
         ..EnvLighting::new(map)
     };
     FrameSettings {
-        shading: Some(Shading::Marschner),
+        shading: Some(DEMO_SHADING),
         preset: DEMO_PRESET.into(),
+        head: DEMO_HEAD,
         ..FrameSettings::new(Lighting::Environment(lighting), [DEMO_SIZE.0, DEMO_SIZE.1])
     }
 }

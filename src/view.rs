@@ -14,7 +14,7 @@ use crate::demo::{DEMO_ENVIRONMENT, DEMO_PRESET};
 
 #[derive(Args, Debug)]
 pub struct ViewArgs {
-    /// Hair file (.hair, .tfx, .data, .ply, USD .usda/.usdc/.usdz BasisCurves, Alembic .abc ICurves); the procedural groom when omitted.
+    /// Hair file (.hair, .tfx, .data, .ply, USD .usda/.usdc/.usdz BasisCurves, Alembic .abc ICurves) or procedural:STYLE (straight-long, wavy-bob, curly); the procedural groom's straight-long when omitted.
     #[arg(long)]
     hair: Option<PathBuf>,
     /// Environment map (.hdr/.exr or procedural:NAME); the demo's sun and sky by default.
@@ -23,7 +23,7 @@ pub struct ViewArgs {
     /// Point-light mode instead: repeatable, as `render lights --light`.
     #[arg(long = "light")]
     lights: Vec<String>,
-    /// Fiber model (default: marschner under an environment, kajiya-kay under lights).
+    /// Fiber model (default: chiang under an environment, kajiya-kay under lights).
     #[arg(long, value_enum)]
     shading: Option<Shading>,
     #[arg(long, default_value = DEMO_PRESET)]
@@ -32,7 +32,7 @@ pub struct ViewArgs {
     scattering: ScatteringMode,
     /// The head the hair grows from: none, ellipsoid (fitted to the strand roots) or a mesh
     /// FILE (.obj, .glb, .gltf, .usd, .usda, .usdc, .usdz).
-    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE")]
+    #[arg(long, default_value = "ellipsoid", value_name = "none|ellipsoid|FILE")]
     head: HeadChoice,
     /// Image size WxH in pixels (the window shows it scaled to fit).
     #[arg(long, default_value = "640x480")]

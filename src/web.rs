@@ -2,7 +2,7 @@
 //! in a browser through WebGPU — the page's wasm module and glue, its HTML, and the bundle of
 //! `strandlight_scene::web_bundle`. `strandlight serve` serves a folder on localhost.
 
-use crate::demo::{CACHE_DIR, DEMO_ENVIRONMENT, DEMO_PRESET, ENVMAP_DIR};
+use crate::demo::{CACHE_DIR, DEMO_ENVIRONMENT, DEMO_HEAD, DEMO_PRESET, DEMO_SHADING, ENVMAP_DIR};
 use anyhow::Context;
 use std::path::{Path, PathBuf};
 use strandlight_runtime::hair::yuksel::{HairWriteOptions, encode_hair};
@@ -11,7 +11,6 @@ use strandlight_scene::environment::ensure_procedural_envmap;
 use strandlight_scene::frame_render::load_settings_hair;
 use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting};
 use strandlight_scene::look::{ForwardDevice, LobeVisibilityArg};
-use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 use strandlight_scene::web_bundle::{
@@ -139,8 +138,9 @@ fn web_settings() -> anyhow::Result<FrameSettings> {
     lighting.view.lobe_visibility = LobeVisibilityArg::LightMaps;
     lighting.view.forward_scattering = ForwardDevice::Gpu;
     Ok(FrameSettings {
-        shading: Some(Shading::Marschner),
+        shading: Some(DEMO_SHADING),
         preset: DEMO_PRESET.into(),
+        head: DEMO_HEAD,
         ..FrameSettings::new(Lighting::Environment(lighting), [640, 480])
     })
 }

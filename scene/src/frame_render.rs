@@ -12,7 +12,7 @@ use crate::env_scene::PreparedEnv;
 use crate::frame_settings::{
     EnvLighting, FrameSettings, Lighting, PointLighting, Shadows, Transparency,
 };
-use crate::hair_input::{OPAQUE_FIBERS, fibers_for, load_hair};
+use crate::hair_input::{OPAQUE_FIBERS, fibers_for, load_hair, procedural_style};
 use crate::head_input::load_head;
 use crate::image_metrics::Image;
 use crate::look::EnvLook;
@@ -49,7 +49,11 @@ pub struct FrameHair {
 /// it: `render` must reproduce the frames they measure.
 pub fn load_settings_hair(settings: &FrameSettings) -> anyhow::Result<FrameHair> {
     let (model, source) = load_hair(settings.hair.as_deref())?;
-    let content = match &settings.hair {
+    let file = match &settings.hair {
+        Some(path) if procedural_style(path)?.is_none() => Some(path),
+        _ => None,
+    };
+    let content = match file {
         Some(path) => {
             sha256_hex(&std::fs::read(path).with_context(|| format!("--hair {}", path.display()))?)
         }

@@ -20,12 +20,13 @@ use strandlight_tables::artist::{ArtistModel, ArtistParams};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct FrameSettings {
-    /// Hair file; None: the procedural groom.
+    /// Hair file or `procedural:STYLE`; None: the procedural groom's default style.
     pub hair: Option<PathBuf>,
     /// Width and height in pixels.
     pub size: [u32; 2],
     pub camera: CameraSettings,
-    /// Fiber model; None: Kajiya-Kay under point lights, Marschner under an environment.
+    /// Fiber model; None: Kajiya-Kay under point lights, Chiang (the path-traced truth's fiber)
+    /// under an environment. Settings written before 6 Dec 2026 with None were Marschner's.
     pub shading: Option<Shading>,
     /// Melanin preset of the Marschner fiber (and the fiber whose tables an environment bakes).
     pub preset: String,
@@ -344,7 +345,7 @@ impl FrameSettings {
     pub fn shading(&self) -> Shading {
         self.shading.unwrap_or(match self.lighting {
             Lighting::Lights(_) => Shading::KajiyaKay,
-            Lighting::Environment(_) => Shading::Marschner,
+            Lighting::Environment(_) => Shading::Chiang,
         })
     }
 

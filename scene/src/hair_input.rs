@@ -1,15 +1,51 @@
-//! A scene's hair and image size as a user names them: a hair file (or the procedural groom when
-//! none is given) and `WxH`.
+//! A scene's hair and image size as a user names them: a hair file or a procedural groom
+//! (`procedural:NAME`; the default style when none is given) and `WxH`.
 
 use crate::point_shading::Shading;
 use anyhow::{Context, bail};
 use std::path::Path;
-use strandlight_runtime::hair::{self, GroomParams, HairModel};
+use strandlight_runtime::hair::{self, GroomStyle, HairModel};
 
-/// The hair file at `path` (format by extension, see [`hair::EXTENSIONS`]), or the procedural
-/// groom, with a description. A scene file's description says what was read and how it was
-/// converted (prims, units, up axis, values dropped), since a user cannot see that in the picture.
+/// What names a procedural groom's style where a hair file could stand (as `procedural:NAME`
+/// names a built-in environment map).
+pub const PROCEDURAL_PREFIX: &str = "procedural:";
+
+/// The groom style `path` names (`procedural:NAME`), or None for a file.
+pub fn procedural_style(path: &Path) -> anyhow::Result<Option<GroomStyle>> {
+    let Some(name) = path
+        .to_str()
+        .and_then(|p| p.strip_prefix(PROCEDURAL_PREFIX))
+    else {
+        return Ok(None);
+    };
+    match GroomStyle::named(name) {
+        Some(style) => Ok(Some(style)),
+        None => bail!(
+            "--hair {}: no procedural groom called {name:?}; the styles are {}",
+            path.display(),
+            GroomStyle::ALL
+                .map(|s| format!("{PROCEDURAL_PREFIX}{}", s.name()))
+                .join(", ")
+        ),
+    }
+}
+
+/// The procedural groom of `style`, with its description.
+fn procedural_groom(style: GroomStyle) -> anyhow::Result<(HairModel, String)> {
+    Ok((
+        hair::generate_groom(&style.params())?,
+        format!("procedural groom ({PROCEDURAL_PREFIX}{})", style.name()),
+    ))
+}
+
+/// The hair file at `path` (format by extension, see [`hair::EXTENSIONS`]) or procedural groom
+/// it names (the default style when None), with a description. A scene file's description says
+/// what was read and how it was converted (prims, units, up axis, values dropped), since a user
+/// cannot see that in the picture.
 pub fn load_hair(path: Option<&Path>) -> anyhow::Result<(HairModel, String)> {
+    if let Some(style) = path.map(procedural_style).transpose()?.flatten() {
+        return procedural_groom(style);
+    }
     match path {
         Some(path) => {
             let loaded = hair::load(path)?;
@@ -24,10 +60,7 @@ pub fn load_hair(path: Option<&Path>) -> anyhow::Result<(HairModel, String)> {
             };
             Ok((loaded.model, source))
         }
-        None => Ok((
-            hair::generate_groom(&GroomParams::default())?,
-            "procedural groom (default parameters)".to_string(),
-        )),
+        None => procedural_groom(GroomStyle::default()),
     }
 }
 
@@ -73,5 +106,32 @@ pub fn fibers_for(
     match opaque_if_physical(shading, hair) {
         (hair, true) => (hair, format!("{sha256}{OPAQUE_FIBERS}")),
         (hair, false) => (hair, sha256),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use strandlight_runtime::hair::generate_groom;
+
+    #[test]
+    fn procedural_names_a_style_and_a_wrong_name_lists_them() {
+        let (curly, source) = load_hair(Some(Path::new("procedural:curly"))).unwrap();
+        assert_eq!(curly, generate_groom(&GroomStyle::Curly.params()).unwrap());
+        assert!(source.contains("procedural:curly"), "{source}");
+        let (default, _) = load_hair(None).unwrap();
+        assert_eq!(
+            default,
+            generate_groom(&GroomStyle::default().params()).unwrap()
+        );
+        // A file is not a style, whatever its name.
+        assert_eq!(procedural_style(Path::new("curly.hair")).unwrap(), None);
+        let error = load_hair(Some(Path::new("procedural:mohawk")))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("mohawk") && error.contains("procedural:wavy-bob"),
+            "{error}"
+        );
     }
 }

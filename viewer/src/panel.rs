@@ -7,11 +7,12 @@ use crate::recompute::{Backdrop, Recompute, ViewState};
 use crate::worker::Status;
 use egui_file_dialog::FileDialog;
 use std::path::PathBuf;
-use strandlight_runtime::hair;
+use strandlight_runtime::hair::{self, GroomStyle};
 use strandlight_runtime::passes::deep_opacity::MAX_LAYERS;
 use strandlight_scene::frame_settings::{
     EnvLighting, Lighting, PointLighting, Shadows, Transparency,
 };
+use strandlight_scene::hair_input::{PROCEDURAL_PREFIX, procedural_style};
 use strandlight_scene::head_input::HeadChoice;
 use strandlight_scene::look::{EnvTransparency, LobeVisibilityArg};
 use strandlight_scene::point_shading::Shading;
@@ -97,9 +98,10 @@ impl Panel {
         ui.heading("Scene");
         ui.label(format!(
             "hair: {}",
-            s.hair
-                .as_ref()
-                .map_or("procedural groom".into(), |p| p.display().to_string())
+            s.hair.as_ref().map_or(
+                format!("{PROCEDURAL_PREFIX}{}", GroomStyle::default().name()),
+                |p| { p.display().to_string() }
+            )
         ));
         ui.horizontal(|ui| {
             if ui.button("Open hair or map…").clicked() {
@@ -116,11 +118,10 @@ impl Panel {
                 dialog.pick_file();
                 self.dialog = Some(dialog);
             }
-            if ui.button("Procedural groom").clicked() {
-                s.hair = None;
-                outcome.reset_camera = true;
-            }
         });
+        if groom_style(ui, &mut s.hair) {
+            outcome.reset_camera = true;
+        }
         ui.small(
             "or drop a .hair/.tfx/.data/.ply/.usd*/.abc, .hdr/.exr or head .obj file on the window",
         );
@@ -152,6 +153,29 @@ impl Panel {
             });
         ui.separator();
     }
+}
+
+/// The procedural groom's style (`procedural:NAME`); true when the user picked one.
+fn groom_style(ui: &mut egui::Ui, hair: &mut Option<PathBuf>) -> bool {
+    let current = match hair {
+        None => Some(GroomStyle::default()),
+        Some(path) => procedural_style(path).ok().flatten(),
+    };
+    let mut picked = false;
+    egui::ComboBox::from_label("procedural groom")
+        .selected_text(current.map_or("(a file)", GroomStyle::name))
+        .show_ui(ui, |ui| {
+            for style in GroomStyle::ALL {
+                if ui
+                    .selectable_label(current == Some(style), style.name())
+                    .clicked()
+                {
+                    *hair = Some(format!("{PROCEDURAL_PREFIX}{}", style.name()).into());
+                    picked = true;
+                }
+            }
+        });
+    picked
 }
 
 /// The head the hair grows from: none, the ellipsoid fitted to the roots, or the mesh the flags or

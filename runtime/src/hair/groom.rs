@@ -1,8 +1,8 @@
 //! The project's own default hair: a procedural groom grown from a scalp.
 //!
 //! Roots are scattered over the top of an ellipsoid (a cap, with a higher hairline over the
-//! face at +z). Each strand grows from its root along the scalp normal and bends toward −y
-//! (gravity) as it goes; a helix around that curve gives waves or curls; strands are pulled
+//! face at +z). Each strand leaves its root combed away from the crown whorl, or from a parting
+//! (then back, off the face), and bends toward −y (gravity) as it goes; a helix around that curve gives waves or curls; strands are pulled
 //! toward the strand at the centre of their clump, more toward the tip; finally the shape is
 //! traced again with "follow the leader" steps of exactly `length / (points − 1)`, which makes
 //! each strand exactly its drawn length and, with the scalp as a convex collider, keeps every
@@ -92,6 +92,10 @@ pub struct GroomParams {
     pub gravity: f32,
     /// Root thickness; strands taper to 30 % of it at the tip.
     pub thickness: f32,
+    /// A parting running from the front hairline to the crown at this x on the unit scalp
+    /// (−1 ear to +1 ear; 0 a centre parting): hair on top flows away from it and back, off
+    /// the face. None: every strand flows away from the crown whorl (the front falls forward).
+    pub parting: Option<f32>,
     pub seed: u64,
 }
 
@@ -116,6 +120,7 @@ impl Default for GroomParams {
             clump_strength: 0.5,
             gravity: 0.85,
             thickness: 0.008,
+            parting: None,
             seed: 1,
         }
     }
@@ -133,26 +138,128 @@ impl GroomParams {
         let points = self.points_per_strand as f64;
         type Check<'a> = (&'static str, f64, &'a dyn Fn(f64) -> bool, &'static str);
         #[rustfmt::skip]
-        let checks: [Check; 19] = [
-            ("scalp.center.x", c.x as f64, &within(-SIZE, SIZE), "must be in [-1e6, 1e6]"),
-            ("scalp.center.y", c.y as f64, &within(-SIZE, SIZE), "must be in [-1e6, 1e6]"),
-            ("scalp.center.z", c.z as f64, &within(-SIZE, SIZE), "must be in [-1e6, 1e6]"),
-            ("scalp.radii.x", r.x as f64, &above(0.0, SIZE), "must be in (0, 1e6]"),
-            ("scalp.radii.y", r.y as f64, &above(0.0, SIZE), "must be in (0, 1e6]"),
-            ("scalp.radii.z", r.z as f64, &above(0.0, SIZE), "must be in (0, 1e6]"),
-            ("scalp.max_polar_angle", scalp.max_polar_angle as f64, &above(0.0, PI), "must be in (0, π]"),
-            ("scalp.front_polar_angle", scalp.front_polar_angle as f64, &above(0.0, PI), "must be in (0, π]"),
-            ("strand_count", strands, &within(1.0, 1e7), "must be in 1..=10,000,000"),
-            ("points_per_strand", points, &within(2.0, 1024.0), "must be in 2..=1024"),
-            ("strand_count × points_per_strand", strands * points, &within(0.0, 1e8), "must be ≤ 1e8"),
-            ("length_min", self.length_min as f64, &above(0.0, SIZE), "must be in (0, 1e6]"),
-            ("length_max", self.length_max as f64, &within(self.length_min as f64, SIZE), "must be in [length_min, 1e6]"),
-            ("curl_radius", self.curl_radius as f64, &within(0.0, SIZE), "must be in [0, 1e6]"),
-            ("curl_frequency", self.curl_frequency as f64, &within(0.0, SIZE), "must be in [0, 1e6]"),
-            ("clump_count", self.clump_count as f64, &within(0.0, strands), "must be ≤ strand_count"),
-            ("clump_strength", self.clump_strength as f64, &within(0.0, 1.0), "must be in [0, 1]"),
-            ("gravity", self.gravity as f64, &within(0.0, 1.0), "must be in [0, 1]"),
-            ("thickness", self.thickness as f64, &within(0.0, SIZE), "must be in [0, 1e6]"),
+        let parting = self.parting.unwrap_or(0.0) as f64;
+        let checks: [Check; 20] = [
+            (
+                "scalp.center.x",
+                c.x as f64,
+                &within(-SIZE, SIZE),
+                "must be in [-1e6, 1e6]",
+            ),
+            (
+                "scalp.center.y",
+                c.y as f64,
+                &within(-SIZE, SIZE),
+                "must be in [-1e6, 1e6]",
+            ),
+            (
+                "scalp.center.z",
+                c.z as f64,
+                &within(-SIZE, SIZE),
+                "must be in [-1e6, 1e6]",
+            ),
+            (
+                "scalp.radii.x",
+                r.x as f64,
+                &above(0.0, SIZE),
+                "must be in (0, 1e6]",
+            ),
+            (
+                "scalp.radii.y",
+                r.y as f64,
+                &above(0.0, SIZE),
+                "must be in (0, 1e6]",
+            ),
+            (
+                "scalp.radii.z",
+                r.z as f64,
+                &above(0.0, SIZE),
+                "must be in (0, 1e6]",
+            ),
+            (
+                "scalp.max_polar_angle",
+                scalp.max_polar_angle as f64,
+                &above(0.0, PI),
+                "must be in (0, π]",
+            ),
+            (
+                "scalp.front_polar_angle",
+                scalp.front_polar_angle as f64,
+                &above(0.0, PI),
+                "must be in (0, π]",
+            ),
+            (
+                "strand_count",
+                strands,
+                &within(1.0, 1e7),
+                "must be in 1..=10,000,000",
+            ),
+            (
+                "points_per_strand",
+                points,
+                &within(2.0, 1024.0),
+                "must be in 2..=1024",
+            ),
+            (
+                "strand_count × points_per_strand",
+                strands * points,
+                &within(0.0, 1e8),
+                "must be ≤ 1e8",
+            ),
+            (
+                "length_min",
+                self.length_min as f64,
+                &above(0.0, SIZE),
+                "must be in (0, 1e6]",
+            ),
+            (
+                "length_max",
+                self.length_max as f64,
+                &within(self.length_min as f64, SIZE),
+                "must be in [length_min, 1e6]",
+            ),
+            (
+                "curl_radius",
+                self.curl_radius as f64,
+                &within(0.0, SIZE),
+                "must be in [0, 1e6]",
+            ),
+            (
+                "curl_frequency",
+                self.curl_frequency as f64,
+                &within(0.0, SIZE),
+                "must be in [0, 1e6]",
+            ),
+            (
+                "clump_count",
+                self.clump_count as f64,
+                &within(0.0, strands),
+                "must be ≤ strand_count",
+            ),
+            (
+                "clump_strength",
+                self.clump_strength as f64,
+                &within(0.0, 1.0),
+                "must be in [0, 1]",
+            ),
+            (
+                "gravity",
+                self.gravity as f64,
+                &within(0.0, 1.0),
+                "must be in [0, 1]",
+            ),
+            (
+                "thickness",
+                self.thickness as f64,
+                &within(0.0, SIZE),
+                "must be in [0, 1e6]",
+            ),
+            (
+                "parting",
+                parting,
+                &within(-0.9, 0.9),
+                "must be in [-0.9, 0.9]",
+            ),
         ];
         for (name, value, ok, requirement) in checks {
             check(name, value, ok, requirement)?;
@@ -274,9 +381,13 @@ fn curled_center_line(seed: &StrandSeed, params: &GroomParams) -> Vec<Vec3> {
     let step = seed.length / (n - 1) as f32;
     let normal = params.scalp.normal(seed.root);
     let in_plane = |v: Vec3| v - v.dot(normal) * normal;
-    // Combed hair leaves the scalp at a low angle, flowing away from the crown whorl; a small
-    // random lean keeps neighbours from running exactly parallel.
-    let comb = in_plane(seed.root - params.scalp.crown())
+    // Combed hair leaves the scalp at a low angle, flowing away from the crown whorl or the
+    // parting; a small random lean keeps neighbours from running exactly parallel.
+    let flow = match params.parting {
+        None => seed.root - params.scalp.crown(),
+        Some(parting) => parted_flow(&params.scalp, seed.root, parting),
+    };
+    let comb = in_plane(flow)
         .try_normalize()
         .unwrap_or_else(|| in_plane(seed.lean).normalize_or(normal.any_orthonormal_vector()));
     let start = (comb + ROOT_LIFT * normal + 0.2 * in_plane(seed.lean)).normalize();
@@ -312,6 +423,21 @@ fn curled_center_line(seed: &StrandSeed, params: &GroomParams) -> Vec<Vec3> {
         line[i] += seed.curl_radius * ramp * (angle.cos() * u + angle.sin() * v);
     }
     line
+}
+
+/// Where hair at `root` flows on a parted scalp: away from the parting and back, off the face;
+/// low on the back and sides it hangs as it would from the crown. The weights are chosen by eye
+/// (a head seen from the front shows its face between two curtains of hair).
+fn parted_flow(scalp: &Scalp, root: Vec3, parting: f32) -> Vec3 {
+    let d = ((root - scalp.center) / scalp.radii).normalize_or(Vec3::Y);
+    let side = if d.x >= parting { 1.0 } else { -1.0 };
+    // The nearer the face, the more a strand is swept back.
+    let back = 0.5 + 1.5 * d.z.max(0.0);
+    let parted = Vec3::new(side, 0.0, -back).normalize() * scalp.radii;
+    let from_crown = (root - scalp.crown()).normalize_or(Vec3::NEG_Y) * scalp.radii;
+    // The parting decides on top and over the face; the crown below the back's equator.
+    let top = smoothstep(((d.y + d.z.max(0.0) + 0.2) / 0.8).clamp(0.0, 1.0));
+    parted * top + from_crown * (1.0 - top)
 }
 
 fn smoothstep(x: f32) -> f32 {

@@ -16,6 +16,7 @@ mod clean;
 mod curves;
 mod error;
 pub mod groom;
+mod groom_style;
 #[cfg(feature = "scene-files")]
 pub mod guard;
 mod model;
@@ -35,6 +36,7 @@ pub use alembic::load_alembic;
 pub use clean::{HairFormat, LoadReport, LoadedHair, is_degenerate_segment};
 pub use error::HairError;
 pub use groom::{GroomParams, Scalp, generate_groom};
+pub use groom_style::GroomStyle;
 pub use model::{Aabb, Attribute, AttributeKind, HairModel, HairSummary};
 pub use ply::load_ply;
 pub use tfx::load_tfx;
