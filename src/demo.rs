@@ -1,16 +1,18 @@
 //! `strandlight demo`: the procedural groom under the project's own sun-and-sky environment,
 //! through fit → bake (cached) → environment-lit render with single and multiple scattering,
-//! on a fresh machine with no files of the user's. Writes `out/demo.png` and `out/demo.exr`
-//! and prints each step's time.
+//! on a fresh machine with no files of the user's. Writes a first look from coarse tables
+//! (`out/demo-preview.png`) within seconds, then `out/demo.png` and `out/demo.exr`, and prints
+//! each step's time.
 
 use anyhow::Context;
 use std::path::Path;
+use strandlight_runtime::hair::HairModel;
 use strandlight_scene::env_frame::{env_adapter, light_summary};
 use strandlight_scene::env_scene::{AlsoServe, prepare_env};
 use strandlight_scene::environment::{ensure_procedural_envmap, load_env};
 use strandlight_scene::exposure::{Exposure, exposure_problem};
 use strandlight_scene::frame_render::{
-    FrameDetails, FramePart, Prepared, load_settings_hair, render_frame,
+    FrameDetails, FramePart, Prepared, coarse_preview_settings, load_settings_hair, render_frame,
 };
 use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting};
 use strandlight_scene::head_input::HeadChoice;
@@ -79,6 +81,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         || load_settings_hair(&settings),
         |h| format!("{}, {} strands", h.source, h.model.strand_count()),
     )?;
+    let out = Path::new(OUT_DIR);
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    write_first_look(&settings, &hair.model, &mut steps)?;
     let prepared = prepare_env(
         &settings,
         &hair.model,
@@ -108,8 +113,6 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let FrameDetails::Env { lights, mode, .. } = &rendered.details else {
         anyhow::bail!("the demo is env-lit");
     };
-    let out = Path::new(OUT_DIR);
-    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let description = format!(
         "strandlight demo: {} under procedural:{DEMO_ENVIRONMENT}, {}, {DEMO_SHADING:?} ({DEMO_PRESET}), {} scattering",
         hair.source,
@@ -140,6 +143,60 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         exr.display(),
         png.display(),
         png_tonemap(stops),
+        steps.total_seconds()
+    ));
+    Ok(())
+}
+
+/// Where the first look is written.
+pub const FIRST_LOOK_PNG: &str = "out/demo-preview.png";
+
+/// A first look before the full tables bake: the demo's frame as the viewer previews it (half
+/// size, the strongest lights, single scattering, the nearest fiber) from coarse tables, which
+/// bake in seconds on a cold cache. The full frame follows in `out/demo.png`.
+fn write_first_look(
+    settings: &FrameSettings,
+    hair: &HairModel,
+    steps: &mut Steps,
+) -> anyhow::Result<()> {
+    let coarse = coarse_preview_settings(settings);
+    let prepared = prepare_env(
+        &coarse,
+        hair,
+        Path::new(CACHE_DIR),
+        AlsoServe::default(),
+        steps,
+        &mut |_| {},
+    )?;
+    let preview = steps.run(
+        "first look",
+        || {
+            render_frame(
+                &coarse,
+                hair,
+                Prepared::Env(&prepared),
+                FramePart::Preview,
+                false,
+            )
+        },
+        |r| format!("{:.1} ms/frame", r.milliseconds),
+    )?;
+    let (image, path) = (&preview.image, Path::new(FIRST_LOOK_PNG));
+    let stops = Exposure::Auto.stops_for(&image.pixels);
+    let description = "strandlight demo, first look: coarse tables, single scattering";
+    write_png_exposed(
+        path,
+        image.width,
+        image.height,
+        &image.pixels,
+        stops,
+        description,
+    )?;
+    steps.say(format!(
+        "wrote {} ({}x{}, coarse tables) {:.1} s after the start; the full frame follows",
+        path.display(),
+        image.width,
+        image.height,
         steps.total_seconds()
     ));
     Ok(())

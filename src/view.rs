@@ -3,7 +3,7 @@
 
 use clap::Args;
 use std::path::PathBuf;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting, PointLighting};
 use strandlight_scene::hair_input::parse_size;
 use strandlight_scene::head_input::HeadChoice;
@@ -94,7 +94,9 @@ fn settings(args: &ViewArgs) -> anyhow::Result<FrameSettings> {
 }
 
 pub fn run(args: ViewArgs) -> anyhow::Result<()> {
+    let started = Instant::now();
     strandlight_viewer::run(strandlight_viewer::ViewOptions {
+        started,
         settings: settings(&args)?,
         cache_dir: args.cache,
         script: args.script,

@@ -96,6 +96,7 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
     phase("the scripted window exited");
 
     assert_bakes_ran_while_the_window_presented(&report);
+    assert_lit_before_the_tables_were_baked(&report);
     assert!(lit_share(&dir.join("shot.png")) > 0.02, "blank screenshot");
     assert_readout_beside_the_image(&report);
     assert_window_captures_show_the_screenshots(&report, &dir);
@@ -215,6 +216,14 @@ fn assert_bakes_ran_while_the_window_presented(report: &Value) {
         .as_f64()
         .unwrap();
     assert!(gap < 1500.0, "the window stalled {gap} ms during a bake");
+}
+
+/// On its empty cache the window showed a lit frame drawn with the first look's coarse tables,
+/// before the full ones were baked (how soon is a benchmark figure: scripts/first-minute.sh).
+fn assert_lit_before_the_tables_were_baked(report: &Value) {
+    assert_eq!(report["first_lit_coarse_tables"], json!(true), "{report}");
+    let seconds = report["first_lit_seconds"].as_f64().unwrap();
+    println!("first lit frame {seconds:.2} s after the start, from the coarse tables");
 }
 
 /// The timing readout sits beside the image, so it never covers the hair.

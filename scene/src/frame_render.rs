@@ -264,6 +264,23 @@ pub enum Prepared<'a> {
 pub const PREVIEW_LIGHTS: usize = 8;
 /// The preview's light maps are at most this many texels across.
 pub const PREVIEW_MAP_RESOLUTION: u32 = 128;
+/// Nodes per direction axis of the tables a first look is drawn with while a cold cache bakes
+/// the full ones: single scattering's tables bake in seconds, and the preview they draw is
+/// 0.049 from the one of the demo's 32-node tables (relative RMSE over the hair; 6 nodes 0.072,
+/// 12 nodes 0.022: docs/BENCHMARKS.md, "The first look").
+pub const PREVIEW_TABLE_NODES: usize = 8;
+
+/// `settings` as a first look draws them on a cold cache ([`FramePart::Preview`]): an
+/// environment's single scattering from tables of [`PREVIEW_TABLE_NODES`] nodes (cached apart
+/// from the full ones). Point lights have no tables to wait for: unchanged.
+pub fn coarse_preview_settings(settings: &FrameSettings) -> FrameSettings {
+    let mut coarse = settings.clone();
+    if let Lighting::Environment(env) = &mut coarse.lighting {
+        env.scattering = ScatteringMode::Single;
+        env.table_resolution = Some(PREVIEW_TABLE_NODES);
+    }
+    coarse
+}
 
 /// Which part of a settings' frame to render.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -94,7 +94,7 @@ pub const MULTIPLE_TABLES: [&str; 4] = [
     "srbf_spread",
 ];
 
-/// The tables a frame in any of `modes` may read: the multiple-scattering tables, the SRBF
+/// The tables a frame in any of `modes` may read: the multiple-scattering tables (full mode), the SRBF
 /// tables and, with `directional` lights (baselines, references, a fit's compact sources), the
 /// direct tables.
 pub fn wanted_tables(
@@ -103,7 +103,11 @@ pub fn wanted_tables(
     srbf: bool,
     directional: bool,
 ) -> Vec<&'static str> {
-    let mut wanted: Vec<&str> = MULTIPLE_TABLES.to_vec();
+    // Only the full mode reads them (a single-scattering first look bakes in half the time).
+    let mut wanted: Vec<&str> = match modes.contains(&ScatteringMode::Full) {
+        true => MULTIPLE_TABLES.to_vec(),
+        false => Vec::new(),
+    };
     for &mode in modes {
         if srbf {
             wanted.push(shading.srbf_table(mode));

@@ -37,6 +37,8 @@ pub struct ViewOptions {
     pub report: Option<PathBuf>,
     /// A scripted run that has not finished by then fails.
     pub timeout: Duration,
+    /// When the command started: the report's first lit frame counts from here.
+    pub started: Instant,
 }
 
 /// Opens the window and runs until it is closed or the script ends.
@@ -413,7 +415,12 @@ impl ApplicationHandler for App {
                 gpu.window.request_redraw();
                 self.window = Some(gpu);
                 let worker = self.worker.take().expect("the worker starts once");
-                self.session = Some(Session::new(self.options.settings.clone(), worker, adapter));
+                self.session = Some(Session::new(
+                    self.options.settings.clone(),
+                    worker,
+                    adapter,
+                    self.options.started,
+                ));
             }
             Err(e) => {
                 self.outcome = Err(e.context("opening the window"));

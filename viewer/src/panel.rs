@@ -505,10 +505,10 @@ pub fn readout(ui: &mut egui::Ui, status: &Status, exposure: Option<f32>) {
                 Stage::Refining { done, total } => format!("refining {done}/{total}"),
                 Stage::Converged => "converged".to_string(),
             },
-            if shown.stale_tables {
-                " (previous tables)"
-            } else {
-                ""
+            match (shown.coarse_tables, shown.stale_tables) {
+                (true, _) => " (coarse tables while the full ones bake)",
+                (false, true) => " (previous tables)",
+                (false, false) => "",
             }
         ),
     ];

@@ -37,6 +37,10 @@ pub struct SessionReport {
     pub bakes_seen: u64,
     /// Per request that converged: seconds to its preview and to the converged image.
     pub requests: Vec<RequestTiming>,
+    /// Seconds from the command's start to the first presented frame with a rendered image,
+    /// and whether that image came from the first look's coarse tables (a cold cache).
+    pub first_lit_seconds: Option<f64>,
+    pub first_lit_coarse_tables: Option<bool>,
     pub screenshots: Vec<PathBuf>,
     /// Captures of the whole window (panel included), one per screenshot.
     pub window_captures: Vec<PathBuf>,
@@ -73,6 +77,8 @@ struct OnScreen {
     texture: egui::TextureHandle,
     job: u64,
     stage: Stage,
+    /// Lit by the first look's coarse tables.
+    coarse_tables: bool,
     display: Display,
     image: Arc<Image>,
     exposure_stops: f32,
@@ -80,6 +86,8 @@ struct OnScreen {
 }
 
 pub struct Session {
+    /// When the command started (`ViewOptions::started`).
+    started: Instant,
     pub state: ViewState,
     submitted: Option<(u64, FrameSettings)>,
     edited_at: Instant,
@@ -115,8 +123,14 @@ struct BackgroundKey {
 }
 
 impl Session {
-    pub fn new(settings: FrameSettings, worker: Worker, window_adapter: String) -> Self {
+    pub fn new(
+        settings: FrameSettings,
+        worker: Worker,
+        window_adapter: String,
+        started: Instant,
+    ) -> Self {
         Self {
+            started,
             last_good: settings.clone(),
             state: ViewState {
                 settings,
@@ -183,6 +197,12 @@ impl Session {
     /// Counts a presented frame.
     pub fn presented(&mut self) {
         let now = Instant::now();
+        if self.report.first_lit_seconds.is_none()
+            && let Some(on_screen) = &self.on_screen
+        {
+            self.report.first_lit_seconds = Some(now.duration_since(self.started).as_secs_f64());
+            self.report.first_lit_coarse_tables = Some(on_screen.coarse_tables);
+        }
         let baking = self.worker.status().bake.is_some();
         if let Some(last) = self.last_present {
             let gap = now.duration_since(last).as_secs_f64() * 1e3;
@@ -438,6 +458,7 @@ impl Session {
             texture,
             job: shown.job,
             stage: shown.stage,
+            coarse_tables: shown.coarse_tables,
             display: self.state.display,
             image,
             exposure_stops: stops,
