@@ -30,8 +30,8 @@ fn every_target_has_a_test_here() {
     assert_eq!(
         names,
         [
-            "hair", "tfx", "data", "ply", "hdr", "exr", "sltab", "srbf", "usda", "abc", "glb",
-            "gltf"
+            "hair", "tfx", "data", "ply", "hdr", "exr", "sltab", "srbf", "usda", "usdc", "usdz",
+            "abc", "glb", "gltf"
         ]
     );
 }
@@ -149,6 +149,16 @@ fn fuzz_scene_target(name: &str) {
 #[test]
 fn usda() {
     fuzz_scene_target("usda");
+}
+
+#[test]
+fn usdc() {
+    fuzz_scene_target("usdc");
+}
+
+#[test]
+fn usdz() {
+    fuzz_scene_target("usdz");
 }
 
 #[test]

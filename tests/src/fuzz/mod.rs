@@ -59,8 +59,8 @@ const JUNK_MAX: usize = 512;
 const JUNK_EVERY: usize = 16;
 /// The first bytes of every format read here (junk goes behind them): `.hair`, a TressFX 4
 /// version, a PLY header, a `.data` strand count, Radiance, OpenEXR, the table asset, JSON,
-/// USD text, Ogawa, binary glTF, glTF JSON.
-const SIGNATURES: [&[u8]; 12] = [
+/// USD text, a USD crate file, a zip (USDZ), Ogawa, binary glTF, glTF JSON.
+const SIGNATURES: [&[u8]; 14] = [
     b"HAIR",
     &[0, 0, 0x80, 0x40],
     b"ply\nformat binary_little_endian 1.0\nelement vertex 3\n",
@@ -70,6 +70,8 @@ const SIGNATURES: [&[u8]; 12] = [
     b"STRNDLUT\x02\0\0\0",
     b"{\"format\":\"strandlight-srbf-set\",",
     b"#usda 1.0\n",
+    b"PXR-USDC\x00\x08\x00\x00\x00\x00\x00\x00",
+    b"PK\x03\x04",
     b"Ogawa\xff\x01\x00",
     b"glTF\x02\0\0\0",
     b"{\"asset\":{\"version\":\"2.0\"},",

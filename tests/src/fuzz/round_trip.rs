@@ -5,7 +5,7 @@
 //!
 //! | target | written with | loaded again with | compared, bit for bit |
 //! | --- | --- | --- | --- |
-//! | `hair`, `tfx`, `ply`, `usda`, `abc` | `hair::yuksel::encode_hair` (`.tfx`, `.ply`, USD and Alembic have no writer here; `.hair` is the strand format the project writes that carries widths and colours) | `parse_hair` | strand offsets, positions, thickness, transparency, colour (an attribute the source lacks must come back as the `.hair` header default the writer documents); the info text |
+//! | `hair`, `tfx`, `ply`, `usda`, `usdc`, `usdz`, `abc` | `hair::yuksel::encode_hair` (`.tfx`, `.ply`, USD and Alembic have no writer here; `.hair` is the strand format the project writes that carries widths and colours) | `parse_hair` | strand offsets, positions, thickness, transparency, colour (an attribute the source lacks must come back as the `.hair` header default the writer documents); the info text |
 //! | `data` | `hair::usc::encode_usc` | `parse_usc` | strand offsets and positions (all the format holds) |
 //! | `hdr`, `exr` | `envmap_io::write_exr` (f32 RGB) | `envmap_io::load`, sanitizing off | size and every pixel; no bad pixel |
 //! | `sltab` | `asset::write_asset_to`, in the storage it was read in | `asset::read_asset` | metadata (descriptions, axes, payload checksum) and every value |
@@ -48,7 +48,9 @@ pub enum Reloaded {
 /// The writer and reader each target's loads go through, for the report.
 pub fn describe(target: &str) -> &'static str {
     match target {
-        "hair" | "tfx" | "ply" | "usda" | "abc" => "hair::yuksel::encode_hair → parse_hair",
+        "hair" | "tfx" | "ply" | "usda" | "usdc" | "usdz" | "abc" => {
+            "hair::yuksel::encode_hair → parse_hair"
+        }
         "data" => "hair::usc::encode_usc → parse_usc",
         "hdr" | "exr" => "envmap_io::write_exr (f32) → envmap_io::load",
         "sltab" => "asset::write_asset_to → asset::read_asset",

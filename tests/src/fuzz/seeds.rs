@@ -65,7 +65,7 @@ pub fn seeds(name: &str) -> Vec<Seed> {
         "exr" => exr_seeds(),
         "sltab" => sltab_seeds(),
         "srbf" => vec![generated("2 lobes, 1 source", srbf_json())],
-        "usda" | "abc" | "glb" | "gltf" => scene_seeds(name),
+        "usda" | "usdc" | "usdz" | "abc" | "glb" | "gltf" => scene_seeds(name),
         other => panic!("no seeds for target {other}"),
     };
     out.extend(shared_seeds(name));
@@ -73,7 +73,7 @@ pub fn seeds(name: &str) -> Vec<Seed> {
 }
 
 /// Targets whose seeds another project's writer makes (usd-core, PyAlembic, pygltflib).
-pub const SCENE_TARGETS: [&str; 4] = ["usda", "abc", "glb", "gltf"];
+pub const SCENE_TARGETS: [&str; 6] = ["usda", "usdc", "usdz", "abc", "glb", "gltf"];
 
 /// Whether the seeds of `target` can be made here: always for the project's own formats; for
 /// the scene formats when Python has the writer (otherwise the skip is printed, or under
@@ -103,6 +103,8 @@ fn scene_seeds(target: &str) -> Vec<Seed> {
             "heads",
             "head-embedded.gltf",
         ),
+        "usdc" => (&USD, Writer::UsdCore, "usd-core", "usd", "groom.usdc"),
+        "usdz" => (&USD, Writer::UsdCore, "usd-core", "usd", "groom.usdz"),
         _ => (&USD, Writer::UsdCore, "usd-core", "usd", "groom.usda"),
     };
     let sub = dir.join(sub);

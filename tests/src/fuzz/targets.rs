@@ -99,20 +99,41 @@ fn run_ply(bytes: &[u8]) -> Result<Loaded, Refusal> {
     hair_with(hair::ply::parse_ply, "fuzz-input.ply", bytes)
 }
 
-/// USD stages open through a path (openusd picks the layer format by extension). Only text
-/// stages are fuzzed: openusd 0.6's crate-file reader allocates what a corrupt array count asks
-/// for (`ReadExt::read_vec`), and the failed allocation aborts the process, which no catch can
-/// stop; the fuzzer found that within its first few hundred `.usdc` mutants. `.usdz` holds a
-/// `.usdc`. Both wait for a fixed openusd (docs/RELIABILITY.md).
-fn run_usda(bytes: &[u8]) -> Result<Loaded, Refusal> {
+/// USD stages open through a path (openusd picks the layer format by extension): text, the
+/// binary crate file and the zip package holding one. The crate reader is openusd's with the
+/// allocation bounds of third_party/openusd/PATCHED.md: before them a corrupt count aborted the
+/// process within the first few hundred `.usdc` mutants.
+fn run_usd(file: &ScratchFile, bytes: &[u8]) -> Result<Loaded, Refusal> {
     use std::io::Write;
-    static FILE: OnceLock<ScratchFile> = OnceLock::new();
-    let file = FILE.get_or_init(|| ScratchFile::new("fuzz-input.usda"));
     file.rewrite(|f| f.write_all(bytes))
         .expect("the scratch file is writable");
     hair::load_usd(file.path())
         .map(Loaded::Hair)
         .map_err(refusal)
+}
+
+fn run_usda(bytes: &[u8]) -> Result<Loaded, Refusal> {
+    static FILE: OnceLock<ScratchFile> = OnceLock::new();
+    run_usd(
+        FILE.get_or_init(|| ScratchFile::new("fuzz-input.usda")),
+        bytes,
+    )
+}
+
+fn run_usdc(bytes: &[u8]) -> Result<Loaded, Refusal> {
+    static FILE: OnceLock<ScratchFile> = OnceLock::new();
+    run_usd(
+        FILE.get_or_init(|| ScratchFile::new("fuzz-input.usdc")),
+        bytes,
+    )
+}
+
+fn run_usdz(bytes: &[u8]) -> Result<Loaded, Refusal> {
+    static FILE: OnceLock<ScratchFile> = OnceLock::new();
+    run_usd(
+        FILE.get_or_init(|| ScratchFile::new("fuzz-input.usdz")),
+        bytes,
+    )
 }
 
 fn run_abc(bytes: &[u8]) -> Result<Loaded, Refusal> {
@@ -232,8 +253,49 @@ pub fn reseal_asset(data: &mut [u8]) {
     }
 }
 
+/// Gives every stored entry of a zip (a USDZ package: entries are stored, not deflated) the
+/// CRC-32 of the bytes it holds, in its local header and in the central directory, so that a
+/// mutant reaches the crate file inside instead of stopping at the zip's checksum.
+pub fn reseal_usdz(data: &mut [u8]) {
+    let u16_at = |d: &[u8], i: usize| d.get(i..i + 2).map(|b| u16::from_le_bytes([b[0], b[1]]));
+    let u32_at = |d: &[u8], i: usize| {
+        d.get(i..i + 4)
+            .map(|b| u32::from_le_bytes(b.try_into().unwrap()))
+    };
+    let mut crcs = std::collections::HashMap::new();
+    let mut i = 0;
+    while u32_at(data, i) == Some(0x0403_4b50) {
+        let (Some(size), Some(name), Some(extra)) = (
+            u32_at(data, i + 18),
+            u16_at(data, i + 26),
+            u16_at(data, i + 28),
+        ) else {
+            return;
+        };
+        let start = i + 30 + name as usize + extra as usize;
+        let Some(bytes) = data.get(start..start.saturating_add(size as usize)) else {
+            return;
+        };
+        let crc = crc32fast::hash(bytes);
+        data[i + 14..i + 18].copy_from_slice(&crc.to_le_bytes());
+        crcs.insert(i as u32, crc);
+        i = start + size as usize;
+    }
+    // The central directory: each entry names its local header's offset.
+    for j in 0..data.len().saturating_sub(46) {
+        if u32_at(data, j) == Some(0x0201_4b50)
+            && let Some(crc) = u32_at(data, j + 42).and_then(|local| crcs.get(&local))
+        {
+            data[j + 16..j + 20].copy_from_slice(&crc.to_le_bytes());
+        }
+    }
+}
+
 /// CI executions of the USD text and Alembic targets (about 0.5 ms and 0.2 ms each here).
 const USDA_EXECS: usize = 5_000;
+/// CI executions of the USD crate-file and package targets.
+const USDC_EXECS: usize = 20_000;
+const USDZ_EXECS: usize = 20_000;
 const ABC_EXECS: usize = 10_000;
 /// CI executions of the glTF head targets.
 const GLB_EXECS: usize = 20_000;
@@ -290,6 +352,18 @@ pub fn all() -> Vec<Target> {
             // A text stage cut after a closing brace is a whole stage.
             prefixes_fail: false,
             ..target("usda", "fuzz-input.usda", run_usda, USDA_EXECS)
+        },
+        Target {
+            // LZ4 expands a byte into at most 256, and the integer coding's 2-bit codes each
+            // into a value of up to 8 bytes.
+            bytes_out_per_byte_in: 256 * 4 * 8,
+            ..target("usdc", "fuzz-input.usdc", run_usdc, USDC_EXECS)
+        },
+        Target {
+            bytes_out_per_byte_in: 256 * 4 * 8,
+            reseal: Some(reseal_usdz),
+            // A zip names its entries' sizes in a directory at its end: a prefix loses it.
+            ..target("usdz", "fuzz-input.usdz", run_usdz, USDZ_EXECS)
         },
         target("abc", "fuzz-input.abc", run_abc, ABC_EXECS),
         // The heads' seeds come from pygltflib (`seeds::scene_seeds`).
