@@ -1056,7 +1056,7 @@ mod tests {
                 a.reference_lights,
                 a.shading()
             ),
-            (64, [640, 480], None, EnvShading::Marschner)
+            (64, [640, 480], None, EnvShading::Chiang)
         );
         assert_eq!(
             validate(&a).unwrap(),

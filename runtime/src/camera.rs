@@ -275,7 +275,8 @@ pub fn light_camera(toward_light: Vec3, bounds: Aabb) -> Camera {
 /// square holds the points' projection across the light ([`Self::light_camera`]) rather than the
 /// box's bounding sphere ([`light_camera`]): on straight.hair it has 1.4–2× more texels across
 /// the hair per side (median 1.53× over directions), so a sun's sharp shadow gets that much finer
-/// for the same map (docs/BENCHMARKS.md, "Compact sources' maps fitted to the hair").
+/// for the same map (docs/history/benchmarks-2026-12-02-to-12-04.md, "Compact sources' maps
+/// fitted to the hair").
 #[derive(Clone, Debug)]
 pub struct LightFootprint {
     pub bounds: Aabb,
