@@ -5,7 +5,7 @@
 # the page's first preview in headless Chromium (WebGPU on SwiftShader). Prints a markdown
 # table for the README.
 #   git clone REPO fresh && cd fresh && scripts/first-minute.sh
-#   (needs xvfb-run, chromium, node and the harness: npm ci --prefix web/harness)
+#   (needs xvfb-run, chromium and node; the harness is installed when missing)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 if [ -e out ]; then
@@ -41,6 +41,7 @@ warm_total=$(view "$work/view-cache" "$work/view-warm.json")
 cp "$work/view-warm.png" "$work/view.png"
 
 scripts/web.sh --page-only >/dev/null
+[ -d web/harness/node_modules ] || npm ci --prefix web/harness --no-audit --no-fund --silent
 $bin web --out "$work/site" >/dev/null
 $bin serve "$work/site" --port 0 >"$work/serve.txt" &
 server=$!

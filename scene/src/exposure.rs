@@ -1,6 +1,7 @@
-//! Exposure of a displayed or written frame: metered on the hair's own pixels, so the background
-//! (or the black around the hair) never decides how bright the hair looks, and a check that what
-//! is written is neither black nor clipped.
+//! Exposure of a displayed or written frame: metered on the subject's own pixels (the hair's and,
+//! with a head, the skin's: every covered pixel), so the background (or the black around the
+//! hair) never decides how bright the subject looks, and a check that what is written is neither
+//! black nor clipped.
 
 use crate::image_metrics::HAIR_ALPHA;
 use std::fmt;

@@ -265,10 +265,10 @@ pub const PREVIEW_LIGHTS: usize = 8;
 /// The preview's light maps are at most this many texels across.
 pub const PREVIEW_MAP_RESOLUTION: u32 = 128;
 /// Nodes per direction axis of the tables a first look is drawn with while a cold cache bakes
-/// the full ones: single scattering's tables bake in seconds, and the preview they draw is
-/// 0.049 from the one of the demo's 32-node tables (relative RMSE over the hair; 6 nodes 0.072,
-/// 12 nodes 0.022: docs/BENCHMARKS.md, "The first look").
-pub const PREVIEW_TABLE_NODES: usize = 8;
+/// the full ones: single scattering's two tables bake in 0.66 s (32 nodes: 2.5 s), and the
+/// preview they draw is 0.022 from the one of the demo's 32-node tables (relative RMSE over the
+/// hair; 8 nodes 0.049 in 0.53 s, 6 nodes 0.072 in 0.49 s: docs/BENCHMARKS.md, "The first look").
+pub const PREVIEW_TABLE_NODES: usize = 12;
 
 /// `settings` as a first look draws them on a cold cache ([`FramePart::Preview`]): an
 /// environment's single scattering from tables of [`PREVIEW_TABLE_NODES`] nodes (cached apart
