@@ -380,14 +380,19 @@ impl WorkerState {
                     &mut progress,
                 )
                 .map_err(|e| format!("{e:#}"));
-                send.send(Baked { coarse, result }).is_ok()
+                let baked = result.is_ok();
+                // None: the request was left behind (nothing listens any more).
+                send.send(Baked { coarse, result }).is_ok().then_some(baked)
             };
             if first_look {
-                if !bake(&coarse_preview_settings(&settings), true) {
-                    return;
+                match bake(&coarse_preview_settings(&settings), true) {
+                    None => return,
+                    // A first look that never comes (a new request) holds nothing up long.
+                    Some(true) => {
+                        let _ = wait_for_first_look.recv_timeout(FIRST_LOOK_WAIT);
+                    }
+                    Some(false) => {}
                 }
-                // A first look that never comes (an error, a new request) holds nothing up long.
-                let _ = wait_for_first_look.recv_timeout(FIRST_LOOK_WAIT);
             }
             bake(&settings, false);
         });
