@@ -3,20 +3,13 @@
 // converged, ticks) to OUT/report.json. For scripts/first-minute.sh; page_check.mjs is the test.
 //
 //   node first_look.mjs URL OUT [TIMEOUT_S]
-import { chromium } from 'playwright-core';
+import { launchChromium } from './browser.mjs';
 import { writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 
 const [url, out, timeoutText] = process.argv.slice(2);
 const timeout = 1000 * Number(timeoutText ?? 600);
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-  args: [
-    '--headless=new', '--no-sandbox', '--enable-unsafe-webgpu', '--use-webgpu-adapter=swiftshader',
-    '--enable-unsafe-swiftshader', '--disable-background-networking', '--disable-component-update',
-    '--no-first-run', '--disable-sync', '--disable-quic',
-  ],
-});
+const browser = await launchChromium();
 try {
   const page = await browser.newPage({ viewport: { width: 1400, height: 1000 } });
   await page.goto(url);

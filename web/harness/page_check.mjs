@@ -9,20 +9,13 @@
 // OUT/report.json (with the settings before the drag).
 //
 //   node page_check.mjs URL OUT [TIMEOUT_S]
-import { chromium } from 'playwright-core';
+import { launchChromium } from './browser.mjs';
 import { writeFileSync } from 'node:fs';
 import { join } from 'node:path';
 
 const [url, out, timeoutText] = process.argv.slice(2);
 const timeout = 1000 * Number(timeoutText ?? 600);
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM ?? '/usr/bin/chromium',
-  args: [
-    '--headless=new', '--no-sandbox', '--enable-unsafe-webgpu', '--use-webgpu-adapter=swiftshader',
-    '--enable-unsafe-swiftshader', '--disable-background-networking', '--disable-component-update',
-    '--no-first-run', '--disable-sync', '--disable-quic', ...(process.env.CHROMIUM_LOG ? ['--enable-logging=stderr', '--v=0'] : []),
-  ],
-});
+const browser = await launchChromium();
 const report = { console: [], phasesMs: {} };
 const t0 = Date.now();
 const phase = (name) => { report.phasesMs[name] = Date.now() - t0; };

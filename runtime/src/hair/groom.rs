@@ -2,7 +2,8 @@
 //!
 //! Roots are scattered over the top of an ellipsoid (a cap, with a higher hairline over the
 //! face at +z). Each strand leaves its root combed away from the crown whorl, or from a parting
-//! (then back, off the face), and bends toward −y (gravity) as it goes; a helix around that curve gives waves or curls; strands are pulled
+//! (then back, off the face), and bends toward −y (gravity) as it goes; a helix around that
+//! curve gives waves or curls; strands are pulled
 //! toward the strand at the centre of their clump, more toward the tip; finally the shape is
 //! traced again with "follow the leader" steps of exactly `length / (points − 1)`, which makes
 //! each strand exactly its drawn length and, with the scalp as a convex collider, keeps every
@@ -137,129 +138,29 @@ impl GroomParams {
         let strands = self.strand_count as f64;
         let points = self.points_per_strand as f64;
         type Check<'a> = (&'static str, f64, &'a dyn Fn(f64) -> bool, &'static str);
-        #[rustfmt::skip]
         let parting = self.parting.unwrap_or(0.0) as f64;
+        #[rustfmt::skip]
         let checks: [Check; 20] = [
-            (
-                "scalp.center.x",
-                c.x as f64,
-                &within(-SIZE, SIZE),
-                "must be in [-1e6, 1e6]",
-            ),
-            (
-                "scalp.center.y",
-                c.y as f64,
-                &within(-SIZE, SIZE),
-                "must be in [-1e6, 1e6]",
-            ),
-            (
-                "scalp.center.z",
-                c.z as f64,
-                &within(-SIZE, SIZE),
-                "must be in [-1e6, 1e6]",
-            ),
-            (
-                "scalp.radii.x",
-                r.x as f64,
-                &above(0.0, SIZE),
-                "must be in (0, 1e6]",
-            ),
-            (
-                "scalp.radii.y",
-                r.y as f64,
-                &above(0.0, SIZE),
-                "must be in (0, 1e6]",
-            ),
-            (
-                "scalp.radii.z",
-                r.z as f64,
-                &above(0.0, SIZE),
-                "must be in (0, 1e6]",
-            ),
-            (
-                "scalp.max_polar_angle",
-                scalp.max_polar_angle as f64,
-                &above(0.0, PI),
-                "must be in (0, π]",
-            ),
-            (
-                "scalp.front_polar_angle",
-                scalp.front_polar_angle as f64,
-                &above(0.0, PI),
-                "must be in (0, π]",
-            ),
-            (
-                "strand_count",
-                strands,
-                &within(1.0, 1e7),
-                "must be in 1..=10,000,000",
-            ),
-            (
-                "points_per_strand",
-                points,
-                &within(2.0, 1024.0),
-                "must be in 2..=1024",
-            ),
-            (
-                "strand_count × points_per_strand",
-                strands * points,
-                &within(0.0, 1e8),
-                "must be ≤ 1e8",
-            ),
-            (
-                "length_min",
-                self.length_min as f64,
-                &above(0.0, SIZE),
-                "must be in (0, 1e6]",
-            ),
-            (
-                "length_max",
-                self.length_max as f64,
-                &within(self.length_min as f64, SIZE),
-                "must be in [length_min, 1e6]",
-            ),
-            (
-                "curl_radius",
-                self.curl_radius as f64,
-                &within(0.0, SIZE),
-                "must be in [0, 1e6]",
-            ),
-            (
-                "curl_frequency",
-                self.curl_frequency as f64,
-                &within(0.0, SIZE),
-                "must be in [0, 1e6]",
-            ),
-            (
-                "clump_count",
-                self.clump_count as f64,
-                &within(0.0, strands),
-                "must be ≤ strand_count",
-            ),
-            (
-                "clump_strength",
-                self.clump_strength as f64,
-                &within(0.0, 1.0),
-                "must be in [0, 1]",
-            ),
-            (
-                "gravity",
-                self.gravity as f64,
-                &within(0.0, 1.0),
-                "must be in [0, 1]",
-            ),
-            (
-                "thickness",
-                self.thickness as f64,
-                &within(0.0, SIZE),
-                "must be in [0, 1e6]",
-            ),
-            (
-                "parting",
-                parting,
-                &within(-0.9, 0.9),
-                "must be in [-0.9, 0.9]",
-            ),
+            ("scalp.center.x", c.x as f64, &within(-SIZE, SIZE), "must be in [-1e6, 1e6]"),
+            ("scalp.center.y", c.y as f64, &within(-SIZE, SIZE), "must be in [-1e6, 1e6]"),
+            ("scalp.center.z", c.z as f64, &within(-SIZE, SIZE), "must be in [-1e6, 1e6]"),
+            ("scalp.radii.x", r.x as f64, &above(0.0, SIZE), "must be in (0, 1e6]"),
+            ("scalp.radii.y", r.y as f64, &above(0.0, SIZE), "must be in (0, 1e6]"),
+            ("scalp.radii.z", r.z as f64, &above(0.0, SIZE), "must be in (0, 1e6]"),
+            ("scalp.max_polar_angle", scalp.max_polar_angle as f64, &above(0.0, PI), "must be in (0, π]"),
+            ("scalp.front_polar_angle", scalp.front_polar_angle as f64, &above(0.0, PI), "must be in (0, π]"),
+            ("strand_count", strands, &within(1.0, 1e7), "must be in 1..=10,000,000"),
+            ("points_per_strand", points, &within(2.0, 1024.0), "must be in 2..=1024"),
+            ("strand_count × points_per_strand", strands * points, &within(0.0, 1e8), "must be ≤ 1e8"),
+            ("length_min", self.length_min as f64, &above(0.0, SIZE), "must be in (0, 1e6]"),
+            ("length_max", self.length_max as f64, &within(self.length_min as f64, SIZE), "must be in [length_min, 1e6]"),
+            ("curl_radius", self.curl_radius as f64, &within(0.0, SIZE), "must be in [0, 1e6]"),
+            ("curl_frequency", self.curl_frequency as f64, &within(0.0, SIZE), "must be in [0, 1e6]"),
+            ("clump_count", self.clump_count as f64, &within(0.0, strands), "must be ≤ strand_count"),
+            ("clump_strength", self.clump_strength as f64, &within(0.0, 1.0), "must be in [0, 1]"),
+            ("gravity", self.gravity as f64, &within(0.0, 1.0), "must be in [0, 1]"),
+            ("thickness", self.thickness as f64, &within(0.0, SIZE), "must be in [0, 1e6]"),
+            ("parting", parting, &within(-0.9, 0.9), "must be in [-0.9, 0.9]"),
         ];
         for (name, value, ok, requirement) in checks {
             check(name, value, ok, requirement)?;
@@ -747,6 +648,13 @@ mod tests {
         let mut p = small();
         p.scalp.radii.y = 0.0;
         bad(p, "scalp.radii.y");
+        bad(
+            GroomParams {
+                parting: Some(1.5),
+                ..small()
+            },
+            "parting",
+        );
     }
 
     #[test]
