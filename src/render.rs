@@ -55,7 +55,7 @@ struct SceneArgs {
     /// Hair file (.hair, .tfx, .data, .ply, USD .usda/.usdc/.usdz BasisCurves, Alembic .abc ICurves); the procedural groom when omitted.
     #[arg(long)]
     hair: Option<PathBuf>,
-    /// Fiber model (default: kajiya-kay under lights, marschner under an environment).
+    /// Fiber model (default: kajiya-kay under lights, chiang under an environment).
     #[arg(long, value_enum)]
     shading: Option<Shading>,
     /// Melanin preset of the Marschner and Chiang fibers: dark, brown, blonde, ...
@@ -211,6 +211,16 @@ struct ReplayArgs {
 }
 
 /// `render.exr` → `render`: the stem may be given with either extension.
+/// Before the render, not after it: a missing folder is made, and one that cannot be is
+/// reported before minutes of work are spent.
+fn create_output_dir(out: &Path) -> anyhow::Result<()> {
+    match out.parent().filter(|p| !p.as_os_str().is_empty()) {
+        Some(dir) => std::fs::create_dir_all(dir)
+            .with_context(|| format!("creating the output folder {}", dir.display())),
+        None => Ok(()),
+    }
+}
+
 fn output_stem(out: &Path) -> PathBuf {
     match out.extension().and_then(|e| e.to_str()) {
         Some("exr" | "png") => out.with_extension(""),
@@ -316,6 +326,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         RenderWhat::Replay(replay) => (FrameSettings::read(&replay.settings)?, &replay.output),
     };
     settings.check()?;
+    create_output_dir(&output.out)?;
     let mut steps = Steps::new(output.json);
     // Before the fit and bake: a machine without a usable GPU device is told at once.
     steps.run("GPU", env_adapter, |adapter| adapter.clone())?;

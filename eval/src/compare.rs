@@ -562,9 +562,11 @@ fn reference_inputs(
         inputs["view_weights"] = json!("rescaled to each pixel's coverage");
     }
     // Layered references rendered before their texel lights were shaded per layer (as lights
-    // standing for regions, 2 Dec 2026) shaded them per fragment: not this renderer's.
+    // standing for regions, 2 Dec 2026) shaded them per fragment, and before 6 Dec 2026 their
+    // compact sources too: not this renderer's.
     if matches!(look(args).transparency, ViewTransparency::Layered { .. }) {
-        inputs["region_lights"] = json!("per layer; compact sources per fragment");
+        inputs["region_lights"] =
+            json!("per layer; compact sources per layer at their fibers' mean visibility");
     }
     // Only the fit's lighting adds a key, so the map's references keep their cache entries.
     // Only with a head: the references rendered before it keep their keys.

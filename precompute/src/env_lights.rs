@@ -37,8 +37,8 @@ pub struct LightSpec {
     pub angular_variance: f64,
     /// Directional lights only: the light stands for a region of the map (a reference's cube
     /// texel, a median-cut region), not a compact source taken out whole (a sun, a lamp). The
-    /// region's own shadow is soft at fiber scale, so the layered view shades it per layer, as it
-    /// does SRBF lobes, and a compact source per fragment.
+    /// region's own shadow is soft at fiber scale, so the layered view reads it at a layer's mean
+    /// position, as it does SRBF lobes', and a compact source's as its fibers' mean visibility.
     pub stands_for_region: bool,
 }
 

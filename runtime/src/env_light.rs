@@ -33,10 +33,11 @@ pub struct EnvLight {
     pub angular_variance: f32,
     /// Directional lights only: it stands for a region of the map (a reference's cube texel, a
     /// median-cut region), not a compact source (a sun, a lamp). A region's own shadow is soft at
-    /// fiber scale, so the layered view shades it per layer, as it does SRBF lobes; a compact
-    /// source's is sharp, so per fragment ([`ViewTransparency::for_batch`]).
+    /// fiber scale, so the layered view reads it at a layer's mean position, as it does SRBF
+    /// lobes'; a compact source's is sharp, so a layer reads its fibers' mean visibility
+    /// ([`ViewTransparency::Layered`]).
     ///
-    /// [`ViewTransparency::for_batch`]: crate::env::ViewTransparency::for_batch
+    /// [`ViewTransparency::Layered`]: crate::env::ViewTransparency::Layered
     pub stands_for_region: bool,
 }
 

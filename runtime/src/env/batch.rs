@@ -8,6 +8,7 @@ use super::light_kinds::LightBatch;
 use super::stats::{BatchUsage, Timings};
 use super::view_binding::ViewBinding;
 use super::view_shading::ViewShadingInputs;
+use super::view_visibility::ViewTransparency;
 use super::{EnvRenderError, EnvRenderer};
 use crate::env_light::EnvLight;
 use crate::gpu::GpuContext;
@@ -55,13 +56,20 @@ pub(super) fn render_batch(
             options.transmittance_filter,
             maps.head.as_ref().filter(|_| !srbf_from_volume),
         );
-        let visibility = frame.visibility(options);
+        let mut visibility = frame.visibility(options);
+        let transparency = options.transparency;
+        visibility.layer_lights = frame.occupancy.layer_light_slots > 0
+            && matches!(transparency, ViewTransparency::Layered { .. })
+            && batch.has_sharp_shadows();
         let view = ViewBinding::new(gpu, &renderer.layouts.view, grid.as_ref(), &visibility);
         usage.grid_bytes = usage.grid_bytes.max(view.bytes);
         let inputs = ViewShadingInputs {
             geometry: &frame.geometry,
             strands: &frame.strands,
-            transparency: options.transparency.for_batch(batch.has_sharp_shadows()),
+            transparency,
+            layer_lights: visibility
+                .layer_lights
+                .then_some((&frame.occupancy, &frame.depth_view)),
             batch: &lights,
             tables: batch.tables,
             view: &view,

@@ -12,6 +12,7 @@
 #import strandlight::strand_quads::frame
 #import strandlight::table_lookup::{single_lookup, multiple_lookup}
 #import strandlight::view_binding::{view, grid_values}
+#import strandlight::view_layers::{NO_LAYER_LIGHTS, load_fixed}
 #import strandlight::visibility_volume::{volume_enabled, volume_lobe_visibility}
 
 fn grid_vertex(slot: u32, i: vec3<u32>) -> vec4<f32> {
@@ -54,8 +55,10 @@ fn shades_from_volume() -> bool {
 }
 
 // Single and multiple scattering of the fiber at `world` along `tangent` under the batch's
-// lights, times `weight` (pre-multiplied; the weight is also the alpha written).
-fn shade(world: vec3<f32>, tangent: vec3<f32>, weight: f32) -> EnvOut {
+// lights, times `weight` (pre-multiplied; the weight is also the alpha written). A layer of the
+// layered view passes `layer_lights`, the word of its fibers' Σw·v for light slot 0
+// (view_layers.wgsl); NO_LAYER_LIGHTS reads each light's visibility at `world`.
+fn shade(world: vec3<f32>, tangent: vec3<f32>, weight: f32, layer_lights: u32) -> EnvOut {
     let t = normalize(tangent);
     let e = toward_eye(world);
     var single = vec3<f32>(0.0);
@@ -65,7 +68,9 @@ fn shade(world: vec3<f32>, tangent: vec3<f32>, weight: f32) -> EnvOut {
     for (var slot = 0u; slot < batch.light_count; slot++) {
         let light = env_lights[slot];
         var visible: f32;
-        if (with_volume && light.direction.w > 0.0) {
+        if (layer_lights != NO_LAYER_LIGHTS) {
+            visible = clamp(load_fixed(layer_lights + slot) / weight, 0.0, 1.0);
+        } else if (with_volume && light.direction.w > 0.0) {
             visible = volume_lobe_visibility(world, light.direction.xyz, light.direction.w);
         } else {
             visible = effective_transmittance(slot, world);

@@ -102,6 +102,7 @@ impl FrameResources {
             head: [&self.head_views[0], &self.head_views[1]],
             skin: self.head.as_ref().map(|h| h.albedo),
             view_proj: self.view_proj,
+            layer_lights: false,
         }
     }
 
@@ -212,7 +213,15 @@ impl FrameResources {
             head,
         } = *request;
         GpuLimits::of(gpu).check_image(width, height)?;
-        let occupancy = OccupancyMap::new(gpu, options.transparency, width, height)?;
+        let compact_slots = kinds
+            .compact_sources()
+            .min(options.dodm.batch_size as usize);
+        let occupancy = OccupancyMap::new(
+            gpu,
+            options.transparency,
+            (width, height),
+            compact_slots as u32,
+        )?;
         FrameSums::check_limits(gpu, width, height)?;
         let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;
         // Per hair and settings, not per light or view: setup, as the upload is.

@@ -51,6 +51,14 @@ impl LightKinds {
             .any(EnvLight::has_sharp_shadow)
     }
 
+    /// How many lights are compact sources.
+    pub(super) fn compact_sources(&self) -> usize {
+        (self.directional.iter())
+            .chain(&self.directional_thinned)
+            .filter(|l| l.has_sharp_shadow())
+            .count()
+    }
+
     /// The kinds whose maps κ thins.
     pub(super) fn thinned(&self) -> [&Vec<EnvLight>; 2] {
         [&self.srbf, &self.directional_thinned]
@@ -71,11 +79,13 @@ pub(super) struct LightBatch<'a> {
 impl LightKinds {
     /// Calls `render` with each batch of the frame, kind by kind (SRBFs drawing every strand,
     /// thinned SRBFs, directional lights, thinned directional lights), each with its kind's
-    /// tables (a kind without tables has no lights), at most `batch_size` shadow groups a batch.
+    /// tables (a kind without tables has no lights), at most `batch_size` shadow groups a batch
+    /// (`compact_batch_size` of compact sources: what the layered view's memory for their
+    /// visibility holds).
     pub(super) fn for_each_batch<E>(
         &self,
         [srbf_tables, directional_tables]: [Option<&TableBinding>; 2],
-        batch_size: u32,
+        [batch_size, compact_batch_size]: [u32; 2],
         mut render: impl FnMut(&LightBatch<'_>) -> Result<(), E>,
     ) -> Result<(), E> {
         let kind_tables = [
@@ -90,7 +100,12 @@ impl LightKinds {
             // A batch is shaded in one view: compact sources and region lights apart.
             let sharp = |g: &ShadowGroup| g.lights[0].has_sharp_shadow();
             for run in groups.chunk_by(|a, b| sharp(a) == sharp(b)) {
-                for groups in run.chunks(batch_size as usize) {
+                let size = if sharp(&run[0]) {
+                    compact_batch_size
+                } else {
+                    batch_size
+                };
+                for groups in run.chunks(size.max(1) as usize) {
                     render(&LightBatch { groups, tables })?;
                 }
             }

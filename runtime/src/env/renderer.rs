@@ -299,7 +299,12 @@ impl EnvRenderer {
             .filter_map(|t| t.as_ref().map(|t| t.bytes))
             .sum();
         let tables = [srbf_tables.as_deref(), directional_tables.as_deref()];
-        kinds.for_each_batch(tables, options.dodm.batch_size, |batch| {
+        let compact_batch_size = match frame.occupancy.layer_light_slots {
+            0 => options.dodm.batch_size,
+            slots => slots,
+        };
+        let batch_sizes = [options.dodm.batch_size, compact_batch_size];
+        kinds.for_each_batch(tables, batch_sizes, |batch| {
             let resources = (&mut frame, sums);
             render_batch(
                 gpu,

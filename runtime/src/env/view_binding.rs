@@ -23,6 +23,9 @@ struct ViewUniform {
     skin: [f32; 4],
     /// Clip space to world (the layered view's layers on their pixels' rays).
     clip_to_world: [[f32; 4]; 4],
+    /// The layers' light visibility: its first word, slots per layer, 1 when this batch reads
+    /// it (`view_layers.wgsl`).
+    layer_lights: [u32; 4],
 }
 
 /// Group 3: one batch's forward-scattering grid (a placeholder without multiple scattering) and
@@ -51,6 +54,9 @@ pub struct FrameVisibility<'a> {
     pub skin: Option<[f32; 3]>,
     /// The view camera's world-to-clip matrix (the layered view inverts it).
     pub view_proj: glam::Mat4,
+    /// This batch's layers read their fibers' mean light visibility (a batch of compact
+    /// sources in the layered view, [`OccupancyMap`]).
+    pub layer_lights: bool,
 }
 
 impl ViewBinding {
@@ -75,6 +81,12 @@ impl ViewBinding {
                 None => [0.0; 4],
             },
             clip_to_world: visibility.view_proj.inverse().to_cols_array_2d(),
+            layer_lights: [
+                visibility.map.record_words as u32,
+                visibility.map.layer_light_slots,
+                visibility.layer_lights as u32,
+                0,
+            ],
         };
         let values = match grid {
             Some(g) => {
@@ -198,7 +210,8 @@ mod wgsl_layout {
                 visibility_cutoff,
                 record_words,
                 skin,
-                clip_to_world
+                clip_to_world,
+                layer_lights
             }),
         );
     }

@@ -22,6 +22,9 @@ struct ViewParams {
     skin: vec4<f32>,
     // Clip space to world: the layered view puts each layer's fibers back on its pixel's ray.
     clip_to_world: mat4x4<f32>,
+    // The layered view's per-layer light visibility (view_layers.wgsl): x its first word in
+    // `occupancy_map`, y the light slots per layer, z 1 when this batch's layers read it.
+    layer_lights: vec4<u32>,
 };
 
 @group(3) @binding(0) var<uniform> view: ViewParams;

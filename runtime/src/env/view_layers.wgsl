@@ -9,6 +9,14 @@
 // price of OCC_LAYERS shading loops per pixel instead of one per fragment
 // (docs/BENCHMARKS.md, "The view: layers").
 //
+// A batch of compact sources (suns, lamps) also gathers, per layer and light slot, Σw·v: its
+// fibers' visibility v of the light (fs_env_layer_lights, view_shading.wgsl), which the layer's
+// shading divides by Σw. A compact source's shadow is sharp at fiber scale: the visibility at
+// the layer's mean position is not its fibers' mean visibility (quarry at 160×120 against the
+// truth: 0.338 read at the mean position, 0.290 shaded per fragment; docs/BENCHMARKS.md, "The
+// view: layers"). These words follow every pixel's record, `view.layer_lights.y` slots per
+// layer from word `view.layer_lights.x` on, zeroed before each such batch.
+//
 // Record words after the occupancy map's OCC_RECORD, per layer: Σw, Σw·z (z the fragment's
 // depth in [0, 1], as the rasterizer writes it), Σw·t (three words, t the unit tangent), each
 // a fixed-point i32 of OCC_LAYER_SCALE summed with wrapping u32 atomics (a pixel's weights add
@@ -16,7 +24,9 @@
 
 #define_import_path strandlight::view_layers
 
-#import strandlight::occupancy_map::{OCC_RECORD, OCC_SLICES, OCC_SLICES_PER_SLAB, OCC_TAU_SCALE}
+#import strandlight::head_view::behind_head
+#import strandlight::occupancy_map::{OCC_RECORD, OCC_SLICES, OCC_SLICES_PER_SLAB, OCC_TAU_SCALE, occupancy_record, occupancy_visibility, occupancy_weight}
+#import strandlight::strand_quads::VertexOut
 #import strandlight::view_binding::{view, occupancy_map}
 
 const OCC_LAYERS: u32 = 4u;
@@ -33,6 +43,37 @@ fn add_fixed(index: u32, value: f32) {
 
 fn load_fixed(index: u32) -> f32 {
     return f32(bitcast<i32>(atomicLoad(&occupancy_map[index]))) / OCC_LAYER_SCALE;
+}
+
+// No per-layer light visibility: the shading reads each light's visibility at its point.
+const NO_LAYER_LIGHTS: u32 = 0xffffffffu;
+
+// A fragment the view shades, in its layer: its pixel's record, the layer and its weight
+// (`kept` false: behind the head, or seen less than the cutoff).
+struct LayerFragment {
+    record: u32,
+    layer: u32,
+    weight: f32,
+    kept: bool,
+}
+
+fn layer_fragment(in: VertexOut) -> LayerFragment {
+    var out = LayerFragment(0u, 0u, 0.0, false);
+    if (behind_head(in)) { return out; }
+    let seen = occupancy_visibility(in);
+    if (seen < view.visibility_cutoff) { return out; }
+    out.record = occupancy_record(in.clip.xy, view.width);
+    out.weight = occupancy_weight(in, seen);
+    let in_front = (1.0 - seen) / max(pixel_coverage(out.record), 1e-6);
+    out.layer = min(u32(max(in_front, 0.0) * f32(OCC_LAYERS)), OCC_LAYERS - 1u);
+    out.kept = true;
+    return out;
+}
+
+// The word of light slot 0 in `layer` of the pixel at `pixel` (after every record).
+fn layer_lights_word(pixel: vec2<f32>, layer: u32) -> u32 {
+    let index = u32(pixel.y) * view.width + u32(pixel.x);
+    return view.layer_lights.x + (index * OCC_LAYERS + layer) * view.layer_lights.y;
 }
 
 // The pixel's coverage 1 − exp(−Σ τ) from its slabs.

@@ -12,12 +12,13 @@
 use super::table_binding::{TableBinding, table_bind_group_layout};
 use super::view_binding::{ViewBinding, view_bind_group_layout};
 use super::view_targets::EnvViewTargets;
-use super::view_visibility::{ViewTransparency, ViewVisibilityPass};
+use super::view_visibility::{OccupancyMap, ViewTransparency, ViewVisibilityPass};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::pipeline_layout;
-use crate::gpu::pipeline::{ADDITIVE, StrandDraw, color_target};
-use crate::passes::attachments::cleared_color;
+use crate::gpu::pipeline::{ADDITIVE, StrandDraw, color_target, depth_test};
+use crate::passes::attachments::{cleared_color, prepassed_depth};
 use crate::passes::convolution_transmittance::{BatchBinding, transmittance_bind_group_layout};
+use crate::passes::render_target::DEPTH_FORMAT;
 use crate::passes::strand_geometry::StrandGeometry;
 use crate::passes::strand_quads::strand_bind_group_layout_vertex_storage;
 use crate::shaders::{Wgsl, shader_module};
@@ -95,6 +96,9 @@ pub(super) struct ViewShadingPass {
     opaque: wgpu::RenderPipeline,
     transparent: wgpu::RenderPipeline,
     layered: wgpu::RenderPipeline,
+    /// A batch of compact sources in the layered view: its lights' visibility gathered per
+    /// layer (`fs_env_layer_lights`) before the layers are shaded.
+    layer_lights: wgpu::RenderPipeline,
     /// Occupancy and layered views: the skin behind the pixel's fibers (`skin.wgsl`), added
     /// after them.
     skin_behind_hair: wgpu::RenderPipeline,
@@ -109,6 +113,9 @@ pub(super) struct ViewShadingInputs<'a> {
     pub(super) tables: &'a TableBinding,
     pub(super) view: &'a ViewBinding,
     pub(super) with_head: bool,
+    /// A batch whose layers read their fibers' mean light visibility: the map that holds it and
+    /// the frame's depth (attached, not tested: the gathering tests against the head itself).
+    pub(super) layer_lights: Option<(&'a OccupancyMap, &'a wgpu::TextureView)>,
 }
 
 impl ViewShadingPass {
@@ -146,6 +153,19 @@ impl ViewShadingPass {
                 ("env view (layered)", "vs_fullscreen", "fs_env_layered"),
                 Some(ADDITIVE),
             ),
+            layer_lights: StrandDraw {
+                label: "env view (layers' light visibility)",
+                layout: &layout,
+                shader,
+                vertex_entry: "vs_main",
+                fragment: Some(("fs_env_layer_lights", &[])),
+                depth: Some(depth_test(
+                    DEPTH_FORMAT,
+                    false,
+                    wgpu::CompareFunction::Always,
+                )),
+            }
+            .build(&gpu.device),
             skin_behind_hair: pipeline(
                 (
                     "env view (skin behind hair)",
@@ -166,6 +186,9 @@ impl ViewShadingPass {
         inputs: &ViewShadingInputs<'_>,
         targets: &EnvViewTargets,
     ) {
+        if let Some((map, depth)) = inputs.layer_lights {
+            self.encode_layer_lights(gpu, encoder, inputs, map, depth);
+        }
         let single = targets.single.create_view(&Default::default());
         let multiple = targets.multiple.create_view(&Default::default());
         let transparency = inputs.transparency;
@@ -194,5 +217,32 @@ impl ViewShadingPass {
             pass.set_pipeline(&self.skin_behind_hair);
             pass.draw(0..3, 0..1);
         }
+    }
+
+    /// The batch's lights' visibility, Σw·v per layer and light, gathered from every fragment
+    /// the layers hold (zeroed first).
+    fn encode_layer_lights(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &ViewShadingInputs<'_>,
+        map: &OccupancyMap,
+        depth: &wgpu::TextureView,
+    ) {
+        map.clear_layer_lights(encoder);
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("env view (layers' light visibility)"),
+            color_attachments: &[],
+            depth_stencil_attachment: prepassed_depth(depth),
+            timestamp_writes: gpu.render_timestamps(),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.layer_lights);
+        pass.set_bind_group(0, inputs.strands, &[]);
+        pass.set_bind_group(1, &inputs.batch.group, &[]);
+        pass.set_bind_group(2, &inputs.tables.group, &[]);
+        pass.set_bind_group(3, &inputs.view.group, &[]);
+        pass.draw(0..6 * inputs.geometry.segment_count, 0..1);
     }
 }

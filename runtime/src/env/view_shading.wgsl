@@ -9,7 +9,9 @@
 //   fs_env_transparent: every fragment is weighted by coverage × its visibility through the
 //                       fragments in front (the occupancy map) and added; fragments that can no
 //                       longer contribute stop before any light is evaluated (early termination).
-//   fs_env_layered:     the layers the frame's visibility gathered, each shaded once.
+//   fs_env_layered:     the layers the frame's visibility gathered, each shaded once; a batch
+//                       of compact sources first gathers its lights' visibility per layer
+//                       (fs_env_layer_lights), the layers' fibers rasterized again.
 // and fs_env_skin, the skin behind the hair of the occupancy and layered views.
 
 #import strandlight::env_shading::{EnvOut, shade}
@@ -19,7 +21,8 @@
 #import strandlight::skin::shade_skin
 #import strandlight::strand_quads::{VertexOut, strand_draw_vertex}
 #import strandlight::view_binding::{view, occupancy_map, coverage, nearest_position, nearest_tangent, head_normal}
-#import strandlight::view_layers::{OCC_LAYERS, layer_word, load_fixed, on_pixel_ray}
+#import strandlight::view_layers::{NO_LAYER_LIGHTS, OCC_LAYERS, add_fixed, layer_fragment, layer_lights_word, layer_word, load_fixed, on_pixel_ray}
+#import strandlight::convolution_transmittance::{batch, effective_transmittance}
 
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> VertexOut {
@@ -44,7 +47,7 @@ fn fs_env_deferred(@builtin(position) pixel: vec4<f32>) -> EnvOut {
     out.multiple = vec4<f32>(0.0);
     if (nearest.w != 0.0) {
         let tau = textureLoad(coverage, p, 0).r;
-        out = shade(nearest.xyz, textureLoad(nearest_tangent, p, 0).xyz, 1.0 - exp(-tau));
+        out = shade(nearest.xyz, textureLoad(nearest_tangent, p, 0).xyz, 1.0 - exp(-tau), NO_LAYER_LIGHTS);
     }
     if (head.w != 0.0) {
         let seen = 1.0 - out.single.a;
@@ -60,7 +63,19 @@ fn fs_env_transparent(in: VertexOut) -> EnvOut {
     if (behind_head(in)) { discard; }
     let seen = occupancy_visibility(in);
     if (seen < view.visibility_cutoff) { discard; }
-    return shade(in.world, in.tangent, occupancy_weight(in, seen));
+    return shade(in.world, in.tangent, occupancy_weight(in, seen), NO_LAYER_LIGHTS);
+}
+
+// A batch of compact sources, before fs_env_layered: each fragment adds w·v of every light
+// slot to its layer (view_layers.wgsl).
+@fragment
+fn fs_env_layer_lights(in: VertexOut) {
+    let f = layer_fragment(in);
+    if (!f.kept) { discard; }
+    let first = layer_lights_word(in.clip.xy, f.layer);
+    for (var slot = 0u; slot < batch.light_count; slot++) {
+        add_fixed(first + slot, f.weight * effective_transmittance(slot, in.world));
+    }
 }
 
 // Every batch: each layer of the pixel shaded once (the skin behind is fs_env_skin's).
@@ -81,7 +96,9 @@ fn fs_env_layered(@builtin(position) pixel: vec4<f32>) -> EnvOut {
         );
         // Fibers crossing in opposite directions can cancel: any unit tangent then, not NaN.
         if (dot(t, t) < 1e-12) { t = vec3<f32>(0.0, 1.0, 0.0); }
-        let shaded = shade(on_pixel_ray(pixel.xy, z), t, w);
+        var lights = NO_LAYER_LIGHTS;
+        if (view.layer_lights.z != 0u) { lights = layer_lights_word(pixel.xy, layer); }
+        let shaded = shade(on_pixel_ray(pixel.xy, z), t, w, lights);
         out.single += shaded.single;
         out.multiple += shaded.multiple;
     }

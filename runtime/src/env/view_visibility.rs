@@ -43,7 +43,8 @@ pub enum ViewTransparency {
     /// The occupancy view's weights gathered into `VIEW_LAYERS` layers of equal coverage per
     /// pixel, each shaded once at its fibers' weighted mean depth and tangent
     /// (`view_layers.wgsl`): the occupancy view's weighting at a few shading loops per pixel.
-    /// Compact sources (suns, lamps) are shaded per fragment ([`Self::for_batch`]).
+    /// A compact source (a sun, a lamp) reads its layer's fibers' mean visibility, gathered per
+    /// batch into the occupancy map (`OccupancyMap::layer_light_slots`).
     Layered { visibility_cutoff: f32 },
 }
 
@@ -76,24 +77,6 @@ impl ViewTransparency {
             Self::Occupancy { visibility_cutoff } | Self::Layered { visibility_cutoff } => {
                 *visibility_cutoff
             }
-        }
-    }
-
-    /// The view a batch of lights is shaded in. A compact source's visibility (a sun, a lamp:
-    /// a directional light not [standing for a region](crate::env_light::EnvLight::stands_for_region))
-    /// is one deep opacity texel per fiber, sharp at fiber scale, so a layer's mean fiber would
-    /// read the visibility of its mean position, not its fibers' mean visibility: the layered
-    /// view shades such batches per fragment, as the occupancy view does (quarry at 160×120
-    /// against the truth: 0.338 with the sun per layer, 0.290 per fragment, for ~3× the frame;
-    /// docs/BENCHMARKS.md, "The view: layers"). SRBF lobes and the lights that stand for a
-    /// region of the map (a reference's cube texel, a median-cut region), whose true shadows
-    /// are soft at fiber scale, are shaded per layer.
-    pub fn for_batch(self, sharp_shadow: bool) -> Self {
-        match self {
-            Self::Layered { visibility_cutoff } if sharp_shadow => {
-                Self::Occupancy { visibility_cutoff }
-            }
-            view => view,
         }
     }
 
@@ -141,29 +124,57 @@ pub struct FragmentCounts {
 }
 
 /// The per-pixel records of the occupancy map (a 16-byte placeholder for
-/// [`ViewTransparency::Opaque`], which reads none).
+/// [`ViewTransparency::Opaque`], which reads none), followed in the layered view by the layers'
+/// light visibility of a batch of compact sources.
+///
+/// A compact source's visibility (a sun, a lamp: a directional light not
+/// [standing for a region](crate::env_light::EnvLight::stands_for_region)) is one deep opacity
+/// texel per fiber, sharp at fiber scale: a layer's mean fiber reads the visibility of its mean
+/// position, not its fibers' mean visibility (quarry at 160×120 against the truth: 0.338 read
+/// at the mean position, 0.290 shaded per fragment, for ~3× the frame; docs/BENCHMARKS.md, "The
+/// view: layers"). So a batch of them first gathers Σw·v per layer and light (its strands
+/// rasterized once, no light shaded), and each layer is shaded once with Σw·v / Σw
+/// (`view_layers.wgsl`). SRBF lobes and the lights that stand for a region of the map (a
+/// reference's cube texel, a median-cut region), whose true shadows are soft at fiber scale,
+/// read theirs at the layer's mean position.
 pub struct OccupancyMap {
     pub buffer: wgpu::Buffer,
+    /// The records' u32 (where the layers' light visibility starts).
+    pub record_words: u64,
+    /// Light slots per layer and pixel: the most lights a batch of compact sources holds
+    /// (0: the frame has none, or is not layered).
+    pub layer_light_slots: u32,
 }
 
 impl OccupancyMap {
-    pub fn bytes(transparency: ViewTransparency, width: u32, height: u32) -> u64 {
-        match transparency {
-            ViewTransparency::Opaque => 16,
-            _ => width as u64 * height as u64 * transparency.record_words() * 4,
-        }
-    }
-
+    /// `compact_slots`: the most light slots a batch of compact sources would take (the batch
+    /// size, or the frame's compact sources if fewer); fewer are kept where the adapter's
+    /// storage binding limit leaves room for fewer, down to one.
     pub fn new(
         gpu: &GpuContext,
         transparency: ViewTransparency,
-        width: u32,
-        height: u32,
+        (width, height): (u32, u32),
+        compact_slots: u32,
     ) -> Result<Self, OccupancyError> {
         transparency.check()?;
-        let bytes = Self::bytes(transparency, width, height);
-        GpuLimits::of(gpu).check_storage_buffer("occupancy map", bytes, |max| {
-            let per_pixel = transparency.record_words() * 4;
+        let pixels = width as u64 * height as u64;
+        let record_words = match transparency {
+            ViewTransparency::Opaque => 0,
+            _ => pixels * transparency.record_words(),
+        };
+        let limits = GpuLimits::of(gpu);
+        let slot_bytes = pixels * VIEW_LAYERS * 4;
+        let layer_light_slots = match transparency {
+            ViewTransparency::Layered { .. } if compact_slots > 0 => {
+                let room = limits.max_storage_bytes().saturating_sub(record_words * 4);
+                (room / slot_bytes).clamp(1, compact_slots as u64) as u32
+            }
+            _ => 0,
+        };
+        let bytes = (record_words * 4 + layer_light_slots as u64 * slot_bytes).max(16);
+        limits.check_storage_buffer("occupancy map", bytes, |max| {
+            let per_pixel =
+                transparency.record_words() * 4 + layer_light_slots.min(1) as u64 * VIEW_LAYERS * 4;
             let (w, h) = fit_pixels(width, height, max / per_pixel);
             format!("render at {w}x{h} or smaller, or use the opaque view")
         })?;
@@ -173,7 +184,16 @@ impl OccupancyMap {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Ok(Self { buffer })
+        Ok(Self {
+            buffer,
+            record_words,
+            layer_light_slots,
+        })
+    }
+
+    /// The layers' light visibility: zeroed before each batch of compact sources gathers it.
+    pub fn clear_layer_lights(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.clear_buffer(&self.buffer, self.record_words * 4, None);
     }
 
     pub fn memory(&self) -> (String, u64) {

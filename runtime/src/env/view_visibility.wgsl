@@ -7,10 +7,10 @@
 
 #import strandlight::fullscreen::fullscreen_triangle
 #import strandlight::head_view::behind_head
-#import strandlight::occupancy_map::{OCC_SLICES_PER_SLAB, OCC_TAU_SCALE, OCC_WEIGHT_SCALE, fragment_optical_depth, occupancy_record, occupancy_slice, occupancy_visibility, occupancy_weight, ordered_depth, pixel_depth_range, view_depth}
+#import strandlight::occupancy_map::{OCC_SLICES_PER_SLAB, OCC_TAU_SCALE, OCC_WEIGHT_SCALE, fragment_optical_depth, occupancy_record, occupancy_slice, occupancy_visibility, ordered_depth, pixel_depth_range, view_depth}
 #import strandlight::strand_quads::{VertexOut, strand_draw_vertex}
 #import strandlight::view_binding::{view, occupancy_map}
-#import strandlight::view_layers::{OCC_LAYERS, add_fixed, layer_word, load_fixed, pixel_coverage}
+#import strandlight::view_layers::{OCC_LAYERS, add_fixed, layer_fragment, layer_word, load_fixed}
 
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> VertexOut {
@@ -98,19 +98,15 @@ fn fs_count_visible(in: VertexOut) -> @location(0) vec4<f32> {
 // its layer.
 @fragment
 fn fs_view_layers(in: VertexOut) {
-    if (behind_head(in)) { discard; }
-    let seen = occupancy_visibility(in);
-    if (seen < view.visibility_cutoff) { discard; }
-    let r = occupancy_record(in.clip.xy, view.width);
-    let w = occupancy_weight(in, seen);
-    let in_front = (1.0 - seen) / max(pixel_coverage(r), 1e-6);
-    let layer = min(u32(max(in_front, 0.0) * f32(OCC_LAYERS)), OCC_LAYERS - 1u);
+    let f = layer_fragment(in);
+    if (!f.kept) { discard; }
     let t = normalize(in.tangent);
-    add_fixed(layer_word(r, layer, 0u), w);
-    add_fixed(layer_word(r, layer, 1u), w * in.clip.z);
-    add_fixed(layer_word(r, layer, 2u), w * t.x);
-    add_fixed(layer_word(r, layer, 3u), w * t.y);
-    add_fixed(layer_word(r, layer, 4u), w * t.z);
+    let w = f.weight;
+    add_fixed(layer_word(f.record, f.layer, 0u), w);
+    add_fixed(layer_word(f.record, f.layer, 1u), w * in.clip.z);
+    add_fixed(layer_word(f.record, f.layer, 2u), w * t.x);
+    add_fixed(layer_word(f.record, f.layer, 3u), w * t.y);
+    add_fixed(layer_word(f.record, f.layer, 4u), w * t.z);
 }
 
 // Benchmarks: the layers one batch shades (green), as fs_count_visible counts fragments.
