@@ -18,8 +18,13 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::window::{Window, WindowId};
 
-/// Frame interval while something changes.
+/// Frame interval while something changes (input, a new image, a script's step).
 const BUSY_FRAME: Duration = Duration::from_millis(33);
+/// Frame interval while only the readout's progress moves (the worker refining or baking): on
+/// a software adapter the window's frames take the cores the worker renders on (at 800×600,
+/// repainting every BUSY_FRAME held the default frame's convergence at 26 s, every
+/// PROGRESS_FRAME at XX s; docs/BENCHMARKS.md, "The first look").
+const PROGRESS_FRAME: Duration = Duration::from_millis(250);
 /// Width of the side panel, points.
 const PANEL_WIDTH: f64 = 320.0;
 
@@ -435,6 +440,9 @@ impl ApplicationHandler for App {
             self.repaint_asked = true;
         }
         let response = gpu.egui_input.on_window_event(&gpu.window, &event);
+        // egui-winit asks a repaint for every event, the redraw itself included: taken as is,
+        // each frame would ask the next and the window would repaint every BUSY_FRAME for ever.
+        let input = !matches!(event, WindowEvent::RedrawRequested);
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => gpu.resize(size.width, size.height),
@@ -442,7 +450,7 @@ impl ApplicationHandler for App {
             _ => {}
         }
         // Input is shown at the next paced frame (at most BUSY_FRAME later).
-        self.repaint_asked |= response.repaint;
+        self.repaint_asked |= input && response.repaint;
     }
 
     /// The worker changed its status: shown at the next paced frame.
@@ -454,11 +462,12 @@ impl ApplicationHandler for App {
         let (Some(gpu), Some(session)) = (&self.window, &self.session) else {
             return;
         };
-        if self.repaint_asked
-            || session.busy()
-            || self.script.as_ref().is_some_and(|s| !s.finished())
-        {
-            let due = self.last_redraw + BUSY_FRAME;
+        let scripted = (self.script.as_ref()).is_some_and(|s| !s.finished() && !s.waiting());
+        let changing = self.repaint_asked || scripted;
+        let waiting = self.script.as_ref().is_some_and(|s| !s.finished());
+        if changing || waiting || session.busy() {
+            let interval = if changing { BUSY_FRAME } else { PROGRESS_FRAME };
+            let due = self.last_redraw + interval;
             if Instant::now() >= due {
                 gpu.window.request_redraw();
             } else {

@@ -106,6 +106,12 @@ impl Script {
         self.next >= self.steps.len()
     }
 
+    /// Whether the next step waits on the renderer (whose changes wake the window), rather
+    /// than acting on the window frame by frame.
+    pub fn waiting(&self) -> bool {
+        matches!(self.steps.get(self.next), Some(Step::Wait(_)))
+    }
+
     /// How far: "step 3/7".
     pub fn position(&self) -> String {
         format!(
