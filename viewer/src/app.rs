@@ -21,9 +21,9 @@ use winit::window::{Window, WindowId};
 /// Frame interval while something changes (input, a new image, a script's step).
 const BUSY_FRAME: Duration = Duration::from_millis(33);
 /// Frame interval while only the readout's progress moves (the worker refining or baking): on
-/// a software adapter the window's frames take the cores the worker renders on (at 800×600,
-/// repainting every BUSY_FRAME held the default frame's convergence at 26 s, every
-/// PROGRESS_FRAME at XX s; docs/BENCHMARKS.md, "The first look").
+/// a software adapter the window's frames take the cores the worker renders on (the default
+/// view at 800×600 on lavapipe converged in 25.5 s repainting every BUSY_FRAME, in 17.8 s
+/// every PROGRESS_FRAME; docs/BENCHMARKS.md, "The first look").
 const PROGRESS_FRAME: Duration = Duration::from_millis(250);
 /// Width of the side panel, points.
 const PANEL_WIDTH: f64 = 320.0;

@@ -131,10 +131,11 @@ pub struct FragmentCounts {
 /// [standing for a region](crate::env_light::EnvLight::stands_for_region)) is one deep opacity
 /// texel per fiber, sharp at fiber scale: a layer's mean fiber reads the visibility of its mean
 /// position, not its fibers' mean visibility (quarry at 160×120 against the truth: 0.338 read
-/// at the mean position, 0.290 shaded per fragment, for ~3× the frame; docs/BENCHMARKS.md, "The
-/// view: layers"). So a batch of them first gathers Σw·v per layer and light (its strands
-/// rasterized once, no light shaded), and each layer is shaded once with Σw·v / Σw
-/// (`view_layers.wgsl`). SRBF lobes and the lights that stand for a region of the map (a
+/// at the mean position, 0.290 shaded per fragment, for ~3× the frame). So a batch of them
+/// first gathers Σw·v per layer and light (its strands rasterized once, no light shaded), and
+/// each layer is shaded once with Σw·v / Σw (`view_layers.wgsl`): quarry 0.2883 against 0.2876
+/// per fragment, on five maps within +0.006 for 1.3–1.6× faster frames (docs/BENCHMARKS.md,
+/// "Compact sources per layer"). SRBF lobes and the lights that stand for a region of the map (a
 /// reference's cube texel, a median-cut region), whose true shadows are soft at fiber scale,
 /// read theirs at the layer's mean position.
 pub struct OccupancyMap {
