@@ -93,6 +93,16 @@ fn main() -> anyhow::Result<()> {
     }
 }
 
+/// Rust ignores SIGPIPE, so printing into a pipe its reader closed (`strandlight … | head`)
+/// panics; a command-line tool should stop quietly, as `cat` does.
+fn quiet_on_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: called first in main, before any other thread exists; SIG_DFL is a valid handler.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 #[cfg(test)]
 mod glossary {
     //! docs/GLOSSARY.md against the flags clap actually accepts, both ways.
@@ -183,15 +193,5 @@ mod glossary {
         }
         let over: Vec<_> = per_subcommand.iter().filter(|(_, n)| **n > 25).collect();
         assert!(over.is_empty(), "subcommands over 25 flags: {over:?}");
-    }
-}
-
-/// Rust ignores SIGPIPE, so printing into a pipe its reader closed (`strandlight … | head`)
-/// panics; a command-line tool should stop quietly, as `cat` does.
-fn quiet_on_closed_pipe() {
-    #[cfg(unix)]
-    // SAFETY: called first in main, before any other thread exists; SIG_DFL is a valid handler.
-    unsafe {
-        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
