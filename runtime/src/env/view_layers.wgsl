@@ -13,9 +13,10 @@
 // fibers' visibility v of the light (fs_env_layer_lights, view_shading.wgsl), which the layer's
 // shading divides by Σw. A compact source's shadow is sharp at fiber scale: the visibility at
 // the layer's mean position is not its fibers' mean visibility (quarry at 160×120 against the
-// truth: 0.338 read at the mean position, 0.290 shaded per fragment; docs/BENCHMARKS.md, "The
-// view: layers"). These words follow every pixel's record, `view.layer_lights.y` slots per
-// layer from word `view.layer_lights.x` on, zeroed before each such batch.
+// truth: 0.338 read at the mean position, 0.290 shaded per fragment, 0.288 from Σw·v;
+// docs/BENCHMARKS.md, "Compact sources per layer"). These words follow every pixel's record,
+// `view.layer_lights.y` slots per layer from word `view.layer_lights.x` on, zeroed before each
+// such batch.
 //
 // Record words after the occupancy map's OCC_RECORD, per layer: Σw, Σw·z (z the fragment's
 // depth in [0, 1], as the rasterizer writes it), Σw·t (three words, t the unit tangent), each
