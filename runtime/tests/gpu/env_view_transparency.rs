@@ -160,6 +160,21 @@ fn render_srbf(
     render_lit(model, table, transparency, &[Kind::Srbf], RES, RES)
 }
 
+/// The test frames' options: 64² light maps, 4 lights a batch, every strand in them.
+fn options(transparency: ViewTransparency, shadowed: bool) -> EnvRenderOptions {
+    EnvRenderOptions {
+        dodm: DodmSettings {
+            resolution: 64,
+            first_layer: None,
+            batch_size: 4,
+        },
+        kappa: 1.0,
+        shadowed,
+        transparency,
+        ..Default::default()
+    }
+}
+
 fn render_lit(
     model: &HairModel,
     table: &Table,
@@ -170,16 +185,8 @@ fn render_lit(
 ) -> Result<(Vec<[f32; 4]>, Option<FragmentCounts>), EnvRenderError> {
     let gpu = gpu();
     let options = EnvRenderOptions {
-        dodm: DodmSettings {
-            resolution: 64,
-            first_layer: None,
-            batch_size: 4,
-        },
-        kappa: 1.0,
-        shadowed: false,
-        transparency,
         count_fragments: true,
-        ..Default::default()
+        ..options(transparency, false)
     };
     let tables = match kinds.contains(&Kind::Srbf) {
         false => EnvTables {
@@ -396,17 +403,7 @@ fn layered_view_shades_each_layer_at_its_fibers_mean_tangent() {
 /// fiber is lit through those between it and the light (its deep opacity map's transmittance,
 /// sharp at fiber scale).
 fn render_shadowed(model: &HairModel, transparency: ViewTransparency) -> Vec<[f32; 4]> {
-    let options = EnvRenderOptions {
-        dodm: DodmSettings {
-            resolution: 64,
-            first_layer: None,
-            batch_size: 4,
-        },
-        kappa: 1.0,
-        shadowed: true,
-        transparency,
-        ..Default::default()
-    };
+    let options = options(transparency, true);
     let axes = direct_table().axes().to_vec();
     let table = Table::from_fn(axes, 3, |_, out| out.copy_from_slice(&COLOUR)).unwrap();
     let tables = EnvTables {
