@@ -210,7 +210,6 @@ struct ReplayArgs {
     output: OutputArgs,
 }
 
-/// `render.exr` → `render`: the stem may be given with either extension.
 /// Before the render, not after it: a missing folder is made, and one that cannot be is
 /// reported before minutes of work are spent.
 fn create_output_dir(out: &Path) -> anyhow::Result<()> {
@@ -221,6 +220,7 @@ fn create_output_dir(out: &Path) -> anyhow::Result<()> {
     }
 }
 
+/// `render.exr` → `render`: the stem may be given with either extension.
 fn output_stem(out: &Path) -> PathBuf {
     match out.extension().and_then(|e| e.to_str()) {
         Some("exr" | "png") => out.with_extension(""),

@@ -462,10 +462,9 @@ impl ApplicationHandler for App {
         let (Some(gpu), Some(session)) = (&self.window, &self.session) else {
             return;
         };
-        let scripted = (self.script.as_ref()).is_some_and(|s| !s.finished() && !s.waiting());
-        let changing = self.repaint_asked || scripted;
-        let waiting = self.script.as_ref().is_some_and(|s| !s.finished());
-        if changing || waiting || session.busy() {
+        let script = self.script.as_ref().filter(|s| !s.finished());
+        let changing = self.repaint_asked || script.is_some_and(|s| !s.waiting());
+        if changing || script.is_some() || session.busy() {
             let interval = if changing { BUSY_FRAME } else { PROGRESS_FRAME };
             let due = self.last_redraw + interval;
             if Instant::now() >= due {

@@ -8,7 +8,6 @@ use super::light_kinds::LightBatch;
 use super::stats::{BatchUsage, Timings};
 use super::view_binding::ViewBinding;
 use super::view_shading::ViewShadingInputs;
-use super::view_visibility::ViewTransparency;
 use super::{EnvRenderError, EnvRenderer};
 use crate::env_light::EnvLight;
 use crate::gpu::GpuContext;
@@ -58,9 +57,9 @@ pub(super) fn render_batch(
         );
         let mut visibility = frame.visibility(options);
         let transparency = options.transparency;
-        visibility.layer_lights = frame.occupancy.layer_light_slots > 0
-            && matches!(transparency, ViewTransparency::Layered { .. })
-            && batch.has_sharp_shadows();
+        // Only the layered view keeps slots for them.
+        visibility.layer_lights =
+            frame.occupancy.layer_light_slots > 0 && batch.has_sharp_shadows();
         let view = ViewBinding::new(gpu, &renderer.layouts.view, grid.as_ref(), &visibility);
         usage.grid_bytes = usage.grid_bytes.max(view.bytes);
         let inputs = ViewShadingInputs {

@@ -46,9 +46,7 @@ impl LightKinds {
     /// Whether any light is a compact source, whose maps are fitted to the hair
     /// ([`LightFraming::Fitted`](crate::camera::LightFraming::Fitted)).
     pub(super) fn has_sharp_shadows(&self) -> bool {
-        (self.directional.iter())
-            .chain(&self.directional_thinned)
-            .any(EnvLight::has_sharp_shadow)
+        self.compact_sources() > 0
     }
 
     /// How many lights are compact sources.

@@ -82,7 +82,7 @@ impl ViewBinding {
             },
             clip_to_world: visibility.view_proj.inverse().to_cols_array_2d(),
             layer_lights: [
-                visibility.map.record_words as u32,
+                visibility.map.layer_lights_word as u32,
                 visibility.map.layer_light_slots,
                 visibility.layer_lights as u32,
                 0,

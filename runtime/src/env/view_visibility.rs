@@ -140,8 +140,8 @@ pub struct FragmentCounts {
 /// read theirs at the layer's mean position.
 pub struct OccupancyMap {
     pub buffer: wgpu::Buffer,
-    /// The records' u32 (where the layers' light visibility starts).
-    pub record_words: u64,
+    /// The first u32 after every pixel's record: where the layers' light visibility starts.
+    pub layer_lights_word: u64,
     /// Light slots per layer and pixel: the most lights a batch of compact sources holds
     /// (0: the frame has none, or is not layered).
     pub layer_light_slots: u32,
@@ -159,7 +159,7 @@ impl OccupancyMap {
     ) -> Result<Self, OccupancyError> {
         transparency.check()?;
         let pixels = width as u64 * height as u64;
-        let record_words = match transparency {
+        let layer_lights_word = match transparency {
             ViewTransparency::Opaque => 0,
             _ => pixels * transparency.record_words(),
         };
@@ -167,12 +167,14 @@ impl OccupancyMap {
         let slot_bytes = pixels * VIEW_LAYERS * 4;
         let layer_light_slots = match transparency {
             ViewTransparency::Layered { .. } if compact_slots > 0 => {
-                let room = limits.max_storage_bytes().saturating_sub(record_words * 4);
+                let room = limits
+                    .max_storage_bytes()
+                    .saturating_sub(layer_lights_word * 4);
                 (room / slot_bytes).clamp(1, compact_slots as u64) as u32
             }
             _ => 0,
         };
-        let bytes = (record_words * 4 + layer_light_slots as u64 * slot_bytes).max(16);
+        let bytes = (layer_lights_word * 4 + layer_light_slots as u64 * slot_bytes).max(16);
         limits.check_storage_buffer("occupancy map", bytes, |max| {
             let per_pixel =
                 transparency.record_words() * 4 + layer_light_slots.min(1) as u64 * VIEW_LAYERS * 4;
@@ -187,14 +189,14 @@ impl OccupancyMap {
         });
         Ok(Self {
             buffer,
-            record_words,
+            layer_lights_word,
             layer_light_slots,
         })
     }
 
     /// The layers' light visibility: zeroed before each batch of compact sources gathers it.
     pub fn clear_layer_lights(&self, encoder: &mut wgpu::CommandEncoder) {
-        encoder.clear_buffer(&self.buffer, self.record_words * 4, None);
+        encoder.clear_buffer(&self.buffer, self.layer_lights_word * 4, None);
     }
 
     pub fn memory(&self) -> (String, u64) {
