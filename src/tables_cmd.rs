@@ -156,6 +156,7 @@ pub fn bake(args: BakeArgs) -> anyhow::Result<()> {
         resolution,
         force_multiple: args.force_multiple,
         multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD,
+        tables: None,
     };
     let start = Instant::now();
     let plan = plan(&fiber, &options)?;

@@ -18,7 +18,7 @@ use crate::srbf_spread::srbf_spread_table;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 use strandlight_tables::FiberAngles;
 use strandlight_tables::artist::{ArtistModel, ArtistParams, Normalization};
 use strandlight_tables::chiang::{Chiang, ChiangParams};
@@ -269,7 +269,8 @@ pub struct BakePlan {
     pub skipped: Vec<SkippedTable>,
     /// The direction-averaged single-event albedo ā_f + ā_b of the brightest channel: the
     /// share of the scattered energy that goes on to scatter again (the multiple-scattering
-    /// share in a dense volume).
+    /// share in a dense volume). `None` when no model has one, or the plan's tables leave out
+    /// `multiple`.
     pub multiple_scattering_share: Option<f64>,
 }
 
@@ -282,6 +283,17 @@ pub struct PlanOptions {
     pub resolution: BakeResolution,
     pub force_multiple: bool,
     pub multiple_threshold: f64,
+    /// Only these of the models' tables (`None`: all of them). A plan without `multiple`
+    /// makes no multiple-scattering decision, so it integrates no fiber averages.
+    pub tables: Option<Vec<String>>,
+}
+
+impl PlanOptions {
+    fn wants(&self, table: &str) -> bool {
+        self.tables
+            .as_ref()
+            .is_none_or(|wanted| wanted.iter().any(|name| name == table))
+    }
 }
 
 impl Default for PlanOptions {
@@ -291,6 +303,7 @@ impl Default for PlanOptions {
             resolution: BakeResolution::default(),
             force_multiple: false,
             multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD,
+            tables: None,
         }
     }
 }
@@ -306,11 +319,50 @@ fn param_error(context: &'static str) -> impl Fn(ParamError) -> FiberError {
     }
 }
 
+/// A model's dual-scattering averages, integrated when a job or the multiple-scattering
+/// decision first reads them: with Chiang's azimuthal grid 0.29 s of every plan, which a first
+/// look's single-scattering tables (or a cache holding every table) never need.
+#[derive(Clone)]
+struct LazyAverages {
+    averages: Arc<OnceLock<Result<DualScatteringAverages, ParamError>>>,
+    compute: Arc<dyn Fn() -> Result<DualScatteringAverages, ParamError> + Send + Sync>,
+    context: &'static str,
+}
+
+impl LazyAverages {
+    fn new<M: LobeDecomposition + 'static>(
+        model: Arc<M>,
+        config: DualScatteringConfig,
+        context: &'static str,
+    ) -> Self {
+        Self {
+            averages: Arc::new(OnceLock::new()),
+            compute: Arc::new(move || DualScatteringAverages::new(model.as_ref(), config)),
+            context,
+        }
+    }
+
+    fn get(&self) -> Result<&DualScatteringAverages, FiberError> {
+        self.averages
+            .get_or_init(|| (self.compute)())
+            .as_ref()
+            .map_err(|e| param_error(self.context)(e.clone()))
+    }
+
+    /// The dual-scattering BCSDF of `single` with these averages (its `d_b S_back` term).
+    fn bcsdf<S: Clone + 'static>(&self, single: &S) -> Result<DualScatteringBcsdf<S>, BuildError> {
+        Ok(DualScatteringBcsdf {
+            single: single.clone(),
+            averages: self.get().map_err(boxed)?.clone(),
+        })
+    }
+}
+
 /// The model whose BCSDF multiple scattering uses, with its dual-scattering averages, their
 /// fiber parameters (for the cache key) and the name written into the `multiple` table.
 struct MultipleScatteringSource {
     single: Arc<dyn ScatteringFunction>,
-    averages: DualScatteringAverages,
+    averages: LazyAverages,
     params: serde_json::Value,
     name: &'static str,
 }
@@ -360,8 +412,13 @@ pub fn plan(fiber: &FiberDescription, options: &PlanOptions) -> Result<BakePlan,
         multiple_source = multiple_source.or(artist_source);
     }
 
-    let share = multiple_source
-        .map(|source| push_multiple_scattering(&mut jobs, &mut skipped, source, options));
+    let share = match multiple_source {
+        Some(source) => push_multiple_scattering(&mut jobs, &mut skipped, source, options)?,
+        None => None,
+    };
+    if let Some(wanted) = &options.tables {
+        jobs.retain(|job| wanted.iter().any(|name| name == job.name));
+    }
     Ok(BakePlan {
         jobs,
         skipped,
@@ -391,16 +448,14 @@ fn push_marschner(
         settings: conv_settings.clone(),
         build: Box::new(move || Ok(bake_convolution_table(&|a: &FiberAngles| s.eval(a), &r.convolution, &settings)?)),
     });
-    let averages =
-        DualScatteringAverages::new(m.as_ref() as &dyn LobeDecomposition, fiber.dual_scattering)
-            .map_err(param_error("[marschner] dual-scattering averages"))?;
+    let averages = LazyAverages::new(
+        m.clone(),
+        fiber.dual_scattering,
+        "[marschner] dual-scattering averages",
+    );
     let full_params =
         json!({ "marschner": fiber.marschner, "dual_scattering": fiber.dual_scattering });
-    let bcsdf = Arc::new(DualScatteringBcsdf {
-        single: (*m).clone(),
-        averages: averages.clone(),
-    });
-    let (b, r) = (bcsdf.clone(), res.clone());
+    let (a, single, r) = (averages.clone(), m.clone(), res.clone());
     jobs.push(TableJob {
         name: "marschner_full",
         quantity: "I_M with d_b·S_back: ∫ G (S + d_b S_back) cos θ_i dω_i (Ren §7), RGB".into(),
@@ -408,6 +463,7 @@ fn push_marschner(
         fiber_parameters: full_params.clone(),
         settings: conv_settings,
         build: Box::new(move || {
+            let b = a.bcsdf(single.as_ref())?;
             Ok(bake_convolution_table(
                 &|a: &FiberAngles| b.eval(a),
                 &r.convolution,
@@ -415,6 +471,7 @@ fn push_marschner(
             )?)
         }),
     });
+    let direct_model = m.clone();
     push_direct(
         jobs,
         "marschner_direct",
@@ -422,8 +479,9 @@ fn push_marschner(
         "marschner",
         params.clone(),
         res,
-        m.clone(),
+        move || Ok(direct_model),
     );
+    let (a, single) = (averages.clone(), m.clone());
     push_direct(
         jobs,
         "marschner_full_direct",
@@ -431,7 +489,7 @@ fn push_marschner(
         "marschner+dual-scattering-back",
         full_params.clone(),
         res,
-        bcsdf,
+        move || Ok(Arc::new(a.bcsdf(single.as_ref())?)),
     );
     push_fiber_averages(
         jobs,
@@ -493,15 +551,20 @@ fn push_artist(
         "artist",
         json!({ "artist": fiber.artist }),
         res,
-        a.clone(),
+        {
+            let a = a.clone();
+            move || Ok(a)
+        },
     );
     if !multiple_source_needed {
         return Ok(None);
     }
-    let normalized = a.normalized(Normalization::PeakPerChannel);
-    let averages =
-        DualScatteringAverages::new(&normalized as &dyn LobeDecomposition, fiber.dual_scattering)
-            .map_err(param_error("[artist] dual-scattering averages"))?;
+    let normalized = Arc::new(a.normalized(Normalization::PeakPerChannel));
+    let averages = LazyAverages::new(
+        normalized.clone(),
+        fiber.dual_scattering,
+        "[artist] dual-scattering averages",
+    );
     let params = json!({ "artist": fiber.artist, "dual_scattering": fiber.dual_scattering, "normalization": "peak-per-channel" });
     push_fiber_averages(
         jobs,
@@ -510,7 +573,7 @@ fn push_artist(
         res.fiber_average_thetas,
     );
     Ok(Some(MultipleScatteringSource {
-        single: Arc::new(normalized),
+        single: normalized,
         averages,
         params,
         name: "artist-normalized",
@@ -527,15 +590,22 @@ fn push_multiple_scattering(
     skipped: &mut Vec<SkippedTable>,
     source: MultipleScatteringSource,
     options: &PlanOptions,
-) -> f64 {
+) -> Result<Option<f64>, FiberError> {
     let MultipleScatteringSource {
         single,
         averages,
         params,
         name,
     } = source;
-    let albedo = single_event_albedo(&averages);
-    if albedo < options.multiple_threshold && !options.force_multiple {
+    // The decision reads the averages: made only for a plan that may bake `multiple`.
+    let albedo = match options.wants("multiple") {
+        true => Some(single_event_albedo(averages.get()?)),
+        false => None,
+    };
+    if let Some(albedo) = albedo
+        && albedo < options.multiple_threshold
+        && !options.force_multiple
+    {
         skipped.push(SkippedTable {
             name: "multiple".into(),
             reason: format!(
@@ -544,9 +614,9 @@ fn push_multiple_scattering(
                 100.0 * options.multiple_threshold
             ),
         });
-    } else {
+    } else if albedo.is_some() {
         let r = options.resolution.clone();
-        let d_b = averages.config().density_backward;
+        let d_b = averages.get()?.config().density_backward;
         jobs.push(TableJob {
             name: "multiple",
             quantity: "I_G: ∫ ψ_f(ξ, ω_i, σ̄_f) (S + d_b S_back) cos θ_i dω_i (Ren eq. 11), σ̄_f = std of θ_i, RGB".into(),
@@ -554,6 +624,7 @@ fn push_multiple_scattering(
             fiber_parameters: params,
             settings: json!({ "multiple": r.multiple }),
             build: Box::new(move || {
+                let averages = averages.get()?;
                 let s_d = |a: &FiberAngles| -> Rgb {
                     let s = single.eval(a);
                     let b = averages.backward_scattering(a);
@@ -581,7 +652,7 @@ fn push_multiple_scattering(
         settings: json!({ "srbf_spread": r.srbf_spread, "lambda": [r.convolution.lambda_min, r.convolution.lambda_max] }),
         build: Box::new(move || Ok(srbf_spread_table(r.srbf_spread[0], r.srbf_spread[1], r.convolution.lambda_min, r.convolution.lambda_max)?)),
     });
-    albedo
+    Ok(albedo)
 }
 
 /// The Chiang jobs, parallel to Marschner's: `chiang` (I of S), `chiang_full` (S + d_b S_back
@@ -595,17 +666,10 @@ fn push_chiang(
     fiber: &FiberDescription,
     res: &BakeResolution,
     settings: ConvolutionSettings,
-) -> Result<
-    (
-        Arc<dyn ScatteringFunction>,
-        DualScatteringAverages,
-        serde_json::Value,
-    ),
-    FiberError,
-> {
+) -> Result<(Arc<dyn ScatteringFunction>, LazyAverages, serde_json::Value), FiberError> {
+    // Its N̄ grid is built by the first job that evaluates it (0.17 s: none, when every
+    // table is cached).
     let c = Arc::new(Chiang::new(fiber.chiang.clone()).map_err(param_error("[chiang]"))?);
-    // Build the model's N̄ grid once, before the jobs share it.
-    c.prepare();
     let params = json!({ "chiang": fiber.chiang });
     let conv_settings = json!({ "resolution": res.convolution, "settings": res.settings });
     let (s, r) = (c.clone(), res.clone());
@@ -617,15 +681,13 @@ fn push_chiang(
         settings: conv_settings.clone(),
         build: Box::new(move || Ok(bake_convolution_table(&|a: &FiberAngles| s.eval(a), &r.convolution, &settings)?)),
     });
-    let averages =
-        DualScatteringAverages::new(c.as_ref() as &dyn LobeDecomposition, fiber.dual_scattering)
-            .map_err(param_error("[chiang] dual-scattering averages"))?;
+    let averages = LazyAverages::new(
+        c.clone(),
+        fiber.dual_scattering,
+        "[chiang] dual-scattering averages",
+    );
     let full_params = json!({ "chiang": fiber.chiang, "dual_scattering": fiber.dual_scattering });
-    let bcsdf = Arc::new(DualScatteringBcsdf {
-        single: (*c).clone(),
-        averages: averages.clone(),
-    });
-    let (b, r) = (bcsdf.clone(), res.clone());
+    let (a, single, r) = (averages.clone(), c.clone(), res.clone());
     jobs.push(TableJob {
         name: "chiang_full",
         quantity: "I_C with d_b·S_back: ∫ G (S + d_b S_back) cos θ_i dω_i (Ren §7), RGB".into(),
@@ -633,6 +695,7 @@ fn push_chiang(
         fiber_parameters: full_params.clone(),
         settings: conv_settings,
         build: Box::new(move || {
+            let b = a.bcsdf(single.as_ref())?;
             Ok(bake_convolution_table(
                 &|a: &FiberAngles| b.eval(a),
                 &r.convolution,
@@ -640,6 +703,7 @@ fn push_chiang(
             )?)
         }),
     });
+    let direct_model = c.clone();
     push_direct(
         jobs,
         "chiang_direct",
@@ -647,8 +711,9 @@ fn push_chiang(
         "chiang",
         params.clone(),
         res,
-        c.clone(),
+        move || Ok(direct_model),
     );
+    let (a, single) = (averages.clone(), c.clone());
     push_direct(
         jobs,
         "chiang_full_direct",
@@ -656,7 +721,7 @@ fn push_chiang(
         "chiang+dual-scattering-back",
         full_params.clone(),
         res,
-        bcsdf,
+        move || Ok(Arc::new(a.bcsdf(single.as_ref())?)),
     );
     let (cm, cn) = (c.clone(), c.clone());
     let luts = res.luts;
@@ -688,7 +753,7 @@ fn push_direct(
     scattering_function: &str,
     fiber_parameters: serde_json::Value,
     res: &BakeResolution,
-    model: Arc<dyn ScatteringFunction>,
+    model: impl FnOnce() -> Result<Arc<dyn ScatteringFunction>, BuildError> + Send + 'static,
 ) {
     let direct = res.direct();
     jobs.push(TableJob {
@@ -698,6 +763,7 @@ fn push_direct(
         fiber_parameters,
         settings: json!({ "direct": direct }),
         build: Box::new(move || {
+            let model = model()?;
             Ok(bake_direct_table(
                 &|a: &FiberAngles| model.eval(a),
                 &direct,
@@ -733,7 +799,7 @@ pub const FIBER_AVERAGE_QUANTITIES: [&str; 9] = [
 
 fn push_fiber_averages(
     jobs: &mut Vec<TableJob>,
-    averages: DualScatteringAverages,
+    averages: LazyAverages,
     params: serde_json::Value,
     thetas: usize,
 ) {
@@ -748,6 +814,7 @@ fn push_fiber_averages(
                 Axis::with_mapping(AXIS_SIN_THETA, -1.0, 1.0, thetas, AxisMapping::Arcsine),
                 Axis::uniform(AXIS_QUANTITY, 0.0, (FIBER_AVERAGE_QUANTITIES.len() - 1) as f64, FIBER_AVERAGE_QUANTITIES.len()),
             ];
+            let averages = averages.get()?;
             Ok(Table::from_fn(axes, 3, |x, out| {
                 let theta = x[0].clamp(-1.0, 1.0).asin();
                 let a = averages.averages_at(theta);
@@ -861,6 +928,35 @@ fn push_kajiya_kay(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_plan_of_some_tables_keeps_their_cache_keys_and_leaves_multiple_undecided() {
+        let all = PlanOptions {
+            models: vec![Model::Chiang],
+            resolution: BakeResolution::reduced(4),
+            ..Default::default()
+        };
+        let first_look = PlanOptions {
+            tables: Some(vec!["chiang".into(), "chiang_full_direct".into()]),
+            ..all.clone()
+        };
+        let fiber = FiberDescription::preset("blonde").unwrap();
+        let keys = |options: &PlanOptions| -> Vec<(&str, String)> {
+            let plan = plan(&fiber, options).unwrap();
+            plan.jobs.iter().map(|j| (j.name, j.inputs_key())).collect()
+        };
+        let some = keys(&first_look);
+        let every = keys(&all);
+        assert_eq!(some.len(), 2, "{some:?}");
+        for job in &some {
+            assert!(every.contains(job), "{job:?} not in the whole plan");
+        }
+        let partial = plan(&fiber, &first_look).unwrap();
+        assert_eq!(partial.multiple_scattering_share, None);
+        assert!(partial.skipped.is_empty());
+        let whole = plan(&fiber, &all).unwrap();
+        assert!(whole.multiple_scattering_share.is_some());
+    }
 
     #[test]
     fn dark_hair_skips_multiple_scattering_and_blonde_keeps_it() {

@@ -91,6 +91,12 @@ fn env_renderer() -> anyhow::Result<(&'static GpuContext, &'static EnvRenderer)>
     Ok((gpu, RENDERER.get_or_init(|| EnvRenderer::new(gpu))))
 }
 
+/// Creates the device and the env-lit renderer's pipelines now (0.3 s on lavapipe), so that
+/// an application's first frame, prepared meanwhile, does not wait for them.
+pub fn prepare_env_renderer() -> anyhow::Result<()> {
+    env_renderer().map(|_| ())
+}
+
 /// The adapter the renderers run on (creating the device on first use).
 pub fn env_adapter() -> anyhow::Result<String> {
     Ok(shared_gpu()?.report.to_string())

@@ -156,6 +156,7 @@ pub fn bake_scene_tables(
         resolution: resolution.with_lambda_range(lambda_range.0, lambda_range.1),
         force_multiple: false,
         multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD,
+        tables: Some(wanted.iter().map(|name| name.to_string()).collect()),
     };
     let plan = plan(fiber, &options)?;
     let skipped = plan
@@ -166,7 +167,7 @@ pub fn bake_scene_tables(
     let mut expected: BTreeMap<String, Value> = BTreeMap::new();
     let mut keys: BTreeMap<String, String> = BTreeMap::new();
     let mut baked = Vec::new();
-    for job in plan.jobs.into_iter().filter(|j| wanted.contains(&j.name)) {
+    for job in plan.jobs {
         expected.insert(job.name.to_string(), job.fiber_parameters.clone());
         keys.insert(job.name.to_string(), job.inputs_key());
         let t = bake_job(job, dir, Storage::F32)?;

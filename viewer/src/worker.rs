@@ -94,6 +94,9 @@ impl Worker {
             quit: Mutex::new(false),
             wake_window,
         });
+        // The device and pipelines are made while the window opens and the tables load; an
+        // error here is the first frame's to report.
+        std::thread::spawn(|| strandlight_scene::env_frame::prepare_env_renderer().ok());
         let for_thread = shared.clone();
         let thread = std::thread::Builder::new()
             .name("strandlight render".into())

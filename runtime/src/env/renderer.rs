@@ -19,6 +19,7 @@ use super::{EncodedFrame, EnvImage, EnvRenderError, EnvRenderOptions, EnvRenderS
 use crate::camera::Camera;
 use crate::env_light::EnvLight;
 use crate::gpu::GpuContext;
+use crate::gpu::pipeline::build_both;
 use crate::gpu::readback::read_buffer;
 use crate::hair::HairModel;
 use crate::head::Head;
@@ -41,12 +42,26 @@ pub struct EnvRenderer {
 impl EnvRenderer {
     pub fn new(gpu: &GpuContext) -> Self {
         let layouts = EnvViewLayouts::new(&gpu.device);
+        let ((shading, visibility), (light_maps, (head, accumulate))) = build_both(
+            || {
+                build_both(
+                    || ViewShadingPass::new(gpu, &layouts),
+                    || view_visibility_pass(gpu, &layouts),
+                )
+            },
+            || {
+                build_both(
+                    || LightMapsPass::new(gpu),
+                    || build_both(|| HeadPass::new(gpu), || AccumulatePass::new(&gpu.device)),
+                )
+            },
+        );
         Self {
-            head: HeadPass::new(gpu),
-            visibility: view_visibility_pass(gpu, &layouts),
-            light_maps: LightMapsPass::new(gpu),
-            shading: ViewShadingPass::new(gpu, &layouts),
-            accumulate: AccumulatePass::new(&gpu.device),
+            head,
+            visibility,
+            light_maps,
+            shading,
+            accumulate,
             volume: VolumeCache::default(),
             tables: TableCache::default(),
             layouts,

@@ -15,7 +15,7 @@ use super::view_targets::EnvViewTargets;
 use super::view_visibility::{OccupancyMap, ViewTransparency, ViewVisibilityPass};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::pipeline_layout;
-use crate::gpu::pipeline::{ADDITIVE, StrandDraw, color_target, depth_test};
+use crate::gpu::pipeline::{ADDITIVE, StrandDraw, build_both, color_target, depth_test};
 use crate::passes::attachments::{cleared_color, prepassed_depth};
 use crate::passes::convolution_transmittance::{BatchBinding, transmittance_bind_group_layout};
 use crate::passes::render_target::DEPTH_FORMAT;
@@ -136,44 +136,75 @@ impl ViewShadingPass {
             ],
         );
         let pipeline = |names, blend| view_pipeline(gpu, &layout, shader, names, blend);
+        // The five compile on threads of their own (`build_both`): each holds the whole
+        // shading loop.
+        let ((opaque, transparent), ((layered, skin_behind_hair), layer_lights)) = build_both(
+            || {
+                build_both(
+                    // The depth prepass left each pixel's nearest fiber in two textures: the
+                    // opaque view shades those pixels, rasterizing no strand per batch.
+                    || {
+                        pipeline(
+                            ("env view (opaque)", "vs_fullscreen", "fs_env_deferred"),
+                            None,
+                        )
+                    },
+                    || {
+                        pipeline(
+                            ("env view (occupancy)", "vs_main", "fs_env_transparent"),
+                            Some(ADDITIVE),
+                        )
+                    },
+                )
+            },
+            || {
+                build_both(
+                    || {
+                        build_both(
+                            // The layers the frame's visibility gathered: a full-screen pass,
+                            // added to by the skin.
+                            || {
+                                pipeline(
+                                    ("env view (layered)", "vs_fullscreen", "fs_env_layered"),
+                                    Some(ADDITIVE),
+                                )
+                            },
+                            || {
+                                pipeline(
+                                    (
+                                        "env view (skin behind hair)",
+                                        "vs_fullscreen",
+                                        "fs_env_skin",
+                                    ),
+                                    Some(ADDITIVE),
+                                )
+                            },
+                        )
+                    },
+                    || {
+                        StrandDraw {
+                            label: "env view (layers' light visibility)",
+                            layout: &layout,
+                            shader,
+                            vertex_entry: "vs_main",
+                            fragment: Some(("fs_env_layer_lights", &[])),
+                            depth: Some(depth_test(
+                                DEPTH_FORMAT,
+                                false,
+                                wgpu::CompareFunction::Always,
+                            )),
+                        }
+                        .build(&gpu.device)
+                    },
+                )
+            },
+        );
         Self {
-            // The depth prepass left each pixel's nearest fiber in two textures: the opaque
-            // view shades those pixels, rasterizing no strand per batch.
-            opaque: pipeline(
-                ("env view (opaque)", "vs_fullscreen", "fs_env_deferred"),
-                None,
-            ),
-            transparent: pipeline(
-                ("env view (occupancy)", "vs_main", "fs_env_transparent"),
-                Some(ADDITIVE),
-            ),
-            // The layers the frame's visibility gathered: a full-screen pass, added to by the
-            // skin.
-            layered: pipeline(
-                ("env view (layered)", "vs_fullscreen", "fs_env_layered"),
-                Some(ADDITIVE),
-            ),
-            layer_lights: StrandDraw {
-                label: "env view (layers' light visibility)",
-                layout: &layout,
-                shader,
-                vertex_entry: "vs_main",
-                fragment: Some(("fs_env_layer_lights", &[])),
-                depth: Some(depth_test(
-                    DEPTH_FORMAT,
-                    false,
-                    wgpu::CompareFunction::Always,
-                )),
-            }
-            .build(&gpu.device),
-            skin_behind_hair: pipeline(
-                (
-                    "env view (skin behind hair)",
-                    "vs_fullscreen",
-                    "fs_env_skin",
-                ),
-                Some(ADDITIVE),
-            ),
+            opaque,
+            transparent,
+            layered,
+            layer_lights,
+            skin_behind_hair,
         }
     }
 

@@ -219,6 +219,7 @@ fn bake_tables(srbf_specs: &[LightSpec]) -> BTreeMap<String, Arc<Table>> {
             resolution: BakeResolution::reduced(nodes).with_lambda_range(lo, hi),
             force_multiple: false,
             multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD,
+            tables: None,
         };
         for job in plan(&fiber, &plan_options)
             .expect("plan")
