@@ -6,6 +6,7 @@
 //!
 //! [`EnvRenderer::encode_part_into`]: super::EnvRenderer::encode_part_into
 
+use super::frame_resources::{FrameView, ViewKey};
 use super::view_targets::EnvViewTargets;
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{
@@ -16,6 +17,7 @@ use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels, fit_within};
 use crate::gpu::pipeline::{compute_pipeline, wgsl_module};
 use crate::gpu::texture::texture_2d;
 use crate::passes::render_target::DEPTH_FORMAT;
+use std::sync::{Arc, Mutex};
 
 /// Pixels along each side of the accumulate pass's workgroups (`@workgroup_size(8, 8)`).
 const WORKGROUP_SIDE: u32 = 8;
@@ -34,7 +36,8 @@ pub(crate) struct AccumulateParams {
 /// A frame's running sums on the GPU: `width·height` RGBA f32 of single scattering, then as many
 /// of multiple scattering; linear, pre-multiplied, row-major from the top. Colour adds up over
 /// the parts added into it; alpha (the coverage, the same under every light) is the latest
-/// part's. Starts at zero.
+/// part's. Starts at zero. The frame's first part keeps its view here (the hair uploaded, the
+/// visibility drawn), and the parts after it reuse that view: one frame's parts, one view.
 pub struct FrameSums {
     buffer: wgpu::Buffer,
     params: wgpu::Buffer,
@@ -43,6 +46,8 @@ pub struct FrameSums {
     /// The nearest of hair and head per pixel (wgpu's 0..1 depth, 1 where neither is), drawn
     /// with each part's visibility when asked for: what a host's depth test compares.
     front_depth: Option<wgpu::Texture>,
+    /// The view the frame's parts share, with what it was drawn for.
+    kept_view: Mutex<Option<(ViewKey, Arc<FrameView>)>>,
 }
 
 impl FrameSums {
@@ -76,6 +81,7 @@ impl FrameSums {
             width,
             height,
             front_depth: None,
+            kept_view: Mutex::new(None),
         })
     }
 
@@ -106,6 +112,25 @@ impl FrameSums {
     /// The front depth, when the sums keep one ([`Self::with_front_depth`]).
     pub fn front_depth(&self) -> Option<&wgpu::Texture> {
         self.front_depth.as_ref()
+    }
+
+    /// The view an earlier part of this frame kept, if it was drawn for `key`.
+    pub(super) fn kept_view(&self, key: &ViewKey) -> Option<Arc<FrameView>> {
+        let kept = self.kept_view.lock().unwrap_or_else(|e| e.into_inner());
+        kept.as_ref()
+            .filter(|(kept, _)| kept == key)
+            .map(|(_, view)| view.clone())
+    }
+
+    /// Keeps `view`, drawn for `key`, for the parts of the frame that follow.
+    pub(super) fn keep_view(&self, key: ViewKey, view: Arc<FrameView>) {
+        *self.kept_view.lock().unwrap_or_else(|e| e.into_inner()) = Some((key, view));
+    }
+
+    /// Drops the kept view: the next part draws its own (a host's next frame, whose hair may
+    /// have moved).
+    pub(crate) fn forget_view(&self) {
+        *self.kept_view.lock().unwrap_or_else(|e| e.into_inner()) = None;
     }
 
     /// Bytes of the sums of a `width`×`height` frame.

@@ -55,28 +55,28 @@ pub(super) fn render_batch(
             options.transmittance_filter,
             maps.head.as_ref().filter(|_| !srbf_from_volume),
         );
-        let mut visibility = frame.visibility(options);
+        let view = &frame.view;
+        let mut visibility = view.visibility(options);
         let transparency = options.transparency;
         // Only the layered view keeps slots for them.
-        visibility.layer_lights =
-            frame.occupancy.layer_light_slots > 0 && batch.has_sharp_shadows();
-        let view = ViewBinding::new(gpu, &renderer.layouts.view, grid.as_ref(), &visibility);
-        usage.grid_bytes = usage.grid_bytes.max(view.bytes);
+        visibility.layer_lights = view.occupancy.layer_light_slots > 0 && batch.has_sharp_shadows();
+        let binding = ViewBinding::new(gpu, &renderer.layouts.view, grid.as_ref(), &visibility);
+        usage.grid_bytes = usage.grid_bytes.max(binding.bytes);
         let inputs = ViewShadingInputs {
-            geometry: &frame.geometry,
-            strands: &frame.strands,
+            geometry: &view.geometry,
+            strands: &view.strands,
             transparency,
             layer_lights: visibility
                 .layer_lights
-                .then_some((&frame.occupancy, &frame.depth_view)),
+                .then_some((&view.occupancy, &view.depth_view)),
             batch: &lights,
             tables: batch.tables,
-            view: &view,
-            with_head: frame.head.is_some(),
+            view: &binding,
+            with_head: view.head.is_some(),
         };
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        (renderer.shading).encode(gpu, &mut encoder, &inputs, &frame.targets);
-        (renderer.accumulate).encode(gpu, &mut encoder, &frame.targets, sums);
+        (renderer.shading).encode(gpu, &mut encoder, &inputs, &view.targets);
+        (renderer.accumulate).encode(gpu, &mut encoder, &view.targets, sums);
         gpu.queue.submit([encoder.finish()]);
     });
     Ok(())

@@ -40,25 +40,17 @@ pub(super) struct FrameRequest<'a> {
     pub(super) head: Option<&'a Head>,
 }
 
-/// What one frame renders into, created once before its passes: the hair (all of it for the
-/// view and directional lights, the κ-simplified order for SRBF light passes), the DODM batch
-/// (DODM: the convolution optical depth map of Ren 2010 §5, one layer per light) and its
-/// summed-area tables, the view's visibility and targets, and the tables bound
-/// per light kind.
-pub(super) struct FrameResources {
+/// What every part of a frame sees alike: the hair as uploaded, the head, and the view's
+/// visibility (its depth, nearest fibers and coverage, or its occupancy map). The frame's first
+/// part creates it and draws the visibility; a progressive frame keeps it in its [`FrameSums`]
+/// for the parts that follow ([`FrameSums::kept_view`]), which draw only their lights.
+#[derive(Clone)]
+pub(super) struct FrameView {
     pub(super) geometry: StrandGeometry,
     pub(super) light_geometry: StrandGeometry,
     /// κ < 1: the strands in simplification order, whose windows the simplified light passes
-    /// draw, and the next light's window.
-    pub(super) simplified: Option<SimplifiedSegments>,
-    pub(super) next_window: u32,
-    pub(super) footprint: LightFootprint,
-    /// The light maps of every-strand SRBFs and directional lights, at the DODM resolution
-    /// (None where the frame has only simplified SRBFs).
-    pub(super) full_maps: Option<LightMaps>,
-    /// The light maps of κ-simplified SRBFs, at [`DodmSettings::simplified_resolution`](crate::passes::convolution_depth::DodmSettings::simplified_resolution)
-    /// (None where that is the full resolution: they share `full_maps`).
-    pub(super) simplified_maps: Option<LightMaps>,
+    /// draw.
+    pub(super) simplified: Option<Arc<SimplifiedSegments>>,
     pub(super) occupancy: OccupancyMap,
     pub(super) targets: EnvViewTargets,
     pub(super) width: u32,
@@ -69,10 +61,6 @@ pub(super) struct FrameResources {
     /// [`EnvViewTargets::nearest_position`] and `nearest_tangent`.
     pub(super) nearest_views: [wgpu::TextureView; 2],
     pub(super) depth_view: wgpu::TextureView,
-    /// The single-scattering tables of the SRBF and the directional lights (None: no such
-    /// lights), each bound with the multiple-scattering table.
-    pub(super) srbf_tables: Option<Arc<TableBinding>>,
-    pub(super) directional_tables: Option<Arc<TableBinding>>,
     /// The groom's visibility volume (or its placeholder under Ren's light maps).
     pub(super) volume: Arc<VolumeBuffers>,
     /// The head (issue 40), drawn into the view's depth and every light map.
@@ -83,12 +71,30 @@ pub(super) struct FrameResources {
     pub(super) head_views: [wgpu::TextureView; 2],
 }
 
-impl FrameResources {
-    /// The light maps a batch draws ([`LightMaps::choose`]).
-    pub(super) fn maps(&mut self, simplified: bool) -> &mut LightMaps {
-        LightMaps::choose(simplified, &mut self.full_maps, &mut self.simplified_maps)
-    }
+/// What one part of a frame renders into, created before its passes: the frame's [`FrameView`],
+/// the light passes' hair (all of it for directional lights, the κ-simplified order for SRBF
+/// light passes), the DODM batch (DODM: the convolution optical depth map of Ren 2010 §5, one
+/// layer per light) and its summed-area tables, and the tables bound per light kind.
+pub(super) struct FrameResources {
+    pub(super) view: Arc<FrameView>,
+    /// Whether `view`'s visibility is still to be drawn (the frame's first part).
+    pub(super) view_is_new: bool,
+    /// The next simplified light's strand window (κ < 1).
+    pub(super) next_window: u32,
+    pub(super) footprint: LightFootprint,
+    /// The light maps of every-strand SRBFs and directional lights, at the DODM resolution
+    /// (None where the frame has only simplified SRBFs).
+    pub(super) full_maps: Option<LightMaps>,
+    /// The light maps of κ-simplified SRBFs, at [`DodmSettings::simplified_resolution`](crate::passes::convolution_depth::DodmSettings::simplified_resolution)
+    /// (None where that is the full resolution: they share `full_maps`).
+    pub(super) simplified_maps: Option<LightMaps>,
+    /// The single-scattering tables of the SRBF and the directional lights (None: no such
+    /// lights), each bound with the multiple-scattering table.
+    pub(super) srbf_tables: Option<Arc<TableBinding>>,
+    pub(super) directional_tables: Option<Arc<TableBinding>>,
+}
 
+impl FrameView {
     /// The visibility input of group 3 for this frame.
     pub(super) fn visibility(&self, options: &EnvRenderOptions) -> FrameVisibility<'_> {
         FrameVisibility {
@@ -105,6 +111,13 @@ impl FrameResources {
             layer_lights: false,
         }
     }
+}
+
+impl FrameResources {
+    /// The light maps a batch draws ([`LightMaps::choose`]).
+    pub(super) fn maps(&mut self, simplified: bool) -> &mut LightMaps {
+        LightMaps::choose(simplified, &mut self.full_maps, &mut self.simplified_maps)
+    }
 
     /// The strand windows of the next `lights` simplified light maps (the frame's κ-thinned
     /// SRBF lights, counted across batches): each light its own subset
@@ -114,8 +127,8 @@ impl FrameResources {
         lights: usize,
         kappa: f32,
     ) -> Vec<Vec<std::ops::Range<u32>>> {
-        let Some(simplified) = &self.simplified else {
-            return vec![vec![0..self.light_geometry.segment_count]; lights];
+        let Some(simplified) = &self.view.simplified else {
+            return vec![vec![0..self.view.light_geometry.segment_count]; lights];
         };
         let first = self.next_window;
         self.next_window += lights as u32;
@@ -126,17 +139,18 @@ impl FrameResources {
 
     /// GPU memory held while one batch renders, per resource (tables and grid added later).
     pub(super) fn memory(&self) -> Vec<(String, u64)> {
-        let mut memory = self.geometry.memory();
+        let view = &self.view;
+        let mut memory = view.geometry.memory();
         if let Some(maps) = &self.full_maps {
             memory.extend(maps.memory(""));
         }
         if let Some(maps) = &self.simplified_maps {
             memory.extend(maps.memory("simplified "));
         }
-        memory.extend(self.targets.memory());
-        memory.push(self.occupancy.memory());
-        memory.push(("visibility volume".into(), self.volume.bytes));
-        if let Some(head) = &self.head {
+        memory.extend(view.targets.memory());
+        memory.push(view.occupancy.memory());
+        memory.push(("visibility volume".into(), view.volume.bytes));
+        if let Some(head) = &view.head {
             memory.push(("head geometry".into(), head.bytes()));
         }
         memory
@@ -193,13 +207,40 @@ fn light_footprint(
     LightFootprint::new(bounds, points.into())
 }
 
-impl FrameResources {
-    /// Creates the frame's resources, after checking them against the adapter's limits.
-    pub(super) fn new(
+/// What decides a frame's view: a part whose key differs from the kept view's draws its own.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct ViewKey {
+    camera: Camera,
+    options: EnvRenderOptions,
+    hair: (usize, usize, Aabb),
+    head: Option<(Aabb, [f32; 3])>,
+}
+
+impl ViewKey {
+    pub(super) fn of(request: &FrameRequest<'_>) -> Self {
+        let model = request.model;
+        Self {
+            camera: *request.camera,
+            // The light maps' settings are each part's own.
+            options: EnvRenderOptions {
+                dodm: Default::default(),
+                count_fragments: false,
+                ..*request.options
+            },
+            hair: (model.segment_count(), model.points().len(), model.bounds()),
+            head: request.head.map(|h| (h.bounds(), h.albedo)),
+        }
+    }
+}
+
+impl FrameView {
+    /// The hair uploaded, the head and the view's targets, after checking them against the
+    /// adapter's limits; the visibility is not drawn yet.
+    fn new(
         gpu: &GpuContext,
         renderer: &EnvRenderer,
         request: &FrameRequest<'_>,
-        kinds: &LightKinds,
+        compact_slots: u32,
         timings: &mut Timings,
     ) -> Result<Self, EnvRenderError> {
         let FrameRequest {
@@ -207,42 +248,22 @@ impl FrameResources {
             camera,
             width,
             height,
-            tables,
             options,
-            multiple,
             head,
+            ..
         } = *request;
         GpuLimits::of(gpu).check_image(width, height)?;
-        let compact_slots = kinds
-            .compact_sources()
-            .min(options.dodm.batch_size as usize);
-        let occupancy = OccupancyMap::new(
-            gpu,
-            options.transparency,
-            (width, height),
-            compact_slots as u32,
-        )?;
+        let occupancy =
+            OccupancyMap::new(gpu, options.transparency, (width, height), compact_slots)?;
         FrameSums::check_limits(gpu, width, height)?;
         let geometry = timings.time(gpu, "upload", || StrandGeometry::upload(gpu, model))?;
         // Per hair and settings, not per light or view: setup, as the upload is.
         let (light_geometry, simplified) = timings.time(gpu, "upload", || {
             light_pass_geometry(gpu, model, &geometry, options)
         });
-        let bounds = model.bounds();
-        let first_layer = options.dodm.first_layer_for(bounds);
-        let (mut full_maps, mut simplified_maps) =
-            LightMaps::for_frame(gpu, options, kinds, first_layer)?;
+        let simplified = simplified.map(Arc::new);
         let head_geometry =
             head.map(|h| timings.time(gpu, "upload", || HeadGeometry::upload(gpu, h)));
-        if head_geometry.is_some() {
-            for maps in [&mut full_maps, &mut simplified_maps].into_iter().flatten() {
-                maps.head = Some(HeadDepthMaps::new(
-                    gpu,
-                    maps.dodm.resolution,
-                    maps.dodm.slots,
-                ));
-            }
-        }
         let targets = EnvViewTargets::new(
             gpu,
             width,
@@ -258,13 +279,9 @@ impl FrameResources {
             shading: KajiyaKay::default(),
             width_override_px: options.width_override_px,
         };
-        check_table_limits(gpu, tables, kinds, multiple.is_some())?;
         let volume = renderer
             .volume
             .buffers(gpu, model, head, options, timings)?;
-        let [srbf_tables, directional_tables] = timings.time(gpu, "table upload", || {
-            bind_kind_tables(gpu, renderer, request, kinds)
-        });
         let head_views = [&targets.head_position, &targets.head_normal]
             .map(|t| t.create_view(&Default::default()));
         Ok(Self {
@@ -277,19 +294,90 @@ impl FrameResources {
             geometry,
             light_geometry,
             simplified,
-            next_window: 0,
-            footprint: light_footprint(model, head, kinds.has_sharp_shadows()),
-            full_maps,
-            simplified_maps,
             occupancy,
             targets,
             width,
             height,
-            srbf_tables,
-            directional_tables,
             volume,
             head_views,
             head: head_geometry,
+        })
+    }
+}
+
+impl FrameResources {
+    /// Creates the part's resources, after checking them against the adapter's limits. A part
+    /// added into `kept`'s sums after another part of the same frame reuses the view that part
+    /// kept there (its occupancy map grown when this part's compact sources need more slots).
+    pub(super) fn new(
+        gpu: &GpuContext,
+        renderer: &EnvRenderer,
+        request: &FrameRequest<'_>,
+        kinds: &LightKinds,
+        kept: Option<&FrameSums>,
+        timings: &mut Timings,
+    ) -> Result<Self, EnvRenderError> {
+        let FrameRequest {
+            model,
+            width,
+            height,
+            tables,
+            options,
+            multiple,
+            head,
+            ..
+        } = *request;
+        let compact_slots = kinds
+            .compact_sources()
+            .min(options.dodm.batch_size as usize) as u32;
+        let key = ViewKey::of(request);
+        let (view, view_is_new) = match kept.and_then(|sums| sums.kept_view(&key)) {
+            Some(view) => {
+                let size = (width, height);
+                match (view.occupancy).grown(gpu, options.transparency, size, compact_slots)? {
+                    Some(occupancy) => {
+                        let grown = FrameView {
+                            occupancy,
+                            ..(*view).clone()
+                        };
+                        (Arc::new(grown), false)
+                    }
+                    None => (view, false),
+                }
+            }
+            None => {
+                let view = FrameView::new(gpu, renderer, request, compact_slots, timings)?;
+                (Arc::new(view), true)
+            }
+        };
+        let first_layer = options.dodm.first_layer_for(model.bounds());
+        let (mut full_maps, mut simplified_maps) =
+            LightMaps::for_frame(gpu, options, kinds, first_layer)?;
+        if view.head.is_some() {
+            for maps in [&mut full_maps, &mut simplified_maps].into_iter().flatten() {
+                maps.head = Some(HeadDepthMaps::new(
+                    gpu,
+                    maps.dodm.resolution,
+                    maps.dodm.slots,
+                ));
+            }
+        }
+        check_table_limits(gpu, tables, kinds, multiple.is_some())?;
+        let [srbf_tables, directional_tables] = timings.time(gpu, "table upload", || {
+            bind_kind_tables(gpu, renderer, request, kinds)
+        });
+        if let Some(sums) = kept {
+            sums.keep_view(key, view.clone());
+        }
+        Ok(Self {
+            view,
+            view_is_new,
+            next_window: 0,
+            footprint: light_footprint(model, head, kinds.has_sharp_shadows()),
+            full_maps,
+            simplified_maps,
+            srbf_tables,
+            directional_tables,
         })
     }
 }

@@ -23,44 +23,44 @@ pub(super) fn encode_visibility(
     timings: &mut Timings,
 ) {
     timings.time(gpu, "view visibility", || {
-        let visibility = frame.visibility(options);
+        let visibility = frame.view.visibility(options);
         let view = ViewBinding::new(gpu, &renderer.layouts.view, None, &visibility);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         // The head first: its depth bounds the hair's passes (and clears the depth).
         renderer.head.encode_view(
             gpu,
             &mut encoder,
-            frame.head.as_ref(),
+            frame.view.head.as_ref(),
             camera,
-            (frame.width, frame.height),
-            &frame.depth_view,
-            [&frame.head_views[0], &frame.head_views[1]],
+            (frame.view.width, frame.view.height),
+            &frame.view.depth_view,
+            [&frame.view.head_views[0], &frame.view.head_views[1]],
         );
         renderer.visibility.encode(
             gpu,
             &mut encoder,
             options.transparency,
-            &frame.strands,
+            &frame.view.strands,
             &view.group,
-            &frame.depth_view,
-            &frame.coverage_view,
-            [&frame.nearest_views[0], &frame.nearest_views[1]],
-            &frame.occupancy,
-            frame.geometry.segment_count,
+            &frame.view.depth_view,
+            &frame.view.coverage_view,
+            [&frame.view.nearest_views[0], &frame.view.nearest_views[1]],
+            &frame.view.occupancy,
+            frame.view.geometry.segment_count,
         );
         if let Some(front_depth) = front_depth {
             let depth = front_depth.create_view(&Default::default());
-            let size = (frame.width, frame.height);
-            let head_views = [&frame.head_views[0], &frame.head_views[1]];
-            let head = frame.head.as_ref();
+            let size = (frame.view.width, frame.view.height);
+            let head_views = [&frame.view.head_views[0], &frame.view.head_views[1]];
+            let head = frame.view.head.as_ref();
             renderer
                 .head
                 .encode_view(gpu, &mut encoder, head, camera, size, &depth, head_views);
-            let segments = frame.geometry.segment_count;
+            let segments = frame.view.geometry.segment_count;
             renderer.visibility.encode_front_depth(
                 gpu,
                 &mut encoder,
-                &frame.strands,
+                &frame.view.strands,
                 &depth,
                 segments,
             );
@@ -76,15 +76,15 @@ pub(super) fn count_fragments(
     frame: &FrameResources,
     options: &EnvRenderOptions,
 ) -> Result<FragmentCounts, ReadbackError> {
-    let visibility = frame.visibility(options);
+    let visibility = frame.view.visibility(options);
     let view = ViewBinding::new(gpu, &renderer.layouts.view, None, &visibility);
     renderer.visibility.count_fragments(
         gpu,
         options.transparency,
-        &frame.strands,
+        &frame.view.strands,
         &view.group,
-        &frame.depth_view,
-        (frame.width, frame.height),
-        frame.geometry.segment_count,
+        &frame.view.depth_view,
+        (frame.view.width, frame.view.height),
+        frame.view.geometry.segment_count,
     )
 }

@@ -162,7 +162,7 @@ impl LightMapsPass {
         let directions: Vec<_> = batch.groups.iter().map(|g| g.direction).collect();
         let windows = match simplified {
             true => frame.next_windows(directions.len(), options.kappa),
-            false => vec![vec![0..frame.geometry.segment_count]; directions.len()],
+            false => vec![vec![0..frame.view.geometry.segment_count]; directions.len()],
         };
         // A simplified map draws 1/κ-times the optical depth of each drawn fiber, enlarged to
         // the same world width at whatever resolution its maps have.
@@ -174,15 +174,16 @@ impl LightMapsPass {
             false => (1.0, 1.0),
         };
         let FrameResources {
-            geometry,
-            light_geometry,
+            view,
             footprint,
             full_maps,
             simplified_maps,
-            head,
             ..
         } = frame;
-        let geometry = if simplified { light_geometry } else { geometry };
+        let (geometry, head) = match simplified {
+            true => (&view.light_geometry, &view.head),
+            false => (&view.geometry, &view.head),
+        };
         let maps = LightMaps::choose(simplified, full_maps, simplified_maps);
         let framing = match batch.has_sharp_shadows() {
             true => LightFraming::Fitted(footprint),

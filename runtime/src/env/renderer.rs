@@ -196,7 +196,8 @@ impl EnvRenderer {
             head,
         };
         let mut timings = Timings(Vec::new());
-        let (frame, kinds) = self.start_part(gpu, &request, lights, first_window, &mut timings)?;
+        let part = (lights, first_window);
+        let (frame, kinds) = self.start_part(gpu, &request, part, None, &mut timings)?;
         let sums = FrameSums::new(gpu, width, height)?;
         let stats = self.finish_part(gpu, &request, lights, frame, &kinds, &sums, timings)?;
         Ok(EncodedFrame {
@@ -237,7 +238,8 @@ impl EnvRenderer {
             head,
         };
         let mut timings = Timings(Vec::new());
-        let (frame, kinds) = self.start_part(gpu, &request, lights, first_window, &mut timings)?;
+        let part = (lights, first_window);
+        let (frame, kinds) = self.start_part(gpu, &request, part, Some(sums), &mut timings)?;
         self.finish_part(gpu, &request, lights, frame, &kinds, sums, timings)
     }
 
@@ -254,13 +256,13 @@ impl EnvRenderer {
     }
 
     /// Checks a part's inputs, then creates its resources (its simplified lights drawing the
-    /// strand windows from `first_window` on).
+    /// strand windows from `first_window` on; the view an earlier part kept in `kept`, if any).
     fn start_part(
         &self,
         gpu: &GpuContext,
         request: &FrameRequest<'_>,
-        lights: &[EnvLight],
-        first_window: u32,
+        (lights, first_window): (&[EnvLight], u32),
+        kept: Option<&FrameSums>,
         timings: &mut Timings,
     ) -> Result<(FrameResources, LightKinds), EnvRenderError> {
         let kinds = LightKinds::of(lights);
@@ -272,7 +274,7 @@ impl EnvRenderer {
             request.options,
             with_multiple,
         )?;
-        let mut frame = FrameResources::new(gpu, self, request, &kinds, timings)?;
+        let mut frame = FrameResources::new(gpu, self, request, &kinds, kept, timings)?;
         frame.next_window = first_window;
         Ok((frame, kinds))
     }
@@ -292,16 +294,19 @@ impl EnvRenderer {
         let options = request.options;
         let mut memory = frame.memory();
         memory.push(("env sums".into(), sums.buffer().size()));
-        let front_depth = sums.front_depth();
-        encode_visibility(
-            gpu,
-            self,
-            &frame,
-            options,
-            request.camera,
-            front_depth,
-            &mut timings,
-        );
+        if frame.view_is_new {
+            let front_depth = sums.front_depth();
+            let camera = request.camera;
+            encode_visibility(
+                gpu,
+                self,
+                &frame,
+                options,
+                camera,
+                front_depth,
+                &mut timings,
+            );
+        }
         let fragments = match options.count_fragments {
             true => Some(count_fragments(gpu, self, &frame, options)?),
             false => None,
@@ -314,7 +319,7 @@ impl EnvRenderer {
             .filter_map(|t| t.as_ref().map(|t| t.bytes))
             .sum();
         let tables = [srbf_tables.as_deref(), directional_tables.as_deref()];
-        let compact_batch_size = match frame.occupancy.layer_light_slots {
+        let compact_batch_size = match frame.view.occupancy.layer_light_slots {
             0 => options.dodm.batch_size,
             slots => slots,
         };
@@ -339,8 +344,8 @@ impl EnvRenderer {
             memory_per_batch: memory,
             batches: usage.batches,
             lights: lights.len() as u32,
-            segments: frame.geometry.segment_count,
-            light_pass_segments: frame.light_geometry.segment_count,
+            segments: frame.view.geometry.segment_count,
+            light_pass_segments: frame.view.light_geometry.segment_count,
             timing_method: crate::point_frame::TIMING_METHOD,
             fragments,
         })

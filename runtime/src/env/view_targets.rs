@@ -11,6 +11,7 @@ use crate::passes::render_target::{DEPTH_FORMAT, NEAREST_SURFACE_FORMAT};
 /// fragments; the opaque view's alpha) and the nearest fiber's position (w: 1 on hair) and
 /// tangent, f32 so that the deferred view shades the very point the rasterizer interpolated
 /// (the three are 1×1 and unused for the transparent view).
+#[derive(Clone)]
 pub struct EnvViewTargets {
     pub single: wgpu::Texture,
     pub multiple: wgpu::Texture,

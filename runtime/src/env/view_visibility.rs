@@ -138,6 +138,7 @@ pub struct FragmentCounts {
 /// "Compact sources per layer"). SRBF lobes and the lights that stand for a region of the map (a
 /// reference's cube texel, a median-cut region), whose true shadows are soft at fiber scale,
 /// read theirs at the layer's mean position.
+#[derive(Clone)]
 pub struct OccupancyMap {
     pub buffer: wgpu::Buffer,
     /// The first u32 after every pixel's record: where the layers' light visibility starts.
@@ -184,7 +185,11 @@ impl OccupancyMap {
         let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("occupancy map"),
             size: bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            // COPY_SRC: a later part of the frame that needs more light slots copies the
+            // records into a larger map (`Self::grown`).
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
         Ok(Self {
@@ -192,6 +197,31 @@ impl OccupancyMap {
             layer_lights_word,
             layer_light_slots,
         })
+    }
+
+    /// This map with light slots for `compact_slots` compact sources a batch, for a later part
+    /// of the same frame: `None` when it has as many already (or the adapter's storage limit
+    /// leaves room for no more); else a larger map holding this one's records, copied on the
+    /// GPU, so that the frame's visibility is not drawn again.
+    pub fn grown(
+        &self,
+        gpu: &GpuContext,
+        transparency: ViewTransparency,
+        size: (u32, u32),
+        compact_slots: u32,
+    ) -> Result<Option<Self>, OccupancyError> {
+        if compact_slots <= self.layer_light_slots || self.layer_lights_word == 0 {
+            return Ok(None);
+        }
+        let grown = Self::new(gpu, transparency, size, compact_slots)?;
+        if grown.layer_light_slots <= self.layer_light_slots {
+            return Ok(None);
+        }
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        let records = self.layer_lights_word * 4;
+        encoder.copy_buffer_to_buffer(&self.buffer, 0, &grown.buffer, 0, records);
+        gpu.queue.submit([encoder.finish()]);
+        Ok(Some(grown))
     }
 
     /// The layers' light visibility: zeroed before each batch of compact sources gathers it.

@@ -195,6 +195,7 @@ impl HairRenderer {
     /// Zeroes `sums` and sets their front depth to the far plane (nothing drawn), on the GPU:
     /// until its first batch a frame draws nothing into the host's pass, not even depth.
     fn clear(&self, sums: &FrameSums) {
+        sums.forget_view();
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         encoder.clear_buffer(sums.buffer(), 0, None);
         if let Some(depth) = sums.front_depth() {

@@ -22,6 +22,7 @@ use crate::head::Head;
 pub const HEAD_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 
 /// The head's triangles on the GPU: interleaved position and normal, and a u32 index list.
+#[derive(Clone)]
 pub struct HeadGeometry {
     vertices: wgpu::Buffer,
     indices: wgpu::Buffer,

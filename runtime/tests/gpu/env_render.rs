@@ -8,7 +8,8 @@ use glam::{DVec3, Vec2, Vec3};
 use strandlight_runtime::camera::{Camera, LightFraming, Projection, light_camera};
 use strandlight_runtime::env::TransmittanceFilter;
 use strandlight_runtime::env::{
-    EnvImage, EnvRenderError, EnvRenderOptions, EnvRenderer, EnvTables, FrameSums, render_env_frame,
+    EnvImage, EnvRenderError, EnvRenderOptions, EnvRenderer, EnvTables, FrameSums,
+    ViewTransparency, render_env_frame,
 };
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::{GpuContext, LimitError, read_texture_rgba};
@@ -1678,7 +1679,9 @@ fn srbf_and_directional_lights_in_one_frame_add_and_directional_ignores_kappa() 
 
 /// A progressive frame's parts encoded into one caller-held [`FrameSums`] add up to the frame
 /// rendered at once: the strongest lobe first (window 0), then the weaker lobe (window 1, the
-/// one simplified light before it) with a sun; coverage is every part's.
+/// one simplified light before it) with a sun; coverage is every part's. The first part draws
+/// the frame's visibility and the second reuses it, in the opaque and the layered view (whose
+/// occupancy map the sun's part grows for its light slot, keeping the records drawn).
 #[test]
 fn parts_encoded_into_one_running_sum_equal_the_whole_frame() {
     let gpu = gpu();
@@ -1686,48 +1689,65 @@ fn parts_encoded_into_one_running_sum_equal_the_whole_frame() {
     let [strong, weak] = groom_lobes();
     assert!(strong.luminous_power() > weak.luminous_power());
     let sun = EnvLight::directional(Vec3::new(0.5, 0.7, 0.6), [2.0, 1.8, 1.5]);
-    let options = EnvRenderOptions {
-        dodm: DodmSettings {
-            resolution: 128,
-            first_layer: None,
-            batch_size: 2,
-        },
-        kappa: 0.5,
-        ..Default::default()
-    };
     let renderer = EnvRenderer::new(&gpu);
-    let whole = renderer
-        .render(
-            &gpu,
-            &model,
-            &camera,
-            RES,
-            RES,
-            &[strong, weak, sun],
-            &tables,
-            &options,
-            None,
-        )
-        .unwrap_or_else(|e| panic!("{e}"));
-    let sums = FrameSums::new(&gpu, RES, RES).unwrap();
-    let parts: [(&[EnvLight], u32); 2] = [(&[strong], 0), (&[weak, sun], 1)];
-    for part in parts {
-        renderer
-            .encode_part_into(
-                &gpu, &model, &camera, part, &tables, &options, None, None, &sums,
+    for transparency in [ViewTransparency::Opaque, ViewTransparency::layered()] {
+        let options = EnvRenderOptions {
+            dodm: DodmSettings {
+                resolution: 128,
+                first_layer: None,
+                batch_size: 2,
+            },
+            kappa: 0.5,
+            transparency,
+            ..Default::default()
+        };
+        let whole = renderer
+            .render(
+                &gpu,
+                &model,
+                &camera,
+                RES,
+                RES,
+                &[strong, weak, sun],
+                &tables,
+                &options,
+                None,
             )
             .unwrap_or_else(|e| panic!("{e}"));
+        let sums = FrameSums::new(&gpu, RES, RES).unwrap();
+        let parts: [(&[EnvLight], u32); 2] = [(&[strong], 0), (&[weak, sun], 1)];
+        let drew_visibility: Vec<bool> = parts
+            .iter()
+            .map(|&part| {
+                let stats = renderer
+                    .encode_part_into(
+                        &gpu, &model, &camera, part, &tables, &options, None, None, &sums,
+                    )
+                    .unwrap_or_else(|e| panic!("{e}"));
+                stats.timings.iter().any(|t| t.pass == "view visibility")
+            })
+            .collect();
+        let bytes = strandlight_runtime::gpu::readback::read_buffer(&gpu, sums.buffer()).unwrap();
+        let single: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        let summed = &single[..(RES * RES) as usize];
+        let worst = worst_relative(summed, &whole.pixels);
+        let lit = whole.pixels.iter().filter(|p| p[0] > 0.0).count();
+        println!(
+            "{transparency:?}: {lit} lit pixels; parts summed vs whole frame: worst relative {worst:.2e}; visibility drawn by the parts {drew_visibility:?}"
+        );
+        assert!(lit > 100, "the lights must light the groom");
+        assert!(
+            worst < 1e-4,
+            "{transparency:?}: parts summed vs whole frame: {worst}"
+        );
+        let alpha = |p: &[[f32; 4]]| p.iter().map(|p| p[3]).collect::<Vec<_>>();
+        assert_eq!(alpha(summed), alpha(&whole.pixels));
+        assert_eq!(
+            drew_visibility,
+            [true, false],
+            "the second part reuses the first's view"
+        );
     }
-    let bytes = strandlight_runtime::gpu::readback::read_buffer(&gpu, sums.buffer()).unwrap();
-    let single: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
-    let summed = &single[..(RES * RES) as usize];
-    let worst = worst_relative(summed, &whole.pixels);
-    let lit = whole.pixels.iter().filter(|p| p[0] > 0.0).count();
-    println!("{lit} lit pixels; parts summed vs whole frame: worst relative {worst:.2e}");
-    assert!(lit > 100, "the lights must light the groom");
-    assert!(worst < 1e-4, "parts summed vs whole frame: {worst}");
-    let alpha = |p: &[[f32; 4]]| p.iter().map(|p| p[3]).collect::<Vec<_>>();
-    assert_eq!(alpha(summed), alpha(&whole.pixels));
 }
 
 /// A compact source not drawing every strand (`EnvLight::every_strand` false) is shadowed through a κ
