@@ -1,8 +1,10 @@
 //! `strandlight image-error TEST.exr REF.exr`: the errors `compare` reports (relative RMSE and
 //! HDR-FLIP over the reference's hair pixels), between any two of its EXR images — e.g. a
 //! 384-light reference against a 1536-light one, to show how far a reduced reference is from
-//! converged. A second line splits the error into what one brightness scale removes (a bias) and
-//! what it leaves (a pattern), and says how the brightest tenth of the hair compares.
+//! converged. A second line gives the error over blocks of 1, 2, 4 and 16 pixels a side, the
+//! coverage's error and the mean ratio (`ScaleErrors`); a third splits the error into what one
+//! brightness scale removes (a bias) and what it leaves (a pattern), and says how the brightest
+//! tenth of the hair compares.
 
 use std::path::PathBuf;
 
@@ -12,7 +14,7 @@ use clap::Args;
 use strandlight_eval::ground_truth::{read_truth_sidecar, without_noise};
 use strandlight_eval::hdr_flip::{error_map_magma, hdr_flip};
 use strandlight_eval::reference_cache::read_rgba_exr;
-use strandlight_scene::image_metrics::{error_split, mean_ratio, relative_rmse};
+use strandlight_scene::image_metrics::{ScaleErrors, error_split, mean_ratio, relative_rmse};
 
 #[derive(Args, Debug)]
 pub struct ImageErrorArgs {
@@ -48,6 +50,8 @@ pub fn run(args: ImageErrorArgs) -> anyhow::Result<()> {
         flip.stop_exposure,
         pair()
     );
+    let scales = ScaleErrors::of(&test, &reference).with_context(pair)?;
+    println!("at every scale: {}", scales.line());
     let split = error_split(&test, &reference).with_context(pair)?;
     println!(
         "bias and pattern: the best single scale {:.4} leaves relative RMSE {:.4}; the brightest tenth of the hair is {:.4}× the reference's and holds {:.0}% of the squared error",

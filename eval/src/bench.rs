@@ -31,7 +31,7 @@ use strandlight_scene::environment::load_env;
 use strandlight_scene::fit_cache::fit_cached;
 use strandlight_scene::frame_settings::{FrameSettings, Lighting};
 use strandlight_scene::head_input::HeadChoice;
-use strandlight_scene::image_metrics::{Image, relative_rmse};
+use strandlight_scene::image_metrics::{Image, ScaleErrors, relative_rmse};
 use strandlight_scene::look::{EnvTransparency, LobeVisibilityArg, ViewArgs};
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
 use strandlight_scene::steps::Steps;
@@ -381,6 +381,9 @@ pub struct TruthError {
     /// With the ground truth's own noise removed in quadrature.
     pub relative_rmse_noise_corrected: f64,
     pub hdr_flip: f64,
+    /// The error over blocks, the coverage's and the mean ratio (absent in runs before them).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scales: Option<ScaleErrors>,
 }
 
 /// How one map and mode's ground truth was made.
@@ -783,6 +786,7 @@ fn truth_error(image: &Image, truth: &GroundTruth) -> anyhow::Result<TruthError>
         relative_rmse: e,
         relative_rmse_noise_corrected: truth.noise_corrected(e),
         hdr_flip: hdr_flip(image, &truth.image)?.mean_over_hair,
+        scales: Some(ScaleErrors::of(image, &truth.image)?),
     })
 }
 

@@ -524,7 +524,7 @@ pub fn truth_section(report: &BenchReport, page_dir: &str) -> String {
         plan.truth_max_spp[1],
         view_phrase(plan.transparency),
     );
-    out.push_str("| map | mode | SRBF ms | SRBF vs truth: rel. RMSE (n.c.) / HDR-FLIP | DOM reference vs truth | × median cut at equal rel. RMSE | at equal HDR-FLIP | truth: spp, depth, noise | Mitsuba s |\n|---|---|---:|---|---|---:|---:|---|---:|\n");
+    out.push_str("| map | mode | SRBF ms | SRBF vs truth: rel. RMSE (n.c.) / HDR-FLIP | over 4×4 / 16×16 blocks; coverage; mean | DOM reference vs truth | × median cut at equal rel. RMSE | at equal HDR-FLIP | truth: spp, depth, noise | Mitsuba s |\n|---|---|---:|---|---|---|---:|---:|---|---:|\n");
     for r in &report.env_lit {
         let (Some(truth), Some(default)) = (&r.truth, r.points.first()) else {
             continue;
@@ -545,11 +545,12 @@ pub fn truth_section(report: &BenchReport, page_dir: &str) -> String {
         };
         let _ = writeln!(
             out,
-            "| {} | {} | {:.0} | {} | {} ({} lights) | {} | {} | {}, {}, {:.4}{} | {:.0} |",
+            "| {} | {} | {:.0} | {} | {} | {} ({} lights) | {} | {} | {}, {}, {:.4}{} | {:.0} |",
             r.map,
             r.mode,
             default.ms,
             cell(Some(default)),
+            scales_cell(default.truth.as_ref()),
             cell(reference),
             r.reference_lights,
             speedup(r.speedup_equal_rmse_truth),
@@ -575,6 +576,18 @@ pub fn truth_section(report: &BenchReport, page_dir: &str) -> String {
     out
 }
 
+/// A frame's error against the truth over 4×4 and 16×16 blocks, its coverage's error and its
+/// mean ratio; "–" for runs measured before them.
+fn scales_cell(truth: Option<&crate::bench::TruthError>) -> String {
+    match truth.and_then(|t| t.scales) {
+        Some(s) => format!(
+            "{:.4} / {:.4}; {:.4}; {:.3}×",
+            s.blocks[2], s.blocks[3], s.coverage, s.mean_ratio
+        ),
+        None => "–".into(),
+    }
+}
+
 /// Every frame of a truth run, map by map, against the truth and the DOM reference, with its
 /// plots (`plot_dir` relative to the page this is written to).
 pub fn truth_details(report: &BenchReport, plot_dir: &str) -> String {
@@ -585,7 +598,7 @@ pub fn truth_details(report: &BenchReport, plot_dir: &str) -> String {
         let Some(truth) = &r.truth else { continue };
         let _ = writeln!(
             out,
-            "\n## {} — {} scattering\n\nGround truth: {} spp (ladder {}){}, noise {:.4}; DOM reference {} lights{}.\n\n| frame | lights | ms | vs truth: rel. RMSE | n.c. | HDR-FLIP | vs DOM reference: rel. RMSE | HDR-FLIP |\n|---|---:|---:|---:|---:|---:|---:|---:|",
+            "\n## {} — {} scattering\n\nGround truth: {} spp (ladder {}){}, noise {:.4}; DOM reference {} lights{}.\n\n| frame | lights | ms | vs truth: rel. RMSE | n.c. | HDR-FLIP | over 4×4 / 16×16 blocks; coverage; mean | vs DOM reference: rel. RMSE | HDR-FLIP |\n|---|---:|---:|---:|---:|---:|---|---:|---:|",
             r.map,
             r.mode,
             truth.spp,
@@ -621,10 +634,11 @@ pub fn truth_details(report: &BenchReport, plot_dir: &str) -> String {
                 relative_rmse: f64::NAN,
                 relative_rmse_noise_corrected: f64::NAN,
                 hdr_flip: f64::NAN,
+                scales: None,
             });
             let _ = writeln!(
                 out,
-                "| {} {} | {} | {:.0} | {:.4} | {:.4} | {:.4} | {:.4} | {:.4} |",
+                "| {} {} | {} | {:.0} | {:.4} | {:.4} | {:.4} | {} | {:.4} | {:.4} |",
                 p.family,
                 p.label,
                 p.lights,
@@ -632,6 +646,7 @@ pub fn truth_details(report: &BenchReport, plot_dir: &str) -> String {
                 t.relative_rmse,
                 t.relative_rmse_noise_corrected,
                 t.hdr_flip,
+                scales_cell(Some(&t)),
                 p.relative_rmse,
                 p.hdr_flip
             );
@@ -690,6 +705,11 @@ mod tests {
                 relative_rmse: truth_rmse,
                 relative_rmse_noise_corrected: truth_rmse - 0.001,
                 hdr_flip: 0.3,
+                scales: Some(strandlight_scene::image_metrics::ScaleErrors {
+                    blocks: [truth_rmse, 0.3, 0.2, 0.1],
+                    coverage: 0.05,
+                    mean_ratio: 1.02,
+                }),
             }),
             ..frame(family, ms, relative_rmse)
         }
@@ -729,7 +749,7 @@ mod tests {
         // Median cut never reaches the SRBF's 0.44 against the truth: at least its costliest
         // frame's time over the SRBF's, 40/10.
         assert!(
-            section.contains("| quarry | single | 10 | 0.4400 (0.4390) / 0.3000 | 0.4800 (0.4790) / 0.3000 (1537 lights) | > 4.0× | 18.1× | 5120, 2, 0.0360 (not converged) | 75 |"),
+            section.contains("| quarry | single | 10 | 0.4400 (0.4390) / 0.3000 | 0.2000 / 0.1000; 0.0500; 1.020× | 0.4800 (0.4790) / 0.3000 (1537 lights) | > 4.0× | 18.1× | 5120, 2, 0.0360 (not converged) | 75 |"),
             "{section}"
         );
         // Each frame's row is in the details page the section links, not on the page.
@@ -738,7 +758,7 @@ mod tests {
         let details = truth_details(&report, ".");
         assert!(
             details
-                .contains("| median cut  | 64 | 40 | 0.4600 | 0.4590 | 0.3000 | 0.1500 | 0.2000 |"),
+                .contains("| median cut  | 64 | 40 | 0.4600 | 0.4590 | 0.3000 | 0.2000 / 0.1000; 0.0500; 1.020× | 0.1500 | 0.2000 |"),
             "{details}"
         );
         assert!(section.contains("bench --truth"), "{section}");

@@ -31,7 +31,9 @@ use strandlight_scene::frame_render::{
 use strandlight_scene::frame_settings::{FrameSettings, Lighting};
 use strandlight_scene::hair_input::fibers_for;
 use strandlight_scene::head_input::load_head;
-use strandlight_scene::image_metrics::{Image, error_legend, relative_rmse, write_side_by_side};
+use strandlight_scene::image_metrics::{
+    Image, ScaleErrors, error_legend, relative_rmse, write_side_by_side,
+};
 use strandlight_scene::look::EnvLook;
 use strandlight_scene::rendered_frame::RenderedFrame;
 use strandlight_scene::scene_tables::{EnvShading, ScatteringMode};
@@ -997,6 +999,7 @@ fn truth_json(truth: &GroundTruth, frames: &[(&str, &Image)]) -> anyhow::Result<
             "relative_rmse": e,
             "relative_rmse_noise_corrected": truth.noise_corrected(e),
             "hdr_flip": hdr_flip(image, &truth.image)?.mean_over_hair,
+            "scales": ScaleErrors::of(image, &truth.image)?,
         });
     }
     Ok(v)
@@ -1004,8 +1007,10 @@ fn truth_json(truth: &GroundTruth, frames: &[(&str, &Image)]) -> anyhow::Result<
 
 fn truth_line(mode: ScatteringMode, truth: &GroundTruth, figures: &Value) -> String {
     let part = |name: &str| {
+        let scales = serde_json::from_value::<ScaleErrors>(figures[name]["scales"].clone())
+            .map_or_else(|_| String::new(), |s| format!(", {}", s.line()));
         format!(
-            "{name} rel. RMSE {:.4} ({:.4} without the truth's noise) HDR-FLIP {:.4}",
+            "{name} rel. RMSE {:.4} ({:.4} without the truth's noise) HDR-FLIP {:.4}{scales}",
             figures[name]["relative_rmse"].as_f64().unwrap_or(f64::NAN),
             figures[name]["relative_rmse_noise_corrected"]
                 .as_f64()

@@ -197,6 +197,122 @@ pub fn mean_ratio(approx: &Image, reference: &Image) -> Result<f64, CompareError
     Ok(sum_a / sum_r)
 }
 
+/// The block sizes an image's error is reported at: the pixel, and boxes of 2, 4 and 16 pixels
+/// a side. A path tracer's noise averages away over a box, a bias does not; a pattern at fiber
+/// scale (which fibers a pixel's centre sees) fades by 4×4.
+pub const ERROR_SCALES: [u32; 4] = [1, 2, 4, 16];
+
+/// An image's error against a reference at every scale of [`ERROR_SCALES`], beside the error of
+/// its coverage and its mean ratio: what `image-error`, `compare` and `bench` report.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ScaleErrors {
+    /// [`relative_rmse_over_blocks`] at each of [`ERROR_SCALES`] (the first is
+    /// [`relative_rmse`]).
+    pub blocks: [f64; 4],
+    /// [`coverage_error`].
+    pub coverage: f64,
+    /// [`mean_ratio`].
+    pub mean_ratio: f64,
+}
+
+impl ScaleErrors {
+    pub fn of(approx: &Image, reference: &Image) -> Result<Self, CompareError> {
+        let mut blocks = [0.0; 4];
+        for (e, n) in blocks.iter_mut().zip(ERROR_SCALES) {
+            *e = relative_rmse_over_blocks(approx, reference, n)?;
+        }
+        Ok(Self {
+            blocks,
+            coverage: coverage_error(approx, reference)?,
+            mean_ratio: mean_ratio(approx, reference)?,
+        })
+    }
+
+    /// One line: the error at each scale, the coverage error and the mean ratio.
+    pub fn line(&self) -> String {
+        let scales: Vec<String> = ERROR_SCALES
+            .iter()
+            .zip(self.blocks)
+            .map(|(n, e)| format!("{n}×{n} {e:.4}"))
+            .collect();
+        format!(
+            "relative RMSE over blocks {}; coverage {:.4}; mean {:.4}×",
+            scales.join(", "),
+            self.coverage,
+            self.mean_ratio
+        )
+    }
+}
+
+/// The relative RMSE of both images box-filtered over `n`×`n` blocks (the last row and column
+/// of blocks hold what is left of the image): √(Σ count·‖ā − r̄‖² / Σ count·‖r̄‖²) over RGB of
+/// the blocks that hold any of the reference's hair, ā and r̄ the blocks' mean pre-multiplied
+/// colours. At n = 1 it is [`relative_rmse`].
+pub fn relative_rmse_over_blocks(
+    approx: &Image,
+    reference: &Image,
+    n: u32,
+) -> Result<f64, CompareError> {
+    check_finite("the reference", reference)?;
+    approx.check_against("the image", reference)?;
+    let n = n.max(1);
+    let (w, h) = (reference.width, reference.height);
+    let (mut num, mut den, mut hair) = (0.0f64, 0.0f64, 0usize);
+    for by in (0..h).step_by(n as usize) {
+        for bx in (0..w).step_by(n as usize) {
+            let (mut a, mut r, mut count, mut has_hair) = ([0.0f64; 3], [0.0f64; 3], 0.0, false);
+            for y in by..(by + n).min(h) {
+                for x in bx..(bx + n).min(w) {
+                    let i = (y * w + x) as usize;
+                    let (pa, pr) = (&approx.pixels[i], &reference.pixels[i]);
+                    has_hair |= is_hair(pr);
+                    for c in 0..3 {
+                        a[c] += pa[c] as f64;
+                        r[c] += pr[c] as f64;
+                    }
+                    count += 1.0;
+                }
+            }
+            if !has_hair {
+                continue;
+            }
+            hair += 1;
+            for c in 0..3 {
+                let (a, r) = (a[c] / count, r[c] / count);
+                num += count * (a - r) * (a - r);
+                den += count * r * r;
+            }
+        }
+    }
+    if hair == 0 {
+        return Err(CompareError::NoHair);
+    }
+    if den == 0.0 {
+        return Err(CompareError::BlackReference);
+    }
+    Ok((num / den).sqrt())
+}
+
+/// The error of the image's coverage: √(Σ(α_a − α_r)² / Σα_r²) over the pixels where either
+/// image has hair. Coverage is the same under every light, so this is the view's error alone
+/// (fibers widened to a pixel and faded by their width, against each fiber's true footprint).
+pub fn coverage_error(approx: &Image, reference: &Image) -> Result<f64, CompareError> {
+    check_finite("the reference", reference)?;
+    approx.check_against("the image", reference)?;
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for (a, r) in approx.pixels.iter().zip(&reference.pixels) {
+        if is_hair(a) || is_hair(r) {
+            let (a, r) = (a[3] as f64, r[3] as f64);
+            num += (a - r) * (a - r);
+            den += r * r;
+        }
+    }
+    if den == 0.0 {
+        return Err(CompareError::NoHair);
+    }
+    Ok((num / den).sqrt())
+}
+
 /// How an image's error over the hair splits between a brightness bias and a pattern, and
 /// where the bias sits: a bias is a modelling error a correction can target, a pattern is
 /// per-pixel scatter (shadow detail placed differently, noise).
@@ -446,6 +562,113 @@ mod tests {
             approx.minus(&image(vec![[0.0; 4]])).is_err(),
             "sizes must match"
         );
+    }
+
+    /// An 8×8 hair patch of colour (1, 2, 3), alpha 1, inside a 10×10 image; `at(x, y)` the
+    /// image's pixels there.
+    fn patch(at: impl Fn(u32, u32, [f32; 4]) -> [f32; 4]) -> Image {
+        let pixels = (0..100)
+            .map(|i| {
+                let (x, y) = (i % 10, i / 10);
+                let hair = (1..9).contains(&x) && (1..9).contains(&y);
+                let p = if hair { [1.0, 2.0, 3.0, 1.0] } else { [0.0; 4] };
+                at(x, y, p)
+            })
+            .collect();
+        Image::new(10, 10, pixels)
+    }
+
+    /// A checkerboard of ±10% averages out over every 2×2 block inside the patch (which starts
+    /// at an odd pixel, so the blocks on its edge hold one or two of its pixels and keep a
+    /// residue), a 10% bias stays 10% at every scale, and at 1×1 the block error is the
+    /// relative RMSE.
+    #[test]
+    fn a_pattern_averages_out_over_blocks_and_a_bias_does_not() {
+        let reference = patch(|_, _, p| p);
+        let checker = patch(|x, y, p| {
+            let s = if (x + y) % 2 == 0 { 1.1 } else { 0.9 };
+            [p[0] * s, p[1] * s, p[2] * s, p[3]]
+        });
+        let errors = ScaleErrors::of(&checker, &reference).unwrap();
+        assert!((errors.blocks[0] - 0.1).abs() < 1e-6, "{errors:?}");
+        // The patch's edge blocks hold 1, 2 or 4 of its pixels: only blocks of an odd count
+        // keep a residue, and over 4×4 the blocks hold 9, 12 or 16.
+        let by_hand_2 = relative_rmse_over_blocks(&checker, &reference, 2).unwrap();
+        assert_eq!(errors.blocks[1], by_hand_2);
+        assert!(errors.blocks[1] < 0.06, "{errors:?}");
+        assert!(errors.blocks[2] < errors.blocks[0] / 3.0, "{errors:?}");
+        assert_eq!(
+            errors.blocks[0],
+            relative_rmse(&checker, &reference).unwrap()
+        );
+        assert_eq!(errors.coverage, 0.0);
+        assert!((errors.mean_ratio - 1.0).abs() < 1e-6);
+
+        let biased = patch(|_, _, p| [p[0] * 1.1, p[1] * 1.1, p[2] * 1.1, p[3]]);
+        let errors = ScaleErrors::of(&biased, &reference).unwrap();
+        for e in errors.blocks {
+            assert!((e - 0.1).abs() < 1e-6, "{errors:?}");
+        }
+        assert!((errors.mean_ratio - 1.1).abs() < 1e-6);
+    }
+
+    /// A block's colour is its pixels' mean: a patch aligned to 2×2 blocks whose pixels swap
+    /// light within each block has no error at 2×2; the same swap across blocks keeps it.
+    #[test]
+    fn light_moved_within_a_block_is_no_error_at_that_block_size() {
+        let reference = Image::new(4, 2, vec![[1.0, 1.0, 1.0, 1.0]; 8]);
+        let within = Image::new(
+            4,
+            2,
+            (0..8)
+                .map(|i| {
+                    if i % 2 == 0 {
+                        [1.5, 1.5, 1.5, 1.0]
+                    } else {
+                        [0.5, 0.5, 0.5, 1.0]
+                    }
+                })
+                .collect(),
+        );
+        let across = Image::new(
+            4,
+            2,
+            (0..8)
+                .map(|i| {
+                    if i % 4 < 2 {
+                        [1.5, 1.5, 1.5, 1.0]
+                    } else {
+                        [0.5, 0.5, 0.5, 1.0]
+                    }
+                })
+                .collect(),
+        );
+        assert_eq!(
+            relative_rmse_over_blocks(&within, &reference, 2).unwrap(),
+            0.0
+        );
+        let kept = relative_rmse_over_blocks(&across, &reference, 2).unwrap();
+        assert!((kept - 0.5).abs() < 1e-9, "{kept}");
+        assert!((relative_rmse_over_blocks(&across, &reference, 4).unwrap()).abs() < 1e-9);
+    }
+
+    /// Coverage: half the alpha on every hair pixel is an error of 0.5; alpha where the
+    /// reference has none counts, whatever the colour.
+    #[test]
+    fn the_coverage_error_is_the_alphas_relative_rmse() {
+        let reference = patch(|_, _, p| p);
+        let half = patch(|_, _, p| [p[0], p[1], p[2], p[3] * 0.5]);
+        let e = coverage_error(&half, &reference).unwrap();
+        assert!((e - 0.5).abs() < 1e-9, "{e}");
+        let extra = patch(|x, y, p| {
+            if (x, y) == (0, 0) {
+                [0.0, 0.0, 0.0, 1.0]
+            } else {
+                p
+            }
+        });
+        let e = coverage_error(&extra, &reference).unwrap();
+        assert!((e - (1.0f64 / 64.0).sqrt()).abs() < 1e-9, "{e}");
     }
 
     #[test]
