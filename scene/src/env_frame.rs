@@ -10,7 +10,7 @@ use std::sync::OnceLock;
 use strandlight_precompute::srbf_set::SrbfSet;
 use strandlight_runtime::camera::Camera;
 use strandlight_runtime::env::{
-    EnvImage, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables, FrameSums,
+    EnvImage, EnvRenderOptions, EnvRenderStats, EnvRenderer, EnvTables, FrameSums, ViewTransparency,
 };
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
@@ -91,10 +91,14 @@ fn env_renderer() -> anyhow::Result<(&'static GpuContext, &'static EnvRenderer)>
     Ok((gpu, RENDERER.get_or_init(|| EnvRenderer::new(gpu))))
 }
 
-/// Creates the device and the env-lit renderer's pipelines now (0.3 s on lavapipe), so that
-/// an application's first frame, prepared meanwhile, does not wait for them.
-pub fn prepare_env_renderer() -> anyhow::Result<()> {
-    env_renderer().map(|_| ())
+/// Creates the device and the env-lit renderer now, and compiles the pipelines of a first
+/// look (the opaque view of [`crate::frame_render::FramePart::Preview`]) and of `view`, so
+/// that an application's first frame, prepared meanwhile, does not wait for them.
+pub fn prepare_env_renderer(view: ViewTransparency) -> anyhow::Result<()> {
+    let (_, renderer) = env_renderer()?;
+    renderer.compile(ViewTransparency::Opaque);
+    renderer.compile(view);
+    Ok(())
 }
 
 /// The adapter the renderers run on (creating the device on first use).

@@ -11,8 +11,10 @@ use anyhow::{Context, bail};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
+use strandlight_runtime::env::ViewTransparency;
 use strandlight_runtime::gpu::GpuContext;
-use strandlight_scene::frame_settings::FrameSettings;
+use strandlight_scene::frame_render::env_look;
+use strandlight_scene::frame_settings::{FrameSettings, Lighting};
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
@@ -60,7 +62,11 @@ pub fn run(options: ViewOptions) -> anyhow::Result<()> {
     let wake: Box<dyn Fn() + Send + Sync> = Box::new(move || {
         let _ = proxy.lock().unwrap().send_event(());
     });
-    let worker = Worker::spawn(options.cache_dir.clone(), wake);
+    let first_view = match &options.settings.lighting {
+        Lighting::Environment(env) => env_look(env)?.transparency,
+        Lighting::Lights(_) => ViewTransparency::Opaque,
+    };
+    let worker = Worker::spawn(options.cache_dir.clone(), first_view, wake);
     let mut app = App {
         options,
         script,

@@ -13,8 +13,8 @@ use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env::FrameSums;
-use strandlight_scene::env_frame::frame_sums;
+use strandlight_runtime::env::{FrameSums, ViewTransparency};
+use strandlight_scene::env_frame::{frame_sums, prepare_env_renderer};
 use strandlight_scene::env_light_sets::{frame_lights, light_luminance};
 use strandlight_scene::env_scene::{AlsoServe, PrepareProgress, PreparedEnv, prepare_env};
 use strandlight_scene::frame_render::{
@@ -86,7 +86,13 @@ pub struct Worker {
 
 impl Worker {
     /// Starts the thread; `wake_window` is called whenever the status changes.
-    pub fn spawn(cache_dir: PathBuf, wake_window: Box<dyn Fn() + Send + Sync>) -> Self {
+    /// The render thread, its renderer prepared for frames in `first_view` (the first
+    /// request's).
+    pub fn spawn(
+        cache_dir: PathBuf,
+        first_view: ViewTransparency,
+        wake_window: Box<dyn Fn() + Send + Sync>,
+    ) -> Self {
         let shared = Arc::new(Shared {
             request: Mutex::new(None),
             wake_worker: Condvar::new(),
@@ -96,7 +102,7 @@ impl Worker {
         });
         // The device and pipelines are made while the window opens and the tables load; an
         // error here is the first frame's to report.
-        std::thread::spawn(|| strandlight_scene::env_frame::prepare_env_renderer().ok());
+        std::thread::spawn(move || prepare_env_renderer(first_view).ok());
         let for_thread = shared.clone();
         let thread = std::thread::Builder::new()
             .name("strandlight render".into())

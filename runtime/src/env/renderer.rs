@@ -13,7 +13,7 @@ use super::light_maps::LightMapsPass;
 use super::stats::{BatchUsage, Timings};
 use super::table_binding::TableCache;
 use super::view_shading::{EnvViewLayouts, ViewShadingPass, view_visibility_pass};
-use super::view_visibility::ViewVisibilityPass;
+use super::view_visibility::{ViewTransparency, ViewVisibilityPass};
 use super::volume::VolumeCache;
 use super::{EncodedFrame, EnvImage, EnvRenderError, EnvRenderOptions, EnvRenderStats, EnvTables};
 use crate::camera::Camera;
@@ -66,6 +66,16 @@ impl EnvRenderer {
             tables: TableCache::default(),
             layouts,
         }
+    }
+
+    /// Compiles the pipelines a frame in `transparency` draws with (each is otherwise compiled
+    /// when a frame first uses it), the visibility's beside the view's: ahead of a first frame,
+    /// on a thread of the application's.
+    pub fn compile(&self, transparency: ViewTransparency) {
+        build_both(
+            || self.visibility.compile(transparency),
+            || self.shading.compile(transparency),
+        );
     }
 
     /// Makes `volume` the visibility volume of `model` under `settings` (instead of building
@@ -195,6 +205,8 @@ impl EnvRenderer {
             multiple,
             head,
         };
+        // Once per renderer, outside the frame's timed passes.
+        self.compile(options.transparency);
         let mut timings = Timings(Vec::new());
         let part = (lights, first_window);
         let (frame, kinds) = self.start_part(gpu, &request, part, None, &mut timings)?;
@@ -237,6 +249,8 @@ impl EnvRenderer {
             multiple,
             head,
         };
+        // Once per renderer, outside the frame's timed passes.
+        self.compile(options.transparency);
         let mut timings = Timings(Vec::new());
         let part = (lights, first_window);
         let (frame, kinds) = self.start_part(gpu, &request, part, Some(sums), &mut timings)?;
@@ -366,7 +380,11 @@ pub fn render_env_frame(
     multiple: Option<&dyn ForwardScatteringSource>,
 ) -> Result<EnvImage, EnvRenderError> {
     let mut timings = Timings(Vec::new());
-    let renderer = timings.time(gpu, "pipelines", || EnvRenderer::new(gpu));
+    let renderer = timings.time(gpu, "pipelines", || {
+        let renderer = EnvRenderer::new(gpu);
+        renderer.compile(options.transparency);
+        renderer
+    });
     let mut frame = renderer.render(
         gpu, model, camera, width, height, lights, tables, options, multiple,
     )?;

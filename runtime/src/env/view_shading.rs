@@ -15,7 +15,9 @@ use super::view_targets::EnvViewTargets;
 use super::view_visibility::{OccupancyMap, ViewTransparency, ViewVisibilityPass};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::pipeline_layout;
-use crate::gpu::pipeline::{ADDITIVE, StrandDraw, build_both, color_target, depth_test};
+use crate::gpu::pipeline::{
+    ADDITIVE, LazyPipeline, StrandDraw, build_both, color_target, depth_test,
+};
 use crate::passes::attachments::{cleared_color, prepassed_depth};
 use crate::passes::convolution_transmittance::{BatchBinding, transmittance_bind_group_layout};
 use crate::passes::render_target::DEPTH_FORMAT;
@@ -70,16 +72,17 @@ pub(super) fn view_visibility_pass(
     )
 }
 
-/// A view pipeline writing the single and multiple targets from vertex entry `vertex` and
-/// fragment entry `entry`.
+/// A view pipeline writing the single and multiple targets (`format`) from vertex entry
+/// `vertex` and fragment entry `entry`.
 fn view_pipeline(
-    gpu: &GpuContext,
+    device: &wgpu::Device,
+    format: wgpu::TextureFormat,
     layout: &wgpu::PipelineLayout,
     shader: &wgpu::ShaderModule,
     (label, vertex, entry): (&str, &str, &str),
     blend: Option<wgpu::BlendState>,
 ) -> wgpu::RenderPipeline {
-    let target = color_target(gpu.hdr_format(), blend);
+    let target = color_target(format, blend);
     StrandDraw {
         label,
         layout,
@@ -88,20 +91,21 @@ fn view_pipeline(
         fragment: Some((entry, &[target.clone(), target])),
         depth: None,
     }
-    .build(&gpu.device)
+    .build(device)
 }
 
-/// The view shading pipelines, one per view transparency, and the skin behind the hair.
+/// The view shading pipelines, one per view transparency, and the skin behind the hair; each
+/// compiled when a frame first uses it.
 pub(super) struct ViewShadingPass {
-    opaque: wgpu::RenderPipeline,
-    transparent: wgpu::RenderPipeline,
-    layered: wgpu::RenderPipeline,
+    opaque: LazyPipeline,
+    transparent: LazyPipeline,
+    layered: LazyPipeline,
     /// A batch of compact sources in the layered view: its lights' visibility gathered per
     /// layer (`fs_env_layer_lights`) before the layers are shaded.
-    layer_lights: wgpu::RenderPipeline,
+    layer_lights: LazyPipeline,
     /// Occupancy and layered views: the skin behind the pixel's fibers (`skin.wgsl`), added
     /// after them.
-    skin_behind_hair: wgpu::RenderPipeline,
+    skin_behind_hair: LazyPipeline,
 }
 
 /// What one batch's view shading binds and draws into.
@@ -124,7 +128,7 @@ impl ViewShadingPass {
             file: "view_shading.wgsl",
             source: include_str!("view_shading.wgsl"),
         };
-        let shader = &shader_module(&gpu.device, &top, None);
+        let shader = shader_module(&gpu.device, &top, None);
         let layout = pipeline_layout(
             &gpu.device,
             "env view",
@@ -135,76 +139,74 @@ impl ViewShadingPass {
                 Some(&layouts.view),
             ],
         );
-        let pipeline = |names, blend| view_pipeline(gpu, &layout, shader, names, blend);
-        // The five compile on threads of their own (`build_both`): each holds the whole
-        // shading loop.
-        let ((opaque, transparent), ((layered, skin_behind_hair), layer_lights)) = build_both(
-            || {
-                build_both(
-                    // The depth prepass left each pixel's nearest fiber in two textures: the
-                    // opaque view shades those pixels, rasterizing no strand per batch.
-                    || {
-                        pipeline(
-                            ("env view (opaque)", "vs_fullscreen", "fs_env_deferred"),
-                            None,
-                        )
-                    },
-                    || {
-                        pipeline(
-                            ("env view (occupancy)", "vs_main", "fs_env_transparent"),
-                            Some(ADDITIVE),
-                        )
-                    },
-                )
-            },
-            || {
-                build_both(
-                    || {
-                        build_both(
-                            // The layers the frame's visibility gathered: a full-screen pass,
-                            // added to by the skin.
-                            || {
-                                pipeline(
-                                    ("env view (layered)", "vs_fullscreen", "fs_env_layered"),
-                                    Some(ADDITIVE),
-                                )
-                            },
-                            || {
-                                pipeline(
-                                    (
-                                        "env view (skin behind hair)",
-                                        "vs_fullscreen",
-                                        "fs_env_skin",
-                                    ),
-                                    Some(ADDITIVE),
-                                )
-                            },
-                        )
-                    },
-                    || {
-                        StrandDraw {
-                            label: "env view (layers' light visibility)",
-                            layout: &layout,
-                            shader,
-                            vertex_entry: "vs_main",
-                            fragment: Some(("fs_env_layer_lights", &[])),
-                            depth: Some(depth_test(
-                                DEPTH_FORMAT,
-                                false,
-                                wgpu::CompareFunction::Always,
-                            )),
-                        }
-                        .build(&gpu.device)
-                    },
-                )
-            },
-        );
+        let (device, format) = (gpu.device.clone(), gpu.hdr_format());
+        let lazy = |names: (&'static str, &'static str, &'static str), blend| {
+            let (device, layout, shader) = (device.clone(), layout.clone(), shader.clone());
+            LazyPipeline::new(move || {
+                view_pipeline(&device, format, &layout, &shader, names, blend)
+            })
+        };
+        let (gather_device, gather_layout, gather_shader) =
+            (device.clone(), layout.clone(), shader.clone());
         Self {
-            opaque,
-            transparent,
-            layered,
-            layer_lights,
-            skin_behind_hair,
+            // The depth prepass left each pixel's nearest fiber in two textures: the opaque
+            // view shades those pixels, rasterizing no strand per batch.
+            opaque: lazy(
+                ("env view (opaque)", "vs_fullscreen", "fs_env_deferred"),
+                None,
+            ),
+            transparent: lazy(
+                ("env view (occupancy)", "vs_main", "fs_env_transparent"),
+                Some(ADDITIVE),
+            ),
+            // The layers the frame's visibility gathered: a full-screen pass, added to by the
+            // skin.
+            layered: lazy(
+                ("env view (layered)", "vs_fullscreen", "fs_env_layered"),
+                Some(ADDITIVE),
+            ),
+            layer_lights: LazyPipeline::new(move || {
+                StrandDraw {
+                    label: "env view (layers' light visibility)",
+                    layout: &gather_layout,
+                    shader: &gather_shader,
+                    vertex_entry: "vs_main",
+                    fragment: Some(("fs_env_layer_lights", &[])),
+                    depth: Some(depth_test(
+                        DEPTH_FORMAT,
+                        false,
+                        wgpu::CompareFunction::Always,
+                    )),
+                }
+                .build(&gather_device)
+            }),
+            skin_behind_hair: lazy(
+                (
+                    "env view (skin behind hair)",
+                    "vs_fullscreen",
+                    "fs_env_skin",
+                ),
+                Some(ADDITIVE),
+            ),
+        }
+    }
+
+    /// Compiles the pipelines a frame in `transparency` draws with, side by side
+    /// ([`build_both`]), before its first batch needs them.
+    pub(super) fn compile(&self, transparency: ViewTransparency) {
+        match transparency {
+            ViewTransparency::Opaque => {
+                self.opaque.get();
+            }
+            ViewTransparency::Occupancy { .. } => {
+                build_both(|| self.transparent.get(), || self.skin_behind_hair.get());
+            }
+            ViewTransparency::Layered { .. } => {
+                build_both(
+                    || self.layered.get(),
+                    || build_both(|| self.layer_lights.get(), || self.skin_behind_hair.get()),
+                );
+            }
         }
     }
 
@@ -224,11 +226,11 @@ impl ViewShadingPass {
         let multiple = targets.multiple.create_view(&Default::default());
         let transparency = inputs.transparency;
         let (pipeline, vertices, instances) = match transparency {
-            ViewTransparency::Opaque => (&self.opaque, 3, 1),
+            ViewTransparency::Opaque => (self.opaque.get(), 3, 1),
             ViewTransparency::Occupancy { .. } => {
-                (&self.transparent, 6, inputs.geometry.segment_count)
+                (self.transparent.get(), 6, inputs.geometry.segment_count)
             }
-            ViewTransparency::Layered { .. } => (&self.layered, 3, 1),
+            ViewTransparency::Layered { .. } => (self.layered.get(), 3, 1),
         };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("env view"),
@@ -245,7 +247,7 @@ impl ViewShadingPass {
         pass.set_bind_group(3, &inputs.view.group, &[]);
         pass.draw(0..vertices, 0..instances);
         if transparency.uses_occupancy_map() && inputs.with_head {
-            pass.set_pipeline(&self.skin_behind_hair);
+            pass.set_pipeline(self.skin_behind_hair.get());
             pass.draw(0..3, 0..1);
         }
     }
@@ -269,7 +271,7 @@ impl ViewShadingPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.layer_lights);
+        pass.set_pipeline(self.layer_lights.get());
         pass.set_bind_group(0, inputs.strands, &[]);
         pass.set_bind_group(1, &inputs.batch.group, &[]);
         pass.set_bind_group(2, &inputs.tables.group, &[]);

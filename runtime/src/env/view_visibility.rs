@@ -25,7 +25,7 @@
 
 use crate::gpu::GpuContext;
 use crate::gpu::limits::{GpuLimits, LimitError, fit_pixels};
-use crate::gpu::pipeline::{StrandDraw, depth_test};
+use crate::gpu::pipeline::{LazyPipeline, StrandDraw, build_both, depth_test};
 use crate::gpu::readback::{ReadbackError, read_texture_rgba};
 use crate::passes::attachments::{cleared_color, cleared_depth, prepassed_depth};
 use crate::passes::render_target::{DEPTH_FORMAT, NEAREST_SURFACE_FORMAT, RenderTarget};
@@ -237,36 +237,45 @@ impl OccupancyMap {
 /// The build pipelines, made from the env view module so that they rasterize exactly the
 /// fragments the view pass shades (the depth prepass's Equal test needs bit-identical depths).
 pub struct ViewVisibilityPass {
-    depth_prepass: wgpu::RenderPipeline,
-    front_depth: wgpu::RenderPipeline,
-    coverage: wgpu::RenderPipeline,
-    range: wgpu::RenderPipeline,
-    slices: wgpu::RenderPipeline,
-    weights: wgpu::RenderPipeline,
-    layers: wgpu::RenderPipeline,
-    count_rasterized: wgpu::RenderPipeline,
-    count_nearest: wgpu::RenderPipeline,
-    count_visible: wgpu::RenderPipeline,
-    count_layers: wgpu::RenderPipeline,
+    depth_prepass: LazyPipeline,
+    front_depth: LazyPipeline,
+    coverage: LazyPipeline,
+    range: LazyPipeline,
+    slices: LazyPipeline,
+    weights: LazyPipeline,
+    layers: LazyPipeline,
+    count_rasterized: LazyPipeline,
+    count_nearest: LazyPipeline,
+    count_visible: LazyPipeline,
+    count_layers: LazyPipeline,
 }
 
-impl ViewVisibilityPass {
-    /// `layout` binds the strands at group 0 and the view group at group 3, `strands_only` the
-    /// strands alone; `float_format` is the (blendable) format of the coverage and count targets.
-    pub fn new(
-        device: &wgpu::Device,
-        module: &wgpu::ShaderModule,
-        layout: &wgpu::PipelineLayout,
-        strands_only: &wgpu::PipelineLayout,
-        float_format: wgpu::TextureFormat,
-    ) -> Self {
+/// What the visibility pipelines are built from (each when a frame first draws with it).
+struct VisibilityShader {
+    device: wgpu::Device,
+    module: wgpu::ShaderModule,
+    layout: wgpu::PipelineLayout,
+    strands_only: wgpu::PipelineLayout,
+    float_format: wgpu::TextureFormat,
+}
+
+impl VisibilityShader {
+    /// A fragment entry point writes the additive float target (or the nearest surface);
+    /// `depth`: the depth test and whether it writes, None without a depth attachment.
+    fn pipeline(
+        &self,
+        label: &str,
+        strands_only: bool,
+        fragment: Option<&str>,
+        depth: Option<(wgpu::CompareFunction, bool)>,
+    ) -> wgpu::RenderPipeline {
         let additive = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::One,
             dst_factor: wgpu::BlendFactor::One,
             operation: wgpu::BlendOperation::Add,
         };
         let float_target = [Some(wgpu::ColorTargetState {
-            format: float_format,
+            format: self.float_format,
             blend: Some(wgpu::BlendState {
                 color: additive,
                 alpha: additive,
@@ -280,48 +289,71 @@ impl ViewVisibilityPass {
             write_mask: wgpu::ColorWrites::ALL,
         });
         let nearest_targets = [nearest_target.clone(), nearest_target];
-        // A fragment entry point writes the additive float target (or the nearest surface); `depth`: the depth test and
-        // whether it writes, None without a depth attachment.
-        let pipeline = |label: &str,
-                        layout: &wgpu::PipelineLayout,
-                        fragment: Option<&str>,
-                        depth: Option<(wgpu::CompareFunction, bool)>| {
-            // The layer count is a full-screen pass; every other pass draws the strands.
-            let vertex_entry = match fragment {
-                Some("fs_count_layers") => "vs_fullscreen",
-                _ => "vs_main",
-            };
-            let targets: &[Option<wgpu::ColorTargetState>] = match fragment {
-                Some(f) if f.starts_with("fs_count") || f == "fs_coverage" => &float_target,
-                Some("fs_nearest_surface") => &nearest_targets,
-                _ => &[],
-            };
-            StrandDraw {
-                label,
-                layout,
-                shader: module,
-                vertex_entry,
-                fragment: fragment.map(|entry| (entry, targets)),
-                depth: depth.map(|(compare, write)| depth_test(DEPTH_FORMAT, write, compare)),
-            }
-            .build(device)
+        // The layer count is a full-screen pass; every other pass draws the strands.
+        let vertex_entry = match fragment {
+            Some("fs_count_layers") => "vs_fullscreen",
+            _ => "vs_main",
+        };
+        let targets: &[Option<wgpu::ColorTargetState>] = match fragment {
+            Some(f) if f.starts_with("fs_count") || f == "fs_coverage" => &float_target,
+            Some("fs_nearest_surface") => &nearest_targets,
+            _ => &[],
+        };
+        StrandDraw {
+            label,
+            layout: match strands_only {
+                true => &self.strands_only,
+                false => &self.layout,
+            },
+            shader: &self.module,
+            vertex_entry,
+            fragment: fragment.map(|entry| (entry, targets)),
+            depth: depth.map(|(compare, write)| depth_test(DEPTH_FORMAT, write, compare)),
+        }
+        .build(&self.device)
+    }
+}
+
+impl ViewVisibilityPass {
+    /// `layout` binds the strands at group 0 and the view group at group 3, `strands_only` the
+    /// strands alone; `float_format` is the (blendable) format of the coverage and count targets.
+    pub fn new(
+        device: &wgpu::Device,
+        module: &wgpu::ShaderModule,
+        layout: &wgpu::PipelineLayout,
+        strands_only: &wgpu::PipelineLayout,
+        float_format: wgpu::TextureFormat,
+    ) -> Self {
+        let shader = std::sync::Arc::new(VisibilityShader {
+            device: device.clone(),
+            module: module.clone(),
+            layout: layout.clone(),
+            strands_only: strands_only.clone(),
+            float_format,
+        });
+        let lazy = |label: &'static str,
+                    strands_only: bool,
+                    fragment: Option<&'static str>,
+                    depth: Option<(wgpu::CompareFunction, bool)>| {
+            let shader = shader.clone();
+            LazyPipeline::new(move || shader.pipeline(label, strands_only, fragment, depth))
         };
         use wgpu::CompareFunction::{Always, Equal, Less};
         let reading =
-            |label, entry, compare| pipeline(label, layout, Some(entry), Some((compare, false)));
+            |label, entry, compare| lazy(label, false, Some(entry), Some((compare, false)));
         Self {
-            depth_prepass: pipeline(
+            depth_prepass: lazy(
                 "view depth prepass",
-                strands_only,
+                true,
                 Some("fs_nearest_surface"),
                 Some((Less, true)),
             ),
-            front_depth: pipeline("view front depth", strands_only, None, Some((Less, true))),
+            front_depth: lazy("view front depth", true, None, Some((Less, true))),
             // Against the head's depth alone (the head pass wrote it; the prepass runs after):
             // fibers behind the head add no coverage.
-            coverage: pipeline(
+            coverage: lazy(
                 "view coverage",
-                strands_only,
+                true,
                 Some("fs_coverage"),
                 Some((Less, false)),
             ),
@@ -333,6 +365,28 @@ impl ViewVisibilityPass {
             count_nearest: reading("count nearest", "fs_count_nearest", Equal),
             count_visible: reading("count visible", "fs_count_visible", Always),
             count_layers: reading("count layers", "fs_count_layers", Always),
+        }
+    }
+
+    /// Compiles the pipelines that build a frame's visibility in `transparency`, side by side
+    /// ([`build_both`]), before its first frame needs them.
+    pub fn compile(&self, transparency: ViewTransparency) {
+        match transparency {
+            ViewTransparency::Opaque => {
+                build_both(|| self.coverage.get(), || self.depth_prepass.get());
+            }
+            ViewTransparency::Occupancy { .. } => {
+                build_both(
+                    || build_both(|| self.range.get(), || self.slices.get()),
+                    || self.weights.get(),
+                );
+            }
+            ViewTransparency::Layered { .. } => {
+                build_both(
+                    || build_both(|| self.range.get(), || self.slices.get()),
+                    || build_both(|| self.weights.get(), || self.layers.get()),
+                );
+            }
         }
     }
 
@@ -364,30 +418,48 @@ impl ViewVisibilityPass {
             bool,
         )> = match transparency {
             ViewTransparency::Opaque => vec![
-                ("view coverage", vec![coverage], true, &self.coverage, false),
+                (
+                    "view coverage",
+                    vec![coverage],
+                    true,
+                    self.coverage.get(),
+                    false,
+                ),
                 (
                     "view depth prepass",
                     nearest.to_vec(),
                     true,
-                    &self.depth_prepass,
+                    self.depth_prepass.get(),
                     false,
                 ),
             ],
             ViewTransparency::Occupancy { .. } => {
                 encoder.clear_buffer(&map.buffer, 0, None);
                 vec![
-                    ("occupancy depth range", vec![], true, &self.range, true),
-                    ("occupancy slices", vec![], true, &self.slices, true),
-                    ("occupancy weights", vec![], true, &self.weights, true),
+                    (
+                        "occupancy depth range",
+                        vec![],
+                        true,
+                        self.range.get(),
+                        true,
+                    ),
+                    ("occupancy slices", vec![], true, self.slices.get(), true),
+                    ("occupancy weights", vec![], true, self.weights.get(), true),
                 ]
             }
             ViewTransparency::Layered { .. } => {
                 encoder.clear_buffer(&map.buffer, 0, None);
                 vec![
-                    ("occupancy depth range", vec![], true, &self.range, true),
-                    ("occupancy slices", vec![], true, &self.slices, true),
-                    ("occupancy weights", vec![], true, &self.weights, true),
-                    ("view layers", vec![], true, &self.layers, true),
+                    (
+                        "occupancy depth range",
+                        vec![],
+                        true,
+                        self.range.get(),
+                        true,
+                    ),
+                    ("occupancy slices", vec![], true, self.slices.get(), true),
+                    ("occupancy weights", vec![], true, self.weights.get(), true),
+                    ("view layers", vec![], true, self.layers.get(), true),
                 ]
             }
         };
@@ -435,7 +507,7 @@ impl ViewVisibilityPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.front_depth);
+        pass.set_pipeline(self.front_depth.get());
         pass.set_bind_group(0, strands, &[]);
         pass.draw(0..6 * segments, 0..1);
     }
@@ -456,9 +528,9 @@ impl ViewVisibilityPass {
     ) -> Result<FragmentCounts, ReadbackError> {
         let counts = RenderTarget::new(gpu, width, height);
         let (shaded, shaded_vertices) = match transparency {
-            ViewTransparency::Opaque => (&self.count_nearest, 6 * segments),
-            ViewTransparency::Occupancy { .. } => (&self.count_visible, 6 * segments),
-            ViewTransparency::Layered { .. } => (&self.count_layers, 3),
+            ViewTransparency::Opaque => (self.count_nearest.get(), 6 * segments),
+            ViewTransparency::Occupancy { .. } => (self.count_visible.get(), 6 * segments),
+            ViewTransparency::Layered { .. } => (self.count_layers.get(), 3),
         };
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         {
@@ -474,7 +546,7 @@ impl ViewVisibilityPass {
             pass.set_bind_group(0, strands, &[]);
             pass.set_bind_group(3, view, &[]);
             for (pipeline, vertices) in [
-                (&self.count_rasterized, 6 * segments),
+                (self.count_rasterized.get(), 6 * segments),
                 (shaded, shaded_vertices),
             ] {
                 pass.set_pipeline(pipeline);
