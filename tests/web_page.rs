@@ -32,9 +32,10 @@ use strandlight_scene::exposure::metered_stops;
 use strandlight_scene::frame_render::settings_camera;
 use strandlight_scene::frame_settings::{FrameSettings, Lighting};
 use strandlight_scene::image_metrics::{Image, relative_rmse};
+use strandlight_scene::web_bundle::{BundleScene, SCENE_FILE};
 use strandlight_tables::image_out::tonemap_channel;
 use strandlight_tables::outside_tools::{missing_tool, program_exists};
-use strandlight_web::session::Session;
+use strandlight_web::session::{BundleFiles, Session};
 
 mod page_session;
 use page_session::{blocks, bundle_files, converge, native_session, step_to_the_end, total};
@@ -193,6 +194,7 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
     let session_error = relative_rmse(&session, &native).unwrap();
     eprintln!("the page's steps on lavapipe vs render replay: relative RMSE {session_error:.2e}");
     assert!(session_error < NATIVE_SESSION_TOLERANCE, "{session_error}");
+    assert_the_first_look_opens_before_the_other_tables(&site.join("bundle"), &session);
 
     phase("native session stepped");
     let report = run_page_harness(&site, &shots);
@@ -237,6 +239,35 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
     phase("limited session converged");
     let _ = std::fs::remove_dir_all(&site);
     let _ = std::fs::remove_file(&test_settings);
+}
+
+/// A session opened with the first look's tables alone (as the page opens it while it fetches
+/// the rest) draws its preview and stops there, unconverged; given the other tables it goes on
+/// to the frame of a session opened with every table.
+fn assert_the_first_look_opens_before_the_other_tables(bundle: &Path, every_table: &Image) {
+    let files = bundle_files(bundle);
+    let scene = BundleScene::parse(&files[SCENE_FILE]).unwrap();
+    let first_look: Vec<&str> = (scene.presets.values().flatten())
+        .filter(|t| scene.first_look.contains(&t.name))
+        .map(|t| t.file.as_str())
+        .collect();
+    assert!(!first_look.is_empty(), "the bundle names no first look");
+    let (first, rest): (BundleFiles, BundleFiles) = (files.clone().into_iter())
+        .partition(|(name, _)| !name.ends_with(".sltab") || first_look.contains(&name.as_str()));
+    assert!(!rest.is_empty());
+    let mut session = Session::new(GpuContext::new_headless().unwrap(), first).unwrap();
+    let mut steps = 0;
+    while session.refining() {
+        session.step().unwrap();
+        steps += 1;
+    }
+    assert_eq!(steps, 1, "the first look's tables draw the preview alone");
+    session.add_tables(rest).unwrap();
+    assert!(session.refining(), "the other tables go on to the batches");
+    let frame = converge(session);
+    let difference = relative_rmse(&frame, every_table).unwrap();
+    eprintln!("first look, then the other tables, vs every table at once: {difference:.2e}");
+    assert!(difference < 1e-6, "{difference}");
 }
 
 /// The canvas's picture against `frame` exposed by the page's metered stops over its black

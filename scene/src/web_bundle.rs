@@ -45,6 +45,10 @@ pub struct BundleScene {
     pub mode: ScatteringMode,
     /// Per fiber preset baked into the bundle: its tables.
     pub presets: BTreeMap<String, Vec<BundledTable>>,
+    /// The tables a first look reads ([`Self::first_look_table_names`]): the page fetches and
+    /// opens these first, draws its preview, and takes the rest as they arrive.
+    #[serde(default)]
+    pub first_look: Vec<String>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -80,6 +84,15 @@ impl BundleScene {
         fetched: impl Fn(&str) -> Option<Vec<u8>>,
     ) -> anyhow::Result<PreparedEnv> {
         let tables = self.scene_tables(preset, fetched)?;
+        self.prepared_from(preset, up, tables)
+    }
+
+    fn prepared_from(
+        &self,
+        preset: &str,
+        up: UpAxis,
+        tables: SceneTables,
+    ) -> anyhow::Result<PreparedEnv> {
         let fiber =
             FiberDescription::preset(preset).with_context(|| format!("preset {preset:?}"))?;
         Ok(PreparedEnv {
@@ -124,10 +137,43 @@ impl BundleScene {
         unique
     }
 
+    /// The tables of a first look (`FramePart::Preview`: single scattering): the SRBF table,
+    /// and the direct table where the fit took compact sources out.
+    pub fn first_look_table_names(&self) -> Vec<&'static str> {
+        let mut names = vec![self.shading.srbf_table(ScatteringMode::Single)];
+        if !self.fit.sources.is_empty() {
+            names.push(self.shading.direct_table(ScatteringMode::Single));
+        }
+        names
+    }
+
+    /// [`Self::prepared`] with only the first look's tables ([`Self::first_look`]): enough for a
+    /// preview while the rest are still being fetched.
+    pub fn prepared_first_look(
+        &self,
+        preset: &str,
+        up: UpAxis,
+        fetched: impl Fn(&str) -> Option<Vec<u8>>,
+    ) -> anyhow::Result<PreparedEnv> {
+        let only = |name: &str| self.first_look.iter().any(|n| n == name);
+        let tables = self.tables_of(preset, only, fetched)?;
+        self.prepared_from(preset, up, tables)
+    }
+
     /// `preset`'s tables from their files' bytes (`fetched(file)`), checked as any asset is.
     pub fn scene_tables(
         &self,
         preset: &str,
+        fetched: impl Fn(&str) -> Option<Vec<u8>>,
+    ) -> anyhow::Result<SceneTables> {
+        self.tables_of(preset, |_| true, fetched)
+    }
+
+    /// The tables of `preset` that `wanted` names, from their files' bytes.
+    fn tables_of(
+        &self,
+        preset: &str,
+        wanted: impl Fn(&str) -> bool,
         fetched: impl Fn(&str) -> Option<Vec<u8>>,
     ) -> anyhow::Result<SceneTables> {
         let tables = self
@@ -135,7 +181,7 @@ impl BundleScene {
             .get(preset)
             .with_context(|| format!("{SCENE_FILE}: no preset {preset:?}"))?;
         let mut assets = BTreeMap::new();
-        for table in tables {
+        for table in tables.iter().filter(|t| wanted(&t.name)) {
             let path = Path::new(TABLES_DIR).join(&table.file);
             let bytes = fetched(&table.file)
                 .with_context(|| format!("{} was not fetched", path.display()))?;
@@ -207,7 +253,11 @@ pub fn bundle_scene(
         shading: first.shading,
         mode: first.scene.mode,
         presets: BTreeMap::new(),
+        first_look: Vec::new(),
     };
+    scene.first_look = (scene.first_look_table_names().iter())
+        .map(|name| name.to_string())
+        .collect();
     let mut files = Vec::new();
     for (preset, prepared) in presets {
         anyhow::ensure!(

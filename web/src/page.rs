@@ -49,6 +49,17 @@ pub struct Page {
     load_ms: f64,
 }
 
+/// The bytes of a JavaScript `Map` of file name → `Uint8Array`.
+fn bundle_files(files: &js_sys::Map) -> BundleFiles {
+    let mut bundle = BundleFiles::new();
+    files.for_each(&mut |value, key| {
+        if let (Some(name), Ok(bytes)) = (key.as_string(), value.dyn_into::<js_sys::Uint8Array>()) {
+            bundle.insert(name, bytes.to_vec());
+        }
+    });
+    bundle
+}
+
 fn js_error(e: anyhow::Error) -> JsValue {
     JsValue::from_str(&format!("{e:#}"))
 }
@@ -57,14 +68,7 @@ fn js_error(e: anyhow::Error) -> JsValue {
 impl Page {
     /// Opens WebGPU (with its default limits) and the bundle in `files` (file name → bytes).
     pub async fn create(files: js_sys::Map) -> Result<Page, JsValue> {
-        let mut bundle = BundleFiles::new();
-        files.for_each(&mut |value, key| {
-            if let (Some(name), Ok(bytes)) =
-                (key.as_string(), value.dyn_into::<js_sys::Uint8Array>())
-            {
-                bundle.insert(name, bytes.to_vec());
-            }
-        });
+        let bundle = bundle_files(&files);
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
             backends: wgpu::Backends::BROWSER_WEBGPU,
             ..wgpu::InstanceDescriptor::new_without_display_handle()
@@ -98,6 +102,16 @@ impl Page {
             message: None,
             failed: None,
         })
+    }
+
+    /// The rest of the bundle's files (file name → bytes), fetched after those `create` opened
+    /// (the first look's tables): the frame goes on from its preview to its batches.
+    pub fn add_files(&mut self, files: js_sys::Map) {
+        let opening = web_time::Instant::now();
+        if let Err(e) = self.session.add_tables(bundle_files(&files)) {
+            self.failed = Some(format!("{e:#}"));
+        }
+        self.load_ms += opening.elapsed().as_secs_f64() * 1e3;
     }
 
     /// How long opening the bundle held the page's thread (ms).

@@ -110,6 +110,9 @@ pub struct Session {
     /// The hair voxelized for multiple scattering (per hair and tables).
     volume: Option<CpuForwardScattering>,
     march: March,
+    /// Only the first look's tables are here (the rest are still being fetched): the frame
+    /// stops after its preview until [`Self::add_tables`].
+    first_look_only: bool,
 }
 
 /// Light maps are not made smaller than this to fit a device's limits.
@@ -136,7 +139,12 @@ impl Session {
         settings.check().context(SETTINGS_FILE)?;
         let hair = parse_hair(file(HAIR_FILE)?, Path::new(HAIR_FILE))?.model;
         let up = up_choice(&settings).axis(&hair);
-        let prepared = bundle.prepared(&settings.preset, up, |f| files.get(f).cloned())?;
+        // Every table, or the first look's while the page fetches the rest.
+        let first_look_only = !Self::has_every_table(&bundle, &settings.preset, &files);
+        let prepared = match first_look_only {
+            false => bundle.prepared(&settings.preset, up, |f| files.get(f).cloned())?,
+            true => bundle.prepared_first_look(&settings.preset, up, |f| files.get(f).cloned())?,
+        };
         let renderer = EnvRenderer::new(&gpu);
         let orbit = orbit_of(&settings, &hair)?;
         let mut session = Self {
@@ -168,6 +176,7 @@ impl Session {
             volume: None,
             march: March::Idle,
             last_memory: Vec::new(),
+            first_look_only,
         };
         session.restart()?;
         Ok(session)
@@ -201,16 +210,46 @@ impl Session {
         }
     }
 
-    /// Plans the frame of the current settings from its first step; the old picture stays on
-    /// the canvas until the new preview replaces it.
-    fn restart(&mut self) -> anyhow::Result<()> {
+    /// Whether `files` hold every table of `preset`.
+    fn has_every_table(bundle: &BundleScene, preset: &str, files: &BundleFiles) -> bool {
+        (bundle.presets.get(preset))
+            .is_some_and(|tables| tables.iter().all(|t| files.contains_key(&t.file)))
+    }
+
+    /// The rest of the bundle's tables, fetched after the first look's: the frame goes on
+    /// from its preview (drawn or not) to its batches.
+    pub fn add_tables(&mut self, files: BundleFiles) -> anyhow::Result<()> {
+        self.files.extend(files);
+        if !self.first_look_only {
+            return Ok(());
+        }
+        let (files, up) = (&self.files, self.prepared.up);
+        self.prepared =
+            (self.bundle).prepared(&self.settings.preset, up, |f| files.get(f).cloned())?;
+        self.first_look_only = false;
+        self.plan = self.planned()?;
+        Ok(())
+    }
+
+    /// The steps of the current settings' frame: a preview, then its batches (the preview
+    /// alone while only the first look's tables are here).
+    fn planned(&mut self) -> anyhow::Result<Vec<Step>> {
         let env = self.env()?.clone();
         // A dropped hair may stand on another axis than the bundle's.
         self.prepared.up = up_choice(&self.settings).axis(&self.hair);
         self.lights = frame_lights(&self.prepared, &env)?;
+        if self.first_look_only {
+            return Ok(vec![Step::Preview]);
+        }
         let powers: Vec<f32> = self.lights.iter().map(light_luminance).collect();
         let batch = env_look(&env)?.dodm.batch_size as usize;
-        self.plan = plan_steps(Some((&powers, batch)));
+        Ok(plan_steps(Some((&powers, batch))))
+    }
+
+    /// Plans the frame of the current settings from its first step; the old picture stays on
+    /// the canvas until the new preview replaces it.
+    fn restart(&mut self) -> anyhow::Result<()> {
+        self.plan = self.planned()?;
         self.next = 0;
         self.generation += 1;
         self.sums = None;
@@ -439,7 +478,7 @@ impl Session {
         self.stops = self.exposure.stops_for(&image);
         self.metered = Some(key);
         self.remeter = false;
-        if key.1 == self.plan.len() {
+        if key.1 == self.plan.len() && !self.first_look_only {
             self.converged = Some(image.clone());
         }
         self.read = Some((image, readback.size));
