@@ -24,7 +24,8 @@ pub struct EnvLight {
     /// Draw every strand into this light's map whatever the frame's κ. SRBFs default to κ's
     /// thinning (Ren §7); directional lights (the reference's, the baseline's, a sun's) draw
     /// every strand. (Marking the most powerful lobes so, adaptive κ, lost its one point on the
-    /// front to the layered view: docs/BENCHMARKS.md, "The view: layers".)
+    /// front to the layered view: docs/history/benchmarks-2026-12-02-to-12-04.md, "The view:
+    /// layers".)
     pub every_strand: bool,
     /// Directional lights only: per-axis variance (rad²) of the directions the light stands
     /// for (an extended compact source: a softbox, a sun's disc). Its visibility is averaged

@@ -10,7 +10,8 @@ use strandlight_runtime::visibility::{LobeVisibility, VisibilityVolumeSettings};
 
 /// What the view shows of each pixel's fibers (Ren §8). The default is the layered view: the
 /// path tracer's pixel averages every fiber it sees, so the opaque view's nearest (best-lit)
-/// fiber reads too bright (docs/BENCHMARKS.md, "The view: layers").
+/// fiber reads too bright (docs/history/benchmarks-2026-12-02-to-12-04.md, "The view:
+/// layers").
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[cfg_attr(any(feature = "cli", test), derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]

@@ -7,7 +7,7 @@
 // mean depth on the pixel's ray with its weighted mean tangent, times Σw. Across a layer the
 // shading is linear in neither, so the mean fiber's radiance is not the mean radiance: the
 // price of OCC_LAYERS shading loops per pixel instead of one per fragment
-// (docs/BENCHMARKS.md, "The view: layers").
+// (docs/history/benchmarks-2026-12-02-to-12-04.md, "The view: layers").
 //
 // A batch of compact sources (suns, lamps) also gathers, per layer and light slot, Σw·v: its
 // fibers' visibility v of the light (fs_env_layer_lights, view_shading.wgsl), which the layer's
