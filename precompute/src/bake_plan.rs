@@ -320,8 +320,9 @@ fn param_error(context: &'static str) -> impl Fn(ParamError) -> FiberError {
 }
 
 /// A model's dual-scattering averages, integrated when a job or the multiple-scattering
-/// decision first reads them: with Chiang's azimuthal grid 0.29 s of every plan, which a first
-/// look's single-scattering tables (or a cache holding every table) never need.
+/// decision first reads them. Built up front (with Chiang's azimuthal grid) they took 0.29 s of
+/// every plan, which a first look's single-scattering tables, or a cache holding every table,
+/// never need.
 #[derive(Clone)]
 struct LazyAverages {
     averages: Arc<OnceLock<Result<DualScatteringAverages, ParamError>>>,

@@ -40,10 +40,12 @@ pub(super) struct FrameRequest<'a> {
     pub(super) head: Option<&'a Head>,
 }
 
-/// What every part of a frame sees alike: the hair as uploaded, the head, and the view's
+/// What every part of a frame sees alike: the hair as uploaded (all of it for the view and
+/// directional lights, the κ-simplified order for SRBF light passes), the head, and the view's
 /// visibility (its depth, nearest fibers and coverage, or its occupancy map). The frame's first
 /// part creates it and draws the visibility; a progressive frame keeps it in its [`FrameSums`]
-/// for the parts that follow ([`FrameSums::kept_view`]), which draw only their lights.
+/// for the parts that follow ([`FrameSums::kept_view`]), which draw only their lights. It lives
+/// as long as the sums keep it (until their owner drops them or starts another frame).
 #[derive(Clone)]
 pub(super) struct FrameView {
     pub(super) geometry: StrandGeometry,
@@ -72,9 +74,8 @@ pub(super) struct FrameView {
 }
 
 /// What one part of a frame renders into, created before its passes: the frame's [`FrameView`],
-/// the light passes' hair (all of it for directional lights, the κ-simplified order for SRBF
-/// light passes), the DODM batch (DODM: the convolution optical depth map of Ren 2010 §5, one
-/// layer per light) and its summed-area tables, and the tables bound per light kind.
+/// the DODM batch (DODM: the convolution optical depth map of Ren 2010 §5, one layer per light)
+/// and its summed-area tables, and the tables bound per light kind.
 pub(super) struct FrameResources {
     pub(super) view: Arc<FrameView>,
     /// Whether `view`'s visibility is still to be drawn (the frame's first part).

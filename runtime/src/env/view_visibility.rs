@@ -433,9 +433,9 @@ impl ViewVisibilityPass {
                     false,
                 ),
             ],
-            ViewTransparency::Occupancy { .. } => {
+            ViewTransparency::Occupancy { .. } | ViewTransparency::Layered { .. } => {
                 encoder.clear_buffer(&map.buffer, 0, None);
-                vec![
+                let mut passes = vec![
                     (
                         "occupancy depth range",
                         vec![],
@@ -445,22 +445,11 @@ impl ViewVisibilityPass {
                     ),
                     ("occupancy slices", vec![], true, self.slices.get(), true),
                     ("occupancy weights", vec![], true, self.weights.get(), true),
-                ]
-            }
-            ViewTransparency::Layered { .. } => {
-                encoder.clear_buffer(&map.buffer, 0, None);
-                vec![
-                    (
-                        "occupancy depth range",
-                        vec![],
-                        true,
-                        self.range.get(),
-                        true,
-                    ),
-                    ("occupancy slices", vec![], true, self.slices.get(), true),
-                    ("occupancy weights", vec![], true, self.weights.get(), true),
-                    ("view layers", vec![], true, self.layers.get(), true),
-                ]
+                ];
+                if let ViewTransparency::Layered { .. } = transparency {
+                    passes.push(("view layers", vec![], true, self.layers.get(), true));
+                }
+                passes
             }
         };
         for (label, colors, with_depth, pipeline, bind_view) in passes {
