@@ -26,6 +26,7 @@ use crate::head::Head;
 use crate::multiple::ForwardScatteringSource;
 use crate::passes::head::HeadPass;
 use crate::visibility::{VisibilityVolume, VisibilityVolumeSettings};
+use std::sync::OnceLock;
 
 /// The pipelines of the env-lit renderer, reusable across frames.
 pub struct EnvRenderer {
@@ -37,6 +38,8 @@ pub struct EnvRenderer {
     pub(super) accumulate: AccumulatePass,
     pub(super) volume: VolumeCache,
     pub(super) tables: TableCache,
+    /// Per view (opaque, occupancy, layered): its pipelines are compiled.
+    compiled: [OnceLock<()>; 3],
 }
 
 impl EnvRenderer {
@@ -64,6 +67,7 @@ impl EnvRenderer {
             accumulate,
             volume: VolumeCache::default(),
             tables: TableCache::default(),
+            compiled: Default::default(),
             layouts,
         }
     }
@@ -72,10 +76,18 @@ impl EnvRenderer {
     /// when a frame first uses it), the visibility's beside the view's: ahead of a first frame,
     /// on a thread of the application's.
     pub fn compile(&self, transparency: ViewTransparency) {
-        build_both(
-            || self.visibility.compile(transparency),
-            || self.shading.compile(transparency),
-        );
+        let view = match transparency {
+            ViewTransparency::Opaque => 0,
+            ViewTransparency::Occupancy { .. } => 1,
+            ViewTransparency::Layered { .. } => 2,
+        };
+        // Once: every part asks, and a frame's path spawns no threads after the first.
+        self.compiled[view].get_or_init(|| {
+            build_both(
+                || self.visibility.compile(transparency),
+                || self.shading.compile(transparency),
+            );
+        });
     }
 
     /// Makes `volume` the visibility volume of `model` under `settings` (instead of building
