@@ -23,10 +23,10 @@ use crate::hair::{Aabb, HairModel};
 use crate::head::Head;
 use crate::multiple::ForwardScatteringSource;
 use crate::passes::convolution_depth::{SimplifiedSegments, simplification_order};
-use crate::passes::frame_params::{FrameParams, KajiyaKay};
+use crate::passes::frame_params::{FrameParams, KajiyaKay, QuadStyle};
 use crate::passes::head::{HeadDepthMaps, HeadGeometry};
 use crate::passes::strand_geometry::StrandGeometry;
-use crate::passes::strand_quads::strand_bind_group;
+use crate::passes::strand_quads::strand_bind_group_styled;
 
 /// What one frame is asked for.
 pub(super) struct FrameRequest<'a> {
@@ -286,7 +286,16 @@ impl FrameView {
         let head_views = [&targets.head_position, &targets.head_normal]
             .map(|t| t.create_view(&Default::default()));
         Ok(Self {
-            strands: strand_bind_group(gpu, &renderer.layouts.strand, &geometry, &view_params),
+            strands: strand_bind_group_styled(
+                gpu,
+                &renderer.layouts.strand,
+                &geometry,
+                &view_params,
+                QuadStyle {
+                    width_scale: 1.0,
+                    exact_coverage: true,
+                },
+            ),
             view_proj: view_params.view_proj(),
             coverage_view: targets.coverage.create_view(&Default::default()),
             nearest_views: [&targets.nearest_position, &targets.nearest_tangent]

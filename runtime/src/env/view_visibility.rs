@@ -348,7 +348,12 @@ impl ViewVisibilityPass {
                 Some("fs_nearest_surface"),
                 Some((Less, true)),
             ),
-            front_depth: lazy("view front depth", true, None, Some((Less, true))),
+            front_depth: lazy(
+                "view front depth",
+                true,
+                Some("fs_front_depth"),
+                Some((Less, true)),
+            ),
             // Against the head's depth alone (the head pass wrote it; the prepass runs after):
             // fibers behind the head add no coverage.
             coverage: lazy(

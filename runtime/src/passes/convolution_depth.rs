@@ -14,9 +14,9 @@ use std::ops::Range;
 use strandlight_tables::hard_case_sweep::SweepRng;
 use wgpu::util::DeviceExt;
 
-use super::frame_params::{FrameParams, KajiyaKay};
+use super::frame_params::{FrameParams, KajiyaKay, QuadStyle};
 use super::strand_geometry::{StrandGeometry, segment_table};
-use super::strand_quads::{strand_bind_group_layout_for, strand_bind_group_scaled};
+use super::strand_quads::{strand_bind_group_layout_for, strand_bind_group_styled};
 use crate::camera::{Camera, LightFraming, Projection};
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{
@@ -510,7 +510,16 @@ impl ConvolutionDepthPass {
                 width_override_px: None,
             };
             let strands =
-                strand_bind_group_scaled(gpu, &self.strand_layout, geometry, &frame, width_scale);
+                strand_bind_group_styled(
+                    gpu,
+                    &self.strand_layout,
+                    geometry,
+                    &frame,
+                    QuadStyle {
+                        width_scale,
+                        exact_coverage: false,
+                    },
+                );
             let ranges: Vec<[u32; 2]> = windows[slot]
                 .iter()
                 .filter(|r| !r.is_empty())

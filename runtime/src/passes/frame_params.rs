@@ -37,6 +37,27 @@ pub struct FrameParams {
     pub width_override_px: Option<f32>,
 }
 
+/// How a pass turns fibers into quads (`strand_quads.wgsl`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QuadStyle {
+    /// Every fiber this many times wider, its optical depth spread over the width: the light
+    /// pass's enlargement by 1/κ (Ren 2010 §7); 1 elsewhere.
+    pub width_scale: f32,
+    /// A fiber thinner than a pixel covers each pixel by its centre line's length in the pixel
+    /// times its width (the box filter the path tracer integrates), not by one sample of a
+    /// one-pixel quad: the env view's passes.
+    pub exact_coverage: bool,
+}
+
+impl Default for QuadStyle {
+    fn default() -> Self {
+        Self {
+            width_scale: 1.0,
+            exact_coverage: false,
+        }
+    }
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct FrameUniform {
@@ -53,7 +74,9 @@ pub(crate) struct FrameUniform {
     /// Fiber width multiplier (the light pass's stochastic simplification enlarges fibers by
     /// 1/κ); 1 elsewhere.
     width_scale: f32,
-    _pad: [f32; 3],
+    /// 1: thin fibers' coverage is exact per pixel (the env view); 0: one-pixel quads.
+    exact_coverage: u32,
+    _pad: [f32; 2],
 }
 
 impl FrameParams {
@@ -62,7 +85,7 @@ impl FrameParams {
         self.camera.view_projection([self.width, self.height])
     }
 
-    pub(crate) fn uniform(&self, width_scale: f32) -> FrameUniform {
+    pub(crate) fn uniform(&self, style: QuadStyle) -> FrameUniform {
         let aspect = self.width as f32 / self.height as f32;
         let proj = self.camera.projection_matrix(aspect);
         let view_proj: Mat4 = self.view_proj();
@@ -85,8 +108,9 @@ impl FrameParams {
             ks: self.shading.ks,
             shininess: self.shading.shininess,
             light_count: self.lights.len() as u32,
-            width_scale,
-            _pad: [0.0; 3],
+            width_scale: style.width_scale,
+            exact_coverage: style.exact_coverage as u32,
+            _pad: [0.0; 2],
         }
     }
 }
@@ -117,7 +141,8 @@ mod wgsl_layout {
                 ks,
                 shininess,
                 light_count,
-                width_scale
+                width_scale,
+                exact_coverage
             }),
         );
     }

@@ -4,7 +4,7 @@
 
 use wgpu::util::DeviceExt;
 
-use super::frame_params::FrameParams;
+use super::frame_params::{FrameParams, QuadStyle};
 use super::strand_geometry::StrandGeometry;
 use crate::gpu::GpuContext;
 use crate::gpu::bind_layout::{bind_group, storage_entry, uniform_entry};
@@ -60,22 +60,22 @@ pub fn strand_bind_group(
     geometry: &StrandGeometry,
     frame: &FrameParams,
 ) -> wgpu::BindGroup {
-    strand_bind_group_scaled(gpu, layout, geometry, frame, 1.0)
+    strand_bind_group_styled(gpu, layout, geometry, frame, QuadStyle::default())
 }
 
-/// [`strand_bind_group`] with every fiber `width_scale` times wider, its optical depth summed
-/// across kept (`strand_quads.wgsl`): the light pass's enlargement by 1/κ (Ren 2010 §7).
-pub fn strand_bind_group_scaled(
+/// [`strand_bind_group`] with its fibers drawn in `style`: the light pass's fibers 1/κ wider
+/// (Ren 2010 §7), the env view's exact coverage.
+pub fn strand_bind_group_styled(
     gpu: &GpuContext,
     layout: &wgpu::BindGroupLayout,
     geometry: &StrandGeometry,
     frame: &FrameParams,
-    width_scale: f32,
+    style: QuadStyle,
 ) -> wgpu::BindGroup {
     let device = &gpu.device;
     let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some("strand frame"),
-        contents: bytemuck::bytes_of(&frame.uniform(width_scale)),
+        contents: bytemuck::bytes_of(&frame.uniform(style)),
         usage: wgpu::BufferUsages::UNIFORM,
     });
     // A storage binding may not be empty: pad with one unused light.

@@ -7,6 +7,7 @@ mod abuffer;
 mod deep_opacity;
 mod env_render;
 mod env_view_transparency;
+mod exact_coverage;
 mod fiber_models;
 mod frame_cube_shadows;
 mod frame_shadows;
