@@ -295,7 +295,7 @@ pub fn relative_rmse_over_blocks(
 
 /// The error of the image's coverage: √(Σ(α_a − α_r)² / Σα_r²) over the pixels where either
 /// image has hair. Coverage is the same under every light, so this is the view's error alone
-/// (fibers widened to a pixel and faded by their width, against each fiber's true footprint).
+/// (each fiber's polyline and its box-filtered coverage, against the true curve's footprint).
 pub fn coverage_error(approx: &Image, reference: &Image) -> Result<f64, CompareError> {
     check_finite("the reference", reference)?;
     approx.check_against("the image", reference)?;

@@ -12,9 +12,10 @@
 //            map gives add up to, which the view pass rescales to the pixel's coverage
 //
 // Sintorn & Assarsson count fragments per slab to rescale the bit order of a fragment; our
-// fragments carry different coverages (thin fibers are one-pixel quads with α = width), so the
-// slab map holds optical depth instead, and the optical depth in front of a fragment is the
-// slabs before its own plus its own slab's share of the occupied slices before it.
+// fragments carry different coverages (a thin fiber's is its length in the pixel × its width,
+// strand_quads.wgsl), so the slab map holds optical depth instead, and the optical depth in
+// front of a fragment is the slabs before its own plus its own slab's share of the occupied
+// slices before it.
 //
 // Fragments that share a slice do not occlude one another in that estimate, and a slab's depth is
 // spread evenly over its occupied slices, so a pixel's weights Σ α·exp(−τ in front) miss its
