@@ -509,17 +509,16 @@ impl ConvolutionDepthPass {
                 shading: KajiyaKay::default(),
                 width_override_px: None,
             };
-            let strands =
-                strand_bind_group_styled(
-                    gpu,
-                    &self.strand_layout,
-                    geometry,
-                    &frame,
-                    QuadStyle {
-                        width_scale,
-                        exact_coverage: false,
-                    },
-                );
+            let strands = strand_bind_group_styled(
+                gpu,
+                &self.strand_layout,
+                geometry,
+                &frame,
+                QuadStyle {
+                    width_scale,
+                    exact_coverage: false,
+                },
+            );
             let ranges: Vec<[u32; 2]> = windows[slot]
                 .iter()
                 .filter(|r| !r.is_empty())
