@@ -15,9 +15,9 @@
 // which is what the path tracer's box pixel filter integrates. One sample at the pixel's centre
 // of a one-pixel quad is that only on average: it gives a fiber crossing a pixel's corner the
 // whole pixel's width, and one passing just beside the centre nothing. Its quad then reaches
-// every pixel the line crosses (1/2 to √2/2 px beyond the line on every side), and the fragment stage
-// clips the segment to its pixel (`exact_fragment`); pixels the quad reaches but the line does
-// not get coverage 0 and are discarded.
+// every pixel the line crosses (1/2 to √2/2 px beyond the line on every side), and the
+// fragment stage clips the segment to its pixel (`exact_fragment`); pixels the quad reaches but
+// the line does not get coverage 0 and are discarded.
 
 #define_import_path strandlight::strand_quads
 
@@ -171,7 +171,8 @@ fn fiber_width_px(index: u32, clip_w: f32) -> f32 {
 // widening off, and the fiber thinner than a pixel at both ends (wider fibers keep their quads).
 fn is_thin_line(f: SegmentFrame) -> bool {
     if (frame.exact_coverage == 0u || frame.width_scale != 1.0) { return false; }
-    return max(fiber_width_px(f.index, f.start_clip.w), fiber_width_px(f.index + 1u, f.end_clip.w)) < 1.0;
+    let start = fiber_width_px(f.index, f.start_clip.w);
+    return max(start, fiber_width_px(f.index + 1u, f.end_clip.w)) < 1.0;
 }
 
 fn framebuffer_px(clip: vec4<f32>) -> vec2<f32> {
@@ -296,8 +297,8 @@ fn length_in_box(a: vec2<f32>, b: vec2<f32>, lo: vec2<f32>, hi: vec2<f32>) -> f3
 // each piece takes its share, by length, of the optical depth −ln(1 − α_strand) of the strand's
 // pieces in the pixel (those of the two segments either side of it joined to it inside the
 // pixel, which is every piece unless the strand runs through the pixel in more than three
-// segments), so that they compose to α_strand. A fragment of alpha 0 lies in the quad's reach but off the line, and is to be
-// discarded.
+// segments), so that they compose to α_strand. A fragment of alpha 0 lies in the quad's reach
+// but off the line, and is to be discarded.
 fn exact_fragment(in: VertexOut) -> VertexOut {
     var out = in;
     if ((in.line_flags & LINE_THIN) == 0u) { return out; }
