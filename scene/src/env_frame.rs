@@ -149,6 +149,7 @@ fn render_options(frame: &EnvFrame) -> EnvRenderOptions {
         count_fragments: look.count_fragments,
         dodm: look.dodm,
         simplification_seed: look.simplification_seed,
+        exact_coverage: look.exact_coverage,
         // Only SRBF lobes read the volume: frames without them (the reference, the baselines)
         // keep the options, and so the cache keys, they always had.
         lobe_visibility: match srbf {

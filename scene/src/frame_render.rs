@@ -288,8 +288,8 @@ pub enum FramePart {
     /// The whole frame at the settings' size.
     Whole,
     /// A cheap first look at half size: for an environment the [`PREVIEW_LIGHTS`] most
-    /// powerful lights, light maps of at most [`PREVIEW_MAP_RESOLUTION`]², the opaque view and
-    /// single scattering.
+    /// powerful lights, light maps of at most [`PREVIEW_MAP_RESOLUTION`]², the opaque view of
+    /// one-pixel quads (no exact coverage) and single scattering.
     Preview,
     /// Lights `first..first + count` of the env-lit frame ([`frame_lights`]' order): parts that
     /// partition the lights sum to the whole frame.
@@ -398,6 +398,7 @@ pub fn env_part(
             let mut look = look;
             look.dodm.resolution = look.dodm.resolution.min(PREVIEW_MAP_RESOLUTION);
             look.transparency = ViewTransparency::Opaque;
+            look.exact_coverage = false;
             let lights = all[..all.len().min(PREVIEW_LIGHTS)].to_vec();
             EnvPart {
                 lights,

@@ -170,6 +170,7 @@ impl LookArgs {
             simplified_lights_before: 0,
             lobe_visibility: view.lobe_visibility.settings(false),
             light_maps_under_a_head: view.lobe_visibility == LobeVisibilityArg::Auto,
+            exact_coverage: true,
         })
     }
 }
@@ -196,6 +197,9 @@ pub struct EnvLook {
     pub lobe_visibility: LobeVisibility,
     /// A frame with a head uses light maps instead ([`LobeVisibilityArg::Auto`]).
     pub light_maps_under_a_head: bool,
+    /// Each pixel covered exactly by its thin fibers (default), or by one-pixel quads faded
+    /// by their width (a preview's: [`strandlight_runtime::env::EnvRenderOptions::exact_coverage`]).
+    pub exact_coverage: bool,
 }
 
 #[cfg(test)]

@@ -293,7 +293,7 @@ impl FrameView {
                 &view_params,
                 QuadStyle {
                     width_scale: 1.0,
-                    exact_coverage: true,
+                    exact_coverage: options.exact_coverage,
                 },
             ),
             view_proj: view_params.view_proj(),

@@ -39,6 +39,11 @@ pub struct EnvRenderOptions {
     /// Where SRBF lobes' visibility comes from: their light maps (Ren's) or the groom's
     /// visibility volume integrated over each lobe.
     pub lobe_visibility: LobeVisibility,
+    /// View pass only: `true` (default) covers each pixel by the length of every thin fiber's
+    /// centre line inside it times its width, the box filter a path tracer integrates;
+    /// `false` draws a thin fiber as a one-pixel quad faded by its width and sampled at the
+    /// pixel's centre: right on average, not per pixel, and cheaper (a first preview's).
+    pub exact_coverage: bool,
 }
 
 impl std::fmt::Debug for EnvRenderOptions {
@@ -54,6 +59,9 @@ impl std::fmt::Debug for EnvRenderOptions {
             .field("width_override_px", &self.width_override_px);
         if self.lobe_visibility != LobeVisibility::LightMaps {
             s.field("lobe_visibility", &self.lobe_visibility);
+        }
+        if !self.exact_coverage {
+            s.field("exact_coverage", &self.exact_coverage);
         }
         s.finish()
     }
@@ -71,6 +79,7 @@ impl Default for EnvRenderOptions {
             transmittance_filter: TransmittanceFilter::default(),
             width_override_px: None,
             lobe_visibility: LobeVisibility::LightMaps,
+            exact_coverage: true,
         }
     }
 }
