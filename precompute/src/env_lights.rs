@@ -40,6 +40,11 @@ pub struct LightSpec {
     /// region's own shadow is soft at fiber scale, so the layered view reads it at a layer's mean
     /// position, as it does SRBF lobes', and a compact source's as its fibers' mean visibility.
     pub stands_for_region: bool,
+    /// A fitted set's compact source: the share of the map's power it holds
+    /// ([`CompactSource::power_share`]); 0 for every other light.
+    ///
+    /// [`CompactSource::power_share`]: crate::compact_sources::CompactSource::power_share
+    pub power_share: f64,
 }
 
 impl LightSpec {
@@ -74,6 +79,7 @@ pub fn srbf_set_lights(set: &SrbfSet) -> Vec<LightSpec> {
             shadowed_from: None,
             angular_variance: 0.0,
             stands_for_region: false,
+            power_share: 0.0,
         },
         LightKind::Directional => LightSpec {
             direction: l.center().normalize(),
@@ -82,6 +88,7 @@ pub fn srbf_set_lights(set: &SrbfSet) -> Vec<LightSpec> {
             shadowed_from: None,
             angular_variance: 0.0,
             stands_for_region: true,
+            power_share: 0.0,
         },
     });
     let sources = set.sources.iter().map(|s| LightSpec {
@@ -91,6 +98,7 @@ pub fn srbf_set_lights(set: &SrbfSet) -> Vec<LightSpec> {
         shadowed_from: None,
         angular_variance: s.angular_variance,
         stands_for_region: false,
+        power_share: s.power_share,
     });
     lobes.chain(sources).collect()
 }
@@ -107,6 +115,7 @@ fn directional(lights: Vec<DirectionalLight>, stands_for_region: bool) -> Vec<Li
             shadowed_from: None,
             angular_variance: 0.0,
             stands_for_region,
+            power_share: 0.0,
         })
         .collect()
 }
@@ -183,6 +192,7 @@ pub fn reference_lights_shaded(
                     shadowed_from,
                     angular_variance: 0.0,
                     stands_for_region: true,
+                    power_share: 0.0,
                 })
             });
             lights.extend(samples);
@@ -260,6 +270,7 @@ pub fn fitted_reference_lights(
             shadowed_from: None,
             angular_variance: 0.0,
             stands_for_region: false,
+            power_share: 0.0,
             ..*l
         });
     let mut lights: Vec<LightSpec> = sources.collect();
@@ -348,6 +359,7 @@ mod tests {
             shadowed_from: None,
             angular_variance: 0.0,
             stands_for_region: false,
+            power_share: 0.0,
         };
         let sun = LightSpec {
             direction: DVec3::new(0.3, 0.8, -0.2).normalize(),
@@ -356,6 +368,7 @@ mod tests {
             shadowed_from: None,
             angular_variance: 1e-3,
             stands_for_region: false,
+            power_share: 0.0,
         };
         let fit = [
             lobe(DVec3::new(0.0, 1.0, 0.0), 3.0, [1.0, 1.5, 2.0]),

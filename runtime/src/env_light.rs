@@ -40,7 +40,19 @@ pub struct EnvLight {
     ///
     /// [`ViewTransparency::Layered`]: crate::env::ViewTransparency::Layered
     pub stands_for_region: bool,
+    /// A compact source's share of its environment's power (0 where unknown). A source
+    /// holding at least [`FINE_MAP_POWER_SHARE`] draws its map at
+    /// [`DodmSettings::fine_resolution`](crate::passes::convolution_depth::DodmSettings::fine_resolution):
+    /// its sharp shadow decides that much of the frame.
+    pub power_share: f32,
 }
+
+/// The power share from which a compact source's map is drawn finer
+/// ([`EnvLight::has_fine_map`]). Measured on straight.hair at 160×120 against the truth
+/// (docs/BENCHMARKS.md, "Fine maps for dominant suns"): quarry's sun, 50% of the power, takes
+/// the frame from 0.274 to 0.226 relative RMSE at 4× the map's side; sources of 2–7% each
+/// (spruit's sun, golf's, studio's and esplanade's lamps) gain at most 0.01 at 1.5–5× the cost.
+pub const FINE_MAP_POWER_SHARE: f32 = 0.25;
 
 impl EnvLight {
     pub fn srbf(direction: Vec3, lambda: f32, amplitude: [f32; 3]) -> Self {
@@ -52,6 +64,7 @@ impl EnvLight {
             every_strand: false,
             angular_variance: 0.0,
             stands_for_region: false,
+            power_share: 0.0,
         }
     }
 
@@ -64,6 +77,7 @@ impl EnvLight {
             every_strand: true,
             angular_variance: 0.0,
             stands_for_region: false,
+            power_share: 0.0,
         }
     }
 
@@ -98,6 +112,12 @@ impl EnvLight {
     /// ([`EnvLight::stands_for_region`]), whose shadow is sharp at fiber scale.
     pub fn has_sharp_shadow(&self) -> bool {
         self.lambda.is_none() && !self.stands_for_region
+    }
+
+    /// A compact source holding at least [`FINE_MAP_POWER_SHARE`] of the power: its map is
+    /// drawn at the fine resolution, in a batch of its own kind.
+    pub fn has_fine_map(&self) -> bool {
+        self.has_sharp_shadow() && self.every_strand && self.power_share >= FINE_MAP_POWER_SHARE
     }
 
     /// The direction of the light pass whose map shadows this light.

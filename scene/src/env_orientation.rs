@@ -69,6 +69,7 @@ impl EnvOrientation {
         };
         EnvLight {
             stands_for_region: spec.stands_for_region,
+            power_share: spec.power_share as f32,
             ..light
         }
     }
@@ -208,6 +209,7 @@ mod tests {
             shadowed_from: None,
             angular_variance: 0.0,
             stands_for_region: false,
+            power_share: 0.0,
         }];
         let l = EnvOrientation::upright(UpAxis::Y).lights(&srbf)[0];
         assert_eq!(l.lambda, Some(32.0));

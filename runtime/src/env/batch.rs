@@ -41,9 +41,9 @@ pub(super) fn render_batch(
         let head_pass = &renderer.head;
         (renderer.light_maps).encode(gpu, frame, batch, options, head_pass, timings);
     }
-    let simplified = batch.is_simplified();
+    let map_size = batch.map_size();
     timings.time(gpu, "view", || {
-        let maps = frame.maps(simplified);
+        let maps = frame.maps.get_mut(map_size);
         let lights = BatchBinding::with_groups(
             gpu,
             &renderer.layouts.batch,

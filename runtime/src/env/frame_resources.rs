@@ -7,7 +7,7 @@ use strandlight_tables::table::Table;
 
 use super::accumulate::FrameSums;
 use super::light_kinds::LightKinds;
-use super::light_maps::LightMaps;
+use super::light_maps::FrameLightMaps;
 use super::stats::Timings;
 use super::table_binding::TableBinding;
 use super::tables::check_table_limits;
@@ -83,12 +83,8 @@ pub(super) struct FrameResources {
     /// The next simplified light's strand window (κ < 1).
     pub(super) next_window: u32,
     pub(super) footprint: LightFootprint,
-    /// The light maps of every-strand SRBFs and directional lights, at the DODM resolution
-    /// (None where the frame has only simplified SRBFs).
-    pub(super) full_maps: Option<LightMaps>,
-    /// The light maps of κ-simplified SRBFs, at [`DodmSettings::simplified_resolution`](crate::passes::convolution_depth::DodmSettings::simplified_resolution)
-    /// (None where that is the full resolution: they share `full_maps`).
-    pub(super) simplified_maps: Option<LightMaps>,
+    /// The light maps of every size the frame's batches draw.
+    pub(super) maps: FrameLightMaps,
     /// The single-scattering tables of the SRBF and the directional lights (None: no such
     /// lights), each bound with the multiple-scattering table.
     pub(super) srbf_tables: Option<Arc<TableBinding>>,
@@ -115,11 +111,6 @@ impl FrameView {
 }
 
 impl FrameResources {
-    /// The light maps a batch draws ([`LightMaps::choose`]).
-    pub(super) fn maps(&mut self, simplified: bool) -> &mut LightMaps {
-        LightMaps::choose(simplified, &mut self.full_maps, &mut self.simplified_maps)
-    }
-
     /// The strand windows of the next `lights` simplified light maps (the frame's κ-thinned
     /// SRBF lights, counted across batches): each light its own subset
     /// ([`SimplifiedSegments::window`]).
@@ -142,12 +133,7 @@ impl FrameResources {
     pub(super) fn memory(&self) -> Vec<(String, u64)> {
         let view = &self.view;
         let mut memory = view.geometry.memory();
-        if let Some(maps) = &self.full_maps {
-            memory.extend(maps.memory(""));
-        }
-        if let Some(maps) = &self.simplified_maps {
-            memory.extend(maps.memory("simplified "));
-        }
+        memory.extend(self.maps.memory());
         memory.extend(view.targets.memory());
         memory.push(view.occupancy.memory());
         memory.push(("visibility volume".into(), view.volume.bytes));
@@ -361,10 +347,9 @@ impl FrameResources {
             }
         };
         let first_layer = options.dodm.first_layer_for(model.bounds());
-        let (mut full_maps, mut simplified_maps) =
-            LightMaps::for_frame(gpu, options, kinds, first_layer)?;
+        let mut maps = FrameLightMaps::for_frame(gpu, options, kinds, first_layer)?;
         if view.head.is_some() {
-            for maps in [&mut full_maps, &mut simplified_maps].into_iter().flatten() {
+            for maps in maps.each_mut() {
                 maps.head = Some(HeadDepthMaps::new(
                     gpu,
                     maps.dodm.resolution,
@@ -384,8 +369,7 @@ impl FrameResources {
             view_is_new,
             next_window: 0,
             footprint: light_footprint(model, head, kinds.has_sharp_shadows()),
-            full_maps,
-            simplified_maps,
+            maps,
             srbf_tables,
             directional_tables,
         })

@@ -95,9 +95,11 @@ impl LightKinds {
         for (kind_lights, tables) in kind_tables {
             let Some(tables) = tables else { continue };
             let groups = shadow_groups(kind_lights);
-            // A batch is shaded in one view: compact sources and region lights apart.
+            // A batch is shaded in one view: compact sources and region lights apart; and it
+            // draws one size of map: the dominant sources' fine maps apart.
             let sharp = |g: &ShadowGroup| g.lights[0].has_sharp_shadow();
-            for run in groups.chunk_by(|a, b| sharp(a) == sharp(b)) {
+            let fine = |g: &ShadowGroup| g.lights[0].has_fine_map();
+            for run in groups.chunk_by(|a, b| sharp(a) == sharp(b) && fine(a) == fine(b)) {
                 let size = if sharp(&run[0]) {
                     compact_batch_size
                 } else {
@@ -128,4 +130,24 @@ impl LightBatch<'_> {
     pub(super) fn is_simplified(&self) -> bool {
         self.first_light().is_some_and(|l| l.is_simplified())
     }
+
+    /// Which of the frame's light maps this batch draws.
+    pub(super) fn map_size(&self) -> MapSize {
+        match self.first_light() {
+            Some(l) if l.has_fine_map() => MapSize::Fine,
+            Some(l) if l.is_simplified() => MapSize::Simplified,
+            _ => MapSize::Full,
+        }
+    }
+}
+
+/// The frame's three sizes of light map: each batch draws one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum MapSize {
+    /// The DODM resolution: every-strand SRBFs and directional lights.
+    Full,
+    /// κ-simplified SRBFs' ([`DodmSettings::simplified_resolution`](crate::passes::convolution_depth::DodmSettings::simplified_resolution)).
+    Simplified,
+    /// Dominant compact sources' ([`DodmSettings::fine_resolution`](crate::passes::convolution_depth::DodmSettings::fine_resolution)).
+    Fine,
 }

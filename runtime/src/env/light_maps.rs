@@ -3,7 +3,7 @@
 //! κ-simplified one, and the pass that draws them.
 
 use super::frame_resources::FrameResources;
-use super::light_kinds::{LightBatch, LightKinds};
+use super::light_kinds::{LightBatch, LightKinds, MapSize};
 use super::stats::Timings;
 use super::{EnvRenderError, EnvRenderOptions};
 use crate::camera::LightFraming;
@@ -54,7 +54,7 @@ impl LightMaps {
 
     /// A frame's full-resolution maps and its simplified ones (each None where no batch draws
     /// them), with as many slots as the most maps one batch of their kinds holds.
-    pub(super) fn for_frame(
+    fn full_and_simplified(
         gpu: &GpuContext,
         options: &EnvRenderOptions,
         kinds: &LightKinds,
@@ -73,7 +73,8 @@ impl LightMaps {
             if !sources.has_directional() {
                 return Ok((Some(placeholder()?), None));
             }
-            let (full, simplified) = Self::for_frame(gpu, options, &sources, first_layer)?;
+            let (full, simplified) =
+                Self::full_and_simplified(gpu, options, &sources, first_layer)?;
             let full = match full {
                 Some(maps) => maps,
                 None => placeholder()?,
@@ -93,11 +94,11 @@ impl LightMaps {
         let full_kinds = [&kinds.srbf_every_strand, &kinds.directional];
         let thinned = kinds.thinned();
         if !kinds.has_thinned() || simplified_resolution == dodm.resolution {
-            let all = slots(&[full_kinds[0], full_kinds[1], thinned[0], thinned[1]]);
-            return Ok((
-                Some(Self::new(gpu, dodm.resolution, all, first_layer)?),
-                None,
-            ));
+            let full = match slots(&[full_kinds[0], full_kinds[1], thinned[0], thinned[1]]) {
+                0 => None,
+                all => Some(Self::new(gpu, dodm.resolution, all, first_layer)?),
+            };
+            return Ok((full, None));
         }
         let full = match slots(&full_kinds) {
             0 => None,
@@ -117,19 +118,84 @@ impl LightMaps {
         }
         memory
     }
+}
 
-    /// The maps a batch draws: the simplified ones for κ-thinned SRBFs where the frame has them.
-    pub(super) fn choose<'a>(
-        simplified: bool,
-        full: &'a mut Option<LightMaps>,
-        simplified_maps: &'a mut Option<LightMaps>,
-    ) -> &'a mut LightMaps {
-        match (simplified, simplified_maps) {
-            (true, Some(maps)) => maps,
-            _ => full
-                .as_mut()
-                .expect("a frame holds full-resolution maps for every batch not simplified"),
-        }
+/// A frame's light maps, one set per [`MapSize`] its batches draw (None where none does), each
+/// with as many slots as the most maps one of those batches holds.
+pub(super) struct FrameLightMaps {
+    /// Every-strand SRBFs' and directional lights' at the DODM resolution (and the simplified
+    /// SRBFs' where theirs is the same).
+    full: Option<LightMaps>,
+    /// κ-simplified SRBFs' at [`DodmSettings::simplified_resolution`](crate::passes::convolution_depth::DodmSettings::simplified_resolution).
+    simplified: Option<LightMaps>,
+    /// Dominant compact sources' at [`DodmSettings::fine_resolution`](crate::passes::convolution_depth::DodmSettings::fine_resolution).
+    fine: Option<LightMaps>,
+}
+
+impl FrameLightMaps {
+    pub(super) fn for_frame(
+        gpu: &GpuContext,
+        options: &EnvRenderOptions,
+        kinds: &LightKinds,
+        first_layer: f32,
+    ) -> Result<Self, EnvRenderError> {
+        let (fine, directional): (Vec<EnvLight>, _) =
+            (kinds.directional.iter()).partition(|l| l.has_fine_map());
+        let fine = match shadow_groups(&fine)
+            .len()
+            .min(options.dodm.batch_size as usize)
+        {
+            0 => None,
+            slots => Some(LightMaps::new(
+                gpu,
+                options.dodm.fine_resolution(),
+                slots as u32,
+                first_layer,
+            )?),
+        };
+        let rest = LightKinds {
+            srbf_every_strand: kinds.srbf_every_strand.clone(),
+            srbf: kinds.srbf.clone(),
+            directional,
+            directional_thinned: kinds.directional_thinned.clone(),
+        };
+        let (full, simplified) = LightMaps::full_and_simplified(gpu, options, &rest, first_layer)?;
+        Ok(Self {
+            full,
+            simplified,
+            fine,
+        })
+    }
+
+    /// The maps a batch of `size` draws: the simplified ones are the full ones where the
+    /// frame has none of their own (the same resolution).
+    pub(super) fn get_mut(&mut self, size: MapSize) -> &mut LightMaps {
+        let maps = match size {
+            MapSize::Fine => self.fine.as_mut(),
+            MapSize::Simplified if self.simplified.is_some() => self.simplified.as_mut(),
+            MapSize::Simplified | MapSize::Full => self.full.as_mut(),
+        };
+        maps.expect("a frame holds the light maps of every batch it draws")
+    }
+
+    /// Every set of maps the frame holds.
+    pub(super) fn each_mut(&mut self) -> impl Iterator<Item = &mut LightMaps> {
+        [&mut self.full, &mut self.simplified, &mut self.fine]
+            .into_iter()
+            .flatten()
+    }
+
+    /// GPU memory per resource, named by the maps' size.
+    pub(super) fn memory(&self) -> Vec<(String, u64)> {
+        [
+            (&self.full, ""),
+            (&self.simplified, "simplified "),
+            (&self.fine, "fine "),
+        ]
+        .into_iter()
+        .filter_map(|(maps, prefix)| maps.as_ref().map(|m| m.memory(prefix)))
+        .flatten()
+        .collect()
     }
 }
 
@@ -176,15 +242,14 @@ impl LightMapsPass {
         let FrameResources {
             view,
             footprint,
-            full_maps,
-            simplified_maps,
+            maps,
             ..
         } = frame;
         let (geometry, head) = match simplified {
             true => (&view.light_geometry, &view.head),
             false => (&view.geometry, &view.head),
         };
-        let maps = LightMaps::choose(simplified, full_maps, simplified_maps);
+        let maps = maps.get_mut(batch.map_size());
         let framing = match batch.has_sharp_shadows() {
             true => LightFraming::Fitted(footprint),
             false => LightFraming::Sphere(footprint.bounds),

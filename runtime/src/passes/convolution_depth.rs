@@ -77,6 +77,15 @@ impl DodmSettings {
         scaled.clamp(16.min(self.resolution), self.resolution)
     }
 
+    /// Texels across the map of a compact source that holds much of the environment's power
+    /// ([`EnvLight::has_fine_map`](crate::env_light::EnvLight::has_fine_map)): four times the
+    /// side, at most [`MAX_DODM_RESOLUTION`]. Its shadow is sharp at fiber scale and decides a
+    /// large share of the frame, so a fiber's shadow should be resolved, not averaged over a
+    /// texel several fibers wide.
+    pub fn fine_resolution(&self) -> u32 {
+        self.resolution.saturating_mul(4).min(MAX_DODM_RESOLUTION)
+    }
+
     /// The fiber enlargement of a simplified light map at [`Self::simplified_resolution`]: 1/κ
     /// of a full-resolution texel (Ren 2010 §7, the drawn fibers cover those left out), so the
     /// same world width whatever the map's texels; a quad is never narrower than its texel.

@@ -11,7 +11,7 @@ use strandlight_runtime::env::{
     EnvImage, EnvRenderError, EnvRenderOptions, EnvRenderer, EnvTables, FrameSums,
     ViewTransparency, render_env_frame,
 };
-use strandlight_runtime::env_light::EnvLight;
+use strandlight_runtime::env_light::{EnvLight, FINE_MAP_POWER_SHARE};
 use strandlight_runtime::gpu::{GpuContext, LimitError, read_texture_rgba};
 use strandlight_runtime::hair::groom::{GroomParams, generate_groom};
 use strandlight_runtime::hair::{Attribute, HairModel};
@@ -2179,4 +2179,70 @@ fn a_host_frame_draws_nothing_before_its_first_batch() {
     let depths = read_depth(&gpu, &depth).unwrap();
     assert!(pixels.iter().all(|p| *p == [0.25, 0.5, 0.75, 1.0]));
     assert!(depths.iter().all(|&d| d == 0.5));
+}
+
+/// A compact source holding at least [`FINE_MAP_POWER_SHARE`] of the power draws its map at
+/// four times the side, in a batch of its own: in a frame of 128² maps, such a sun is exactly
+/// the same sun (no share) drawn in a frame of 512² maps, while a weak lamp and the SRBF lobes
+/// keep the frame's maps; and the scene is one where the map's side shows (the sun at 128² is
+/// another image), so routing the sun to the wrong maps fails.
+#[test]
+fn a_dominant_compact_source_draws_its_map_at_four_times_the_side() {
+    let gpu = gpu();
+    let (model, camera, tables) = groom_scene();
+    let lobes = groom_lobes();
+    let sun = EnvLight::directional(Vec3::new(0.5, 0.7, 0.6), [2.0, 1.8, 1.5]);
+    let lamp = EnvLight::directional(Vec3::new(-0.6, 0.3, 0.7), [0.3, 0.3, 0.3]);
+    let dominant = EnvLight {
+        power_share: 2.0 * FINE_MAP_POWER_SHARE,
+        ..sun
+    };
+    let weak = EnvLight {
+        power_share: 0.2 * FINE_MAP_POWER_SHARE,
+        ..lamp
+    };
+    assert!(dominant.has_fine_map() && !weak.has_fine_map());
+    let render = |lights: &[EnvLight], resolution: u32| {
+        let options = EnvRenderOptions {
+            dodm: DodmSettings {
+                resolution,
+                first_layer: None,
+                batch_size: 2,
+            },
+            ..Default::default()
+        };
+        render_env_frame(
+            &gpu, &model, &camera, RES, RES, lights, &tables, &options, None,
+        )
+        .unwrap_or_else(|e| panic!("{e}"))
+    };
+    let fine = render(&[dominant], 128);
+    let sun_at_512 = render(&[sun], 512).pixels;
+    let sun_at_128 = render(&[sun], 128).pixels;
+    let (same, coarse) = (
+        worst_relative(&fine.pixels, &sun_at_512),
+        relative_rmse(&fine.pixels, &sun_at_128),
+    );
+    let fine_maps: Vec<_> = (fine.stats.memory_per_batch.iter())
+        .filter(|(name, _)| name.starts_with("fine "))
+        .collect();
+    // Lobes, the dominant sun and the lamp in one frame: the sum of the lobes and the lamp in
+    // 128² maps and the sun in 512² ones.
+    let mixed = render(&[lobes[0], lobes[1], dominant, weak], 128).pixels;
+    let rest = render(&[lobes[0], lobes[1], weak], 128).pixels;
+    let sum: Vec<[f32; 4]> = (rest.iter().zip(&sun_at_512))
+        .map(|(a, b)| std::array::from_fn(|c| a[c] + b[c]))
+        .collect();
+    let parts = worst_relative(&mixed, &sum);
+    println!(
+        "the dominant sun in 128² frame vs 512²: worst relative {same:.2e}; vs 128²: relative \
+         RMSE {coarse:.3}; mixed frame vs its parts {parts:.2e}; fine maps {fine_maps:?}"
+    );
+    assert!(same < 1e-5, "the dominant sun's maps are not 512²: {same}");
+    assert!(
+        coarse > 0.01,
+        "the map's side must show in this scene (0.019 measured): {coarse}"
+    );
+    assert!(!fine_maps.is_empty(), "no fine maps reported");
+    assert!(parts < 1e-4, "mixed frame vs its parts: {parts}");
 }
