@@ -123,7 +123,9 @@ struct EnvArgs {
     /// (scene/src/env_orientation.rs; the fitted lobes are turned exactly, nothing is refitted).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     rotate: f32,
-    /// Side of each light's convolution optical depth map, texels.
+    /// Side of each light's convolution optical depth map, texels; a compact source holding
+    /// at least a quarter of the map's power draws its map at four times the side (at most
+    /// 2048; docs/BENCHMARKS.md, "Fine maps for dominant suns").
     #[arg(long, default_value_t = 512)]
     light_map_size: u32,
     /// The head's skin: diffuse albedo, linear R,G,B each in [0, 1].

@@ -28,7 +28,8 @@ pub struct EnvLighting {
     /// The environment turned about the hair's up axis, degrees (the convention:
     /// `crate::env_orientation`): every light set is turned exactly, nothing is refitted.
     pub rotation_deg: f32,
-    /// Convolution optical depth map resolution (square).
+    /// Convolution optical depth map resolution (square); a dominant compact source's is four
+    /// times it (`DodmSettings::fine_resolution`).
     pub dodm_size: u32,
     pub transparency: EnvTransparency,
     pub view: ViewArgs,

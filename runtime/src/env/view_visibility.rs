@@ -134,8 +134,8 @@ pub struct FragmentCounts {
 /// at the mean position, 0.290 shaded per fragment, for ~3× the frame). So a batch of them
 /// first gathers Σw·v per layer and light (its strands rasterized once, no light shaded), and
 /// each layer is shaded once with Σw·v / Σw (`view_layers.wgsl`): quarry 0.2883 against 0.2876
-/// per fragment, on five maps within +0.006 for 1.3–1.6× faster frames (docs/BENCHMARKS.md,
-/// "Compact sources per layer"). SRBF lobes and the lights that stand for a region of the map (a
+/// per fragment, on five maps within +0.006 for 1.3–1.6× faster frames
+/// (docs/history/benchmarks-2026-12-05-to-12-06.md, "Compact sources per layer"). SRBF lobes and the lights that stand for a region of the map (a
 /// reference's cube texel, a median-cut region), whose true shadows are soft at fiber scale,
 /// read theirs at the layer's mean position.
 #[derive(Clone)]
