@@ -277,9 +277,9 @@ impl FrameView {
                 &renderer.layouts.strand,
                 &geometry,
                 &view_params,
-                QuadStyle {
-                    width_scale: 1.0,
-                    exact_coverage: options.exact_coverage,
+                match options.exact_coverage {
+                    true => QuadStyle::ExactCoverage,
+                    false => QuadStyle::PixelQuads,
                 },
             ),
             view_proj: view_params.view_proj(),

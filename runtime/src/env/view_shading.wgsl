@@ -19,7 +19,7 @@
 #import strandlight::head_view::{head_at, behind_head}
 #import strandlight::occupancy_map::{OCC_TAU_SCALE, occupancy_record, occupancy_visibility, occupancy_weight}
 #import strandlight::skin::shade_skin
-#import strandlight::strand_quads::{VertexOut, exact_fragment, off_the_line, strand_draw_vertex}
+#import strandlight::strand_quads::{VertexOut, covered_fragment, strand_draw_vertex}
 #import strandlight::view_binding::{view, occupancy_map, coverage, nearest_position, nearest_tangent, head_normal}
 #import strandlight::view_layers::{NO_LAYER_LIGHTS, OCC_LAYERS, add_fixed, layer_fragment, layer_lights_word, layer_word, load_fixed, on_pixel_ray}
 #import strandlight::convolution_transmittance::{batch, effective_transmittance}
@@ -60,8 +60,7 @@ fn fs_env_deferred(@builtin(position) pixel: vec4<f32>) -> EnvOut {
 
 @fragment
 fn fs_env_transparent(drawn: VertexOut) -> EnvOut {
-    let in = exact_fragment(drawn);
-    if (off_the_line(in)) { discard; }
+    let in = covered_fragment(drawn);
     if (behind_head(in)) { discard; }
     let seen = occupancy_visibility(in);
     if (seen < view.visibility_cutoff) { discard; }
@@ -72,8 +71,7 @@ fn fs_env_transparent(drawn: VertexOut) -> EnvOut {
 // slot to its layer (view_layers.wgsl).
 @fragment
 fn fs_env_layer_lights(drawn: VertexOut) {
-    let in = exact_fragment(drawn);
-    if (off_the_line(in)) { discard; }
+    let in = covered_fragment(drawn);
     let f = layer_fragment(in);
     if (!f.kept) { discard; }
     let first = layer_lights_word(in.clip.xy, f.layer);

@@ -8,7 +8,7 @@
 #import strandlight::fullscreen::fullscreen_triangle
 #import strandlight::head_view::behind_head
 #import strandlight::occupancy_map::{OCC_SLICES_PER_SLAB, OCC_TAU_SCALE, OCC_WEIGHT_SCALE, fragment_optical_depth, occupancy_record, occupancy_slice, occupancy_visibility, ordered_depth, pixel_depth_range, view_depth}
-#import strandlight::strand_quads::{VertexOut, exact_fragment, off_the_line, strand_draw_vertex}
+#import strandlight::strand_quads::{VertexOut, covered_fragment, strand_draw_vertex}
 #import strandlight::view_binding::{view, occupancy_map}
 #import strandlight::view_layers::{OCC_LAYERS, add_fixed, layer_fragment, layer_word, load_fixed}
 
@@ -26,8 +26,7 @@ fn vs_fullscreen(@builtin(vertex_index) vertex: u32) -> @builtin(position) vec4<
 // that one opaque fiber covers its pixel to 1e-6, not to the light pass's 0.999.
 @fragment
 fn fs_coverage(drawn: VertexOut) -> @location(0) vec4<f32> {
-    let in = exact_fragment(drawn);
-    if (off_the_line(in)) { discard; }
+    let in = covered_fragment(drawn);
     return vec4<f32>(-log(max(1.0 - in.alpha, 1e-6)), 0.0, 0.0, 0.0);
 }
 
@@ -35,7 +34,7 @@ fn fs_coverage(drawn: VertexOut) -> @location(0) vec4<f32> {
 // covers something.
 @fragment
 fn fs_front_depth(drawn: VertexOut) {
-    if (off_the_line(exact_fragment(drawn))) { discard; }
+    _ = covered_fragment(drawn);
 }
 
 // Opaque view, the depth prepass: the nearest fragment of each pixel (depth test Less, so the
@@ -47,16 +46,14 @@ struct NearestSurface {
 
 @fragment
 fn fs_nearest_surface(drawn: VertexOut) -> NearestSurface {
-    let in = exact_fragment(drawn);
-    if (off_the_line(in)) { discard; }
+    let in = covered_fragment(drawn);
     return NearestSurface(vec4<f32>(in.world, 1.0), vec4<f32>(in.tangent, 0.0));
 }
 
 // Pass 1: the nearest and farthest view depth of each pixel's fragments.
 @fragment
 fn fs_occupancy_range(drawn: VertexOut) {
-    let in = exact_fragment(drawn);
-    if (off_the_line(in)) { discard; }
+    let in = covered_fragment(drawn);
     if (behind_head(in)) { discard; }
     let r = occupancy_record(in.clip.xy, view.width);
     let key = ordered_depth(view_depth(in.world));
@@ -67,8 +64,7 @@ fn fs_occupancy_range(drawn: VertexOut) {
 // Pass 2: each fragment marks its slice and adds its optical depth to its slab.
 @fragment
 fn fs_occupancy_slices(drawn: VertexOut) {
-    let in = exact_fragment(drawn);
-    if (off_the_line(in)) { discard; }
+    let in = covered_fragment(drawn);
     if (behind_head(in)) { discard; }
     let r = occupancy_record(in.clip.xy, view.width);
     let range = pixel_depth_range(r);
@@ -83,8 +79,7 @@ fn fs_occupancy_slices(drawn: VertexOut) {
 // culled fragments' share is dropped, not handed to the others).
 @fragment
 fn fs_occupancy_weights(drawn: VertexOut) {
-    let in = exact_fragment(drawn);
-    if (off_the_line(in)) { discard; }
+    let in = covered_fragment(drawn);
     if (behind_head(in)) { discard; }
     let r = occupancy_record(in.clip.xy, view.width);
     let weight = in.alpha * occupancy_visibility(in);
@@ -101,15 +96,13 @@ fn fs_count_rasterized(in: VertexOut) -> @location(0) vec4<f32> {
 
 @fragment
 fn fs_count_nearest(drawn: VertexOut) -> @location(0) vec4<f32> {
-    let in = exact_fragment(drawn);
-    if (off_the_line(in)) { discard; }
+    let in = covered_fragment(drawn);
     return vec4<f32>(0.0, 1.0, 0.0, 0.0);
 }
 
 @fragment
 fn fs_count_visible(drawn: VertexOut) -> @location(0) vec4<f32> {
-    let in = exact_fragment(drawn);
-    if (off_the_line(in)) { discard; }
+    let in = covered_fragment(drawn);
     if (behind_head(in)) { discard; }
     if (occupancy_visibility(in) < view.visibility_cutoff) { discard; }
     return vec4<f32>(0.0, 1.0, 0.0, 0.0);
@@ -119,8 +112,7 @@ fn fs_count_visible(drawn: VertexOut) -> @location(0) vec4<f32> {
 // its layer.
 @fragment
 fn fs_view_layers(drawn: VertexOut) {
-    let in = exact_fragment(drawn);
-    if (off_the_line(in)) { discard; }
+    let in = covered_fragment(drawn);
     let f = layer_fragment(in);
     if (!f.kept) { discard; }
     let t = normalize(in.tangent);

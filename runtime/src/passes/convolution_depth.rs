@@ -523,10 +523,7 @@ impl ConvolutionDepthPass {
                 &self.strand_layout,
                 geometry,
                 &frame,
-                QuadStyle {
-                    width_scale,
-                    exact_coverage: false,
-                },
+                QuadStyle::Widened(width_scale),
             );
             let ranges: Vec<[u32; 2]> = windows[slot]
                 .iter()

@@ -38,22 +38,26 @@ pub struct FrameParams {
 }
 
 /// How a pass turns fibers into quads (`strand_quads.wgsl`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct QuadStyle {
-    /// Every fiber this many times wider, its optical depth spread over the width: the light
-    /// pass's enlargement by 1/κ (Ren 2010 §7); 1 elsewhere.
-    pub width_scale: f32,
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub enum QuadStyle {
+    /// A fiber thinner than a pixel is a one-pixel quad faded by its width, sampled at the
+    /// pixel's centre: right on average, not per pixel (the light passes, the point-light
+    /// techniques, a first preview).
+    #[default]
+    PixelQuads,
+    /// [`QuadStyle::PixelQuads`] with every fiber this many times wider, its optical depth
+    /// spread over the width: the light pass's enlargement by 1/κ (Ren 2010 §7).
+    Widened(f32),
     /// A fiber thinner than a pixel covers each pixel by its centre line's length in the pixel
-    /// times its width (the box filter the path tracer integrates), not by one sample of a
-    /// one-pixel quad: the env view's passes.
-    pub exact_coverage: bool,
+    /// times its width (the box filter the path tracer integrates): the env view's passes.
+    ExactCoverage,
 }
 
-impl Default for QuadStyle {
-    fn default() -> Self {
-        Self {
-            width_scale: 1.0,
-            exact_coverage: false,
+impl QuadStyle {
+    fn width_scale(self) -> f32 {
+        match self {
+            QuadStyle::Widened(scale) => scale,
+            QuadStyle::PixelQuads | QuadStyle::ExactCoverage => 1.0,
         }
     }
 }
@@ -108,8 +112,8 @@ impl FrameParams {
             ks: self.shading.ks,
             shininess: self.shading.shininess,
             light_count: self.lights.len() as u32,
-            width_scale: style.width_scale,
-            exact_coverage: style.exact_coverage as u32,
+            width_scale: style.width_scale(),
+            exact_coverage: (style == QuadStyle::ExactCoverage) as u32,
             _pad: [0.0; 2],
         }
     }

@@ -167,10 +167,11 @@ fn fiber_width_px(index: u32, clip_w: f32) -> f32 {
     return attributes[index].thickness * frame.focal_px / clip_w;
 }
 
-// A segment whose coverage is clipped per pixel: exact coverage asked for, the light pass's
-// widening off, and the fiber thinner than a pixel at both ends (wider fibers keep their quads).
+// A segment whose coverage is clipped per pixel: exact coverage asked for (never with the light
+// pass's widening: QuadStyle) and the fiber thinner than a pixel at both ends (wider fibers keep
+// their quads).
 fn is_thin_line(f: SegmentFrame) -> bool {
-    if (frame.exact_coverage == 0u || frame.width_scale != 1.0) { return false; }
+    if (frame.exact_coverage == 0u) { return false; }
     let start = fiber_width_px(f.index, f.start_clip.w);
     return max(start, fiber_width_px(f.index + 1u, f.end_clip.w)) < 1.0;
 }
@@ -353,7 +354,10 @@ fn strand_draw_vertex(vertex: u32, segment: u32) -> VertexOut {
     return strand_vertex(vertex % 6u, segment + vertex / 6u);
 }
 
-// An exact fragment (`exact_fragment`) in its quad's reach but off its line: it covers nothing.
-fn off_the_line(f: VertexOut) -> bool {
-    return (f.line_flags & LINE_THIN) != 0u && f.alpha <= 0.0;
+// The fragment a view pass draws: `drawn` with its exact coverage (`exact_fragment`), discarded
+// where the pixel is in its quad's reach but off its line (it covers nothing there).
+fn covered_fragment(drawn: VertexOut) -> VertexOut {
+    let in = exact_fragment(drawn);
+    if ((in.line_flags & LINE_THIN) != 0u && in.alpha <= 0.0) { discard; }
+    return in;
 }
