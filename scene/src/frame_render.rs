@@ -267,7 +267,8 @@ pub const PREVIEW_MAP_RESOLUTION: u32 = 128;
 /// Nodes per direction axis of the tables a first look is drawn with while a cold cache bakes
 /// the full ones: single scattering's two tables bake in 0.66 s (32 nodes: 2.5 s), and the
 /// preview they draw is 0.022 from the one of the demo's 32-node tables (relative RMSE over the
-/// hair; 8 nodes 0.049 in 0.53 s, 6 nodes 0.072 in 0.49 s: docs/BENCHMARKS.md, "The first look").
+/// hair; 8 nodes 0.049 in 0.53 s, 6 nodes 0.072 in 0.49 s:
+/// docs/history/benchmarks-2026-12-05-to-12-06.md, "The first look").
 pub const PREVIEW_TABLE_NODES: usize = 12;
 
 /// `settings` as a first look draws them on a cold cache ([`FramePart::Preview`]): an

@@ -25,7 +25,8 @@ const BUSY_FRAME: Duration = Duration::from_millis(33);
 /// Frame interval while only the readout's progress moves (the worker refining or baking): on
 /// a software adapter the window's frames take the cores the worker renders on (the default
 /// view at 800×600 on lavapipe converged in 25.5 s repainting every BUSY_FRAME, in 17.8 s
-/// every PROGRESS_FRAME; docs/BENCHMARKS.md, "The first look").
+/// every PROGRESS_FRAME; docs/history/benchmarks-2026-12-05-to-12-06.md, "Compact sources per
+/// layer").
 const PROGRESS_FRAME: Duration = Duration::from_millis(250);
 /// Width of the side panel, points.
 const PANEL_WIDTH: f64 = 320.0;
