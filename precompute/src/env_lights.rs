@@ -270,6 +270,8 @@ pub fn fitted_reference_lights(
             shadowed_from: None,
             angular_variance: 0.0,
             stands_for_region: false,
+            // The reference draws every map at one resolution (its cached images stay valid);
+            // the fine maps of dominant sources are the method's, measured against the truth.
             power_share: 0.0,
             ..*l
         });
