@@ -4,7 +4,9 @@
 //! converged. A second line gives the error over blocks of 1, 2, 4 and 16 pixels a side, the
 //! coverage's error and the mean ratio (`ScaleErrors`); a third splits the error into what one
 //! brightness scale removes (a bias) and what it leaves (a pattern), and says how the brightest
-//! tenth of the hair compares.
+//! tenth of the hair compares. Given the single-scattering images of the same two frames
+//! (`--single`), it splits a full frame's error into its single- and multiple-scattering parts
+//! at every scale (issue 65: each term against the truth on its own).
 
 use std::path::PathBuf;
 
@@ -14,7 +16,10 @@ use clap::Args;
 use strandlight_eval::ground_truth::{read_truth_sidecar, without_noise};
 use strandlight_eval::hdr_flip::{error_map_magma, hdr_flip};
 use strandlight_eval::reference_cache::read_rgba_exr;
-use strandlight_scene::image_metrics::{ScaleErrors, error_split, mean_ratio, relative_rmse};
+use strandlight_scene::image_metrics::{
+    ERROR_SCALES, Image, ScaleErrors, error_split, mean_ratio, relative_rmse,
+    relative_rmse_of_part_over_blocks,
+};
 
 #[derive(Args, Debug)]
 pub struct ImageErrorArgs {
@@ -25,13 +30,62 @@ pub struct ImageErrorArgs {
     /// Also write HDR-FLIP's error map here (PNG, magma colour map from 0 to 1).
     #[arg(long, value_name = "PNG")]
     pub flip_map: Option<PathBuf>,
+    /// The single-scattering images of the same frames, the test's then the reference's, when
+    /// TEST and REFERENCE are full scattering: reports each part (single, and full less single)
+    /// against the reference's, over the full reference's norm at every scale, and its light.
+    #[arg(long, num_args = 2, value_names = ["TEST_SINGLE", "REFERENCE_SINGLE"])]
+    pub single: Option<Vec<PathBuf>>,
+}
+
+fn read(path: &std::path::Path) -> anyhow::Result<Image> {
+    read_rgba_exr(path).with_context(|| format!("reading {}", path.display()))
+}
+
+/// One line per part: its light against the reference part's and its error at every scale,
+/// each over the full reference's norm (the parts add as vectors to the full frame's error).
+fn print_parts(
+    test: &Image,
+    reference: &Image,
+    [test_single, reference_single]: [&std::path::Path; 2],
+) -> anyhow::Result<()> {
+    let (ts, rs) = (read(test_single)?, read(reference_single)?);
+    let single_pair = || {
+        format!(
+            "{} against {}",
+            test_single.display(),
+            reference_single.display()
+        )
+    };
+    let test_multiple = test.minus(&ts).with_context(single_pair)?;
+    let reference_multiple = reference.minus(&rs).with_context(single_pair)?;
+    for (name, a, r) in [
+        ("single-scattering part", &ts, &rs),
+        (
+            "multiple-scattering part (full less single)",
+            &test_multiple,
+            &reference_multiple,
+        ),
+    ] {
+        let light = mean_ratio(a, r).with_context(single_pair)?;
+        let scales = ERROR_SCALES
+            .iter()
+            .map(|&n| {
+                let e = relative_rmse_of_part_over_blocks(a, r, reference, n)?;
+                Ok(format!("{n}×{n} {e:.4}"))
+            })
+            .collect::<Result<Vec<_>, strandlight_scene::image_metrics::CompareError>>()
+            .with_context(single_pair)?;
+        println!(
+            "{name}: {light:.4}× the reference's light; error over the full reference's norm {}",
+            scales.join(", ")
+        );
+    }
+    Ok(())
 }
 
 pub fn run(args: ImageErrorArgs) -> anyhow::Result<()> {
-    let test =
-        read_rgba_exr(&args.test).with_context(|| format!("reading {}", args.test.display()))?;
-    let reference = read_rgba_exr(&args.reference)
-        .with_context(|| format!("reading {}", args.reference.display()))?;
+    let test = read(&args.test)?;
+    let reference = read(&args.reference)?;
     let pair = || {
         format!(
             "{} against {}",
@@ -74,6 +128,9 @@ pub fn run(args: ImageErrorArgs) -> anyhow::Result<()> {
             truth.noise,
             without_noise(error, truth.noise)
         );
+    }
+    if let Some(single) = &args.single {
+        print_parts(&test, &reference, [&single[0], &single[1]])?;
     }
     if let Some(path) = &args.flip_map {
         let (w, h) = (reference.width, reference.height);

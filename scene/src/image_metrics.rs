@@ -253,22 +253,39 @@ pub fn relative_rmse_over_blocks(
     reference: &Image,
     n: u32,
 ) -> Result<f64, CompareError> {
-    check_finite("the reference", reference)?;
-    approx.check_against("the image", reference)?;
+    relative_rmse_of_part_over_blocks(approx, reference, reference, n)
+}
+
+/// [`relative_rmse_of_part`] over `n`×`n` blocks: the part's block means against the
+/// reference part's, over the norm of the `whole` reference's block means, on the blocks that
+/// hold any of the whole's hair. The parts' block errors add as vectors to the whole's, as
+/// the pixels' do.
+pub fn relative_rmse_of_part_over_blocks(
+    approx_part: &Image,
+    reference_part: &Image,
+    whole: &Image,
+    n: u32,
+) -> Result<f64, CompareError> {
+    check_finite("the reference", whole)?;
+    check_finite("the reference's part", reference_part)?;
+    reference_part.check_against("the reference's part", whole)?;
+    approx_part.check_against("the image", whole)?;
     let n = n.max(1);
-    let (w, h) = (reference.width, reference.height);
+    let (w, h) = (whole.width, whole.height);
     let (mut num, mut den, mut hair) = (0.0f64, 0.0f64, 0usize);
     for by in (0..h).step_by(n as usize) {
         for bx in (0..w).step_by(n as usize) {
-            let (mut a, mut r, mut count, mut has_hair) = ([0.0f64; 3], [0.0f64; 3], 0.0, false);
+            let mut sums = [[0.0f64; 3]; 3];
+            let (mut count, mut has_hair) = (0.0, false);
             for y in by..(by + n).min(h) {
                 for x in bx..(bx + n).min(w) {
                     let i = (y * w + x) as usize;
-                    let (pa, pr) = (&approx.pixels[i], &reference.pixels[i]);
-                    has_hair |= is_hair(pr);
-                    for c in 0..3 {
-                        a[c] += pa[c] as f64;
-                        r[c] += pr[c] as f64;
+                    has_hair |= is_hair(&whole.pixels[i]);
+                    let pixels = [approx_part, reference_part, whole].map(|im| im.pixels[i]);
+                    for (sum, p) in sums.iter_mut().zip(pixels) {
+                        for c in 0..3 {
+                            sum[c] += p[c] as f64;
+                        }
                     }
                     count += 1.0;
                 }
@@ -277,10 +294,11 @@ pub fn relative_rmse_over_blocks(
                 continue;
             }
             hair += 1;
+            let [a, r, whole] = sums;
             for c in 0..3 {
-                let (a, r) = (a[c] / count, r[c] / count);
+                let (a, r, whole) = (a[c] / count, r[c] / count, whole[c] / count);
                 num += count * (a - r) * (a - r);
-                den += count * r * r;
+                den += count * whole * whole;
             }
         }
     }
@@ -562,6 +580,45 @@ mod tests {
             approx.minus(&image(vec![[0.0; 4]])).is_err(),
             "sizes must match"
         );
+        // One pixel a block, the parts' block errors are the pixels' (the definition above).
+        let at_one =
+            relative_rmse_of_part_over_blocks(&multiple_approx, &multiple_reference, &reference, 1)
+                .unwrap();
+        assert!((at_one - multiple).abs() < 1e-7, "{at_one} vs {multiple}");
+    }
+
+    /// Over blocks, a part's error is its block means' against the reference part's, over the
+    /// whole's block means: worked by hand on the 8×8 patch (colour (1, 2, 3)), whose reference
+    /// part is half the whole and whose approximated part is 0.6 of it left of x = 5 and 0.4
+    /// from there: every hair pixel is 0.1 of the whole off, and a block straddling x = 5
+    /// cancels.
+    #[test]
+    fn a_parts_error_over_blocks_is_its_block_means_against_the_references() {
+        let whole = patch(|_, _, p| p);
+        let half = patch(|_, _, p| [0.5 * p[0], 0.5 * p[1], 0.5 * p[2], p[3]]);
+        let skewed = patch(|x, _, p| {
+            let k = if x < 5 { 0.6 } else { 0.4 };
+            [k * p[0], k * p[1], k * p[2], p[3]]
+        });
+        // Per pixel: every hair pixel is off by 0.1 of its colour, the whole is 1: 0.1.
+        let pixels = relative_rmse_of_part_over_blocks(&skewed, &half, &whole, 1).unwrap();
+        assert!((pixels - 0.1).abs() < 1e-7, "{pixels}");
+        // Over 2×2 blocks, a block of k hair pixels that deviate alike has squared error
+        // 4·(0.1·k·c/4)² against the whole's 4·(k·c/4)²; the blocks at x 4–5 cancel. k is the
+        // block's hair columns times its hair rows, so the rows cancel from the ratio, and the
+        // hair columns per block column (x 0–1, 2–3, 4–5, 6–7, 8–9) are 1, 2, 2, 2, 1: squared
+        // 1 + 4 + 4 + 1 = 10 deviate of 1 + 4 + 4 + 4 + 1 = 14.
+        let two = relative_rmse_of_part_over_blocks(&skewed, &half, &whole, 2).unwrap();
+        let expected = (0.01f64 * 10.0 / 14.0).sqrt();
+        assert!((two - expected).abs() < 1e-7, "{two} vs {expected}");
+        // The reference part itself is exact at every scale.
+        for n in ERROR_SCALES {
+            let e = relative_rmse_of_part_over_blocks(&half, &half, &whole, n).unwrap();
+            assert_eq!(e, 0.0);
+        }
+        // A part of another size is refused.
+        let small = image(vec![[0.0; 4]]);
+        assert!(relative_rmse_of_part_over_blocks(&small, &half, &whole, 4).is_err());
     }
 
     /// An 8×8 hair patch of colour (1, 2, 3), alpha 1, inside a 10×10 image; `at(x, y)` the
