@@ -747,8 +747,8 @@ mod tests {
     /// volume reads 0.646–0.694 and 0.417–0.467 against 0.647–0.669 and 0.421–0.448 (λ 8–128);
     /// fibers 20% thicker (or thinner) in the volume than in the closed form read 0.597 (0.691)
     /// against 0.647 and fail. Where bands 0–3 cannot follow the transmittance the volume stays
-    /// off; the test prints those figures (`-- --nocapture`; docs/BENCHMARKS.md, "Single and
-    /// multiple scattering by melanin, term by term"): on the surface itself, 60° from the
+    /// off; the test prints those figures (`-- --nocapture`; docs/BENCHMARKS.md, "Multiple
+    /// scattering by melanin", its "Blonde on every map"): on the surface itself, 60° from the
     /// normal and along the fibers.
     #[test]
     fn under_the_surface_a_random_slab_is_seen_through_as_its_closed_form() {
