@@ -136,9 +136,8 @@ const HEAD_TAPS: i32 = 5;
 // texel), so that a broad lobe's head shadow is soft; 5 × 5 taps across the box, each opaque
 // where the head is nearer the light than the point by more than two texels (the head's own
 // surface, and the roots on it, must not shadow themselves).
-fn head_transmittance(slot: u32, uv: vec2<f32>, z: f32) -> f32 {
+fn head_transmittance(slot: u32, light: EnvLightGpu, uv: vec2<f32>, z: f32) -> f32 {
     if ((batch.flags & FLAG_HEAD) == 0u) { return 1.0; }
-    let light = env_lights[slot];
     let res = f32(batch.resolution);
     let last = i32(batch.resolution) - 1;
     let texel = min(vec2<i32>(uv * res), vec2<i32>(last));
@@ -163,20 +162,17 @@ fn head_transmittance(slot: u32, uv: vec2<f32>, z: f32) -> f32 {
 
 fn effective_transmittance(slot: u32, world: vec3<f32>) -> f32 {
     if ((batch.flags & FLAG_UNSHADOWED) != 0u) { return 1.0; }
+    // Loaded and projected once: the view's compact sources call this per fragment and light.
     let light = env_lights[slot];
     let clip = light.view_proj * vec4<f32>(world, 1.0);
     let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
     if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }
-    let head = head_transmittance(slot, uv, clip.z);
+    let head = head_transmittance(slot, light, uv, clip.z);
     if (head <= 0.0) { return 0.0; }
-    return head * hair_transmittance(slot, world);
+    return head * hair_transmittance(slot, light, uv, clip.z);
 }
 
-fn hair_transmittance(slot: u32, world: vec3<f32>) -> f32 {
-    let light = env_lights[slot];
-    let clip = light.view_proj * vec4<f32>(world, 1.0);
-    let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
-    if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }
+fn hair_transmittance(slot: u32, light: EnvLightGpu, uv: vec2<f32>, z: f32) -> f32 {
     let res = f32(batch.resolution);
     let texel = min(vec2<i32>(uv * res), vec2<i32>(i32(batch.resolution) - 1));
     var z0 = textureLoad(dodm_depth, texel, i32(slot), 0).r;
@@ -188,7 +184,7 @@ fn hair_transmittance(slot: u32, world: vec3<f32>) -> f32 {
         z0 = nearest_depth_around(slot, texel);
         if (z0 >= 1.0) { return 1.0; }
     }
-    let delta = max(clip.z - z0, 0.0) * (light.far - light.near);
+    let delta = max(z - z0, 0.0) * (light.far - light.near);
     // Continuous box half-width in texels (R = δ/2 · slope); the texel box of half-size h spans
     // h + 1/2 each side, so blend the two integer boxes around h = R − 1/2 (smooth in R).
     let radius = 0.5 * delta * light.rgb.w * light.texels_per_unit;
