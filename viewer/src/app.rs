@@ -67,7 +67,12 @@ pub fn run(options: ViewOptions) -> anyhow::Result<()> {
         Lighting::Environment(env) => env_look(env)?.transparency,
         Lighting::Lights(_) => ViewTransparency::Opaque,
     };
-    let worker = Worker::spawn(options.cache_dir.clone(), first_view, wake);
+    let worker = Worker::spawn(
+        options.cache_dir.clone(),
+        first_view,
+        !options.settings.head.is_none(),
+        wake,
+    );
     let mut app = App {
         options,
         script,

@@ -86,11 +86,12 @@ pub struct Worker {
 
 impl Worker {
     /// Starts the thread; `wake_window` is called whenever the status changes.
-    /// The render thread, its renderer prepared for frames in `first_view` (the first
-    /// request's).
+    /// The render thread, its renderer prepared for frames in `first_view`, with a head or not
+    /// (the first request's).
     pub fn spawn(
         cache_dir: PathBuf,
         first_view: ViewTransparency,
+        first_with_head: bool,
         wake_window: Box<dyn Fn() + Send + Sync>,
     ) -> Self {
         let shared = Arc::new(Shared {
@@ -102,7 +103,7 @@ impl Worker {
         });
         // The device and pipelines are made while the window opens and the tables load; an
         // error here is the first frame's to report.
-        std::thread::spawn(move || prepare_env_renderer(first_view).ok());
+        std::thread::spawn(move || prepare_env_renderer(first_view, first_with_head).ok());
         let for_thread = shared.clone();
         let thread = std::thread::Builder::new()
             .name("strandlight render".into())

@@ -38,8 +38,9 @@ pub struct EnvRenderer {
     pub(super) accumulate: AccumulatePass,
     pub(super) volume: VolumeCache,
     pub(super) tables: TableCache,
-    /// Per view (opaque, occupancy, layered): its pipelines are compiled.
-    compiled: [OnceLock<()>; 3],
+    /// Per view (opaque, occupancy, layered), without and with a head: its pipelines are
+    /// compiled.
+    compiled: [[OnceLock<()>; 2]; 3],
 }
 
 impl EnvRenderer {
@@ -72,20 +73,20 @@ impl EnvRenderer {
         }
     }
 
-    /// Compiles the pipelines a frame in `transparency` draws with (each is otherwise compiled
-    /// when a frame first uses it), the visibility's beside the view's: ahead of a first frame,
-    /// on a thread of the application's.
-    pub fn compile(&self, transparency: ViewTransparency) {
+    /// Compiles the pipelines a frame in `transparency`, with a head or not, draws with (each
+    /// is otherwise compiled when a frame first uses it), the visibility's beside the view's:
+    /// ahead of a first frame, on a thread of the application's.
+    pub fn compile(&self, transparency: ViewTransparency, with_head: bool) {
         let view = match transparency {
             ViewTransparency::Opaque => 0,
             ViewTransparency::Occupancy { .. } => 1,
             ViewTransparency::Layered { .. } => 2,
         };
         // Once: every part asks, and a frame's path spawns no threads after the first.
-        self.compiled[view].get_or_init(|| {
+        self.compiled[view][usize::from(with_head)].get_or_init(|| {
             build_both(
                 || self.visibility.compile(transparency),
-                || self.shading.compile(transparency),
+                || self.shading.compile(transparency, with_head),
             );
         });
     }
@@ -218,7 +219,7 @@ impl EnvRenderer {
             head,
         };
         // Once per renderer, outside the frame's timed passes.
-        self.compile(options.transparency);
+        self.compile(options.transparency, head.is_some());
         let mut timings = Timings(Vec::new());
         let part = (lights, first_window);
         let (frame, kinds) = self.start_part(gpu, &request, part, None, &mut timings)?;
@@ -262,7 +263,7 @@ impl EnvRenderer {
             head,
         };
         // Once per renderer, outside the frame's timed passes.
-        self.compile(options.transparency);
+        self.compile(options.transparency, head.is_some());
         let mut timings = Timings(Vec::new());
         let part = (lights, first_window);
         let (frame, kinds) = self.start_part(gpu, &request, part, Some(sums), &mut timings)?;
@@ -394,7 +395,7 @@ pub fn render_env_frame(
     let mut timings = Timings(Vec::new());
     let renderer = timings.time(gpu, "pipelines", || {
         let renderer = EnvRenderer::new(gpu);
-        renderer.compile(options.transparency);
+        renderer.compile(options.transparency, false);
         renderer
     });
     let mut frame = renderer.render(

@@ -101,8 +101,9 @@ pub(super) struct ViewShadingPass {
     transparent: LazyPipeline,
     layered: LazyPipeline,
     /// A batch of compact sources in the layered view: its lights' visibility gathered per
-    /// layer (`fs_env_layer_lights`) before the layers are shaded.
-    layer_lights: LazyPipeline,
+    /// layer (`fs_env_layer_lights`) before the layers are shaded; without a head and with
+    /// one (`fs_env_layer_lights_head`, which filters the head's shadow).
+    layer_lights: [LazyPipeline; 2],
     /// Occupancy and layered views: the skin behind the pixel's fibers (`skin.wgsl`), added
     /// after them.
     skin_behind_hair: LazyPipeline,
@@ -146,8 +147,24 @@ impl ViewShadingPass {
                 view_pipeline(&device, format, &layout, &shader, names, blend)
             })
         };
-        let (gather_device, gather_layout, gather_shader) =
-            (device.clone(), layout.clone(), shader.clone());
+        let gather = |entry: &'static str| {
+            let (device, layout, shader) = (device.clone(), layout.clone(), shader.clone());
+            LazyPipeline::new(move || {
+                StrandDraw {
+                    label: "env view (layers' light visibility)",
+                    layout: &layout,
+                    shader: &shader,
+                    vertex_entry: "vs_main",
+                    fragment: Some((entry, &[])),
+                    depth: Some(depth_test(
+                        DEPTH_FORMAT,
+                        false,
+                        wgpu::CompareFunction::Always,
+                    )),
+                }
+                .build(&device)
+            })
+        };
         Self {
             // The depth prepass left each pixel's nearest fiber in two textures: the opaque
             // view shades those pixels, rasterizing no strand per batch.
@@ -165,21 +182,10 @@ impl ViewShadingPass {
                 ("env view (layered)", "vs_fullscreen", "fs_env_layered"),
                 Some(ADDITIVE),
             ),
-            layer_lights: LazyPipeline::new(move || {
-                StrandDraw {
-                    label: "env view (layers' light visibility)",
-                    layout: &gather_layout,
-                    shader: &gather_shader,
-                    vertex_entry: "vs_main",
-                    fragment: Some(("fs_env_layer_lights", &[])),
-                    depth: Some(depth_test(
-                        DEPTH_FORMAT,
-                        false,
-                        wgpu::CompareFunction::Always,
-                    )),
-                }
-                .build(&gather_device)
-            }),
+            layer_lights: [
+                gather("fs_env_layer_lights"),
+                gather("fs_env_layer_lights_head"),
+            ],
             skin_behind_hair: lazy(
                 (
                     "env view (skin behind hair)",
@@ -191,9 +197,9 @@ impl ViewShadingPass {
         }
     }
 
-    /// Compiles the pipelines a frame in `transparency` draws with, side by side
-    /// ([`build_both`]), before its first batch needs them.
-    pub(super) fn compile(&self, transparency: ViewTransparency) {
+    /// Compiles the pipelines a frame in `transparency`, with a head or not, draws with, side
+    /// by side ([`build_both`]), before its first batch needs them.
+    pub(super) fn compile(&self, transparency: ViewTransparency, with_head: bool) {
         match transparency {
             ViewTransparency::Opaque => {
                 self.opaque.get();
@@ -204,7 +210,12 @@ impl ViewShadingPass {
             ViewTransparency::Layered { .. } => {
                 build_both(
                     || self.layered.get(),
-                    || build_both(|| self.layer_lights.get(), || self.skin_behind_hair.get()),
+                    || {
+                        build_both(
+                            || self.layer_lights[usize::from(with_head)].get(),
+                            || self.skin_behind_hair.get(),
+                        )
+                    },
                 );
             }
         }
@@ -271,7 +282,7 @@ impl ViewShadingPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(self.layer_lights.get());
+        pass.set_pipeline(self.layer_lights[usize::from(inputs.with_head)].get());
         pass.set_bind_group(0, inputs.strands, &[]);
         pass.set_bind_group(1, &inputs.batch.group, &[]);
         pass.set_bind_group(2, &inputs.tables.group, &[]);

@@ -11,7 +11,8 @@
 //                       longer contribute stop before any light is evaluated (early termination).
 //   fs_env_layered:     the layers the frame's visibility gathered, each shaded once; a batch
 //                       of compact sources first gathers its lights' visibility per layer
-//                       (fs_env_layer_lights), the layers' fibers rasterized again.
+//                       (fs_env_layer_lights, _head with a head), the layers' fibers
+//                       rasterized again.
 // and fs_env_skin, the skin behind the hair of the occupancy and layered views.
 
 #import strandlight::env_shading::{EnvOut, shade}
@@ -22,7 +23,7 @@
 #import strandlight::strand_quads::{VertexOut, covered_fragment, strand_draw_vertex}
 #import strandlight::view_binding::{view, occupancy_map, coverage, nearest_position, nearest_tangent, head_normal}
 #import strandlight::view_layers::{NO_LAYER_LIGHTS, OCC_LAYERS, add_fixed, layer_fragment, layer_lights_word, layer_word, load_fixed, on_pixel_ray}
-#import strandlight::convolution_transmittance::{batch, effective_transmittance}
+#import strandlight::convolution_transmittance::{batch, directional_transmittance}
 
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> VertexOut {
@@ -68,15 +69,25 @@ fn fs_env_transparent(drawn: VertexOut) -> EnvOut {
 }
 
 // A batch of compact sources, before fs_env_layered: each fragment adds w·v of every light
-// slot to its layer (view_layers.wgsl).
+// slot to its layer (view_layers.wgsl). A frame with a head takes the entry point that filters
+// its shadow; without one the filter's code is compiled out (directional_transmittance).
 @fragment
 fn fs_env_layer_lights(drawn: VertexOut) {
+    gather_layer_lights(drawn, false);
+}
+
+@fragment
+fn fs_env_layer_lights_head(drawn: VertexOut) {
+    gather_layer_lights(drawn, true);
+}
+
+fn gather_layer_lights(drawn: VertexOut, with_head: bool) {
     let in = covered_fragment(drawn);
     let f = layer_fragment(in);
     if (!f.kept) { discard; }
     let first = layer_lights_word(in.clip.xy, f.layer);
     for (var slot = 0u; slot < batch.light_count; slot++) {
-        add_fixed(first + slot, f.weight * effective_transmittance(slot, in.world));
+        add_fixed(first + slot, f.weight * directional_transmittance(slot, in.world, with_head));
     }
 }
 

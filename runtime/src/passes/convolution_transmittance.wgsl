@@ -162,7 +162,7 @@ fn head_transmittance(slot: u32, light: EnvLightGpu, uv: vec2<f32>, z: f32) -> f
 
 fn effective_transmittance(slot: u32, world: vec3<f32>) -> f32 {
     if ((batch.flags & FLAG_UNSHADOWED) != 0u) { return 1.0; }
-    // Loaded and projected once: the view's compact sources call this per fragment and light.
+    // Loaded and projected once for the head and the hair.
     let light = env_lights[slot];
     let clip = light.view_proj * vec4<f32>(world, 1.0);
     let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
@@ -172,9 +172,31 @@ fn effective_transmittance(slot: u32, world: vec3<f32>) -> f32 {
     return head * hair_transmittance(slot, light, uv, clip.z);
 }
 
+// effective_transmittance of a compact source (a directional light, whose box follows its
+// angular spread), as the layered view gathers it per fragment and source: an empty texel lets
+// the light through instead of searching for the hair's front (the frame moves by 1e-4), and
+// the head's filter is compiled in only `with_head` (a constant of the entry point). llvmpipe
+// runs every branch, taken or not, the loops' first pass included: these two are most of the
+// gather's cost (docs/BENCHMARKS.md, "The compact sources' gather").
+fn directional_transmittance(slot: u32, world: vec3<f32>, with_head: bool) -> f32 {
+    if ((batch.flags & FLAG_UNSHADOWED) != 0u) { return 1.0; }
+    let light = env_lights[slot];
+    let clip = light.view_proj * vec4<f32>(world, 1.0);
+    let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
+    if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }
+    var head = 1.0;
+    if (with_head) {
+        head = head_transmittance(slot, light, uv, clip.z);
+        if (head <= 0.0) { return 0.0; }
+    }
+    let texel = min(vec2<i32>(uv * f32(batch.resolution)), vec2<i32>(i32(batch.resolution) - 1));
+    let z0 = textureLoad(dodm_depth, texel, i32(slot), 0).r;
+    if (z0 >= 1.0) { return head; }
+    return head * box_transmittance(slot, light, texel, z0, clip.z);
+}
+
 fn hair_transmittance(slot: u32, light: EnvLightGpu, uv: vec2<f32>, z: f32) -> f32 {
-    let res = f32(batch.resolution);
-    let texel = min(vec2<i32>(uv * res), vec2<i32>(i32(batch.resolution) - 1));
+    let texel = min(vec2<i32>(uv * f32(batch.resolution)), vec2<i32>(i32(batch.resolution) - 1));
     var z0 = textureLoad(dodm_depth, texel, i32(slot), 0).r;
     if (z0 >= 1.0) {
         // Nothing drawn on this texel: the point's own fiber fell in a gap of the map (left out
@@ -184,6 +206,11 @@ fn hair_transmittance(slot: u32, light: EnvLightGpu, uv: vec2<f32>, z: f32) -> f
         z0 = nearest_depth_around(slot, texel);
         if (z0 >= 1.0) { return 1.0; }
     }
+    return box_transmittance(slot, light, texel, z0, z);
+}
+
+// exp(−l(δ)) at depth z behind the hair's front z0 seen from `texel`.
+fn box_transmittance(slot: u32, light: EnvLightGpu, texel: vec2<i32>, z0: f32, z: f32) -> f32 {
     let delta = max(z - z0, 0.0) * (light.far - light.near);
     // Continuous box half-width in texels (R = δ/2 · slope); the texel box of half-size h spans
     // h + 1/2 each side, so blend the two integer boxes around h = R − 1/2 (smooth in R).

@@ -16,7 +16,7 @@ use crate::common::*;
 
 use glam::{DVec3, Vec3};
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env::{EnvRenderOptions, EnvRenderer, EnvTables};
+use strandlight_runtime::env::{EnvRenderOptions, EnvRenderer, EnvTables, ViewTransparency};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
@@ -363,7 +363,23 @@ fn the_skin_under_fibers_is_shadowed_through_the_volume_and_a_mesh_head_agrees()
 /// only the hair, the head was clipped from the fiber's map and cast no shadow (T = 1).
 #[test]
 fn a_head_outside_the_hairs_footprint_casts_and_receives_a_suns_shadow() {
+    // The layered view gathers a compact source's visibility per layer in a pass of its own,
+    // whose head filter is compiled in only for frames with a head (seen failing, T = 1 behind
+    // the head, with the gather's pipeline without it).
+    for transparency in [ViewTransparency::Opaque, ViewTransparency::layered()] {
+        head_and_suns_shadows_in(transparency);
+    }
+}
+
+fn head_and_suns_shadows_in(transparency: ViewTransparency) {
     let gpu = gpu();
+    let render = |gpu: &GpuContext, model: &HairModel, lights: &[EnvLight], shadowed, head| {
+        let options = EnvRenderOptions {
+            transparency,
+            ..options(shadowed)
+        };
+        render_with(gpu, model, lights, &options, head)
+    };
     let head = head();
     let toward = DVec3::X;
     let sun = [EnvLight::directional(toward.as_vec3(), [1.0; 3])];
@@ -387,9 +403,15 @@ fn a_head_outside_the_hairs_footprint_casts_and_receives_a_suns_shadow() {
         let p = Vec3::new(FIBER_X, y, 0.0);
         assert!(head.ray_hit(p, toward.as_vec3(), 10.0).is_some());
         let ratio = shadowed[i][0] / lit[i][0];
-        assert!(ratio < 0.02, "row {row}: behind the head, T = {ratio}");
+        assert!(
+            ratio < 0.02,
+            "{transparency:?}, row {row}: behind the head, T = {ratio}"
+        );
         let free = no_head[i][0] / lit[i][0];
-        assert!(free > 0.95, "row {row}: no head, T = {free}");
+        assert!(
+            free > 0.95,
+            "{transparency:?}, row {row}: no head, T = {free}"
+        );
         dark += 1;
     }
     assert!(dark > 10, "{dark} rows");
