@@ -29,8 +29,13 @@ pub struct ForwardScatteringSettings {
     pub step_fraction: f32,
     /// Start points per axis of the one-voxel box filter around each sample (1 = none).
     pub filter_taps: u32,
-    /// Zinke's d_f (0.6–0.8 for human hair).
+    /// Zinke's d_f (0.6–0.8 for human hair) for the SRBF lobes.
     pub density_forward: f64,
+    /// d_f for the fit's compact sources ([`EnvLight::has_sharp_shadow`]). Their shadow paths cross the
+    /// grid's measured density, and at Zinke's 0.7 they drew 0.64–0.81 of the truth's multiple
+    /// scattering on the maps with a dominant sun; 1 (no correction) takes it to 0.80–1.0
+    /// (docs/BENCHMARKS.md, "Multiple scattering by melanin").
+    pub compact_density_forward: f64,
     /// Compute each light's paths once on a light-aligned lattice of rays one voxel apart
     /// ([`super::light_sweep`]) and interpolate, instead of marching from every sample
     /// (`filter_taps` is then unused: the lateral interpolation is the filter). Faster for
@@ -51,6 +56,7 @@ impl Default for ForwardScatteringSettings {
             step_fraction: 0.5,
             filter_taps: 2,
             density_forward: strandlight_tables::dual_scattering::DEFAULT_DENSITY_FACTOR,
+            compact_density_forward: 1.0,
             light_sweep: false,
             include_direct: false,
         }
@@ -114,21 +120,30 @@ impl ForwardScatteringSettings {
                 "must be in 1..=8",
             );
         }
-        if !(self.density_forward.is_finite() && (0.0..=1.0).contains(&self.density_forward)) {
-            return bad(
-                "density_forward",
-                self.density_forward.to_string(),
-                "must be in [0, 1]",
-            );
+        for (name, value) in [
+            ("density_forward", self.density_forward),
+            ("compact_density_forward", self.compact_density_forward),
+        ] {
+            if !(value.is_finite() && (0.0..=1.0).contains(&value)) {
+                return bad(name, value.to_string(), "must be in [0, 1]");
+            }
         }
         Ok(())
     }
 
-    fn march(&self) -> MarchSettings {
+    /// The d_f of `light`'s shadow paths.
+    pub fn density_forward_of(&self, light: &EnvLight) -> f64 {
+        match light.has_sharp_shadow() {
+            true => self.compact_density_forward,
+            false => self.density_forward,
+        }
+    }
+
+    fn march(&self, light: &EnvLight) -> MarchSettings {
         MarchSettings {
             step_fraction: self.step_fraction,
             filter_taps: self.filter_taps,
-            density_forward: self.density_forward,
+            density_forward: self.density_forward_of(light),
             include_direct: self.include_direct,
         }
     }
@@ -298,7 +313,7 @@ impl CpuForwardScattering {
     fn unblocked_values_at(&self, light: &EnvLight, points: &[Vec3]) -> Vec<[f32; 4]> {
         let medium = self.medium(light);
         let xi = light_direction(light);
-        let march = self.settings.march();
+        let march = self.settings.march(light);
         if self.settings.light_sweep {
             let h = self.volume.grid.voxel_size;
             let substeps = (1.0 / march.step_fraction).ceil() as u32;

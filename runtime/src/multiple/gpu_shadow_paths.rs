@@ -36,9 +36,8 @@ struct MarchParams {
     lights: u32,
     taps: u32,
     step_fraction: f32,
-    density_forward: f32,
     include_direct: u32,
-    _pad: [u32; 3],
+    _pad: [u32; 4],
 }
 
 /// T_f and σ̄_f for batches of lights, marched by a compute shader.
@@ -178,7 +177,11 @@ impl<'g> GpuForwardScattering<'g> {
         }
         let directions: Vec<[f32; 4]> = lights
             .iter()
-            .map(|l| light_direction(l).extend(0.0).to_array())
+            // w: the light's d_f (compact sources and SRBF lobes differ).
+            .map(|l| {
+                let d_f = settings.density_forward_of(l) as f32;
+                light_direction(l).extend(d_f).to_array()
+            })
             .collect();
         let g = &volume.grid;
         let params = MarchParams {
@@ -189,9 +192,8 @@ impl<'g> GpuForwardScattering<'g> {
             lights: lights.len() as u32,
             taps: settings.filter_taps.max(1),
             step_fraction: settings.step_fraction,
-            density_forward: settings.density_forward as f32,
             include_direct: settings.include_direct as u32,
-            _pad: [0; 3],
+            _pad: [0; 4],
         };
         let init = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -383,7 +385,6 @@ mod wgsl_layout {
                 lights,
                 taps,
                 step_fraction,
-                density_forward,
                 include_direct
             }),
         );

@@ -14,17 +14,18 @@ struct MarchParams {
     // Start points per axis of the one-voxel box filter.
     taps: u32,
     step_fraction: f32,
-    density_forward: f32,
     // 1: T_f counts the zero-hit (direct) paths too.
     include_direct: u32,
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
+    _pad3: u32,
 };
 
 @group(0) @binding(0) var<uniform> params: MarchParams;
 @group(0) @binding(1) var<storage, read> medium: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> sample_points: array<vec4<f32>>;
+// xyz: toward the light; w: its d_f (Zinke's density factor).
 @group(0) @binding(3) var<storage, read> light_directions: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read_write> values: array<vec4<f32>>;
 
@@ -129,7 +130,7 @@ fn march_samples(@builtin(global_invocation_id) id: vec3<u32>) {
     let xi = light_directions[light].xyz;
     let h = params.voxel_size;
     let taps = max(params.taps, 1u);
-    let df = params.density_forward;
+    let df = light_directions[light].w;
     var transmittance = vec3<f32>(0.0);
     var variance_numerator = vec3<f32>(0.0);
     var plain_variance = 0.0;

@@ -122,6 +122,7 @@ fn settings(voxels: u32, taps: u32, step: f32) -> ForwardScatteringSettings {
         step_fraction: step,
         filter_taps: taps,
         density_forward: 0.7,
+        compact_density_forward: 0.7,
         include_direct: true,
         light_sweep: false,
     }
@@ -298,6 +299,45 @@ fn slab_attenuation_matches_the_expected_value_closed_form() {
         den += want;
     }
     assert!((got[3] as f64 / (num / den).sqrt() - 1.0).abs() < 2e-6);
+}
+
+/// A compact source's paths take `compact_density_forward`, an SRBF lobe's `density_forward`:
+/// each equals the slab's closed form at its own d_f (seen failing with one d_f for both).
+#[test]
+fn compact_sources_and_lobes_take_their_own_density_factor() {
+    let d = 0.15f32;
+    let model = parallel_block(Some(d));
+    let point = Vec3::new(4.0, 13.0, 6.0);
+    let mu = d as f64 * 12.0;
+    let source = CpuForwardScattering::new(
+        &model,
+        tables(),
+        ForwardScatteringSettings {
+            density_forward: 0.7,
+            compact_density_forward: 1.0,
+            ..settings(8, 1, 0.5)
+        },
+    )
+    .unwrap();
+    let sun = EnvLight::directional(Vec3::X, [1.0; 3]);
+    let lobe = EnvLight::srbf(Vec3::X, 100.0, [1.0; 3]);
+    assert!(sun.has_sharp_shadow() && !lobe.has_sharp_shadow());
+    for (light, srbf_var, d_f) in [(sun, 0.0, 1.0), (lobe, SRBF_VARIANCE, 0.7)] {
+        let got = source.values_at(&light, &[point])[0];
+        let (want, sigma) = poisson_closed_form(mu, srbf_var, d_f);
+        println!(
+            "d_f {d_f}: T_f {:?} σ̄_f {}; closed form {want:.6?} σ̄ {sigma:.6}",
+            &got[..3],
+            got[3]
+        );
+        for c in 0..3 {
+            assert!(
+                (got[c] as f64 - want[c]).abs() < 2e-6,
+                "d_f {d_f}, channel {c}"
+            );
+        }
+        assert!((got[3] as f64 / sigma - 1.0).abs() < 2e-6, "d_f {d_f}");
+    }
 }
 
 #[test]
@@ -498,6 +538,10 @@ fn bad_settings_are_typed_errors() {
             ..Default::default()
         },
         ForwardScatteringSettings {
+            compact_density_forward: -0.1,
+            ..Default::default()
+        },
+        ForwardScatteringSettings {
             voxels: VoxelSettings {
                 voxels_longest_side: 0,
                 default_diameter: None,
@@ -663,9 +707,11 @@ fn gpu_march_matches_the_cpu_march() {
     }
     let gpu = crate::gpu::GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
     for include_direct in [true, false] {
+        // The compact sources' d_f differs from the lobes': each light carries its own.
         let s = ForwardScatteringSettings {
             coarse_factor: 2,
             include_direct,
+            compact_density_forward: 1.0,
             ..settings(16, 2, 0.5)
         };
         let cpu = CpuForwardScattering::new(&model, tables(), s).unwrap();
