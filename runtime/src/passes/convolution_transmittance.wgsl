@@ -138,9 +138,8 @@ const HEAD_TAPS: i32 = 5;
 // surface, and the roots on it, must not shadow themselves).
 fn head_transmittance(slot: u32, light: EnvLightGpu, uv: vec2<f32>, z: f32) -> f32 {
     if ((batch.flags & FLAG_HEAD) == 0u) { return 1.0; }
-    let res = f32(batch.resolution);
     let last = i32(batch.resolution) - 1;
-    let texel = min(vec2<i32>(uv * res), vec2<i32>(last));
+    let texel = map_texel(uv);
     let bias = 2.0 / (light.texels_per_unit * (light.far - light.near));
     let centre = textureLoad(head_depth, texel, i32(slot), 0).r;
     let behind = max(z - centre, 0.0) * (light.far - light.near);
@@ -160,12 +159,22 @@ fn head_transmittance(slot: u32, light: EnvLightGpu, uv: vec2<f32>, z: f32) -> f
     return passed / f32(HEAD_TAPS * HEAD_TAPS);
 }
 
+// A light's map coordinates of a point it projects to `clip` (outside [0, 1)² off the map).
+fn map_uv(clip: vec4<f32>) -> vec2<f32> {
+    return vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
+}
+
+// The texel of the slot's maps holding `uv` (in [0, 1)²).
+fn map_texel(uv: vec2<f32>) -> vec2<i32> {
+    return min(vec2<i32>(uv * f32(batch.resolution)), vec2<i32>(i32(batch.resolution) - 1));
+}
+
 fn effective_transmittance(slot: u32, world: vec3<f32>) -> f32 {
     if ((batch.flags & FLAG_UNSHADOWED) != 0u) { return 1.0; }
     // Loaded and projected once for the head and the hair.
     let light = env_lights[slot];
     let clip = light.view_proj * vec4<f32>(world, 1.0);
-    let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
+    let uv = map_uv(clip);
     if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }
     let head = head_transmittance(slot, light, uv, clip.z);
     if (head <= 0.0) { return 0.0; }
@@ -182,21 +191,21 @@ fn directional_transmittance(slot: u32, world: vec3<f32>, with_head: bool) -> f3
     if ((batch.flags & FLAG_UNSHADOWED) != 0u) { return 1.0; }
     let light = env_lights[slot];
     let clip = light.view_proj * vec4<f32>(world, 1.0);
-    let uv = vec2<f32>(0.5 + 0.5 * clip.x, 0.5 - 0.5 * clip.y);
+    let uv = map_uv(clip);
     if (any(uv < vec2<f32>(0.0)) || any(uv >= vec2<f32>(1.0))) { return 1.0; }
     var head = 1.0;
     if (with_head) {
         head = head_transmittance(slot, light, uv, clip.z);
         if (head <= 0.0) { return 0.0; }
     }
-    let texel = min(vec2<i32>(uv * f32(batch.resolution)), vec2<i32>(i32(batch.resolution) - 1));
+    let texel = map_texel(uv);
     let z0 = textureLoad(dodm_depth, texel, i32(slot), 0).r;
     if (z0 >= 1.0) { return head; }
     return head * box_transmittance(slot, light, texel, z0, clip.z);
 }
 
 fn hair_transmittance(slot: u32, light: EnvLightGpu, uv: vec2<f32>, z: f32) -> f32 {
-    let texel = min(vec2<i32>(uv * f32(batch.resolution)), vec2<i32>(i32(batch.resolution) - 1));
+    let texel = map_texel(uv);
     var z0 = textureLoad(dodm_depth, texel, i32(slot), 0).r;
     if (z0 >= 1.0) {
         // Nothing drawn on this texel: the point's own fiber fell in a gap of the map (left out
