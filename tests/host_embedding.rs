@@ -20,7 +20,9 @@ use std::path::Path;
 use std::process::Command;
 use strandlight_eval::reference_cache::read_rgba_exr;
 use strandlight_scene::env_lighting::EnvLighting;
-use strandlight_scene::frame_settings::{FrameSettings, Lighting};
+use strandlight_scene::frame_settings::{
+    FrameSettings, Lighting, PointLighting, Shadows, Transparency,
+};
 use strandlight_scene::point_shading::Shading;
 use strandlight_scene::scene_tables::ScatteringMode;
 
@@ -152,6 +154,33 @@ fn the_host_hides_the_hair_where_its_mesh_is_nearer_and_shows_the_replayed_frame
     let dir = std::env::temp_dir().join(format!("strandlight-host-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let settings = settings(&dir);
+    host_matches_references(&dir, &settings);
+}
+
+/// The same for a frame of the thesis techniques: two lights with deep opacity maps, the
+/// K-buffer's transparency, drawn whole by `HairRenderer::draw_point_lit`.
+#[test]
+fn a_point_lit_frame_in_the_host_is_hidden_by_its_mesh_and_is_the_replayed_frame_elsewhere() {
+    let dir = std::env::temp_dir().join(format!("strandlight-host-points-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let point = PointLighting {
+        lights: vec!["directional:0.4,1,0.6:2".into(), "point:1,0.5,1.5:3".into()],
+        shadows: Shadows::Dom,
+        transparency: Transparency::Kbuffer,
+        ..PointLighting::default()
+    };
+    let settings = FrameSettings {
+        shading: Some(Shading::Chiang),
+        preset: "brown".into(),
+        ..FrameSettings::new(Lighting::Lights(point), [160, 120])
+    };
+    std::fs::write(dir.join("settings.json"), settings.to_json()).unwrap();
+    host_matches_references(&dir, &settings);
+}
+
+fn host_matches_references(dir: &Path, settings: &FrameSettings) {
+    let dir = dir.to_path_buf();
+    let settings = settings.clone();
     // One timed frame each way first: the checked picture is then a frame started again on
     // the same sums (each new frame must zero them).
     let (frame, times) = host::run(&settings, &dir.join("out/cache"), 1).unwrap();

@@ -7,7 +7,8 @@
 //! ```
 //!
 //! Without `--settings` it draws the default scene: the procedural groom under the procedural
-//! sun and sky (its tables are baked into `out/cache` on first use, as `render` does).
+//! sun and sky (its tables are baked into `out/cache` on first use, as `render` does). A
+//! point-lit settings file (`render lights`' sidecar) is drawn with the thesis techniques.
 //! tests/host_embedding.rs runs [`run`] and checks the picture against `render replay`.
 
 use anyhow::Context;
@@ -19,7 +20,10 @@ use strandlight_runtime::host::{HairRenderer, HairTargets};
 use strandlight_scene::env_frame::{hair_frame, lights_call};
 use strandlight_scene::env_lighting::EnvLighting;
 use strandlight_scene::env_scene::{AlsoServe, prepare_env};
-use strandlight_scene::frame_render::{FramePart, env_frame, load_settings_hair};
+use strandlight_scene::frame_render::{
+    FramePart, env_frame, load_settings_hair, point_frame_inputs, point_lit_frame, prepare_point,
+    settings_camera,
+};
 use strandlight_scene::frame_settings::{FrameSettings, Lighting};
 use strandlight_scene::steps::Steps;
 use wgpu::util::DeviceExt;
@@ -62,7 +66,8 @@ pub struct FrameTimes {
 }
 
 /// Renders `settings`' hair into the host's scene (tables cached under `cache`), and times
-/// `timed_frames` more frames each way.
+/// `timed_frames` more frames each way. Env-lit settings are drawn batch by batch, point-lit
+/// ones (the thesis techniques) whole.
 pub fn run(
     settings: &FrameSettings,
     cache: &Path,
@@ -70,67 +75,114 @@ pub fn run(
 ) -> anyhow::Result<(HostFrame, FrameTimes)> {
     // What the application had before it wanted hair: its device, meshes and camera.
     let hair = load_settings_hair(settings)?;
-    let prepared = prepare_env(
-        settings,
-        &hair.model,
-        cache,
-        AlsoServe::default(),
-        &mut Steps::new(true),
-        &mut |_| {},
-    )?;
-    let frame = env_frame(settings, &hair.model, &prepared, FramePart::Whole, false)?;
+    let camera = settings_camera(settings, &hair.model)?;
     let triangles = head_and_floor(&hair.model.bounds());
-    let host = Host::new(&triangles, frame.camera.view_projection(settings.size))?;
+    let host = Host::new(&triangles, camera.view_projection(settings.size))?;
 
     // The hair, on the host's device, into the host's pass.
     let gpu = GpuContext::from_device(host.device.clone(), host.queue.clone());
-    let call = lights_call(&frame, &gpu)?;
-    let hair_frame = hair_frame(&frame, &call);
     let targets = HairTargets {
         color: COLOR,
         depth: Some(DEPTH),
         sample_count: 1,
     };
-    let mut hair_renderer = HairRenderer::new(&host.device, &host.queue, targets);
-    hair_renderer.prepare(&hair_frame)?;
-    while !hair_renderer.encode_next_batch(&hair_frame)?.converged() {}
-
-    let mut times = FrameTimes {
-        on_gpu: Vec::new(),
-        with_readback: Vec::new(),
-        readbacks_on_gpu: 0,
+    let hair_renderer = HairRenderer::new(&host.device, &host.queue, targets);
+    let scene = HostScene {
+        host,
+        size: settings.size,
+        camera,
+        triangles,
     };
-    for readback in [false, true].repeat(timed_frames) {
-        let readbacks_before = readbacks_so_far();
-        let start = std::time::Instant::now();
-        hair_renderer.prepare(&hair_frame)?;
-        while !hair_renderer.encode_next_batch(&hair_frame)?.converged() {}
-        host.draw_pass(settings.size, Some(&hair_renderer));
-        match readback {
-            true => drop(hair_renderer.read_image()?),
-            false => {
-                times.readbacks_on_gpu += readbacks_so_far() - readbacks_before;
-                drop(host.device.poll(wgpu::PollType::wait_indefinitely()))
-            }
+    match &settings.lighting {
+        Lighting::Environment(_) => {
+            let prepared = prepare_env(
+                settings,
+                &hair.model,
+                cache,
+                AlsoServe::default(),
+                &mut Steps::new(true),
+                &mut |_| {},
+            )?;
+            let frame = env_frame(settings, &hair.model, &prepared, FramePart::Whole, false)?;
+            let call = lights_call(&frame, &gpu)?;
+            let hair_frame = hair_frame(&frame, &call);
+            scene.draw_hair(hair_renderer, timed_frames, |hair_renderer| {
+                hair_renderer.prepare(&hair_frame)?;
+                while !hair_renderer.encode_next_batch(&hair_frame)?.converged() {}
+                Ok(())
+            })
         }
-        let ms = start.elapsed().as_secs_f64() * 1e3;
-        match readback {
-            true => times.with_readback.push(ms),
-            false => times.on_gpu.push(ms),
+        Lighting::Lights(point) => {
+            let prepared = prepare_point(settings, point)?;
+            let inputs = point_frame_inputs(settings, point, &hair.model, settings.size)?;
+            let frame = point_lit_frame(&hair.model, &prepared, &inputs);
+            scene.draw_hair(hair_renderer, timed_frames, |hair_renderer| {
+                Ok(hair_renderer.draw_point_lit(&frame)?)
+            })
         }
     }
-    // The picture is drawn after the timed frames: each started again on the same sums.
-    let with_hair = host.draw(settings.size, Some(&hair_renderer))?;
-    let host_only = host.draw(settings.size, None)?;
-    let frame = HostFrame {
-        size: settings.size,
-        with_hair,
-        host_only,
-        triangles,
-        camera: frame.camera,
-        hair_depth: hair_renderer.read_front_depth()?,
-    };
-    Ok((frame, times))
+}
+
+/// The host's scene before the hair: its meshes and the camera it projects them with.
+struct HostScene {
+    host: Host,
+    size: [u32; 2],
+    camera: Camera,
+    triangles: Vec<[Vec3; 3]>,
+}
+
+impl HostScene {
+    /// Adds the hair `new_frame` draws (a new frame, on the host's device) to the host's pass:
+    /// times `timed_frames` frames each way, then draws the checked picture.
+    fn draw_hair(
+        self,
+        mut hair_renderer: HairRenderer,
+        timed_frames: usize,
+        mut new_frame: impl FnMut(&mut HairRenderer) -> anyhow::Result<()>,
+    ) -> anyhow::Result<(HostFrame, FrameTimes)> {
+        let Self {
+            host,
+            size,
+            camera,
+            triangles,
+        } = self;
+        new_frame(&mut hair_renderer)?;
+        let mut times = FrameTimes {
+            on_gpu: Vec::new(),
+            with_readback: Vec::new(),
+            readbacks_on_gpu: 0,
+        };
+        for readback in [false, true].repeat(timed_frames) {
+            let readbacks_before = readbacks_so_far();
+            let start = std::time::Instant::now();
+            new_frame(&mut hair_renderer)?;
+            host.draw_pass(size, Some(&hair_renderer));
+            match readback {
+                true => drop(hair_renderer.read_pixels()?),
+                false => {
+                    times.readbacks_on_gpu += readbacks_so_far() - readbacks_before;
+                    drop(host.device.poll(wgpu::PollType::wait_indefinitely()))
+                }
+            }
+            let ms = start.elapsed().as_secs_f64() * 1e3;
+            match readback {
+                true => times.with_readback.push(ms),
+                false => times.on_gpu.push(ms),
+            }
+        }
+        // The picture is drawn after the timed frames: each started again on the same sums.
+        let with_hair = host.draw(size, Some(&hair_renderer))?;
+        let host_only = host.draw(size, None)?;
+        let frame = HostFrame {
+            size,
+            with_hair,
+            host_only,
+            triangles,
+            camera,
+            hair_depth: hair_renderer.read_front_depth()?,
+        };
+        Ok((frame, times))
+    }
 }
 
 impl Host {

@@ -400,7 +400,7 @@ fn print_table(results: &[Measured]) {
             m.name,
             cell(pass_ms(m, "deep opacity")),
             cell(pass_ms(m, "strands")),
-            cell(pass_ms(m, "abuffer build + resolve + readback")),
+            cell(pass_ms(m, "abuffer build + resolve")),
             cell(pass_ms(m, "readback")),
             m.frame_ms,
             m.frame_min_ms,

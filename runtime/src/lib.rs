@@ -5,7 +5,10 @@
 //! [`host::HairRenderer`] draws env-lit hair into an application's own render pass, on the
 //! application's device, depth-tested against what it drew, with no readback and no wait on the
 //! frame's path. The scene layer (`strandlight-scene`) turns a frame's settings into the groom,
-//! lights and baked tables it draws; the runtime takes them from anywhere.
+//! lights and baked tables it draws; the runtime takes them from anywhere. The thesis
+//! techniques (point and directional lights with shadow or deep opacity maps, and every
+//! transparency technique) go the same way: [`host::HairRenderer::draw_point_lit`] draws such a
+//! frame whole, and `render` draws it into the host's pass as below.
 //!
 //! ```
 //! # use strandlight_runtime::camera::Camera;

@@ -5,21 +5,22 @@ use crate::gpu::readback::ReadbackError;
 use crate::gpu::{AdapterReport, GpuContext, GpuLimits, LimitError, read_texture_rgba};
 use crate::hair::HairModel;
 use crate::head::Head;
-use crate::passes::abuffer::{ABufferError, ABufferPass, ListMode};
+use crate::passes::abuffer::{ABufferError, ABufferPass, ABufferResources, ListMode};
+use crate::passes::attachments::cleared_depth;
 use crate::passes::deep_opacity::{
     DeepOpacityMap, DeepOpacityPass, DomSettings, DomSettingsError, ShadowLookup, ShadowMapError,
     array_layers_for,
 };
 use crate::passes::fiber_shading::ShadingModel;
 use crate::passes::frame_params::FrameParams;
-use crate::passes::kbuffer::{KBufferError, KBufferPass};
+use crate::passes::kbuffer::{KBufferError, KBufferOnGpu, KBufferPass};
 use crate::passes::point_skin::{PointHead, PointSkinPass, composite_over};
-use crate::passes::random_subsets::{RandomSubsetsPass, SubsetsError};
+use crate::passes::random_subsets::{RandomSubsetsPass, SubsetsError, SubsetsOnGpu};
 use crate::passes::render_target::RenderTarget;
 use crate::passes::shadow_slots::{HeadInput, MAX_SHADOWED_LIGHTS, ShadowInput, TooManyShadowMaps};
 use crate::passes::sorted_blend::{BadSortBins, SortedBlendPass};
 use crate::passes::strand_geometry::{StrandGeometry, TooManyPoints};
-use crate::passes::strands::StrandPass;
+use crate::passes::strands::{StrandDepthPass, StrandPass};
 use crate::shadow_layout::{PointLayoutChoice, ShadowLayout};
 
 #[derive(Debug, thiserror::Error)]
@@ -406,9 +407,142 @@ pub fn render_frame_with_head(
     shading: &ShadingModel,
     head: Option<&Head>,
 ) -> Result<PointImage, RenderError> {
+    let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let drawn = submit_frame(gpu, model, frame, options, shading, head, None);
+    let read = drawn.and_then(|drawn| drawn.read(gpu, frame));
+    if let Some(error) = pollster::block_on(scope.pop()) {
+        return Err(RenderError::Gpu(error.to_string()));
+    }
+    read
+}
+
+/// A point-lit frame drawn and left on the GPU ([`submit_frame`]): the hair composited by its
+/// technique, the skin under it, and what the frame cost so far.
+pub(crate) struct PointFrameOnGpu {
+    pub hair: HairColour,
+    /// The head's skin, pre-multiplied, alpha 1 on the head (the hair composites over it).
+    pub skin: Option<RenderTarget>,
+    costs: Costs,
+    segments: u32,
+}
+
+/// Where a technique left the hair's composited colour (pre-multiplied RGBA, row-major from
+/// the top): a target's texture or a storage buffer of f32 RGBA per pixel.
+pub(crate) enum HairColour {
+    /// The opaque and sorted techniques' target.
+    Target(RenderTarget),
+    KBuffer {
+        out: KBufferOnGpu,
+        slots: u64,
+    },
+    Subsets(SubsetsOnGpu),
+    /// The A-buffer's and DBK's lists, with the node pool's size and the nodes asked for.
+    Lists {
+        resources: ABufferResources,
+        capacity: u32,
+        wanted: u64,
+    },
+}
+
+/// The hair's colour on the GPU, as [`HairColour`] holds it.
+pub(crate) enum ColourOnGpu<'a> {
+    Texture(&'a wgpu::Texture),
+    Buffer(&'a wgpu::Buffer),
+}
+
+impl HairColour {
+    pub fn on_gpu(&self) -> ColourOnGpu<'_> {
+        match self {
+            HairColour::Target(target) => ColourOnGpu::Texture(&target.color),
+            HairColour::KBuffer { out, .. } => ColourOnGpu::Buffer(&out.resolved),
+            HairColour::Subsets(out) => ColourOnGpu::Buffer(&out.resolved),
+            HairColour::Lists { resources, .. } => ColourOnGpu::Buffer(resources.resolved()),
+        }
+    }
+
+    /// The pixels and, for the techniques that count them, the fragments kept and dropped.
+    fn read(
+        self,
+        gpu: &GpuContext,
+    ) -> Result<(Vec<[f32; 4]>, Option<FragmentCounts>), RenderError> {
+        Ok(match self {
+            HairColour::Target(target) => (read_texture_rgba(gpu, &target.color)?, None),
+            HairColour::KBuffer { out, slots } => {
+                let out = out.read(gpu)?;
+                let counts = FragmentCounts {
+                    stored: out.fragments_kept,
+                    dropped: out.fragments_dropped,
+                    truncated: 0,
+                    capacity: slots,
+                    requested_capacity: slots,
+                };
+                (out.pixels, Some(counts))
+            }
+            HairColour::Subsets(out) => (out.read(gpu)?.pixels, None),
+            HairColour::Lists {
+                resources,
+                capacity,
+                wanted,
+            } => {
+                let out = resources.read(gpu)?;
+                let counts = FragmentCounts {
+                    stored: out.fragments_stored,
+                    dropped: out.fragments_dropped,
+                    truncated: out.fragments_truncated,
+                    capacity: capacity as u64,
+                    requested_capacity: wanted,
+                };
+                (out.pixels, Some(counts))
+            }
+        })
+    }
+}
+
+impl PointFrameOnGpu {
+    /// The frame read back: the hair over the skin, with its costs (waits for the GPU).
+    fn read(self, gpu: &GpuContext, frame: &FrameParams) -> Result<PointImage, RenderError> {
+        let mut costs = self.costs;
+        let (mut pixels, fragments) =
+            timed(&mut costs.timings, gpu, "readback", || self.hair.read(gpu))?;
+        if let Some(skin) = &self.skin {
+            let skin = timed(&mut costs.timings, gpu, "skin readback", || {
+                read_texture_rgba(gpu, &skin.color)
+            })?;
+            composite_over(&mut pixels, &skin);
+        }
+        Ok(PointImage {
+            width: frame.width,
+            height: frame.height,
+            pixels,
+            stats: RenderStats {
+                adapter: gpu.report.clone(),
+                timings: costs.timings,
+                memory_bytes: costs.memory_bytes,
+                segments: self.segments,
+                timing_method: TIMING_METHOD,
+                fragments,
+            },
+        })
+    }
+}
+
+/// Draws the point-lit frame and submits it without reading anything back: the light maps, the
+/// head's depth and skin, and the hair by its technique. With `front_depth` (a
+/// [`DEPTH_FORMAT`](crate::passes::render_target::DEPTH_FORMAT) texture of the frame's size)
+/// it also draws there the nearest of head and fiber per pixel, what a host's depth test
+/// compares. One exception to "nothing read back": the A-buffer and DBK without a node count
+/// count their fragments first, to size the pool.
+pub(crate) fn submit_frame(
+    gpu: &GpuContext,
+    model: &HairModel,
+    frame: &FrameParams,
+    options: &RenderOptions,
+    shading: &ShadingModel,
+    head: Option<&Head>,
+    front_depth: Option<&wgpu::Texture>,
+) -> Result<PointFrameOnGpu, RenderError> {
     let shadowed_lights = shadowed_lights(model, frame, options, head)?;
     check_frame_limits(gpu, frame, &shadowed_lights)?;
-    let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
     let mut costs = Costs::default();
     let geometry = timed(&mut costs.timings, gpu, "upload", || {
         StrandGeometry::upload(gpu, model)
@@ -438,32 +572,22 @@ pub fn render_frame_with_head(
         shadows: &shadows,
         head: head.as_ref().map(|(_, head)| head.input()),
     };
-    let (mut pixels, fragments) = hair.draw(options.transparency, &mut costs)?;
-    if let Some((pass, head)) = &head {
+    let colour = hair.draw(options.transparency, &mut costs)?;
+    if let Some(depth) = front_depth {
         let timings = &mut costs.timings;
-        let skin = timed(timings, gpu, "skin", || {
+        timed(timings, gpu, "front depth", || hair.front_depth(depth))?;
+    }
+    let skin = match &head {
+        Some((pass, head)) => Some(timed(&mut costs.timings, gpu, "skin", || {
             pass.shade(gpu, &geometry, frame, &shadows, head)
-        })?;
-        let skin = timed(timings, gpu, "skin readback", || {
-            read_texture_rgba(gpu, &skin.color)
-        })?;
-        composite_over(&mut pixels, &skin);
-    }
-    if let Some(error) = pollster::block_on(scope.pop()) {
-        return Err(RenderError::Gpu(error.to_string()));
-    }
-    Ok(PointImage {
-        width: frame.width,
-        height: frame.height,
-        pixels,
-        stats: RenderStats {
-            adapter: gpu.report.clone(),
-            timings: costs.timings,
-            memory_bytes: costs.memory_bytes,
-            segments: geometry.segment_count,
-            timing_method: TIMING_METHOD,
-            fragments,
-        },
+        })?),
+        None => None,
+    };
+    Ok(PointFrameOnGpu {
+        hair: colour,
+        skin,
+        costs,
+        segments: geometry.segment_count,
     })
 }
 
@@ -556,37 +680,61 @@ struct HairDraw<'a> {
 }
 
 impl HairDraw<'_> {
-    /// The hair's pixels under `transparency`, and the fragments the modes that count them
-    /// stored and dropped.
+    /// The hair under `transparency`, submitted: its colour stays where the technique left it.
     fn draw(
         &self,
         transparency: Transparency,
         costs: &mut Costs,
-    ) -> Result<(Vec<[f32; 4]>, Option<FragmentCounts>), RenderError> {
+    ) -> Result<HairColour, RenderError> {
         match transparency {
-            Transparency::Opaque => Ok((self.opaque(costs)?, None)),
-            Transparency::Sorted { bins } => Ok((self.sorted(bins, costs)?, None)),
-            Transparency::KBuffer { k } => {
-                let (pixels, counts) = self.kbuffer(k, costs)?;
-                Ok((pixels, Some(counts)))
-            }
-            Transparency::RandomSubsets { subsets } => Ok((self.subsets(subsets, costs)?, None)),
+            Transparency::Opaque => self.opaque(costs),
+            Transparency::Sorted { bins } => self.sorted(bins, costs),
+            Transparency::KBuffer { k } => self.kbuffer(k, costs),
+            Transparency::RandomSubsets { subsets } => self.subsets(subsets, costs),
             Transparency::ABuffer { nodes_per_pixel } => {
-                let (pixels, counts) = self.lists(nodes_per_pixel, ListMode::All, costs)?;
-                Ok((pixels, Some(counts)))
+                self.lists(nodes_per_pixel, ListMode::All, costs)
             }
             Transparency::Dbk {
                 nodes_per_pixel,
                 delta,
-            } => {
-                let list_mode = ListMode::Dbk { delta };
-                let (pixels, counts) = self.lists(nodes_per_pixel, list_mode, costs)?;
-                Ok((pixels, Some(counts)))
-            }
+            } => self.lists(nodes_per_pixel, ListMode::Dbk { delta }, costs),
         }
     }
 
-    fn opaque(&self, costs: &mut Costs) -> Result<Vec<[f32; 4]>, RenderError> {
+    /// The nearest of the head (its view depth) and the fibers per pixel, into `depth`.
+    fn front_depth(&self, depth: &wgpu::Texture) -> Result<(), RenderError> {
+        let gpu = self.gpu;
+        let pass = StrandDepthPass::with_model(gpu, self.shading);
+        let view = depth.create_view(&Default::default());
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        match &self.head {
+            Some(head) => encoder.copy_texture_to_texture(
+                head.view_depth.as_image_copy(),
+                depth.as_image_copy(),
+                depth.size(),
+            ),
+            None => {
+                encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("front depth cleared"),
+                    depth_stencil_attachment: cleared_depth(&view, true),
+                    ..Default::default()
+                });
+            }
+        }
+        pass.encode(
+            gpu,
+            &mut encoder,
+            self.geometry,
+            self.frame,
+            self.shadows,
+            self.head,
+            &view,
+        )?;
+        gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    fn opaque(&self, costs: &mut Costs) -> Result<HairColour, RenderError> {
         let (gpu, frame, timings) = (self.gpu, self.frame, &mut costs.timings);
         let pass = timed(timings, gpu, "strand pipeline", || {
             StrandPass::with_model(gpu, self.shading)
@@ -596,12 +744,10 @@ impl HairDraw<'_> {
             pass.draw_shadowed(gpu, self.geometry, frame, &target, self.shadows, self.head)
         })?;
         costs.memory_bytes.extend(target.memory());
-        Ok(timed(&mut costs.timings, gpu, "readback", || {
-            read_texture_rgba(gpu, &target.color)
-        })?)
+        Ok(HairColour::Target(target))
     }
 
-    fn sorted(&self, bins: u32, costs: &mut Costs) -> Result<Vec<[f32; 4]>, RenderError> {
+    fn sorted(&self, bins: u32, costs: &mut Costs) -> Result<HairColour, RenderError> {
         let (gpu, frame, geometry, timings) =
             (self.gpu, self.frame, self.geometry, &mut costs.timings);
         let pass = timed(timings, gpu, "sorted blend pipeline", || {
@@ -624,43 +770,30 @@ impl HairDraw<'_> {
         })?;
         costs.memory_bytes.extend(order.memory());
         costs.memory_bytes.extend(target.memory());
-        Ok(timed(&mut costs.timings, gpu, "readback", || {
-            read_texture_rgba(gpu, &target.color)
-        })?)
+        Ok(HairColour::Target(target))
     }
 
-    fn kbuffer(
-        &self,
-        k: u32,
-        costs: &mut Costs,
-    ) -> Result<(Vec<[f32; 4]>, FragmentCounts), RenderError> {
+    fn kbuffer(&self, k: u32, costs: &mut Costs) -> Result<HairColour, RenderError> {
         let (gpu, frame, timings) = (self.gpu, self.frame, &mut costs.timings);
         let pass = timed(timings, gpu, "kbuffer pipeline", || {
             KBufferPass::with_model(gpu, self.shading)
         });
-        let out = timed(timings, gpu, "kbuffer build + resolve + readback", || {
-            pass.draw(gpu, self.geometry, frame, self.shadows, self.head, k)
+        let out = timed(timings, gpu, "kbuffer build + resolve", || {
+            pass.submit(gpu, self.geometry, frame, self.shadows, self.head, k)
         })?;
-        costs.memory_bytes.extend(out.memory_bytes);
+        costs.memory_bytes.extend(out.memory_bytes.iter().cloned());
         let slots = frame.width as u64 * frame.height as u64 * k as u64;
-        let counts = FragmentCounts {
-            stored: out.fragments_kept,
-            dropped: out.fragments_dropped,
-            truncated: 0,
-            capacity: slots,
-            requested_capacity: slots,
-        };
-        Ok((out.pixels, counts))
+        Ok(HairColour::KBuffer { out, slots })
     }
 
-    fn subsets(&self, subsets: u32, costs: &mut Costs) -> Result<Vec<[f32; 4]>, RenderError> {
+    fn subsets(&self, subsets: u32, costs: &mut Costs) -> Result<HairColour, RenderError> {
         let (gpu, timings) = (self.gpu, &mut costs.timings);
         let pass = timed(timings, gpu, "random subsets pipeline", || {
             RandomSubsetsPass::with_model(gpu, self.shading)
         });
-        let out = timed(timings, gpu, "random subsets + resolve + readback", || {
+        let out = timed(timings, gpu, "random subsets + resolve", || {
             let (model, geometry, frame) = (self.model, self.geometry, self.frame);
-            pass.draw(
+            pass.submit(
                 gpu,
                 model,
                 geometry,
@@ -670,8 +803,8 @@ impl HairDraw<'_> {
                 subsets,
             )
         })?;
-        costs.memory_bytes.extend(out.memory_bytes);
-        Ok(out.pixels)
+        costs.memory_bytes.extend(out.memory_bytes.iter().cloned());
+        Ok(HairColour::Subsets(out))
     }
 
     /// The A-buffer's or the DBK-buffer's per-pixel lists.
@@ -680,7 +813,7 @@ impl HairDraw<'_> {
         nodes_per_pixel: Option<u32>,
         list_mode: ListMode,
         costs: &mut Costs,
-    ) -> Result<(Vec<[f32; 4]>, FragmentCounts), RenderError> {
+    ) -> Result<HairColour, RenderError> {
         let (gpu, frame, geometry, timings) =
             (self.gpu, self.frame, self.geometry, &mut costs.timings);
         let (shadows, head) = (self.shadows, self.head);
@@ -696,19 +829,18 @@ impl HairDraw<'_> {
             .max(1),
         };
         let capacity = ABufferPass::max_capacity(gpu, wanted);
-        let out = timed(timings, gpu, "abuffer build + resolve + readback", || {
-            abuffer.draw_shadowed(gpu, geometry, frame, shadows, head, capacity, list_mode)
+        let resources = timed(timings, gpu, "abuffer build + resolve", || {
+            let size = (frame.width, frame.height);
+            let resources = ABufferResources::new(gpu, &abuffer, size, capacity, list_mode)?;
+            abuffer.submit_into(gpu, &resources, geometry, frame, shadows, head)?;
+            Ok::<_, ABufferError>(resources)
+        })?;
+        costs.memory_bytes.extend(resources.memory());
+        Ok(HairColour::Lists {
+            resources,
+            capacity,
+            wanted,
         })
-        .map_err(RenderError::from)?;
-        costs.memory_bytes.extend(out.memory_bytes);
-        let counts = FragmentCounts {
-            stored: out.fragments_stored,
-            dropped: out.fragments_dropped,
-            truncated: out.fragments_truncated,
-            capacity: capacity as u64,
-            requested_capacity: wanted,
-        };
-        Ok((out.pixels, counts))
     }
 }
 

@@ -25,6 +25,8 @@ use strandlight_runtime::env::{FrameSums, ViewTransparency};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
+use strandlight_runtime::head::Head;
+use strandlight_runtime::host::PointLitFrame;
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
 use strandlight_runtime::passes::fiber_shading::ShadingModel;
@@ -174,8 +176,35 @@ fn render_point(
     prepared: &PreparedPoint,
     size: [u32; 2],
 ) -> anyhow::Result<point_frame::PointImage> {
+    let inputs = point_frame_inputs(settings, point, hair, size)?;
+    Ok(render_frame_with_head(
+        gpu,
+        hair,
+        &inputs.params,
+        &inputs.options,
+        &prepared.shading,
+        inputs.head.as_ref(),
+    )?)
+}
+
+/// What a point-lit frame of `settings` draws besides the hair and its shading: the camera,
+/// size and lights, the shadow maps and transparency, the head.
+pub struct PointFrameInputs {
+    pub params: FrameParams,
+    pub options: RenderOptions,
+    pub head: Option<Head>,
+}
+
+/// The [`PointFrameInputs`] of `settings` for `hair` at `size`: what `render lights` draws, and
+/// what a host hands the runtime's `HairRenderer::draw_point_lit` (see [`point_lit_frame`]).
+pub fn point_frame_inputs(
+    settings: &FrameSettings,
+    point: &PointLighting,
+    hair: &HairModel,
+    size: [u32; 2],
+) -> anyhow::Result<PointFrameInputs> {
     let camera = settings_camera(settings, hair)?;
-    let frame = FrameParams {
+    let params = FrameParams {
         camera,
         width: size[0],
         height: size[1],
@@ -183,16 +212,29 @@ fn render_point(
         shading: KajiyaKay::default(),
         width_override_px: settings.fiber_width_px,
     };
-    // The head (issue 40): opaque in every light's maps and in the view, drawn as skin.
-    let head = load_head(&settings.head, hair, settings.skin_albedo)?;
-    Ok(render_frame_with_head(
-        gpu,
-        hair,
-        &frame,
-        &point_render_options(point, hair),
-        &prepared.shading,
-        head.as_ref(),
-    )?)
+    Ok(PointFrameInputs {
+        params,
+        options: point_render_options(point, hair),
+        // The head (issue 40): opaque in every light's maps and in the view, drawn as skin.
+        head: load_head(&settings.head, hair, settings.skin_albedo)?,
+    })
+}
+
+/// The point-lit frame a host draws with the runtime's
+/// [`HairRenderer::draw_point_lit`](strandlight_runtime::host::HairRenderer::draw_point_lit):
+/// `inputs` and `prepared`'s shading for `hair`.
+pub fn point_lit_frame<'a>(
+    hair: &'a HairModel,
+    prepared: &'a PreparedPoint,
+    inputs: &'a PointFrameInputs,
+) -> PointLitFrame<'a> {
+    PointLitFrame {
+        model: hair,
+        params: &inputs.params,
+        options: &inputs.options,
+        shading: &prepared.shading,
+        head: inputs.head.as_ref(),
+    }
 }
 
 /// How an env-lit frame of `env` looks.

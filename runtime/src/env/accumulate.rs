@@ -86,7 +86,7 @@ impl FrameSums {
     }
 
     /// [`Self::new`] with the frame's front depth kept beside the sums (a host depth-tests the
-    /// hair with it; `TEXTURE_BINDING | COPY_SRC`, [`DEPTH_FORMAT`]).
+    /// hair with it; `TEXTURE_BINDING | COPY_SRC | COPY_DST`, [`DEPTH_FORMAT`]).
     pub fn with_front_depth(gpu: &GpuContext, width: u32, height: u32) -> Result<Self, LimitError> {
         // Checked (in `new`) before the texture is made: past a limit, wgpu would abort.
         let sums = Self::new(gpu, width, height)?;
@@ -99,9 +99,11 @@ impl FrameSums {
                 depth_or_array_layers: 1,
             },
             DEPTH_FORMAT,
+            // COPY_DST: a point-lit frame's starts as a copy of the head's view depth.
             wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::TEXTURE_BINDING
-                | wgpu::TextureUsages::COPY_SRC,
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST,
         );
         Ok(Self {
             front_depth: Some(depth),

@@ -10,11 +10,16 @@
 //!   rendered at once).
 //! - [`HairRenderer::render`] draws the frame so far into the host's render pass.
 //!
+//! - [`HairRenderer::draw_point_lit`] draws a frame of the thesis techniques instead (point and
+//!   directional lights, their shadow or deep opacity maps, any transparency technique), whole:
+//!   [`HairRenderer::render`] then draws it the same way.
+//!
 //! Nothing on that path reads back or waits for the GPU: work is submitted on the host's queue
 //! and the frame stays on the GPU. [`HairRenderer::read_image`] is the one readback, for a
 //! headless host that writes files. One exception: multiple scattering from the GPU's
 //! forward-scattering march (`multiple::GpuForwardScattering`) reads its grid back once per
-//! batch; single scattering and the CPU's source read nothing back. GPU validation errors go to
+//! batch; single scattering and the CPU's source read nothing back. The A-buffer and DBK without
+//! a node count count their fragments first, to size the pool. GPU validation errors go to
 //! the device's own error handler (the host's).
 //!
 //! The hair's depth is wgpu's 0..1 depth of [`Camera::view_projection`] at the frame's size: a
@@ -29,9 +34,14 @@ use crate::gpu::GpuContext;
 use crate::hair::HairModel;
 use crate::head::Head;
 use crate::multiple::ForwardScatteringSource;
+use crate::passes::fiber_shading::ShadingModel;
+use crate::passes::frame_params::FrameParams;
+use crate::point_frame::{RenderError, RenderOptions, submit_frame};
 use composite::{CompositeBinding, CompositePass};
+use point_gather::PointGatherPass;
 
 mod composite;
+mod point_gather;
 
 /// The host's render targets that [`HairRenderer::render`] draws into.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -66,6 +76,21 @@ pub struct HairFrame<'a> {
     pub options: &'a EnvRenderOptions,
     /// Multiple scattering's forward-scattering source; `None` for single scattering.
     pub multiple: Option<&'a dyn ForwardScatteringSource>,
+    /// A head that hides the fibers behind it, is drawn as skin and shadows the hair.
+    pub head: Option<&'a Head>,
+}
+
+/// One frame of the thesis techniques ([`HairRenderer::draw_point_lit`]), borrowed for the call.
+#[derive(Clone, Copy)]
+pub struct PointLitFrame<'a> {
+    /// The groom.
+    pub model: &'a HairModel,
+    /// The camera, the size (the host's target size), the lights and Kajiya-Kay's constants.
+    pub params: &'a FrameParams,
+    /// The shadow maps and the transparency technique.
+    pub options: &'a RenderOptions,
+    /// The fiber model the strands are shaded with.
+    pub shading: &'a ShadingModel,
     /// A head that hides the fibers behind it, is drawn as skin and shadows the hair.
     pub head: Option<&'a Head>,
 }
@@ -124,6 +149,8 @@ pub struct HairRenderer {
     gpu: GpuContext,
     env: EnvRenderer,
     composite: CompositePass,
+    /// Made when the first point-lit frame is drawn.
+    point_gather: Option<PointGatherPass>,
     frame: Option<FrameInProgress>,
 }
 
@@ -142,6 +169,7 @@ impl HairRenderer {
         Self {
             env: EnvRenderer::new(&gpu),
             composite: CompositePass::new(&gpu.device, &targets),
+            point_gather: None,
             frame: None,
             gpu,
         }
@@ -160,24 +188,7 @@ impl HairRenderer {
         if frame.lights.is_empty() {
             return Err(EnvRenderError::NoLights);
         }
-        let [width, height] = frame.size;
-        let kept = match self.frame.take() {
-            Some(kept) if kept.sums.size() == frame.size => kept,
-            _ => {
-                let sums = FrameSums::with_front_depth(&self.gpu, width, height)?;
-                FrameInProgress {
-                    composite: self.composite.bind(&self.gpu.device, &sums),
-                    sums,
-                    order: Vec::new(),
-                    progress: BatchProgress {
-                        lights_drawn: 0,
-                        lights_total: 0,
-                    },
-                    with_multiple: false,
-                    last_stats: None,
-                }
-            }
-        };
+        let kept = self.frame_of_size(frame.size)?;
         self.clear(&kept.sums);
         self.frame = Some(FrameInProgress {
             order: drawing_order(frame.lights),
@@ -186,6 +197,63 @@ impl HairRenderer {
                 lights_total: frame.lights.len(),
             },
             with_multiple: frame.multiple.is_some(),
+            last_stats: None,
+            ..kept
+        });
+        Ok(())
+    }
+
+    /// The frame kept from before if it has this size (its sums are reused), else a new one.
+    fn frame_of_size(&mut self, size: [u32; 2]) -> Result<FrameInProgress, crate::gpu::LimitError> {
+        if let Some(kept) = self.frame.take().filter(|kept| kept.sums.size() == size) {
+            return Ok(kept);
+        }
+        let sums = FrameSums::with_front_depth(&self.gpu, size[0], size[1])?;
+        Ok(FrameInProgress {
+            composite: self.composite.bind(&self.gpu.device, &sums),
+            sums,
+            order: Vec::new(),
+            progress: BatchProgress {
+                lights_drawn: 0,
+                lights_total: 0,
+            },
+            with_multiple: false,
+            last_stats: None,
+        })
+    }
+
+    /// Draws a frame of the thesis techniques, whole, and submits it without waiting:
+    /// [`Self::render`] then draws it into the host's pass like an env-lit frame (hidden where
+    /// the host's depth is nearer; the radiance scale applies). Its progress is converged at
+    /// once. Errors name the setting or limit at fault (a frame past the adapter's limits, a
+    /// technique's bad count, shadows without a light).
+    pub fn draw_point_lit(&mut self, frame: &PointLitFrame<'_>) -> Result<(), RenderError> {
+        let params = frame.params;
+        let kept = self.frame_of_size([params.width, params.height])?;
+        kept.sums.forget_view();
+        let drawn = submit_frame(
+            &self.gpu,
+            frame.model,
+            params,
+            frame.options,
+            frame.shading,
+            frame.head,
+            kept.sums.front_depth(),
+        )?;
+        let gather = self
+            .point_gather
+            .get_or_insert_with(|| PointGatherPass::new(&self.gpu));
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        gather.encode(&self.gpu, &mut encoder, &drawn, &kept.sums);
+        self.gpu.queue.submit([encoder.finish()]);
+        let lights = params.lights.len();
+        self.frame = Some(FrameInProgress {
+            order: Vec::new(),
+            progress: BatchProgress {
+                lights_drawn: lights,
+                lights_total: lights,
+            },
+            with_multiple: false,
             last_stats: None,
             ..kept
         });
@@ -284,15 +352,32 @@ impl HairRenderer {
         }
     }
 
-    /// The frame so far, read back to the CPU (linear, pre-multiplied; the radiance scale is
-    /// not applied): the one readback, for a headless host that writes files. Waits for the
-    /// GPU.
+    /// The env-lit frame so far, read back to the CPU with its stats (linear, pre-multiplied;
+    /// the radiance scale is not applied): the one readback, for a headless host that writes
+    /// files. Waits for the GPU.
     pub fn read_image(&self) -> Result<EnvImage, EnvRenderError> {
         let Some(kept) = &self.frame else {
             return Err(EnvRenderError::NotPrepared);
         };
         let stats = kept.last_stats.clone().ok_or(EnvRenderError::NotPrepared)?;
         EnvRenderer::read_sums(&self.gpu, &kept.sums, kept.with_multiple, stats)
+    }
+
+    /// The frame so far as [`Self::render`] draws it (linear, pre-multiplied: single and
+    /// multiple scattering added; the radiance scale is not applied), read back, for either
+    /// lighting. Waits for the GPU.
+    pub fn read_pixels(&self) -> Result<Vec<[f32; 4]>, EnvRenderError> {
+        let Some(kept) = &self.frame else {
+            return Err(EnvRenderError::NotPrepared);
+        };
+        let bytes = crate::gpu::readback::read_buffer(&self.gpu, kept.sums.buffer())?;
+        let sums: &[[f32; 4]] = bytemuck::cast_slice(&bytes);
+        let (single, multiple) = sums.split_at(sums.len() / 2);
+        Ok(single
+            .iter()
+            .zip(multiple)
+            .map(|(s, m)| [s[0] + m[0], s[1] + m[1], s[2] + m[2], s[3]])
+            .collect())
     }
 
     /// The frame's front depth (wgpu's 0..1, 1 where neither hair nor head is), read back:

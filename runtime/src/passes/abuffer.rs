@@ -380,8 +380,14 @@ impl ABufferResources {
         encoder.clear_buffer(&self.resolved, 0, None);
     }
 
-    /// The resolved image and the fragment counts.
-    fn read(&self, gpu: &GpuContext) -> Result<ABufferFrame, ReadbackError> {
+    /// The composited colour per pixel (pre-multiplied RGBA f32, row-major from the top),
+    /// on the GPU.
+    pub fn resolved(&self) -> &wgpu::Buffer {
+        &self.resolved
+    }
+
+    /// The resolved image and the fragment counts, read back (waits for the GPU).
+    pub fn read(&self, gpu: &GpuContext) -> Result<ABufferFrame, ReadbackError> {
         let colour_bytes = read_buffer(gpu, &self.resolved)?;
         let counter_bytes = read_buffer(gpu, &self.counters)?;
         let truncated_bytes = read_buffer(gpu, &self.truncated)?;
@@ -561,7 +567,8 @@ impl ABufferPass {
         self.draw_into(gpu, &resources, geometry, frame, shadows, head)
     }
 
-    /// Builds and resolves one frame in `resources` (whose size must be the frame's).
+    /// Builds and resolves one frame in `resources` (whose size must be the frame's), and
+    /// reads it back.
     pub fn draw_into(
         &self,
         gpu: &GpuContext,
@@ -571,6 +578,21 @@ impl ABufferPass {
         shadows: &[ShadowInput<'_>],
         head: Option<HeadInput<'_>>,
     ) -> Result<ABufferFrame, ABufferError> {
+        self.submit_into(gpu, resources, geometry, frame, shadows, head)?;
+        Ok(resources.read(gpu)?)
+    }
+
+    /// [`Self::draw_into`] submitted without waiting: the resolved image stays in
+    /// `resources` ([`ABufferResources::resolved`]).
+    pub fn submit_into(
+        &self,
+        gpu: &GpuContext,
+        resources: &ABufferResources,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        shadows: &[ShadowInput<'_>],
+        head: Option<HeadInput<'_>>,
+    ) -> Result<(), ABufferError> {
         if (frame.width, frame.height) != (resources.width, resources.height) {
             return Err(ABufferError::SizeMismatch {
                 frame_width: frame.width,
@@ -583,7 +605,7 @@ impl ABufferPass {
         self.encode_build(gpu, &mut encoder, resources, geometry, frame, shadows, head)?;
         self.encode_resolve(gpu, &mut encoder, resources);
         gpu.queue.submit([encoder.finish()]);
-        Ok(resources.read(gpu)?)
+        Ok(())
     }
 
     /// The nodes a frame's lists need in `mode`: the build run into a one-node pool, whose

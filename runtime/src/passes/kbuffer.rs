@@ -51,6 +51,30 @@ pub struct KBufferFrame {
     pub memory_bytes: Vec<(String, u64)>,
 }
 
+/// A resolved frame still on the GPU ([`KBufferPass::submit`]).
+pub struct KBufferOnGpu {
+    /// Pre-multiplied RGBA f32 per pixel, row-major from the top.
+    pub resolved: wgpu::Buffer,
+    /// Fragments dropped, fragments kept.
+    counters: wgpu::Buffer,
+    pub memory_bytes: Vec<(String, u64)>,
+}
+
+impl KBufferOnGpu {
+    /// The image and the fragment counts, read back (waits for the GPU).
+    pub fn read(self, gpu: &GpuContext) -> Result<KBufferFrame, KBufferError> {
+        let image = read_buffer(gpu, &self.resolved)?;
+        let counts = read_buffer(gpu, &self.counters)?;
+        let counts: &[u32] = bytemuck::cast_slice(&counts);
+        Ok(KBufferFrame {
+            pixels: bytemuck::cast_slice::<u8, [f32; 4]>(&image).to_vec(),
+            fragments_dropped: u64::from(counts[0]),
+            fragments_kept: u64::from(counts[1]),
+            memory_bytes: self.memory_bytes,
+        })
+    }
+}
+
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct Params {
@@ -133,7 +157,7 @@ impl KBufferPass {
         }
     }
 
-    /// The k nearest fragments of every pixel of `frame`, composited.
+    /// The k nearest fragments of every pixel of `frame`, composited and read back.
     pub fn draw(
         &self,
         gpu: &GpuContext,
@@ -143,6 +167,20 @@ impl KBufferPass {
         head: Option<HeadInput<'_>>,
         k: u32,
     ) -> Result<KBufferFrame, KBufferError> {
+        self.submit(gpu, geometry, frame, shadows, head, k)?
+            .read(gpu)
+    }
+
+    /// [`Self::draw`] submitted without waiting: the resolved image stays on the GPU.
+    pub fn submit(
+        &self,
+        gpu: &GpuContext,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        shadows: &[ShadowInput<'_>],
+        head: Option<HeadInput<'_>>,
+        k: u32,
+    ) -> Result<KBufferOnGpu, KBufferError> {
         if !(1..=MAX_K).contains(&k) {
             return Err(KBufferError::K(k));
         }
@@ -175,19 +213,15 @@ impl KBufferPass {
             resolved,
             ..
         } = buffers;
-        let image = read_buffer(gpu, &resolved)?;
-        let counts = read_buffer(gpu, &counters)?;
-        let counts: &[u32] = bytemuck::cast_slice(&counts);
-        Ok(KBufferFrame {
-            pixels: bytemuck::cast_slice::<u8, [f32; 4]>(&image).to_vec(),
-            fragments_dropped: u64::from(counts[0]),
-            fragments_kept: u64::from(counts[1]),
+        Ok(KBufferOnGpu {
             memory_bytes: vec![
                 ("kbuffer depths".into(), depths.size()),
                 ("kbuffer colours".into(), colors.size()),
                 ("kbuffer resolved image".into(), resolved.size()),
                 ("kbuffer pass depth".into(), pixels * 4),
             ],
+            resolved,
+            counters,
         })
     }
 

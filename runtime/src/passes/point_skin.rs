@@ -159,7 +159,14 @@ impl PointSkinPass {
             depth_or_array_layers: 1,
         };
         let read = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
-        let view_depth = texture_2d(gpu, "head view depth", size, DEPTH_FORMAT, read);
+        // COPY_SRC: a host's front depth starts from it (`point_frame::submit_frame`).
+        let view_depth = texture_2d(
+            gpu,
+            "head view depth",
+            size,
+            DEPTH_FORMAT,
+            read | wgpu::TextureUsages::COPY_SRC,
+        );
         let surface = ["head view position", "head view normal"]
             .map(|label| texture_2d(gpu, label, size, NEAREST_SURFACE_FORMAT, read));
         let views = surface

@@ -49,6 +49,24 @@ pub struct SubsetsFrame {
     pub memory_bytes: Vec<(String, u64)>,
 }
 
+/// A resolved frame still on the GPU ([`RandomSubsetsPass::submit`]).
+pub struct SubsetsOnGpu {
+    /// Pre-multiplied RGBA f32 per pixel, row-major from the top.
+    pub resolved: wgpu::Buffer,
+    pub memory_bytes: Vec<(String, u64)>,
+}
+
+impl SubsetsOnGpu {
+    /// The image, read back (waits for the GPU).
+    pub fn read(self, gpu: &GpuContext) -> Result<SubsetsFrame, SubsetsError> {
+        let image = read_buffer(gpu, &self.resolved)?;
+        Ok(SubsetsFrame {
+            pixels: bytemuck::cast_slice::<u8, [f32; 4]>(&image).to_vec(),
+            memory_bytes: self.memory_bytes,
+        })
+    }
+}
+
 /// Strand `strand`'s subset among `subsets`: a fixed hash, so frames are repeatable.
 pub fn subset_of(strand: usize, subsets: u32) -> u32 {
     // SplitMix64's finalizer.
@@ -139,7 +157,8 @@ impl RandomSubsetsPass {
         }
     }
 
-    /// `model`'s strands (uploaded as `geometry`) in `subsets` random subsets, composited.
+    /// `model`'s strands (uploaded as `geometry`) in `subsets` random subsets, composited and
+    /// read back.
     #[allow(clippy::too_many_arguments)]
     pub fn draw(
         &self,
@@ -151,6 +170,22 @@ impl RandomSubsetsPass {
         head: Option<HeadInput<'_>>,
         subsets: u32,
     ) -> Result<SubsetsFrame, SubsetsError> {
+        self.submit(gpu, model, geometry, frame, shadows, head, subsets)?
+            .read(gpu)
+    }
+
+    /// [`Self::draw`] submitted without waiting: the resolved image stays on the GPU.
+    #[allow(clippy::too_many_arguments)]
+    pub fn submit(
+        &self,
+        gpu: &GpuContext,
+        model: &HairModel,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        shadows: &[ShadowInput<'_>],
+        head: Option<HeadInput<'_>>,
+        subsets: u32,
+    ) -> Result<SubsetsOnGpu, SubsetsError> {
         if !(1..=MAX_SUBSETS).contains(&subsets) {
             return Err(SubsetsError::Count(subsets));
         }
@@ -187,16 +222,15 @@ impl RandomSubsetsPass {
         }
         self.encode_resolve(gpu, &mut encoder, &layers, &resolved);
         gpu.queue.submit([encoder.finish()]);
-        let image = read_buffer(gpu, &resolved)?;
         let texel = SUBSET_COLOR_FORMAT.block_copy_size(None).unwrap_or(8) as u64;
-        Ok(SubsetsFrame {
-            pixels: bytemuck::cast_slice::<u8, [f32; 4]>(&image).to_vec(),
+        Ok(SubsetsOnGpu {
             memory_bytes: vec![
                 ("subset colours".into(), pixels * subsets as u64 * texel),
                 ("subset depths".into(), pixels * subsets as u64 * 4),
                 ("subset segment lists".into(), order.size()),
                 ("random subsets resolved image".into(), resolved.size()),
             ],
+            resolved,
         })
     }
 

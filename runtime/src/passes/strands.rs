@@ -107,6 +107,78 @@ impl StrandPass {
     }
 }
 
+/// The strands' depth alone, the nearest fiber per pixel, tested and written into a depth the
+/// caller keeps: a host depth-tests a point-lit frame against it whichever technique drew the
+/// colour (the transparency techniques keep no depth of their own). The same quads as
+/// [`StrandPass`], so the depth is the one the opaque frame's colour was drawn at.
+pub struct StrandDepthPass {
+    pipeline: wgpu::RenderPipeline,
+    layouts: ShadedStrandLayouts,
+}
+
+impl StrandDepthPass {
+    /// The quads of [`StrandPass::with_model`], whose module `model` completes.
+    pub fn with_model(gpu: &GpuContext, model: &ShadingModel) -> Self {
+        let device = &gpu.device;
+        let top = Wgsl {
+            file: "strands.wgsl",
+            source: include_str!("strands.wgsl"),
+        };
+        let shader = strand_shading_module(device, &top, model);
+        let layouts = ShadedStrandLayouts::new(gpu, model);
+        let pipeline_layout = layouts.pipeline_layout(device, "strand depth", None);
+        let pipeline = StrandDraw {
+            label: "strand depth",
+            layout: &pipeline_layout,
+            shader: &shader,
+            vertex_entry: "vs_main",
+            fragment: None,
+            depth: Some(depth_test(DEPTH_FORMAT, true, wgpu::CompareFunction::Less)),
+        }
+        .build(device);
+        Self { pipeline, layouts }
+    }
+
+    /// Draws every segment's depth into `depth` (a [`DEPTH_FORMAT`] view), over what it holds.
+    #[allow(clippy::too_many_arguments)]
+    pub fn encode(
+        &self,
+        gpu: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &StrandGeometry,
+        frame: &FrameParams,
+        shadows: &[ShadowInput<'_>],
+        head: Option<HeadInput<'_>>,
+        depth: &wgpu::TextureView,
+    ) -> Result<(), TooManyShadowMaps> {
+        let shadow_group = shadow_bind_group_for(gpu, &self.layouts.shadow, frame, shadows, head)?;
+        let bind_group = strand_bind_group(gpu, &self.layouts.strand, geometry, frame);
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("strand depth"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Load,
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &bind_group, &[]);
+        pass.set_bind_group(1, &shadow_group, &[]);
+        if let Some(model) = &self.layouts.model {
+            pass.set_bind_group(2, &model.group, &[]);
+        }
+        pass.draw(0..6, 0..geometry.segment_count);
+        Ok(())
+    }
+}
+
 /// The bind group layouts of a pass that shades strand quads under point lights: the strands
 /// (group 0), their shadow maps (1), the fiber model's constants and tables (2; none for
 /// Kajiya-Kay), then what the pass adds (3).

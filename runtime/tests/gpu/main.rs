@@ -15,6 +15,7 @@ mod gpu_limits;
 mod hair_samples;
 mod head_occlusion;
 mod head_point_lights;
+mod host_point_lights;
 mod ktx2_strand;
 mod pass_timing;
 mod shadow_maps;
