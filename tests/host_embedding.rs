@@ -9,7 +9,9 @@
 //!   the hair is that frame.
 //!
 //! The host's frame path (a new frame, every batch, its render pass) must make no GPU→CPU copy:
-//! the runtime counts every one it makes.
+//! the runtime counts every one it makes. The same holds for a point-lit frame
+//! (`HairRenderer::draw_point_lit`); with its fibers' front depth left undrawn, no hair pixel
+//! reached the host's picture and the test failed.
 
 #[path = "../runtime/examples/host.rs"]
 #[allow(dead_code)]
