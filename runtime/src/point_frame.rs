@@ -438,7 +438,7 @@ pub(crate) enum HairColour {
     Subsets(SubsetsOnGpu),
     /// The A-buffer's and DBK's lists, with the node pool's size and the nodes asked for.
     Lists {
-        resources: ABufferResources,
+        resources: Box<ABufferResources>,
         capacity: u32,
         wanted: u64,
     },
@@ -837,7 +837,7 @@ impl HairDraw<'_> {
         })?;
         costs.memory_bytes.extend(resources.memory());
         Ok(HairColour::Lists {
-            resources,
+            resources: Box::new(resources),
             capacity,
             wanted,
         })
