@@ -11,10 +11,8 @@ use anyhow::{Context, bail};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
-use strandlight_runtime::env::ViewTransparency;
 use strandlight_runtime::gpu::GpuContext;
-use strandlight_scene::frame_render::env_look;
-use strandlight_scene::frame_settings::{FrameSettings, Lighting};
+use strandlight_scene::frame_settings::FrameSettings;
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
@@ -50,8 +48,11 @@ pub struct ViewOptions {
 }
 
 /// Opens the window and runs until it is closed or the script ends.
-pub fn run(options: ViewOptions) -> anyhow::Result<()> {
+pub fn run(mut options: ViewOptions) -> anyhow::Result<()> {
     options.settings.check()?;
+    // The panel names the fiber model it shows: the first request carries it already, so that
+    // the window's first frame does not ask for the same frame again.
+    options.settings.shading = Some(options.settings.shading());
     let mut script = options.script.as_deref().map(Script::read).transpose()?;
     if script.is_none() && options.screenshot.is_some() {
         script = Some(Script::converged_then_exit());
@@ -63,16 +64,15 @@ pub fn run(options: ViewOptions) -> anyhow::Result<()> {
     let wake: Box<dyn Fn() + Send + Sync> = Box::new(move || {
         let _ = proxy.lock().unwrap().send_event(());
     });
-    let first_view = match &options.settings.lighting {
-        Lighting::Environment(env) => env_look(env)?.transparency,
-        Lighting::Lights(_) => ViewTransparency::Opaque,
-    };
     let worker = Worker::spawn(
         options.cache_dir.clone(),
-        first_view,
         !options.settings.head.is_none(),
         wake,
     );
+    // The first frame is asked for now: the worker loads the scene and draws its first look
+    // while the window and its device are made (a request from the first window frame came
+    // 0.5 s after the start on lavapipe).
+    worker.submit(Session::FIRST_JOB, options.settings.clone());
     let mut app = App {
         options,
         script,

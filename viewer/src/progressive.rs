@@ -68,6 +68,11 @@ impl Accumulator {
         }
     }
 
+    /// Whether a step was added (there is an image to show).
+    pub fn has_shown(&self) -> bool {
+        self.shown.is_some()
+    }
+
     pub fn shown(&self) -> (Arc<Image>, FrameStats) {
         self.shown.clone().expect("a step was added")
     }

@@ -123,22 +123,28 @@ struct BackgroundKey {
 }
 
 impl Session {
+    /// The job of the first request, which `run` sends before the window opens, so that the
+    /// worker loads the scene and draws its first look while the window and its device are made.
+    pub const FIRST_JOB: u64 = 1;
+
+    /// The session of a window whose worker was sent `settings` as [`Self::FIRST_JOB`].
     pub fn new(
         settings: FrameSettings,
         worker: Worker,
         window_adapter: String,
         started: Instant,
     ) -> Self {
+        let last_good = settings.clone();
         Self {
             started,
-            last_good: settings.clone(),
+            last_good: last_good.clone(),
             state: ViewState {
                 settings,
                 display: Display::default(),
             },
-            submitted: None,
+            submitted: Some((Self::FIRST_JOB, last_good.clone())),
             edited_at: Instant::now(),
-            next_job: 1,
+            next_job: Self::FIRST_JOB + 1,
             orbit: None,
             worker,
             on_screen: None,

@@ -13,7 +13,7 @@ use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 use strandlight_runtime::camera::Camera;
-use strandlight_runtime::env::{FrameSums, ViewTransparency};
+use strandlight_runtime::env::FrameSums;
 use strandlight_scene::env_frame::{frame_sums, prepare_env_renderer};
 use strandlight_scene::env_light_sets::{frame_lights, light_luminance};
 use strandlight_scene::env_scene::{AlsoServe, PrepareProgress, PreparedEnv, prepare_env};
@@ -85,12 +85,10 @@ pub struct Worker {
 }
 
 impl Worker {
-    /// Starts the thread; `wake_window` is called whenever the status changes.
-    /// The render thread, its renderer prepared for frames in `first_view`, with a head or not
-    /// (the first request's).
+    /// Starts the thread; `wake_window` is called whenever the status changes. Its renderer
+    /// is prepared for a first look with a head or not (the first request's).
     pub fn spawn(
         cache_dir: PathBuf,
-        first_view: ViewTransparency,
         first_with_head: bool,
         wake_window: Box<dyn Fn() + Send + Sync>,
     ) -> Self {
@@ -103,7 +101,7 @@ impl Worker {
         });
         // The device and pipelines are made while the window opens and the tables load; an
         // error here is the first frame's to report.
-        std::thread::spawn(move || prepare_env_renderer(first_view, first_with_head).ok());
+        std::thread::spawn(move || prepare_env_renderer(first_with_head).ok());
         let for_thread = shared.clone();
         let thread = std::thread::Builder::new()
             .name("strandlight render".into())
@@ -237,13 +235,23 @@ impl WorkerState {
     }
 
     fn start(&mut self, id: u64, settings: FrameSettings) {
-        self.publish(|s| {
-            s.preview_seconds = None;
-            s.converged_seconds = None;
-        });
-        let started = Instant::now();
+        // A request planned again when its tables arrive keeps its start and its first look:
+        // the preview it showed is not drawn again (at 800×600 on lavapipe that was 0.6 s
+        // before the first batch).
+        let restarted = self.job.as_ref().filter(|j| j.id == id);
+        let started = restarted.map_or_else(Instant::now, |j| j.started);
+        let previewed = restarted.is_some_and(|j| j.accumulator.has_shown());
+        if restarted.is_none() {
+            self.publish(|s| {
+                s.preview_seconds = None;
+                s.converged_seconds = None;
+            });
+        }
         match self.plan(&settings) {
-            Ok(Some((steps, stale_tables))) => {
+            Ok(Some((mut steps, stale_tables))) => {
+                if previewed && steps.len() > 1 {
+                    steps.retain(|s| *s != Step::Preview);
+                }
                 let mut accumulator = Accumulator::default();
                 accumulator.expect_batches(
                     steps

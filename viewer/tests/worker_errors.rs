@@ -3,7 +3,6 @@
 //! preview and then converged, with the image the size asked for.
 
 use std::time::{Duration, Instant};
-use strandlight_runtime::env::ViewTransparency;
 use strandlight_scene::frame_settings::{FrameSettings, Lighting, PointLighting};
 use strandlight_viewer::frame::Stage;
 use strandlight_viewer::worker::Worker;
@@ -25,12 +24,7 @@ fn a_bad_file_is_an_error_naming_it_and_the_next_request_still_renders() {
     std::fs::create_dir_all(&dir).unwrap();
     let bad = dir.join("dropped.hair");
     std::fs::write(&bad, b"HAIR but not really a hair file").unwrap();
-    let worker = Worker::spawn(
-        dir.join("cache"),
-        ViewTransparency::Opaque,
-        false,
-        Box::new(|| {}),
-    );
+    let worker = Worker::spawn(dir.join("cache"), false, Box::new(|| {}));
     let mut settings = FrameSettings::new(Lighting::Lights(PointLighting::default()), [48, 32]);
     settings.hair = Some(bad.clone());
     worker.submit(1, settings.clone());
