@@ -14,6 +14,7 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 use strandlight_runtime::camera::Camera;
 use strandlight_runtime::env::FrameSums;
+use strandlight_runtime::hair::HairModel;
 use strandlight_scene::env_frame::{frame_sums, prepare_env_renderer};
 use strandlight_scene::env_light_sets::{frame_lights, light_luminance};
 use strandlight_scene::env_scene::{AlsoServe, PrepareProgress, PreparedEnv, prepare_env};
@@ -21,7 +22,9 @@ use strandlight_scene::frame_render::{
     FrameHair, Prepared, PreparedPoint, coarse_preview_settings, env_look, load_settings_hair,
     prepare_point, render_frame, render_frame_into, settings_camera,
 };
-use strandlight_scene::frame_settings::{FrameSettings, Lighting, PointLighting, up_choice};
+use strandlight_scene::frame_settings::{
+    CameraSettings, ExactCamera, FrameSettings, Lighting, PointLighting, up_choice,
+};
 use strandlight_scene::steps::Steps;
 
 use crate::frame::{FrameStats, Stage};
@@ -507,6 +510,11 @@ impl WorkerState {
                 };
                 render_frame_into(&settings, &hair.model, env, step.part(), sums)?
             }
+            // The first look draws a fraction of the strands, each as much thicker.
+            (Step::Preview, Prepared::Env(_)) => {
+                let (look_settings, look_hair) = first_look(&settings, &hair.model)?;
+                render_frame(&look_settings, &look_hair, prepared, step.part(), false)?
+            }
             _ => render_frame(&settings, &hair.model, prepared, step.part(), false)?,
         };
         let stats = FrameStats {
@@ -560,4 +568,26 @@ impl WorkerState {
         });
         Ok(())
     }
+}
+
+/// A first look draws every this many strands, each this many times as thick. The viewer's
+/// first lit frame at 800×600 on lavapipe, tables cached: 0.96–1.03 s drawing every strand,
+/// 0.72–0.76 s every fourth; that first look differs from the unthinned one by 0.18 over
+/// 16×16 blocks (every second strand: 0.09), and the full frame replaces it (docs/BENCHMARKS.md,
+/// "The viewer's first look").
+const FIRST_LOOK_THINNING: usize = 4;
+
+/// The settings and groom a first look of `settings` is drawn with: a thinned groom
+/// ([`HairModel::thinned`]) seen by the full groom's camera, so the picture does not move when
+/// the full frame replaces it.
+fn first_look(
+    settings: &FrameSettings,
+    hair: &HairModel,
+) -> anyhow::Result<(FrameSettings, HairModel)> {
+    let camera = ExactCamera::of(&settings_camera(settings, hair)?);
+    let settings = FrameSettings {
+        camera: CameraSettings::Exact(camera),
+        ..settings.clone()
+    };
+    Ok((settings, hair.thinned(FIRST_LOOK_THINNING)))
 }

@@ -172,6 +172,43 @@ impl HairModel {
         })
     }
 
+    /// Every `n`th strand (the first of each `n`), each `n` times as thick: about the same
+    /// coverage and optical depth from a `n`th of the segments, for a first look drawn in a
+    /// fraction of the time. A model without thickness gets the renderer's default times `n`.
+    pub fn thinned(&self, n: usize) -> HairModel {
+        if n <= 1 {
+            return self.clone();
+        }
+        let kept: Vec<usize> = (0..self.strand_count()).step_by(n).collect();
+        let mut point_indices = Vec::new();
+        let mut strand_offsets = vec![0u32];
+        for &s in &kept {
+            let range = self.strand_offsets[s] as usize..self.strand_offsets[s + 1] as usize;
+            point_indices.extend(range);
+            strand_offsets.push(point_indices.len() as u32);
+        }
+        let points = point_indices.iter().map(|&i| self.points[i]).collect();
+        let thicker = |t: f32| t * n as f32;
+        let thickness = match &self.thickness {
+            Some(Attribute::Uniform(t)) => Attribute::Uniform(thicker(*t)),
+            Some(Attribute::PerPoint(t)) => {
+                Attribute::PerPoint(point_indices.iter().map(|&i| thicker(t[i])).collect())
+            }
+            None => Attribute::Uniform(thicker(crate::passes::strand_geometry::default_thickness(
+                self,
+            ))),
+        };
+        let kept_of = |a: &Option<Attribute<f32>>| a.as_ref().map(|a| a.at_points(&point_indices));
+        HairModel::new(
+            points,
+            strand_offsets,
+            Some(thickness),
+            kept_of(&self.transparency),
+            self.color.as_ref().map(|c| c.at_points(&point_indices)),
+        )
+        .expect("a subset of a valid model's strands is valid")
+    }
+
     pub fn points(&self) -> &[Vec3] {
         &self.points
     }
@@ -426,5 +463,56 @@ mod tests {
                 .as_ref(),
             &[1.0, 2.0]
         );
+    }
+
+    /// A thinned groom keeps every `n`th strand whole (points, colour) at `n` times the
+    /// thickness, and a groom without thickness gets `n` times the renderer's default.
+    #[test]
+    fn a_thinned_groom_keeps_every_nth_strand_at_n_times_the_thickness() {
+        let strands: Vec<[Vec3; 3]> = (0..10)
+            .map(|s| {
+                let x = s as f32;
+                [
+                    Vec3::new(x, 0.0, 0.0),
+                    Vec3::new(x, 1.0, 0.0),
+                    Vec3::new(x, 2.0, 0.5),
+                ]
+            })
+            .collect();
+        let points: Vec<Vec3> = strands.iter().flatten().copied().collect();
+        let offsets = (0..=10u32).map(|s| 3 * s).collect();
+        let thickness = (0..30).map(|i| 0.01 + 0.001 * i as f32).collect();
+        let colour = (0..30).map(|i| Vec3::splat(i as f32 / 30.0)).collect();
+        let model = HairModel::new(
+            points,
+            offsets,
+            Some(Attribute::PerPoint(thickness)),
+            None,
+            Some(Attribute::PerPoint(colour)),
+        )
+        .unwrap();
+        let thin = model.thinned(3);
+        assert_eq!(thin.strand_count(), 4, "strands 0, 3, 6, 9");
+        for (k, s) in [0usize, 3, 6, 9].into_iter().enumerate() {
+            assert_eq!(thin.strand(k), model.strand(s));
+            for p in 0..3 {
+                let (i, j) = (3 * k + p, 3 * s + p);
+                let thick = |m: &HairModel, i| m.thickness().unwrap().at(i);
+                assert!((thick(&thin, i) - 3.0 * thick(&model, j)).abs() < 1e-6);
+                assert_eq!(thin.color().unwrap().at(i), model.color().unwrap().at(j));
+            }
+        }
+        let unthickened = HairModel::new(
+            model.points().to_vec(),
+            model.strand_offsets().to_vec(),
+            None,
+            None,
+            None,
+        )
+        .unwrap();
+        let default = crate::passes::strand_geometry::default_thickness(&unthickened);
+        let thin = unthickened.thinned(2);
+        assert_eq!(thin.strand_count(), 5);
+        assert!((thin.thickness().unwrap().at(0) - 2.0 * default).abs() < 1e-7);
     }
 }
