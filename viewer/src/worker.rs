@@ -579,7 +579,8 @@ const FIRST_LOOK_THINNING: usize = 4;
 
 /// The settings and groom a first look of `settings` is drawn with: a thinned groom
 /// ([`HairModel::thinned`]) seen by the full groom's camera, so the picture does not move when
-/// the full frame replaces it.
+/// the full frame replaces it. A head fitted to the roots (`--head ellipsoid`) is fitted to the
+/// kept strands' roots, an even sample of them.
 fn first_look(
     settings: &FrameSettings,
     hair: &HairModel,
