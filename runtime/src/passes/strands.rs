@@ -32,26 +32,8 @@ impl StrandPass {
 
     /// Shading with `model`; its tables and constants are uploaded once, here.
     pub fn with_model(gpu: &GpuContext, model: &ShadingModel) -> Self {
-        let device = &gpu.device;
-        let top = Wgsl {
-            file: "strands.wgsl",
-            source: include_str!("strands.wgsl"),
-        };
-        let shader = strand_shading_module(device, &top, model);
-        let layouts = ShadedStrandLayouts::new(gpu, model);
-        let pipeline_layout = layouts.pipeline_layout(device, "strands", None);
-        let pipeline = StrandDraw {
-            label: "strands",
-            layout: &pipeline_layout,
-            shader: &shader,
-            vertex_entry: "vs_main",
-            fragment: Some((
-                "fs_main",
-                &[color_target(gpu.hdr_format(), Some(PREMULTIPLIED_OVER))],
-            )),
-            depth: Some(depth_test(DEPTH_FORMAT, true, wgpu::CompareFunction::Less)),
-        }
-        .build(device);
+        let targets = [color_target(gpu.hdr_format(), Some(PREMULTIPLIED_OVER))];
+        let (pipeline, layouts) = strand_quads_pipeline(gpu, model, "strands", Some(&targets));
         Self { pipeline, layouts }
     }
 
@@ -119,23 +101,7 @@ pub struct StrandDepthPass {
 impl StrandDepthPass {
     /// The quads of [`StrandPass::with_model`], whose module `model` completes.
     pub fn with_model(gpu: &GpuContext, model: &ShadingModel) -> Self {
-        let device = &gpu.device;
-        let top = Wgsl {
-            file: "strands.wgsl",
-            source: include_str!("strands.wgsl"),
-        };
-        let shader = strand_shading_module(device, &top, model);
-        let layouts = ShadedStrandLayouts::new(gpu, model);
-        let pipeline_layout = layouts.pipeline_layout(device, "strand depth", None);
-        let pipeline = StrandDraw {
-            label: "strand depth",
-            layout: &pipeline_layout,
-            shader: &shader,
-            vertex_entry: "vs_main",
-            fragment: None,
-            depth: Some(depth_test(DEPTH_FORMAT, true, wgpu::CompareFunction::Less)),
-        }
-        .build(device);
+        let (pipeline, layouts) = strand_quads_pipeline(gpu, model, "strand depth", None);
         Self { pipeline, layouts }
     }
 
@@ -177,6 +143,34 @@ impl StrandDepthPass {
         pass.draw(0..6, 0..geometry.segment_count);
         Ok(())
     }
+}
+
+/// The strand quads of `strands.wgsl` (its module completed by `model`), depth-tested and
+/// written, into `targets` with `fs_main`, or depth alone without targets.
+fn strand_quads_pipeline(
+    gpu: &GpuContext,
+    model: &ShadingModel,
+    label: &str,
+    targets: Option<&[Option<wgpu::ColorTargetState>]>,
+) -> (wgpu::RenderPipeline, ShadedStrandLayouts) {
+    let device = &gpu.device;
+    let top = Wgsl {
+        file: "strands.wgsl",
+        source: include_str!("strands.wgsl"),
+    };
+    let shader = strand_shading_module(device, &top, model);
+    let layouts = ShadedStrandLayouts::new(gpu, model);
+    let pipeline_layout = layouts.pipeline_layout(device, label, None);
+    let pipeline = StrandDraw {
+        label,
+        layout: &pipeline_layout,
+        shader: &shader,
+        vertex_entry: "vs_main",
+        fragment: targets.map(|targets| ("fs_main", targets)),
+        depth: Some(depth_test(DEPTH_FORMAT, true, wgpu::CompareFunction::Less)),
+    }
+    .build(device);
+    (pipeline, layouts)
 }
 
 /// The bind group layouts of a pass that shades strand quads under point lights: the strands
