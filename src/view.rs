@@ -58,6 +58,12 @@ pub struct ViewArgs {
     /// A scripted run that takes longer than this fails.
     #[arg(long, default_value_t = 900)]
     timeout_s: u64,
+    /// Whether the window presents on the renderer's device (shared: frames never leave the
+    /// GPU) or on its own (own: each new image is read back once and uploaded; on a software
+    /// adapter's single queue the window would otherwise wait for every pass). auto: shared on
+    /// a hardware GPU, own on a software one.
+    #[arg(long, value_enum, default_value = "auto")]
+    window_device: strandlight_viewer::WindowDevice,
 }
 
 fn settings(args: &ViewArgs) -> anyhow::Result<FrameSettings> {
@@ -104,5 +110,6 @@ pub fn run(args: ViewArgs) -> anyhow::Result<()> {
         frames: args.frames,
         report: args.report,
         timeout: Duration::from_secs(args.timeout_s),
+        window_device: args.window_device,
     })
 }

@@ -9,6 +9,9 @@
 //! - switched to point lights (DOM shadows, sorted transparency) as the panel's radio button
 //!   does, and orbited again, the window converges to another picture whose screenshot
 //!   `render replay` also reproduces.
+//!
+//! And on the renderer's device (`--window-device shared`), the window draws each frame where it
+//! is: the process reads back nothing but its screenshot, and the window shows that picture.
 
 use serde_json::{Value, json};
 use std::path::Path;
@@ -122,6 +125,64 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
 
     assert_point_lit_screenshot_changed_and_replays(&dir, &shot);
     phase("the point-lit screenshot replayed");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn on_the_renderers_device_the_window_reads_back_nothing_but_its_screenshot() {
+    let Some(xvfb) = xvfb_run() else {
+        missing_tool("xvfb-run", "apt-get install -y xvfb");
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("strandlight-view-shared-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = Command::new(xvfb)
+        .current_dir(&dir)
+        .args(["-a", "-s", "-screen 0 1280x800x24"])
+        .args([
+            env!("CARGO_BIN_EXE_strandlight"),
+            "view",
+            "--size",
+            "160x120",
+        ])
+        .args(["--scattering", "full", "--window-device", "shared"])
+        .args(["--screenshot", "shot", "--report", "report.json"])
+        .output()
+        .expect("xvfb-run runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "view failed:\n{stderr}");
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    println!("{}", serde_json::to_string_pretty(&report).unwrap());
+    assert_eq!(report["window_device"], json!("shared"));
+    let presented = report["frames_presented"].as_u64().unwrap();
+    assert!(presented >= 3, "{report}");
+    // The preview, each batch and the converged frame reached the window without a copy to
+    // the CPU; the screenshot's one readback is all.
+    assert_eq!(report["screenshot_readbacks"], json!(1), "{report}");
+    assert_eq!(
+        report["data_readbacks"],
+        json!(1),
+        "GPU→CPU copies besides the screenshot over {presented} presented frames"
+    );
+    assert!(lit_share(&dir.join("shot.png")) > 0.02, "blank screenshot");
+    let rect: Vec<f64> = report["window_capture_image_rects_px"][0]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let difference = window_against_screenshot(
+        &dir.join("shot-window.png"),
+        &dir.join("shot.png"),
+        rect.try_into().unwrap(),
+    );
+    println!("window capture against the screenshot: mean |Δ| {difference:.2} levels");
+    assert!(
+        difference < 2.0,
+        "the window shows another picture: {difference} levels"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

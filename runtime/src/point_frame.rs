@@ -47,6 +47,8 @@ pub enum RenderError {
     Settings(String),
     #[error("A-buffer nodes per pixel 0: must be at least 1 (or left unset to size the pool)")]
     NoListNodes,
+    #[error("a {}x{} frame cannot be drawn into sums of {}x{}", frame[0], frame[1], sums[0], sums[1])]
+    SumsSize { sums: [u32; 2], frame: [u32; 2] },
 }
 
 /// The time one pass took.
@@ -499,6 +501,18 @@ impl HairColour {
 }
 
 impl PointFrameOnGpu {
+    /// The frame's costs so far, without reading it back (no fragment counts).
+    pub(crate) fn stats(&self, gpu: &GpuContext) -> RenderStats {
+        RenderStats {
+            adapter: gpu.report.clone(),
+            timings: self.costs.timings.clone(),
+            memory_bytes: self.costs.memory_bytes.clone(),
+            segments: self.segments,
+            timing_method: TIMING_METHOD,
+            fragments: None,
+        }
+    }
+
     /// The frame read back: the hair over the skin, with its costs (waits for the GPU).
     fn read(self, gpu: &GpuContext, frame: &FrameParams) -> Result<PointImage, RenderError> {
         let mut costs = self.costs;

@@ -3,7 +3,7 @@
 
 use crate::image_metrics::Image;
 use crate::look::{EnvLook, ForwardDevice};
-use crate::rendered_frame::{FrameDetails, RenderedFrame};
+use crate::rendered_frame::{FrameDetails, RenderedFrame, SubmittedFrame};
 use crate::scene_tables::{EnvShading, ScatteringMode, SceneTables};
 use anyhow::Context;
 use std::sync::OnceLock;
@@ -77,10 +77,21 @@ pub struct EnvFrame<'a> {
 /// env-lit frame, a point-light frame, the viewer's render thread) and shared by all of them,
 /// so a run opens one device and every timing is on the same adapter.
 pub fn shared_gpu() -> anyhow::Result<&'static GpuContext> {
-    static GPU: OnceLock<Result<GpuContext, String>> = OnceLock::new();
-    GPU.get_or_init(|| GpuContext::new_headless().map_err(|e| e.to_string()))
+    SHARED_GPU
+        .get_or_init(|| GpuContext::new_headless().map_err(|e| e.to_string()))
         .as_ref()
         .map_err(|e| anyhow::anyhow!("no GPU device: {e}"))
+}
+
+static SHARED_GPU: OnceLock<Result<GpuContext, String>> = OnceLock::new();
+
+/// Makes `gpu` the process's [`shared_gpu`], before anything has used one: an application
+/// that presents to a window renders on the device its surface needs (the viewer draws and
+/// presents on one device). An error once a device exists.
+pub fn install_shared_gpu(gpu: GpuContext) -> anyhow::Result<()> {
+    SHARED_GPU
+        .set(Ok(gpu))
+        .map_err(|_| anyhow::anyhow!("the process's GPU device was made before it was installed"))
 }
 
 /// The environment-lit renderer's pipelines on [`shared_gpu`], created on first use and kept for
@@ -325,6 +336,35 @@ pub fn render_lights_into(frame: &EnvFrame, sums: &FrameSums) -> anyhow::Result<
         )
         .with_context(|| format!("adding {} lights to the frame", frame.lights.len()))?;
     Ok(rendered_env(frame, gpu, out))
+}
+
+/// [`render_lights_into`] without the readback: the frame's lights added into `sums` and
+/// submitted, the sums left on the GPU for a front end that shows them there (the viewer).
+pub fn submit_lights_into(frame: &EnvFrame, sums: &FrameSums) -> anyhow::Result<SubmittedFrame> {
+    let (gpu, renderer) = env_renderer()?;
+    let call = lights_call(frame, gpu)?;
+    let stats = renderer
+        .submit_part_into(
+            gpu,
+            frame.hair,
+            &frame.camera,
+            (&frame.lights, frame.look.simplified_lights_before),
+            &call.tables,
+            &call.options,
+            call.source.as_deref(),
+            frame.head.as_ref(),
+            sums,
+        )
+        .with_context(|| format!("adding {} lights to the frame", frame.lights.len()))?;
+    Ok(SubmittedFrame {
+        milliseconds: frame_milliseconds(&stats),
+        passes: stats.timings.clone(),
+        memory: stats.memory_per_batch.clone(),
+        adapter: gpu.report.to_string(),
+        timing_method: stats.timing_method.into(),
+        lights: frame.lights.len(),
+        with_multiple: call.source.is_some(),
+    })
 }
 
 /// THE call into the environment-lit renderer. The SRBF path reads

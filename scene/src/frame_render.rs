@@ -6,7 +6,9 @@
 //! through [`render_frame_into`] (the same frame, added into one running sum on the GPU). Every
 //! env-lit frame, whoever draws it, is built by [`env_frame`].
 
-use crate::env_frame::{EnvFrame, FrameRole, render_lights, render_lights_into, shared_gpu};
+use crate::env_frame::{
+    EnvFrame, FrameRole, render_lights, render_lights_into, shared_gpu, submit_lights_into,
+};
 use crate::env_light_sets::frame_lights;
 use crate::env_scene::PreparedEnv;
 use crate::frame_settings::{
@@ -17,7 +19,7 @@ use crate::head_input::load_head;
 use crate::image_metrics::Image;
 use crate::look::EnvLook;
 use crate::point_shading::{PointShadingRequest, point_shading_model};
-pub use crate::rendered_frame::{FrameDetails, RenderedFrame};
+pub use crate::rendered_frame::{FrameDetails, RenderedFrame, SubmittedFrame};
 use crate::scene_tables::ScatteringMode;
 use anyhow::Context;
 use strandlight_runtime::camera::Camera;
@@ -26,7 +28,7 @@ use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::hair::HairModel;
 use strandlight_runtime::head::Head;
-use strandlight_runtime::host::PointLitFrame;
+use strandlight_runtime::host::{PointLitDrawer, PointLitFrame};
 use strandlight_runtime::passes::convolution_depth::DodmSettings;
 use strandlight_runtime::passes::deep_opacity::{DomSettings, ShadowLookup};
 use strandlight_runtime::passes::fiber_shading::ShadingModel;
@@ -399,6 +401,44 @@ pub fn render_frame_into(
     sums: &FrameSums,
 ) -> anyhow::Result<RenderedFrame> {
     render_lights_into(&env_frame(settings, hair, prepared, part, false)?, sums)
+}
+
+/// [`render_frame`] for a front end that shows the frame where it is (the viewer): `part` of
+/// the frame of `settings`, added into `sums` (an env-lit part) or drawn into them (a point-lit
+/// frame, whole; `sums` fresh), on [`shared_gpu`], with nothing read back. `sums` has
+/// [`FramePart::size`] of the part.
+pub fn submit_frame_into(
+    settings: &FrameSettings,
+    hair: &HairModel,
+    prepared: Prepared,
+    part: FramePart,
+    sums: &FrameSums,
+) -> anyhow::Result<SubmittedFrame> {
+    match (&settings.lighting, prepared) {
+        (Lighting::Lights(point), Prepared::Point(prepared)) => {
+            if let FramePart::Lights { .. } = part {
+                anyhow::bail!("a point-lit frame is rendered whole, not by light batches");
+            }
+            let gpu = shared_gpu()?;
+            static DRAWER: std::sync::OnceLock<PointLitDrawer> = std::sync::OnceLock::new();
+            let drawer = DRAWER.get_or_init(|| PointLitDrawer::new(gpu));
+            let inputs = point_frame_inputs(settings, point, hair, sums.size())?;
+            let stats = drawer.draw_into(gpu, &point_lit_frame(hair, prepared, &inputs), sums)?;
+            Ok(SubmittedFrame {
+                milliseconds: point_frame_milliseconds(&stats.timings),
+                passes: stats.timings,
+                memory: stats.memory_bytes,
+                adapter: stats.adapter.to_string(),
+                timing_method: stats.timing_method.to_string(),
+                lights: point.lights.len(),
+                with_multiple: false,
+            })
+        }
+        (Lighting::Environment(_), Prepared::Env(prepared)) => {
+            submit_lights_into(&env_frame(settings, hair, prepared, part, false)?, sums)
+        }
+        _ => anyhow::bail!("the frame's lighting was prepared for other settings"),
+    }
 }
 
 /// Milliseconds of a point-lit frame: its passes without the one-time setup (the hair's upload

@@ -21,6 +21,21 @@ pub struct RenderedFrame {
     pub details: FrameDetails,
 }
 
+/// A frame (or part of one) submitted into sums on the GPU, not read back, and what it cost.
+pub struct SubmittedFrame {
+    /// Frame time without the one-time setup passes.
+    pub milliseconds: f64,
+    pub passes: Vec<PassTiming>,
+    /// GPU memory per resource while it renders (per light batch for an environment), bytes.
+    pub memory: Vec<(String, u64)>,
+    pub adapter: String,
+    pub timing_method: String,
+    /// Lights drawn: point lights, or SRBF lobes and directional sources.
+    pub lights: usize,
+    /// The sums' multiple-scattering half holds light (a full-scattering env frame).
+    pub with_multiple: bool,
+}
+
 /// What only one kind of lighting reports.
 pub enum FrameDetails {
     Point(RenderStats),

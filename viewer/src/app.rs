@@ -2,6 +2,7 @@
 //! input injected into egui's input like the mouse and keyboard. The window presents at its own
 //! pace (about 30 frames a second while anything is changing, on events otherwise).
 
+use crate::gpu_display::GpuDisplay;
 use crate::script::{Action, Script};
 use crate::session::WindowCapture;
 use crate::session::{Session, SessionReport};
@@ -11,7 +12,8 @@ use anyhow::{Context, bail};
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
-use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::gpu::{GpuContext, data_readbacks_so_far};
+use strandlight_scene::env_frame::{install_shared_gpu, shared_gpu};
 use strandlight_scene::frame_settings::FrameSettings;
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
@@ -45,6 +47,34 @@ pub struct ViewOptions {
     pub timeout: Duration,
     /// When the command started: the report's first lit frame counts from here.
     pub started: Instant,
+    pub window_device: WindowDevice,
+}
+
+/// Which device the window presents on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WindowDevice {
+    /// Shared on a hardware adapter, own on a software one.
+    Auto,
+    /// The renderer's device: the frame goes from the passes to the window on the GPU, nothing
+    /// read back. On a software adapter's single queue the window waits for each of the
+    /// renderer's submissions (1.3 s at 160×120 on lavapipe; docs/BENCHMARKS.md, "The
+    /// viewer on one device").
+    Shared,
+    /// A device of its own: each new image is read back once by the render thread and uploaded
+    /// to the window's device, so the window presents while a long pass runs.
+    Own,
+}
+
+impl WindowDevice {
+    /// `Shared` or `Own` on `adapter`.
+    fn resolve(self, adapter: &wgpu::AdapterInfo) -> Self {
+        match self {
+            Self::Auto if adapter.device_type == wgpu::DeviceType::Cpu => Self::Own,
+            Self::Auto => Self::Shared,
+            chosen => chosen,
+        }
+    }
 }
 
 /// Opens the window and runs until it is closed or the script ends.
@@ -57,9 +87,24 @@ pub fn run(mut options: ViewOptions) -> anyhow::Result<()> {
     if script.is_none() && options.screenshot.is_some() {
         script = Some(Script::converged_then_exit());
     }
+    let readbacks_at_start = data_readbacks_so_far();
     let event_loop = EventLoop::<()>::with_user_event()
         .build()
         .context("opening a window: no display (on a headless machine run under xvfb-run -a)")?;
+    // A shared device is made on the instance the window's surface comes from, so that one
+    // device draws and presents (issue 62). A window with a device of its own keeps this
+    // instance to itself: the renderer makes its device on another, because on one instance
+    // lavapipe's devices share one rasterizer, and the window's presents waited for the
+    // renderer's passes (up to 1.1 s at 160×120).
+    let instance = window_instance(&event_loop);
+    let adapter = pollster::block_on(GpuContext::preferred_adapter(&instance))?;
+    let window_device = options.window_device.resolve(&adapter.get_info());
+    if window_device == WindowDevice::Shared {
+        install_shared_gpu(pollster::block_on(GpuContext::for_adapter(
+            adapter.clone(),
+            None,
+        ))?)?;
+    }
     let proxy = Mutex::new(event_loop.create_proxy());
     let wake: Box<dyn Fn() + Send + Sync> = Box::new(move || {
         let _ = proxy.lock().unwrap().send_event(());
@@ -67,6 +112,7 @@ pub fn run(mut options: ViewOptions) -> anyhow::Result<()> {
     let worker = Worker::spawn(
         options.cache_dir.clone(),
         !options.settings.head.is_none(),
+        window_device == WindowDevice::Own,
         wake,
     );
     // The first frame is asked for now: the worker loads the scene and draws its first look
@@ -74,6 +120,10 @@ pub fn run(mut options: ViewOptions) -> anyhow::Result<()> {
     // 0.5 s after the start on lavapipe).
     worker.submit(Session::FIRST_JOB, options.settings.clone());
     let mut app = App {
+        instance,
+        adapter,
+        window_device,
+        readbacks_at_start,
         options,
         script,
         worker: Some(worker),
@@ -90,6 +140,14 @@ pub fn run(mut options: ViewOptions) -> anyhow::Result<()> {
 }
 
 struct App {
+    /// The instance and adapter the window's surface and device are made on (the renderer's
+    /// too when the device is shared).
+    instance: wgpu::Instance,
+    adapter: wgpu::Adapter,
+    /// Shared or Own, resolved.
+    window_device: WindowDevice,
+    /// [`data_readbacks_so_far`] when the command started.
+    readbacks_at_start: u64,
     options: ViewOptions,
     script: Option<Script>,
     worker: Option<Worker>,
@@ -102,8 +160,8 @@ struct App {
     outcome: anyhow::Result<()>,
 }
 
-/// The window's own device (the renderer has its own; frames cross as pixels: see
-/// `WindowGpu::new` for why).
+/// The window, its surface and egui's renderer on the renderer's device, and the display pass
+/// that draws each frame for egui where the frame is.
 struct WindowGpu {
     window: Arc<Window>,
     surface: wgpu::Surface<'static>,
@@ -112,6 +170,17 @@ struct WindowGpu {
     config: wgpu::SurfaceConfiguration,
     renderer: egui_wgpu::Renderer,
     egui_input: egui_winit::State,
+    display: GpuDisplay,
+}
+
+/// The instance a window's surface can be made on: the display's handle, Vulkan, Metal or DX12
+/// (the passes need compute; WGPU_BACKEND overrides).
+fn window_instance(event_loop: &EventLoop<()>) -> wgpu::Instance {
+    let mut desc = wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(
+        event_loop.owned_display_handle(),
+    ));
+    desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
+    wgpu::Instance::new(desc)
 }
 
 impl WindowGpu {
@@ -119,6 +188,8 @@ impl WindowGpu {
         event_loop: &ActiveEventLoop,
         egui: &egui::Context,
         size: [u32; 2],
+        (instance, adapter): (&wgpu::Instance, &wgpu::Adapter),
+        device_choice: WindowDevice,
     ) -> anyhow::Result<(Self, String)> {
         let attributes = Window::default_attributes()
             .with_title("strandlight")
@@ -127,29 +198,27 @@ impl WindowGpu {
                 (size[1] as f64 + 16.0).max(560.0),
             ));
         let window = Arc::new(event_loop.create_window(attributes)?);
-        let mut desc = wgpu::InstanceDescriptor::new_with_display_handle_from_env(Box::new(
-            event_loop.owned_display_handle(),
-        ));
-        desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::all());
-        let instance = wgpu::Instance::new(desc);
         let surface = instance.create_surface(window.clone())?;
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            compatible_surface: Some(&surface),
-            ..Default::default()
-        }))
-        .context("no adapter can present to this window")?;
         let info = adapter.get_info();
         let adapter_name = format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type);
-        // Made by the runtime's one device request, as the render thread's is. The window keeps
-        // a device of its own: on one queue, lavapipe runs the window's frames behind the
-        // render thread's passes (a 1.9 s view pass held the window 1.9 s, issue 62).
-        let window_gpu = pollster::block_on(GpuContext::for_adapter(adapter.clone(), None))?;
-        let (device, queue) = (window_gpu.device, window_gpu.queue);
+        if !adapter.is_surface_supported(&surface) {
+            bail!("the renderer's adapter {adapter_name} cannot present to this window");
+        }
+        let (device, queue) = match device_choice {
+            WindowDevice::Own => {
+                let own = pollster::block_on(GpuContext::for_adapter(adapter.clone(), None))?;
+                (own.device, own.queue)
+            }
+            _ => {
+                let gpu = shared_gpu()?;
+                (gpu.device.clone(), gpu.queue.clone())
+            }
+        };
         let physical = window.inner_size();
         let mut config = surface
-            .get_default_config(&adapter, physical.width.max(1), physical.height.max(1))
+            .get_default_config(adapter, physical.width.max(1), physical.height.max(1))
             .context("the window's surface has no configuration on this adapter")?;
-        let caps = surface.get_capabilities(&adapter);
+        let caps = surface.get_capabilities(adapter);
         config.format = caps
             .formats
             .iter()
@@ -172,6 +241,7 @@ impl WindowGpu {
         );
         Ok((
             Self {
+                display: GpuDisplay::new(&device, device_choice == WindowDevice::Own),
                 window,
                 surface,
                 device,
@@ -316,6 +386,13 @@ impl App {
                 event_loop.exit();
             }
         }
+        // A new frame or new display settings: drawn for egui on the GPU before the UI shows it.
+        if let Some(picture) = session.picture_to_draw() {
+            let texture = gpu
+                .display
+                .show(&gpu.device, &gpu.queue, &mut gpu.renderer, &picture);
+            session.picture_drawn(texture);
+        }
         let output = self.egui.run_ui(input, |ui| session.frame(ui));
         let repaint = output
             .viewport_output
@@ -360,9 +437,11 @@ impl App {
     }
 
     fn finish(mut self) -> anyhow::Result<()> {
-        let report = self.session.take().map(|s| s.report).unwrap_or_default();
+        let mut report = self.session.take().map(|s| s.report).unwrap_or_default();
         // Stop the renderer before the window's device goes.
         drop(self.worker.take());
+        report.data_readbacks = data_readbacks_so_far() - self.readbacks_at_start;
+        report.window_device = Some(self.window_device);
         if let Some(path) = &self.options.report {
             write_report(path, &report)?;
         }
@@ -427,7 +506,9 @@ impl ApplicationHandler for App {
         if self.window.is_some() {
             return;
         }
-        match WindowGpu::new(event_loop, &self.egui, self.options.settings.size) {
+        let gpu_of = (&self.instance, &self.adapter);
+        let size = self.options.settings.size;
+        match WindowGpu::new(event_loop, &self.egui, size, gpu_of, self.window_device) {
             Ok((gpu, adapter)) => {
                 gpu.window.request_redraw();
                 self.window = Some(gpu);

@@ -6,6 +6,7 @@
 mod app;
 pub mod display;
 pub mod frame;
+pub mod gpu_display;
 pub use strandlight_scene::orbit;
 mod panel;
 pub mod progressive;
@@ -16,5 +17,5 @@ mod session;
 pub mod window_capture;
 pub mod worker;
 
-pub use app::{ViewOptions, run};
+pub use app::{ViewOptions, WindowDevice, run};
 pub use session::{RequestTiming, SessionReport};

@@ -491,8 +491,9 @@ pub fn waiting_text(ui: &egui::Ui, rect: egui::Rect, status: &Status) {
     );
 }
 
-/// Adapter, stage, per-pass times, GPU memory and lights, in their own panel right of the image
-/// so that they never cover the hair.
+/// Adapter, stage, per-pass times, GPU memory, lights and the exposure (`exposure`: manual
+/// stops; None: automatic, metered on the GPU), in their own panel right of the image so that
+/// they never cover the hair.
 pub fn readout(ui: &mut egui::Ui, status: &Status, exposure: Option<f32>) {
     let Some(shown) = &status.shown else { return };
     let st = &shown.stats;
@@ -526,9 +527,10 @@ pub fn readout(ui: &mut egui::Ui, status: &Status, exposure: Option<f32>) {
     for (name, bytes) in memory_items.iter().take(4) {
         lines.push(format!("  {name:<20} {:>7.1} MB", *bytes as f64 / 1e6));
     }
-    if let Some(stops) = exposure {
-        lines.push(format!("exposure {stops:+.2} stops"));
-    }
+    lines.push(match exposure {
+        Some(stops) => format!("exposure {stops:+.2} stops"),
+        None => "exposure auto (hair's 90th percentile)".into(),
+    });
     ui.add(
         egui::Label::new(egui::RichText::new(lines.join("\n")).monospace().size(10.0))
             .wrap_mode(egui::TextWrapMode::Wrap),

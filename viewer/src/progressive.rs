@@ -1,18 +1,18 @@
 //! Progressive refinement: what the worker draws for a request, step by step, and what the window
 //! shows of it. An env-lit frame is a sum over its lights: the renderer adds each batch of the
-//! full frame into one running sum on the GPU (`render_frame_into`), which after the last batch
+//! full frame into one running sum on the GPU (`submit_frame_into`), which after the last batch
 //! is that frame; before it the window shows the running sum scaled by the share of the lights'
-//! power it holds (lights are drawn most powerful first).
+//! power it holds (lights are drawn most powerful first). The images stay on the GPU: a step
+//! changes only the scale the display pass draws them at.
 
-use crate::frame::{FrameStats, Stage};
+use crate::frame::{FrameStats, GpuImage, Stage};
 use std::sync::Arc;
-use strandlight_scene::image_metrics::Image;
 pub use strandlight_scene::progressive::{Step, plan_steps};
 
 /// The image the window shows of one request's steps, and their stats added up.
 #[derive(Default)]
 pub struct Accumulator {
-    shown: Option<(Arc<Image>, FrameStats)>,
+    shown: Option<(Arc<GpuImage>, FrameStats)>,
     stats: FrameStats,
     batches_done: usize,
     batches_total: usize,
@@ -21,7 +21,7 @@ pub struct Accumulator {
 impl Accumulator {
     /// Adds one step: a preview or full frame, or a batch's running sum (every batch so far);
     /// returns the stage the shown image is at.
-    pub fn add(&mut self, step: Step, image: Image, stats: FrameStats) -> Stage {
+    pub fn add(&mut self, step: Step, image: GpuImage, stats: FrameStats) -> Stage {
         match step {
             Step::Preview => {
                 self.shown = Some((Arc::new(image), stats));
@@ -40,7 +40,7 @@ impl Accumulator {
         self.batches_total = total;
     }
 
-    fn add_batch(&mut self, sum: Image, stats: FrameStats, power_after: f32) -> Stage {
+    fn add_batch(&mut self, sum: GpuImage, stats: FrameStats, power_after: f32) -> Stage {
         self.batches_done += 1;
         add_stats(&mut self.stats, stats);
         let scale = if power_after > 0.0 {
@@ -48,15 +48,7 @@ impl Accumulator {
         } else {
             1.0
         };
-        let estimate = Image {
-            width: sum.width,
-            height: sum.height,
-            pixels: sum
-                .pixels
-                .iter()
-                .map(|p| [p[0] * scale, p[1] * scale, p[2] * scale, p[3]])
-                .collect(),
-        };
+        let estimate = GpuImage { scale, ..sum };
         self.shown = Some((Arc::new(estimate), self.stats.clone()));
         if self.batches_done >= self.batches_total {
             Stage::Converged
@@ -73,7 +65,7 @@ impl Accumulator {
         self.shown.is_some()
     }
 
-    pub fn shown(&self) -> (Arc<Image>, FrameStats) {
+    pub fn shown(&self) -> (Arc<GpuImage>, FrameStats) {
         self.shown.clone().expect("a step was added")
     }
 }
@@ -93,42 +85,52 @@ fn add_stats(total: &mut FrameStats, batch: FrameStats) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use strandlight_runtime::gpu::GpuContext;
 
-    fn image(value: f32) -> Image {
-        Image {
-            width: 2,
-            height: 1,
-            pixels: vec![[value, 2.0 * value, 0.0, 0.5]; 2],
+    fn image(gpu: &GpuContext) -> GpuImage {
+        GpuImage {
+            buffer: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                label: None,
+                size: 64,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            }),
+            size: [2, 1],
+            with_multiple: false,
+            scale: 1.0,
+            read_back: None,
         }
     }
 
     #[test]
     fn the_running_sum_is_scaled_by_its_power_share_and_the_last_sum_is_shown_as_it_is() {
+        let gpu = GpuContext::new_headless().unwrap_or_else(|e| panic!("{e}"));
         let mut acc = Accumulator::default();
         acc.expect_batches(2);
         assert_eq!(
-            acc.add(Step::Preview, image(9.0), FrameStats::default()),
+            acc.add(Step::Preview, image(&gpu), FrameStats::default()),
             Stage::Preview
         );
+        assert_eq!(acc.shown().0.scale, 1.0);
         let first = Step::Batch {
             first: 0,
             count: 1,
             power_after: 0.75,
         };
         assert_eq!(
-            acc.add(first, image(3.0), FrameStats::default()),
+            acc.add(first, image(&gpu), FrameStats::default()),
             Stage::Refining { done: 1, total: 2 }
         );
-        assert_eq!(acc.shown().0.pixels[0], [4.0, 8.0, 0.0, 0.5]);
+        assert_eq!(acc.shown().0.scale, 1.0 / 0.75);
         let last = Step::Batch {
             first: 1,
             count: 1,
             power_after: 1.0,
         };
         assert_eq!(
-            acc.add(last, image(4.0), FrameStats::default()),
+            acc.add(last, image(&gpu), FrameStats::default()),
             Stage::Converged
         );
-        assert_eq!(acc.shown().0.pixels[1], [4.0, 8.0, 0.0, 0.5]);
+        assert_eq!(acc.shown().0.scale, 1.0);
     }
 }

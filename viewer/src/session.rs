@@ -2,8 +2,9 @@
 //! screen and the screenshots asked for. It draws one egui frame at a time and never waits for
 //! the renderer.
 
-use crate::display::{backdrop_pixels, composite, soft_backdrop_map, to_rgba8};
+use crate::display::{backdrop_pixels, composite, soft_backdrop_map};
 use crate::frame::Stage;
+use crate::gpu_display::DisplayRequest;
 use crate::orbit::Orbit;
 use crate::panel::{Panel, PanelOutcome};
 use crate::recompute::{Backdrop, Display, Recompute, ViewState, recompute};
@@ -14,12 +15,13 @@ use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 use strandlight_precompute::envmap::EnvMap;
+use strandlight_runtime::gpu::data_readbacks_on_this_thread;
 use strandlight_runtime::hair;
 use strandlight_scene::camera_choice::CameraChoice;
+use strandlight_scene::env_frame::shared_gpu;
 use strandlight_scene::exposure::metered_stops;
 use strandlight_scene::frame_settings::{CameraSettings, ExactCamera, FrameSettings, Lighting};
 use strandlight_scene::head_input::HeadChoice;
-use strandlight_scene::image_metrics::Image;
 
 /// Changes that need a rebake wait this long after the last edit (a slider being dragged).
 const REBAKE_SETTLE: Duration = Duration::from_millis(400);
@@ -53,6 +55,14 @@ pub struct SessionReport {
     pub readout_rect_px: Option<[f32; 4]>,
     pub adapter: String,
     pub window_adapter: String,
+    /// GPU→CPU copies of data (frames, depth, counters; not the pass timer's timestamps) made
+    /// in the process from the command's start to the session's end, and those of them the
+    /// screenshots made. The rest would be on the frame path, which reads nothing back: the
+    /// renderer and the window share one device, and the window draws the frame where it is.
+    pub data_readbacks: u64,
+    pub screenshot_readbacks: u64,
+    /// The device the window presented on.
+    pub window_device: Option<crate::WindowDevice>,
     pub errors: Vec<String>,
 }
 
@@ -72,17 +82,18 @@ pub struct WindowCapture {
     pub result: Option<anyhow::Result<()>>,
 }
 
-/// The shown image as a texture, and what it was made from.
+/// The shown image, what it was made from, and the texture the display pass drew it into.
 struct OnScreen {
-    texture: egui::TextureHandle,
+    /// None until the window's display pass has drawn the picture.
+    texture: Option<egui::TextureId>,
     job: u64,
     stage: Stage,
     /// Lit by the first look's coarse tables.
     coarse_tables: bool,
     display: Display,
-    image: Arc<Image>,
-    exposure_stops: f32,
-    composited: Vec<[f32; 4]>,
+    request: DisplayRequest,
+    /// The request the window's display pass has yet to draw.
+    undrawn: bool,
 }
 
 pub struct Session {
@@ -204,7 +215,7 @@ impl Session {
     pub fn presented(&mut self) {
         let now = Instant::now();
         if self.report.first_lit_seconds.is_none()
-            && let Some(on_screen) = &self.on_screen
+            && let Some(on_screen) = self.on_screen.as_ref().filter(|o| o.texture.is_some())
         {
             self.report.first_lit_seconds = Some(now.duration_since(self.started).as_secs_f64());
             self.report.first_lit_coarse_tables = Some(on_screen.coarse_tables);
@@ -258,7 +269,6 @@ impl Session {
         self.take_error(&status);
         self.time_requests(&status);
         self.keys(ctx);
-        self.update_texture(ctx, &status);
         let before = self.state.clone();
         let outcome = self.panel.show(ui, &mut self.state, &status, &self.message);
         if self.state != before {
@@ -426,55 +436,49 @@ impl Session {
         self.submitted = Some((job, self.state.settings.clone()));
     }
 
-    fn exposure_for(&self, image: &Image) -> f32 {
-        match self.state.display.exposure_stops {
-            Some(stops) => stops,
-            None => metered_stops(&image.pixels).unwrap_or(0.0),
-        }
-    }
-
-    fn update_texture(&mut self, ctx: &egui::Context, status: &Status) {
-        let Some(shown) = &status.shown else { return };
+    /// The picture the window's display pass should draw before this frame's UI, when it
+    /// changed: a new image from the worker, or new display settings.
+    pub fn picture_to_draw(&mut self) -> Option<DisplayRequest> {
+        let status = self.worker.status().clone();
+        let shown = status.shown.as_ref()?;
         let unchanged = self.on_screen.as_ref().is_some_and(|o| {
             o.job == shown.job
                 && o.stage == shown.stage
-                && Arc::ptr_eq(&o.image, &shown.image)
+                && Arc::ptr_eq(&o.request.image, &shown.image)
                 && o.display == self.state.display
         });
-        if unchanged {
-            return;
+        if !unchanged {
+            let backdrop = self.background_of(shown, shown.image.size);
+            let request = DisplayRequest {
+                image: shown.image.clone(),
+                exposure_stops: self.state.display.exposure_stops,
+                backdrop,
+            };
+            self.on_screen = Some(OnScreen {
+                texture: self.on_screen.as_ref().and_then(|o| o.texture),
+                job: shown.job,
+                stage: shown.stage,
+                coarse_tables: shown.coarse_tables,
+                display: self.state.display,
+                request,
+                undrawn: true,
+            });
         }
-        let image = shown.image.clone();
-        let stops = self.exposure_for(&image);
-        let behind = self.background_of(shown, &image);
-        let composited = composite(&image, stops, behind.as_deref().map(|b| b.as_slice()));
-        let rgba = to_rgba8(&composited);
-        let color = egui::ColorImage::from_rgba_unmultiplied(
-            [image.width as usize, image.height as usize],
-            &rgba,
-        );
-        let texture = match self.on_screen.take() {
-            Some(mut o) => {
-                o.texture.set(color, egui::TextureOptions::LINEAR);
-                o.texture
-            }
-            None => ctx.load_texture("frame", color, egui::TextureOptions::LINEAR),
-        };
-        self.on_screen = Some(OnScreen {
-            texture,
-            job: shown.job,
-            stage: shown.stage,
-            coarse_tables: shown.coarse_tables,
-            display: self.state.display,
-            image,
-            exposure_stops: stops,
-            composited,
-        });
+        let on_screen = self.on_screen.as_mut()?;
+        on_screen.undrawn.then(|| on_screen.request.clone())
+    }
+
+    /// The display pass drew the picture into `texture`.
+    pub fn picture_drawn(&mut self, texture: egui::TextureId) {
+        if let Some(o) = &mut self.on_screen {
+            o.texture = Some(texture);
+            o.undrawn = false;
+        }
     }
 
     /// The map behind the hair, computed once per view (the refinement steps of one request
     /// share it).
-    fn background_of(&mut self, shown: &Shown, image: &Image) -> Option<Arc<Vec<[f32; 3]>>> {
+    fn background_of(&mut self, shown: &Shown, size: [u32; 2]) -> Option<Arc<Vec<[f32; 3]>>> {
         if self.state.display.backdrop == Backdrop::Black {
             return None;
         }
@@ -487,7 +491,7 @@ impl Session {
         let key = BackgroundKey {
             backdrop: self.state.display.backdrop,
             camera: ExactCamera::of(&shown.camera),
-            size: [image.width, image.height],
+            size,
             rotation_deg: lighting.rotation_deg,
             map: env.sha256.clone(),
         };
@@ -523,7 +527,7 @@ impl Session {
             self.report.readout_rect_px = None;
             return;
         }
-        let exposure = self.on_screen.as_ref().map(|o| o.exposure_stops);
+        let exposure = self.state.display.exposure_stops;
         // Exact: a panel of wrapping text shrinks to egui's 96-point minimum otherwise.
         let response = egui::Panel::right("readout")
             .exact_size(READOUT_WIDTH)
@@ -549,9 +553,9 @@ impl Session {
                 self.report.image_rect_px =
                     [rect.min.x, rect.min.y, rect.max.x, rect.max.y].map(|v| v * ppp);
                 let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
-                if let Some(o) = &self.on_screen {
+                if let Some(texture) = self.on_screen.as_ref().and_then(|o| o.texture) {
                     ui.painter().image(
-                        o.texture.id(),
+                        texture,
                         rect,
                         egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0)),
                         egui::Color32::WHITE,
@@ -610,15 +614,12 @@ impl Session {
         if on_screen.job != shown.job || on_screen.stage != Stage::Converged {
             return;
         }
+        let request = on_screen.request.clone();
         for stem in std::mem::take(&mut self.screenshots) {
-            match save(
-                &stem,
-                &shown.settings,
-                &self.state.display,
-                on_screen.exposure_stops,
-                &on_screen.image,
-                &on_screen.composited,
-            ) {
+            let before = data_readbacks_on_this_thread();
+            let saved = save_picture(&stem, &shown.settings, &self.state.display, &request);
+            self.report.screenshot_readbacks += data_readbacks_on_this_thread() - before;
+            match saved {
                 Ok(files) => {
                     let ScreenshotFiles {
                         png,
@@ -681,6 +682,25 @@ impl Session {
             }
         }
     }
+}
+
+/// The screenshot of `request`'s picture: the frame read back (the one readback), exposed as
+/// the window shows it (automatic exposure metered on the CPU, which the display pass's meter
+/// matches within 1/1000 of a stop) and composited over the same backdrop.
+fn save_picture(
+    stem: &std::path::Path,
+    settings: &FrameSettings,
+    display: &crate::recompute::Display,
+    request: &DisplayRequest,
+) -> anyhow::Result<ScreenshotFiles> {
+    let image = request.image.read(shared_gpu()?)?;
+    let stops = match request.exposure_stops {
+        Some(stops) => stops,
+        None => metered_stops(&image.pixels).unwrap_or(0.0),
+    };
+    let behind = request.backdrop.as_deref().map(|b| b.as_slice());
+    let composited = composite(&image, stops, behind);
+    save(stem, settings, display, stops, &image, &composited)
 }
 
 /// `out/view-<unix seconds>`.

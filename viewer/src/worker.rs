@@ -15,28 +15,28 @@ use std::time::{Duration, Instant};
 use strandlight_runtime::camera::Camera;
 use strandlight_runtime::env::FrameSums;
 use strandlight_runtime::hair::HairModel;
-use strandlight_scene::env_frame::{frame_sums, prepare_env_renderer};
+use strandlight_scene::env_frame::{frame_sums, prepare_env_renderer, shared_gpu};
 use strandlight_scene::env_light_sets::{frame_lights, light_luminance};
 use strandlight_scene::env_scene::{AlsoServe, PrepareProgress, PreparedEnv, prepare_env};
 use strandlight_scene::frame_render::{
-    FrameHair, Prepared, PreparedPoint, coarse_preview_settings, env_look, load_settings_hair,
-    prepare_point, render_frame, render_frame_into, settings_camera,
+    FrameHair, Prepared, PreparedPoint, SubmittedFrame, coarse_preview_settings, env_look,
+    load_settings_hair, prepare_point, settings_camera, submit_frame_into,
 };
 use strandlight_scene::frame_settings::{
     CameraSettings, ExactCamera, FrameSettings, Lighting, PointLighting, up_choice,
 };
 use strandlight_scene::steps::Steps;
 
-use crate::frame::{FrameStats, Stage};
+use crate::frame::{FrameStats, GpuImage, Stage};
 use crate::recompute::{TablesKey, tables_key};
-use strandlight_scene::image_metrics::Image;
 
 /// The worker's latest image of a request.
 #[derive(Clone)]
 pub struct Shown {
     pub job: u64,
     pub settings: FrameSettings,
-    pub image: Arc<Image>,
+    /// On the renderer's device (the window's too): the window draws it there.
+    pub image: Arc<GpuImage>,
     pub stage: Stage,
     pub stats: FrameStats,
     /// Rendered with the previous tables while this request's tables bake.
@@ -93,6 +93,7 @@ impl Worker {
     pub fn spawn(
         cache_dir: PathBuf,
         first_with_head: bool,
+        read_back: bool,
         wake_window: Box<dyn Fn() + Send + Sync>,
     ) -> Self {
         let shared = Arc::new(Shared {
@@ -108,7 +109,7 @@ impl Worker {
         let for_thread = shared.clone();
         let thread = std::thread::Builder::new()
             .name("strandlight render".into())
-            .spawn(move || WorkerState::new(cache_dir, for_thread).run())
+            .spawn(move || WorkerState::new(cache_dir, read_back, for_thread).run())
             .expect("spawn the render thread");
         Self {
             shared,
@@ -167,6 +168,8 @@ type HairKey = (Option<PathBuf>, bool);
 
 struct WorkerState {
     cache_dir: PathBuf,
+    /// Read each image back for a window on a device of its own.
+    read_back: bool,
     shared: Arc<Shared>,
     hair: Option<(HairKey, Arc<FrameHair>)>,
     point: Option<(String, Arc<PreparedPoint>)>,
@@ -181,9 +184,10 @@ struct WorkerState {
 }
 
 impl WorkerState {
-    fn new(cache_dir: PathBuf, shared: Arc<Shared>) -> Self {
+    fn new(cache_dir: PathBuf, read_back: bool, shared: Arc<Shared>) -> Self {
         Self {
             cache_dir,
+            read_back,
             shared,
             hair: None,
             point: None,
@@ -497,9 +501,11 @@ impl WorkerState {
             }
             (Lighting::Environment(_), None) => unreachable!("set just above"),
         };
-        let rendered = match (step, prepared) {
-            // Batches add up on the GPU, in the renderer's own batch-sum pass.
-            (Step::Batch { .. }, Prepared::Env(env)) => {
+        // Each step leaves its image on the GPU, where a window on the same device draws it.
+        let (submitted, image) = match (step, prepared) {
+            // Batches add up on the GPU, in the renderer's own batch-sum pass; the window gets
+            // a copy of the sum so far.
+            (Step::Batch { .. }, Prepared::Env(_)) => {
                 let job = self.job.as_mut().expect("a job");
                 let sums = match &mut job.sums {
                     Some(sums) => sums,
@@ -508,27 +514,29 @@ impl WorkerState {
                         job.sums.insert(frame_sums(width, height)?)
                     }
                 };
-                render_frame_into(&settings, &hair.model, env, step.part(), sums)?
+                let submitted =
+                    submit_frame_into(&settings, &hair.model, prepared, step.part(), sums)?;
+                let image = GpuImage::copy_of(shared_gpu()?, sums, submitted.with_multiple);
+                (submitted, image)
             }
             // The first look draws a fraction of the strands, each as much thicker.
             (Step::Preview, Prepared::Env(_)) => {
                 let (look_settings, look_hair) = first_look(&settings, &hair.model)?;
-                render_frame(&look_settings, &look_hair, prepared, step.part(), false)?
+                submit_whole(&look_settings, &look_hair, prepared, step)?
             }
-            _ => render_frame(&settings, &hair.model, prepared, step.part(), false)?,
+            _ => submit_whole(&settings, &hair.model, prepared, step)?,
+        };
+        let image = match self.read_back {
+            true => image.with_read_back(shared_gpu()?)?,
+            false => image,
         };
         let stats = FrameStats {
-            lights: rendered.light_count(&settings),
-            passes: rendered.passes,
-            memory: rendered.memory,
+            lights: submitted.lights,
+            passes: submitted.passes,
+            memory: submitted.memory,
             batches: 1,
-            adapter: rendered.adapter,
-            timing_method: rendered.timing_method,
-        };
-        let image = Image {
-            width: rendered.image.width,
-            height: rendered.image.height,
-            pixels: rendered.image.pixels,
+            adapter: submitted.adapter,
+            timing_method: submitted.timing_method,
         };
         let camera = settings_camera(&settings, &hair.model)?;
         let front = up_choice(&settings).axis(&hair.model).toward_front();
@@ -568,6 +576,20 @@ impl WorkerState {
         });
         Ok(())
     }
+}
+
+/// `step` of the frame of `settings` drawn whole into sums of its own, which become the image.
+fn submit_whole(
+    settings: &FrameSettings,
+    hair: &HairModel,
+    prepared: Prepared,
+    step: Step,
+) -> anyhow::Result<(SubmittedFrame, GpuImage)> {
+    let [width, height] = step.part().size(settings.size);
+    let sums = frame_sums(width, height)?;
+    let submitted = submit_frame_into(settings, hair, prepared, step.part(), &sums)?;
+    let image = GpuImage::of_finished(sums, submitted.with_multiple);
+    Ok((submitted, image))
 }
 
 /// A first look draws every this many strands, each this many times as thick. The viewer's

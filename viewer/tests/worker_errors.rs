@@ -3,6 +3,7 @@
 //! preview and then converged, with the image the size asked for.
 
 use std::time::{Duration, Instant};
+use strandlight_scene::env_frame::shared_gpu;
 use strandlight_scene::frame_settings::{FrameSettings, Lighting, PointLighting};
 use strandlight_viewer::frame::Stage;
 use strandlight_viewer::worker::Worker;
@@ -24,7 +25,8 @@ fn a_bad_file_is_an_error_naming_it_and_the_next_request_still_renders() {
     std::fs::create_dir_all(&dir).unwrap();
     let bad = dir.join("dropped.hair");
     std::fs::write(&bad, b"HAIR but not really a hair file").unwrap();
-    let worker = Worker::spawn(dir.join("cache"), false, Box::new(|| {}));
+    // The image stays on the GPU (no read back), as for a window on the renderer's device.
+    let worker = Worker::spawn(dir.join("cache"), false, false, Box::new(|| {}));
     let mut settings = FrameSettings::new(Lighting::Lights(PointLighting::default()), [48, 32]);
     settings.hair = Some(bad.clone());
     worker.submit(1, settings.clone());
@@ -44,8 +46,11 @@ fn a_bad_file_is_an_error_naming_it_and_the_next_request_still_renders() {
     });
     let status = worker.status().clone();
     let shown = status.shown.unwrap();
-    assert_eq!((shown.image.width, shown.image.height), (48, 32));
-    assert!(shown.image.pixels.iter().any(|p| p[3] > 0.0), "hair drawn");
+    assert_eq!(shown.image.size, [48, 32]);
+    assert!(shown.image.read_back.is_none(), "kept on the GPU");
+    let image = shown.image.read(shared_gpu().unwrap()).unwrap();
+    assert_eq!((image.width, image.height), (48, 32));
+    assert!(image.pixels.iter().any(|p| p[3] > 0.0), "hair drawn");
     assert!(status.preview_seconds.is_some(), "a preview came first");
     assert!(status.error.is_none(), "the success cleared the error");
     drop(worker);

@@ -191,6 +191,32 @@ impl EnvRenderer {
         )
     }
 
+    /// [`Self::render_part_into`] without the readback: the part added into `sums` and
+    /// submitted, the sums left on the GPU for a caller that shows them there; validation
+    /// errors are checked. Returns the part's stats.
+    #[allow(clippy::too_many_arguments)]
+    pub fn submit_part_into(
+        &self,
+        gpu: &GpuContext,
+        model: &HairModel,
+        camera: &Camera,
+        part: (&[EnvLight], u32),
+        tables: &EnvTables,
+        options: &EnvRenderOptions,
+        multiple: Option<&dyn ForwardScatteringSource>,
+        head: Option<&Head>,
+        sums: &FrameSums,
+    ) -> Result<EnvRenderStats, EnvRenderError> {
+        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let stats = self.encode_part_into(
+            gpu, model, camera, part, tables, options, multiple, head, sums,
+        )?;
+        if let Some(error) = pollster::block_on(scope.pop()) {
+            return Err(EnvRenderError::Gpu(error.to_string()));
+        }
+        Ok(stats)
+    }
+
     /// [`Self::render_part`] up to the pixels: every pass submitted, the sums left on the GPU
     /// (a web page cannot wait for a readback; it draws them or maps them later). The caller
     /// owns the error scope.

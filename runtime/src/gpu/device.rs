@@ -95,6 +95,16 @@ impl GpuContext {
         // backend lacks. WGPU_BACKEND overrides.
         desc.backends = wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
         let instance = wgpu::Instance::new(desc);
+        let adapter = Self::preferred_adapter(&instance).await?;
+        Self::for_adapter(adapter, limits).await
+    }
+
+    /// The adapter [`Self::new_headless`] would choose on `instance`: hardware first (discrete,
+    /// integrated, virtual), the software rasterizer last. An application that presents to a
+    /// window asks on the instance its surface comes from, then [`Self::for_adapter`].
+    pub async fn preferred_adapter(
+        instance: &wgpu::Instance,
+    ) -> Result<wgpu::Adapter, DeviceError> {
         let adapters = instance.enumerate_adapters(wgpu::Backends::all()).await;
         let looked_at = if adapters.is_empty() {
             "no Vulkan, Metal or DX12 adapters".to_string()
@@ -118,7 +128,7 @@ impl GpuContext {
                 .await
                 .map_err(|_| DeviceError::NoAdapter { looked_at })?,
         };
-        Self::for_adapter(adapter, limits).await
+        Ok(adapter)
     }
 
     /// A device on `adapter` with the features the passes use: `limits` (a web page asks for

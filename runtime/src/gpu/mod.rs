@@ -12,4 +12,7 @@ pub mod texture;
 pub use device::{AdapterReport, DeviceError, GpuContext};
 pub use limits::{GpuLimits, LimitError};
 pub use pass_timer::PassTimer;
-pub use readback::{read_buffer, read_texture_rgba, readbacks_so_far};
+pub use readback::{
+    data_readbacks_on_this_thread, data_readbacks_so_far, read_buffer, read_texture_rgba,
+    readbacks_so_far,
+};

@@ -10,7 +10,8 @@
 use std::sync::Mutex;
 use std::thread::ThreadId;
 
-use super::{GpuContext, read_buffer};
+use super::GpuContext;
+use super::readback::read_timestamps;
 
 /// Query slots per section: two per pass, so up to 2048 passes between `begin` and `end`.
 const CAPACITY: u32 = wgpu::QUERY_SET_MAX_QUERIES;
@@ -86,7 +87,7 @@ impl PassTimer {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         encoder.resolve_query_set(&self.queries, 0..queries, &self.resolved, 0);
         gpu.queue.submit([encoder.finish()]);
-        let bytes = read_buffer(gpu, &self.resolved).ok()?;
+        let bytes = read_timestamps(gpu, &self.resolved).ok()?;
         let ticks: Vec<u64> = bytes
             .chunks_exact(8)
             .take(queries as usize)

@@ -6,15 +6,55 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// Copies from the GPU to the CPU so far in this process: every readback of the runtime goes
 /// through [`wait_for_copy`], so a host can check that its frame path makes none.
 static READBACKS: AtomicU64 = AtomicU64::new(0);
+/// Those of them that read the pass timer's timestamps (a measurement, not the frame's data).
+static TIMESTAMP_READBACKS: AtomicU64 = AtomicU64::new(0);
+
+thread_local! {
+    /// Data readbacks (not timestamps) made on this thread.
+    static DATA_READBACKS_HERE: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
 
 /// How many GPU→CPU copies this process has made (textures, buffers, timestamps).
 pub fn readbacks_so_far() -> u64 {
     READBACKS.load(Ordering::Relaxed)
 }
 
+/// How many GPU→CPU copies of data (pixels, depth, counters, grids) this process has made: every
+/// copy but the pass timer's timestamps. A frame path that keeps its frame on the GPU makes none.
+pub fn data_readbacks_so_far() -> u64 {
+    READBACKS.load(Ordering::Relaxed) - TIMESTAMP_READBACKS.load(Ordering::Relaxed)
+}
+
+/// [`data_readbacks_so_far`] made on the calling thread.
+pub fn data_readbacks_on_this_thread() -> u64 {
+    DATA_READBACKS_HERE.with(|n| n.get())
+}
+
+/// What a copy reads.
+#[derive(Clone, Copy, PartialEq)]
+enum CopyOf {
+    Data,
+    Timestamps,
+}
+
 /// Maps `slice` for reading and waits for it: the one place the runtime blocks on a copy.
 fn wait_for_copy(gpu: &GpuContext, slice: &wgpu::BufferSlice<'_>) -> Result<(), ReadbackError> {
+    wait_for_copy_of(gpu, slice, CopyOf::Data)
+}
+
+fn wait_for_copy_of(
+    gpu: &GpuContext,
+    slice: &wgpu::BufferSlice<'_>,
+    of: CopyOf,
+) -> Result<(), ReadbackError> {
+    // Counted before the wait, as the one copy asked for whether or not it succeeds.
     READBACKS.fetch_add(1, Ordering::Relaxed);
+    match of {
+        CopyOf::Timestamps => {
+            TIMESTAMP_READBACKS.fetch_add(1, Ordering::Relaxed);
+        }
+        CopyOf::Data => DATA_READBACKS_HERE.with(|n| n.set(n.get() + 1)),
+    }
     let (sender, receiver) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = sender.send(r);
@@ -154,6 +194,22 @@ fn read_texels(
 
 /// A storage buffer's bytes (the buffer needs `COPY_SRC`).
 pub fn read_buffer(gpu: &GpuContext, source: &wgpu::Buffer) -> Result<Vec<u8>, ReadbackError> {
+    read_buffer_of(gpu, source, CopyOf::Data)
+}
+
+/// [`read_buffer`] of the pass timer's resolved timestamps (counted apart from data).
+pub(crate) fn read_timestamps(
+    gpu: &GpuContext,
+    source: &wgpu::Buffer,
+) -> Result<Vec<u8>, ReadbackError> {
+    read_buffer_of(gpu, source, CopyOf::Timestamps)
+}
+
+fn read_buffer_of(
+    gpu: &GpuContext,
+    source: &wgpu::Buffer,
+    of: CopyOf,
+) -> Result<Vec<u8>, ReadbackError> {
     let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
         size: source.size(),
@@ -164,7 +220,7 @@ pub fn read_buffer(gpu: &GpuContext, source: &wgpu::Buffer) -> Result<Vec<u8>, R
     encoder.copy_buffer_to_buffer(source, 0, &buffer, 0, source.size());
     gpu.queue.submit([encoder.finish()]);
     let slice = buffer.slice(..);
-    wait_for_copy(gpu, &slice)?;
+    wait_for_copy_of(gpu, &slice, of)?;
     let bytes = slice.get_mapped_range()?.to_vec();
     buffer.unmap();
     Ok(bytes)

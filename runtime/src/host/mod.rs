@@ -36,7 +36,7 @@ use crate::head::Head;
 use crate::multiple::ForwardScatteringSource;
 use crate::passes::fiber_shading::ShadingModel;
 use crate::passes::frame_params::FrameParams;
-use crate::point_frame::{RenderError, RenderOptions, submit_frame};
+use crate::point_frame::{RenderError, RenderOptions, RenderStats, submit_frame};
 use composite::{CompositeBinding, CompositePass};
 use point_gather::PointGatherPass;
 
@@ -150,7 +150,7 @@ pub struct HairRenderer {
     env: EnvRenderer,
     composite: CompositePass,
     /// Made when the first point-lit frame is drawn.
-    point_gather: Option<PointGatherPass>,
+    point_lit: Option<PointLitDrawer>,
     frame: Option<FrameInProgress>,
 }
 
@@ -169,7 +169,7 @@ impl HairRenderer {
         Self {
             env: EnvRenderer::new(&gpu),
             composite: CompositePass::new(&gpu.device, &targets),
-            point_gather: None,
+            point_lit: None,
             frame: None,
             gpu,
         }
@@ -231,21 +231,9 @@ impl HairRenderer {
         let params = frame.params;
         let kept = self.frame_of_size([params.width, params.height])?;
         kept.sums.forget_view();
-        let drawn = submit_frame(
-            &self.gpu,
-            frame.model,
-            params,
-            frame.options,
-            frame.shading,
-            frame.head,
-            kept.sums.front_depth(),
-        )?;
-        let gather = self
-            .point_gather
-            .get_or_insert_with(|| PointGatherPass::new(&self.gpu));
-        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        gather.encode(&self.gpu, &mut encoder, &drawn, &kept.sums);
-        self.gpu.queue.submit([encoder.finish()]);
+        self.point_lit
+            .get_or_insert_with(|| PointLitDrawer::new(&self.gpu))
+            .draw_into(&self.gpu, frame, &kept.sums)?;
         let lights = params.lights.len();
         self.frame = Some(FrameInProgress {
             order: Vec::new(),
@@ -388,5 +376,52 @@ impl HairRenderer {
         };
         let depth = kept.sums.front_depth().expect("the host's sums keep one");
         Ok(crate::gpu::readback::read_depth(&self.gpu, depth)?)
+    }
+}
+
+/// Draws frames of the thesis techniques into [`FrameSums`] a caller keeps, on the GPU: what
+/// [`HairRenderer::draw_point_lit`] does for its own frame, for an application that shows the
+/// sums itself (the viewer's display pass reads them where they are).
+pub struct PointLitDrawer {
+    gather: PointGatherPass,
+}
+
+impl PointLitDrawer {
+    /// The gather pipeline on `gpu`'s device.
+    pub fn new(gpu: &GpuContext) -> Self {
+        Self {
+            gather: PointGatherPass::new(gpu),
+        }
+    }
+
+    /// Draws `frame` whole and gathers it into `sums` (the frame's size; their single-scattering
+    /// half gets the hair over the skin, the multiple-scattering half zero), submitted without
+    /// reading anything back, and the frame's costs. With a front depth in `sums`, the
+    /// nearest of head and fiber is drawn there. Errors name the setting or limit at fault.
+    pub fn draw_into(
+        &self,
+        gpu: &GpuContext,
+        frame: &PointLitFrame<'_>,
+        sums: &FrameSums,
+    ) -> Result<RenderStats, RenderError> {
+        if sums.size() != [frame.params.width, frame.params.height] {
+            return Err(RenderError::SumsSize {
+                sums: sums.size(),
+                frame: [frame.params.width, frame.params.height],
+            });
+        }
+        let drawn = submit_frame(
+            gpu,
+            frame.model,
+            frame.params,
+            frame.options,
+            frame.shading,
+            frame.head,
+            sums.front_depth(),
+        )?;
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.gather.encode(gpu, &mut encoder, &drawn, sums);
+        gpu.queue.submit([encoder.finish()]);
+        Ok(drawn.stats(gpu))
     }
 }
