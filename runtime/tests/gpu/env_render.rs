@@ -2123,60 +2123,17 @@ fn a_host_frame_draws_nothing_before_its_first_batch() {
     };
     let mut host = HairRenderer::new(&gpu.device, &gpu.queue, targets);
     host.prepare(&frame).unwrap();
-    let target = |format, label| {
-        gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d {
-                width: RES,
-                height: RES,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        })
+    let host_targets = HostTargets::new(&gpu, [RES, RES], colour, depth);
+    let clear = wgpu::Color {
+        r: 0.25,
+        g: 0.5,
+        b: 0.75,
+        a: 1.0,
     };
-    let (colour, depth) = (target(colour, "host colour"), target(depth, "host depth"));
-    let (colour_view, depth_view) = (
-        colour.create_view(&Default::default()),
-        depth.create_view(&Default::default()),
-    );
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("host"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &colour_view,
-                resolve_target: None,
-                depth_slice: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color {
-                        r: 0.25,
-                        g: 0.5,
-                        b: 0.75,
-                        a: 1.0,
-                    }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(0.5),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            ..Default::default()
-        });
-        host.render(&mut pass);
-    }
-    gpu.queue.submit([encoder.finish()]);
-    let pixels = read_texture_rgba(&gpu, &colour).unwrap();
-    let depths = read_depth(&gpu, &depth).unwrap();
+    host_targets.draw(&gpu, clear, 0.5, |pass| host.render(pass));
+    let (colour, depth) = (&host_targets.colour, &host_targets.depth);
+    let pixels = read_texture_rgba(&gpu, colour).unwrap();
+    let depths = read_depth(&gpu, depth).unwrap();
     assert!(pixels.iter().all(|p| *p == [0.25, 0.5, 0.75, 1.0]));
     assert!(depths.iter().all(|&d| d == 0.5));
 }

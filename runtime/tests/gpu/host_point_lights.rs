@@ -95,55 +95,9 @@ fn techniques() -> [Transparency; 6] {
 /// hair drawn in; the colour read back.
 fn host_frame(gpu: &GpuContext, hair: &HairRenderer, format: wgpu::TextureFormat) -> Vec<[f32; 4]> {
     use strandlight_runtime::gpu::readback::read_texture_rgba;
-    let target = |format, label| {
-        gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some(label),
-            size: wgpu::Extent3d {
-                width: RES,
-                height: RES,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        })
-    };
-    let colour = target(format, "host colour");
-    let depth = target(wgpu::TextureFormat::Depth32Float, "host depth");
-    let (colour_view, depth_view) = (
-        colour.create_view(&Default::default()),
-        depth.create_view(&Default::default()),
-    );
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("host"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &colour_view,
-                resolve_target: None,
-                depth_slice: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
-                    store: wgpu::StoreOp::Store,
-                }),
-                stencil_ops: None,
-            }),
-            ..Default::default()
-        });
-        hair.render(&mut pass);
-    }
-    gpu.queue.submit([encoder.finish()]);
-    read_texture_rgba(gpu, &colour).unwrap()
+    let targets = HostTargets::new(gpu, [RES, RES], format, wgpu::TextureFormat::Depth32Float);
+    targets.draw(gpu, wgpu::Color::TRANSPARENT, 1.0, |pass| hair.render(pass));
+    read_texture_rgba(gpu, &targets.colour).unwrap()
 }
 
 /// Every technique's frame, drawn by the host API into a host's pass, equals the frame the

@@ -1,5 +1,5 @@
-//! Scene pieces shared by the GPU tests: a device, the orthographic test camera and the slab of
-//! parallel strands whose transmittance has a closed form.
+//! Scene pieces shared by the GPU tests: a device, the orthographic test camera, the slab of
+//! parallel strands whose transmittance has a closed form, and a host application's targets.
 
 use glam::{DVec3, Vec3};
 use strandlight_runtime::camera::{Camera, Projection};
@@ -125,4 +125,80 @@ pub fn two_point_hair(fibers: &[[Vec3; 2]]) -> HairModel {
         None,
     )
     .unwrap()
+}
+
+/// A host application's colour and depth targets (`RENDER_ATTACHMENT | COPY_SRC`), for tests
+/// that draw the hair into a host's own pass.
+pub struct HostTargets {
+    pub colour: wgpu::Texture,
+    pub depth: wgpu::Texture,
+}
+
+impl HostTargets {
+    pub fn new(
+        gpu: &GpuContext,
+        [width, height]: [u32; 2],
+        colour: wgpu::TextureFormat,
+        depth: wgpu::TextureFormat,
+    ) -> Self {
+        let target = |format, label| {
+            gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            })
+        };
+        Self {
+            colour: target(colour, "host colour"),
+            depth: target(depth, "host depth"),
+        }
+    }
+
+    /// The host's own pass: colour cleared to `clear_colour` and depth to `clear_depth`, then
+    /// `draw` recorded in it; submitted.
+    pub fn draw(
+        &self,
+        gpu: &GpuContext,
+        clear_colour: wgpu::Color,
+        clear_depth: f32,
+        draw: impl FnOnce(&mut wgpu::RenderPass<'_>),
+    ) {
+        let colour_view = self.colour.create_view(&Default::default());
+        let depth_view = self.depth.create_view(&Default::default());
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("host"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &colour_view,
+                    resolve_target: None,
+                    depth_slice: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(clear_colour),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(clear_depth),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                ..Default::default()
+            });
+            draw(&mut pass);
+        }
+        gpu.queue.submit([encoder.finish()]);
+    }
 }
