@@ -380,7 +380,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         let report = json_report(&settings, &hair, &rendered, &written)?;
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        for line in text_report(&hair, &rendered) {
+        for line in text_report(&settings, &hair, &rendered) {
             steps.say(line);
         }
         steps.say(format!(
@@ -527,7 +527,11 @@ fn json_report(
     Ok(report)
 }
 
-fn text_report(hair: &FrameHair, rendered: &RenderedFrame) -> Vec<String> {
+fn text_report(
+    settings: &FrameSettings,
+    hair: &FrameHair,
+    rendered: &RenderedFrame,
+) -> Vec<String> {
     let mut lines = vec![format!("adapter: {}", rendered.adapter)];
     match &rendered.details {
         FrameDetails::Point(stats) => {
@@ -541,10 +545,24 @@ fn text_report(hair: &FrameHair, rendered: &RenderedFrame) -> Vec<String> {
                 lines.push(format!("  {:<28} {:>9.2} ms", t.pass, t.milliseconds));
             }
             if let Some(f) = stats.fragments {
-                lines.push(format!(
-                    "A-buffer: {} fragments stored, {} dropped (node buffer holds {}), {} truncated at resolve (over 64 in a pixel)",
-                    f.stored, f.dropped, f.capacity, f.truncated
-                ));
+                let technique = match &settings.lighting {
+                    Lighting::Lights(point) => point.transparency,
+                    Lighting::Environment(_) => Transparency::None,
+                };
+                lines.push(match technique {
+                    Transparency::Kbuffer => format!(
+                        "K-buffer: {} fragments kept, {} dropped beyond the k nearest ({} slots)",
+                        f.stored, f.dropped, f.capacity
+                    ),
+                    Transparency::Dbk => format!(
+                        "DBK: {} fragments stored, {} dropped (node buffer holds {}), {} truncated at resolve (over 64 in a pixel)",
+                        f.stored, f.dropped, f.capacity, f.truncated
+                    ),
+                    _ => format!(
+                        "A-buffer: {} fragments stored, {} dropped (node buffer holds {}), {} truncated at resolve (over 64 in a pixel)",
+                        f.stored, f.dropped, f.capacity, f.truncated
+                    ),
+                });
             }
         }
         FrameDetails::Env { .. } => {
