@@ -317,29 +317,9 @@ pub fn frame_sums(width: u32, height: u32) -> anyhow::Result<FrameSums> {
     Ok(FrameSums::new(gpu, width, height)?)
 }
 
-/// [`render_lights`] adding the frame's lights into `sums`, the one batch-sum pass of the
-/// runtime: the image is the running sum after this part, its stats the part's own.
-pub fn render_lights_into(frame: &EnvFrame, sums: &FrameSums) -> anyhow::Result<RenderedFrame> {
-    let (gpu, renderer) = env_renderer()?;
-    let call = lights_call(frame, gpu)?;
-    let out = renderer
-        .render_part_into(
-            gpu,
-            frame.hair,
-            &frame.camera,
-            (&frame.lights, frame.look.simplified_lights_before),
-            &call.tables,
-            &call.options,
-            call.source.as_deref(),
-            frame.head.as_ref(),
-            sums,
-        )
-        .with_context(|| format!("adding {} lights to the frame", frame.lights.len()))?;
-    Ok(rendered_env(frame, gpu, out))
-}
-
-/// [`render_lights_into`] without the readback: the frame's lights added into `sums` and
-/// submitted, the sums left on the GPU for a front end that shows them there (the viewer).
+/// [`render_lights`] added into `sums`, the running sum a progressive front end keeps across
+/// its batches ([`frame_sums`]), and submitted: the sums stay on the GPU, where the front end
+/// shows them (the viewer).
 pub fn submit_lights_into(frame: &EnvFrame, sums: &FrameSums) -> anyhow::Result<SubmittedFrame> {
     let (gpu, renderer) = env_renderer()?;
     let call = lights_call(frame, gpu)?;

@@ -2,13 +2,11 @@
 //! hair; build the point-light fiber model, or fit and bake the environment's SRBF scene) and
 //! *render* ([`render_frame`]: camera, lights and look → pixels). `strandlight render` and the
 //! demo do both once; the viewer prepares again only when a setting that preparation depends on
-//! changes, and renders its preview through the same [`render_frame`] and its light batches
-//! through [`render_frame_into`] (the same frame, added into one running sum on the GPU). Every
-//! env-lit frame, whoever draws it, is built by [`env_frame`].
+//! changes, and draws its preview and light batches through [`submit_frame_into`] (the same
+//! frame, its batches added into one running sum that stays on the GPU). Every env-lit frame,
+//! whoever draws it, is built by [`env_frame`].
 
-use crate::env_frame::{
-    EnvFrame, FrameRole, render_lights, render_lights_into, shared_gpu, submit_lights_into,
-};
+use crate::env_frame::{EnvFrame, FrameRole, render_lights, shared_gpu, submit_lights_into};
 use crate::env_light_sets::frame_lights;
 use crate::env_scene::PreparedEnv;
 use crate::frame_settings::{
@@ -388,19 +386,6 @@ pub fn render_frame(
         }
         _ => anyhow::bail!("the frame's lighting was prepared for other settings"),
     }
-}
-
-/// [`render_frame`] for a part of an env-lit frame added into `sums`, the running sum a
-/// progressive front end keeps across its batches (see [`crate::env_frame::frame_sums`]): the
-/// image is the sum so far.
-pub fn render_frame_into(
-    settings: &FrameSettings,
-    hair: &HairModel,
-    prepared: &PreparedEnv,
-    part: FramePart,
-    sums: &FrameSums,
-) -> anyhow::Result<RenderedFrame> {
-    render_lights_into(&env_frame(settings, hair, prepared, part, false)?, sums)
 }
 
 /// [`render_frame`] for a front end that shows the frame where it is (the viewer): `part` of

@@ -1,7 +1,8 @@
-//! From a linear frame to the window's pixels: the backdrop drawn behind the hair (exposure is
-//! `strandlight_scene::exposure`'s, metered on the hair), and the PNG's tonemap curve
-//! ([`PNG_TONEMAP`](strandlight_tables::image_out::PNG_TONEMAP)) so the window and a screenshot
-//! show the same thing.
+//! The window's picture on the CPU: the backdrop drawn behind the hair (uploaded to the GPU's
+//! display pass, `gpu_display`), and the composite and tonemap a screenshot's PNG is made with
+//! (exposure is `strandlight_scene::exposure`'s, metered on the hair; the curve is
+//! [`PNG_TONEMAP`](strandlight_tables::image_out::PNG_TONEMAP)), so the window and a screenshot
+//! show the same thing. The display pass is tested against [`composite`] and [`to_rgba8`].
 
 use crate::recompute::Backdrop;
 use glam::{DVec3, Vec4};

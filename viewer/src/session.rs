@@ -57,8 +57,9 @@ pub struct SessionReport {
     pub window_adapter: String,
     /// GPU→CPU copies of data (frames, depth, counters; not the pass timer's timestamps) made
     /// in the process from the command's start to the session's end, and those of them the
-    /// screenshots made. The rest would be on the frame path, which reads nothing back: the
-    /// renderer and the window share one device, and the window draws the frame where it is.
+    /// screenshots made. The rest are the frame path's: none where the window shares the
+    /// renderer's device and draws each frame where it is, one per new image where the window
+    /// has a device of its own (`WindowDevice`).
     pub data_readbacks: u64,
     pub screenshot_readbacks: u64,
     /// The device the window presented on.

@@ -161,39 +161,10 @@ impl EnvRenderer {
         )
     }
 
-    /// [`Self::render_part`] adding the part into `sums`, a running sum the caller keeps across
-    /// the parts of a progressive frame (a viewer's batches): the image is the running sum after
-    /// this part, read back; its stats are the part's own.
-    #[allow(clippy::too_many_arguments)]
-    pub fn render_part_into(
-        &self,
-        gpu: &GpuContext,
-        model: &HairModel,
-        camera: &Camera,
-        part: (&[EnvLight], u32),
-        tables: &EnvTables,
-        options: &EnvRenderOptions,
-        multiple: Option<&dyn ForwardScatteringSource>,
-        head: Option<&Head>,
-        sums: &FrameSums,
-    ) -> Result<EnvImage, EnvRenderError> {
-        let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::Validation);
-        let stats = self.encode_part_into(
-            gpu, model, camera, part, tables, options, multiple, head, sums,
-        )?;
-        read_image(
-            gpu,
-            scope,
-            sums.buffer(),
-            sums.size(),
-            multiple.is_some(),
-            stats,
-        )
-    }
-
-    /// [`Self::render_part_into`] without the readback: the part added into `sums` and
-    /// submitted, the sums left on the GPU for a caller that shows them there; validation
-    /// errors are checked. Returns the part's stats.
+    /// [`Self::render_part`] added into `sums`, a running sum the caller keeps across the parts
+    /// of a progressive frame (a viewer's batches), and submitted: the sums stay on the GPU for
+    /// a caller that shows them there ([`Self::read_sums`] reads them back). Validation errors
+    /// are checked. Returns the part's own stats.
     #[allow(clippy::too_many_arguments)]
     pub fn submit_part_into(
         &self,
