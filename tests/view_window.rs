@@ -146,7 +146,10 @@ fn on_the_renderers_device_the_window_reads_back_nothing_but_its_screenshot() {
             "--size",
             "160x120",
         ])
-        .args(["--scattering", "full", "--window-device", "shared"])
+        // Single scattering: on a hardware adapter the forward-scattering march of multiple
+        // scattering reads its grid (not the frame) back once per batch, the runtime's one
+        // documented exception; the display of the multiple-scattering half is unit-tested.
+        .args(["--scattering", "single", "--window-device", "shared"])
         .args(["--screenshot", "shot", "--report", "report.json"])
         .output()
         .expect("xvfb-run runs");

@@ -160,8 +160,8 @@ struct App {
     outcome: anyhow::Result<()>,
 }
 
-/// The window, its surface and egui's renderer on the renderer's device, and the display pass
-/// that draws each frame for egui where the frame is.
+/// The window, its surface and egui's renderer on the renderer's device or a device of its own
+/// ([`WindowDevice`]), and the display pass that draws each frame for egui.
 struct WindowGpu {
     window: Arc<Window>,
     surface: wgpu::Surface<'static>,
@@ -199,26 +199,38 @@ impl WindowGpu {
             ));
         let window = Arc::new(event_loop.create_window(attributes)?);
         let surface = instance.create_surface(window.clone())?;
+        let shared = device_choice != WindowDevice::Own;
+        // A window of its own may present from another adapter than the renderer's (a machine
+        // whose preferred GPU drives no display); a shared device must present from its own.
+        let adapter = match adapter.is_surface_supported(&surface) {
+            true => adapter.clone(),
+            false if shared => bail!(
+                "the renderer's adapter {} cannot present to this window (try --window-device own)",
+                adapter.get_info().name
+            ),
+            false => pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+                compatible_surface: Some(&surface),
+                ..Default::default()
+            }))
+            .context("no adapter can present to this window")?,
+        };
         let info = adapter.get_info();
         let adapter_name = format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type);
-        if !adapter.is_surface_supported(&surface) {
-            bail!("the renderer's adapter {adapter_name} cannot present to this window");
-        }
-        let (device, queue) = match device_choice {
-            WindowDevice::Own => {
-                let own = pollster::block_on(GpuContext::for_adapter(adapter.clone(), None))?;
-                (own.device, own.queue)
-            }
-            _ => {
+        let (device, queue) = match shared {
+            true => {
                 let gpu = shared_gpu()?;
                 (gpu.device.clone(), gpu.queue.clone())
+            }
+            false => {
+                let own = pollster::block_on(GpuContext::for_adapter(adapter.clone(), None))?;
+                (own.device, own.queue)
             }
         };
         let physical = window.inner_size();
         let mut config = surface
-            .get_default_config(adapter, physical.width.max(1), physical.height.max(1))
+            .get_default_config(&adapter, physical.width.max(1), physical.height.max(1))
             .context("the window's surface has no configuration on this adapter")?;
-        let caps = surface.get_capabilities(adapter);
+        let caps = surface.get_capabilities(&adapter);
         config.format = caps
             .formats
             .iter()
@@ -241,7 +253,7 @@ impl WindowGpu {
         );
         Ok((
             Self {
-                display: GpuDisplay::new(&device, device_choice == WindowDevice::Own),
+                display: GpuDisplay::new(&device, !shared),
                 window,
                 surface,
                 device,

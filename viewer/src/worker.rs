@@ -35,7 +35,8 @@ use crate::recompute::{TablesKey, tables_key};
 pub struct Shown {
     pub job: u64,
     pub settings: FrameSettings,
-    /// On the renderer's device (the window's too): the window draws it there.
+    /// On the renderer's device, where a window sharing it draws it; read back too for a
+    /// window with a device of its own.
     pub image: Arc<GpuImage>,
     pub stage: Stage,
     pub stats: FrameStats,
@@ -502,6 +503,7 @@ impl WorkerState {
             (Lighting::Environment(_), None) => unreachable!("set just above"),
         };
         // Each step leaves its image on the GPU, where a window on the same device draws it.
+        // Nothing is read back here but for a window with a device of its own (below).
         let (submitted, image) = match (step, prepared) {
             // Batches add up on the GPU, in the renderer's own batch-sum pass; the window gets
             // a copy of the sum so far.
