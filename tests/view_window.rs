@@ -153,11 +153,7 @@ fn on_the_renderers_device_the_window_reads_back_nothing_but_its_screenshot() {
         .args(["--screenshot", "shot", "--report", "report.json"])
         .output()
         .expect("xvfb-run runs");
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "view failed:\n{stderr}");
-    let report: Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
-    println!("{}", serde_json::to_string_pretty(&report).unwrap());
+    let report = view_report(&out, &dir);
     assert_eq!(report["window_device"], json!("shared"));
     let presented = report["frames_presented"].as_u64().unwrap();
     assert!(presented >= 3, "{report}");
@@ -170,16 +166,10 @@ fn on_the_renderers_device_the_window_reads_back_nothing_but_its_screenshot() {
         "GPU→CPU copies besides the screenshot over {presented} presented frames"
     );
     assert!(lit_share(&dir.join("shot.png")) > 0.02, "blank screenshot");
-    let rect: Vec<f64> = report["window_capture_image_rects_px"][0]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|v| v.as_f64().unwrap())
-        .collect();
     let difference = window_against_screenshot(
         &dir.join("shot-window.png"),
         &dir.join("shot.png"),
-        rect.try_into().unwrap(),
+        capture_rect(&report, 0),
     );
     println!("window capture against the screenshot: mean |Δ| {difference:.2} levels");
     assert!(
@@ -260,12 +250,29 @@ fn run_scripted_window(xvfb: &str, dir: &Path) -> Value {
         ])
         .output()
         .expect("xvfb-run runs");
+    view_report(&out, dir)
+}
+
+/// The report `view --report report.json` wrote in `dir`, printed; the run must have exited
+/// cleanly.
+fn view_report(out: &std::process::Output, dir: &Path) -> Value {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "view failed:\n{stderr}");
     let report: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
     println!("{}", serde_json::to_string_pretty(&report).unwrap());
     report
+}
+
+/// Where the image sat in window capture `i`, physical pixels: [x0, y0, x1, y1].
+fn capture_rect(report: &Value, i: usize) -> [f64; 4] {
+    let rect: Vec<f64> = report["window_capture_image_rects_px"][i]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    rect.try_into().unwrap()
 }
 
 /// The first bake and the rebake both ran while the window presented frames, with no gap near
@@ -322,16 +329,10 @@ fn assert_window_captures_show_the_screenshots(report: &Value, dir: &Path) {
         let window = dir.join(format!("{stem}-window.png"));
         let (ww, wh, _) = read_rgb8(&window);
         assert!(ww > 160 + 300 && wh > 120, "window capture {ww}x{wh}");
-        let rect: Vec<f64> = report["window_capture_image_rects_px"][i]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|v| v.as_f64().unwrap())
-            .collect();
         let difference = window_against_screenshot(
             &window,
             &dir.join(format!("{stem}.png")),
-            rect.try_into().unwrap(),
+            capture_rect(report, i),
         );
         println!(
             "{stem}: window capture against the screenshot in the image rect: mean |Δ| {difference:.2} levels"
