@@ -230,11 +230,15 @@ impl GpuDisplay {
             timestamp_writes: None,
         });
         pass.set_bind_group(0, &group, &[]);
-        for (pipeline, groups) in
-            self.passes
-                .iter()
-                .zip([per_pixel, [1, 1, 1], per_pixel, [1, 1, 1], per_pixel])
-        {
+        let dispatches =
+            (self.passes.iter()).zip([per_pixel, [1, 1, 1], per_pixel, [1, 1, 1], per_pixel]);
+        // Manual stops need no metering: only the display pass (the last) runs.
+        let metering = if request.exposure_stops.is_some() {
+            4
+        } else {
+            0
+        };
+        for (pipeline, groups) in dispatches.skip(metering) {
             pass.set_pipeline(pipeline);
             pass.dispatch_workgroups(groups[0], groups[1], groups[2]);
         }

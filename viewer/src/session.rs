@@ -440,8 +440,7 @@ impl Session {
     /// The picture the window's display pass should draw before this frame's UI, when it
     /// changed: a new image from the worker, or new display settings.
     pub fn picture_to_draw(&mut self) -> Option<DisplayRequest> {
-        let status = self.worker.status().clone();
-        let shown = status.shown.as_ref()?;
+        let shown = self.worker.status().shown.clone()?;
         let unchanged = self.on_screen.as_ref().is_some_and(|o| {
             o.job == shown.job
                 && o.stage == shown.stage
@@ -449,7 +448,7 @@ impl Session {
                 && o.display == self.state.display
         });
         if !unchanged {
-            let backdrop = self.background_of(shown, shown.image.size);
+            let backdrop = self.background_of(&shown, shown.image.size);
             let request = DisplayRequest {
                 image: shown.image.clone(),
                 exposure_stops: self.state.display.exposure_stops,

@@ -4,6 +4,7 @@
 use glam::{DVec3, Vec3};
 use strandlight_runtime::camera::{Camera, Projection};
 use strandlight_runtime::gpu::GpuContext;
+use strandlight_runtime::gpu::texture::texture_2d;
 use strandlight_runtime::hair::{Attribute, HairModel};
 
 /// Texels of the slab's light maps (and pixels of the test images) across.
@@ -141,22 +142,13 @@ impl HostTargets {
         colour: wgpu::TextureFormat,
         depth: wgpu::TextureFormat,
     ) -> Self {
-        let target = |format, label| {
-            gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[],
-            })
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
         };
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC;
+        let target = |format, label| texture_2d(gpu, label, size, format, usage);
         Self {
             colour: target(colour, "host colour"),
             depth: target(depth, "host depth"),
