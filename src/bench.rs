@@ -65,8 +65,9 @@ pub struct BenchArgs {
     #[arg(long)]
     pub decomposition_only: bool,
     /// The head in every frame, the ground truth's too: none, ellipsoid (fitted to the strand
-    /// roots) or a mesh FILE (.obj, .glb, .gltf, .usd*) (default: the plan's, none).
-    #[arg(long, value_name = "none|ellipsoid|FILE")]
+    /// roots) or a mesh FILE (.obj, .glb, .gltf, .usd*; several, comma-separated, make one
+    /// head) (default: the plan's, none).
+    #[arg(long, value_name = "none|ellipsoid|FILE[,FILE...]")]
     pub head: Option<HeadChoice>,
     /// The fiber's melanin preset (white, blonde, red, auburn, brown, dark) in every frame and
     /// ground truth (default: the plan's, brown).

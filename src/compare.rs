@@ -57,9 +57,9 @@ struct SceneFlags {
     #[arg(long)]
     preset: Option<String>,
     /// The head in every frame (the SRBF path's, the reference's, the baseline's, the truth's):
-    /// none, ellipsoid (fitted to the strand roots) or a mesh FILE (.obj, .glb, .gltf, .usd*)
-    /// (default: none).
-    #[arg(long, value_name = "none|ellipsoid|FILE")]
+    /// none, ellipsoid (fitted to the strand roots) or a mesh FILE (.obj, .glb, .gltf, .usd*;
+    /// several, comma-separated, make one head) (default: none).
+    #[arg(long, value_name = "none|ellipsoid|FILE[,FILE...]")]
     head: Option<strandlight_scene::head_input::HeadChoice>,
 }
 

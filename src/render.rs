@@ -83,8 +83,9 @@ struct SceneArgs {
     /// The head the hair grows from: none, ellipsoid (fitted to the strand roots) or a mesh FILE:
     /// .obj (in the hair's units and frame), .glb/.gltf or .usd/.usda/.usdc/.usdz (every mesh in
     /// the scene, Y up in centimetres as USD grooms are); it hides the hair behind it, is drawn
-    /// as diffuse skin and shadows every light.
-    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE")]
+    /// as diffuse skin and shadows every light. Several files, comma-separated, make one head
+    /// (a character's skin, eyes and lashes).
+    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE[,FILE...]")]
     head: HeadChoice,
 }
 

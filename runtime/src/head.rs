@@ -78,6 +78,19 @@ impl TriangleMesh {
         Self::new(positions, normals, indices)
     }
 
+    /// One mesh holding every triangle of `meshes` (a character's skin, eyes and lashes read
+    /// from separate files), in the order given.
+    pub fn merged(meshes: impl IntoIterator<Item = TriangleMesh>) -> Self {
+        let (mut positions, mut normals, mut indices) = (Vec::new(), Vec::new(), Vec::new());
+        for mesh in meshes {
+            let base = positions.len() as u32;
+            indices.extend(mesh.indices.iter().map(|i| base + i));
+            positions.extend(mesh.positions);
+            normals.extend(mesh.normals);
+        }
+        Self::new(positions, normals, indices)
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
     }
@@ -374,6 +387,28 @@ pub fn tessellate_ellipsoid(center: Vec3, radii: Vec3) -> TriangleMesh {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Two meshes merged keep each one's triangles where they were: a ray through the part only
+    /// the second covers meets the second's triangle (an index not offset past the first
+    /// mesh's vertices would draw it from the first's corners instead).
+    #[test]
+    fn merged_meshes_keep_every_triangle_in_place() {
+        let triangle = |z: f32, x0: f32| {
+            TriangleMesh::with_computed_normals(
+                vec![Vec3::new(x0, 0.0, z), Vec3::new(x0 + 1.0, 0.0, z), Vec3::new(x0, 1.0, z)],
+                vec![0, 1, 2],
+            )
+        };
+        let merged = TriangleMesh::merged([triangle(0.0, 0.0), triangle(1.0, 5.0)]);
+        assert_eq!(merged.triangle_count(), 2);
+        assert_eq!(merged.normals.len(), merged.positions.len());
+        let down = Vec3::new(0.0, 0.0, -1.0);
+        let first = merged.ray_hit(Vec3::new(0.2, 0.2, 3.0), down, 10.0);
+        let second = merged.ray_hit(Vec3::new(5.2, 0.2, 3.0), down, 10.0);
+        assert!((first.unwrap() - 3.0).abs() < 1e-5, "{first:?}");
+        assert!((second.unwrap() - 2.0).abs() < 1e-5, "{second:?}");
+        assert_eq!(merged.ray_hit(Vec3::new(3.0, 0.2, 3.0), down, 10.0), None);
+    }
 
     /// ∫ exp(λ(ω·ξ − 1)) max(n·ω, 0) dω by quadrature in f64: ξ at the pole, n tilted by θ_n in
     /// the xz plane; Gauss-free midpoint rule, 800 × 1600 cells in (cos θ, φ) (exact area

@@ -486,7 +486,7 @@ mod tests {
         assert_eq!(back.head, HeadChoice::None);
         assert_eq!(back.skin_albedo, default_skin_albedo());
         let mut with_head = settings.clone();
-        with_head.head = HeadChoice::Mesh("heads/a.obj".into());
+        with_head.head = HeadChoice::mesh("heads/a.obj");
         with_head.skin_albedo = [0.2, 0.1, 0.05];
         let json = with_head.to_json();
         let back: FrameSettings = serde_json::from_str(&json).unwrap();

@@ -32,8 +32,59 @@ pub enum HeadChoice {
     None,
     /// An ellipsoid fitted to the strand roots (see the module's documentation).
     Ellipsoid,
-    /// A triangle mesh from a file ([`MESH_EXTENSIONS`]): every mesh in it, merged.
-    Mesh(PathBuf),
+    /// Triangle meshes from one or more files ([`MESH_EXTENSIONS`]): every mesh in each,
+    /// merged (a character's skin, eyes and lashes often come as separate files).
+    Mesh(MeshFiles),
+}
+
+/// The files of a mesh head, at least one; written as one path, or as a list when several
+/// (settings written before several were taken hold one path and read the same).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(from = "MeshFilesForm", into = "MeshFilesForm")]
+pub struct MeshFiles(Vec<PathBuf>);
+
+#[derive(Serialize, Deserialize)]
+#[serde(untagged)]
+enum MeshFilesForm {
+    One(PathBuf),
+    Several(Vec<PathBuf>),
+}
+
+impl From<MeshFilesForm> for MeshFiles {
+    fn from(form: MeshFilesForm) -> Self {
+        match form {
+            MeshFilesForm::One(path) => Self(vec![path]),
+            MeshFilesForm::Several(paths) => Self(paths),
+        }
+    }
+}
+
+impl From<MeshFiles> for MeshFilesForm {
+    fn from(files: MeshFiles) -> Self {
+        match <[PathBuf; 1]>::try_from(files.0) {
+            Ok([path]) => Self::One(path),
+            Err(paths) => Self::Several(paths),
+        }
+    }
+}
+
+impl MeshFiles {
+    pub fn paths(&self) -> &[PathBuf] {
+        &self.0
+    }
+}
+
+impl From<PathBuf> for MeshFiles {
+    fn from(path: PathBuf) -> Self {
+        Self(vec![path])
+    }
+}
+
+impl HeadChoice {
+    /// The head in the mesh file at `path`.
+    pub fn mesh(path: impl Into<PathBuf>) -> Self {
+        Self::Mesh(MeshFiles::from(path.into()))
+    }
 }
 
 impl HeadChoice {
@@ -41,16 +92,29 @@ impl HeadChoice {
         *self == HeadChoice::None
     }
 
-    /// `none`, `ellipsoid` or a path to a mesh file (one of [`MESH_EXTENSIONS`]).
+    /// `none`, `ellipsoid`, or mesh files (each one of [`MESH_EXTENSIONS`]) separated by
+    /// commas: `sintel.obj,sintel-eyes.obj`. A path that is itself a mesh file name is taken
+    /// whole, commas and all.
     pub fn parse(text: &str) -> Result<Self, String> {
+        let refused = |what: &str| {
+            format!(
+                "`{what}`: give none, ellipsoid or mesh files ending in {} (several separated by commas)",
+                MESH_EXTENSIONS.map(|e| format!(".{e}")).join(", ")
+            )
+        };
         match text {
             "none" => Ok(Self::None),
             "ellipsoid" => Ok(Self::Ellipsoid),
-            path if is_mesh_file(Path::new(path)) => Ok(Self::Mesh(PathBuf::from(path))),
-            other => Err(format!(
-                "`{other}`: give none, ellipsoid or a mesh file ending in {}",
-                MESH_EXTENSIONS.map(|e| format!(".{e}")).join(", ")
-            )),
+            path if is_mesh_file(Path::new(path)) && Path::new(path).exists() => {
+                Ok(Self::mesh(path))
+            }
+            list => {
+                let paths: Vec<PathBuf> = list.split(',').map(PathBuf::from).collect();
+                match paths.iter().find(|p| !is_mesh_file(p)) {
+                    Some(bad) => Err(refused(&bad.display().to_string())),
+                    None => Ok(Self::Mesh(MeshFiles(paths))),
+                }
+            }
         }
     }
 }
@@ -60,7 +124,10 @@ impl std::fmt::Display for HeadChoice {
         match self {
             Self::None => write!(f, "none"),
             Self::Ellipsoid => write!(f, "ellipsoid"),
-            Self::Mesh(path) => write!(f, "{}", path.display()),
+            Self::Mesh(files) => {
+                let paths: Vec<String> = files.0.iter().map(|p| p.display().to_string()).collect();
+                write!(f, "{}", paths.join(","))
+            }
         }
     }
 }
@@ -98,7 +165,9 @@ pub fn load_head(
                 radii: fit.radii,
             }
         }
-        HeadChoice::Mesh(path) => HeadSurface::Mesh(load_mesh(path)?),
+        HeadChoice::Mesh(files) => HeadSurface::Mesh(TriangleMesh::merged(
+            files.paths().iter().map(|p| load_mesh(p)).collect::<anyhow::Result<Vec<_>>>()?,
+        )),
     };
     if albedo.iter().any(|a| !(0.0..=1.0).contains(a)) {
         bail!("skin albedo {albedo:?}: each channel must be in [0, 1]");
@@ -486,12 +555,60 @@ mod tests {
         assert_eq!(HeadChoice::parse("ellipsoid"), Ok(HeadChoice::Ellipsoid));
         assert_eq!(
             HeadChoice::parse("a/head.OBJ"),
-            Ok(HeadChoice::Mesh("a/head.OBJ".into()))
+            Ok(HeadChoice::mesh("a/head.OBJ"))
         );
         assert!(
             HeadChoice::parse("head.ply")
                 .unwrap_err()
                 .contains("head.ply")
         );
+        let several = HeadChoice::parse("a/skin.obj,b/eyes.glb").unwrap();
+        assert_eq!(
+            several,
+            HeadChoice::Mesh(MeshFiles(vec!["a/skin.obj".into(), "b/eyes.glb".into()]))
+        );
+        assert_eq!(several.to_string(), "a/skin.obj,b/eyes.glb");
+        let error = HeadChoice::parse("skin.obj,eyes.png").unwrap_err();
+        assert!(error.contains("`eyes.png`"), "{error}");
+    }
+
+    /// One file is written as the path alone, as every settings file before several were
+    /// taken; several as a list; both read back.
+    #[test]
+    fn mesh_files_are_written_as_one_path_or_a_list() {
+        let one = HeadChoice::mesh("a.obj");
+        assert_eq!(serde_json::to_string(&one).unwrap(), r#"{"mesh":"a.obj"}"#);
+        let several = HeadChoice::parse("a.obj,b.obj").unwrap();
+        let json = serde_json::to_string(&several).unwrap();
+        assert_eq!(json, r#"{"mesh":["a.obj","b.obj"]}"#);
+        for (json, choice) in [(r#"{"mesh":"a.obj"}"#, one), (json.as_str(), several)] {
+            assert_eq!(serde_json::from_str::<HeadChoice>(json).unwrap(), choice);
+        }
+    }
+
+    /// A head from two OBJ files has both files' triangles; a missing second file is named.
+    #[test]
+    fn a_head_from_several_files_holds_every_files_triangles() {
+        let dir = std::env::temp_dir().join(format!("strandlight-head-m{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (quad, triangle) = (dir.join("quad.obj"), dir.join("tri.obj"));
+        std::fs::write(&quad, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+        std::fs::write(&triangle, "v 0 0 2\nv 1 0 2\nv 0 1 2\nf 1 2 3\n").unwrap();
+        let hair = HairModel::new(vec![Vec3::ZERO, Vec3::Y], vec![0, 2], None, None, None).unwrap();
+        let list = format!("{},{}", quad.display(), triangle.display());
+        let head = load_head(&HeadChoice::parse(&list).unwrap(), &hair, [0.5; 3])
+            .unwrap()
+            .unwrap();
+        let HeadSurface::Mesh(mesh) = head.surface else {
+            panic!("a mesh head")
+        };
+        assert_eq!(mesh.triangle_count(), 3);
+        assert_eq!(mesh.positions[4].z, 2.0);
+        let missing = format!("{},{}", quad.display(), dir.join("gone.obj").display());
+        let error = format!(
+            "{:#}",
+            load_head(&HeadChoice::parse(&missing).unwrap(), &hair, [0.5; 3]).unwrap_err()
+        );
+        assert!(error.contains("gone.obj"), "{error}");
     }
 }

@@ -343,7 +343,7 @@ impl Session {
                 self.edit(|s| s.settings.light_with_environment(map));
             }
             // A USD file stays a groom: hair is what a dropped scene file usually brings.
-            "obj" | "glb" | "gltf" => self.edit(|s| s.settings.head = HeadChoice::Mesh(path)),
+            "obj" | "glb" | "gltf" => self.edit(|s| s.settings.head = HeadChoice::mesh(path)),
             _ => {
                 self.message = Some(format!(
                     "{}: not a hair file (.hair, .tfx, .data, .ply, .usda, .usdc, .usdz, .usd, .abc), an environment map (.hdr, .exr) or a head mesh (.obj, .glb, .gltf)",

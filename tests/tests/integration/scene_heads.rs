@@ -122,6 +122,18 @@ fn gltf_and_usd_heads_load_where_their_writers_put_them() {
             .expect("a head");
         assert!(matches!(&head.surface, HeadSurface::Mesh(m) if *m == mesh));
     }
+    // Files of both kinds in one head, as `--head skin.glb,eyes.usda`: every triangle of each.
+    let (glb, usda) = (dir.join("head.glb"), dir.join("head.usda"));
+    let both = HeadChoice::parse(&format!("{},{}", glb.display(), usda.display())).unwrap();
+    let head = load_head(&both, &hair, default_skin_albedo())
+        .unwrap()
+        .expect("a head");
+    let HeadSurface::Mesh(merged) = &head.surface else {
+        panic!("a mesh head")
+    };
+    let parts = [load_mesh(&glb).unwrap(), load_mesh(&usda).unwrap()];
+    assert_eq!(merged.triangle_count(), parts[0].triangle_count() + parts[1].triangle_count());
+    assert_eq!(*merged, TriangleMesh::merged(parts));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
