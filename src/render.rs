@@ -85,7 +85,11 @@ struct SceneArgs {
     /// the scene, Y up in centimetres as USD grooms are); it hides the hair behind it, is drawn
     /// as diffuse skin and shadows every light. Several files, comma-separated, make one head
     /// (a character's skin, eyes and lashes).
-    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE[,FILE...]")]
+    #[arg(
+        long,
+        default_value = "none",
+        value_name = "none|ellipsoid|FILE[,FILE...]"
+    )]
     head: HeadChoice,
 }
 
@@ -126,7 +130,7 @@ struct EnvArgs {
     rotate: f32,
     /// Side of each light's convolution optical depth map, texels; a compact source holding
     /// at least a quarter of the map's power draws its map at four times the side (at most
-    /// 2048; docs/BENCHMARKS.md, "Fine maps for dominant suns").
+    /// 2048; docs/history/benchmarks-2026-12-05-to-12-06.md, "Fine maps for dominant suns").
     #[arg(long, default_value_t = 512)]
     light_map_size: u32,
     /// The head's skin: diffuse albedo, linear R,G,B each in [0, 1].

@@ -43,7 +43,11 @@ pub struct TruthArgs {
     /// The head under the hair: none, ellipsoid (fitted to the strand roots) or a mesh
     /// FILE (.obj, .glb, .gltf, .usd, .usda, .usdc, .usdz); several files, comma-separated,
     /// make one head.
-    #[arg(long, default_value = "none", value_name = "none|ellipsoid|FILE[,FILE...]")]
+    #[arg(
+        long,
+        default_value = "none",
+        value_name = "none|ellipsoid|FILE[,FILE...]"
+    )]
     pub head: HeadChoice,
     /// Scattering modes: single (direct light, max_depth 2) and full (path traced).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "single,full")]

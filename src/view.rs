@@ -33,7 +33,11 @@ pub struct ViewArgs {
     /// The head the hair grows from: none, ellipsoid (fitted to the strand roots) or a mesh
     /// FILE (.obj, .glb, .gltf, .usd, .usda, .usdc, .usdz); several files, comma-separated,
     /// make one head (skin, eyes, lashes).
-    #[arg(long, default_value = "ellipsoid", value_name = "none|ellipsoid|FILE[,FILE...]")]
+    #[arg(
+        long,
+        default_value = "ellipsoid",
+        value_name = "none|ellipsoid|FILE[,FILE...]"
+    )]
     head: HeadChoice,
     /// Image size WxH in pixels (the window shows it scaled to fit).
     #[arg(long, default_value = "640x480")]

@@ -49,10 +49,10 @@ pub struct EnvLight {
 
 /// The power share from which a compact source's map is drawn finer
 /// ([`EnvLight::has_fine_map`]). Measured on straight.hair at 160×120 against the truth
-/// (docs/BENCHMARKS.md, "Fine maps for dominant suns"): quarry's sun, 50% of the power, takes
-/// the frame from 0.274 to 0.226 relative RMSE at 4× the map's side, a held-out low sun 0.297
-/// to 0.288 (a held-out high sun loses 0.009); sources of 2–7% each (spruit's sun, golf's and
-/// studio's lamps) gain at most 0.01 at 1.5–5× the cost.
+/// (docs/history/benchmarks-2026-12-05-to-12-06.md, "Fine maps for dominant suns"): quarry's
+/// sun, 50% of the power, takes the frame from 0.274 to 0.226 relative RMSE at 4× the map's
+/// side, a held-out low sun 0.297 to 0.288 (a held-out high sun loses 0.009); sources of 2–7%
+/// each (spruit's sun, golf's and studio's lamps) gain at most 0.01 at 1.5–5× the cost.
 pub const FINE_MAP_POWER_SHARE: f32 = 0.25;
 
 impl EnvLight {

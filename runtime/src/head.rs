@@ -395,7 +395,11 @@ mod tests {
     fn merged_meshes_keep_every_triangle_in_place() {
         let triangle = |z: f32, x0: f32| {
             TriangleMesh::with_computed_normals(
-                vec![Vec3::new(x0, 0.0, z), Vec3::new(x0 + 1.0, 0.0, z), Vec3::new(x0, 1.0, z)],
+                vec![
+                    Vec3::new(x0, 0.0, z),
+                    Vec3::new(x0 + 1.0, 0.0, z),
+                    Vec3::new(x0, 1.0, z),
+                ],
                 vec![0, 1, 2],
             )
         };

@@ -10,7 +10,8 @@ use crate::env_frame::{EnvFrame, FrameRole, render_lights, shared_gpu, submit_li
 use crate::env_light_sets::frame_lights;
 use crate::env_scene::PreparedEnv;
 use crate::frame_settings::{
-    EnvLighting, FrameSettings, Lighting, PointLighting, Shadows, Transparency,
+    CameraSettings, EnvLighting, ExactCamera, FrameSettings, Lighting, PointLighting, Shadows,
+    Transparency,
 };
 use crate::hair_input::{OPAQUE_FIBERS, fibers_for, load_hair, procedural_style};
 use crate::head_input::load_head;
@@ -312,17 +313,57 @@ pub const PREVIEW_MAP_RESOLUTION: u32 = 128;
 /// hair; 8 nodes 0.049 in 0.53 s, 6 nodes 0.072 in 0.49 s:
 /// docs/history/benchmarks-2026-12-05-to-12-06.md, "The first look").
 pub const PREVIEW_TABLE_NODES: usize = 12;
+/// Most SRBF lobes of the map's fit a first look is drawn with (the compact sources are fitted
+/// as always). The preview draws only its [`PREVIEW_LIGHTS`] strongest lights: of the full
+/// fit's 30–64 lobes those are the compact sources and a lobe or two, and the sky is missing
+/// (0.22–0.47 of the whole frame's light). A fit of 6 lobes spreads the map over few lights,
+/// and fits in 0.2–0.5 s where the full fit takes 0.9–4.5 s on a cold cache; its first look is
+/// 0.25–0.36 from the whole frame over 16×16 blocks where the full fit's was 0.51–0.74 (four
+/// maps, 800×600; docs/BENCHMARKS.md, "The viewer's first look").
+pub const FIRST_LOOK_FIT_LOBES: usize = 6;
 
 /// `settings` as a first look draws them on a cold cache ([`FramePart::Preview`]): an
-/// environment's single scattering from tables of [`PREVIEW_TABLE_NODES`] nodes (cached apart
-/// from the full ones). Point lights have no tables to wait for: unchanged.
+/// environment fitted with at most [`FIRST_LOOK_FIT_LOBES`] lobes, single scattering from
+/// tables of [`PREVIEW_TABLE_NODES`] nodes (fit and tables cached apart from the full ones).
+/// Point lights have no tables to wait for: unchanged.
 pub fn coarse_preview_settings(settings: &FrameSettings) -> FrameSettings {
     let mut coarse = settings.clone();
     if let Lighting::Environment(env) = &mut coarse.lighting {
         env.scattering = ScatteringMode::Single;
         env.table_resolution = Some(PREVIEW_TABLE_NODES);
+        env.fit.max_lobes = env.fit.max_lobes.min(FIRST_LOOK_FIT_LOBES);
     }
     coarse
+}
+
+/// A first look draws every this many strands, each this many times as thick. The viewer's
+/// first lit frame at 800×600 on lavapipe, tables cached: 0.96–1.03 s drawing every strand,
+/// 0.72–0.76 s every fourth; that first look differs from the unthinned one by 0.18 over
+/// 16×16 blocks (every second strand: 0.09), and the full frame replaces it (docs/BENCHMARKS.md,
+/// "The viewer's first look").
+pub const FIRST_LOOK_THINNING: usize = 4;
+/// ... and keeps every this many points of each strand (and its last). The default groom's
+/// first look, its lights' maps and visibility drawn from half the segments: the view
+/// visibility pass 133–144 → 91 ms and the light pass 63–65 → 46–49 ms at 800×600 on lavapipe
+/// (first lit 0.75–0.82 → 0.69–0.79 s, three runs alternating); against the whole frame it reads as it did (0.356 over
+/// 16×16 blocks at both; every third point: 0.347).
+pub const FIRST_LOOK_POINT_STEP: usize = 2;
+
+/// The settings and groom a first look of `settings` is drawn with ([`FramePart::Preview`]): a
+/// thinned groom ([`HairModel::thinned`], [`HairModel::with_fewer_points`]) seen by the full
+/// groom's camera, so the picture does not move when the full frame replaces it. A head fitted to the roots (`--head ellipsoid`) is fitted to the
+/// kept strands' roots, an even sample of them.
+pub fn first_look(
+    settings: &FrameSettings,
+    hair: &HairModel,
+) -> anyhow::Result<(FrameSettings, HairModel)> {
+    let camera = ExactCamera::of(&settings_camera(settings, hair)?);
+    let settings = FrameSettings {
+        camera: CameraSettings::Exact(camera),
+        ..settings.clone()
+    };
+    let hair = hair.thinned(FIRST_LOOK_THINNING);
+    Ok((settings, hair.with_fewer_points(FIRST_LOOK_POINT_STEP)))
 }
 
 /// Which part of a settings' frame to render.

@@ -166,7 +166,11 @@ pub fn load_head(
             }
         }
         HeadChoice::Mesh(files) => HeadSurface::Mesh(TriangleMesh::merged(
-            files.paths().iter().map(|p| load_mesh(p)).collect::<anyhow::Result<Vec<_>>>()?,
+            files
+                .paths()
+                .iter()
+                .map(|p| load_mesh(p))
+                .collect::<anyhow::Result<Vec<_>>>()?,
         )),
     };
     if albedo.iter().any(|a| !(0.0..=1.0).contains(a)) {

@@ -20,11 +20,9 @@ use strandlight_scene::env_light_sets::{frame_lights, light_luminance};
 use strandlight_scene::env_scene::{AlsoServe, PrepareProgress, PreparedEnv, prepare_env};
 use strandlight_scene::frame_render::{
     FrameHair, Prepared, PreparedPoint, SubmittedFrame, coarse_preview_settings, env_look,
-    load_settings_hair, prepare_point, settings_camera, submit_frame_into,
+    first_look, load_settings_hair, prepare_point, settings_camera, submit_frame_into,
 };
-use strandlight_scene::frame_settings::{
-    CameraSettings, ExactCamera, FrameSettings, Lighting, PointLighting, up_choice,
-};
+use strandlight_scene::frame_settings::{FrameSettings, Lighting, PointLighting, up_choice};
 use strandlight_scene::steps::Steps;
 
 use crate::frame::{FrameStats, GpuImage, Stage};
@@ -592,27 +590,4 @@ fn submit_whole(
     let submitted = submit_frame_into(settings, hair, prepared, step.part(), &sums)?;
     let image = GpuImage::of_finished(sums, submitted.with_multiple);
     Ok((submitted, image))
-}
-
-/// A first look draws every this many strands, each this many times as thick. The viewer's
-/// first lit frame at 800×600 on lavapipe, tables cached: 0.96–1.03 s drawing every strand,
-/// 0.72–0.76 s every fourth; that first look differs from the unthinned one by 0.18 over
-/// 16×16 blocks (every second strand: 0.09), and the full frame replaces it (docs/BENCHMARKS.md,
-/// "The viewer's first look").
-const FIRST_LOOK_THINNING: usize = 4;
-
-/// The settings and groom a first look of `settings` is drawn with: a thinned groom
-/// ([`HairModel::thinned`]) seen by the full groom's camera, so the picture does not move when
-/// the full frame replaces it. A head fitted to the roots (`--head ellipsoid`) is fitted to the
-/// kept strands' roots, an even sample of them.
-fn first_look(
-    settings: &FrameSettings,
-    hair: &HairModel,
-) -> anyhow::Result<(FrameSettings, HairModel)> {
-    let camera = ExactCamera::of(&settings_camera(settings, hair)?);
-    let settings = FrameSettings {
-        camera: CameraSettings::Exact(camera),
-        ..settings.clone()
-    };
-    Ok((settings, hair.thinned(FIRST_LOOK_THINNING)))
 }

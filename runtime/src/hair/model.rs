@@ -209,6 +209,38 @@ impl HairModel {
         .expect("a subset of a valid model's strands is valid")
     }
 
+    /// Every `k`th point of each strand and its last (so no strand gets shorter): about a
+    /// `k`th of the segments, each `k` times as long, for a first look drawn at a fraction of
+    /// a strand's on-screen length per segment.
+    pub fn with_fewer_points(&self, k: usize) -> HairModel {
+        if k <= 1 {
+            return self.clone();
+        }
+        let mut point_indices = Vec::new();
+        let mut strand_offsets = vec![0u32];
+        for s in 0..self.strand_count() {
+            let (first, end) = (
+                self.strand_offsets[s] as usize,
+                self.strand_offsets[s + 1] as usize,
+            );
+            point_indices.extend((first..end).step_by(k));
+            if (end - 1 - first) % k != 0 {
+                point_indices.push(end - 1);
+            }
+            strand_offsets.push(point_indices.len() as u32);
+        }
+        let points = point_indices.iter().map(|&i| self.points[i]).collect();
+        let kept_of = |a: &Option<Attribute<f32>>| a.as_ref().map(|a| a.at_points(&point_indices));
+        HairModel::new(
+            points,
+            strand_offsets,
+            kept_of(&self.thickness),
+            kept_of(&self.transparency),
+            self.color.as_ref().map(|c| c.at_points(&point_indices)),
+        )
+        .expect("a strand's first and last points with some between form a valid strand")
+    }
+
     pub fn points(&self) -> &[Vec3] {
         &self.points
     }
@@ -514,5 +546,44 @@ mod tests {
         let thin = unthickened.thinned(2);
         assert_eq!(thin.strand_count(), 5);
         assert!((thin.thickness().unwrap().at(0) - 2.0 * default).abs() < 1e-7);
+    }
+
+    /// Fewer points keep every `k`th point of each strand and its last, with their attributes:
+    /// a strand of 7 points at k = 3 keeps 0, 3, 6; one of 5 keeps 0, 3, 4; one of 2 keeps both.
+    #[test]
+    fn fewer_points_keep_every_kth_point_and_each_strands_last() {
+        let lengths = [7usize, 5, 2];
+        let mut points = Vec::new();
+        let mut offsets = vec![0u32];
+        for (s, &n) in lengths.iter().enumerate() {
+            points.extend((0..n).map(|i| Vec3::new(s as f32, i as f32, 0.0)));
+            offsets.push(points.len() as u32);
+        }
+        let thickness = (0..points.len()).map(|i| 0.01 * (i + 1) as f32).collect();
+        let model = HairModel::new(
+            points,
+            offsets,
+            Some(Attribute::PerPoint(thickness)),
+            None,
+            None,
+        )
+        .unwrap();
+        let fewer = model.with_fewer_points(3);
+        let kept: [&[usize]; 3] = [&[0, 3, 6], &[0, 3, 4], &[0, 1]];
+        assert_eq!(fewer.strand_count(), 3);
+        let mut i = 0;
+        for (s, kept) in kept.into_iter().enumerate() {
+            let ys: Vec<f32> = fewer.strand(s).iter().map(|p| p.y).collect();
+            assert_eq!(ys, kept.iter().map(|&k| k as f32).collect::<Vec<_>>());
+            for &k in kept {
+                let j = model.strand_offsets()[s] as usize + k;
+                assert_eq!(
+                    fewer.thickness().unwrap().at(i),
+                    model.thickness().unwrap().at(j)
+                );
+                i += 1;
+            }
+        }
+        assert_eq!(model.with_fewer_points(1), model);
     }
 }

@@ -186,7 +186,7 @@ fn effective_transmittance(slot: u32, world: vec3<f32>) -> f32 {
 // the light through instead of searching for the hair's front (the frame moves by 1e-4), and
 // the head's filter is compiled in only `with_head` (a constant of the entry point). llvmpipe
 // runs every branch, taken or not, the loops' first pass included: these two are most of the
-// gather's cost (docs/BENCHMARKS.md, "The compact sources' gather").
+// gather's cost (docs/history/benchmarks-2026-12-05-to-12-06.md, "The compact sources' gather").
 fn directional_transmittance(slot: u32, world: vec3<f32>, with_head: bool) -> f32 {
     if ((batch.flags & FLAG_UNSHADOWED) != 0u) { return 1.0; }
     let light = env_lights[slot];

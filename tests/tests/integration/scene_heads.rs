@@ -132,7 +132,10 @@ fn gltf_and_usd_heads_load_where_their_writers_put_them() {
         panic!("a mesh head")
     };
     let parts = [load_mesh(&glb).unwrap(), load_mesh(&usda).unwrap()];
-    assert_eq!(merged.triangle_count(), parts[0].triangle_count() + parts[1].triangle_count());
+    assert_eq!(
+        merged.triangle_count(),
+        parts[0].triangle_count() + parts[1].triangle_count()
+    );
     assert_eq!(*merged, TriangleMesh::merged(parts));
     std::fs::remove_dir_all(&dir).unwrap();
 }
