@@ -8,13 +8,13 @@ use std::path::{Path, PathBuf};
 use strandlight_runtime::hair::yuksel::{HairWriteOptions, encode_hair};
 use strandlight_scene::env_scene::{AlsoServe, PreparedEnv, prepare_env};
 use strandlight_scene::environment::ensure_procedural_envmap;
-use strandlight_scene::frame_render::load_settings_hair;
+use strandlight_scene::frame_render::{coarse_preview_settings, load_settings_hair};
 use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting};
 use strandlight_scene::look::{ForwardDevice, LobeVisibilityArg};
 use strandlight_scene::scene_tables::ScatteringMode;
 use strandlight_scene::steps::Steps;
 use strandlight_scene::web_bundle::{
-    HAIR_FILE, SCENE_FILE, SETTINGS_FILE, TABLES_DIR, bundle_scene,
+    BundledPreset, HAIR_FILE, SCENE_FILE, SETTINGS_FILE, TABLES_DIR, bundle_scene,
 };
 use strandlight_tables::atomic_write::write_atomically;
 
@@ -90,13 +90,20 @@ pub fn run(args: WebArgs) -> anyhow::Result<()> {
     )?;
     let mut prepared = Vec::new();
     for preset in &args.preset {
-        let scene = prepare_preset(&settings, &hair.model, preset, &mut steps)?;
-        prepared.push((preset.clone(), scene));
+        let full = prepare_preset(&settings, &hair.model, preset, &mut steps)?;
+        let coarse = coarse_preview_settings(&settings);
+        let first_look = prepare_preset(&coarse, &hair.model, preset, &mut steps)?;
+        prepared.push((preset.clone(), full, first_look));
     }
     let first_preset = &args.preset[0];
     settings.preset = first_preset.clone();
-    let presets: Vec<(String, &PreparedEnv)> =
-        prepared.iter().map(|(p, s)| (p.clone(), s)).collect();
+    let presets: Vec<BundledPreset> = (prepared.iter())
+        .map(|(name, full, first_look)| BundledPreset {
+            name: name.clone(),
+            full,
+            first_look,
+        })
+        .collect();
     let (scene, tables) = bundle_scene(&prepared[0].1.map()?.name, &presets)?;
     let out = &args.out;
     let written = steps.run(

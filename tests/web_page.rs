@@ -247,8 +247,7 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
 fn assert_the_first_look_opens_before_the_other_tables(bundle: &Path, every_table: &Image) {
     let files = bundle_files(bundle);
     let scene = BundleScene::parse(&files[SCENE_FILE]).unwrap();
-    let first_look: Vec<&str> = (scene.presets.values().flatten())
-        .filter(|t| scene.first_look.contains(&t.name))
+    let first_look: Vec<&str> = (scene.first_look.presets.values().flatten())
         .map(|t| t.file.as_str())
         .collect();
     assert!(!first_look.is_empty(), "the bundle names no first look");

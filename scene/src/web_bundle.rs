@@ -28,8 +28,9 @@ pub const SETTINGS_FILE: &str = "settings.json";
 pub const SCENE_FILE: &str = "scene.json";
 pub const HAIR_FILE: &str = "hair.hair";
 pub const TABLES_DIR: &str = "tables";
-/// Bumped when a reader of the old layout would misread the new one.
-pub const FORMAT: u32 = 1;
+/// Bumped when a reader of the old layout would misread the new one (2: the first look has a
+/// fit and tables of its own).
+pub const FORMAT: u32 = 2;
 
 /// Half floats are kept only where they change no table value by more than this (relative to
 /// the table's largest value): below the tables' own interpolation error (docs/BENCHMARKS.md).
@@ -45,10 +46,18 @@ pub struct BundleScene {
     pub mode: ScatteringMode,
     /// Per fiber preset baked into the bundle: its tables.
     pub presets: BTreeMap<String, Vec<BundledTable>>,
-    /// The tables a first look reads ([`Self::first_look_table_names`]): the page fetches and
-    /// opens these first, draws its preview, and takes the rest as they arrive.
-    #[serde(default)]
-    pub first_look: Vec<String>,
+    /// What the first look is drawn from, as the desktop's (`coarse_preview_settings`): the
+    /// page fetches and opens these first, draws its preview, and takes the rest as they
+    /// arrive.
+    pub first_look: FirstLookScene,
+}
+
+/// The first look's own fit (few lobes) and, per preset, its coarse single-scattering tables
+/// ([`BundleScene::first_look_table_names`]).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct FirstLookScene {
+    pub fit: SrbfSet,
+    pub presets: BTreeMap<String, Vec<BundledTable>>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -84,13 +93,14 @@ impl BundleScene {
         fetched: impl Fn(&str) -> Option<Vec<u8>>,
     ) -> anyhow::Result<PreparedEnv> {
         let tables = self.scene_tables(preset, fetched)?;
-        self.prepared_from(preset, up, tables)
+        self.prepared_from(preset, up, &self.fit, tables)
     }
 
     fn prepared_from(
         &self,
         preset: &str,
         up: UpAxis,
+        fit: &SrbfSet,
         tables: SceneTables,
     ) -> anyhow::Result<PreparedEnv> {
         let fiber =
@@ -98,7 +108,7 @@ impl BundleScene {
         Ok(PreparedEnv {
             env: None,
             scene: EnvScene {
-                fit: self.fit.clone(),
+                fit: fit.clone(),
                 tables,
                 mode: self.mode,
             },
@@ -137,17 +147,17 @@ impl BundleScene {
         unique
     }
 
-    /// The tables of a first look (`FramePart::Preview`: single scattering): the SRBF table,
-    /// and the direct table where the fit took compact sources out.
-    pub fn first_look_table_names(&self) -> Vec<&'static str> {
+    /// The tables of a first look of `fit` (`FramePart::Preview`: single scattering): the SRBF
+    /// table, and the direct table where the fit took compact sources out.
+    pub fn first_look_table_names(&self, fit: &SrbfSet) -> Vec<&'static str> {
         let mut names = vec![self.shading.srbf_table(ScatteringMode::Single)];
-        if !self.fit.sources.is_empty() {
+        if !fit.sources.is_empty() {
             names.push(self.shading.direct_table(ScatteringMode::Single));
         }
         names
     }
 
-    /// [`Self::prepared`] with only the first look's tables ([`Self::first_look`]): enough for a
+    /// The first look's scene ([`Self::first_look`]): its fit and coarse tables, enough for a
     /// preview while the rest are still being fetched.
     pub fn prepared_first_look(
         &self,
@@ -155,9 +165,8 @@ impl BundleScene {
         up: UpAxis,
         fetched: impl Fn(&str) -> Option<Vec<u8>>,
     ) -> anyhow::Result<PreparedEnv> {
-        let only = |name: &str| self.first_look.iter().any(|n| n == name);
-        let tables = self.tables_of(preset, only, fetched)?;
-        self.prepared_from(preset, up, tables)
+        let tables = tables_of(&self.first_look.presets, preset, fetched)?;
+        self.prepared_from(preset, up, &self.first_look.fit, tables)
     }
 
     /// `preset`'s tables from their files' bytes (`fetched(file)`), checked as any asset is.
@@ -166,33 +175,32 @@ impl BundleScene {
         preset: &str,
         fetched: impl Fn(&str) -> Option<Vec<u8>>,
     ) -> anyhow::Result<SceneTables> {
-        self.tables_of(preset, |_| true, fetched)
+        tables_of(&self.presets, preset, fetched)
     }
+}
 
-    /// The tables of `preset` that `wanted` names, from their files' bytes.
-    fn tables_of(
-        &self,
-        preset: &str,
-        wanted: impl Fn(&str) -> bool,
-        fetched: impl Fn(&str) -> Option<Vec<u8>>,
-    ) -> anyhow::Result<SceneTables> {
-        let tables = self
-            .presets
-            .get(preset)
-            .with_context(|| format!("{SCENE_FILE}: no preset {preset:?}"))?;
-        let mut assets = BTreeMap::new();
-        for table in tables.iter().filter(|t| wanted(&t.name)) {
-            let path = Path::new(TABLES_DIR).join(&table.file);
-            let bytes = fetched(&table.file)
-                .with_context(|| format!("{} was not fetched", path.display()))?;
-            assets.insert(table.name.clone(), read_asset_bytes(&path, &bytes)?);
-        }
-        Ok(SceneTables {
-            assets,
-            baked: Vec::new(),
-            skipped: Vec::new(),
-        })
+/// The tables `presets` lists for `preset`, from their files' bytes (`fetched(file)`), checked
+/// as any asset is.
+fn tables_of(
+    presets: &BTreeMap<String, Vec<BundledTable>>,
+    preset: &str,
+    fetched: impl Fn(&str) -> Option<Vec<u8>>,
+) -> anyhow::Result<SceneTables> {
+    let tables = presets
+        .get(preset)
+        .with_context(|| format!("{SCENE_FILE}: no preset {preset:?}"))?;
+    let mut assets = BTreeMap::new();
+    for table in tables {
+        let path = Path::new(TABLES_DIR).join(&table.file);
+        let bytes =
+            fetched(&table.file).with_context(|| format!("{} was not fetched", path.display()))?;
+        assets.insert(table.name.clone(), read_asset_bytes(&path, &bytes)?);
     }
+    Ok(SceneTables {
+        assets,
+        baked: Vec::new(),
+        skipped: Vec::new(),
+    })
 }
 
 /// A table's file in the bundle: half floats within [`HALF_TOLERANCE`], else f32.
@@ -240,39 +248,68 @@ fn write_half(path: &Path, asset: &TableAsset) -> anyhow::Result<(Vec<u8>, f64)>
 /// A table file of the bundle: its name under `tables/` and its bytes.
 pub type TableFile = (String, Vec<u8>);
 
-/// The bundle's scene description and table files for `prepared` (one per preset).
+/// What one preset of the bundle was prepared into: its full scene and its first look's
+/// (`coarse_preview_settings`).
+pub struct BundledPreset<'a> {
+    pub name: String,
+    pub full: &'a PreparedEnv,
+    pub first_look: &'a PreparedEnv,
+}
+
+/// The bundle's scene description and table files for `presets`.
 pub fn bundle_scene(
     environment: &str,
-    presets: &[(String, &PreparedEnv)],
+    presets: &[BundledPreset],
 ) -> anyhow::Result<(BundleScene, Vec<TableFile>)> {
-    let (_, first) = presets.first().context("no preset to bundle")?;
+    let first = presets.first().context("no preset to bundle")?;
     let mut scene = BundleScene {
         format: FORMAT,
         environment: environment.into(),
-        fit: first.scene.fit.clone(),
-        shading: first.shading,
-        mode: first.scene.mode,
+        fit: first.full.scene.fit.clone(),
+        shading: first.full.shading,
+        mode: first.full.scene.mode,
         presets: BTreeMap::new(),
-        first_look: Vec::new(),
+        first_look: FirstLookScene {
+            fit: first.first_look.scene.fit.clone(),
+            presets: BTreeMap::new(),
+        },
     };
-    scene.first_look = (scene.first_look_table_names().iter())
-        .map(|name| name.to_string())
-        .collect();
     let mut files = Vec::new();
-    for (preset, prepared) in presets {
+    for preset in presets {
+        let name = &preset.name;
         anyhow::ensure!(
-            prepared.scene.fit == scene.fit && prepared.scene.mode == scene.mode,
-            "preset {preset}: prepared under another fit or scattering mode than the first"
+            preset.full.scene.fit == scene.fit && preset.full.scene.mode == scene.mode,
+            "preset {name}: prepared under another fit or scattering mode than the first"
         );
-        let mut entries = Vec::new();
-        for name in scene.table_names() {
-            let asset = prepared.scene.tables.get(name)?;
-            let file = format!("{preset}-{name}.sltab");
-            let (entry, bytes) = bundled_table_bytes(name, &file, asset)?;
-            files.push((file, bytes));
-            entries.push(entry);
-        }
-        scene.presets.insert(preset.clone(), entries);
+        anyhow::ensure!(
+            preset.first_look.scene.fit == scene.first_look.fit,
+            "preset {name}: its first look was fitted apart from the first preset's"
+        );
+        let full = (scene.table_names().into_iter()).map(|t| (t, format!("{name}-{t}.sltab")));
+        let entries = bundle_tables(preset.full, full, &mut files)?;
+        scene.presets.insert(name.clone(), entries);
+        let first_look = (scene
+            .first_look_table_names(&scene.first_look.fit)
+            .into_iter())
+        .map(|t| (t, format!("{name}-first-look-{t}.sltab")));
+        let entries = bundle_tables(preset.first_look, first_look, &mut files)?;
+        scene.first_look.presets.insert(name.clone(), entries);
     }
     Ok((scene, files))
+}
+
+/// The tables `names` (table, file) of `prepared`, their files pushed onto `files`.
+fn bundle_tables(
+    prepared: &PreparedEnv,
+    names: impl Iterator<Item = (&'static str, String)>,
+    files: &mut Vec<TableFile>,
+) -> anyhow::Result<Vec<BundledTable>> {
+    let mut entries = Vec::new();
+    for (name, file) in names {
+        let asset = prepared.scene.tables.get(name)?;
+        let (entry, bytes) = bundled_table_bytes(name, &file, asset)?;
+        files.push((file, bytes));
+        entries.push(entry);
+    }
+    Ok(entries)
 }

@@ -20,7 +20,7 @@ use strandlight_scene::env_frame::{EnvFrame, gpu_march_volume, lights_call_witho
 use strandlight_scene::env_light_sets::{frame_lights, light_luminance};
 use strandlight_scene::env_scene::PreparedEnv;
 use strandlight_scene::exposure::Exposure;
-use strandlight_scene::frame_render::{env_frame, env_look, settings_camera};
+use strandlight_scene::frame_render::{env_frame, env_look, first_look, settings_camera};
 use strandlight_scene::frame_settings::{
     CameraSettings, EnvLighting, ExactCamera, FrameSettings, Lighting, up_choice,
 };
@@ -337,13 +337,16 @@ impl Session {
         let Some(&step) = self.plan.get(self.next) else {
             return Ok(());
         };
-        let frame = env_frame(
-            &self.settings,
-            &self.hair,
-            &self.prepared,
-            step.part(),
-            false,
-        )?;
+        // A preview is the viewer's first look: a thinned groom seen by the whole groom's camera.
+        let first_look = match step {
+            Step::Preview => Some(first_look(&self.settings, &self.hair)?),
+            _ => None,
+        };
+        let (settings, hair) = match &first_look {
+            Some((settings, hair)) => (settings, hair),
+            None => (&self.settings, &self.hair),
+        };
+        let frame = env_frame(settings, hair, &self.prepared, step.part(), false)?;
         let [width, height] = [frame.width, frame.height];
         // Multiple scattering's grid is marched for all the frame's lights before the first
         // batch that needs it; until the page has read it back, the step waits.
