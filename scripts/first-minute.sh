@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # A new user's first minute (issue 63), from a fresh clone with no out/: the release build, the
 # demo's first PNG (the first look from coarse tables) and its full frame, the viewer's first lit
-# frame and its convergence at 800x600 under Xvfb on an empty cache and again on a warm one, and
+# frame and its convergence at 800x600 under Xvfb as the very first command (lavapipe's shader
+# cache empty too), on an empty table cache after demo and again on a warm one, and
 # the page's first preview in headless Chromium (WebGPU on SwiftShader). Prints a markdown
 # table for the README.
 #   git clone REPO fresh && cd fresh && scripts/first-minute.sh
