@@ -345,14 +345,15 @@ pub const FIRST_LOOK_THINNING: usize = 4;
 /// ... and keeps every this many points of each strand (and its last). The default groom's
 /// first look, its lights' maps and visibility drawn from half the segments: the view
 /// visibility pass 133–144 → 91 ms and the light pass 63–65 → 46–49 ms at 800×600 on lavapipe
-/// (first lit 0.75–0.82 → 0.69–0.79 s, three runs alternating); against the whole frame it reads as it did (0.356 over
-/// 16×16 blocks at both; every third point: 0.347).
+/// (first lit 0.75–0.82 → 0.69–0.79 s, three runs alternating); against the whole frame it
+/// reads as it did (0.356 over 16×16 blocks at both; every third point: 0.347).
 pub const FIRST_LOOK_POINT_STEP: usize = 2;
 
 /// The settings and groom a first look of `settings` is drawn with ([`FramePart::Preview`]): a
 /// thinned groom ([`HairModel::thinned`], [`HairModel::with_fewer_points`]) seen by the full
-/// groom's camera, so the picture does not move when the full frame replaces it. A head fitted to the roots (`--head ellipsoid`) is fitted to the
-/// kept strands' roots, an even sample of them.
+/// groom's camera, so the picture does not move when the full frame replaces it. A head fitted
+/// to the roots (`--head ellipsoid`) is fitted to the kept strands' roots, an even sample of
+/// them.
 pub fn first_look(
     settings: &FrameSettings,
     hair: &HairModel,

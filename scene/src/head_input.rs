@@ -93,8 +93,8 @@ impl HeadChoice {
     }
 
     /// `none`, `ellipsoid`, or mesh files (each one of [`MESH_EXTENSIONS`]) separated by
-    /// commas: `sintel.obj,sintel-eyes.obj`. A path that is itself a mesh file name is taken
-    /// whole, commas and all.
+    /// commas: `sintel.obj,sintel-eyes.obj`. The path of an existing mesh file is taken whole,
+    /// commas and all.
     pub fn parse(text: &str) -> Result<Self, String> {
         let refused = |what: &str| {
             format!(
