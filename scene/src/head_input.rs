@@ -40,7 +40,7 @@ pub enum HeadChoice {
 /// The files of a mesh head, at least one; written as one path, or as a list when several
 /// (settings written before several were taken hold one path and read the same).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(from = "MeshFilesForm", into = "MeshFilesForm")]
+#[serde(try_from = "MeshFilesForm", into = "MeshFilesForm")]
 pub struct MeshFiles(Vec<PathBuf>);
 
 #[derive(Serialize, Deserialize)]
@@ -50,11 +50,15 @@ enum MeshFilesForm {
     Several(Vec<PathBuf>),
 }
 
-impl From<MeshFilesForm> for MeshFiles {
-    fn from(form: MeshFilesForm) -> Self {
+impl TryFrom<MeshFilesForm> for MeshFiles {
+    type Error = &'static str;
+    fn try_from(form: MeshFilesForm) -> Result<Self, Self::Error> {
         match form {
-            MeshFilesForm::One(path) => Self(vec![path]),
-            MeshFilesForm::Several(paths) => Self(paths),
+            MeshFilesForm::One(path) => Ok(Self(vec![path])),
+            MeshFilesForm::Several(paths) if paths.is_empty() => {
+                Err("a mesh head names no file (give one or more mesh files)")
+            }
+            MeshFilesForm::Several(paths) => Ok(Self(paths)),
         }
     }
 }
@@ -588,6 +592,8 @@ mod tests {
         for (json, choice) in [(r#"{"mesh":"a.obj"}"#, one), (json.as_str(), several)] {
             assert_eq!(serde_json::from_str::<HeadChoice>(json).unwrap(), choice);
         }
+        let empty = serde_json::from_str::<HeadChoice>(r#"{"mesh":[]}"#).unwrap_err();
+        assert!(empty.to_string().contains("names no file"), "{empty}");
     }
 
     /// A head from two OBJ files has both files' triangles; a missing second file is named.
