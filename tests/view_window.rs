@@ -100,6 +100,7 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
 
     assert_bakes_ran_while_the_window_presented(&report);
     assert_lit_before_the_tables_were_baked(&report);
+    assert_rebake_starts_with_a_first_look(&report);
     assert!(lit_share(&dir.join("shot.png")) > 0.02, "blank screenshot");
     assert_readout_beside_the_image(&report);
     assert_window_captures_show_the_screenshots(&report, &dir);
@@ -295,6 +296,14 @@ fn assert_lit_before_the_tables_were_baked(report: &Value) {
     assert_eq!(report["first_lit_coarse_tables"], json!(true), "{report}");
     let seconds = report["first_lit_seconds"].as_f64().unwrap();
     println!("first lit frame {seconds:.2} s after the start, from the coarse tables");
+}
+
+/// The artist change's rebake showed a first look of the new colours from coarse tables, never
+/// the old colours' tables drawn with the new settings.
+fn assert_rebake_starts_with_a_first_look(report: &Value) {
+    assert_eq!(report["pictures_from_previous_tables"], json!(0), "{report}");
+    let coarse = report["coarse_pictures"].as_u64().unwrap();
+    assert!(coarse >= 2, "a coarse first look at the start and at the rebake: {coarse}");
 }
 
 /// The timing readout sits beside the image, so it never covers the hair.

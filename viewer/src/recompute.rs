@@ -113,6 +113,21 @@ pub enum TablesKey {
     },
 }
 
+impl TablesKey {
+    /// Both keys light a fiber alike in single scattering: they differ at most in scattering.
+    pub fn same_single_scattering(&self, other: &TablesKey) -> bool {
+        self.without_scattering() == other.without_scattering()
+    }
+
+    fn without_scattering(&self) -> TablesKey {
+        let mut key = self.clone();
+        if let TablesKey::Environment { scattering, .. } = &mut key {
+            *scattering = "";
+        }
+        key
+    }
+}
+
 pub fn tables_key(settings: &FrameSettings) -> TablesKey {
     let shading = settings.shading();
     match &settings.lighting {

@@ -43,6 +43,11 @@ pub struct SessionReport {
     /// and whether that image came from the first look's coarse tables (a cold cache).
     pub first_lit_seconds: Option<f64>,
     pub first_lit_coarse_tables: Option<bool>,
+    /// Pictures drawn with the first look's coarse tables, and pictures drawn with the tables
+    /// of settings before a rebake (another map, fiber or colours; none since a rebake starts
+    /// with a first look of its own).
+    pub coarse_pictures: u64,
+    pub pictures_from_previous_tables: u64,
     pub screenshots: Vec<PathBuf>,
     /// Captures of the whole window (panel included), one per screenshot.
     pub window_captures: Vec<PathBuf>,
@@ -448,6 +453,9 @@ impl Session {
                 && o.display == self.state.display
         });
         if !unchanged {
+            self.report.coarse_pictures += shown.coarse_tables as u64;
+            self.report.pictures_from_previous_tables +=
+                (shown.stale_tables && !shown.coarse_tables) as u64;
             let backdrop = self.background_of(&shown, shown.image.size);
             let request = DisplayRequest {
                 image: shown.image.clone(),

@@ -156,7 +156,7 @@ type BakeResult = Result<PreparedEnv, String>;
 /// The longest the full bake waits for the first look to be drawn.
 const FIRST_LOOK_WAIT: Duration = Duration::from_secs(10);
 
-/// What the bake thread sends: on a cold start the first look's coarse tables, then the full ones.
+/// What the bake thread sends: for a first look its coarse tables, then the full ones.
 struct Baked {
     coarse: bool,
     result: BakeResult,
@@ -178,6 +178,9 @@ struct WorkerState {
     /// Tells the bake thread the first look is drawn, so that its full bake starts then: on a
     /// software adapter the bake's threads and the GPU share the same cores.
     first_look_drawn: Option<Sender<()>>,
+    /// The bake under way starts with a first look's coarse tables, not yet arrived: env-lit
+    /// requests wait for them rather than draw with `env`, another settings' tables.
+    awaiting_first_look: bool,
     baking: Option<(TablesKey, Receiver<Baked>)>,
     job: Option<Job>,
 }
@@ -193,6 +196,7 @@ impl WorkerState {
             env: None,
             env_is_coarse: false,
             first_look_drawn: None,
+            awaiting_first_look: false,
             baking: None,
             job: None,
         }
@@ -310,7 +314,8 @@ impl WorkerState {
                 if !current && self.baking.as_ref().is_none_or(|(k, _)| *k != key) {
                     self.start_bake(settings.clone(), hair, key);
                 }
-                let Some((_, prepared)) = &self.env else {
+                let Some((_, prepared)) = self.env.as_ref().filter(|_| !self.awaiting_first_look)
+                else {
                     return Ok(None);
                 };
                 if self.env_is_coarse {
@@ -357,13 +362,20 @@ impl WorkerState {
     }
 
     fn start_bake(&mut self, settings: FrameSettings, hair: Arc<FrameHair>, key: TablesKey) {
-        // Nothing to light a frame with yet: coarse tables first, for a preview in seconds (with
-        // the full tables cached too, loading them took as long: 1.88 s to the first lit frame
-        // against 1.68 s through the coarse ones, 800×600 on lavapipe).
-        let first_look = self.env.is_none();
+        // Coarse tables first, for a preview in seconds, whenever the frame would otherwise
+        // wait with nothing to draw (a cold start; with the full tables cached too, loading
+        // them took as long: 1.88 s to the first lit frame against 1.68 s through the coarse
+        // ones, 800×600 on lavapipe) or be drawn with another map's, fiber's or colours'
+        // tables (a rebake). A change of scattering alone keeps the tables it has: the first
+        // look's are single scattering either way.
+        let first_look = self
+            .env
+            .as_ref()
+            .is_none_or(|(current, _)| !current.same_single_scattering(&key));
         let (send, receive) = channel();
         let (drawn, wait_for_first_look) = channel();
         self.first_look_drawn = first_look.then_some(drawn);
+        self.awaiting_first_look = first_look;
         let shared = self.shared.clone();
         let cache_dir = self.cache_dir.clone();
         let map = match &settings.lighting {
@@ -441,17 +453,20 @@ impl WorkerState {
             .filter(|j| matches!(j.settings.lighting, Lighting::Environment(_)))
             .map(|j| (j.id, j.settings.clone()));
         if coarse {
-            // The full bake goes on; a failed coarse one leaves the request waiting for it.
-            if let (Ok(prepared), None) = (result, &self.env) {
+            // The full bake goes on; a failed coarse one leaves the request waiting for it, or
+            // drawn with the tables it had.
+            self.awaiting_first_look = false;
+            if let Ok(prepared) = result {
                 self.env = Some((key, Arc::new(prepared)));
                 self.env_is_coarse = true;
-                if let Some((id, settings)) = env_job {
-                    self.start(id, settings);
-                }
+            }
+            if let Some((id, settings)) = env_job {
+                self.start(id, settings);
             }
             return;
         }
         self.baking = None;
+        self.awaiting_first_look = false;
         self.publish(|s| s.bake = None);
         match result {
             Ok(prepared) => {
