@@ -103,13 +103,14 @@ fn env_renderer() -> anyhow::Result<(&'static GpuContext, &'static EnvRenderer)>
 }
 
 /// Creates the device and the env-lit renderer now, and compiles the pipelines of a first
-/// look (the opaque view of [`crate::frame_render::FramePart::Preview`]), with a head or not,
+/// look (the opaque view of [`crate::frame_render::FramePart::Preview`], single scattering
+/// from light maps), with a head or not,
 /// so that an application's first frame, prepared meanwhile, does not wait for them. The full
 /// frame's view compiles when its first part needs it: compiled beside the first look, it took
 /// the cores that look was drawn on (viewer, 800×600 on lavapipe).
 pub fn prepare_env_renderer(with_head: bool) -> anyhow::Result<()> {
     let (_, renderer) = env_renderer()?;
-    renderer.compile(ViewTransparency::Opaque, with_head);
+    renderer.compile(ViewTransparency::Opaque, with_head, true);
     Ok(())
 }
 

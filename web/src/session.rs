@@ -7,7 +7,7 @@ use anyhow::Context;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use strandlight_runtime::env::{EnvRenderError, EnvRenderer, FrameSums};
+use strandlight_runtime::env::{EnvRenderError, EnvRenderer, FrameSums, ViewTransparency};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
 use strandlight_runtime::gpu::LimitError;
@@ -137,6 +137,10 @@ impl Session {
         let settings: FrameSettings =
             serde_json::from_slice(file(SETTINGS_FILE)?).context(SETTINGS_FILE)?;
         settings.check().context(SETTINGS_FILE)?;
+        // The pipelines first, the first look's among them: the browser's GPU process compiles
+        // them while this thread decodes the groom and the tables.
+        let renderer = EnvRenderer::new(&gpu);
+        renderer.compile(ViewTransparency::Opaque, !settings.head.is_none(), true);
         let hair = parse_hair(file(HAIR_FILE)?, Path::new(HAIR_FILE))?.model;
         let up = up_choice(&settings).axis(&hair);
         // Every table, or the first look's while the page fetches the rest.
@@ -145,7 +149,6 @@ impl Session {
             false => bundle.prepared(&settings.preset, up, |f| files.get(f).cloned())?,
             true => bundle.prepared_first_look(&settings.preset, up, |f| files.get(f).cloned())?,
         };
-        let renderer = EnvRenderer::new(&gpu);
         let orbit = orbit_of(&settings, &hair)?;
         let mut session = Self {
             gpu,

@@ -73,6 +73,7 @@ pub(super) fn render_batch(
             tables: batch.tables,
             view: &binding,
             with_head: view.head.is_some(),
+            single_from_light_maps: request.single_from_light_maps(),
         };
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         (renderer.shading).encode(gpu, &mut encoder, &inputs, &view.targets);

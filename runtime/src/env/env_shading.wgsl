@@ -59,12 +59,29 @@ fn shades_from_volume() -> bool {
 // layered view passes `layer_lights`, the word of its fibers' Σw·v for light slot 0
 // (view_layers.wgsl); NO_LAYER_LIGHTS reads each light's visibility at `world`.
 fn shade(world: vec3<f32>, tangent: vec3<f32>, weight: f32, layer_lights: u32) -> EnvOut {
+    let with_grid = (batch.flags & FLAG_GRID) != 0u;
+    return shade_lights(world, tangent, weight, layer_lights, with_grid, shades_from_volume());
+}
+
+// `shade` for a frame of single scattering whose lights all read their light maps (no grid, no
+// visibility volume): with both known false when the pipeline is compiled, their code goes,
+// and a software adapter compiles and runs a smaller shader (a first look).
+fn shade_single_from_light_maps(world: vec3<f32>, tangent: vec3<f32>, weight: f32) -> EnvOut {
+    return shade_lights(world, tangent, weight, NO_LAYER_LIGHTS, false, false);
+}
+
+fn shade_lights(
+    world: vec3<f32>,
+    tangent: vec3<f32>,
+    weight: f32,
+    layer_lights: u32,
+    with_grid: bool,
+    with_volume: bool,
+) -> EnvOut {
     let t = normalize(tangent);
     let e = toward_eye(world);
     var single = vec3<f32>(0.0);
     var multiple = vec3<f32>(0.0);
-    let with_grid = (batch.flags & FLAG_GRID) != 0u;
-    let with_volume = shades_from_volume();
     for (var slot = 0u; slot < batch.light_count; slot++) {
         let light = env_lights[slot];
         var visible: f32;

@@ -40,6 +40,20 @@ pub(super) struct FrameRequest<'a> {
     pub(super) head: Option<&'a Head>,
 }
 
+impl FrameRequest<'_> {
+    /// Single scattering with every light shadowed by its light map: no forward-scattering
+    /// grid, no visibility volume.
+    pub(super) fn single_from_light_maps(&self) -> bool {
+        single_from_light_maps(self.options, self.multiple.is_some())
+    }
+}
+
+/// [`FrameRequest::single_from_light_maps`] of a frame with `options`, with multiple
+/// scattering or not.
+pub(super) fn single_from_light_maps(options: &EnvRenderOptions, with_multiple: bool) -> bool {
+    !with_multiple && options.lobe_visibility.volume().is_none()
+}
+
 /// What every part of a frame sees alike: the hair as uploaded (all of it for the view and
 /// directional lights, the κ-simplified order for SRBF light passes), the head, and the view's
 /// visibility (its depth, nearest fibers and coverage, or its occupancy map). The frame's first

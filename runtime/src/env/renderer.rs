@@ -5,7 +5,7 @@
 use super::accumulate::{AccumulatePass, FrameSums};
 use super::batch::render_batch;
 use super::checks::check_inputs;
-use super::frame_resources::{FrameRequest, FrameResources};
+use super::frame_resources::{FrameRequest, FrameResources, single_from_light_maps};
 use super::frame_visibility::{count_fragments, encode_visibility};
 use super::image::split_sums;
 use super::light_kinds::LightKinds;
@@ -38,9 +38,9 @@ pub struct EnvRenderer {
     pub(super) accumulate: AccumulatePass,
     pub(super) volume: VolumeCache,
     pub(super) tables: TableCache,
-    /// Per view (opaque, occupancy, layered), without and with a head: its pipelines are
-    /// compiled.
-    compiled: [[OnceLock<()>; 2]; 3],
+    /// Per view (opaque, occupancy, layered), without and with a head, of any scattering or of
+    /// single scattering from light maps: its pipelines are compiled.
+    compiled: [[[OnceLock<()>; 2]; 2]; 3],
 }
 
 impl EnvRenderer {
@@ -75,18 +75,27 @@ impl EnvRenderer {
 
     /// Compiles the pipelines a frame in `transparency`, with a head or not, draws with (each
     /// is otherwise compiled when a frame first uses it), the visibility's beside the view's:
-    /// ahead of a first frame, on a thread of the application's.
-    pub fn compile(&self, transparency: ViewTransparency, with_head: bool) {
+    /// ahead of a first frame, on a thread of the application's. `single_from_light_maps`: the
+    /// frame has single scattering alone, every light shadowed by its light map (a first look).
+    pub fn compile(
+        &self,
+        transparency: ViewTransparency,
+        with_head: bool,
+        single_from_light_maps: bool,
+    ) {
         let view = match transparency {
             ViewTransparency::Opaque => 0,
             ViewTransparency::Occupancy { .. } => 1,
             ViewTransparency::Layered { .. } => 2,
         };
         // Once: every part asks, and a frame's path spawns no threads after the first.
-        self.compiled[view][usize::from(with_head)].get_or_init(|| {
+        let shading = usize::from(single_from_light_maps);
+        self.compiled[view][usize::from(with_head)][shading].get_or_init(|| {
             build_both(
                 || self.visibility.compile(transparency),
-                || self.shading.compile(transparency, with_head),
+                || {
+                    (self.shading).compile(transparency, with_head, single_from_light_maps)
+                },
             );
         });
     }
@@ -216,7 +225,11 @@ impl EnvRenderer {
             head,
         };
         // Once per renderer, outside the frame's timed passes.
-        self.compile(options.transparency, head.is_some());
+        self.compile(
+            options.transparency,
+            head.is_some(),
+            request.single_from_light_maps(),
+        );
         let mut timings = Timings(Vec::new());
         let part = (lights, first_window);
         let (frame, kinds) = self.start_part(gpu, &request, part, None, &mut timings)?;
@@ -260,7 +273,11 @@ impl EnvRenderer {
             head,
         };
         // Once per renderer, outside the frame's timed passes.
-        self.compile(options.transparency, head.is_some());
+        self.compile(
+            options.transparency,
+            head.is_some(),
+            request.single_from_light_maps(),
+        );
         let mut timings = Timings(Vec::new());
         let part = (lights, first_window);
         let (frame, kinds) = self.start_part(gpu, &request, part, Some(sums), &mut timings)?;
@@ -392,7 +409,8 @@ pub fn render_env_frame(
     let mut timings = Timings(Vec::new());
     let renderer = timings.time(gpu, "pipelines", || {
         let renderer = EnvRenderer::new(gpu);
-        renderer.compile(options.transparency, false);
+        let single = single_from_light_maps(options, multiple.is_some());
+        renderer.compile(options.transparency, false, single);
         renderer
     });
     let mut frame = renderer.render(

@@ -6,6 +6,7 @@
 //                       prepass left in two textures (position, tangent); its radiance stands
 //                       for the pixel's, weighted by the coverage of all its fibers,
 //                       1 − exp(−Σ τ). No strand is rasterized again per batch of lights.
+//                       _single: the same for single scattering from light maps alone.
 //   fs_env_transparent: every fragment is weighted by coverage × its visibility through the
 //                       fragments in front (the occupancy map) and added; fragments that can no
 //                       longer contribute stop before any light is evaluated (early termination).
@@ -15,7 +16,7 @@
 //                       rasterized again.
 // and fs_env_skin, the skin behind the hair of the occupancy and layered views.
 
-#import strandlight::env_shading::{EnvOut, shade}
+#import strandlight::env_shading::{EnvOut, shade, shade_single_from_light_maps}
 #import strandlight::fullscreen::fullscreen_triangle
 #import strandlight::head_view::{head_at, behind_head}
 #import strandlight::occupancy_map::{OCC_TAU_SCALE, occupancy_record, occupancy_visibility, occupancy_weight}
@@ -39,6 +40,15 @@ fn vs_fullscreen(@builtin(vertex_index) vertex: u32) -> @builtin(position) vec4<
 // the head's depth): the hair's radiance over the skin's, the skin seen through 1 − coverage.
 @fragment
 fn fs_env_deferred(@builtin(position) pixel: vec4<f32>) -> EnvOut {
+    return deferred(pixel, false);
+}
+
+@fragment
+fn fs_env_deferred_single(@builtin(position) pixel: vec4<f32>) -> EnvOut {
+    return deferred(pixel, true);
+}
+
+fn deferred(pixel: vec4<f32>, single_from_light_maps: bool) -> EnvOut {
     let p = vec2<i32>(pixel.xy);
     let nearest = textureLoad(nearest_position, p, 0);
     let head = head_at(p);
@@ -48,7 +58,13 @@ fn fs_env_deferred(@builtin(position) pixel: vec4<f32>) -> EnvOut {
     out.multiple = vec4<f32>(0.0);
     if (nearest.w != 0.0) {
         let tau = textureLoad(coverage, p, 0).r;
-        out = shade(nearest.xyz, textureLoad(nearest_tangent, p, 0).xyz, 1.0 - exp(-tau), NO_LAYER_LIGHTS);
+        let tangent = textureLoad(nearest_tangent, p, 0).xyz;
+        let weight = 1.0 - exp(-tau);
+        if (single_from_light_maps) {
+            out = shade_single_from_light_maps(nearest.xyz, tangent, weight);
+        } else {
+            out = shade(nearest.xyz, tangent, weight, NO_LAYER_LIGHTS);
+        }
     }
     if (head.w != 0.0) {
         let seen = 1.0 - out.single.a;
