@@ -301,9 +301,16 @@ fn assert_lit_before_the_tables_were_baked(report: &Value) {
 /// The artist change's rebake showed a first look of the new colours from coarse tables, never
 /// the old colours' tables drawn with the new settings.
 fn assert_rebake_starts_with_a_first_look(report: &Value) {
-    assert_eq!(report["pictures_from_previous_tables"], json!(0), "{report}");
+    assert_eq!(
+        report["pictures_from_previous_tables"],
+        json!(0),
+        "{report}"
+    );
     let coarse = report["coarse_pictures"].as_u64().unwrap();
-    assert!(coarse >= 2, "a coarse first look at the start and at the rebake: {coarse}");
+    assert!(
+        coarse >= 2,
+        "a coarse first look at the start and at the rebake: {coarse}"
+    );
 }
 
 /// The timing readout sits beside the image, so it never covers the hair.

@@ -93,9 +93,7 @@ impl EnvRenderer {
         self.compiled[view][usize::from(with_head)][shading].get_or_init(|| {
             build_both(
                 || self.visibility.compile(transparency),
-                || {
-                    (self.shading).compile(transparency, with_head, single_from_light_maps)
-                },
+                || (self.shading).compile(transparency, with_head, single_from_light_maps),
             );
         });
     }
