@@ -12,7 +12,8 @@ use strandlight_scene::env_scene::{AlsoServe, prepare_env};
 use strandlight_scene::environment::{ensure_procedural_envmap, load_env};
 use strandlight_scene::exposure::{Exposure, exposure_problem};
 use strandlight_scene::frame_render::{
-    FrameDetails, FramePart, Prepared, coarse_preview_settings, load_settings_hair, render_frame,
+    FrameDetails, FramePart, Prepared, coarse_preview_settings, first_look, load_settings_hair,
+    render_frame,
 };
 use strandlight_scene::frame_settings::{EnvLighting, FrameSettings, Lighting};
 use strandlight_scene::head_input::HeadChoice;
@@ -151,9 +152,10 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
 /// Where the first look is written.
 pub const FIRST_LOOK_PNG: &str = "out/demo-preview.png";
 
-/// A first look before the full tables bake: the demo's frame as the viewer previews it (half
-/// size, the strongest lights, single scattering, the nearest fiber) from coarse tables, which
-/// bake in seconds on a cold cache. The full frame follows in `out/demo.png`.
+/// A first look before the full tables bake: the demo's frame as the viewer and the page
+/// preview it ([`first_look`]: half size, the strongest lights, single scattering, the nearest
+/// fiber of a thinned groom) from coarse tables, which bake in seconds on a cold cache. The
+/// full frame follows in `out/demo.png`.
 fn write_first_look(
     settings: &FrameSettings,
     hair: &HairModel,
@@ -168,12 +170,14 @@ fn write_first_look(
         steps,
         &mut |_| {},
     )?;
+    // The viewer's and the page's first look: a thinned groom seen by the whole groom's camera.
+    let (look, look_hair) = first_look(&coarse, hair)?;
     let preview = steps.run(
         "first look",
         || {
             render_frame(
-                &coarse,
-                hair,
+                &look,
+                &look_hair,
                 Prepared::Env(&prepared),
                 FramePart::Preview,
                 false,
