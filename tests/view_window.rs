@@ -101,6 +101,7 @@ fn scripted_window_keeps_presenting_through_a_rebake_and_its_screenshot_replays(
     assert_bakes_ran_while_the_window_presented(&report);
     assert_lit_before_the_tables_were_baked(&report);
     assert_rebake_starts_with_a_first_look(&report);
+    assert_previews_from_the_first_look_tables(&report);
     assert!(lit_share(&dir.join("shot.png")) > 0.02, "blank screenshot");
     assert_readout_beside_the_image(&report);
     assert_window_captures_show_the_screenshots(&report, &dir);
@@ -310,6 +311,20 @@ fn assert_rebake_starts_with_a_first_look(report: &Value) {
     assert!(
         coarse >= 2,
         "a coarse first look at the start and at the rebake: {coarse}"
+    );
+}
+
+/// Every env-lit preview (the start, the drags, the rebake, the map's turn) came from the first
+/// look's fit and tables, also once the full ones were baked.
+fn assert_previews_from_the_first_look_tables(report: &Value) {
+    let previews = report["env_previews"].as_u64().unwrap();
+    assert!(previews >= 3, "{report}");
+    assert_eq!(
+        report["env_previews_from_first_look_tables"]
+            .as_u64()
+            .unwrap(),
+        previews,
+        "{report}"
     );
 }
 

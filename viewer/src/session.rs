@@ -48,6 +48,9 @@ pub struct SessionReport {
     /// with a first look of its own).
     pub coarse_pictures: u64,
     pub pictures_from_previous_tables: u64,
+    /// Env-lit previews shown, and those of them drawn from the first look's fit and tables.
+    pub env_previews: u64,
+    pub env_previews_from_first_look_tables: u64,
     pub screenshots: Vec<PathBuf>,
     /// Captures of the whole window (panel included), one per screenshot.
     pub window_captures: Vec<PathBuf>,
@@ -456,6 +459,10 @@ impl Session {
             self.report.coarse_pictures += shown.coarse_tables as u64;
             self.report.pictures_from_previous_tables +=
                 (shown.stale_tables && !shown.coarse_tables) as u64;
+            if shown.stage == Stage::Preview && shown.env.is_some() {
+                self.report.env_previews += 1;
+                self.report.env_previews_from_first_look_tables += shown.first_look_tables as u64;
+            }
             let backdrop = self.background_of(&shown, shown.image.size);
             let request = DisplayRequest {
                 image: shown.image.clone(),

@@ -42,6 +42,8 @@ pub struct Shown {
     pub stale_tables: bool,
     /// Those tables are the first look's coarse ones (a cold start).
     pub coarse_tables: bool,
+    /// A preview drawn from the first look's fit and coarse tables, the full ones baked or not.
+    pub first_look_tables: bool,
     /// Seconds from the request to this image.
     pub seconds: f64,
     /// The camera it was rendered with, the hair's front and bounding radius (for the orbit).
@@ -175,6 +177,11 @@ struct WorkerState {
     env: Option<(TablesKey, Arc<PreparedEnv>)>,
     /// `env` holds only the first look's coarse tables: previews, no batches.
     env_is_coarse: bool,
+    /// The first look's fit and coarse tables of the latest bake, kept once the full tables
+    /// arrive: every preview while their single scattering matches is drawn from them. The full
+    /// fit's strongest lights are its compact sources and a lobe or two, and drew 0.22–0.47 of
+    /// the frame's light, the sky missing (docs/BENCHMARKS.md, "The viewer's first look").
+    first_look_env: Option<(TablesKey, Arc<PreparedEnv>)>,
     /// Tells the bake thread the first look is drawn, so that its full bake starts then: on a
     /// software adapter the bake's threads and the GPU share the same cores.
     first_look_drawn: Option<Sender<()>>,
@@ -195,6 +202,7 @@ impl WorkerState {
             point: None,
             env: None,
             env_is_coarse: false,
+            first_look_env: None,
             first_look_drawn: None,
             awaiting_first_look: false,
             baking: None,
@@ -457,7 +465,9 @@ impl WorkerState {
             // drawn with the tables it had.
             self.awaiting_first_look = false;
             if let Ok(prepared) = result {
-                self.env = Some((key, Arc::new(prepared)));
+                let prepared = Arc::new(prepared);
+                self.first_look_env = Some((key.clone(), prepared.clone()));
+                self.env = Some((key, prepared));
                 self.env_is_coarse = true;
             }
             if let Some((id, settings)) = env_job {
@@ -507,7 +517,19 @@ impl WorkerState {
                 Some(prepared.clone())
             }
         };
-        let prepared = match (&settings.lighting, &env_used) {
+        // A preview is drawn from the first look's tables where they light these settings.
+        let first_look_env = match step {
+            Step::Preview => env_used
+                .as_ref()
+                .and(self.first_look_env.as_ref())
+                .filter(|(key, _)| key.same_single_scattering(&tables_key(&settings))),
+            _ => None,
+        };
+        let first_look_tables = first_look_env.is_some();
+        let drawn_env = first_look_env
+            .map(|(_, env)| env.clone())
+            .or(env_used.clone());
+        let prepared = match (&settings.lighting, &drawn_env) {
             (Lighting::Environment(_), Some(env)) => Prepared::Env(env),
             (Lighting::Lights(lights), _) => {
                 point = self.prepared_point(&settings, lights)?;
@@ -569,6 +591,7 @@ impl WorkerState {
             stats,
             stale_tables: job.stale_tables,
             coarse_tables,
+            first_look_tables,
             seconds,
             camera,
             front,
