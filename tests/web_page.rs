@@ -38,7 +38,9 @@ use strandlight_tables::outside_tools::{missing_tool, program_exists};
 use strandlight_web::session::{BundleFiles, Session};
 
 mod page_session;
-use page_session::{blocks, bundle_files, converge, native_session, step_to_the_end, total};
+use page_session::{
+    blocks, bundle_files, converge, map_blocking, native_session, step_to_the_end, total,
+};
 
 /// SwiftShader and lavapipe rasterize a fiber a pixel wide with different rounding, so single
 /// pixels differ where a fiber's edge falls, while the light is the same: the error falls as
@@ -243,7 +245,8 @@ fn the_page_converges_in_chromium_to_the_native_frame_and_survives_a_bad_file() 
 
 /// A session opened with the first look's tables alone (as the page opens it while it fetches
 /// the rest) draws its preview and stops there, unconverged; given the other tables it goes on
-/// to the frame of a session opened with every table.
+/// to the frame of a session opened with every table. Its previews stay the first look's: the
+/// preview of a restarted frame equals the one drawn before the other tables came.
 fn assert_the_first_look_opens_before_the_other_tables(bundle: &Path, every_table: &Image) {
     let files = bundle_files(bundle);
     let scene = BundleScene::parse(&files[SCENE_FILE]).unwrap();
@@ -261,12 +264,34 @@ fn assert_the_first_look_opens_before_the_other_tables(bundle: &Path, every_tabl
         steps += 1;
     }
     assert_eq!(steps, 1, "the first look's tables draw the preview alone");
+    let first_preview = shown_sums(&session);
     session.add_tables(rest).unwrap();
     assert!(session.refining(), "the other tables go on to the batches");
+    let Lighting::Environment(env) = &session.settings.lighting else {
+        panic!("the bundle's frame is env-lit");
+    };
+    let rotation = env.rotation_deg;
+    session.set_rotation(rotation).unwrap();
+    session.step().unwrap();
+    let preview = shown_sums(&session);
+    assert_eq!(preview.len(), first_preview.len());
+    let most = (first_preview.iter().zip(&preview))
+        .map(|(a, b)| (0..4).map(|k| (a[k] - b[k]).abs()).fold(0.0, f32::max))
+        .fold(0.0, f32::max);
+    assert!(
+        most < 1e-6,
+        "a preview with every table is not the first look's: {most}"
+    );
     let frame = converge(session);
     let difference = relative_rmse(&frame, every_table).unwrap();
     eprintln!("first look, then the other tables, vs every table at once: {difference:.2e}");
     assert!(difference < 1e-6, "{difference}");
+}
+
+/// The sums of the step the session drew last, read back.
+fn shown_sums(session: &Session) -> Vec<[f32; 4]> {
+    let readback = session.readback().expect("a picture to read back");
+    map_blocking(session, &readback.buffer)
 }
 
 /// The canvas's picture against `frame` exposed by the page's metered stops over its black

@@ -113,6 +113,10 @@ pub struct Session {
     /// Only the first look's tables are here (the rest are still being fetched): the frame
     /// stops after its preview until [`Self::add_tables`].
     first_look_only: bool,
+    /// The first look's fit and coarse tables of the preset, kept once every table is here:
+    /// every preview is drawn from them, as the viewer's are (the full fit's strongest lights
+    /// leave the sky out). None where the bundle's files lack them.
+    first_look: Option<PreparedEnv>,
 }
 
 /// Light maps are not made smaller than this to fit a device's limits.
@@ -149,6 +153,13 @@ impl Session {
             false => bundle.prepared(&settings.preset, up, |f| files.get(f).cloned())?,
             true => bundle.prepared_first_look(&settings.preset, up, |f| files.get(f).cloned())?,
         };
+        // While only the first look's tables are here, they are `prepared`.
+        let first_look = match first_look_only {
+            true => None,
+            false => {
+                (bundle.prepared_first_look(&settings.preset, up, |f| files.get(f).cloned())).ok()
+            }
+        };
         let orbit = orbit_of(&settings, &hair)?;
         let mut session = Self {
             gpu,
@@ -180,6 +191,7 @@ impl Session {
             march: March::Idle,
             last_memory: Vec::new(),
             first_look_only,
+            first_look,
         };
         session.restart()?;
         Ok(session)
@@ -227,8 +239,9 @@ impl Session {
             return Ok(());
         }
         let (files, up) = (&self.files, self.prepared.up);
-        self.prepared =
+        let every_table =
             (self.bundle).prepared(&self.settings.preset, up, |f| files.get(f).cloned())?;
+        self.first_look = Some(std::mem::replace(&mut self.prepared, every_table));
         self.first_look_only = false;
         self.plan = self.planned()?;
         Ok(())
@@ -239,7 +252,11 @@ impl Session {
     fn planned(&mut self) -> anyhow::Result<Vec<Step>> {
         let env = self.env()?.clone();
         // A dropped hair may stand on another axis than the bundle's.
-        self.prepared.up = up_choice(&self.settings).axis(&self.hair);
+        let up = up_choice(&self.settings).axis(&self.hair);
+        self.prepared.up = up;
+        if let Some(first_look) = &mut self.first_look {
+            first_look.up = up;
+        }
         self.lights = frame_lights(&self.prepared, &env)?;
         if self.first_look_only {
             return Ok(vec![Step::Preview]);
@@ -349,7 +366,11 @@ impl Session {
             Some((settings, hair)) => (settings, hair),
             None => (&self.settings, &self.hair),
         };
-        let frame = env_frame(settings, hair, &self.prepared, step.part(), false)?;
+        let prepared = match (step, &self.first_look) {
+            (Step::Preview, Some(first_look)) => first_look,
+            _ => &self.prepared,
+        };
+        let frame = env_frame(settings, hair, prepared, step.part(), false)?;
         let [width, height] = [frame.width, frame.height];
         // Multiple scattering's grid is marched for all the frame's lights before the first
         // batch that needs it; until the page has read it back, the step waits.
@@ -584,6 +605,9 @@ impl Session {
         self.prepared = self
             .bundle
             .prepared(preset, up, |f| files.get(f).cloned())?;
+        self.first_look = (self.bundle)
+            .prepared_first_look(preset, up, |f| files.get(f).cloned())
+            .ok();
         self.settings.preset = preset.into();
         self.restart()
     }
