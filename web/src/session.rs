@@ -7,6 +7,7 @@ use anyhow::Context;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use strandlight_runtime::camera::UpAxis;
 use strandlight_runtime::env::{EnvRenderError, EnvRenderer, FrameSums, ViewTransparency};
 use strandlight_runtime::env_light::EnvLight;
 use strandlight_runtime::gpu::GpuContext;
@@ -156,9 +157,7 @@ impl Session {
         // While only the first look's tables are here, they are `prepared`.
         let first_look = match first_look_only {
             true => None,
-            false => {
-                (bundle.prepared_first_look(&settings.preset, up, |f| files.get(f).cloned())).ok()
-            }
+            false => Self::first_look_of(&bundle, &settings.preset, up, &files)?,
         };
         let orbit = orbit_of(&settings, &hair)?;
         let mut session = Self {
@@ -223,6 +222,20 @@ impl Session {
             Lighting::Environment(env) => env,
             Lighting::Lights(_) => unreachable!("checked when the session was made"),
         }
+    }
+
+    /// The first look's fit and tables of `preset`, where `files` hold them (a corrupt one is
+    /// an error).
+    fn first_look_of(
+        bundle: &BundleScene,
+        preset: &str,
+        up: UpAxis,
+        files: &BundleFiles,
+    ) -> anyhow::Result<Option<PreparedEnv>> {
+        let held = (bundle.first_look.presets.get(preset))
+            .is_some_and(|tables| tables.iter().all(|t| files.contains_key(&t.file)));
+        held.then(|| bundle.prepared_first_look(preset, up, |f| files.get(f).cloned()))
+            .transpose()
     }
 
     /// Whether `files` hold every table of `preset`.
@@ -602,12 +615,10 @@ impl Session {
     pub fn set_preset(&mut self, preset: &str) -> anyhow::Result<()> {
         let files = &self.files;
         let up = self.prepared.up;
-        self.prepared = self
-            .bundle
-            .prepared(preset, up, |f| files.get(f).cloned())?;
-        self.first_look = (self.bundle)
-            .prepared_first_look(preset, up, |f| files.get(f).cloned())
-            .ok();
+        // Both or neither: a bad table leaves the page on its preset.
+        let prepared = (self.bundle).prepared(preset, up, |f| files.get(f).cloned())?;
+        self.first_look = Self::first_look_of(&self.bundle, preset, up, files)?;
+        self.prepared = prepared;
         self.settings.preset = preset.into();
         self.restart()
     }
