@@ -69,6 +69,10 @@ const LIBRARY: &[Wgsl] = &[
         source: include_str!("env/view_layers.wgsl"),
     },
     Wgsl {
+        file: "env/segment_light_samples.wgsl",
+        source: include_str!("env/segment_light_samples.wgsl"),
+    },
+    Wgsl {
         file: "env/head_view.wgsl",
         source: include_str!("env/head_view.wgsl"),
     },

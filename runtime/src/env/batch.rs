@@ -5,6 +5,7 @@ use super::accumulate::FrameSums;
 use super::checks::check_grid;
 use super::frame_resources::{FrameRequest, FrameResources};
 use super::light_kinds::LightBatch;
+use super::segment_light_visibility::sample_bytes;
 use super::stats::{BatchUsage, Timings};
 use super::view_binding::ViewBinding;
 use super::view_shading::ViewShadingInputs;
@@ -62,8 +63,14 @@ pub(super) fn render_batch(
         visibility.layer_lights = view.occupancy.layer_light_slots > 0 && batch.has_sharp_shadows();
         let binding = ViewBinding::new(gpu, &renderer.layouts.view, grid.as_ref(), &visibility);
         usage.grid_bytes = usage.grid_bytes.max(binding.bytes);
+        if visibility.layer_lights {
+            let (segments, intervals) = (view.geometry.segment_count, view.gather_intervals);
+            let bytes = sample_bytes(segments, intervals, lights.light_count);
+            usage.segment_visibility_bytes = usage.segment_visibility_bytes.max(bytes);
+        }
         let inputs = ViewShadingInputs {
             geometry: &view.geometry,
+            gather_intervals: view.gather_intervals,
             strands: &view.strands,
             transparency,
             layer_lights: visibility

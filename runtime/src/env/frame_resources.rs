@@ -8,6 +8,7 @@ use strandlight_tables::table::Table;
 use super::accumulate::FrameSums;
 use super::light_kinds::LightKinds;
 use super::light_maps::FrameLightMaps;
+use super::segment_light_visibility::{intervals_per_segment, slots_that_fit};
 use super::stats::Timings;
 use super::table_binding::TableBinding;
 use super::tables::check_table_limits;
@@ -83,6 +84,9 @@ pub(super) struct FrameView {
     pub(super) head: Option<HeadGeometry>,
     /// The view camera's world to clip space.
     pub(super) view_proj: glam::Mat4,
+    /// Intervals the gather of compact sources' visibility cuts each segment into
+    /// ([`intervals_per_segment`]).
+    pub(super) gather_intervals: u32,
     /// [`EnvViewTargets::head_position`] and `head_normal`.
     pub(super) head_views: [wgpu::TextureView; 2],
 }
@@ -241,7 +245,7 @@ impl FrameView {
         gpu: &GpuContext,
         renderer: &EnvRenderer,
         request: &FrameRequest<'_>,
-        compact_slots: u32,
+        (compact_slots, gather_intervals): (u32, u32),
         timings: &mut Timings,
     ) -> Result<Self, EnvRenderError> {
         let FrameRequest {
@@ -311,6 +315,7 @@ impl FrameView {
             volume,
             head_views,
             head: head_geometry,
+            gather_intervals,
         })
     }
 }
@@ -337,9 +342,16 @@ impl FrameResources {
             head,
             ..
         } = *request;
+        let gather_intervals = intervals_per_segment(
+            model,
+            request.camera.view_projection([width, height]),
+            (width, height),
+        );
+        let segments = model.segment_count() as u64;
         let compact_slots = kinds
             .compact_sources()
             .min(options.dodm.batch_size as usize) as u32;
+        let compact_slots = slots_that_fit(gpu, segments, gather_intervals, compact_slots);
         let key = ViewKey::of(request);
         let (view, view_is_new) = match kept.and_then(|sums| sums.kept_view(&key)) {
             Some(view) => {
@@ -356,7 +368,8 @@ impl FrameResources {
                 }
             }
             None => {
-                let view = FrameView::new(gpu, renderer, request, compact_slots, timings)?;
+                let slots = (compact_slots, gather_intervals);
+                let view = FrameView::new(gpu, renderer, request, slots, timings)?;
                 (Arc::new(view), true)
             }
         };

@@ -25,6 +25,7 @@ mod light_kinds;
 mod light_maps;
 mod options;
 mod renderer;
+mod segment_light_visibility;
 mod stats;
 mod table_binding;
 mod tables;

@@ -377,6 +377,10 @@ impl EnvRenderer {
         })?;
         memory.push(("env tables".into(), usage.table_bytes));
         memory.push(("forward-scattering grid".into(), usage.grid_bytes));
+        if usage.segment_visibility_bytes > 0 {
+            let bytes = usage.segment_visibility_bytes;
+            memory.push(("compact sources' visibility along segments".into(), bytes));
+        }
         Ok(EnvRenderStats {
             adapter: gpu.report.clone(),
             timings: timings.0,

@@ -45,4 +45,6 @@ pub(super) struct BatchUsage {
     pub(super) batches: u32,
     pub(super) table_bytes: u64,
     pub(super) grid_bytes: u64,
+    /// The compact sources' visibility along the segments (the layered view's gather).
+    pub(super) segment_visibility_bytes: u64,
 }

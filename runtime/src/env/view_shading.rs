@@ -9,6 +9,7 @@
 //! [`TableBinding`] (group 2: the tables), [`ViewBinding`] (group 3: the batch's grid and the
 //! frame's visibility). Output: the batch's single and multiple images in [`EnvViewTargets`].
 
+use super::segment_light_visibility::SegmentLightVisibilityPass;
 use super::table_binding::{TableBinding, table_bind_group_layout};
 use super::view_binding::{ViewBinding, view_bind_group_layout};
 use super::view_targets::EnvViewTargets;
@@ -38,7 +39,11 @@ impl EnvViewLayouts {
     pub(super) fn new(device: &wgpu::Device) -> Self {
         Self {
             strand: strand_bind_group_layout_vertex_storage(device),
-            batch: transmittance_bind_group_layout(device, wgpu::ShaderStages::FRAGMENT),
+            // COMPUTE: the compact sources' visibility at the strands' points.
+            batch: transmittance_bind_group_layout(
+                device,
+                wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE,
+            ),
             table: table_bind_group_layout(device),
             view: view_bind_group_layout(device),
         }
@@ -104,10 +109,11 @@ pub(super) struct ViewShadingPass {
     opaque_single_from_light_maps: LazyPipeline,
     transparent: LazyPipeline,
     layered: LazyPipeline,
-    /// A batch of compact sources in the layered view: its lights' visibility gathered per
-    /// layer (`fs_env_layer_lights`) before the layers are shaded; without a head and with
-    /// one (`fs_env_layer_lights_head`, which filters the head's shadow).
-    layer_lights: [LazyPipeline; 2],
+    /// A batch of compact sources in the layered view: its lights' visibility along every
+    /// strand segment, then gathered per layer (`vs_/fs_env_layer_lights`) before the layers are
+    /// shaded.
+    segment_light_visibility: SegmentLightVisibilityPass,
+    layer_lights: LazyPipeline,
     /// Occupancy and layered views: the skin behind the pixel's fibers (`skin.wgsl`), added
     /// after them.
     skin_behind_hair: LazyPipeline,
@@ -116,6 +122,8 @@ pub(super) struct ViewShadingPass {
 /// What one batch's view shading binds and draws into.
 pub(super) struct ViewShadingInputs<'a> {
     pub(super) geometry: &'a StrandGeometry,
+    /// Intervals the gather of compact sources' visibility cuts each segment into.
+    pub(super) gather_intervals: u32,
     pub(super) strands: &'a wgpu::BindGroup,
     pub(super) transparency: ViewTransparency,
     pub(super) batch: &'a BatchBinding,
@@ -154,15 +162,26 @@ impl ViewShadingPass {
                 view_pipeline(&device, format, &layout, &shader, names, blend)
             })
         };
-        let gather = |entry: &'static str| {
-            let (device, layout, shader) = (device.clone(), layout.clone(), shader.clone());
+        let segment_light_visibility = SegmentLightVisibilityPass::new(gpu, &layouts.batch);
+        let gather_layout = pipeline_layout(
+            &gpu.device,
+            "env view (layers' light visibility)",
+            &[
+                Some(&layouts.strand),
+                Some(&layouts.batch),
+                Some(&segment_light_visibility.gather_layout),
+                Some(&layouts.view),
+            ],
+        );
+        let gather = {
+            let (device, shader) = (device.clone(), shader.clone());
             LazyPipeline::new(move || {
                 StrandDraw {
                     label: "env view (layers' light visibility)",
-                    layout: &layout,
+                    layout: &gather_layout,
                     shader: &shader,
-                    vertex_entry: "vs_main",
-                    fragment: Some((entry, &[])),
+                    vertex_entry: "vs_layer_lights",
+                    fragment: Some(("fs_env_layer_lights", &[])),
                     depth: Some(depth_test(
                         DEPTH_FORMAT,
                         false,
@@ -197,10 +216,8 @@ impl ViewShadingPass {
                 ("env view (layered)", "vs_fullscreen", "fs_env_layered"),
                 Some(ADDITIVE),
             ),
-            layer_lights: [
-                gather("fs_env_layer_lights"),
-                gather("fs_env_layer_lights_head"),
-            ],
+            segment_light_visibility,
+            layer_lights: gather,
             skin_behind_hair: lazy(
                 (
                     "env view (skin behind hair)",
@@ -233,7 +250,10 @@ impl ViewShadingPass {
                     || self.layered.get(),
                     || {
                         build_both(
-                            || self.layer_lights[usize::from(with_head)].get(),
+                            || {
+                                self.layer_lights.get();
+                                self.segment_light_visibility.pipeline(with_head);
+                            },
                             || self.skin_behind_hair.get(),
                         )
                     },
@@ -292,7 +312,7 @@ impl ViewShadingPass {
     }
 
     /// The batch's lights' visibility, Σw·v per layer and light, gathered from every fragment
-    /// the layers hold (zeroed first).
+    /// the layers hold (zeroed first), v interpolated along its segment.
     fn encode_layer_lights(
         &self,
         gpu: &GpuContext,
@@ -301,6 +321,13 @@ impl ViewShadingPass {
         map: &OccupancyMap,
         depth: &wgpu::TextureView,
     ) {
+        let samples = self.segment_light_visibility.encode(
+            gpu,
+            encoder,
+            (inputs.geometry, inputs.gather_intervals),
+            inputs.batch,
+            inputs.with_head,
+        );
         map.clear_layer_lights(encoder);
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("env view (layers' light visibility)"),
@@ -310,10 +337,10 @@ impl ViewShadingPass {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(self.layer_lights[usize::from(inputs.with_head)].get());
+        pass.set_pipeline(self.layer_lights.get());
         pass.set_bind_group(0, inputs.strands, &[]);
         pass.set_bind_group(1, &inputs.batch.group, &[]);
-        pass.set_bind_group(2, &inputs.tables.group, &[]);
+        pass.set_bind_group(2, &samples.gather_group, &[]);
         pass.set_bind_group(3, &inputs.view.group, &[]);
         pass.draw(0..6 * inputs.geometry.segment_count, 0..1);
     }

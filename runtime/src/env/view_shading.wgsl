@@ -12,8 +12,8 @@
 //                       longer contribute stop before any light is evaluated (early termination).
 //   fs_env_layered:     the layers the frame's visibility gathered, each shaded once; a batch
 //                       of compact sources first gathers its lights' visibility per layer
-//                       (fs_env_layer_lights, _head with a head), the layers' fibers
-//                       rasterized again.
+//                       (vs_/fs_env_layer_lights, from samples along each segment), the layers'
+//                       fibers rasterized again.
 // and fs_env_skin, the skin behind the hair of the occupancy and layered views.
 
 #import strandlight::env_shading::{EnvOut, shade, shade_single_from_light_maps}
@@ -21,10 +21,11 @@
 #import strandlight::head_view::{head_at, behind_head}
 #import strandlight::occupancy_map::{OCC_TAU_SCALE, occupancy_record, occupancy_visibility, occupancy_weight}
 #import strandlight::skin::shade_skin
-#import strandlight::strand_quads::{VertexOut, covered_fragment, strand_draw_vertex}
+#import strandlight::strand_quads::{VertexOut, corner, covered_fragment, strand_draw_vertex}
 #import strandlight::view_binding::{view, occupancy_map, coverage, nearest_position, nearest_tangent, head_normal}
 #import strandlight::view_layers::{NO_LAYER_LIGHTS, OCC_LAYERS, add_fixed, layer_fragment, layer_lights_word, layer_word, load_fixed, on_pixel_ray}
-#import strandlight::convolution_transmittance::{batch, directional_transmittance}
+#import strandlight::convolution_transmittance::batch
+#import strandlight::segment_light_samples::{SampleCounts, sample_word}
 
 @vertex
 fn vs_main(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> VertexOut {
@@ -85,25 +86,55 @@ fn fs_env_transparent(drawn: VertexOut) -> EnvOut {
 }
 
 // A batch of compact sources, before fs_env_layered: each fragment adds w·v of every light
-// slot to its layer (view_layers.wgsl). A frame with a head takes the entry point that filters
-// its shadow; without one the filter's code is compiled out (directional_transmittance).
-@fragment
-fn fs_env_layer_lights(drawn: VertexOut) {
-    gather_layer_lights(drawn, false);
+// slot to its layer (view_layers.wgsl), v interpolated at its place along its segment from the
+// samples the batch's compute pass left there (segment_light_visibility.rs).
+struct GatherVertex {
+    // VertexOut's fields (an entry point's struct cannot nest one), then the segment and the
+    // place along it (0 at its first point, 1 at its last).
+    @builtin(position) @invariant clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) tangent: vec3<f32>,
+    @location(2) color: vec3<f32>,
+    @location(3) alpha: f32,
+    @location(4) @interpolate(flat) segment_px: vec4<f32>,
+    @location(5) @interpolate(flat) before_px: vec4<f32>,
+    @location(6) @interpolate(flat) after_px: vec4<f32>,
+    @location(7) @interpolate(flat) line_flags: u32,
+    @location(8) @interpolate(flat) segment: u32,
+    @location(9) along: f32,
+};
+
+@group(2) @binding(4) var<storage, read> sample_visibility: array<u32>;
+@group(2) @binding(5) var<uniform> sample_counts: SampleCounts;
+
+@vertex
+fn vs_layer_lights(@builtin(vertex_index) vertex: u32) -> GatherVertex {
+    let drawn = strand_draw_vertex(vertex, 0u);
+    return GatherVertex(
+        drawn.clip, drawn.world, drawn.tangent, drawn.color, drawn.alpha, drawn.segment_px,
+        drawn.before_px, drawn.after_px, drawn.line_flags, vertex / 6u, corner(vertex % 6u).x,
+    );
 }
 
 @fragment
-fn fs_env_layer_lights_head(drawn: VertexOut) {
-    gather_layer_lights(drawn, true);
-}
-
-fn gather_layer_lights(drawn: VertexOut, with_head: bool) {
+fn fs_env_layer_lights(g: GatherVertex) {
+    let drawn = VertexOut(
+        g.clip, g.world, g.tangent, g.color, g.alpha, g.segment_px, g.before_px, g.after_px,
+        g.line_flags,
+    );
     let in = covered_fragment(drawn);
     let f = layer_fragment(in);
     if (!f.kept) { discard; }
     let first = layer_lights_word(in.clip.xy, f.layer);
+    // A thin line's quad reaches beyond its segment's ends: those pixels take the end's value.
+    let x = clamp(g.along, 0.0, 1.0) * f32(sample_counts.per_segment);
+    let j = min(u32(x), sample_counts.per_segment - 1u);
+    let t = x - f32(j);
     for (var slot = 0u; slot < batch.light_count; slot++) {
-        add_fixed(first + slot, f.weight * directional_transmittance(slot, in.world, with_head));
+        let word = slot / 2u;
+        let v0 = unpack2x16float(sample_visibility[sample_word(sample_counts, g.segment, j, word)]);
+        let v1 = unpack2x16float(sample_visibility[sample_word(sample_counts, g.segment, j + 1u, word)]);
+        add_fixed(first + slot, f.weight * mix(v0[slot % 2u], v1[slot % 2u], t));
     }
 }
 

@@ -88,6 +88,8 @@ pub fn transmittance_bind_group_layout(
 /// Group 1's resources for one batch: its lights, DODM and SATs.
 pub struct BatchBinding {
     pub group: wgpu::BindGroup,
+    /// Light slots bound (`batch.light_count` in the shaders).
+    pub light_count: u32,
 }
 
 impl BatchBinding {
@@ -202,6 +204,7 @@ impl BatchBinding {
         ];
         Self {
             group: bind_group(device, "env batch", layout, &resources),
+            light_count: params.light_count,
         }
     }
 }
