@@ -182,11 +182,12 @@ fn effective_transmittance(slot: u32, world: vec3<f32>) -> f32 {
 }
 
 // effective_transmittance of a compact source (a directional light, whose box follows its
-// angular spread), as the layered view gathers it per fragment and source: an empty texel lets
-// the light through instead of searching for the hair's front (the frame moves by 1e-4), and
-// the head's filter is compiled in only `with_head` (a constant of the entry point). llvmpipe
-// runs every branch, taken or not, the loops' first pass included: these two are most of the
-// gather's cost (docs/history/benchmarks-2026-12-05-to-12-06.md, "The compact sources' gather").
+// angular spread), as the layered view gathers it at samples along each segment and per source
+// (segment_light_visibility.wgsl): an empty texel lets the light through instead of searching
+// for the hair's front (the frame moves by 1e-4), and the head's filter is compiled in only
+// `with_head` (a constant of the entry point). llvmpipe runs every branch, taken or not, the
+// loops' first pass included: these two were most of the per-fragment gather's cost
+// (docs/history/benchmarks-2026-12-05-to-12-06.md, "The compact sources' gather").
 fn directional_transmittance(slot: u32, world: vec3<f32>, with_head: bool) -> f32 {
     if ((batch.flags & FLAG_UNSHADOWED) != 0u) { return 1.0; }
     let light = env_lights[slot];
