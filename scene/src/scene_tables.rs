@@ -6,12 +6,13 @@ use anyhow::{Context, bail};
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::Path;
-use strandlight_precompute::bake::{BakedTable, bake_job};
+use strandlight_precompute::bake::{BakedTable, bake_and_load};
 use strandlight_precompute::bake_plan::{
-    BakeResolution, DEFAULT_MULTIPLE_THRESHOLD, FiberDescription, Model, PlanOptions, plan,
+    BakeResolution, DEFAULT_MULTIPLE_THRESHOLD, FiberDescription, Model, PlanOptions,
+    plan_with_cache,
 };
 use strandlight_precompute::srbf_set::SrbfSet;
-use strandlight_tables::asset::{Storage, TableAsset, expect_parameters, read_asset};
+use strandlight_tables::asset::{Storage, TableAsset, expect_parameters};
 
 /// The fiber model whose tables shade the hair.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -158,7 +159,7 @@ pub fn bake_scene_tables(
         multiple_threshold: DEFAULT_MULTIPLE_THRESHOLD,
         tables: Some(wanted.iter().map(|name| name.to_string()).collect()),
     };
-    let plan = plan(fiber, &options)?;
+    let plan = plan_with_cache(fiber, &options, Some(dir))?;
     let skipped = plan
         .skipped
         .iter()
@@ -167,10 +168,11 @@ pub fn bake_scene_tables(
     let mut expected: BTreeMap<String, Value> = BTreeMap::new();
     let mut keys: BTreeMap<String, String> = BTreeMap::new();
     let mut baked = Vec::new();
+    let mut assets = BTreeMap::new();
     for job in plan.jobs {
         expected.insert(job.name.to_string(), job.fiber_parameters.clone());
         keys.insert(job.name.to_string(), job.inputs_key());
-        let t = bake_job(job, dir, Storage::F32)?;
+        let (t, asset) = bake_and_load(job, dir, Storage::F32)?;
         if let Some(reason) = &t.replaced_damaged {
             eprintln!(
                 "warning: the cached table {} was damaged and has been rebaked ({reason})",
@@ -178,12 +180,9 @@ pub fn bake_scene_tables(
             );
         }
         report(&t);
-        baked.push(t);
-    }
-    let mut assets = BTreeMap::new();
-    for t in &baked {
-        let asset = load_baked(t, &keys[&t.name], &expected[&t.name])?;
+        check_baked(&asset, &keys[&t.name], &expected[&t.name])?;
         assets.insert(t.name.clone(), asset);
+        baked.push(t);
     }
     Ok(SceneTables {
         assets,
@@ -192,19 +191,19 @@ pub fn bake_scene_tables(
     })
 }
 
-/// The table `t` as baked or found with inputs `key`, its fiber `parameters` checked. Another
+/// The table as baked or found with inputs `key`, its fiber `parameters` checked. Another
 /// process baking other settings (a λ range, a resolution) into the same folder may have
-/// replaced the file since: that is an error, never a table of other settings.
-fn load_baked(t: &BakedTable, key: &str, parameters: &Value) -> anyhow::Result<TableAsset> {
-    let asset = read_asset(&t.path)?;
-    expect_parameters(&asset, parameters)?;
+/// replaced a freshly baked file before it was read back: that is an error, never a table of
+/// other settings.
+fn check_baked(asset: &TableAsset, key: &str, parameters: &Value) -> anyhow::Result<()> {
+    expect_parameters(asset, parameters)?;
     if asset.metadata.description.inputs_key.as_deref() != Some(key) {
         bail!(
             "{}: the table was replaced after it was baked, by one of other settings (another run baking into the same folder at the same time?); run again, or give each run its own --cache",
-            t.path.display()
+            asset.path.display()
         );
     }
-    Ok(asset)
+    Ok(())
 }
 
 /// λ range of an SRBF set with a 10% margin (the bake's 1/λ axis spans only this). A set of
@@ -263,9 +262,10 @@ mod tests {
         let key = asset.metadata.description.inputs_key.clone().unwrap();
         let parameters = asset.metadata.description.fiber_parameters.clone();
         let baked = &first.baked[0];
-        load_baked(baked, &key, &parameters).expect("the file as baked loads");
+        let read = || strandlight_tables::asset::read_asset(&baked.path).unwrap();
+        check_baked(&read(), &key, &parameters).expect("the file as baked loads");
         bake((30.0, 60.0));
-        let error = load_baked(baked, &key, &parameters)
+        let error = check_baked(&read(), &key, &parameters)
             .unwrap_err()
             .to_string();
         assert!(error.contains("replaced after it was baked"), "{error}");

@@ -3,6 +3,7 @@
 //! pace (about 30 frames a second while anything is changing, on events otherwise).
 
 use crate::gpu_display::GpuDisplay;
+use crate::pacing::FramePacing;
 use crate::script::{Action, Script};
 use crate::session::WindowCapture;
 use crate::session::{Session, SessionReport};
@@ -20,14 +21,6 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop};
 use winit::window::{Window, WindowId};
 
-/// Frame interval while something changes (input, a new image, a script's step).
-const BUSY_FRAME: Duration = Duration::from_millis(33);
-/// Frame interval while only the readout's progress moves (the worker refining or baking): on
-/// a software adapter the window's frames take the cores the worker renders on (the default
-/// view at 800×600 on lavapipe converged in 25.5 s repainting every BUSY_FRAME, in 17.8 s
-/// every PROGRESS_FRAME; docs/history/benchmarks-2026-12-05-to-12-06.md, "Compact sources per
-/// layer").
-const PROGRESS_FRAME: Duration = Duration::from_millis(250);
 /// Width of the side panel, points.
 const PANEL_WIDTH: f64 = 320.0;
 
@@ -131,8 +124,9 @@ pub fn run(mut options: ViewOptions) -> anyhow::Result<()> {
         session: None,
         egui: egui::Context::default(),
         started: Instant::now(),
-        last_redraw: Instant::now(),
+        pacing: FramePacing::default(),
         repaint_asked: false,
+        worker_news: false,
         outcome: Ok(()),
     };
     event_loop.run_app(&mut app)?;
@@ -155,8 +149,10 @@ struct App {
     session: Option<Session>,
     egui: egui::Context,
     started: Instant,
-    last_redraw: Instant,
+    pacing: FramePacing,
     repaint_asked: bool,
+    /// The worker changed its status since the last frame.
+    worker_news: bool,
     outcome: anyhow::Result<()>,
 }
 
@@ -384,7 +380,8 @@ impl App {
         let (Some(gpu), Some(session)) = (&mut self.window, &mut self.session) else {
             return;
         };
-        self.last_redraw = Instant::now();
+        let frame_started = self.pacing.frame_started();
+        self.worker_news = false;
         let mut input = gpu.egui_input.take_egui_input(&gpu.window);
         let actions = match &mut self.script {
             Some(script) => script.advance(&|cond| session.wait_done(cond)),
@@ -417,6 +414,7 @@ impl App {
         session.window_captures_done(captures);
         // egui asks for a repaint while anything animates; about_to_wait paces it.
         self.repaint_asked = repaint;
+        self.pacing.frame_ended(frame_started);
         self.check_exit(event_loop);
     }
 
@@ -560,7 +558,7 @@ impl ApplicationHandler for App {
 
     /// The worker changed its status: shown at the next paced frame.
     fn user_event(&mut self, _: &ActiveEventLoop, _: ()) {
-        self.repaint_asked = true;
+        self.worker_news = true;
     }
 
     fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
@@ -568,10 +566,11 @@ impl ApplicationHandler for App {
             return;
         };
         let script = self.script.as_ref().filter(|s| !s.finished());
-        let changing = self.repaint_asked || script.is_some_and(|s| !s.waiting());
-        if changing || script.is_some() || session.busy() {
-            let interval = if changing { BUSY_FRAME } else { PROGRESS_FRAME };
-            let due = self.last_redraw + interval;
+        // A refinement's next batch waits for the progress pace; any other news is shown now.
+        let news = self.worker_news && !session.only_refined();
+        let changing = self.repaint_asked || news || script.is_some_and(|s| !s.waiting());
+        if changing || script.is_some() || session.busy() || self.worker_news {
+            let due = self.pacing.next_frame(changing);
             if Instant::now() >= due {
                 gpu.window.request_redraw();
             } else {

@@ -8,6 +8,7 @@ pub mod display;
 pub mod frame;
 pub mod gpu_display;
 pub use strandlight_scene::orbit;
+mod pacing;
 mod panel;
 pub mod progressive;
 pub mod recompute;

@@ -196,6 +196,17 @@ impl Session {
         status.bake.is_some() || refining || self.screenshots_pending() || self.unsubmitted()
     }
 
+    /// The worker's picture is a further batch of the request on screen and nothing failed:
+    /// news the window shows at its progress pace rather than at once.
+    pub fn only_refined(&self) -> bool {
+        let status = self.worker.status();
+        status.error.is_none()
+            && status.shown.as_ref().is_some_and(|shown| {
+                matches!(shown.stage, Stage::Refining { .. })
+                    && self.on_screen.as_ref().is_some_and(|o| o.job == shown.job)
+            })
+    }
+
     fn unsubmitted(&self) -> bool {
         self.submitted
             .as_ref()
