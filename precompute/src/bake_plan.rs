@@ -868,9 +868,9 @@ fn push_fiber_averages(
 }
 
 /// Zinke's averages of `averages` at `thetas` inclinations (arcsine-spaced), one node per
-/// [`FIBER_AVERAGE_QUANTITIES`]: the table the forward-scattering grid reads and the
-/// multiple-scattering decision is made on.
-fn fiber_averages_table(
+/// [`FIBER_AVERAGE_QUANTITIES`]: the `fiber_averages` table, which the forward-scattering grid
+/// reads and the multiple-scattering decision is made on.
+pub fn fiber_averages_table(
     averages: &DualScatteringAverages,
     thetas: usize,
 ) -> Result<Table, TableError> {

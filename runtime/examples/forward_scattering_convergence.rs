@@ -25,11 +25,9 @@ use strandlight_tables::dual_scattering::{
     DualScatteringAverages, DualScatteringConfig, LobeDecomposition,
 };
 use strandlight_tables::marschner::{Marschner, MarschnerParams};
-use strandlight_tables::table::{Axis, AxisMapping, Table};
-use strandlight_tables::table_axes::{AXIS_QUANTITY, AXIS_SIN_THETA};
+use strandlight_tables::table::Table;
 
-/// The `fiber_averages` table as `bake_plan::push_fiber_averages` writes it (same axes, same
-/// quantity order), from Marschner's default fiber.
+/// The `fiber_averages` table as the bake writes it, from Marschner's default fiber.
 fn fiber_averages_table(thetas: usize) -> Table {
     let m =
         Marschner::new(MarschnerParams::default()).expect("default Marschner parameters are valid");
@@ -38,30 +36,8 @@ fn fiber_averages_table(thetas: usize) -> Table {
         DualScatteringConfig::default(),
     )
     .expect("default dual-scattering configuration is valid");
-    let axes = vec![
-        Axis::with_mapping(AXIS_SIN_THETA, -1.0, 1.0, thetas, AxisMapping::Arcsine),
-        Axis::uniform(AXIS_QUANTITY, 0.0, 8.0, 9),
-    ];
-    Table::from_fn(axes, 3, |x, out| {
-        let theta = x[0].clamp(-1.0, 1.0).asin();
-        let a = averages.averages_at(theta);
-        let mo = averages.moments_at(theta);
-        let q = match x[1].round() as usize {
-            0 => a.a_f,
-            1 => a.a_b,
-            2 => a.alpha_f,
-            3 => a.alpha_b,
-            4 => a.beta2_f,
-            5 => a.beta2_b,
-            6 => mo.attenuation,
-            7 => mo.shift,
-            _ => mo.variance,
-        };
-        for c in 0..3 {
-            out[c] = q[c] as f32;
-        }
-    })
-    .expect("fiber-average axes are valid")
+    strandlight_precompute::bake_plan::fiber_averages_table(&averages, thetas)
+        .expect("fiber-average axes are valid")
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
